@@ -1,0 +1,49 @@
+//! One error type for the whole crate (gpu-allocator style): every failure a user can cause
+//! is a variant with a message that names the file, the mesh or the missing feature.
+
+/// Everything that can go wrong in umbrage.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// Bad user input in a file: scene TOML, OBJ, dump directory. `location` is
+    /// `path` or `path:line` where a line is known.
+    #[error("{location}: {msg}")]
+    Input { location: String, msg: String },
+    /// A mesh that cannot be used as asked (NaN, empty, non-manifold in the manifold path...).
+    #[error("mesh '{name}': {msg}")]
+    Mesh { name: String, msg: String },
+    /// Unknown built-in scene, method, shape or view name.
+    #[error("unknown {what} '{name}' (expected one of: {expected})")]
+    UnknownName { what: &'static str, name: String, expected: String },
+    /// No Vulkan loader, driver or usable device.
+    #[error("no usable Vulkan device: {0}\n  hint: on Debian/Ubuntu install the CPU driver with \
+             `apt-get install libvulkan1 mesa-vulkan-drivers vulkan-validationlayers` (lavapipe), \
+             or run `make deps`")]
+    NoDevice(String),
+    /// A Vulkan call failed.
+    #[error("Vulkan error in {call}: {result}")]
+    Vulkan { call: &'static str, result: String },
+    /// A device feature a requested path needs is missing.
+    #[error("unsupported on this device: {0}")]
+    Unsupported(String),
+    /// Validation layers reported errors (only when validation is on).
+    #[error("Vulkan validation reported {count} error(s); first: {first}")]
+    Validation { count: usize, first: String },
+    #[error("{0}")]
+    Other(String),
+    #[error("I/O error on {path}: {source}")]
+    Io { path: String, source: std::io::Error },
+}
+
+pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+impl Error {
+    pub fn input(location: impl Into<String>, msg: impl Into<String>) -> Self {
+        Error::Input { location: location.into(), msg: msg.into() }
+    }
+    pub fn mesh(name: impl Into<String>, msg: impl Into<String>) -> Self {
+        Error::Mesh { name: name.into(), msg: msg.into() }
+    }
+    pub fn io(path: impl Into<String>, source: std::io::Error) -> Self {
+        Error::Io { path: path.into(), source }
+    }
+}

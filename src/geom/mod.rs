@@ -1,0 +1,3 @@
+//! Pure CPU geometry: no Vulkan, no `unsafe`. The heart of the shadow algorithm.
+pub mod mesh;
+pub use mesh::{Aabb, Mesh};
