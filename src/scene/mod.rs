@@ -25,7 +25,7 @@ impl Default for Camera {
 impl Camera {
     /// World -> view (right-handed, looking down -Z).
     pub fn view(&self) -> Mat4 {
-        Mat4::look_at_rh(self.eye, self.target, self.up)
+        glam::camera::rh::view::look_at_mat4(self.eye, self.target, self.up.normalize())
     }
     /// View -> Vulkan clip space with the far plane at infinity: depth 0 at `near`, 1 at
     /// infinity; y points down in the framebuffer (row 0 is the top of the image).
