@@ -1,6 +1,7 @@
 //! umbrage: exact hard shadows with stencil shadow volumes on raw Vulkan.
-#![forbid(unsafe_op_in_unsafe_fn)]
+#![warn(unsafe_op_in_unsafe_fn)]
 pub mod error;
 pub mod geom;
+pub mod gpu;
 pub mod scene;
 pub use error::{Error, Result};

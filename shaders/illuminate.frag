@@ -1,0 +1,46 @@
+#version 450
+// Per-light illumination (Blinn-Phong), drawn as a full-screen pass where the stencil count
+// is zero, added into the float accumulation target.
+layout(set = 0, binding = 0) uniform texture2D t_albedo;
+layout(set = 0, binding = 1) uniform texture2D t_normal;
+layout(set = 0, binding = 2) uniform texture2D t_position;
+layout(set = 0, binding = 3) uniform sampler s_nearest;
+
+layout(push_constant) uniform Push {
+    vec4 light_pos;   // xyz relative to the eye, w = 1; or xyz towards the light, w = 0
+    vec4 color;       // rgb = colour * intensity
+    vec4 spot;        // xyz = travel direction, w = cos(half cone) (-2 when not a spot)
+    vec4 params;      // x = radius (0: unbounded)
+} pc;
+
+layout(location = 0) out vec4 out_color;
+
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    vec4 pos = texelFetch(sampler2D(t_position, s_nearest), px, 0);
+    if (pos.w == 0.0) {
+        discard;
+    }
+    vec3 n = normalize(texelFetch(sampler2D(t_normal, s_nearest), px, 0).xyz);
+    vec3 albedo = texelFetch(sampler2D(t_albedo, s_nearest), px, 0).rgb;
+    vec3 to_light = pc.light_pos.xyz - pos.xyz * pc.light_pos.w;
+    float dist = length(to_light);
+    vec3 l = to_light / max(dist, 1e-30);
+    float ndotl = dot(n, l);
+    if (ndotl <= 0.0) {
+        discard;
+    }
+    float atten = 1.0;
+    if (pc.params.x > 0.0) {
+        float r = clamp(dist / pc.params.x, 0.0, 1.0);
+        atten = (1.0 - r * r) * (1.0 - r * r);
+    }
+    if (pc.spot.w > -1.5) {
+        float c = dot(-l, normalize(pc.spot.xyz));
+        atten *= smoothstep(pc.spot.w, mix(pc.spot.w, 1.0, 0.15), c);
+    }
+    vec3 v = normalize(-pos.xyz);
+    vec3 h = normalize(l + v);
+    float spec = pow(max(dot(n, h), 0.0), 48.0) * 0.3;
+    out_color = vec4((albedo * ndotl + vec3(spec)) * pc.color.rgb * atten, 0.0);
+}

@@ -1,0 +1,418 @@
+//! The Vulkan context: instance (+ validation and a debug messenger when asked), physical
+//! device choice, feature probing, logical device, queue, allocator, command pool.
+//!
+//! Design notes
+//! - Every optional feature the shadow algorithm can use is *probed* and enabled only when
+//!   present; [`Features`] records what was found, and the renderer picks its code path from
+//!   it (and says so in `umbrage info` and the stats JSON).
+//! - Validation messages of severity ERROR are collected in [`Context::validation_errors`]; tests
+//!   (which always run with `UMBRAGE_VALIDATION=1`) fail when any was reported.
+//! - Teardown order: device idle -> allocator -> pool -> device -> messenger -> instance.
+
+use crate::error::{Error, Result};
+use ash::vk;
+use std::ffi::{c_void, CStr};
+use std::sync::{Arc, Mutex};
+
+/// Optional device capabilities, as probed.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct Features {
+    pub depth_clamp: bool,
+    pub depth_bounds: bool,
+    pub depth_range_unrestricted: bool,
+    pub index_type_uint8: bool,
+    pub pipeline_statistics_query: bool,
+    pub timestamps: bool,
+    /// Nanoseconds per timestamp tick.
+    pub timestamp_period_ns: f32,
+    pub depth_stencil_format: String,
+    pub geometry_shader: bool,
+}
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct DeviceInfo {
+    pub name: String,
+    pub kind: String,
+    pub driver: String,
+    pub driver_info: String,
+    pub api_version: String,
+    pub vendor_id: u32,
+    pub device_id: u32,
+}
+
+/// Shared sink for validation messages.
+#[derive(Default)]
+pub struct ValidationLog {
+    pub errors: Vec<String>,
+    pub warnings: usize,
+}
+
+pub struct Context {
+    pub entry: ash::Entry,
+    pub instance: ash::Instance,
+    debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    log: Arc<Mutex<ValidationLog>>,
+    _log_ptr: Box<Arc<Mutex<ValidationLog>>>,
+    pub physical: vk::PhysicalDevice,
+    pub device: ash::Device,
+    pub queue: vk::Queue,
+    pub queue_family: u32,
+    pub allocator: std::mem::ManuallyDrop<Mutex<gpu_allocator::vulkan::Allocator>>,
+    pub pool: vk::CommandPool,
+    pub features: Features,
+    pub info: DeviceInfo,
+    pub depth_format: vk::Format,
+    pub limits: vk::PhysicalDeviceLimits,
+    pub validation: bool,
+}
+
+/// Whether validation is requested through `UMBRAGE_VALIDATION=1`.
+pub fn validation_requested() -> bool {
+    std::env::var("UMBRAGE_VALIDATION").map(|v| v == "1" || v.eq_ignore_ascii_case("true")).unwrap_or(false)
+}
+
+fn vkerr(call: &'static str) -> impl Fn(vk::Result) -> Error {
+    move |r| Error::Vulkan { call, result: format!("{r:?}") }
+}
+
+unsafe extern "system" fn debug_callback(
+    severity: vk::DebugUtilsMessageSeverityFlagsEXT,
+    _types: vk::DebugUtilsMessageTypeFlagsEXT,
+    data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
+    user: *mut c_void,
+) -> vk::Bool32 {
+    // SAFETY: the loader passes a valid callback-data pointer for the duration of the call, and
+    // `user` is the boxed Arc we registered, alive until the messenger is destroyed.
+    let (msg, log) = unsafe {
+        let msg = if data.is_null() || (*data).p_message.is_null() {
+            String::from("(no message)")
+        } else {
+            CStr::from_ptr((*data).p_message).to_string_lossy().into_owned()
+        };
+        (msg, &*(user as *const Arc<Mutex<ValidationLog>>))
+    };
+    if let Ok(mut log) = log.lock() {
+        if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
+            eprintln!("[vulkan validation] {msg}");
+            log.errors.push(msg);
+        } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING) {
+            if std::env::var_os("UMBRAGE_VERBOSE").is_some() {
+                eprintln!("[vulkan warning] {msg}");
+            }
+            log.warnings += 1;
+        }
+    }
+    vk::FALSE
+}
+
+impl Context {
+    /// Creates the context. Validation follows `UMBRAGE_VALIDATION`; the device can be chosen
+    /// with `UMBRAGE_DEVICE=<substring of its name>`.
+    pub fn new() -> Result<Context> {
+        Self::with_validation(validation_requested())
+    }
+
+    pub fn with_validation(validation: bool) -> Result<Context> {
+        // SAFETY: loading the Vulkan loader library; we keep `entry` alive in the context for as
+        // long as any object created from it.
+        let entry = unsafe { ash::Entry::load() }
+            .map_err(|e| Error::NoDevice(format!("cannot load the Vulkan loader (libvulkan.so.1): {e}")))?;
+
+        let layer_name = c"VK_LAYER_KHRONOS_validation";
+        let mut layers = Vec::new();
+        let mut extensions = Vec::new();
+        if validation {
+            // SAFETY: plain enumeration calls on a loaded entry.
+            let available = unsafe { entry.enumerate_instance_layer_properties() }.map_err(vkerr("vkEnumerateInstanceLayerProperties"))?;
+            let has = available.iter().any(|l| l.layer_name_as_c_str().map(|n| n == layer_name).unwrap_or(false));
+            if !has {
+                return Err(Error::NoDevice(
+                    "UMBRAGE_VALIDATION=1 but VK_LAYER_KHRONOS_validation is not installed (apt-get install vulkan-validationlayers)".into(),
+                ));
+            }
+            layers.push(layer_name.as_ptr());
+            extensions.push(ash::ext::debug_utils::NAME.as_ptr());
+        }
+        let app = vk::ApplicationInfo::default()
+            .application_name(c"umbrage")
+            .engine_name(c"umbrage")
+            .api_version(vk::API_VERSION_1_3);
+        let create = vk::InstanceCreateInfo::default()
+            .application_info(&app)
+            .enabled_layer_names(&layers)
+            .enabled_extension_names(&extensions);
+        // SAFETY: all pointers in `create` refer to locals alive for this call.
+        let instance = unsafe { entry.create_instance(&create, None) }.map_err(|e| {
+            Error::NoDevice(format!("vkCreateInstance failed ({e:?}): no Vulkan driver installed?"))
+        })?;
+
+        let log = Arc::new(Mutex::new(ValidationLog::default()));
+        let log_ptr = Box::new(log.clone());
+        let debug = if validation {
+            let du = ash::ext::debug_utils::Instance::new(&entry, &instance);
+            let info = vk::DebugUtilsMessengerCreateInfoEXT::default()
+                .message_severity(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING)
+                .message_type(
+                    vk::DebugUtilsMessageTypeFlagsEXT::GENERAL
+                        | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION
+                        | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
+                )
+                .pfn_user_callback(Some(debug_callback))
+                .user_data(&*log_ptr as *const Arc<Mutex<ValidationLog>> as *mut c_void);
+            // SAFETY: the callback and the boxed user data outlive the messenger (both owned by self).
+            let m = unsafe { du.create_debug_utils_messenger(&info, None) }.map_err(vkerr("vkCreateDebugUtilsMessengerEXT"))?;
+            Some((du, m))
+        } else {
+            None
+        };
+
+        match Self::open_device(&instance) {
+            Ok((physical, device, queue_family, features, info, depth_format, limits)) => {
+                // SAFETY: the queue family/index were requested at device creation.
+                let queue = unsafe { device.get_device_queue(queue_family, 0) };
+                let allocator = gpu_allocator::vulkan::Allocator::new(&gpu_allocator::vulkan::AllocatorCreateDesc {
+                    instance: instance.clone(),
+                    device: device.clone(),
+                    physical_device: physical,
+                    debug_settings: Default::default(),
+                    buffer_device_address: false,
+                    allocation_sizes: Default::default(),
+                })
+                .map_err(|e| Error::Other(format!("gpu-allocator: {e}")))?;
+                let pool_info = vk::CommandPoolCreateInfo::default()
+                    .queue_family_index(queue_family)
+                    .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+                // SAFETY: valid device and create info.
+                let pool = unsafe { device.create_command_pool(&pool_info, None) }.map_err(vkerr("vkCreateCommandPool"))?;
+                Ok(Context {
+                    entry,
+                    instance,
+                    debug,
+                    log,
+                    _log_ptr: log_ptr,
+                    physical,
+                    device,
+                    queue,
+                    queue_family,
+                    allocator: std::mem::ManuallyDrop::new(Mutex::new(allocator)),
+                    pool,
+                    features,
+                    info,
+                    depth_format,
+                    limits,
+                    validation,
+                })
+            }
+            Err(e) => {
+                // SAFETY: nothing else was created from the instance except the messenger.
+                unsafe {
+                    if let Some((du, m)) = &debug {
+                        du.destroy_debug_utils_messenger(*m, None);
+                    }
+                    instance.destroy_instance(None);
+                }
+                Err(e)
+            }
+        }
+    }
+
+    #[allow(clippy::type_complexity)]
+    fn open_device(
+        instance: &ash::Instance,
+    ) -> Result<(vk::PhysicalDevice, ash::Device, u32, Features, DeviceInfo, vk::Format, vk::PhysicalDeviceLimits)> {
+        // SAFETY: enumeration on a valid instance.
+        let physicals = unsafe { instance.enumerate_physical_devices() }.map_err(vkerr("vkEnumeratePhysicalDevices"))?;
+        if physicals.is_empty() {
+            return Err(Error::NoDevice("the Vulkan loader found no physical device".into()));
+        }
+        let wanted = std::env::var("UMBRAGE_DEVICE").ok().map(|s| s.to_lowercase());
+        let mut candidates = Vec::new();
+        for &pd in &physicals {
+            // SAFETY: `pd` comes from the enumeration above.
+            let props = unsafe { instance.get_physical_device_properties(pd) };
+            let name = props.device_name_as_c_str().map(|c| c.to_string_lossy().into_owned()).unwrap_or_default();
+            if props.api_version < vk::API_VERSION_1_3 {
+                continue;
+            }
+            // SAFETY: as above.
+            let families = unsafe { instance.get_physical_device_queue_family_properties(pd) };
+            let Some(qf) = families.iter().position(|f| f.queue_flags.contains(vk::QueueFlags::GRAPHICS)) else {
+                continue;
+            };
+            if let Some(w) = &wanted {
+                if !name.to_lowercase().contains(w) {
+                    continue;
+                }
+            }
+            let rank = match props.device_type {
+                vk::PhysicalDeviceType::DISCRETE_GPU => 0,
+                vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
+                vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
+                vk::PhysicalDeviceType::CPU => 3,
+                _ => 4,
+            };
+            candidates.push((rank, pd, qf as u32, props, name));
+        }
+        candidates.sort_by_key(|c| c.0);
+        let Some((_, physical, queue_family, props, name)) = candidates.into_iter().next() else {
+            return Err(Error::NoDevice(match wanted {
+                Some(w) => format!("no Vulkan 1.3 device with graphics whose name contains '{w}' (UMBRAGE_DEVICE)"),
+                None => "no Vulkan 1.3 device with a graphics queue".into(),
+            }));
+        };
+
+        // Probe optional features.
+        let mut f_u8 = vk::PhysicalDeviceIndexTypeUint8FeaturesEXT::default();
+        let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
+        let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13);
+        // SAFETY: enumeration of extensions on a valid physical device.
+        let exts = unsafe { instance.enumerate_device_extension_properties(physical) }.map_err(vkerr("vkEnumerateDeviceExtensionProperties"))?;
+        let has_ext = |n: &CStr| exts.iter().any(|e| e.extension_name_as_c_str().map(|x| x == n).unwrap_or(false));
+        let has_u8_ext = has_ext(ash::ext::index_type_uint8::NAME);
+        let has_dru = has_ext(ash::ext::depth_range_unrestricted::NAME);
+        if has_u8_ext {
+            f2 = f2.push_next(&mut f_u8);
+        }
+        // SAFETY: the chain points at locals alive for this call.
+        unsafe { instance.get_physical_device_features2(physical, &mut f2) };
+        let base = f2.features;
+        let (dyn_rendering, sync2) = (f13.dynamic_rendering == vk::TRUE, f13.synchronization2 == vk::TRUE);
+        let u8_supported = has_u8_ext && f_u8.index_type_uint8 == vk::TRUE;
+        if !dyn_rendering || !sync2 {
+            return Err(Error::Unsupported(format!("{name}: umbrage needs dynamicRendering and synchronization2 (Vulkan 1.3)")));
+        }
+        // SAFETY: as above.
+        let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
+        let timestamps = families[queue_family as usize].timestamp_valid_bits > 0 && props.limits.timestamp_period > 0.0;
+
+        // Depth-stencil format with 8 stencil bits, usable as attachment and transfer source.
+        let needed = vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT | vk::FormatFeatureFlags::TRANSFER_SRC;
+        let depth_format = [vk::Format::D32_SFLOAT_S8_UINT, vk::Format::D24_UNORM_S8_UINT]
+            .into_iter()
+            .find(|&f| {
+                // SAFETY: format query on a valid physical device.
+                let p = unsafe { instance.get_physical_device_format_properties(physical, f) };
+                p.optimal_tiling_features.contains(needed)
+            })
+            .ok_or_else(|| Error::Unsupported(format!("{name}: no depth-stencil format with 8 stencil bits (D32S8 or D24S8)")))?;
+
+        let features = Features {
+            depth_clamp: base.depth_clamp == vk::TRUE,
+            depth_bounds: base.depth_bounds == vk::TRUE,
+            depth_range_unrestricted: has_dru,
+            index_type_uint8: u8_supported,
+            pipeline_statistics_query: base.pipeline_statistics_query == vk::TRUE,
+            timestamps,
+            timestamp_period_ns: props.limits.timestamp_period,
+            depth_stencil_format: format!("{depth_format:?}"),
+            geometry_shader: base.geometry_shader == vk::TRUE,
+        };
+
+        let enabled = vk::PhysicalDeviceFeatures::default()
+            .depth_clamp(features.depth_clamp)
+            .depth_bounds(features.depth_bounds)
+            .pipeline_statistics_query(features.pipeline_statistics_query);
+        let mut e13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true);
+        let mut e_u8 = vk::PhysicalDeviceIndexTypeUint8FeaturesEXT::default().index_type_uint8(true);
+        let mut dev_exts = Vec::new();
+        if u8_supported {
+            dev_exts.push(ash::ext::index_type_uint8::NAME.as_ptr());
+        }
+        if has_dru {
+            dev_exts.push(ash::ext::depth_range_unrestricted::NAME.as_ptr());
+        }
+        let prio = [1.0f32];
+        let qinfo = [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&prio)];
+        let mut dinfo = vk::DeviceCreateInfo::default()
+            .queue_create_infos(&qinfo)
+            .enabled_features(&enabled)
+            .enabled_extension_names(&dev_exts)
+            .push_next(&mut e13);
+        if u8_supported {
+            dinfo = dinfo.push_next(&mut e_u8);
+        }
+        // SAFETY: all pointers refer to locals alive for the call.
+        let device = unsafe { instance.create_device(physical, &dinfo, None) }.map_err(vkerr("vkCreateDevice"))?;
+
+        let mut driver = vk::PhysicalDeviceDriverProperties::default();
+        let mut p2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
+        // SAFETY: chain of locals.
+        unsafe { instance.get_physical_device_properties2(physical, &mut p2) };
+        let v = props.api_version;
+        let info = DeviceInfo {
+            name,
+            kind: format!("{:?}", props.device_type),
+            driver: driver.driver_name_as_c_str().map(|c| c.to_string_lossy().into_owned()).unwrap_or_default(),
+            driver_info: driver.driver_info_as_c_str().map(|c| c.to_string_lossy().into_owned()).unwrap_or_default(),
+            api_version: format!("{}.{}.{}", vk::api_version_major(v), vk::api_version_minor(v), vk::api_version_patch(v)),
+            vendor_id: props.vendor_id,
+            device_id: props.device_id,
+        };
+        Ok((physical, device, queue_family, features, info, depth_format, props.limits))
+    }
+
+    /// Validation errors reported so far (drains them).
+    pub fn take_validation_errors(&self) -> Vec<String> {
+        self.log.lock().map(|mut l| std::mem::take(&mut l.errors)).unwrap_or_default()
+    }
+
+    /// `Err(Error::Validation)` if validation reported any error so far.
+    pub fn check_validation(&self) -> Result<()> {
+        let errors = self.take_validation_errors();
+        match errors.first() {
+            None => Ok(()),
+            Some(first) => Err(Error::Validation { count: errors.len(), first: first.clone() }),
+        }
+    }
+
+    pub fn allocator(&self) -> std::sync::MutexGuard<'_, gpu_allocator::vulkan::Allocator> {
+        match self.allocator.lock() {
+            Ok(g) => g,
+            Err(p) => p.into_inner(),
+        }
+    }
+
+    /// Records commands into a fresh primary command buffer, submits, and waits.
+    pub fn one_shot(&self, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
+        let info = vk::CommandBufferAllocateInfo::default().command_pool(self.pool).command_buffer_count(1);
+        // SAFETY: valid pool; the buffer is freed below after the fence wait.
+        let cb = unsafe { self.device.allocate_command_buffers(&info) }.map_err(vkerr("vkAllocateCommandBuffers"))?[0];
+        let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+        // SAFETY: `cb` is a new primary buffer in the initial state.
+        unsafe { self.device.begin_command_buffer(cb, &begin) }.map_err(vkerr("vkBeginCommandBuffer"))?;
+        record(cb);
+        // SAFETY: recording state; then submit with a fence and wait, so `cb` is idle before free.
+        let result = unsafe {
+            self.device.end_command_buffer(cb).map_err(vkerr("vkEndCommandBuffer"))?;
+            let fence = self.device.create_fence(&vk::FenceCreateInfo::default(), None).map_err(vkerr("vkCreateFence"))?;
+            let cbs = [cb];
+            let submit = vk::SubmitInfo::default().command_buffers(&cbs);
+            let r = self
+                .device
+                .queue_submit(self.queue, &[submit], fence)
+                .map_err(vkerr("vkQueueSubmit"))
+                .and_then(|_| self.device.wait_for_fences(&[fence], true, u64::MAX).map_err(vkerr("vkWaitForFences")));
+            self.device.destroy_fence(fence, None);
+            self.device.free_command_buffers(self.pool, &cbs);
+            r
+        };
+        result
+    }
+}
+
+impl Drop for Context {
+    fn drop(&mut self) {
+        // SAFETY: wait for all work, then destroy children before parents. The allocator must be
+        // dropped (freeing its device memory blocks) before the device.
+        unsafe {
+            let _ = self.device.device_wait_idle();
+            std::mem::ManuallyDrop::drop(&mut self.allocator);
+            self.device.destroy_command_pool(self.pool, None);
+            self.device.destroy_device(None);
+            if let Some((du, m)) = self.debug.take() {
+                du.destroy_debug_utils_messenger(m, None);
+            }
+            self.instance.destroy_instance(None);
+        }
+    }
+}
