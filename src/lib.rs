@@ -3,5 +3,7 @@
 pub mod error;
 pub mod geom;
 pub mod gpu;
+pub mod render;
 pub mod scene;
+pub mod shadow;
 pub use error::{Error, Result};

@@ -1,0 +1,1103 @@
+//! The renderer: owns the Vulkan context, the scene's GPU buffers, the GPU-resident casters
+//! and the pipelines, and records one frame per [`Renderer::render`].
+
+use super::stats::*;
+use super::targets::*;
+use crate::error::{Error, Result};
+use crate::gpu::pipeline::{self, Blend, PipelineDesc};
+use crate::gpu::resources::{memory_barrier, transition};
+use crate::gpu::{shaders, Buffer, Context};
+use crate::scene::{LightKind, Scene};
+use crate::shadow::{self, Case, Caster, LightPlan, Method, PlanInput};
+use ash::vk;
+use glam::{DMat4, DVec3, Mat4, Vec3, Vec4};
+use gpu_allocator::MemoryLocation;
+use std::time::Instant;
+
+fn vkerr(call: &'static str) -> impl Fn(vk::Result) -> Error {
+    move |r| Error::Vulkan { call, result: format!("{r:?}") }
+}
+
+/// How z-fail keeps the far plane out of the way.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DepthMode {
+    /// Far plane at infinity (w = 0 vertices land exactly on depth 1).
+    Infinite,
+    /// A finite far plane beyond the scene, with `depthClamp` on the shadow pipelines.
+    Clamp,
+}
+
+impl std::str::FromStr for DepthMode {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "infinite" => Ok(DepthMode::Infinite),
+            "clamp" => Ok(DepthMode::Clamp),
+            _ => Err(Error::UnknownName { what: "depth mode", name: s.into(), expected: "infinite, clamp".into() }),
+        }
+    }
+}
+
+impl DepthMode {
+    pub fn name(self) -> &'static str {
+        match self {
+            DepthMode::Infinite => "infinite",
+            DepthMode::Clamp => "clamp",
+        }
+    }
+}
+
+/// How shadow geometry reaches the GPU each frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IndexFormat {
+    U32,
+    U16,
+    /// 8-bit indices for chunks of at most 128 vertices (needs `indexTypeUint8`), else u16.
+    U8,
+    /// u8 where possible, else u16.
+    Auto,
+    /// No indices: every shadow-triangle vertex streamed as 4 x f32 (the naive baseline).
+    Naive,
+}
+
+impl std::str::FromStr for IndexFormat {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "u32" => Ok(IndexFormat::U32),
+            "u16" => Ok(IndexFormat::U16),
+            "u8" => Ok(IndexFormat::U8),
+            "auto" => Ok(IndexFormat::Auto),
+            "naive" => Ok(IndexFormat::Naive),
+            _ => Err(Error::UnknownName { what: "index format", name: s.into(), expected: "u32, u16, u8, auto, naive".into() }),
+        }
+    }
+}
+
+impl IndexFormat {
+    pub fn name(self) -> &'static str {
+        match self {
+            IndexFormat::U32 => "u32",
+            IndexFormat::U16 => "u16",
+            IndexFormat::U8 => "u8",
+            IndexFormat::Auto => "auto",
+            IndexFormat::Naive => "naive",
+        }
+    }
+}
+
+/// What the final image shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum View {
+    /// The lit scene.
+    Shaded,
+    /// Shadow volumes translucent over the scene, coloured by case.
+    Volumes,
+    /// Stencil counts of light 0 as a heat map.
+    Stencil,
+}
+
+impl std::str::FromStr for View {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "shaded" => Ok(View::Shaded),
+            "volumes" => Ok(View::Volumes),
+            "stencil" => Ok(View::Stencil),
+            _ => Err(Error::UnknownName { what: "view", name: s.into(), expected: "shaded, volumes, stencil".into() }),
+        }
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct RenderOptions {
+    pub width: u32,
+    pub height: u32,
+    pub method: Method,
+    pub depth_mode: DepthMode,
+    pub index_format: IndexFormat,
+    pub view: View,
+    /// Read back per-light stencil counts, positions and normals (dumps, tests).
+    pub capture: bool,
+}
+
+impl Default for RenderOptions {
+    fn default() -> Self {
+        RenderOptions {
+            width: 960,
+            height: 540,
+            method: Method::McGuire,
+            depth_mode: DepthMode::Infinite,
+            index_format: IndexFormat::Auto,
+            view: View::Shaded,
+            capture: false,
+        }
+    }
+}
+
+/// What a frame produced.
+pub struct FrameOutput {
+    pub width: u32,
+    pub height: u32,
+    /// sRGB RGBA8, row-major from the top-left.
+    pub color: Vec<u8>,
+    /// Per light: stencil count after its determination (captured frames only).
+    pub stencil: Vec<Vec<u8>>,
+    /// World position per pixel (NaN for background), captured frames only.
+    pub positions: Vec<[f32; 3]>,
+    /// Geometric face normal per pixel (NaN for background), captured frames only.
+    pub normals: Vec<[f32; 3]>,
+    pub stats: Stats,
+}
+
+impl FrameOutput {
+    /// Per light: 255 where the light reaches the pixel (stencil count zero and the surface
+    /// faces the light), 0 where it does not, 128 for background. Captured frames only.
+    pub fn shadow_masks(&self, scene: &Scene) -> Vec<Vec<u8>> {
+        scene
+            .lights
+            .iter()
+            .enumerate()
+            .map(|(k, light)| {
+                let l = light.homogeneous();
+                (0..(self.width * self.height) as usize)
+                    .map(|i| {
+                        let p = Vec3::from(self.positions[i]);
+                        let n = Vec3::from(self.normals[i]);
+                        if !p.x.is_finite() {
+                            return 128;
+                        }
+                        let to_light = if l.w == 0.0 { l.truncate() } else { l.truncate() - p };
+                        let faces = n.dot(to_light) > 0.0;
+                        let count = self.stencil.get(k).map(|s| s[i]).unwrap_or(0);
+                        if faces && count == 0 {
+                            255
+                        } else {
+                            0
+                        }
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+}
+
+/// A caster chunk on the GPU: the dual-length vertex buffer (n x (xyz,1) then n x (xyz,0)).
+struct GpuChunk {
+    vertices: Buffer,
+    n: u32,
+}
+
+struct Pipelines {
+    gbuffer: vk::Pipeline,
+    zpass: vk::Pipeline,
+    zfail: vk::Pipeline,
+    zfail_cap: vk::Pipeline,
+    illuminate: vk::Pipeline,
+    volumes: vk::Pipeline,
+    tonemap: vk::Pipeline,
+}
+
+pub struct Renderer {
+    pub scene: Scene,
+    pub opts: RenderOptions,
+    casters: Vec<Caster>,
+    /// Per caster (same order as `casters`), its chunks' GPU buffers.
+    gpu_casters: Vec<Vec<GpuChunk>>,
+    scene_vertices: Buffer,
+    scene_vertex_count: u32,
+    targets: Targets,
+    set_layouts: [vk::DescriptorSetLayout; 2],
+    layouts: [vk::PipelineLayout; 4],
+    descriptor_pool: vk::DescriptorPool,
+    sets: [vk::DescriptorSet; 2],
+    sampler: vk::Sampler,
+    pipes: Pipelines,
+    stream: Option<Buffer>,
+    readback: Vec<Buffer>,
+    query_pool: vk::QueryPool,
+    cmd: vk::CommandBuffer,
+    fence: vk::Fence,
+    // Last so it drops after everything above has been destroyed in `Drop`.
+    pub ctx: Context,
+}
+
+const MAX_TIMESTAMPS: u32 = 256;
+const TS_BEGIN: u32 = 0;
+const TS_DEPTH: u32 = 1;
+const TS_END: u32 = 2;
+
+fn bytes_of<T: Copy>(v: &[T]) -> &[u8] {
+    // SAFETY: T is a plain-old-data type (f32 arrays / integers) with no padding; the slice is
+    // viewed as bytes for upload only.
+    unsafe { std::slice::from_raw_parts(v.as_ptr() as *const u8, std::mem::size_of_val(v)) }
+}
+
+impl Renderer {
+    pub fn new(ctx: Context, scene: Scene, opts: RenderOptions) -> Result<Renderer> {
+        if opts.width == 0 || opts.height == 0 || opts.width > 16384 || opts.height > 16384 {
+            return Err(Error::Other(format!("invalid image size {}x{} (1..=16384 each)", opts.width, opts.height)));
+        }
+        if opts.depth_mode == DepthMode::Clamp && !ctx.features.depth_clamp {
+            return Err(Error::Unsupported("--depth-mode clamp needs the depthClamp feature; use --depth-mode infinite".into()));
+        }
+        if opts.index_format == IndexFormat::U8 && !ctx.features.index_type_uint8 {
+            return Err(Error::Unsupported("--index-format u8 needs VK_EXT_index_type_uint8; use auto or u16".into()));
+        }
+        // Casters: CPU preparation (welding, topology, chunks) then the dual-length buffers.
+        let mut casters = Vec::new();
+        for (i, m) in scene.meshes.iter().enumerate() {
+            if m.casts_shadow {
+                casters.push(Caster::new(i, m)?);
+            }
+        }
+        let mut gpu_casters = Vec::new();
+        for c in &casters {
+            let mut chunks = Vec::new();
+            for ch in &c.chunks {
+                let mut data: Vec<[f32; 4]> = Vec::with_capacity(ch.vertices.len() * 2);
+                data.extend(ch.vertices.iter().map(|v| [v.x, v.y, v.z, 1.0]));
+                data.extend(ch.vertices.iter().map(|v| [v.x, v.y, v.z, 0.0]));
+                let vertices = upload(&ctx, &format!("caster {}", c.name), bytes_of(&data), vk::BufferUsageFlags::VERTEX_BUFFER)?;
+                chunks.push(GpuChunk { vertices, n: ch.vertices.len() as u32 });
+            }
+            gpu_casters.push(chunks);
+        }
+
+        // Scene geometry for the ambient pass: flat-shaded triangles, eye-relative.
+        let eye = scene.camera.eye.as_dvec3();
+        let mut verts: Vec<[f32; 9]> = Vec::new();
+        for m in &scene.meshes {
+            let xf = m.transform.as_dmat4();
+            for t in 0..m.mesh.triangles.len() {
+                let p = m.mesh.triangle(t).map(|v| xf.transform_point3(v.as_dvec3()));
+                let n = (p[1] - p[0]).cross(p[2] - p[0]);
+                if !(n.length_squared() > 0.0) {
+                    continue; // zero-area: nothing to rasterise, and no normal to shade with
+                }
+                let n = n.normalize().as_vec3();
+                for v in p {
+                    let r = (v - eye).as_vec3();
+                    verts.push([r.x, r.y, r.z, n.x, n.y, n.z, m.color.x, m.color.y, m.color.z]);
+                }
+            }
+        }
+        if verts.is_empty() {
+            return Err(Error::Other(format!("scene '{}' has no triangle to draw", scene.name)));
+        }
+        let scene_vertices = upload(&ctx, "scene", bytes_of(&verts), vk::BufferUsageFlags::VERTEX_BUFFER)?;
+        let targets = Targets::new(&ctx, opts.width, opts.height)?;
+
+        // Descriptors: set 0 = G-buffer for illumination, set 1 = accumulation for tone mapping.
+        let d = &ctx.device;
+        // SAFETY: plain object creation on a valid device; everything is destroyed in Drop.
+        let (sampler, set_layouts, layouts, descriptor_pool, sets) = unsafe {
+            let sampler = d
+                .create_sampler(
+                    &vk::SamplerCreateInfo::default().mag_filter(vk::Filter::NEAREST).min_filter(vk::Filter::NEAREST),
+                    None,
+                )
+                .map_err(vkerr("vkCreateSampler"))?;
+            let mk_set_layout = |images: u32| {
+                let mut b: Vec<_> = (0..images)
+                    .map(|i| {
+                        vk::DescriptorSetLayoutBinding::default()
+                            .binding(i)
+                            .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
+                            .descriptor_count(1)
+                            .stage_flags(vk::ShaderStageFlags::FRAGMENT)
+                    })
+                    .collect();
+                b.push(
+                    vk::DescriptorSetLayoutBinding::default()
+                        .binding(images)
+                        .descriptor_type(vk::DescriptorType::SAMPLER)
+                        .descriptor_count(1)
+                        .stage_flags(vk::ShaderStageFlags::FRAGMENT),
+                );
+                d.create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&b), None)
+                    .map_err(vkerr("vkCreateDescriptorSetLayout"))
+            };
+            let set_layouts = [mk_set_layout(3)?, mk_set_layout(1)?];
+            let mk_layout = |sets: &[vk::DescriptorSetLayout], push: u32, stages: vk::ShaderStageFlags| {
+                let ranges = [vk::PushConstantRange { stage_flags: stages, offset: 0, size: push }];
+                let info = vk::PipelineLayoutCreateInfo::default().set_layouts(sets).push_constant_ranges(if push > 0 { &ranges } else { &[] });
+                d.create_pipeline_layout(&info, None).map_err(vkerr("vkCreatePipelineLayout"))
+            };
+            let vf = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
+            let layouts = [
+                mk_layout(&[], 80, vf)?,
+                mk_layout(&[], 96, vf)?,
+                mk_layout(&set_layouts[0..1], 64, vk::ShaderStageFlags::FRAGMENT)?,
+                mk_layout(&set_layouts[1..2], 0, vk::ShaderStageFlags::FRAGMENT)?,
+            ];
+            let sizes = [
+                vk::DescriptorPoolSize { ty: vk::DescriptorType::SAMPLED_IMAGE, descriptor_count: 4 },
+                vk::DescriptorPoolSize { ty: vk::DescriptorType::SAMPLER, descriptor_count: 2 },
+            ];
+            let pool = d
+                .create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(2).pool_sizes(&sizes), None)
+                .map_err(vkerr("vkCreateDescriptorPool"))?;
+            let sets = d
+                .allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&set_layouts))
+                .map_err(vkerr("vkAllocateDescriptorSets"))?;
+            let sets = [sets[0], sets[1]];
+            let img = |i: &crate::gpu::Image| {
+                [vk::DescriptorImageInfo { sampler: vk::Sampler::null(), image_view: i.view, image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL }]
+            };
+            let samp = [vk::DescriptorImageInfo { sampler, image_view: vk::ImageView::null(), image_layout: vk::ImageLayout::UNDEFINED }];
+            let (a, n, p, acc) = (img(&targets.albedo), img(&targets.normal), img(&targets.position), img(&targets.accum));
+            fn w(set: vk::DescriptorSet, binding: u32, ty: vk::DescriptorType, info: &[vk::DescriptorImageInfo]) -> vk::WriteDescriptorSet<'_> {
+                vk::WriteDescriptorSet::default().dst_set(set).dst_binding(binding).descriptor_type(ty).image_info(info)
+            }
+            let writes = [
+                w(sets[0], 0, vk::DescriptorType::SAMPLED_IMAGE, &a),
+                w(sets[0], 1, vk::DescriptorType::SAMPLED_IMAGE, &n),
+                w(sets[0], 2, vk::DescriptorType::SAMPLED_IMAGE, &p),
+                w(sets[0], 3, vk::DescriptorType::SAMPLER, &samp),
+                w(sets[1], 0, vk::DescriptorType::SAMPLED_IMAGE, &acc),
+                w(sets[1], 1, vk::DescriptorType::SAMPLER, &samp),
+            ];
+            d.update_descriptor_sets(&writes, &[]);
+            (sampler, set_layouts, layouts, pool, sets)
+        };
+
+        let pipes = create_pipelines(&ctx, &layouts, opts.depth_mode)?;
+
+        // SAFETY: object creation on a valid device; destroyed in Drop.
+        let (query_pool, cmd, fence) = unsafe {
+            let qp = d
+                .create_query_pool(
+                    &vk::QueryPoolCreateInfo::default().query_type(vk::QueryType::TIMESTAMP).query_count(MAX_TIMESTAMPS),
+                    None,
+                )
+                .map_err(vkerr("vkCreateQueryPool"))?;
+            let cmd = d
+                .allocate_command_buffers(&vk::CommandBufferAllocateInfo::default().command_pool(ctx.pool).command_buffer_count(1))
+                .map_err(vkerr("vkAllocateCommandBuffers"))?[0];
+            let fence = d.create_fence(&vk::FenceCreateInfo::default(), None).map_err(vkerr("vkCreateFence"))?;
+            (qp, cmd, fence)
+        };
+
+        Ok(Renderer {
+            scene,
+            opts,
+            casters,
+            gpu_casters,
+            scene_vertex_count: verts.len() as u32,
+            scene_vertices,
+            targets,
+            set_layouts,
+            layouts,
+            descriptor_pool,
+            sets,
+            sampler,
+            pipes,
+            stream: None,
+            readback: Vec::new(),
+            query_pool,
+            cmd,
+            fence,
+            ctx,
+        })
+    }
+
+    pub fn casters(&self) -> &[Caster] {
+        &self.casters
+    }
+
+    /// World -> clip with the configured depth mode (used by the planner for its frustum tests).
+    fn projection(&self) -> Mat4 {
+        let aspect = self.opts.width as f32 / self.opts.height as f32;
+        match self.opts.depth_mode {
+            DepthMode::Infinite => self.scene.camera.proj_infinite(aspect),
+            DepthMode::Clamp => {
+                // Far plane just beyond the scene: everything further is clamped to depth 1.
+                let eye = self.scene.camera.eye;
+                let far = self
+                    .scene
+                    .meshes
+                    .iter()
+                    .flat_map(|m| m.world_bounds().corners())
+                    .map(|c| c.distance(eye))
+                    .fold(1.0f32, f32::max)
+                    * 1.5;
+                self.scene.camera.proj_finite(aspect, far.max(self.scene.camera.near * 2.0))
+            }
+        }
+    }
+
+    /// Plans every light (CPU), then records, submits and reads back one frame.
+    pub fn render(&mut self) -> Result<FrameOutput> {
+        let wall = Instant::now();
+        let (w, h) = (self.opts.width, self.opts.height);
+        let proj = self.projection();
+        let cam = &self.scene.camera;
+        let view_world = cam.view();
+        let view_proj = proj * view_world;
+        // Eye-relative view: rotation only, the translation is folded into every model matrix
+        // in f64.
+        let view_rel = glam::camera::rh::view::look_at_mat4(Vec3::ZERO, cam.target - cam.eye, cam.up.normalize());
+        let eye = cam.eye.as_dvec3();
+        let vp_rel_d = proj.as_dmat4() * view_rel.as_dmat4();
+        let vp_rel = vp_rel_d.as_mat4();
+
+        // 1. Plans (pure CPU).
+        let plans: Vec<LightPlan> = self
+            .scene
+            .lights
+            .iter()
+            .map(|light| {
+                shadow::plan_light(
+                    &PlanInput { camera: cam, width: w, height: h, view_proj, light, method: self.opts.method },
+                    &self.casters,
+                )
+            })
+            .collect();
+
+        // 2. Shadow geometry stream for the frame.
+        let record_start = Instant::now();
+        let u8_ok = self.ctx.features.index_type_uint8;
+        let mut stream: Vec<u8> = Vec::new();
+        // Per light, per caster: draws (chunk, stream offset, count, format, is_light_cap).
+        let mut draws: Vec<Vec<(usize, Case, Vec<Draw>)>> = Vec::new();
+        let mut light_stats = Vec::new();
+        let mut totals = Totals::default();
+        let mut cpu = CpuMs::default();
+        for (li, plan) in plans.iter().enumerate() {
+            cpu.silhouettes += plan.silhouette_ms;
+            cpu.plan += plan.plan_ms;
+            let mut ldraws = Vec::new();
+            let mut cstats = Vec::new();
+            for cp in &plan.casters {
+                let caster = &self.casters[cp.caster];
+                let mut cdraws = Vec::new();
+                let mut index_bytes = 0u64;
+                let mut vertex_bytes = 0u64;
+                let mut fmt_used = "none";
+                for cd in &cp.chunks {
+                    let chunk = &caster.chunks[cd.chunk];
+                    let n = chunk.vertices.len();
+                    for (indices, cap) in [(&cd.volume, false), (&cd.light_cap, true)] {
+                        if indices.is_empty() {
+                            continue;
+                        }
+                        let fmt = match self.opts.index_format {
+                            IndexFormat::Auto | IndexFormat::U8 if u8_ok && 2 * n <= 256 => IndexFormat::U8,
+                            IndexFormat::Auto | IndexFormat::U8 => IndexFormat::U16,
+                            f => f,
+                        };
+                        fmt_used = fmt.name();
+                        align(&mut stream, 16);
+                        let offset = stream.len() as u64;
+                        match fmt {
+                            IndexFormat::U8 => stream.extend(indices.iter().map(|&i| i as u8)),
+                            IndexFormat::U16 => stream.extend(indices.iter().flat_map(|&i| i.to_le_bytes())),
+                            IndexFormat::U32 => stream.extend(indices.iter().flat_map(|&i| (i as u32).to_le_bytes())),
+                            IndexFormat::Naive | IndexFormat::Auto => {
+                                for &i in indices.iter() {
+                                    let i = i as usize;
+                                    let (v, wv) = if i < n { (chunk.vertices[i], 1.0f32) } else { (chunk.vertices[i - n], 0.0) };
+                                    for f in [v.x, v.y, v.z, wv] {
+                                        stream.extend(f.to_le_bytes());
+                                    }
+                                }
+                            }
+                        }
+                        let bytes = stream.len() as u64 - offset;
+                        if fmt == IndexFormat::Naive {
+                            vertex_bytes += bytes;
+                        } else {
+                            index_bytes += bytes;
+                        }
+                        cdraws.push(Draw { chunk: cd.chunk, offset, count: indices.len() as u32, format: fmt, light_cap: cap });
+                    }
+                }
+                let tris = Triangles { sides: cp.sides as u64, dark_cap: cp.dark_cap as u64, light_cap: cp.light_cap as u64 };
+                let ntris = tris.total();
+                totals.triangles.add(&tris);
+                totals.index_bytes += index_bytes;
+                totals.vertex_bytes += vertex_bytes;
+                match cp.case {
+                    Case::Culled => totals.cases.culled += 1,
+                    Case::ZPass => totals.cases.zpass += 1,
+                    Case::ZFail => totals.cases.zfail += 1,
+                    Case::ZFailLightCap => totals.cases.zfail_light_cap += 1,
+                }
+                cstats.push(CasterStats {
+                    name: caster.name.clone(),
+                    case: cp.case.name().to_string(),
+                    silhouette_edges: cp.silhouette_edges as u64,
+                    triangles: tris,
+                    index_bytes,
+                    vertex_bytes,
+                    bytes_per_triangle: if ntris > 0 { (index_bytes + vertex_bytes) as f64 / ntris as f64 } else { 0.0 },
+                    index_format: fmt_used.to_string(),
+                    dark_cap_kind: format!("{:?}", cp.dark_cap_kind),
+                });
+                ldraws.push((cp.caster, cp.case, cdraws));
+            }
+            let light = &self.scene.lights[li];
+            light_stats.push(LightStats {
+                index: li,
+                kind: format!("{:?}", light.kind).to_lowercase(),
+                scissor: plan.scissor,
+                depth_bounds: if self.ctx.features.depth_bounds { plan.depth_bounds.map(|(a, b)| [a, b]) } else { None },
+                casters: cstats,
+            });
+            draws.push(ldraws);
+        }
+        align(&mut stream, 16);
+        if self.stream.as_ref().map(|b| b.size < stream.len() as u64).unwrap_or(true) {
+            if let Some(mut old) = self.stream.take() {
+                old.destroy(&self.ctx);
+            }
+            let size = (stream.len() as u64).max(1 << 16).next_power_of_two();
+            self.stream = Some(Buffer::new(
+                &self.ctx,
+                "shadow stream",
+                size,
+                vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::VERTEX_BUFFER,
+                MemoryLocation::CpuToGpu,
+            )?);
+        }
+        let stream_buf = self.stream.as_mut().ok_or_else(|| Error::Other("no stream buffer".into()))?;
+        stream_buf.write(0, &stream)?;
+        let stream_raw = stream_buf.raw;
+
+        // 3. Readback buffers.
+        let npx = (w * h) as u64;
+        let nlights = self.scene.lights.len();
+        let capture = self.opts.capture || self.opts.view == View::Stencil;
+        let mut sizes = vec![npx * 4];
+        if capture {
+            sizes.push(npx * 16); // positions
+            sizes.push(npx * 16); // normals
+            sizes.extend(std::iter::repeat(npx).take(nlights)); // stencil per light
+        }
+        if self.readback.len() != sizes.len() || self.readback.iter().zip(&sizes).any(|(b, &s)| b.size != s) {
+            for mut b in self.readback.drain(..) {
+                b.destroy(&self.ctx);
+            }
+            for (i, &s) in sizes.iter().enumerate() {
+                self.readback.push(Buffer::new(&self.ctx, &format!("readback {i}"), s, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?);
+            }
+        }
+
+        // 4. Record.
+        let ambient = self.scene.ambient;
+        let light_uniforms: Vec<[Vec4; 4]> = self
+            .scene
+            .lights
+            .iter()
+            .map(|l| {
+                let pos = match l.kind {
+                    LightKind::Directional => (-l.direction.normalize()).extend(0.0),
+                    _ => (l.position.as_dvec3() - eye).as_vec3().extend(1.0),
+                };
+                let spot = match l.kind {
+                    LightKind::Spot => l.direction.normalize().extend((l.cone_deg.to_radians() * 0.5).cos()),
+                    _ => Vec4::new(0.0, 0.0, -1.0, -2.0),
+                };
+                [pos, (l.color * l.intensity).extend(1.0), spot, Vec4::new(l.radius.unwrap_or(0.0), 0.0, 0.0, 0.0)]
+            })
+            .collect();
+        // Per caster: MVP (eye-relative, composed in f64) and the light in object space per light.
+        let caster_mvp: Vec<Mat4> = self
+            .casters
+            .iter()
+            .map(|c| (vp_rel_d * DMat4::from_translation(-eye) * c.transform.as_dmat4()).as_mat4())
+            .collect();
+        let caster_light: Vec<Vec<Vec4>> = self
+            .casters
+            .iter()
+            .map(|c| {
+                let inv = c.transform.as_dmat4().inverse();
+                self.scene.lights.iter().map(|l| (inv * l.homogeneous().as_dvec4()).as_vec4()).collect()
+            })
+            .collect();
+
+        let ctx = &self.ctx;
+        let d = &ctx.device;
+        let cb = self.cmd;
+        let t = &self.targets;
+        let full = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: t.extent };
+        let viewport = vk::Viewport { x: 0.0, y: 0.0, width: w as f32, height: h as f32, min_depth: 0.0, max_depth: 1.0 };
+        let timestamps = ctx.features.timestamps;
+        let mut ts_next = 3u32;
+        let mut ts_shadow: Vec<(u32, u32)> = Vec::new();
+        let mut ts_illum: Vec<(u32, u32)> = Vec::new();
+        let ts = |stage: vk::PipelineStageFlags2, q: u32| {
+            if timestamps && q < MAX_TIMESTAMPS {
+                // SAFETY: `cb` is recording; the query was reset at the start of the buffer.
+                unsafe { d.cmd_write_timestamp2(cb, stage, self.query_pool, q) };
+            }
+        };
+        let att = |img: &crate::gpu::Image, load: vk::AttachmentLoadOp, clear: vk::ClearValue| {
+            vk::RenderingAttachmentInfo::default()
+                .image_view(img.view)
+                .image_layout(if img.aspect == vk::ImageAspectFlags::COLOR {
+                    vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL
+                } else {
+                    vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL
+                })
+                .load_op(load)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(clear)
+        };
+        let zero = vk::ClearValue { color: vk::ClearColorValue { float32: [0.0; 4] } };
+        let ds_clear = vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } };
+        let load = vk::AttachmentLoadOp::LOAD;
+
+        // SAFETY: every command below is recorded into `cb`, which is reset and begun here and
+        // submitted once; all handles belong to this device and live until Drop; layouts are
+        // tracked by hand in the order written.
+        unsafe {
+            d.reset_command_buffer(cb, vk::CommandBufferResetFlags::empty()).map_err(vkerr("vkResetCommandBuffer"))?;
+            d.begin_command_buffer(cb, &vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT))
+                .map_err(vkerr("vkBeginCommandBuffer"))?;
+            if timestamps {
+                d.cmd_reset_query_pool(cb, self.query_pool, 0, MAX_TIMESTAMPS);
+            }
+            for img in t.gbuffer() {
+                transition(ctx, cb, img, vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
+            }
+            transition(ctx, cb, &t.depth, vk::ImageLayout::UNDEFINED, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
+            ts(vk::PipelineStageFlags2::TOP_OF_PIPE, TS_BEGIN);
+
+            // Ambient pass.
+            let colors: Vec<_> = t.gbuffer().iter().map(|i| att(i, vk::AttachmentLoadOp::CLEAR, zero)).collect();
+            let depth_att = att(&t.depth, vk::AttachmentLoadOp::CLEAR, ds_clear);
+            d.cmd_begin_rendering(
+                cb,
+                &vk::RenderingInfo::default()
+                    .render_area(full)
+                    .layer_count(1)
+                    .color_attachments(&colors)
+                    .depth_attachment(&depth_att)
+                    .stencil_attachment(&depth_att),
+            );
+            d.cmd_set_viewport(cb, 0, &[viewport]);
+            d.cmd_set_scissor(cb, 0, &[full]);
+            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.pipes.gbuffer);
+            let mut push = [0f32; 20];
+            push[..16].copy_from_slice(&vp_rel.to_cols_array());
+            push[16..19].copy_from_slice(&ambient.to_array());
+            d.cmd_push_constants(cb, self.layouts[0], vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT, 0, bytes_of(&push));
+            d.cmd_bind_vertex_buffers(cb, 0, &[self.scene_vertices.raw], &[0]);
+            d.cmd_draw(cb, self.scene_vertex_count, 1, 0, 0);
+            d.cmd_end_rendering(cb);
+            ts(vk::PipelineStageFlags2::ALL_COMMANDS, TS_DEPTH);
+            for img in [&t.albedo, &t.normal, &t.position] {
+                transition(ctx, cb, img, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
+            }
+
+            let frag_tests = vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS;
+            let ds_rw = vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE;
+            let color_rw = vk::AccessFlags2::COLOR_ATTACHMENT_READ | vk::AccessFlags2::COLOR_ATTACHMENT_WRITE;
+            for (li, ldraws) in draws.iter().enumerate() {
+                let plan = &plans[li];
+                let scissor = plan
+                    .scissor
+                    .map(|[x, y, sw, sh]| vk::Rect2D { offset: vk::Offset2D { x: x as i32, y: y as i32 }, extent: vk::Extent2D { width: sw, height: sh } })
+                    .filter(|r| r.extent.width > 0 && r.extent.height > 0)
+                    .unwrap_or(full);
+                let bounds = if ctx.features.depth_bounds { plan.depth_bounds } else { None };
+
+                // Shadow determination: stencil cleared inside the scissor, volumes drawn.
+                let q0 = ts_next;
+                ts(vk::PipelineStageFlags2::ALL_COMMANDS, q0);
+                let depth_load = att(&t.depth, load, ds_clear);
+                let stencil_clear = att(&t.depth, vk::AttachmentLoadOp::CLEAR, ds_clear);
+                d.cmd_begin_rendering(
+                    cb,
+                    &vk::RenderingInfo::default()
+                        .render_area(scissor)
+                        .layer_count(1)
+                        .depth_attachment(&depth_load)
+                        .stencil_attachment(&stencil_clear),
+                );
+                d.cmd_set_viewport(cb, 0, &[viewport]);
+                d.cmd_set_scissor(cb, 0, &[scissor]);
+                let _ = bounds; // depth bounds on the determination pass: see ARCHITECTURE.md
+                let mut bound_pipe = vk::Pipeline::null();
+                for (ci, case, cdraws) in ldraws {
+                    if *case == Case::Culled {
+                        continue;
+                    }
+                    let mut push = [0f32; 24];
+                    push[..16].copy_from_slice(&caster_mvp[*ci].to_cols_array());
+                    push[16..20].copy_from_slice(&caster_light[*ci][li].to_array());
+                    d.cmd_push_constants(cb, self.layouts[1], vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT, 0, bytes_of(&push));
+                    for dr in cdraws {
+                        let pipe = match (case, dr.light_cap) {
+                            (Case::ZPass, _) => self.pipes.zpass,
+                            (_, false) => self.pipes.zfail,
+                            (_, true) => self.pipes.zfail_cap,
+                        };
+                        if pipe != bound_pipe {
+                            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipe);
+                            bound_pipe = pipe;
+                        }
+                        self.record_draw(cb, *ci, dr, stream_raw);
+                    }
+                }
+                d.cmd_end_rendering(cb);
+                ts(vk::PipelineStageFlags2::ALL_COMMANDS, q0 + 1);
+                ts_shadow.push((q0, q0 + 1));
+                memory_barrier(ctx, cb, (frag_tests, ds_rw), (frag_tests, ds_rw));
+
+                if capture {
+                    transition(ctx, cb, &t.depth, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+                    let region = vk::BufferImageCopy::default()
+                        .image_subresource(vk::ImageSubresourceLayers { aspect_mask: vk::ImageAspectFlags::STENCIL, mip_level: 0, base_array_layer: 0, layer_count: 1 })
+                        .image_extent(vk::Extent3D { width: w, height: h, depth: 1 });
+                    d.cmd_copy_image_to_buffer(cb, t.depth.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, self.readback[3 + li].raw, &[region]);
+                    transition(ctx, cb, &t.depth, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
+                }
+
+                // Illumination where the count is zero.
+                let q1 = q0 + 2;
+                ts(vk::PipelineStageFlags2::ALL_COMMANDS, q1);
+                let accum_att = [att(&t.accum, load, zero)];
+                d.cmd_begin_rendering(
+                    cb,
+                    &vk::RenderingInfo::default()
+                        .render_area(scissor)
+                        .layer_count(1)
+                        .color_attachments(&accum_att)
+                        .depth_attachment(&depth_load)
+                        .stencil_attachment(&depth_load),
+                );
+                d.cmd_set_viewport(cb, 0, &[viewport]);
+                d.cmd_set_scissor(cb, 0, &[scissor]);
+                d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.pipes.illuminate);
+                d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, self.layouts[2], 0, &[self.sets[0]], &[]);
+                d.cmd_push_constants(cb, self.layouts[2], vk::ShaderStageFlags::FRAGMENT, 0, bytes_of(&light_uniforms[li]));
+                d.cmd_draw(cb, 3, 1, 0, 0);
+                d.cmd_end_rendering(cb);
+                ts(vk::PipelineStageFlags2::ALL_COMMANDS, q1 + 1);
+                ts_illum.push((q1, q1 + 1));
+                ts_next += 4;
+                memory_barrier(
+                    ctx,
+                    cb,
+                    (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT | frag_tests, color_rw | ds_rw),
+                    (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT | frag_tests, color_rw | ds_rw),
+                );
+            }
+
+            if self.opts.view == View::Volumes {
+                let accum_att = [att(&t.accum, load, zero)];
+                let depth_load = att(&t.depth, load, ds_clear);
+                d.cmd_begin_rendering(
+                    cb,
+                    &vk::RenderingInfo::default()
+                        .render_area(full)
+                        .layer_count(1)
+                        .color_attachments(&accum_att)
+                        .depth_attachment(&depth_load)
+                        .stencil_attachment(&depth_load),
+                );
+                d.cmd_set_viewport(cb, 0, &[viewport]);
+                d.cmd_set_scissor(cb, 0, &[full]);
+                d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.pipes.volumes);
+                for (li, ldraws) in draws.iter().enumerate() {
+                    for (ci, case, cdraws) in ldraws {
+                        let color = match case {
+                            Case::Culled => continue,
+                            Case::ZPass => [0.2f32, 0.4, 1.0, 0.12],
+                            Case::ZFail => [1.0, 0.3, 0.2, 0.12],
+                            Case::ZFailLightCap => [0.1, 1.0, 0.2, 0.12],
+                        };
+                        let mut push = [0f32; 24];
+                        push[..16].copy_from_slice(&caster_mvp[*ci].to_cols_array());
+                        push[16..20].copy_from_slice(&caster_light[*ci][li].to_array());
+                        push[20..24].copy_from_slice(&color);
+                        d.cmd_push_constants(cb, self.layouts[1], vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT, 0, bytes_of(&push));
+                        for dr in cdraws.iter().filter(|dr| !dr.light_cap) {
+                            self.record_draw(cb, *ci, dr, stream_raw);
+                        }
+                    }
+                }
+                d.cmd_end_rendering(cb);
+            }
+
+            // Final pass: tone map to sRGB.
+            transition(ctx, cb, &t.accum, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
+            transition(ctx, cb, &t.output, vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
+            let out_att = [att(&t.output, vk::AttachmentLoadOp::DONT_CARE, zero)];
+            d.cmd_begin_rendering(cb, &vk::RenderingInfo::default().render_area(full).layer_count(1).color_attachments(&out_att));
+            d.cmd_set_viewport(cb, 0, &[viewport]);
+            d.cmd_set_scissor(cb, 0, &[full]);
+            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.pipes.tonemap);
+            d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, self.layouts[3], 0, &[self.sets[1]], &[]);
+            d.cmd_draw(cb, 3, 1, 0, 0);
+            d.cmd_end_rendering(cb);
+            ts(vk::PipelineStageFlags2::ALL_COMMANDS, TS_END);
+
+            // Readback.
+            transition(ctx, cb, &t.output, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+            let color_region = |aspect| {
+                vk::BufferImageCopy::default()
+                    .image_subresource(vk::ImageSubresourceLayers { aspect_mask: aspect, mip_level: 0, base_array_layer: 0, layer_count: 1 })
+                    .image_extent(vk::Extent3D { width: w, height: h, depth: 1 })
+            };
+            d.cmd_copy_image_to_buffer(cb, t.output.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, self.readback[0].raw, &[color_region(vk::ImageAspectFlags::COLOR)]);
+            if capture {
+                for (img, buf) in [(&t.position, 1), (&t.normal, 2)] {
+                    transition(ctx, cb, img, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+                    d.cmd_copy_image_to_buffer(cb, img.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, self.readback[buf].raw, &[color_region(vk::ImageAspectFlags::COLOR)]);
+                }
+            }
+            memory_barrier(ctx, cb, (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE), (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ));
+            d.end_command_buffer(cb).map_err(vkerr("vkEndCommandBuffer"))?;
+            cpu.record = record_start.elapsed().as_secs_f64() * 1e3;
+
+            let cbs = [cb];
+            d.reset_fences(&[self.fence]).map_err(vkerr("vkResetFences"))?;
+            d.queue_submit(ctx.queue, &[vk::SubmitInfo::default().command_buffers(&cbs)], self.fence).map_err(vkerr("vkQueueSubmit"))?;
+            d.wait_for_fences(&[self.fence], true, u64::MAX).map_err(vkerr("vkWaitForFences"))?;
+        }
+        ctx.check_validation()?;
+
+        // 5. Timings.
+        let gpu_ms = if timestamps {
+            let n = ts_next.min(MAX_TIMESTAMPS) as usize;
+            let mut raw = vec![0u64; n];
+            // SAFETY: the fence wait above guarantees the queries are available.
+            unsafe { d.get_query_pool_results(self.query_pool, 0, &mut raw, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT) }
+                .map_err(vkerr("vkGetQueryPoolResults"))?;
+            let ms = |a: u32, b: u32| (raw[b as usize].wrapping_sub(raw[a as usize])) as f64 * ctx.features.timestamp_period_ns as f64 * 1e-6;
+            Some(GpuMs {
+                depth: ms(TS_BEGIN, TS_DEPTH),
+                shadow: ts_shadow.iter().map(|&(a, b)| ms(a, b)).sum(),
+                illuminate: ts_illum.iter().map(|&(a, b)| ms(a, b)).sum(),
+                frame: ms(TS_BEGIN, TS_END),
+            })
+        } else {
+            None
+        };
+
+        // 6. Read back.
+        let color = self.readback[0].read()?.to_vec();
+        let (mut positions, mut normals, mut stencil) = (Vec::new(), Vec::new(), Vec::new());
+        if capture {
+            let floats = |b: &Buffer| -> Result<Vec<[f32; 4]>> {
+                Ok(b.read()?.chunks_exact(16).map(|c| std::array::from_fn(|k| f32::from_le_bytes([c[4 * k], c[4 * k + 1], c[4 * k + 2], c[4 * k + 3]]))).collect())
+            };
+            let pos = floats(&self.readback[1])?;
+            let nrm = floats(&self.readback[2])?;
+            for (p, n) in pos.iter().zip(&nrm) {
+                if p[3] == 0.0 {
+                    positions.push([f32::NAN; 3]);
+                    normals.push([f32::NAN; 3]);
+                } else {
+                    let wp = DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64) + eye;
+                    positions.push(wp.as_vec3().to_array());
+                    normals.push([n[0], n[1], n[2]]);
+                }
+            }
+            for li in 0..nlights {
+                stencil.push(self.readback[3 + li].read()?.to_vec());
+            }
+        }
+
+        let mut features_used = Vec::new();
+        let mut features_missing = Vec::new();
+        let f = &ctx.features;
+        for (name, has, used) in [
+            ("depthClamp", f.depth_clamp, self.opts.depth_mode == DepthMode::Clamp),
+            ("depthBounds", f.depth_bounds, f.depth_bounds),
+            ("indexTypeUint8", f.index_type_uint8, f.index_type_uint8 && matches!(self.opts.index_format, IndexFormat::U8 | IndexFormat::Auto)),
+            ("timestamps", f.timestamps, f.timestamps),
+        ] {
+            if used {
+                features_used.push(name.to_string());
+            } else if !has {
+                features_missing.push(name.to_string());
+            }
+        }
+        let stats = Stats {
+            device: ctx.info.name.clone(),
+            method: self.opts.method.to_string(),
+            depth_mode: self.opts.depth_mode.name().into(),
+            index_format: self.opts.index_format.name().into(),
+            width: w,
+            height: h,
+            lights: light_stats,
+            totals,
+            cpu_ms: cpu,
+            gpu_ms,
+            wall_ms: wall.elapsed().as_secs_f64() * 1e3,
+            features_used,
+            features_missing,
+        };
+        let mut out = FrameOutput { width: w, height: h, color, stencil, positions, normals, stats };
+        if self.opts.view == View::Stencil {
+            if let Some(s) = out.stencil.first() {
+                out.color = stencil_heatmap(s);
+            }
+        }
+        Ok(out)
+    }
+
+    /// Binds the chunk's vertices (or the streamed naive vertices) and draws.
+    fn record_draw(&self, cb: vk::CommandBuffer, caster: usize, dr: &Draw, stream: vk::Buffer) {
+        let d = &self.ctx.device;
+        let chunk = &self.gpu_casters[caster][dr.chunk];
+        // SAFETY: `cb` is recording inside a rendering instance with a bound shadow pipeline; the
+        // buffers live until Drop and the offsets were computed from the stream just written.
+        unsafe {
+            match dr.format {
+                IndexFormat::Naive => {
+                    d.cmd_bind_vertex_buffers(cb, 0, &[stream], &[dr.offset]);
+                    d.cmd_draw(cb, dr.count, 1, 0, 0);
+                }
+                f => {
+                    let ty = match f {
+                        IndexFormat::U8 => vk::IndexType::UINT8_EXT,
+                        IndexFormat::U32 => vk::IndexType::UINT32,
+                        _ => vk::IndexType::UINT16,
+                    };
+                    let _ = chunk.n;
+                    d.cmd_bind_vertex_buffers(cb, 0, &[chunk.vertices.raw], &[0]);
+                    d.cmd_bind_index_buffer(cb, stream, dr.offset, ty);
+                    d.cmd_draw_indexed(cb, dr.count, 1, 0, 0, 0);
+                }
+            }
+        }
+    }
+}
+
+struct Draw {
+    chunk: usize,
+    offset: u64,
+    count: u32,
+    format: IndexFormat,
+    light_cap: bool,
+}
+
+fn align(v: &mut Vec<u8>, a: usize) {
+    while v.len() % a != 0 {
+        v.push(0);
+    }
+}
+
+/// Stencil counts as a heat map: 0 black, then blue -> green -> yellow -> red by count.
+pub fn stencil_heatmap(s: &[u8]) -> Vec<u8> {
+    let ramp = [[0u8, 0, 0], [40, 60, 220], [30, 200, 80], [240, 220, 40], [230, 40, 30], [255, 255, 255]];
+    s.iter()
+        .flat_map(|&c| {
+            let rgb = ramp[(c as usize).min(ramp.len() - 1)];
+            [rgb[0], rgb[1], rgb[2], 255]
+        })
+        .collect()
+}
+
+/// Uploads `data` into a device-local buffer through a staging buffer.
+fn upload(ctx: &Context, name: &str, data: &[u8], usage: vk::BufferUsageFlags) -> Result<Buffer> {
+    let mut staging = Buffer::with_data(ctx, "staging", data, vk::BufferUsageFlags::TRANSFER_SRC)?;
+    let dst = Buffer::new(ctx, name, data.len() as u64, usage | vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuOnly)?;
+    let r = ctx.one_shot(|cb| {
+        // SAFETY: both buffers are at least `data.len()` bytes and alive until after the wait.
+        unsafe { ctx.device.cmd_copy_buffer(cb, staging.raw, dst.raw, &[vk::BufferCopy { src_offset: 0, dst_offset: 0, size: data.len() as u64 }]) };
+    });
+    staging.destroy(ctx);
+    r.map(|_| dst)
+}
+
+fn create_pipelines(ctx: &Context, layouts: &[vk::PipelineLayout; 4], depth_mode: DepthMode) -> Result<Pipelines> {
+    let df = ctx.depth_format;
+    let gbuffer_formats = [ACCUM_FORMAT, ALBEDO_FORMAT, NORMAL_FORMAT, POSITION_FORMAT];
+    let mut g = PipelineDesc::new(shaders::GBUFFER_VERT, layouts[0], df);
+    g.fragment = Some(shaders::GBUFFER_FRAG);
+    g.vertex_stride = 36;
+    g.attributes = &[(0, vk::Format::R32G32B32_SFLOAT, 0), (1, vk::Format::R32G32B32_SFLOAT, 12), (2, vk::Format::R32G32B32_SFLOAT, 24)];
+    g.color_formats = &gbuffer_formats;
+    g.depth_test = true;
+    g.depth_write = true;
+    g.depth_compare = vk::CompareOp::LESS;
+    g.cull = vk::CullModeFlags::BACK;
+    let gbuffer = pipeline::create(ctx, &g)?;
+
+    use vk::StencilOp as S;
+    let mut s = PipelineDesc::new(shaders::SHADOW_VERT, layouts[1], df);
+    s.vertex_stride = 16;
+    s.attributes = &[(0, vk::Format::R32G32B32A32_SFLOAT, 0)];
+    s.depth_test = true;
+    s.depth_compare = vk::CompareOp::LESS;
+    s.depth_clamp = depth_mode == DepthMode::Clamp;
+    s.stencil = Some((pipeline::stencil_ops(S::INCREMENT_AND_WRAP, S::KEEP), pipeline::stencil_ops(S::DECREMENT_AND_WRAP, S::KEEP)));
+    let zpass = pipeline::create(ctx, &s)?;
+    s.stencil = Some((pipeline::stencil_ops(S::KEEP, S::DECREMENT_AND_WRAP), pipeline::stencil_ops(S::KEEP, S::INCREMENT_AND_WRAP)));
+    let zfail = pipeline::create(ctx, &s)?;
+    s.depth_compare = vk::CompareOp::NEVER;
+    let zfail_cap = pipeline::create(ctx, &s)?;
+
+    let accum = [ACCUM_FORMAT];
+    let mut v = PipelineDesc::new(shaders::SHADOW_VERT, layouts[1], df);
+    v.fragment = Some(shaders::VOLUME_FRAG);
+    v.vertex_stride = 16;
+    v.attributes = &[(0, vk::Format::R32G32B32A32_SFLOAT, 0)];
+    v.color_formats = &accum;
+    v.blend = Blend::Alpha;
+    v.depth_test = true;
+    v.depth_compare = vk::CompareOp::LESS;
+    v.depth_clamp = depth_mode == DepthMode::Clamp;
+    let volumes = pipeline::create(ctx, &v)?;
+
+    let mut i = PipelineDesc::new(shaders::FULLSCREEN_VERT, layouts[2], df);
+    i.fragment = Some(shaders::ILLUMINATE_FRAG);
+    i.color_formats = &accum;
+    i.blend = Blend::Additive;
+    i.stencil = Some((pipeline::stencil_equal(0), pipeline::stencil_equal(0)));
+    let illuminate = pipeline::create(ctx, &i)?;
+
+    let out = [OUTPUT_FORMAT];
+    let mut t = PipelineDesc::new(shaders::FULLSCREEN_VERT, layouts[3], vk::Format::UNDEFINED);
+    t.fragment = Some(shaders::TONEMAP_FRAG);
+    t.color_formats = &out;
+    let tonemap = pipeline::create(ctx, &t)?;
+    Ok(Pipelines { gbuffer, zpass, zfail, zfail_cap, illuminate, volumes, tonemap })
+}
+
+impl Drop for Renderer {
+    fn drop(&mut self) {
+        let ctx = &self.ctx;
+        // SAFETY: wait for the GPU, then destroy everything this renderer created; the context
+        // (declared last) is dropped after this body.
+        unsafe {
+            let _ = ctx.device.device_wait_idle();
+            let d = &ctx.device;
+            let p = &self.pipes;
+            for pipe in [p.gbuffer, p.zpass, p.zfail, p.zfail_cap, p.illuminate, p.volumes, p.tonemap] {
+                d.destroy_pipeline(pipe, None);
+            }
+            for l in self.layouts {
+                d.destroy_pipeline_layout(l, None);
+            }
+            d.destroy_descriptor_pool(self.descriptor_pool, None);
+            for l in self.set_layouts {
+                d.destroy_descriptor_set_layout(l, None);
+            }
+            d.destroy_sampler(self.sampler, None);
+            d.destroy_query_pool(self.query_pool, None);
+            d.destroy_fence(self.fence, None);
+            d.free_command_buffers(ctx.pool, &[self.cmd]);
+        }
+        self.targets.destroy(ctx);
+        self.scene_vertices.destroy(ctx);
+        for chunks in &mut self.gpu_casters {
+            for c in chunks {
+                c.vertices.destroy(ctx);
+            }
+        }
+        if let Some(mut s) = self.stream.take() {
+            s.destroy(ctx);
+        }
+        for b in &mut self.readback {
+            b.destroy(ctx);
+        }
+    }
+}
