@@ -2,6 +2,7 @@
 #![warn(unsafe_op_in_unsafe_fn)]
 pub mod error;
 pub mod geom;
+pub mod output;
 pub mod gpu;
 pub mod render;
 pub mod scene;

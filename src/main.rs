@@ -1,1 +1,165 @@
-fn main(){}
+//! The `umbrage` command line: render | info | check | conform | bench.
+
+use clap::{Parser, Subcommand};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use umbrage::render::{DepthMode, IndexFormat, RenderOptions, Renderer, View};
+use umbrage::shadow::Method;
+use umbrage::{Error, Result};
+
+#[derive(Parser)]
+#[command(name = "umbrage", version, about = "Exact hard shadows with stencil shadow volumes on Vulkan, measured against a CPU reference")]
+struct Cli {
+    #[command(subcommand)]
+    command: Option<Command>,
+}
+
+#[derive(clap::Args, Clone)]
+struct FrameArgs {
+    /// Scene file (TOML) or built-in name (default, stairs, cubes, spheres, hard/...).
+    #[arg(long, default_value = "default")]
+    scene: String,
+    /// Image size, WxH.
+    #[arg(long, default_value = "960x540", value_parser = parse_size)]
+    size: (u32, u32),
+    /// Shadow method: mcguire, lengyel, everitt-kilgard, zfail, zpass.
+    #[arg(long, default_value = "mcguire")]
+    method: String,
+    /// infinite (far plane at infinity) or clamp (finite far plane + depthClamp).
+    #[arg(long, default_value = "infinite")]
+    depth_mode: String,
+    /// u32, u16, u8, auto, or naive (stream 4 x f32 per shadow vertex, no indices).
+    #[arg(long, default_value = "auto")]
+    index_format: String,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene to a PNG (and optionally stats JSON and a frame dump).
+    Render {
+        #[command(flatten)]
+        frame: FrameArgs,
+        /// Output PNG.
+        #[arg(long, default_value = "umbrage.png")]
+        out: PathBuf,
+        /// Write per-frame statistics (triangles, bytes, cases, timings) as JSON.
+        #[arg(long)]
+        stats: Option<PathBuf>,
+        /// shaded, volumes (shadow volumes coloured by case) or stencil (counts of light 0).
+        #[arg(long, default_value = "shaded")]
+        view: String,
+        /// Write a frame dump (frame.json, world.obj, positions/normals, masks) into DIR.
+        #[arg(long)]
+        dump: Option<PathBuf>,
+    },
+    /// Device, driver, optional features and the code paths they select.
+    Info {
+        #[arg(long)]
+        json: bool,
+    },
+    /// Compare a frame dump with the exact CPU reference.
+    Check {
+        dir: PathBuf,
+        /// Pixels within this distance of a shadow edge or silhouette are not counted.
+        #[arg(long, default_value_t = 1)]
+        band: u32,
+        /// Highest accepted fraction of mismatched pixels outside the band.
+        #[arg(long, default_value_t = 1e-4)]
+        threshold: f64,
+    },
+}
+
+fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
+    let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WxH, got '{s}'"))?;
+    let w: u32 = w.trim().parse().map_err(|_| format!("bad width in '{s}'"))?;
+    let h: u32 = h.trim().parse().map_err(|_| format!("bad height in '{s}'"))?;
+    if w == 0 || h == 0 || w > 16384 || h > 16384 {
+        return Err(format!("size {w}x{h} out of range (1..=16384)"));
+    }
+    Ok((w, h))
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command.unwrap_or(Command::Render {
+        frame: FrameArgs::parse_from(["frame"]),
+        out: "umbrage.png".into(),
+        stats: None,
+        view: "shaded".into(),
+        dump: None,
+    }) {
+        Command::Render { frame, out, stats, view, dump } => render(&frame, &out, stats.as_deref(), &view, dump.as_deref()),
+        Command::Info { json } => info(json),
+        Command::Check { dir, band, threshold } => check(&dir, band, threshold),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+impl FrameArgs {
+    fn options(&self) -> Result<RenderOptions> {
+        Ok(RenderOptions {
+            width: self.size.0,
+            height: self.size.1,
+            method: self.method.parse::<Method>()?,
+            depth_mode: self.depth_mode.parse::<DepthMode>()?,
+            index_format: self.index_format.parse::<IndexFormat>()?,
+            ..Default::default()
+        })
+    }
+}
+
+fn render(frame: &FrameArgs, out: &Path, stats: Option<&Path>, view: &str, dump: Option<&Path>) -> Result<ExitCode> {
+    let mut opts = frame.options()?;
+    opts.view = view.parse::<View>()?;
+    opts.capture = dump.is_some();
+    let scene = umbrage::scene::load(&frame.scene)?;
+    let ctx = umbrage::gpu::Context::new()?;
+    let mut renderer = Renderer::new(ctx, scene, opts)?;
+    let frame_out = renderer.render()?;
+    umbrage::output::write_png(out, frame_out.width, frame_out.height, &frame_out.color)?;
+    if let Some(path) = stats {
+        let json = serde_json::to_string_pretty(&frame_out.stats).map_err(|e| Error::Other(e.to_string()))?;
+        std::fs::write(path, json).map_err(|e| Error::io(path.display().to_string(), e))?;
+    }
+    if let Some(dir) = dump {
+        umbrage::output::write_frame_dump(dir, &renderer.scene, &frame_out)?;
+    }
+    let s = &frame_out.stats;
+    let gpu = s.gpu_ms.as_ref().map(|g| format!(" (gpu {:.2} ms: shadow {:.2}, illuminate {:.2})", g.frame, g.shadow, g.illuminate)).unwrap_or_default();
+    println!(
+        "{} | {}x{} | {} | frame {:.2} ms{} | {} shadow triangles | {}",
+        s.device,
+        s.width,
+        s.height,
+        s.method,
+        s.wall_ms,
+        gpu,
+        s.totals.triangles.total(),
+        out.display()
+    );
+    renderer.ctx.check_validation()?;
+    Ok(ExitCode::SUCCESS)
+}
+
+fn info(json: bool) -> Result<ExitCode> {
+    let ctx = umbrage::gpu::Context::new()?;
+    let report = umbrage::output::info_report(&ctx);
+    if json {
+        println!("{}", serde_json::to_string_pretty(&report).map_err(|e| Error::Other(e.to_string()))?);
+    } else {
+        println!("{}", umbrage::output::info_text(&report));
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn check(dir: &Path, band: u32, threshold: f64) -> Result<ExitCode> {
+    let report = umbrage::reference::check_dump(dir, band)?;
+    println!("{report}");
+    Ok(if report.passed(threshold) { ExitCode::SUCCESS } else { ExitCode::FAILURE })
+}

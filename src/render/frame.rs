@@ -169,8 +169,12 @@ impl FrameOutput {
                         }
                         let to_light = if l.w == 0.0 { l.truncate() } else { l.truncate() - p };
                         let faces = n.dot(to_light) > 0.0;
+                        // The light reaches the point at all: within its range and its cone.
+                        let in_range = light.radius.map(|r| l.w == 0.0 || to_light.length() < r).unwrap_or(true);
+                        let in_cone = light.kind != LightKind::Spot
+                            || (-to_light.normalize()).dot(light.direction.normalize()) > (light.cone_deg.to_radians() * 0.5).cos();
                         let count = self.stencil.get(k).map(|s| s[i]).unwrap_or(0);
-                        if faces && count == 0 {
+                        if faces && in_range && in_cone && count == 0 {
                             255
                         } else {
                             0

@@ -1,0 +1,21 @@
+# Quick start: `make run` renders the default scene to umbrage.png; `make test` runs every test
+# with Vulkan validation on. Both install what is missing first (scripts/deps.sh).
+export PATH := $(HOME)/.cargo/bin:$(PATH)
+CARGO ?= cargo
+
+.PHONY: deps run test bench conform doc clean
+
+deps:
+	@./scripts/deps.sh
+
+run: deps
+	$(CARGO) run -- render
+
+test: deps
+	UMBRAGE_VALIDATION=1 $(CARGO) test --all-targets
+
+bench: deps
+	$(CARGO) bench
+
+clean:
+	$(CARGO) clean

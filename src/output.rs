@@ -1,0 +1,105 @@
+//! Files a frame turns into: PNGs, frame dumps, and the `info` report.
+
+use crate::error::{Error, Result};
+use crate::gpu::Context;
+use crate::reference::dump::{write_dump, Dump, DumpLight};
+use crate::render::FrameOutput;
+use crate::scene::Scene;
+use std::path::Path;
+
+/// Writes RGBA8 pixels as a PNG.
+pub fn write_png(path: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<()> {
+    image::save_buffer(path, rgba, width, height, image::ExtendedColorType::Rgba8)
+        .map_err(|e| Error::Other(format!("{}: cannot write PNG: {e}", path.display())))
+}
+
+/// Writes an 8-bit grey PNG.
+pub fn write_grey_png(path: &Path, width: u32, height: u32, grey: &[u8]) -> Result<()> {
+    image::save_buffer(path, grey, width, height, image::ExtendedColorType::L8)
+        .map_err(|e| Error::Other(format!("{}: cannot write PNG: {e}", path.display())))
+}
+
+/// The dump of a captured frame: frame.json, world.obj, positions.f32, normals.f32,
+/// shadow_K.png, stencil_K.png and color.png (format in the README).
+pub fn write_frame_dump(dir: &Path, scene: &Scene, frame: &FrameOutput) -> Result<()> {
+    if frame.positions.is_empty() {
+        return Err(Error::Other("frame was rendered without capture; cannot dump".into()));
+    }
+    let mut triangles = Vec::new();
+    for m in scene.meshes.iter().filter(|m| m.casts_shadow) {
+        let xf = m.transform.as_dmat4();
+        for t in 0..m.mesh.triangles.len() {
+            triangles.push(m.mesh.triangle(t).map(|p| xf.transform_point3(p.as_dvec3()).as_vec3()));
+        }
+    }
+    let dump = Dump {
+        width: frame.width,
+        height: frame.height,
+        camera_pos: scene.camera.eye,
+        lights: scene.lights.iter().map(DumpLight::from_light).collect(),
+        triangles,
+        positions: frame.positions.iter().flatten().copied().collect(),
+        normals: frame.normals.iter().flatten().copied().collect(),
+        shadow: frame.shadow_masks(scene),
+        camera: Some(scene.camera.clone()),
+        extra: Default::default(),
+    };
+    write_dump(dir, &dump)?;
+    for (k, s) in frame.stencil.iter().enumerate() {
+        write_grey_png(&dir.join(format!("stencil_{k}.png")), frame.width, frame.height, s)?;
+    }
+    write_png(&dir.join("color.png"), frame.width, frame.height, &frame.color)
+}
+
+#[derive(serde::Serialize)]
+pub struct InfoReport {
+    pub device: crate::gpu::DeviceInfo,
+    pub features: crate::gpu::Features,
+    pub validation: bool,
+    /// Feature -> the code path it selects on this device.
+    pub paths: Vec<(String, String)>,
+}
+
+pub fn info_report(ctx: &Context) -> InfoReport {
+    let f = &ctx.features;
+    let yes_no = |b: bool, y: &str, n: &str| if b { y.to_string() } else { n.to_string() };
+    let paths = vec![
+        ("depthClamp".into(), yes_no(f.depth_clamp, "available: --depth-mode clamp (finite far plane, clamped) works", "missing: only --depth-mode infinite")),
+        (
+            "depthBounds".into(),
+            yes_no(f.depth_bounds, "used: illumination limited to each light's depth range", "missing: depth bounds test skipped (scissor only)"),
+        ),
+        (
+            "VK_EXT_depth_range_unrestricted".into(),
+            yes_no(
+                f.depth_range_unrestricted,
+                "present: not needed (the infinite projection keeps depth in [0,1])",
+                "absent: not needed (the infinite projection keeps depth in [0,1])",
+            ),
+        ),
+        (
+            "indexTypeUint8".into(),
+            yes_no(f.index_type_uint8, "used: 3-byte triangles for caster chunks of <= 128 vertices (--index-format auto|u8)", "missing: u16 indices (6 bytes per triangle)"),
+        ),
+        ("pipelineStatisticsQuery".into(), yes_no(f.pipeline_statistics_query, "present", "missing")),
+        ("timestamps".into(), yes_no(f.timestamps, "used: gpu_ms in --stats", "missing: gpu_ms omitted")),
+        ("depth-stencil format".into(), format!("{} (8 stencil bits, wrap increments)", f.depth_stencil_format)),
+    ];
+    InfoReport { device: ctx.info.clone(), features: f.clone(), validation: ctx.validation, paths }
+}
+
+pub fn info_text(r: &InfoReport) -> String {
+    let mut s = format!(
+        "device:  {} ({})\ndriver:  {} {}\nVulkan:  {}\nvalidation: {}\n",
+        r.device.name,
+        r.device.kind,
+        r.device.driver,
+        r.device.driver_info,
+        r.device.api_version,
+        if r.validation { "on" } else { "off (UMBRAGE_VALIDATION=1 to enable)" }
+    );
+    for (k, v) in &r.paths {
+        s += &format!("  {k:<34} {v}\n");
+    }
+    s
+}
