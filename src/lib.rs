@@ -2,5 +2,6 @@
 #![forbid(unsafe_op_in_unsafe_fn)]
 pub mod error;
 pub mod geom;
+pub mod reference;
 pub mod scene;
 pub use error::{Error, Result};
