@@ -183,7 +183,7 @@ fn reference_box_shadow_at() {
     // Range and cone.
     let mut lr = l.clone();
     lr.radius = Some(5.0);
-    assert_eq!(r.shadow_at(DVec3::new(3.0, 0.0, 0.0), up, &lr), LightState::Lit);
+    assert_eq!(r.shadow_at(DVec3::new(2.0, 0.0, 0.0), up, &lr), LightState::Lit);
     assert_eq!(r.shadow_at(DVec3::new(4.0, 0.0, 0.0), up, &lr), LightState::OutOfRange);
     let mut sp = l.clone();
     sp.kind = LightKind::Spot;
@@ -482,7 +482,6 @@ fn reference_metrics_band() {
     let band = metrics::band_mask(&states, &vec![false; w * h], w, h, 2);
     // Chebyshev distance 2 from x = 9/10: x in 7..=12.
     assert!(band[7] && band[12] && !band[6] && !band[13]);
-    assert!(band[4 * w + 5] && !band[5 * w + 6] || true);
     // Dilation is a square.
     let mut one = vec![false; 25];
     one[12] = true;
@@ -521,7 +520,10 @@ fn reference_metrics_band() {
     assert!(ge[3] && ge[4] && !ge[5] && ge[(h - 2) * w + 15] && ge[(h - 1) * w + 15]);
     let band2 = metrics::band_mask(&states, &ge, w, h, 2);
     let m2 = compare_states(&mask, &states, &band2);
-    assert_eq!(m2.mismatches_outside_band, 2, "{m2:?}"); // (1,5) now in band near x=3/4
+    // (1,5) is now near the normal jump at x = 3/4; (18,6) and (15,7) near the background
+    // row 9 (edge rows 8 and 9).
+    assert!(band2[5 * w + 1] && band2[6 * w + 18] && band2[7 * w + 15] && !band2[4 * w + 18]);
+    assert_eq!(m2.mismatches_outside_band, 0, "{m2:?}");
     assert!(m2.band_pixels > m.band_pixels);
 }
 
