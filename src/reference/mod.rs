@@ -175,9 +175,9 @@ impl RefImage {
 /// The ray-cast ground truth over a set of world-space triangles.
 #[derive(Clone, Debug)]
 pub struct Reference {
-    /// BVH over the visible triangles (triangle ids index `tris`).
+    /// BVH over the visible triangles (hit ids index `tris`).
     visible: Bvh,
-    /// BVH over the shadow-casting triangles (triangle ids index `tris`... via `occ_ids`).
+    /// BVH over the shadow-casting triangles (hit ids index `tris`).
     occluders: Bvh,
     tris: Vec<[DVec3; 3]>,
     mesh_of: Vec<u32>,
@@ -197,7 +197,8 @@ pub struct TriFlags {
 }
 
 impl Reference {
-    /// A reference over world-space triangles with per-triangle flags (same length).
+    /// A reference over world-space triangles with per-triangle flags (same length; panics
+    /// otherwise).
     /// Zero-area and non-finite triangles are dropped (they can neither be seen nor occlude).
     pub fn new(triangles: Vec<[DVec3; 3]>, flags: &[TriFlags]) -> Reference {
         assert_eq!(triangles.len(), flags.len(), "one TriFlags per triangle");
@@ -220,8 +221,6 @@ impl Reference {
             }
             tris.push(t);
             mesh_of.push(f.mesh);
-            // Keep the triangle list index in step: BVH ids are positions in `vis`/`occ`,
-            // so the BVHs get sparse copies with identical indexing via a mapping below.
             vis.push(f.visible);
             occ.push(f.occluder);
         }
@@ -506,8 +505,8 @@ impl CheckReport {
     pub fn worst_fraction(&self) -> f64 {
         self.lights.iter().map(|l| l.metrics.fraction_outside_band).fold(0.0, f64::max)
     }
-    /// True iff every light has `fraction_outside_band <= threshold_fraction` and no
-    /// background mismatch outside the band.
+    /// True iff every light has `fraction_outside_band <= threshold_fraction` (background
+    /// mismatches outside the band count in that fraction).
     pub fn passed(&self, threshold_fraction: f64) -> bool {
         self.lights.iter().all(|l| l.metrics.fraction_outside_band <= threshold_fraction)
     }

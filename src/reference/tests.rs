@@ -536,3 +536,30 @@ fn reference_homogeneous_light_round_trip() {
     let p = point_light(Vec3::new(1.0, 2.0, 3.0));
     assert_eq!(DumpLight::homogeneous(Vec4::new(2.0, 4.0, 6.0, 2.0)).to_light().unwrap().position, p.position);
 }
+
+/// Timing check (run with `cargo test --lib reference_perf -- --ignored --nocapture`):
+/// ~100k triangles, 512x512, two lights.
+#[test]
+#[ignore]
+fn reference_perf_512() {
+    let mut meshes = vec![(plane(10.0), true)];
+    for k in 0..5 {
+        let c = Vec3::new(-4.0 + 2.0 * k as f32, 1.5, (k as f32 - 2.0) * 0.7);
+        meshes.push((icosphere(c, 0.9, 5), true));
+    }
+    let cam = Camera { eye: Vec3::new(0.0, 7.0, 9.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0, near: 0.1 };
+    let s = scene(meshes, vec![point_light(Vec3::new(1.0, 6.0, 1.0)), dir_light(Vec3::new(0.3, -1.0, -0.4))], cam);
+    let t0 = std::time::Instant::now();
+    let r = Reference::from_scene(&s);
+    let t1 = std::time::Instant::now();
+    let img = r.render(&s.camera, &s.lights, 512, 512);
+    let t2 = std::time::Instant::now();
+    let amb = img.states.iter().filter(|s| **s == LightState::Ambiguous).count();
+    let sh = img.states.iter().filter(|s| **s == LightState::Shadowed).count();
+    eprintln!(
+        "{} tris: build {:?}, render 512x512x2 lights {:?}; shadowed {sh}, ambiguous {amb}",
+        r.triangle_count(),
+        t1 - t0,
+        t2 - t1
+    );
+}
