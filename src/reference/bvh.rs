@@ -124,7 +124,7 @@ impl Bvh {
         // Binned SAH on the widest centroid axis.
         let ext = cb.max - cb.min;
         let axis = if ext.x >= ext.y && ext.x >= ext.z { 0 } else if ext.y >= ext.z { 1 } else { 2 };
-        if !(ext[axis] > 0.0) {
+        if ext[axis].is_nan() || ext[axis] <= 0.0 {
             // All centroids coincide: split in the middle of the list if large, else leaf.
             if n <= 16 {
                 return me;

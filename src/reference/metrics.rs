@@ -68,7 +68,8 @@ fn discontinuous(a: &GeoSample, b: &GeoSample) -> bool {
             if na.dot(nb) < NORMAL_JUMP_DEG.to_radians().cos() {
                 return true;
             }
-            !((da - db).abs() <= DEPTH_JUMP_REL * da.min(*db))
+            let jump = (da - db).abs();
+            jump.is_nan() || jump > DEPTH_JUMP_REL * da.min(*db)
         }
     }
 }

@@ -310,7 +310,7 @@ impl Reference {
             _ => {
                 let d = lpos - p;
                 let len = d.length();
-                if !(len > 0.0) {
+                if len.is_nan() || len <= 0.0 {
                     return LightState::Ambiguous;
                 }
                 (d / len, len)
@@ -376,7 +376,7 @@ impl Reference {
             _ => {
                 let to = light.position.as_dvec3() - o;
                 let dist = to.length();
-                if !(dist > off) {
+                if dist.is_nan() || dist <= off {
                     return false;
                 }
                 self.occluders.any_hit(o, to / dist, 0.0, dist - off, |_| false)
