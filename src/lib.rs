@@ -1,9 +1,14 @@
 //! umbrage: exact hard shadows with stencil shadow volumes on raw Vulkan.
+//!
+//! Layers, dependencies pointing one way: [`scene`] -> [`geom`] -> [`shadow`] (pure CPU
+//! planning) -> [`gpu`] / [`render`]. [`reference`] is the exact CPU ground truth and shares
+//! nothing with the shadow algorithm but the camera model.
 #![warn(unsafe_op_in_unsafe_fn)]
 pub mod error;
 pub mod geom;
-pub mod output;
 pub mod gpu;
+pub mod output;
+pub mod reference;
 pub mod render;
 pub mod scene;
 pub mod shadow;
