@@ -1,0 +1,554 @@
+//! The TOML scene file format (see `scenes/default.toml` for an example).
+//!
+//! Rotation convention: `rotate_deg = [x, y, z]` is R = Rz * Ry * Rx (X applied first), the same
+//! as glam's `Mat4::from_euler(EulerRot::ZYX, z, y, x)`. A mesh's transform is T * R * S.
+
+use super::{builtin, obj, shapes, Camera, Light, LightKind, Scene, SceneMesh};
+use crate::error::{Error, Result};
+use crate::geom::Mesh;
+use glam::{Mat4, Vec2, Vec3};
+use serde::Deserialize;
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+use toml::Spanned;
+
+/// Where `obj = "..."` paths are resolved.
+pub(crate) enum ObjSource<'a> {
+    /// A directory on disk (the scene file's).
+    Dir(&'a Path),
+    /// A built-in scene: paths resolve among the embedded files, relative to this
+    /// repository-relative directory (e.g. `scenes/hard`).
+    Builtin(&'a str),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileScene {
+    name: Option<String>,
+    ambient: Option<[f64; 3]>,
+    camera: Spanned<FileCamera>,
+    #[serde(default)]
+    light: Vec<Spanned<FileLight>>,
+    #[serde(default)]
+    mesh: Vec<Spanned<FileMesh>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileCamera {
+    eye: [f64; 3],
+    target: [f64; 3],
+    up: Option<[f64; 3]>,
+    fov_y_deg: Option<f64>,
+    near: Option<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileLight {
+    kind: String,
+    position: Option<[f64; 3]>,
+    direction: Option<[f64; 3]>,
+    color: Option<[f64; 3]>,
+    intensity: Option<f64>,
+    radius: Option<f64>,
+    cone_deg: Option<f64>,
+}
+
+#[derive(Deserialize, Clone)]
+#[serde(untagged)]
+enum NumOrVec {
+    Num(f64),
+    Vec(Vec<f64>),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FileMesh {
+    obj: Option<String>,
+    shape: Option<String>,
+    // shape parameters
+    size: Option<NumOrVec>,
+    radius: Option<f64>,
+    segments: Option<i64>,
+    rings: Option<i64>,
+    major_radius: Option<f64>,
+    minor_radius: Option<f64>,
+    sides: Option<i64>,
+    height: Option<f64>,
+    steps: Option<i64>,
+    step: Option<[f64; 3]>,
+    count: Option<NumOrVec>,
+    spacing: Option<f64>,
+    offset: Option<[f64; 3]>,
+    divisions: Option<i64>,
+    bump: Option<f64>,
+    // instance
+    name: Option<String>,
+    translate: Option<[f64; 3]>,
+    rotate_deg: Option<[f64; 3]>,
+    scale: Option<NumOrVec>,
+    color: Option<[f64; 3]>,
+    opacity: Option<f64>,
+    casts_shadow: Option<bool>,
+}
+
+/// Shape names and the parameter keys each accepts.
+pub const SHAPES: &[(&str, &[&str])] = &[
+    ("plane", &["size"]),
+    ("box", &["size"]),
+    ("sphere", &["radius", "segments", "rings"]),
+    ("torus", &["major_radius", "minor_radius", "segments", "sides"]),
+    ("cylinder", &["radius", "height", "segments"]),
+    ("stairs", &["steps", "step"]),
+    ("cube_grid", &["count", "size", "spacing"]),
+    ("box_stack", &["count", "size", "offset"]),
+    ("bumpy_slab", &["size", "divisions", "bump"]),
+];
+
+fn line_of(src: &str, offset: usize) -> usize {
+    src.as_bytes()[..offset.min(src.len())].iter().filter(|&&b| b == b'\n').count() + 1
+}
+
+/// Error context: the scene file's name and text.
+struct Ctx<'a> {
+    origin: &'a str,
+    src: &'a str,
+}
+
+impl Ctx<'_> {
+    fn at(&self, line: usize, msg: impl Into<String>) -> Error {
+        Error::input(format!("{}:{line}", self.origin), msg)
+    }
+    /// The line of `key = ...` inside the table starting at `span` (up to the next table
+    /// header), or the table's first line.
+    fn key_line(&self, span: &Range<usize>, key: &str) -> usize {
+        let start = span.start.min(self.src.len());
+        let mut off = start;
+        for (i, line) in self.src[start..].split_inclusive('\n').enumerate() {
+            let t = line.trim_start();
+            if i > 0 && t.starts_with('[') {
+                break;
+            }
+            if let Some(rest) = t.strip_prefix(key) {
+                if rest.trim_start().starts_with('=') {
+                    return line_of(self.src, off);
+                }
+            }
+            off += line.len();
+        }
+        line_of(self.src, start)
+    }
+    fn key_err(&self, span: &Range<usize>, key: &str, msg: impl std::fmt::Display) -> Error {
+        self.at(self.key_line(span, key), format!("{key}: {msg}"))
+    }
+    fn num(&self, span: &Range<usize>, key: &str, v: f64) -> Result<f32> {
+        let f = v as f32;
+        if f.is_finite() {
+            Ok(f)
+        } else {
+            Err(self.key_err(span, key, format!("non-finite number {v} (nan/inf or out of f32 range)")))
+        }
+    }
+    fn v3(&self, span: &Range<usize>, key: &str, v: [f64; 3]) -> Result<Vec3> {
+        Ok(Vec3::new(self.num(span, key, v[0])?, self.num(span, key, v[1])?, self.num(span, key, v[2])?))
+    }
+    fn color(&self, span: &Range<usize>, key: &str, v: Option<[f64; 3]>, default: Vec3) -> Result<Vec3> {
+        let c = match v {
+            Some(v) => self.v3(span, key, v)?,
+            None => default,
+        };
+        if c.min_element() < 0.0 {
+            return Err(self.key_err(span, key, "colour components must be >= 0"));
+        }
+        Ok(c)
+    }
+    fn positive(&self, span: &Range<usize>, key: &str, v: Option<f64>, default: f32) -> Result<f32> {
+        let x = match v {
+            Some(v) => self.num(span, key, v)?,
+            None => default,
+        };
+        if x <= 0.0 {
+            return Err(self.key_err(span, key, format!("must be > 0, got {x}")));
+        }
+        Ok(x)
+    }
+    fn int(&self, span: &Range<usize>, key: &str, v: Option<i64>, default: u32, min: u32, max: u32) -> Result<u32> {
+        let x = v.unwrap_or(default as i64);
+        if x < min as i64 || x > max as i64 {
+            return Err(self.key_err(span, key, format!("must be an integer in [{min}, {max}], got {x}")));
+        }
+        Ok(x as u32)
+    }
+    fn vecn(&self, span: &Range<usize>, key: &str, v: &[f64], n: usize) -> Result<Vec<f32>> {
+        if v.len() != n {
+            return Err(self.key_err(span, key, format!("expected {n} numbers, got {}", v.len())));
+        }
+        v.iter().map(|&x| self.num(span, key, x)).collect()
+    }
+    fn size_vec(&self, span: &Range<usize>, key: &str, v: &Option<NumOrVec>, default: &[f32]) -> Result<Vec<f32>> {
+        let out = match v {
+            None => default.to_vec(),
+            Some(NumOrVec::Vec(a)) => self.vecn(span, key, a, default.len())?,
+            Some(NumOrVec::Num(_)) => return Err(self.key_err(span, key, format!("expected an array of {} numbers", default.len()))),
+        };
+        if out.iter().any(|&x| x <= 0.0) {
+            return Err(self.key_err(span, key, "every component must be > 0"));
+        }
+        Ok(out)
+    }
+}
+
+/// Parses and validates a scene from TOML text. `origin` names the file in every error.
+pub(crate) fn parse(src: &str, origin: &str, objs: ObjSource<'_>) -> Result<Scene> {
+    let cx = Ctx { origin, src };
+    let file: FileScene = toml::from_str(src).map_err(|e| match e.span() {
+        Some(s) => cx.at(line_of(src, s.start), e.message().trim().to_string()),
+        None => Error::input(origin, e.message().trim().to_string()),
+    })?;
+    let top = 0..0;
+    let ambient = cx.color(&top, "ambient", file.ambient, Vec3::splat(0.08))?;
+
+    // camera
+    let cs = file.camera.span();
+    let c = file.camera.into_inner();
+    let camera = Camera {
+        eye: cx.v3(&cs, "eye", c.eye)?,
+        target: cx.v3(&cs, "target", c.target)?,
+        up: match c.up {
+            Some(u) => cx.v3(&cs, "up", u)?,
+            None => Vec3::Y,
+        },
+        fov_y_deg: match c.fov_y_deg {
+            Some(f) => cx.num(&cs, "fov_y_deg", f)?,
+            None => 60.0,
+        },
+        near: cx.positive(&cs, "near", c.near, 0.1)?,
+    };
+    let view = camera.target - camera.eye;
+    if view.length_squared() == 0.0 || !view.is_finite() {
+        return Err(cx.key_err(&cs, "target", "camera target must differ from eye"));
+    }
+    if camera.up.length_squared() == 0.0 || view.normalize().cross(camera.up.normalize()).length() < 1e-4 {
+        return Err(cx.key_err(&cs, "up", "camera up must be nonzero and not parallel to the view direction"));
+    }
+    if !(camera.fov_y_deg > 0.0 && camera.fov_y_deg < 180.0) {
+        return Err(cx.key_err(&cs, "fov_y_deg", format!("must be in (0, 180), got {}", camera.fov_y_deg)));
+    }
+
+    // lights
+    let mut lights = Vec::new();
+    for sl in &file.light {
+        let s = sl.span();
+        let l = sl.get_ref();
+        let kind = match l.kind.as_str() {
+            "point" => LightKind::Point,
+            "spot" => LightKind::Spot,
+            "directional" => LightKind::Directional,
+            other => {
+                return Err(Error::UnknownName {
+                    what: "light kind",
+                    name: other.to_string(),
+                    expected: format!("point, spot, directional; at {}:{}", origin, cx.key_line(&s, "kind")),
+                })
+            }
+        };
+        let positional = kind != LightKind::Directional;
+        let position = match (positional, l.position) {
+            (true, Some(p)) => cx.v3(&s, "position", p)?,
+            (true, None) => return Err(cx.at(line_of(src, s.start), format!("{} light needs a position", l.kind))),
+            (false, Some(_)) => return Err(cx.key_err(&s, "position", "a directional light has no position")),
+            (false, None) => Vec3::ZERO,
+        };
+        let direction = match (kind != LightKind::Point, l.direction) {
+            (true, Some(d)) => {
+                let d = cx.v3(&s, "direction", d)?;
+                if d.length_squared() == 0.0 || !d.normalize().is_finite() {
+                    return Err(cx.key_err(&s, "direction", "direction must be a nonzero vector"));
+                }
+                d.normalize()
+            }
+            (true, None) => return Err(cx.at(line_of(src, s.start), format!("{} light needs a direction", l.kind))),
+            (false, Some(_)) => return Err(cx.key_err(&s, "direction", "a point light has no direction")),
+            (false, None) => Vec3::NEG_Y,
+        };
+        let cone_deg = match (kind == LightKind::Spot, l.cone_deg) {
+            (true, c) => {
+                let c = match c {
+                    Some(c) => cx.num(&s, "cone_deg", c)?,
+                    None => 45.0,
+                };
+                if !(c > 0.0 && c < 180.0) {
+                    return Err(cx.key_err(&s, "cone_deg", format!("must be in (0, 180), got {c}")));
+                }
+                c
+            }
+            (false, Some(_)) => return Err(cx.key_err(&s, "cone_deg", "only spot lights have a cone")),
+            (false, None) => 45.0,
+        };
+        let intensity = match l.intensity {
+            Some(i) => cx.num(&s, "intensity", i)?,
+            None => 1.0,
+        };
+        if intensity < 0.0 {
+            return Err(cx.key_err(&s, "intensity", "must be >= 0"));
+        }
+        let radius = match l.radius {
+            Some(r) => Some(cx.positive(&s, "radius", Some(r), 1.0)?),
+            None => None,
+        };
+        if positional && position == camera.eye {
+            return Err(cx.key_err(&s, "position", "a light must not coincide with the camera eye"));
+        }
+        lights.push(Light {
+            kind,
+            position,
+            direction,
+            color: cx.color(&s, "color", l.color, Vec3::ONE)?,
+            intensity,
+            radius,
+            cone_deg,
+        });
+    }
+
+    // meshes
+    let mut meshes = Vec::new();
+    for (i, sm) in file.mesh.iter().enumerate() {
+        meshes.push(mesh(&cx, i, &sm.span(), sm.get_ref(), &objs)?);
+    }
+
+    let name = file.name.unwrap_or_else(|| {
+        Path::new(origin).file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| origin.to_string())
+    });
+    Ok(Scene { name, camera, lights, meshes, ambient })
+}
+
+fn present_params(m: &FileMesh) -> Vec<&'static str> {
+    let mut v = Vec::new();
+    let mut p = |k: &'static str, b: bool| {
+        if b {
+            v.push(k)
+        }
+    };
+    p("size", m.size.is_some());
+    p("radius", m.radius.is_some());
+    p("segments", m.segments.is_some());
+    p("rings", m.rings.is_some());
+    p("major_radius", m.major_radius.is_some());
+    p("minor_radius", m.minor_radius.is_some());
+    p("sides", m.sides.is_some());
+    p("height", m.height.is_some());
+    p("steps", m.steps.is_some());
+    p("step", m.step.is_some());
+    p("count", m.count.is_some());
+    p("spacing", m.spacing.is_some());
+    p("offset", m.offset.is_some());
+    p("divisions", m.divisions.is_some());
+    p("bump", m.bump.is_some());
+    v
+}
+
+/// Lexically joins `rel` onto `dir` ("a/b" + "../c.obj" -> "a/c.obj").
+fn join_lexical(dir: &str, rel: &str) -> String {
+    let mut parts: Vec<&str> = dir.split('/').filter(|s| !s.is_empty() && *s != ".").collect();
+    for p in rel.split('/') {
+        match p {
+            "" | "." => {}
+            ".." => {
+                parts.pop();
+            }
+            p => parts.push(p),
+        }
+    }
+    parts.join("/")
+}
+
+fn mesh(cx: &Ctx, i: usize, s: &Range<usize>, m: &FileMesh, objs: &ObjSource) -> Result<SceneMesh> {
+    let table_line = line_of(cx.src, s.start);
+    let params = present_params(m);
+    let (object, kind): (Mesh, String) = match (&m.obj, &m.shape) {
+        (Some(_), Some(_)) | (None, None) => {
+            return Err(cx.at(table_line, format!("mesh {i}: give exactly one of `obj` or `shape`")))
+        }
+        (Some(path), None) => {
+            if let Some(k) = params.first() {
+                return Err(cx.key_err(s, k, "shape parameters do not apply to an obj mesh"));
+            }
+            let wrap = |e: Error| cx.key_err(s, "obj", format!("mesh {i}: {e}"));
+            let mesh = match objs {
+                ObjSource::Dir(dir) => {
+                    let p: PathBuf = dir.join(path);
+                    obj::load_obj(&p).map_err(wrap)?
+                }
+                ObjSource::Builtin(dir) => {
+                    let key = join_lexical(dir, path);
+                    let text = builtin::obj(&key)
+                        .ok_or_else(|| cx.key_err(s, "obj", format!("mesh {i}: no embedded file {key}")))?;
+                    obj::load_obj_str(text, &key).map_err(wrap)?
+                }
+            };
+            let stem = Path::new(path).file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+            (mesh, stem)
+        }
+        (None, Some(shape)) => {
+            let Some((_, allowed)) = SHAPES.iter().find(|(n, _)| n == shape) else {
+                return Err(Error::UnknownName {
+                    what: "shape",
+                    name: shape.clone(),
+                    expected: format!(
+                        "{}; at {}:{}",
+                        SHAPES.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", "),
+                        cx.origin,
+                        cx.key_line(s, "shape")
+                    ),
+                });
+            };
+            if let Some(k) = params.iter().find(|k| !allowed.contains(k)) {
+                return Err(cx.key_err(s, k, format!("not a parameter of shape '{shape}' (it takes: {})", allowed.join(", "))));
+            }
+            (build_shape(cx, s, shape, m)?, shape.clone())
+        }
+    };
+
+    let translate = match m.translate {
+        Some(t) => cx.v3(s, "translate", t)?,
+        None => Vec3::ZERO,
+    };
+    let rot = match m.rotate_deg {
+        Some(r) => cx.v3(s, "rotate_deg", r)?,
+        None => Vec3::ZERO,
+    };
+    let scale = match &m.scale {
+        None => Vec3::ONE,
+        Some(NumOrVec::Num(x)) => Vec3::splat(cx.num(s, "scale", *x)?),
+        Some(NumOrVec::Vec(v)) => {
+            let v = cx.vecn(s, "scale", v, 3)?;
+            Vec3::new(v[0], v[1], v[2])
+        }
+    };
+    if scale.cmpeq(Vec3::ZERO).any() {
+        return Err(cx.key_err(s, "scale", "scale factors must be nonzero"));
+    }
+    let r = Mat4::from_rotation_z(rot.z.to_radians())
+        * Mat4::from_rotation_y(rot.y.to_radians())
+        * Mat4::from_rotation_x(rot.x.to_radians());
+    let transform = Mat4::from_translation(translate) * r * Mat4::from_scale(scale);
+    if !transform.is_finite() {
+        return Err(cx.at(table_line, format!("mesh {i}: transform is not finite")));
+    }
+    let mut object = object;
+    if transform.determinant() < 0.0 {
+        for t in &mut object.triangles {
+            t.swap(1, 2);
+        }
+    }
+    let name = m.name.clone().unwrap_or_else(|| format!("mesh{i}-{kind}"));
+    object.validate(&name).map_err(|e| cx.at(table_line, e.to_string()))?;
+    let opacity = match m.opacity {
+        Some(o) => cx.num(s, "opacity", o)?,
+        None => 1.0,
+    };
+    if !(0.0..=1.0).contains(&opacity) {
+        return Err(cx.key_err(s, "opacity", format!("must be in [0, 1], got {opacity}")));
+    }
+    Ok(SceneMesh {
+        name,
+        mesh: object,
+        transform,
+        color: cx.color(s, "color", m.color, Vec3::splat(0.8))?,
+        opacity,
+        casts_shadow: m.casts_shadow.unwrap_or(true),
+    })
+}
+
+const MAX_SEG: u32 = 4096;
+
+fn build_shape(cx: &Ctx, s: &Range<usize>, shape: &str, m: &FileMesh) -> Result<Mesh> {
+    Ok(match shape {
+        "plane" => {
+            let v = cx.size_vec(s, "size", &m.size, &[10.0, 10.0])?;
+            shapes::plane(Vec2::new(v[0], v[1]))
+        }
+        "box" => {
+            let v = cx.size_vec(s, "size", &m.size, &[1.0, 1.0, 1.0])?;
+            shapes::cuboid(Vec3::new(v[0], v[1], v[2]))
+        }
+        "sphere" => shapes::sphere(
+            cx.positive(s, "radius", m.radius, 0.5)?,
+            cx.int(s, "segments", m.segments, 24, 3, MAX_SEG)?,
+            cx.int(s, "rings", m.rings, 16, 2, MAX_SEG)?,
+        ),
+        "torus" => {
+            let major = cx.positive(s, "major_radius", m.major_radius, 0.5)?;
+            let minor = cx.positive(s, "minor_radius", m.minor_radius, 0.2)?;
+            if minor >= major {
+                return Err(cx.key_err(s, "minor_radius", "must be smaller than major_radius"));
+            }
+            shapes::torus(
+                major,
+                minor,
+                cx.int(s, "segments", m.segments, 32, 3, MAX_SEG)?,
+                cx.int(s, "sides", m.sides, 16, 3, MAX_SEG)?,
+            )
+        }
+        "cylinder" => shapes::cylinder(
+            cx.positive(s, "radius", m.radius, 0.5)?,
+            cx.positive(s, "height", m.height, 1.0)?,
+            cx.int(s, "segments", m.segments, 24, 3, MAX_SEG)?,
+        ),
+        "stairs" => {
+            let step = match m.step {
+                Some(v) => cx.v3(s, "step", v)?,
+                None => Vec3::new(2.0, 0.2, 0.3),
+            };
+            if step.min_element() <= 0.0 {
+                return Err(cx.key_err(s, "step", "every component must be > 0"));
+            }
+            shapes::stairs(cx.int(s, "steps", m.steps, 8, 1, 10_000)?, step)
+        }
+        "cube_grid" => {
+            let (nx, nz) = match &m.count {
+                None => (4, 4),
+                Some(NumOrVec::Vec(v)) if v.len() == 2 => {
+                    let ok = |x: f64| x.fract() == 0.0 && (1.0..=1000.0).contains(&x);
+                    if !(ok(v[0]) && ok(v[1])) {
+                        return Err(cx.key_err(s, "count", "expected [nx, nz], integers in [1, 1000]"));
+                    }
+                    (v[0] as u32, v[1] as u32)
+                }
+                Some(_) => return Err(cx.key_err(s, "count", "expected [nx, nz], integers in [1, 1000]")),
+            };
+            let size = match &m.size {
+                None => 0.4,
+                Some(NumOrVec::Num(x)) => cx.positive(s, "size", Some(*x), 0.4)?,
+                Some(_) => return Err(cx.key_err(s, "size", "cube_grid size is one number (the cube edge)")),
+            };
+            shapes::cube_grid(nx, nz, size, cx.positive(s, "spacing", m.spacing, 1.0)?)
+        }
+        "box_stack" => {
+            let count = match &m.count {
+                None => 10,
+                Some(NumOrVec::Num(x)) if x.fract() == 0.0 && (1.0..=100_000.0).contains(x) => *x as u32,
+                Some(_) => return Err(cx.key_err(s, "count", "expected an integer in [1, 100000]")),
+            };
+            let v = cx.size_vec(s, "size", &m.size, &[1.0, 0.02, 1.0])?;
+            let offset = match m.offset {
+                Some(o) => cx.v3(s, "offset", o)?,
+                None => Vec3::new(0.0, 0.05, 0.0),
+            };
+            shapes::box_stack(count, Vec3::new(v[0], v[1], v[2]), offset)
+        }
+        "bumpy_slab" => {
+            let v = cx.size_vec(s, "size", &m.size, &[2.0, 0.05, 2.0])?;
+            let bump = match m.bump {
+                Some(b) => cx.num(s, "bump", b)?,
+                None => 1e-7,
+            };
+            if bump < 0.0 || bump >= v[1] {
+                return Err(cx.key_err(s, "bump", "must be in [0, size y)"));
+            }
+            shapes::bumpy_slab(Vec3::new(v[0], v[1], v[2]), cx.int(s, "divisions", m.divisions, 16, 1, 1024)?, bump)
+        }
+        other => return Err(cx.key_err(s, "shape", format!("unknown shape {other}"))),
+    })
+}
