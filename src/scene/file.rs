@@ -605,6 +605,54 @@ mod tests {
         }
     }
 
+    /// Does the segment a-b pass through the box?
+    fn seg_hits(a: Vec3, b: Vec3, bx: crate::geom::Aabb) -> bool {
+        let (mut t0, mut t1) = (0.0f32, 1.0f32);
+        let d = b - a;
+        for k in 0..3 {
+            if d[k].abs() < 1e-12 {
+                if a[k] < bx.min[k] || a[k] > bx.max[k] {
+                    return false;
+                }
+            } else {
+                let (u, v) = ((bx.min[k] - a[k]) / d[k], (bx.max[k] - a[k]) / d[k]);
+                t0 = t0.max(u.min(v));
+                t1 = t1.min(u.max(v));
+            }
+        }
+        t0 <= t1
+    }
+
+    fn blockers(name: &str, p: Vec3) -> usize {
+        let s = load(name).unwrap();
+        let l = s.lights[0].position;
+        s.meshes.iter().filter(|m| m.mesh.triangles.len() > 2).filter(|m| seg_hits(p, l, m.world_bounds())).count()
+    }
+
+    #[test]
+    fn hard_cases_are_exercised() {
+        let eye = |n: &str| load(n).unwrap().camera.eye;
+        assert_eq!(blockers("hard/eye_in_volume", eye("hard/eye_in_volume")), 1);
+        assert_eq!(blockers("hard/eye_in_two_volumes", eye("hard/eye_in_two_volumes")), 2);
+        assert_eq!(blockers("hard/look_at_light", eye("hard/look_at_light")), 1);
+        // near_plane_cut: eye just outside, a point of the near rectangle 0.2 to its left inside
+        let e = eye("hard/near_plane_cut");
+        assert_eq!(blockers("hard/near_plane_cut", e), 0);
+        assert_eq!(blockers("hard/near_plane_cut", e - Vec3::new(0.2, 0.0, 0.0)), 1);
+        // staircase_300: a floor point below all 300 slabs
+        let s = load("hard/staircase_300").unwrap();
+        let l = s.lights[0].position;
+        let m = &s.meshes[1];
+        let hits = (0..300)
+            .filter(|i| {
+                let tri = &m.mesh.positions[i * 8..i * 8 + 8];
+                let b = crate::geom::Aabb::from_points(tri.iter()).transformed(&m.transform);
+                seg_hits(Vec3::new(0.5, 0.0, 0.0), l, b)
+            })
+            .count();
+        assert_eq!(hits, 300);
+    }
+
     #[test]
     fn default_scene_content() {
         let s = load("default").unwrap();
