@@ -24,7 +24,8 @@ pub const SCENES: &[(&str, &str)] = &[
 ];
 
 /// Embedded data files the built-in scenes reference, by repository-relative path.
-pub const DATA: &[(&str, &str)] = &[("scenes/data/zero_area_cube.obj", include_str!("../../scenes/data/zero_area_cube.obj"))];
+pub const DATA: &[(&str, &str)] =
+    &[("scenes/data/zero_area_cube.obj", include_str!("../../scenes/data/zero_area_cube.obj"))];
 
 pub fn scene(name: &str) -> Option<&'static str> {
     SCENES.iter().find(|(n, _)| *n == name).map(|(_, t)| *t)

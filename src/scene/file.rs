@@ -190,7 +190,9 @@ impl Ctx<'_> {
         let out = match v {
             None => default.to_vec(),
             Some(NumOrVec::Vec(a)) => self.vecn(span, key, a, default.len())?,
-            Some(NumOrVec::Num(_)) => return Err(self.key_err(span, key, format!("expected an array of {} numbers", default.len()))),
+            Some(NumOrVec::Num(_)) => {
+                return Err(self.key_err(span, key, format!("expected an array of {} numbers", default.len())))
+            }
         };
         if out.iter().any(|&x| x <= 0.0) {
             return Err(self.key_err(span, key, "every component must be > 0"));
@@ -404,7 +406,11 @@ fn mesh(cx: &Ctx, i: usize, s: &Range<usize>, m: &FileMesh, objs: &ObjSource) ->
                 });
             };
             if let Some(k) = params.iter().find(|k| !allowed.contains(k)) {
-                return Err(cx.key_err(s, k, format!("not a parameter of shape '{shape}' (it takes: {})", allowed.join(", "))));
+                return Err(cx.key_err(
+                    s,
+                    k,
+                    format!("not a parameter of shape '{shape}' (it takes: {})", allowed.join(", ")),
+                ));
             }
             (build_shape(cx, s, shape, m)?, shape.clone())
         }
@@ -582,7 +588,9 @@ mod tests {
     #[test]
     fn every_builtin_loads_and_validates() {
         let names = builtin_names();
-        for want in ["default", "stairs", "cubes", "spheres", "hard/eye_in_volume", "hard/staircase_300", "hard/look_at_light"] {
+        for want in
+            ["default", "stairs", "cubes", "spheres", "hard/eye_in_volume", "hard/staircase_300", "hard/look_at_light"]
+        {
             assert!(names.contains(&want), "{want} missing");
         }
         assert_eq!(names.len(), 4 + 15);
@@ -736,7 +744,10 @@ mod tests {
         check(&format!("{CAM}[[mesh]]\nshape = \"box\"\ncolour = [1, 1, 1]\n"), &["bad.toml:6", "colour"]);
         check(&format!("colour = 1\n{CAM}"), &["bad.toml:1", "colour"]);
         check(&format!("{CAM}[[mesh]]\nshape = \"box\"\nrings = 3\n"), &["bad.toml:6", "rings"]);
-        check(&format!("{CAM}[[light]]\nkind = \"point\"\nposition = [0, 1, 0]\ncone_deg = 30\n"), &["bad.toml:7", "cone_deg"]);
+        check(
+            &format!("{CAM}[[light]]\nkind = \"point\"\nposition = [0, 1, 0]\ncone_deg = 30\n"),
+            &["bad.toml:7", "cone_deg"],
+        );
     }
 
     #[test]
@@ -767,8 +778,9 @@ mod tests {
         assert!(matches!(e, Error::UnknownName { what: "shape", .. }));
         let e = e.to_string();
         assert!(e.contains("hexagon") && e.contains("torus") && e.contains("bad.toml:5"), "{e}");
-        let e = load_str(&format!("{CAM}[[light]]\nkind = \"area\"\nposition = [0, 1, 0]\n"), "bad.toml", Path::new("."))
-            .unwrap_err();
+        let e =
+            load_str(&format!("{CAM}[[light]]\nkind = \"area\"\nposition = [0, 1, 0]\n"), "bad.toml", Path::new("."))
+                .unwrap_err();
         assert!(matches!(e, Error::UnknownName { what: "light kind", .. }));
         assert!(e.to_string().contains("bad.toml:5"));
         let e = load("no_such_scene").unwrap_err();
@@ -802,12 +814,21 @@ mod tests {
         check("[camera]\neye = [0, 2, 0]\ntarget = [0, 0, 0]\n", &["bad.toml", "up"]);
         check("[camera]\neye = [0, 2, 5]\ntarget = [0, 0, 0]\nfov_y_deg = 180\n", &["bad.toml:4", "fov_y_deg"]);
         check("[camera]\neye = [0, 2, 5]\ntarget = [0, 0, 0]\nnear = 0\n", &["bad.toml:4", "near"]);
-        check(&format!("{CAM}[[light]]\nkind = \"directional\"\ndirection = [0, 0, 0]\n"), &["bad.toml:6", "direction"]);
+        check(
+            &format!("{CAM}[[light]]\nkind = \"directional\"\ndirection = [0, 0, 0]\n"),
+            &["bad.toml:6", "direction"],
+        );
         check(&format!("{CAM}[[light]]\nkind = \"spot\"\ndirection = [0, -1, 0]\n"), &["bad.toml:4", "position"]);
         check(&format!("{CAM}[[light]]\nkind = \"point\"\n"), &["bad.toml:4", "position"]);
         check(&format!("{CAM}[[light]]\nkind = \"point\"\nposition = [0, 2, 5]\n"), &["bad.toml:6", "eye"]);
-        check(&format!("{CAM}[[light]]\nkind = \"point\"\nposition = [0, 2, 1]\nradius = 0\n"), &["bad.toml:7", "radius"]);
-        check(&format!("{CAM}[[light]]\nkind = \"spot\"\nposition = [0, 2, 1]\ndirection = [0, -1, 0]\ncone_deg = 180\n"), &["bad.toml:8", "cone_deg"]);
+        check(
+            &format!("{CAM}[[light]]\nkind = \"point\"\nposition = [0, 2, 1]\nradius = 0\n"),
+            &["bad.toml:7", "radius"],
+        );
+        check(
+            &format!("{CAM}[[light]]\nkind = \"spot\"\nposition = [0, 2, 1]\ndirection = [0, -1, 0]\ncone_deg = 180\n"),
+            &["bad.toml:8", "cone_deg"],
+        );
         check(&format!("{CAM}[[mesh]]\nshape = \"box\"\nopacity = 2\n"), &["bad.toml:6", "opacity"]);
         check(&format!("{CAM}[[mesh]]\nshape = \"box\"\nscale = [1, 0, 1]\n"), &["bad.toml:6", "scale"]);
         check(&format!("{CAM}[[mesh]]\nshape = \"box\"\nobj = \"a.obj\"\n"), &["bad.toml:4", "exactly one"]);

@@ -14,7 +14,7 @@ use std::io::BufRead;
 use std::path::Path;
 
 fn options() -> tobj::LoadOptions {
-    tobj::LoadOptions { triangulate: true, single_index: false, ignore_points: true, ignore_lines: true, ..Default::default() }
+    tobj::LoadOptions { triangulate: true, single_index: false, ignore_points: true, ignore_lines: true }
 }
 
 /// Loads an OBJ file as one mesh (see the module docs). Errors name the path.
@@ -72,11 +72,20 @@ fn load_obj_reader(reader: &mut impl BufRead, name: &str) -> Result<Mesh> {
         let mut map: Vec<u32> = Vec::with_capacity(m.positions.len() / 3);
         let mut added: Vec<([u32; 3], u32)> = Vec::new();
         for (i, c) in m.positions.chunks_exact(3).enumerate() {
+            // tobj's `Float` is f64 with its `use_f64` feature
+            #[allow(clippy::unnecessary_cast)]
             let p = Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32);
             if !p.is_finite() {
                 return Err(Error::input(
                     name,
-                    format!("vertex {} of object '{}' has a non-finite coordinate ({}, {}, {})", i + 1, model.name, c[0], c[1], c[2]),
+                    format!(
+                        "vertex {} of object '{}' has a non-finite coordinate ({}, {}, {})",
+                        i + 1,
+                        model.name,
+                        c[0],
+                        c[1],
+                        c[2]
+                    ),
                 ));
             }
             let key = [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
@@ -96,7 +105,10 @@ fn load_obj_reader(reader: &mut impl BufRead, name: &str) -> Result<Mesh> {
             let mut tri = [0u32; 3];
             for (k, &i) in t.iter().enumerate() {
                 tri[k] = *map.get(i as usize).ok_or_else(|| {
-                    Error::input(name, format!("malformed OBJ: face index {} out of range in object '{}'", i + 1, model.name))
+                    Error::input(
+                        name,
+                        format!("malformed OBJ: face index {} out of range in object '{}'", i + 1, model.name),
+                    )
                 })?;
             }
             triangles.push(tri);

@@ -181,9 +181,9 @@ pub fn stairs(steps: u32, step: Vec3) -> Mesh {
     let n = steps as usize;
     let (w, h, d) = (step.x, step.y, step.z);
     let z0 = n as f32 * d * 0.5; // front (lowest) edge
-    // Profile in (z, y); column k occupies z in [z0-(k+1)d, z0-kd], y in [0, (k+1)h].
+                                 // Profile in (z, y); column k occupies z in [z0-(k+1)d, z0-kd], y in [0, (k+1)h].
     let mut prof: Vec<Vec2> = Vec::new(); // (z, y)
-    // bottom points from front to back: (z0 - k d, 0), k = 0..=n
+                                          // bottom points from front to back: (z0 - k d, 0), k = 0..=n
     for k in 0..=n {
         prof.push(Vec2::new(z0 - k as f32 * d, 0.0));
     }
@@ -198,7 +198,7 @@ pub fn stairs(steps: u32, step: Vec3) -> Mesh {
     // inner corners (riser bottoms): they are the points (z0-kd, kh) pushed as tread ends of step k-1.
     let np = prof.len();
     let bottom = |k: usize| k; // (z0 - k d, 0)
-    // index of (z0-(k+1)d, (k+1)h) and (z0-kd, (k+1)h)
+                               // index of (z0-(k+1)d, (k+1)h) and (z0-kd, (k+1)h)
     let tread_back = |k: usize| n + 1 + 2 * (n - 1 - k);
     let tread_front = |k: usize| n + 1 + 2 * (n - 1 - k) + 1;
     // Cap triangulation (indices into prof), columns.
@@ -329,7 +329,7 @@ pub(crate) mod tests_support {
     use std::collections::HashMap;
 
     /// Every undirected edge used exactly twice, once in each direction; welded; no unused vertex.
-pub(crate) fn assert_closed(m: &Mesh, what: &str) {
+    pub(crate) fn assert_closed(m: &Mesh, what: &str) {
         let mut directed: HashMap<(u32, u32), u32> = HashMap::new();
         for t in &m.triangles {
             for k in 0..3 {
@@ -353,7 +353,6 @@ pub(crate) fn assert_closed(m: &Mesh, what: &str) {
         let used: std::collections::HashSet<u32> = m.triangles.iter().flatten().copied().collect();
         assert_eq!(used.len(), m.positions.len(), "{what}: unused vertices");
     }
-
 
     pub(crate) fn assert_closed_outward(m: &Mesh, what: &str) {
         assert_closed(m, what);
