@@ -132,3 +132,47 @@ pub struct Scene {
     /// Ambient light colour (default 0.08 grey).
     pub ambient: Vec3,
 }
+
+pub mod builtin;
+pub mod file;
+pub mod obj;
+pub mod shapes;
+
+pub use obj::load_obj;
+
+use crate::error::{Error, Result};
+use std::path::Path;
+
+/// Names accepted by [`load`] besides file paths: `default`, `stairs`, `cubes`, `spheres`
+/// and the hard cases `hard/<name>`.
+pub fn builtin_names() -> Vec<&'static str> {
+    builtin::SCENES.iter().map(|(n, _)| *n).collect()
+}
+
+/// Loads a scene: a built-in name (see [`builtin_names`]; takes precedence) or the path of a
+/// TOML scene file. A name that is neither a built-in nor an existing file (and does not end
+/// in `.toml`) is [`Error::UnknownName`].
+pub fn load(spec: &str) -> Result<Scene> {
+    if let Some(text) = builtin::scene(spec) {
+        let origin = format!("scenes/{spec}.toml");
+        let dir = match origin.rfind('/') {
+            Some(i) => origin[..i].to_string(),
+            None => String::new(),
+        };
+        return file::parse(text, &origin, file::ObjSource::Builtin(&dir));
+    }
+    let path = Path::new(spec);
+    if path.is_file() || spec.ends_with(".toml") {
+        let text =
+            std::fs::read_to_string(path).map_err(|e| Error::input(spec, format!("cannot read scene file: {e}")))?;
+        let dir = path.parent().unwrap_or(Path::new(""));
+        return load_str(&text, spec, dir);
+    }
+    Err(Error::UnknownName { what: "scene", name: spec.to_string(), expected: builtin_names().join(", ") })
+}
+
+/// Parses a scene from TOML text held in memory. `origin` names it in errors; `obj` paths
+/// are resolved relative to `base_dir`.
+pub fn load_str(toml: &str, origin: &str, base_dir: &Path) -> Result<Scene> {
+    file::parse(toml, origin, file::ObjSource::Dir(base_dir))
+}

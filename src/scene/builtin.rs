@@ -1,0 +1,36 @@
+//! Built-in scenes: the TOML files under `scenes/` at the repository root, embedded.
+
+/// (name, TOML text). The file of `name` is `scenes/<name>.toml`.
+pub const SCENES: &[(&str, &str)] = &[
+    ("default", include_str!("../../scenes/default.toml")),
+    ("stairs", include_str!("../../scenes/stairs.toml")),
+    ("cubes", include_str!("../../scenes/cubes.toml")),
+    ("spheres", include_str!("../../scenes/spheres.toml")),
+    ("hard/eye_in_volume", include_str!("../../scenes/hard/eye_in_volume.toml")),
+    ("hard/eye_in_two_volumes", include_str!("../../scenes/hard/eye_in_two_volumes.toml")),
+    ("hard/near_plane_cut", include_str!("../../scenes/hard/near_plane_cut.toml")),
+    ("hard/light_inside_bounds", include_str!("../../scenes/hard/light_inside_bounds.toml")),
+    ("hard/light_in_face_plane", include_str!("../../scenes/hard/light_in_face_plane.toml")),
+    ("hard/grazing_directional", include_str!("../../scenes/hard/grazing_directional.toml")),
+    ("hard/light_very_close", include_str!("../../scenes/hard/light_very_close.toml")),
+    ("hard/near_coplanar", include_str!("../../scenes/hard/near_coplanar.toml")),
+    ("hard/far_coordinates", include_str!("../../scenes/hard/far_coordinates.toml")),
+    ("hard/tiny_casters", include_str!("../../scenes/hard/tiny_casters.toml")),
+    ("hard/slivers", include_str!("../../scenes/hard/slivers.toml")),
+    ("hard/zero_area", include_str!("../../scenes/hard/zero_area.toml")),
+    ("hard/staircase_300", include_str!("../../scenes/hard/staircase_300.toml")),
+    ("hard/background", include_str!("../../scenes/hard/background.toml")),
+    ("hard/look_at_light", include_str!("../../scenes/hard/look_at_light.toml")),
+];
+
+/// Embedded data files the built-in scenes reference, by repository-relative path.
+pub const DATA: &[(&str, &str)] =
+    &[("scenes/data/zero_area_cube.obj", include_str!("../../scenes/data/zero_area_cube.obj"))];
+
+pub fn scene(name: &str) -> Option<&'static str> {
+    SCENES.iter().find(|(n, _)| *n == name).map(|(_, t)| *t)
+}
+
+pub fn obj(path: &str) -> Option<&'static str> {
+    DATA.iter().find(|(n, _)| *n == path).map(|(_, t)| *t)
+}
