@@ -3,4 +3,5 @@
 pub mod error;
 pub mod geom;
 pub mod scene;
+pub mod shadow;
 pub use error::{Error, Result};

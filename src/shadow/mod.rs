@@ -1,0 +1,8 @@
+//! Shadow-volume planning (McGuire et al. 2003): casters prepared at load, and per light
+//! the culling, case selection and index lists the GPU side draws.
+pub mod caster;
+pub mod plan;
+pub mod testmesh;
+
+pub use caster::{Caster, Chunk};
+pub use plan::{plan_light, Case, CasterPlan, ChunkDraw, DarkCap, LightPlan, Method, PlanInput};
