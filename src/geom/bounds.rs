@@ -142,6 +142,11 @@ impl OcclusionPyramid {
                     return None;
                 }
             }
+            // supporting plane at the apex (cuts off the mirrored cone behind the light)
+            let axis = centre - lp;
+            if r.iter().all(|c| (*c - lp).dot(axis) > 1e-9 * axis.length() * size) {
+                push(axis, lp, inside);
+            }
         } else {
             let d = l.truncate();
             if d.length() == 0.0 || nn.dot(d).abs() < 1e-9 * d.length() {

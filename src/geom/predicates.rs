@@ -66,8 +66,9 @@ pub fn facing_f64(p0: DVec3, p1: DVec3, p2: DVec3, l: Vec4) -> bool {
         let lp = if l.w == 1.0 { l.truncate().as_dvec3() } else { l.truncate().as_dvec3() / l.w as f64 };
         // sign((p1-p0) x (p2-p0) . (L-p0)) = sign det[p0-L, p1-L, p2-L]
         let (a, b, cc) = (p0 - lp, p1 - lp, p2 - lp);
+        // det[p0-L, p1-L, p2-L] = -n . (L - p0)
         match filtered_det(a, b, cc) {
-            Some(s) => s,
+            Some(s) => !s,
             // robust: positive iff pd lies BELOW the plane of CCW (pa, pb, pc).
             None => orient3d(c(p0), c(p1), c(p2), c(lp)) < 0.0,
         }
