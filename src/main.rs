@@ -69,6 +69,18 @@ enum Command {
     },
 }
 
+impl Default for FrameArgs {
+    fn default() -> Self {
+        FrameArgs {
+            scene: "default".into(),
+            size: (960, 540),
+            method: "mcguire".into(),
+            depth_mode: "infinite".into(),
+            index_format: "auto".into(),
+        }
+    }
+}
+
 fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
     let (w, h) = s.split_once(['x', 'X']).ok_or_else(|| format!("expected WxH, got '{s}'"))?;
     let w: u32 = w.trim().parse().map_err(|_| format!("bad width in '{s}'"))?;
@@ -82,7 +94,7 @@ fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command.unwrap_or(Command::Render {
-        frame: FrameArgs::parse_from(["frame"]),
+        frame: FrameArgs::default(),
         out: "umbrage.png".into(),
         stats: None,
         view: "shaded".into(),

@@ -250,9 +250,9 @@ impl Renderer {
         }
         // Casters: CPU preparation (welding, topology, chunks) then the dual-length buffers.
         let mut casters = Vec::new();
-        for (i, m) in scene.meshes.iter().enumerate() {
+        for m in &scene.meshes {
             if m.casts_shadow {
-                casters.push(Caster::new(i, m)?);
+                casters.push(Caster::from_scene_mesh(m)?);
             }
         }
         let mut gpu_casters = Vec::new();
@@ -464,7 +464,7 @@ impl Renderer {
         let u8_ok = self.ctx.features.index_type_uint8;
         let mut stream: Vec<u8> = Vec::new();
         // Per light, per caster: draws (chunk, stream offset, count, format, is_light_cap).
-        let mut draws: Vec<Vec<(usize, Case, Vec<Draw>)>> = Vec::new();
+        let mut draws: Vec<Vec<(usize, Case, Vec4, Vec<Draw>)>> = Vec::new();
         let mut light_stats = Vec::new();
         let mut totals = Totals::default();
         let mut cpu = CpuMs::default();
@@ -530,7 +530,7 @@ impl Renderer {
                 }
                 cstats.push(CasterStats {
                     name: caster.name.clone(),
-                    case: cp.case.name().to_string(),
+                    case: case_name(cp.case).to_string(),
                     silhouette_edges: cp.silhouette_edges as u64,
                     triangles: tris,
                     index_bytes,
@@ -539,7 +539,7 @@ impl Renderer {
                     index_format: fmt_used.to_string(),
                     dark_cap_kind: format!("{:?}", cp.dark_cap_kind),
                 });
-                ldraws.push((cp.caster, cp.case, cdraws));
+                ldraws.push((cp.caster, cp.case, Vec4::from_array(cp.light_object), cdraws));
             }
             let light = &self.scene.lights[li];
             light_stats.push(LightStats {
@@ -611,14 +611,6 @@ impl Renderer {
             .casters
             .iter()
             .map(|c| (vp_rel_d * DMat4::from_translation(-eye) * c.transform.as_dmat4()).as_mat4())
-            .collect();
-        let caster_light: Vec<Vec<Vec4>> = self
-            .casters
-            .iter()
-            .map(|c| {
-                let inv = c.transform.as_dmat4().inverse();
-                self.scene.lights.iter().map(|l| (inv * l.homogeneous().as_dvec4()).as_vec4()).collect()
-            })
             .collect();
 
         let ctx = &self.ctx;
@@ -725,13 +717,13 @@ impl Renderer {
                 d.cmd_set_scissor(cb, 0, &[scissor]);
                 let _ = bounds; // depth bounds on the determination pass: see ARCHITECTURE.md
                 let mut bound_pipe = vk::Pipeline::null();
-                for (ci, case, cdraws) in ldraws {
+                for (ci, case, light_obj, cdraws) in ldraws {
                     if *case == Case::Culled {
                         continue;
                     }
                     let mut push = [0f32; 24];
                     push[..16].copy_from_slice(&caster_mvp[*ci].to_cols_array());
-                    push[16..20].copy_from_slice(&caster_light[*ci][li].to_array());
+                    push[16..20].copy_from_slice(&light_obj.to_array());
                     d.cmd_push_constants(cb, self.layouts[1], vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT, 0, bytes_of(&push));
                     for dr in cdraws {
                         let pipe = match (case, dr.light_cap) {
@@ -806,8 +798,8 @@ impl Renderer {
                 d.cmd_set_viewport(cb, 0, &[viewport]);
                 d.cmd_set_scissor(cb, 0, &[full]);
                 d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.pipes.volumes);
-                for (li, ldraws) in draws.iter().enumerate() {
-                    for (ci, case, cdraws) in ldraws {
+                for ldraws in draws.iter() {
+                    for (ci, case, light_obj, cdraws) in ldraws {
                         let color = match case {
                             Case::Culled => continue,
                             Case::ZPass => [0.2f32, 0.4, 1.0, 0.12],
@@ -816,7 +808,7 @@ impl Renderer {
                         };
                         let mut push = [0f32; 24];
                         push[..16].copy_from_slice(&caster_mvp[*ci].to_cols_array());
-                        push[16..20].copy_from_slice(&caster_light[*ci][li].to_array());
+                        push[16..20].copy_from_slice(&light_obj.to_array());
                         push[20..24].copy_from_slice(&color);
                         d.cmd_push_constants(cb, self.layouts[1], vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT, 0, bytes_of(&push));
                         for dr in cdraws.iter().filter(|dr| !dr.light_cap) {
@@ -971,6 +963,15 @@ impl Renderer {
                 }
             }
         }
+    }
+}
+
+fn case_name(c: Case) -> &'static str {
+    match c {
+        Case::Culled => "culled",
+        Case::ZPass => "zpass",
+        Case::ZFail => "zfail",
+        Case::ZFailLightCap => "zfail_light_cap",
     }
 }
 

@@ -1,0 +1,215 @@
+//! Shadow casters prepared once at load: welded closed mesh, topology, and GPU chunks.
+
+use crate::error::{Error, Result};
+use crate::geom::topology::Topology;
+use crate::geom::{Aabb, Mesh};
+use crate::scene::SceneMesh;
+use glam::{Mat4, Vec3};
+
+/// Most vertices a chunk may hold INCLUDING its apex, so that `2n - 1` fits in a u16.
+pub const MAX_CHUNK_VERTICES: usize = 32768;
+
+/// A piece of a caster drawn with one dual-length vertex buffer: index `i` (`i < n`) is
+/// `(vertices[i], 1)`, index `i + n` is `(vertices[i], 0)`, `n = vertices.len()`.
+#[derive(Clone, Debug)]
+pub struct Chunk {
+    /// Object space, `n <= 32768`; the LAST vertex is the apex (object-space AABB centre of
+    /// the whole caster), used by the dark-cap fan.
+    pub vertices: Vec<Vec3>,
+    /// The chunk's triangles in local indices (< n - 1).
+    pub local_tris: Vec<[u16; 3]>,
+    /// Global (welded-mesh) triangle id of each local triangle.
+    pub tri_ids: Vec<u32>,
+    /// Welded-mesh vertex id of each local vertex (`u32::MAX` for the apex).
+    pub global_ids: Vec<u32>,
+}
+
+impl Chunk {
+    pub fn n(&self) -> usize {
+        self.vertices.len()
+    }
+    /// Index of the apex's w=1 copy (its w=0 copy is `apex() + n`).
+    pub fn apex(&self) -> u16 {
+        (self.vertices.len() - 1) as u16
+    }
+    /// When `n <= 128` every index (< 2n) fits in 8 bits.
+    pub fn fits_u8(&self) -> bool {
+        self.vertices.len() <= 128
+    }
+}
+
+/// A closed 2-manifold shadow caster.
+#[derive(Clone, Debug)]
+pub struct Caster {
+    pub name: String,
+    pub topology: Topology,
+    pub chunks: Vec<Chunk>,
+    /// For every welded triangle: (chunk, local triangle index).
+    pub tri_chunk: Vec<(u32, u32)>,
+    pub object_bounds: Aabb,
+    pub transform: Mat4,
+    pub inverse: Mat4,
+    /// The transform mirrors (negative determinant): object-space orientation is reversed.
+    pub mirrored: bool,
+    pub triangle_count: usize,
+    /// Largest chunk vertex count (apex included); `<= 128` means 8-bit indices everywhere.
+    pub max_local_vertices: usize,
+    /// True iff every chunk can use 8-bit indices.
+    pub max_local_vertices_u8: bool,
+}
+
+impl Caster {
+    pub fn from_scene_mesh(m: &SceneMesh) -> Result<Caster> {
+        Caster::new(&m.name, &m.mesh, m.transform)
+    }
+
+    pub fn new(name: &str, mesh: &Mesh, transform: Mat4) -> Result<Caster> {
+        Caster::with_chunk_limit(name, mesh, transform, MAX_CHUNK_VERTICES)
+    }
+
+    /// `limit`: most vertices per chunk including the apex (2..=32768; tests use small ones).
+    pub fn with_chunk_limit(name: &str, mesh: &Mesh, transform: Mat4, limit: usize) -> Result<Caster> {
+        assert!((4..=MAX_CHUNK_VERTICES).contains(&limit));
+        mesh.validate(name)?;
+        let topology = Topology::build(mesh);
+        if !topology.is_closed_manifold() {
+            return Err(Error::mesh(
+                name,
+                format!(
+                    "not a closed 2-manifold: {} (non-manifold casters are not supported yet)",
+                    topology.describe_problem()
+                ),
+            ));
+        }
+        let det = transform.determinant();
+        if !(det.is_finite() && det != 0.0) {
+            return Err(Error::mesh(name, "transform is singular"));
+        }
+        let object_bounds = topology.mesh.bounds();
+        let apex = object_bounds.center();
+        let (chunks, tri_chunk) = build_chunks(&topology.mesh, apex, limit);
+        let max_local_vertices = chunks.iter().map(|c| c.vertices.len()).max().unwrap_or(0);
+        Ok(Caster {
+            name: name.to_string(),
+            triangle_count: topology.mesh.triangles.len(),
+            topology,
+            chunks,
+            tri_chunk,
+            object_bounds,
+            transform,
+            inverse: transform.inverse(),
+            mirrored: det < 0.0,
+            max_local_vertices,
+            max_local_vertices_u8: max_local_vertices <= 128,
+        })
+    }
+
+    pub fn mesh(&self) -> &Mesh {
+        &self.topology.mesh
+    }
+
+    pub fn world_bounds(&self) -> Aabb {
+        self.object_bounds.transformed(&self.transform)
+    }
+}
+
+/// Greedy chunking in triangle order (mesh order usually has good locality).
+fn build_chunks(mesh: &Mesh, apex: Vec3, limit: usize) -> (Vec<Chunk>, Vec<(u32, u32)>) {
+    let max_local = limit - 1; // room for the apex
+    let mut chunks = Vec::new();
+    let mut tri_chunk = vec![(0u32, 0u32); mesh.triangles.len()];
+    // vertex -> (chunk stamp, local index)
+    let mut stamp = vec![u32::MAX; mesh.positions.len()];
+    let mut local = vec![0u16; mesh.positions.len()];
+    let new_chunk = || Chunk { vertices: Vec::new(), local_tris: Vec::new(), tri_ids: Vec::new(), global_ids: Vec::new() };
+    let mut cur = new_chunk();
+    let finish = |mut c: Chunk, chunks: &mut Vec<Chunk>| {
+        c.vertices.push(apex);
+        c.global_ids.push(u32::MAX);
+        chunks.push(c);
+    };
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        let cid = chunks.len() as u32;
+        let mut needed = 0;
+        for (k, &v) in tri.iter().enumerate() {
+            if stamp[v as usize] != cid && !tri[..k].contains(&v) {
+                needed += 1;
+            }
+        }
+        if cur.vertices.len() + needed > max_local {
+            finish(std::mem::replace(&mut cur, new_chunk()), &mut chunks);
+        }
+        let cid = chunks.len() as u32;
+        let mut lt = [0u16; 3];
+        for (k, &v) in tri.iter().enumerate() {
+            if stamp[v as usize] != cid {
+                stamp[v as usize] = cid;
+                local[v as usize] = cur.vertices.len() as u16;
+                cur.vertices.push(mesh.positions[v as usize]);
+                cur.global_ids.push(v);
+            }
+            lt[k] = local[v as usize];
+        }
+        tri_chunk[t] = (cid, cur.local_tris.len() as u32);
+        cur.local_tris.push(lt);
+        cur.tri_ids.push(t as u32);
+    }
+    if !cur.local_tris.is_empty() {
+        finish(cur, &mut chunks);
+    }
+    (chunks, tri_chunk)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shadow::testmesh::{cube, uv_sphere};
+
+    #[test]
+    fn rejects_open_mesh() {
+        let mut m = cube(Vec3::ZERO, 1.0);
+        m.triangles.pop();
+        let e = Caster::new("boxy", &m, Mat4::IDENTITY).unwrap_err().to_string();
+        assert!(e.contains("boxy") && e.contains("not a closed 2-manifold: 3 boundary edges (open mesh)"), "{e}");
+        assert!(e.contains("non-manifold casters are not supported yet"));
+    }
+
+    fn check_chunks(c: &Caster) {
+        let mut seen = vec![0u32; c.triangle_count];
+        for (ci, ch) in c.chunks.iter().enumerate() {
+            assert!(ch.vertices.len() <= MAX_CHUNK_VERTICES);
+            assert_eq!(*ch.vertices.last().unwrap(), c.object_bounds.center());
+            assert_eq!(ch.vertices.len(), ch.global_ids.len());
+            for (li, (lt, &g)) in ch.local_tris.iter().zip(&ch.tri_ids).enumerate() {
+                seen[g as usize] += 1;
+                assert_eq!(c.tri_chunk[g as usize], (ci as u32, li as u32));
+                let gt = c.mesh().triangles[g as usize];
+                for k in 0..3 {
+                    assert!((lt[k] as usize) < ch.vertices.len() - 1);
+                    assert_eq!(ch.global_ids[lt[k] as usize], gt[k]);
+                    assert_eq!(ch.vertices[lt[k] as usize], c.mesh().positions[gt[k] as usize]);
+                }
+            }
+        }
+        assert!(seen.iter().all(|&s| s == 1));
+    }
+
+    #[test]
+    fn chunks_70k_vertices() {
+        let m = uv_sphere(1.0, 350, 202); // 350 * 201 + 2 = 70352 vertices
+        assert!(m.positions.len() > 70000);
+        let c = Caster::new("sphere", &m, Mat4::IDENTITY).unwrap();
+        assert!(c.chunks.len() >= 3);
+        assert!(c.chunks.iter().all(|ch| ch.vertices.len() <= 32768 && ch.vertices.len() < 32769));
+        check_chunks(&c);
+        assert!(!c.max_local_vertices_u8);
+    }
+
+    #[test]
+    fn small_chunks() {
+        let c = Caster::with_chunk_limit("s", &uv_sphere(1.0, 20, 10), Mat4::IDENTITY, 40).unwrap();
+        assert!(c.chunks.len() > 3);
+        check_chunks(&c);
+        assert!(c.max_local_vertices_u8 && c.chunks.iter().all(|c| c.fits_u8()));
+    }
+}

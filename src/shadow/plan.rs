@@ -1,0 +1,382 @@
+//! Per-light shadow-volume plans: culling, case selection and index generation.
+//!
+//! Geometry (object space, chunk-local indices; w=1 copy of vertex i is `i`, w=0 copy `i+n`):
+//! * sides, per silhouette edge a->b (as in the light-facing triangle): point light
+//!   `(b, a, a∞), (b, a∞, b∞)`; directional `(b, a, a∞)` (all ∞ coincide);
+//! * dark cap: `Fan` = `(apex∞, b∞, a∞)` per silhouette edge (point light strictly outside
+//!   the caster's AABB); `FrontFaces` = every light-facing triangle's w=0 copy reversed;
+//!   `BackFaces` = every non-light-facing triangle's w=0 copy as is;
+//! * light cap: front formulation = light-facing triangles as is; back formulation =
+//!   non-light-facing triangles reversed.
+//!
+//! Every emitted triangle's front face points OUT of the shadow volume (tests prove it with
+//! directed-edge cancellation and a positive signed volume at finite extrusion).
+
+use super::caster::Caster;
+use crate::error::Error;
+use crate::geom::bounds::{
+    box_distance, light_depth_bounds, light_scissor, shadow_volume_outside_frustum, Frustum, OcclusionPyramid,
+};
+use crate::geom::silhouette::{facing_bits, possible_silhouette, SilhouetteEdge};
+use crate::geom::Aabb;
+use crate::scene::{Camera, Light, LightKind};
+use glam::{Mat4, Vec4};
+use std::time::Instant;
+
+/// Which shadow-volume algorithm to plan for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+pub enum Method {
+    #[serde(rename = "zpass")]
+    ZPass,
+    #[serde(rename = "zfail")]
+    ZFail,
+    #[serde(rename = "everitt-kilgard")]
+    EverittKilgard,
+    #[serde(rename = "lengyel")]
+    Lengyel,
+    #[serde(rename = "mcguire")]
+    McGuire,
+}
+
+impl Method {
+    pub const ALL: [Method; 5] = [Method::ZPass, Method::ZFail, Method::EverittKilgard, Method::Lengyel, Method::McGuire];
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::ZPass => "zpass",
+            Method::ZFail => "zfail",
+            Method::EverittKilgard => "everitt-kilgard",
+            Method::Lengyel => "lengyel",
+            Method::McGuire => "mcguire",
+        }
+    }
+}
+
+impl std::fmt::Display for Method {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Method {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Method, Error> {
+        Method::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| Error::UnknownName {
+            what: "method",
+            name: s.to_string(),
+            expected: Method::ALL.map(|m| m.name()).join(", "),
+        })
+    }
+}
+
+/// How one caster's volume is drawn for one light.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+pub enum Case {
+    /// Nothing drawn (outside the light's radius or cone, or the volume is off screen).
+    #[serde(rename = "culled")]
+    Culled,
+    /// Case 1: z-pass, sides only.
+    #[serde(rename = "zpass")]
+    ZPass,
+    /// Case 2: z-fail, sides + dark cap, no light cap.
+    #[serde(rename = "zfail")]
+    ZFail,
+    /// Case 3 (and Carmack / Everitt-Kilgard / Lengyel z-fail): sides + dark cap + light cap.
+    #[serde(rename = "zfail_light_cap")]
+    ZFailLightCap,
+}
+
+/// Which dark cap was emitted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DarkCap {
+    /// Fan from the apex at infinity over the silhouette: s triangles.
+    Fan,
+    /// w=0 copies of the non-light-facing triangles (back-face formulation: light in/on the
+    /// caster's bounding box).
+    BackFaces,
+    /// w=0 copies of the light-facing triangles, reversed (classic O(f) z-fail cap).
+    FrontFaces,
+    /// No dark cap (z-pass, or a directional light: all of infinity is one point).
+    None,
+}
+
+/// Which closed volume the geometry describes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Formulation {
+    /// Occluders are the light-facing triangles.
+    Front,
+    /// Occluders are the non-light-facing triangles (point light inside/on the caster AABB).
+    Back,
+}
+
+pub struct PlanInput<'a> {
+    pub camera: &'a Camera,
+    pub width: u32,
+    pub height: u32,
+    pub view_proj: Mat4,
+    pub light: &'a Light,
+    pub method: Method,
+}
+
+/// Index lists for one chunk of a caster (indices into its dual-length vertex buffer).
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct ChunkDraw {
+    pub chunk: usize,
+    /// Sides then dark cap; drawn with depth test LESS.
+    pub volume: Vec<u16>,
+    /// Light cap; drawn with depth compare NEVER.
+    pub light_cap: Vec<u16>,
+}
+
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct CasterPlan {
+    pub caster: usize,
+    pub case: Case,
+    pub silhouette_edges: usize,
+    /// Triangle counts actually emitted.
+    pub sides: usize,
+    pub dark_cap: usize,
+    pub light_cap: usize,
+    /// Only chunks with at least one index.
+    pub chunks: Vec<ChunkDraw>,
+    pub dark_cap_kind: DarkCap,
+    pub formulation: Formulation,
+    /// Object-space homogeneous light the facing bits were decided for (the GPU must use the
+    /// same value in EXTRUDE).
+    pub light_object: [f32; 4],
+}
+
+impl CasterPlan {
+    pub fn triangles(&self) -> usize {
+        self.sides + self.dark_cap + self.light_cap
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct LightPlan {
+    pub scissor: Option<[u32; 4]>,
+    pub depth_bounds: Option<(f32, f32)>,
+    pub casters: Vec<CasterPlan>,
+    pub silhouette_ms: f64,
+    pub plan_ms: f64,
+}
+
+/// The object-space homogeneous light (w exactly 1 or 0).
+pub fn object_light(caster: &Caster, light_h: Vec4) -> Vec4 {
+    let inv = caster.transform.as_dmat4().inverse();
+    let l = inv * light_h.as_dvec4();
+    if light_h.w == 0.0 {
+        l.truncate().as_vec3().extend(0.0)
+    } else {
+        (l.truncate() / l.w).as_vec3().extend(1.0)
+    }
+}
+
+fn spot_culls(light: &Light, b: &Aabb) -> bool {
+    if light.kind != LightKind::Spot {
+        return false;
+    }
+    let half = (light.cone_deg as f64 * 0.5).to_radians();
+    if !(half < std::f64::consts::FRAC_PI_2) {
+        return false;
+    }
+    let c = b.center().as_dvec3();
+    let r = (b.extent().as_dvec3() * 0.5).length();
+    let v = c - light.position.as_dvec3();
+    let dist = v.length();
+    let d = light.direction.as_dvec3();
+    if dist <= r || d.length() == 0.0 {
+        return false;
+    }
+    let ang = (v.dot(d) / (dist * d.length())).clamp(-1.0, 1.0).acos();
+    ang > half + (r / dist).asin() + 1e-6
+}
+
+/// What to emit for one caster.
+#[derive(Clone, Copy, Debug)]
+pub struct Emit {
+    pub formulation: Formulation,
+    pub directional: bool,
+    pub dark_cap: DarkCap,
+    pub light_cap: bool,
+}
+
+/// Emits the index lists; returns (chunk draws, sides, dark cap, light cap) triangle counts.
+pub fn emit(caster: &Caster, facing: &[bool], sil: &[SilhouetteEdge], e: Emit) -> (Vec<ChunkDraw>, usize, usize, usize) {
+    let nch = caster.chunks.len();
+    let mut vol: Vec<Vec<u16>> = vec![Vec::new(); nch];
+    let mut cap: Vec<Vec<u16>> = vec![Vec::new(); nch];
+    let (mut sides, mut dark, mut light) = (0, 0, 0);
+    for s in sil {
+        // a->b as in the lit triangle; the back formulation uses the unlit triangle's chunk
+        let (tri, corner, rev) = match e.formulation {
+            Formulation::Front => (s.lit, s.lit_corner, false),
+            Formulation::Back => (s.unlit, s.unlit_corner, true),
+        };
+        let (ci, li) = caster.tri_chunk[tri as usize];
+        let ch = &caster.chunks[ci as usize];
+        let n = ch.n() as u16;
+        let lt = ch.local_tris[li as usize];
+        let k = corner as usize;
+        let (mut a, mut b) = (lt[k], lt[(k + 1) % 3]);
+        if rev {
+            std::mem::swap(&mut a, &mut b);
+        }
+        let v = &mut vol[ci as usize];
+        if e.directional {
+            v.extend_from_slice(&[b, a, a + n]);
+            sides += 1;
+        } else {
+            v.extend_from_slice(&[b, a, a + n, b, a + n, b + n]);
+            sides += 2;
+        }
+    }
+    if !e.directional {
+        match e.dark_cap {
+            DarkCap::Fan => {
+                assert_eq!(e.formulation, Formulation::Front, "the fan dark cap needs the front formulation");
+                for s in sil {
+                    let (ci, li) = caster.tri_chunk[s.lit as usize];
+                    let ch = &caster.chunks[ci as usize];
+                    let n = ch.n() as u16;
+                    let lt = ch.local_tris[li as usize];
+                    let k = s.lit_corner as usize;
+                    let (a, b) = (lt[k], lt[(k + 1) % 3]);
+                    vol[ci as usize].extend_from_slice(&[ch.apex() + n, b + n, a + n]);
+                    dark += 1;
+                }
+            }
+            DarkCap::FrontFaces | DarkCap::BackFaces => {
+                let want = e.dark_cap == DarkCap::FrontFaces;
+                for (ci, ch) in caster.chunks.iter().enumerate() {
+                    let n = ch.n() as u16;
+                    for (lt, &g) in ch.local_tris.iter().zip(&ch.tri_ids) {
+                        if facing[g as usize] == want {
+                            let t = if want { [lt[0] + n, lt[2] + n, lt[1] + n] } else { [lt[0] + n, lt[1] + n, lt[2] + n] };
+                            vol[ci].extend_from_slice(&t);
+                            dark += 1;
+                        }
+                    }
+                }
+            }
+            DarkCap::None => {}
+        }
+    }
+    if e.light_cap {
+        let want = e.formulation == Formulation::Front;
+        for (ci, ch) in caster.chunks.iter().enumerate() {
+            for (lt, &g) in ch.local_tris.iter().zip(&ch.tri_ids) {
+                if facing[g as usize] == want {
+                    let t = if want { *lt } else { [lt[0], lt[2], lt[1]] };
+                    cap[ci].extend_from_slice(&t);
+                    light += 1;
+                }
+            }
+        }
+    }
+    let draws = vol
+        .into_iter()
+        .zip(cap)
+        .enumerate()
+        .filter(|(_, (v, c))| !v.is_empty() || !c.is_empty())
+        .map(|(chunk, (volume, light_cap))| ChunkDraw { chunk, volume, light_cap })
+        .collect();
+    (draws, sides, dark, light)
+}
+
+/// Plans every caster's shadow volume for one light.
+pub fn plan_light(input: &PlanInput, casters: &[Caster]) -> LightPlan {
+    let t0 = Instant::now();
+    let light = input.light;
+    let light_h = light.homogeneous();
+    let directional = light.kind == LightKind::Directional;
+    let frustum = Frustum::from_view_proj(input.view_proj, false);
+    let pyramid = OcclusionPyramid::new(light_h, input.view_proj);
+    let mut sil_time = 0.0f64;
+    let mut plans = Vec::with_capacity(casters.len());
+    for (ci, caster) in casters.iter().enumerate() {
+        let wb = caster.world_bounds();
+        let l_obj = object_light(caster, light_h);
+        let culled_plan = |case| CasterPlan {
+            caster: ci,
+            case,
+            silhouette_edges: 0,
+            sides: 0,
+            dark_cap: 0,
+            light_cap: 0,
+            chunks: Vec::new(),
+            dark_cap_kind: DarkCap::None,
+            formulation: Formulation::Front,
+            light_object: l_obj.to_array(),
+        };
+        let out_of_radius =
+            !directional && light.radius.is_some_and(|r| box_distance(&wb, light.position) > r);
+        if out_of_radius || spot_culls(light, &wb) || shadow_volume_outside_frustum(&wb, light_h, &frustum) {
+            plans.push(culled_plan(Case::Culled));
+            continue;
+        }
+        let ts = Instant::now();
+        let facing = facing_bits(caster.mesh(), l_obj, caster.mirrored);
+        let sil = possible_silhouette(&caster.topology.manifold_edges, &facing);
+        sil_time += ts.elapsed().as_secs_f64() * 1e3;
+
+        let formulation = if !directional && caster.object_bounds.contains(l_obj.truncate()) {
+            Formulation::Back
+        } else {
+            Formulation::Front
+        };
+        let case = match input.method {
+            Method::ZPass => Case::ZPass,
+            Method::ZFail | Method::EverittKilgard => Case::ZFailLightCap,
+            Method::Lengyel => {
+                if pyramid.intersects_box(&wb) {
+                    Case::ZFailLightCap
+                } else {
+                    Case::ZPass
+                }
+            }
+            Method::McGuire => {
+                if !pyramid.intersects_box(&wb) {
+                    Case::ZPass
+                } else if !frustum.intersects_box(&wb) {
+                    Case::ZFail
+                } else {
+                    Case::ZFailLightCap
+                }
+            }
+        };
+        let dark_cap_kind = if case == Case::ZPass || directional {
+            DarkCap::None
+        } else if formulation == Formulation::Back {
+            DarkCap::BackFaces
+        } else if input.method == Method::McGuire {
+            DarkCap::Fan
+        } else {
+            DarkCap::FrontFaces
+        };
+        let e = Emit { formulation, directional, dark_cap: dark_cap_kind, light_cap: case == Case::ZFailLightCap };
+        let (chunks, sides, dark_cap, light_cap) = emit(caster, &facing, &sil, e);
+        plans.push(CasterPlan {
+            caster: ci,
+            case,
+            silhouette_edges: sil.len(),
+            sides,
+            dark_cap,
+            light_cap,
+            chunks,
+            dark_cap_kind,
+            formulation,
+            light_object: l_obj.to_array(),
+        });
+    }
+    let (scissor, depth_bounds) = if directional {
+        (None, None)
+    } else {
+        (light_scissor(light, input.view_proj, input.width, input.height), light_depth_bounds(light, input.view_proj))
+    };
+    LightPlan { scissor, depth_bounds, casters: plans, silhouette_ms: sil_time, plan_ms: t0.elapsed().as_secs_f64() * 1e3 }
+}
+
+#[cfg(test)]
+mod tests;
