@@ -406,6 +406,23 @@ impl Renderer {
         })
     }
 
+    /// Tears the renderer down and hands back its context (to render another scene).
+    pub fn into_context(self) -> Context {
+        let mut me = std::mem::ManuallyDrop::new(self);
+        me.destroy_resources();
+        // SAFETY: `me` is never used or dropped again; each remaining field is read out exactly
+        // once (or dropped in place), so nothing is freed twice.
+        unsafe {
+            std::ptr::drop_in_place(&mut me.scene);
+            std::ptr::drop_in_place(&mut me.opts);
+            std::ptr::drop_in_place(&mut me.casters);
+            std::ptr::drop_in_place(&mut me.gpu_casters);
+            std::ptr::drop_in_place(&mut me.readback);
+            std::ptr::drop_in_place(&mut me.stream);
+            std::ptr::read(&me.ctx)
+        }
+    }
+
     pub fn casters(&self) -> &[Caster] {
         &self.casters
     }
@@ -1069,6 +1086,12 @@ fn create_pipelines(ctx: &Context, layouts: &[vk::PipelineLayout; 4], depth_mode
 
 impl Drop for Renderer {
     fn drop(&mut self) {
+        self.destroy_resources();
+    }
+}
+
+impl Renderer {
+    fn destroy_resources(&mut self) {
         let ctx = &self.ctx;
         // SAFETY: wait for the GPU, then destroy everything this renderer created; the context
         // (declared last) is dropped after this body.
