@@ -1,0 +1,95 @@
+//! The command line as a user meets it: bad input gives a clear message and a non-zero exit,
+//! never a panic; good input writes what it says.
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn umbrage(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_umbrage")).args(args).env("UMBRAGE_VALIDATION", "1").output().unwrap()
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("umbrage-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn fails_with(out: &Output, needle: &str) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "expected failure, got success; stderr: {err}");
+    assert!(!err.contains("panicked"), "panicked: {err}");
+    assert!(err.contains(needle), "stderr should mention '{needle}': {err}");
+}
+
+#[test]
+fn bad_inputs_fail_cleanly() {
+    let d = tmp("bad");
+    fails_with(&umbrage(&["render", "--scene", "no/such/scene.toml", "--out", d.join("a.png").to_str().unwrap()]), "no/such/scene.toml");
+    fails_with(&umbrage(&["render", "--scene", "nonexistent_builtin"]), "nonexistent_builtin");
+    fails_with(&umbrage(&["render", "--method", "magic"]), "magic");
+    fails_with(&umbrage(&["render", "--depth-mode", "sideways"]), "sideways");
+    fails_with(&umbrage(&["render", "--index-format", "u7"]), "u7");
+    fails_with(&umbrage(&["render", "--size", "0x10"]), "size");
+    let nan = d.join("nan.toml");
+    std::fs::write(&nan, "[camera]\neye = [0, 1, nan]\ntarget = [0, 0, 0]\n").unwrap();
+    fails_with(&umbrage(&["render", "--scene", nan.to_str().unwrap()]), "nan.toml");
+    let syntax = d.join("syntax.toml");
+    std::fs::write(&syntax, "[camera]\neye = [0, 1, 2\n").unwrap();
+    fails_with(&umbrage(&["render", "--scene", syntax.to_str().unwrap()]), "syntax.toml");
+    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data");
+    let obj = d.join("obj.toml");
+    std::fs::write(&obj, format!("[camera]\neye = [0, 1, 4]\ntarget = [0, 0, 0]\n[[light]]\nkind = \"point\"\nposition = [0, 5, 0]\n[[mesh]]\nobj = \"{data}/malformed.obj\"\n")).unwrap();
+    fails_with(&umbrage(&["render", "--scene", obj.to_str().unwrap()]), "malformed.obj");
+    let empty = d.join("empty.toml");
+    std::fs::write(&empty, format!("[camera]\neye = [0, 1, 4]\ntarget = [0, 0, 0]\n[[mesh]]\nobj = \"{data}/no_faces.obj\"\n")).unwrap();
+    fails_with(&umbrage(&["render", "--scene", empty.to_str().unwrap()]), "no_faces");
+    fails_with(&umbrage(&["check", d.join("missing").to_str().unwrap()]), "missing");
+}
+
+#[test]
+fn no_vulkan_driver_says_how_to_install_one() {
+    let out = Command::new(env!("CARGO_BIN_EXE_umbrage"))
+        .args(["info"])
+        .env("VK_ICD_FILENAMES", "/nonexistent/icd.json")
+        .env("VK_DRIVER_FILES", "/nonexistent/icd.json")
+        .output()
+        .unwrap();
+    fails_with(&out, "mesa-vulkan-drivers");
+}
+
+#[test]
+fn render_stats_dump_and_check() {
+    let d = tmp("good");
+    let png = d.join("out.png");
+    let stats = d.join("stats.json");
+    let dump = d.join("dump");
+    let out = umbrage(&[
+        "render", "--scene", "stairs", "--size", "160x120", "--out", png.to_str().unwrap(), "--stats", stats.to_str().unwrap(), "--dump",
+        dump.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let line = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(line.lines().count(), 1, "render prints one line: {line}");
+    assert!(png.exists());
+    let s: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    for key in ["device", "method", "depth_mode", "lights", "totals", "cpu_ms", "gpu_ms"] {
+        assert!(s.get(key).is_some(), "stats lacks {key}");
+    }
+    let caster = &s["lights"][0]["casters"][0];
+    for key in ["name", "case", "silhouette_edges", "triangles", "index_bytes", "vertex_bytes"] {
+        assert!(caster.get(key).is_some(), "caster stats lack {key}");
+    }
+    for key in ["sides", "dark_cap", "light_cap"] {
+        assert!(s["totals"]["triangles"].get(key).is_some());
+    }
+    for f in ["frame.json", "world.obj", "positions.f32", "normals.f32", "shadow_0.png", "stencil_0.png", "color.png"] {
+        assert!(dump.join(f).exists(), "dump lacks {f}");
+    }
+    assert_eq!(std::fs::metadata(dump.join("positions.f32")).unwrap().len(), 160 * 120 * 3 * 4);
+    let check = umbrage(&["check", dump.to_str().unwrap()]);
+    assert!(check.status.success(), "{}", String::from_utf8_lossy(&check.stdout));
+    let info = umbrage(&["info", "--json"]);
+    assert!(info.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    assert!(v["features"].get("depth_clamp").is_some());
+}

@@ -1,0 +1,21 @@
+//! Every embedded SPIR-V module passes `spirv-val` (Vulkan 1.3 rules).
+use std::process::Command;
+
+#[test]
+fn every_embedded_module_passes_spirv_val() {
+    let dir = std::env::temp_dir().join(format!("umbrage-spv-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    if Command::new("spirv-val").arg("--version").output().is_err() {
+        assert!(std::env::var_os("CI").is_none(), "spirv-val missing under CI (apt-get install spirv-tools)");
+        eprintln!("SKIPPED: spirv-val not installed (apt-get install spirv-tools)");
+        return;
+    }
+    assert!(!umbrage::gpu::shaders::ALL.is_empty());
+    for (name, spv) in umbrage::gpu::shaders::ALL {
+        let path = dir.join(format!("{name}.spv"));
+        std::fs::write(&path, spv).unwrap();
+        let out = Command::new("spirv-val").args(["--target-env", "vulkan1.3"]).arg(&path).output().unwrap();
+        assert!(out.status.success(), "{name}: {}", String::from_utf8_lossy(&out.stderr));
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
