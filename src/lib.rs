@@ -5,6 +5,7 @@
 //! nothing with the shadow algorithm but the camera model.
 #![warn(unsafe_op_in_unsafe_fn)]
 pub mod accuracy;
+pub mod bench;
 pub mod error;
 pub mod geom;
 pub mod gpu;

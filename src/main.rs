@@ -57,6 +57,27 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Speed against error: every method on each scene, side by side on this device.
+    Bench {
+        /// Scenes (repeatable); default: the fill-rate and vertex-rate bench scenes plus default.
+        #[arg(long = "scene")]
+        scenes: Vec<String>,
+        /// Comma-separated methods (default: all).
+        #[arg(long, value_delimiter = ',')]
+        methods: Vec<String>,
+        #[arg(long, default_value_t = 10)]
+        frames: usize,
+        #[arg(long, default_value = "960x540", value_parser = parse_size)]
+        size: (u32, u32),
+        #[arg(long, default_value = "auto")]
+        index_format: String,
+        /// Write the report as JSON.
+        #[arg(long)]
+        json: Option<PathBuf>,
+        /// Write the report as a Markdown table.
+        #[arg(long)]
+        markdown: Option<PathBuf>,
+    },
     /// Compare a frame dump with the exact CPU reference.
     Check {
         dir: PathBuf,
@@ -103,6 +124,9 @@ fn main() -> ExitCode {
         Command::Render { frame, out, stats, view, dump } => render(&frame, &out, stats.as_deref(), &view, dump.as_deref()),
         Command::Info { json } => info(json),
         Command::Check { dir, band, threshold } => check(&dir, band, threshold),
+        Command::Bench { scenes, methods, frames, size, index_format, json, markdown } => {
+            bench(scenes, methods, frames, size, &index_format, json.as_deref(), markdown.as_deref())
+        }
     };
     match result {
         Ok(code) => code,
@@ -174,4 +198,45 @@ fn check(dir: &Path, band: u32, threshold: f64) -> Result<ExitCode> {
     let report = umbrage::reference::check_dump(dir, band)?;
     println!("{report}");
     Ok(if report.passed(threshold) { ExitCode::SUCCESS } else { ExitCode::FAILURE })
+}
+
+fn bench(
+    scenes: Vec<String>,
+    methods: Vec<String>,
+    frames: usize,
+    size: (u32, u32),
+    index_format: &str,
+    json: Option<&Path>,
+    markdown: Option<&Path>,
+) -> Result<ExitCode> {
+    let scenes = if scenes.is_empty() { vec!["bench/fill".into(), "bench/vertex".into(), "default".into()] } else { scenes };
+    let methods = if methods.is_empty() {
+        Method::ALL.to_vec()
+    } else {
+        methods.iter().map(|m| m.parse::<Method>()).collect::<Result<Vec<_>>>()?
+    };
+    let opts = RenderOptions { width: size.0, height: size.1, index_format: index_format.parse::<IndexFormat>()?, ..Default::default() };
+    let ctx = umbrage::gpu::Context::new()?;
+    let cfg = umbrage::bench::BenchConfig { scenes, methods, frames, opts };
+    let report = umbrage::bench::run(ctx, &cfg, |r| {
+        eprintln!(
+            "{:<14} {:<16} gpu {:>8} ms  shadow {:>8} ms  {:>8} tris  error {:.4}%",
+            r.scene,
+            r.method,
+            r.gpu_frame_ms.map(|v| format!("{v:.2}")).unwrap_or_else(|| "-".into()),
+            r.gpu_shadow_ms.map(|v| format!("{v:.2}")).unwrap_or_else(|| "-".into()),
+            r.shadow_triangles,
+            r.error_fraction * 100.0
+        )
+    })?;
+    let md = report.markdown();
+    println!("{md}");
+    if let Some(p) = json {
+        let s = serde_json::to_string_pretty(&report).map_err(|e| Error::Other(e.to_string()))?;
+        std::fs::write(p, s).map_err(|e| Error::io(p.display().to_string(), e))?;
+    }
+    if let Some(p) = markdown {
+        std::fs::write(p, md).map_err(|e| Error::io(p.display().to_string(), e))?;
+    }
+    Ok(ExitCode::SUCCESS)
 }
