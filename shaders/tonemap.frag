@@ -8,5 +8,5 @@ layout(location = 0) out vec4 out_color;
 
 void main() {
     vec3 c = texelFetch(sampler2D(t_accum, s_nearest), ivec2(gl_FragCoord.xy), 0).rgb;
-    out_color = vec4(vec3(1.0) - exp(-c * 1.6), 1.0);
+    out_color = vec4(vec3(1.0) - exp(-c * 1.1), 1.0);
 }

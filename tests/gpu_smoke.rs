@@ -1,7 +1,7 @@
 mod common;
 use glam::{Mat4, Vec3};
 use umbrage::geom::Mesh;
-use umbrage::render::{RenderOptions, Renderer};
+use umbrage::render::{RenderOptions, Renderer, View};
 use umbrage::scene::{Camera, Light, LightKind, Scene, SceneMesh};
 
 fn quad(size: f32) -> Mesh {
@@ -28,4 +28,26 @@ fn ambient_and_light_without_casters() {
     assert!(out.color[c] > 100, "centre should be lit: {:?}", &out.color[c..c + 4]);
     assert!(out.positions[24 * 64 + 32][1].abs() < 1e-4);
     r.ctx.check_validation().unwrap();
+    // Teardown: every object destroyed, in order; validation reports leaks at device destruction.
+    let log = r.ctx.validation_log();
+    drop(r);
+    let errors = log.lock().unwrap().errors.clone();
+    assert!(errors.is_empty(), "validation errors during teardown: {errors:#?}");
+}
+
+#[test]
+fn default_scene_with_every_view_tears_down_cleanly() {
+    let Some(mut ctx) = common::context() else { return };
+    for view in [View::Shaded, View::Volumes, View::Stencil] {
+        let scene = umbrage::scene::load("default").unwrap();
+        let mut r = Renderer::new(ctx, scene, RenderOptions { width: 96, height: 64, view, ..Default::default() }).unwrap();
+        let out = r.render().unwrap();
+        assert_eq!(out.color.len(), 96 * 64 * 4);
+        r.ctx.check_validation().unwrap();
+        ctx = r.into_context();
+    }
+    let log = ctx.validation_log();
+    drop(ctx);
+    let errors = log.lock().unwrap().errors.clone();
+    assert!(errors.is_empty(), "validation errors during teardown: {errors:#?}");
 }

@@ -351,6 +351,12 @@ impl Context {
         Ok((physical, device, queue_family, features, info, depth_format, props.limits))
     }
 
+    /// The shared validation log: keep a clone to read what validation said during teardown
+    /// (leaked objects are reported when the device is destroyed).
+    pub fn validation_log(&self) -> Arc<Mutex<ValidationLog>> {
+        self.log.clone()
+    }
+
     /// Validation errors reported so far (drains them).
     pub fn take_validation_errors(&self) -> Vec<String> {
         self.log.lock().map(|mut l| std::mem::take(&mut l.errors)).unwrap_or_default()

@@ -366,7 +366,7 @@ impl Renderer {
             (sampler, set_layouts, layouts, pool, sets)
         };
 
-        let pipes = create_pipelines(&ctx, &layouts, opts.depth_mode)?;
+        let pipes = create_pipelines(&ctx, &layouts, opts.depth_mode, ctx.features.depth_bounds)?;
 
         // SAFETY: object creation on a valid device; destroyed in Drop.
         let (query_pool, cmd, fence) = unsafe {
@@ -732,7 +732,10 @@ impl Renderer {
                 );
                 d.cmd_set_viewport(cb, 0, &[viewport]);
                 d.cmd_set_scissor(cb, 0, &[scissor]);
-                let _ = bounds; // depth bounds on the determination pass: see ARCHITECTURE.md
+                if ctx.features.depth_bounds {
+                    let (lo, hi) = bounds.unwrap_or((0.0, 1.0));
+                    d.cmd_set_depth_bounds(cb, lo, hi);
+                }
                 let mut bound_pipe = vk::Pipeline::null();
                 for (ci, case, light_obj, cdraws) in ldraws {
                     if *case == Case::Culled {
@@ -785,6 +788,10 @@ impl Renderer {
                 d.cmd_set_viewport(cb, 0, &[viewport]);
                 d.cmd_set_scissor(cb, 0, &[scissor]);
                 d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.pipes.illuminate);
+                if ctx.features.depth_bounds {
+                    let (lo, hi) = bounds.unwrap_or((0.0, 1.0));
+                    d.cmd_set_depth_bounds(cb, lo, hi);
+                }
                 d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, self.layouts[2], 0, &[self.sets[0]], &[]);
                 d.cmd_push_constants(cb, self.layouts[2], vk::ShaderStageFlags::FRAGMENT, 0, bytes_of(&light_uniforms[li]));
                 d.cmd_draw(cb, 3, 1, 0, 0);
@@ -1029,7 +1036,10 @@ fn upload(ctx: &Context, name: &str, data: &[u8], usage: vk::BufferUsageFlags) -
     r.map(|_| dst)
 }
 
-fn create_pipelines(ctx: &Context, layouts: &[vk::PipelineLayout; 4], depth_mode: DepthMode) -> Result<Pipelines> {
+/// `depth_bounds`: when the device has the feature, the determination and illumination
+/// pipelines test the stored depth against the light's depth range (set per light, dynamic
+/// state; [0, 1] when the light is unbounded, which passes everything).
+fn create_pipelines(ctx: &Context, layouts: &[vk::PipelineLayout; 4], depth_mode: DepthMode, depth_bounds: bool) -> Result<Pipelines> {
     let df = ctx.depth_format;
     let gbuffer_formats = [ACCUM_FORMAT, ALBEDO_FORMAT, NORMAL_FORMAT, POSITION_FORMAT];
     let mut g = PipelineDesc::new(shaders::GBUFFER_VERT, layouts[0], df);
@@ -1050,6 +1060,7 @@ fn create_pipelines(ctx: &Context, layouts: &[vk::PipelineLayout; 4], depth_mode
     s.depth_test = true;
     s.depth_compare = vk::CompareOp::LESS;
     s.depth_clamp = depth_mode == DepthMode::Clamp;
+    s.depth_bounds = depth_bounds;
     s.stencil = Some((pipeline::stencil_ops(S::INCREMENT_AND_WRAP, S::KEEP), pipeline::stencil_ops(S::DECREMENT_AND_WRAP, S::KEEP)));
     let zpass = pipeline::create(ctx, &s)?;
     s.stencil = Some((pipeline::stencil_ops(S::KEEP, S::DECREMENT_AND_WRAP), pipeline::stencil_ops(S::KEEP, S::INCREMENT_AND_WRAP)));
@@ -1073,6 +1084,7 @@ fn create_pipelines(ctx: &Context, layouts: &[vk::PipelineLayout; 4], depth_mode
     i.fragment = Some(shaders::ILLUMINATE_FRAG);
     i.color_formats = &accum;
     i.blend = Blend::Additive;
+    i.depth_bounds = depth_bounds;
     i.stencil = Some((pipeline::stencil_equal(0), pipeline::stencil_equal(0)));
     let illuminate = pipeline::create(ctx, &i)?;
 
