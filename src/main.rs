@@ -167,6 +167,9 @@ fn render(frame: &FrameArgs, out: &Path, stats: Option<&Path>, view: &str, dump:
         umbrage::output::write_frame_dump(dir, &renderer.scene, &frame_out)?;
     }
     let s = &frame_out.stats;
+    for w in &s.warnings {
+        eprintln!("warning: {w}");
+    }
     let gpu = s.gpu_ms.as_ref().map(|g| format!(" (gpu {:.2} ms: shadow {:.2}, illuminate {:.2})", g.frame, g.shadow, g.illuminate)).unwrap_or_default();
     println!(
         "{} | {}x{} | {} | frame {:.2} ms{} | {} shadow triangles | {}",

@@ -206,6 +206,8 @@ pub struct Renderer {
     pub scene: Scene,
     pub opts: RenderOptions,
     casters: Vec<Caster>,
+    /// Per caster, its number of connected shells (for the stencil-overflow warning).
+    shells: Vec<usize>,
     /// Per caster (same order as `casters`), its chunks' GPU buffers.
     gpu_casters: Vec<Vec<GpuChunk>>,
     scene_vertices: Buffer,
@@ -383,10 +385,12 @@ impl Renderer {
             (qp, cmd, fence)
         };
 
+        let shells = casters.iter().map(|c| shell_count(c.mesh())).collect();
         Ok(Renderer {
             scene,
             opts,
             casters,
+            shells,
             gpu_casters,
             scene_vertex_count: verts.len() as u32,
             scene_vertices,
@@ -416,6 +420,7 @@ impl Renderer {
             std::ptr::drop_in_place(&mut me.scene);
             std::ptr::drop_in_place(&mut me.opts);
             std::ptr::drop_in_place(&mut me.casters);
+            std::ptr::drop_in_place(&mut me.shells);
             std::ptr::drop_in_place(&mut me.gpu_casters);
             std::ptr::drop_in_place(&mut me.readback);
             std::ptr::drop_in_place(&mut me.stream);
@@ -938,6 +943,18 @@ impl Renderer {
                 features_missing.push(name.to_string());
             }
         }
+        // 8-bit stencil counts wrap at 256: a pixel inside a multiple of 256 volumes reads as
+        // lit. Flag lights whose drawn casters could nest that deep (a heuristic: one caster
+        // folding 256 times over itself is not detected).
+        let mut warnings = Vec::new();
+        for (li, plan) in plans.iter().enumerate() {
+            let drawn: usize = plan.casters.iter().filter(|c| c.case != Case::Culled).map(|c| self.shells[c.caster]).sum();
+            if drawn > 255 {
+                warnings.push(format!(
+                    "light {li}: {drawn} closed shells cast shadow volumes; pixels inside 256k of them wrap to 0 in the 8-bit stencil and read as lit"
+                ));
+            }
+        }
         let stats = Stats {
             device: ctx.info.name.clone(),
             method: self.opts.method.to_string(),
@@ -952,6 +969,7 @@ impl Renderer {
             wall_ms: wall.elapsed().as_secs_f64() * 1e3,
             features_used,
             features_missing,
+            warnings,
         };
         let mut out = FrameOutput { width: w, height: h, color, stencil, positions, normals, stats };
         if self.opts.view == View::Stencil {
@@ -988,6 +1006,30 @@ impl Renderer {
             }
         }
     }
+}
+
+/// Connected components of a mesh (triangles sharing a vertex), by union-find.
+fn shell_count(mesh: &crate::geom::Mesh) -> usize {
+    let mut parent: Vec<u32> = (0..mesh.positions.len() as u32).collect();
+    fn find(p: &mut [u32], mut i: u32) -> u32 {
+        while p[i as usize] != i {
+            p[i as usize] = p[p[i as usize] as usize];
+            i = p[i as usize];
+        }
+        i
+    }
+    for t in &mesh.triangles {
+        for k in 1..3 {
+            let (a, b) = (find(&mut parent, t[0]), find(&mut parent, t[k]));
+            if a != b {
+                parent[a as usize] = b;
+            }
+        }
+    }
+    let mut roots: Vec<u32> = mesh.triangles.iter().map(|t| find(&mut parent, t[0])).collect();
+    roots.sort_unstable();
+    roots.dedup();
+    roots.len()
 }
 
 fn case_name(c: Case) -> &'static str {

@@ -91,4 +91,6 @@ pub struct Stats {
     /// Which optional features were used and which were missing (so skipped).
     pub features_used: Vec<String>,
     pub features_missing: Vec<String>,
+    /// Things the user should know about this frame (e.g. possible 8-bit stencil overflow).
+    pub warnings: Vec<String>,
 }
