@@ -10,6 +10,7 @@ pub const SCENES: &[(&str, &str)] = &[
     ("bench/vertex", include_str!("../../scenes/bench/vertex.toml")),
     ("hard/big_caster", include_str!("../../scenes/hard/big_caster.toml")),
     ("hard/light_inside_caster", include_str!("../../scenes/hard/light_inside_caster.toml")),
+    ("hard/nested_256", include_str!("../../scenes/hard/nested_256.toml")),
     ("hard/eye_in_volume", include_str!("../../scenes/hard/eye_in_volume.toml")),
     ("hard/eye_in_two_volumes", include_str!("../../scenes/hard/eye_in_two_volumes.toml")),
     ("hard/near_plane_cut", include_str!("../../scenes/hard/near_plane_cut.toml")),
