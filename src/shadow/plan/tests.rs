@@ -386,3 +386,68 @@ fn scissor_depth_in_plan() {
     assert!(0.0 < d0 && d0 < d1 && d1 < 1.0);
     assert!(p.plan_ms >= p.silhouette_ms);
 }
+
+/// FNV-1a over the parts of a plan the GPU consumes (index lists, counts, kinds, light).
+fn plan_digest(h: &mut u64, p: &CasterPlan) {
+    let mut eat = |bytes: &[u8]| {
+        for &b in bytes {
+            *h ^= b as u64;
+            *h = h.wrapping_mul(0x100000001b3);
+        }
+    };
+    let head = format!(
+        "{:?}|{}|{}|{}|{}|{:?}|{:?}|{:?}|",
+        p.case, p.silhouette_edges, p.sides, p.dark_cap, p.light_cap, p.dark_cap_kind, p.formulation,
+        p.light_object.map(f32::to_bits)
+    );
+    eat(head.as_bytes());
+    for d in &p.chunks {
+        eat(&(d.chunk as u64).to_le_bytes());
+        eat(&(d.volume.len() as u64).to_le_bytes());
+        for i in &d.volume {
+            eat(&i.to_le_bytes());
+        }
+        eat(&(d.light_cap.len() as u64).to_le_bytes());
+        for i in &d.light_cap {
+            eat(&i.to_le_bytes());
+        }
+    }
+}
+
+/// Closed manifold casters keep the exact plans (index bytes, counts, kinds) they had before
+/// the multiplicity path existed: the digest was recorded on the manifold-only planner.
+#[test]
+fn closed_manifold_plans_unchanged() {
+    let casters = vec![
+        Caster::new("box", &cube(Vec3::ZERO, 0.5), Mat4::IDENTITY).unwrap(),
+        Caster::new("sphere", &uv_sphere(1.0, 24, 13), Mat4::from_translation(Vec3::new(0.3, -0.2, 0.1))).unwrap(),
+        Caster::new("torus", &torus(1.0, 0.35, 20, 10), Mat4::from_translation(Vec3::new(0.5, 0.0, 0.0))).unwrap(),
+        Caster::with_chunk_limit("sphere-chunks", &uv_sphere(1.0, 24, 13), Mat4::IDENTITY, 40).unwrap(),
+        {
+            let mut m = torus(1.0, 0.35, 20, 10);
+            for t in &mut m.triangles {
+                t.swap(1, 2);
+            }
+            Caster::new("mirrored", &m, Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0))).unwrap()
+        },
+    ];
+    let mut r = rng(4242);
+    let mut h = 0xcbf29ce484222325u64;
+    let mut cases = std::collections::BTreeMap::<String, usize>::new();
+    for i in 0..60 {
+        let dist = [0.2f32, 1.0, 1.5, 4.0, 30.0][i % 5];
+        let p = Vec3::new(r(), r(), r()).normalize_or(Vec3::X) * dist;
+        let light = if i % 7 == 0 { dir(-p) } else { point(p) };
+        let cams = [cam1(), cam2(), cam3(), Camera { up: Vec3::Y, ..camera(-p.normalize_or(Vec3::X) * 6.0 + Vec3::new(0.01, 0.02, 0.0), Vec3::ZERO) }];
+        for cam in &cams {
+            for method in Method::ALL {
+                for cp in &plan(cam, &light, method, &casters).casters {
+                    *cases.entry(format!("{:?}/{:?}/{:?}", cp.case, cp.dark_cap_kind, cp.formulation)).or_default() += 1;
+                    plan_digest(&mut h, cp);
+                }
+            }
+        }
+    }
+    assert!(cases.len() >= 7, "{cases:?}");
+    assert_eq!(h, 0x86ce1563d2ec8b79, "digest {h:#018x} {cases:?}");
+}
