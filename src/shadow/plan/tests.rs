@@ -700,15 +700,17 @@ fn multiplicity_counts_equal_occluders() {
                 let light = if i % 6 == 0 { dir(-lp) } else { point(lp) };
                 let lh = light.homogeneous();
                 let eye = Vec3::new(r(), r(), r()).normalize_or(Vec3::Y) * (3.0 + 2.0 * r().abs());
-                let cam = Camera { up: Vec3::new(0.3, 0.1, 1.0), ..camera(eye, Vec3::new(r(), r(), r()) * 0.3) };
+                // every fourth camera looks away from the caster (McGuire's case 2)
+                let target = if i % 4 == 3 { eye * 2.0 } else { Vec3::new(r(), r(), r()) * 0.3 };
+                let cam = Camera { up: Vec3::new(0.3, 0.1, 1.0), ..camera(eye, target) };
                 let vp = cam.proj_infinite(1.0) * cam.view();
                 for method in Method::ALL {
                     let cp = &plan(&cam, &light, method, cs).casters[0];
                     assert_eq!(cp.path, "multiplicity");
-                    assert_eq!(cp.formulation, Formulation::TwoSided);
                     if cp.case == Case::Culled {
                         continue;
                     }
+                    assert_eq!(cp.formulation, Formulation::TwoSided);
                     if cp.case == Case::ZFailLightCap {
                         assert_closed(caster, cp, light.kind == LightKind::Directional);
                     }
@@ -719,7 +721,11 @@ fn multiplicity_counts_equal_occluders() {
                     let mut tries = 0;
                     while n < 25 && tries < 400 {
                         tries += 1;
-                        let p = DVec3::new(r() as f64, r() as f64, r() as f64) * 2.5;
+                        let p = if i % 4 == 3 {
+                            e * 1.6 + DVec3::new(r() as f64, r() as f64, r() as f64) * 2.5
+                        } else {
+                            DVec3::new(r() as f64, r() as f64, r() as f64) * 2.5
+                        };
                         let clip = vp.as_dmat4() * p.extend(1.0);
                         if !(clip.w > 0.2 && clip.x.abs() < clip.w && clip.y.abs() < clip.w) {
                             continue; // outside the view frustum: no pixel
@@ -754,9 +760,72 @@ fn multiplicity_counts_equal_occluders() {
         }
     }
     eprintln!("{checked:?}");
-    for k in ["ZPass/None", "ZFailLightCap/Fan", "ZFailLightCap/AllFaces", "ZFailLightCap/None"] {
+    for k in ["ZPass/None", "ZFailLightCap/Fan", "ZFailLightCap/AllFaces", "ZFailLightCap/None", "ZFail/Fan", "ZFail/AllFaces"] {
         assert!(checked.get(k).copied().unwrap_or(0) > 100, "{k}: {checked:?}");
     }
 }
 
 const MAX_CHUNK_VERTICES_TEST: usize = crate::shadow::caster::MAX_CHUNK_VERTICES;
+
+/// The rules on small cases: multiplicity per edge, caps, stats.
+#[test]
+fn multiplicity_rules() {
+    let meshes: HashMap<_, _> = open_meshes().into_iter().collect();
+    let above = point(Vec3::new(0.05, 5.0, 0.02));
+    let one = |name: &str, light: &Light, cam: &Camera, method: Method| {
+        let c = multiplicity_caster(name, &meshes[name], Mat4::IDENTITY, MAX_CHUNK_VERTICES_TEST);
+        plan(cam, light, method, std::slice::from_ref(&c)).casters[0].clone()
+    };
+    // a quad: the diagonal cancels (m = 0), the four boundary edges have |m| = 1
+    let p = one("quad", &above, &cam3(), Method::McGuire);
+    assert_eq!((p.path, p.case, p.dark_cap_kind), ("multiplicity", Case::ZFailLightCap, DarkCap::Fan));
+    assert_eq!((p.silhouette_edges, p.multiplicity_max, p.sides, p.dark_cap, p.light_cap), (4, 1, 8, 4, 2));
+    // seen from below (cam3 looks up the y axis): both triangles face the eye, caps are NEVER
+    assert_eq!(p.chunks[0].light_cap.len(), 6);
+    // from above the eye sees the quad's back: its caps go to the LESS list, none to NEVER
+    let cam_above = Camera { up: Vec3::Z, ..camera(Vec3::new(0.0, 3.0, 0.0), Vec3::ZERO) };
+    let p = one("quad", &point(Vec3::new(0.05, -5.0, 0.02)), &cam_above, Method::McGuire);
+    assert_eq!(p.light_cap, 2);
+    assert!(p.chunks[0].light_cap.is_empty());
+    // z-pass: only the see-through caps are drawn (in the volume list): cam1 is above the
+    // quad and sees its back
+    let p = one("quad", &above, &cam1(), Method::McGuire);
+    assert_eq!((p.case, p.light_cap), (Case::ZPass, 2));
+    assert!(p.chunks[0].light_cap.is_empty());
+    let p = one("quad", &above, &cam_above, Method::ZPass);
+    assert_eq!((p.case, p.light_cap, p.chunks[0].volume.len()), (Case::ZPass, 2, 3 * (8 + 2)));
+    // open box lit from above: only the rim, once
+    let p = one("open box", &above, &cam3(), Method::ZFail);
+    assert_eq!((p.silhouette_edges, p.multiplicity_max, p.dark_cap_kind, p.light_cap), (4, 1, DarkCap::AllFaces, 10));
+    assert_eq!(p.dark_cap, 10);
+    // a box whose lit (-z) face is duplicated: its rim counts 3 (2 copies + the far wall),
+    // 4 on the edge it shares with the back-to-back -y triangle pair
+    let p = one("box with duplicates", &point(Vec3::new(0.05, 0.02, -5.0)), &cam3(), Method::McGuire);
+    assert_eq!(p.multiplicity_max, 4);
+    let c = multiplicity_caster("d", &meshes["box with duplicates"], Mat4::IDENTITY, MAX_CHUNK_VERTICES_TEST);
+    let f = facing_bits(c.mesh(), Vec4::new(0.05, 0.02, -5.0, 1.0), false);
+    let mult = edge_multiplicities(&c, &f);
+    let m_of = |a: u32, b: u32| {
+        let e = c.topology.edges.iter().position(|e| e.v == [a.min(b), a.max(b)]).unwrap();
+        mult[e] * if a < b { 1 } else { -1 }
+    };
+    assert_eq!(m_of(0, 1), -4); // welded ids = cube ids here
+    assert_eq!(m_of(2, 3).abs(), 3);
+    assert_eq!(m_of(0, 3), 0); // the -z diagonal
+    // a closed box on the multiplicity path: every silhouette edge twice (near + far face)
+    let p = one("inside-out box", &above, &cam3(), Method::McGuire);
+    assert_eq!((p.silhouette_edges, p.multiplicity_max, p.sides), (4, 2, 16));
+    // McGuire case 2 (caster out of view): no light cap at all
+    let p = one("T junction", &above, &cam2(), Method::McGuire);
+    assert_eq!((p.case, p.light_cap), (Case::ZFail, 0));
+    assert!(p.chunks.iter().all(|d| d.light_cap.is_empty()));
+    // directional: one triangle per side, no dark cap
+    let p = one("triangle", &dir(Vec3::NEG_Y), &cam3(), Method::McGuire);
+    assert_eq!((p.silhouette_edges, p.sides, p.dark_cap, p.dark_cap_kind), (3, 3, 0, DarkCap::None));
+    // light inside the open box: per-triangle dark caps even for McGuire
+    let p = one("open box", &point(Vec3::new(0.1, 0.2, -0.1)), &cam3(), Method::McGuire);
+    assert_eq!(p.dark_cap_kind, DarkCap::AllFaces);
+    // closed manifolds report the manifold path
+    let p = &plan(&cam3(), &above, Method::McGuire, &box_caster()).casters[0];
+    assert_eq!((p.path, p.multiplicity_max, p.formulation), ("manifold", 1, Formulation::Front));
+}
