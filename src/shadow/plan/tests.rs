@@ -488,25 +488,10 @@ fn open_meshes() -> Vec<(&'static str, Mesh)> {
     out.push(("two boxes back-to-back", two.clone()));
     // the same with the shared face kept once: its edges are used by 3 triangles
     let mut one_wall = two.clone();
-    let xs = |m: &Mesh, t: &[u32; 3]| t.iter().all(|&i| m.positions[i as usize].x == 0.0);
-    let mut seen = false;
-    let tris = one_wall.triangles.clone();
-    one_wall.triangles = tris
-        .iter()
-        .filter(|t| {
-            if !xs(&two, t) {
-                return true;
-            }
-            // keep the first box's two triangles of the wall
-            let keep = !seen || true;
-            seen = true;
-            keep
-        })
-        .copied()
-        .collect();
-    let wall: Vec<usize> = (0..one_wall.triangles.len()).filter(|&i| xs(&two, &one_wall.triangles[i])).collect();
+    let on_wall = |t: &[u32; 3]| t.iter().all(|&i| two.positions[i as usize].x == 0.0);
+    let wall: Vec<usize> = (0..two.triangles.len()).filter(|&i| on_wall(&two.triangles[i])).collect();
     assert_eq!(wall.len(), 4);
-    one_wall.triangles.remove(wall[3]);
+    one_wall.triangles.remove(wall[3]); // the second box's copy of the wall goes
     one_wall.triangles.remove(wall[2]);
     out.push(("two boxes one wall", one_wall));
     // a box with duplicated faces: two faces repeated as they are, one back-to-back
