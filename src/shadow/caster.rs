@@ -1,4 +1,10 @@
-//! Shadow casters prepared once at load: welded closed mesh, topology, and GPU chunks.
+//! Shadow casters prepared once at load: welded mesh, topology, and GPU chunks.
+//!
+//! Closed, consistently oriented 2-manifolds take the classic path (silhouette edges, one
+//! closed volume). Every other mesh (open boundaries, edges shared by 3+ triangles,
+//! inconsistent winding, duplicated or back-to-back faces) takes the multiplicity path of
+//! Kim, Kim & Turk (2008): every triangle occludes from both sides, and the count at a point
+//! is the number of caster triangles between it and the light (see `plan`).
 
 use crate::error::{Error, Result};
 use crate::geom::topology::Topology;
@@ -38,10 +44,36 @@ impl Chunk {
     }
 }
 
-/// A closed 2-manifold shadow caster.
+/// Which volume construction a caster takes.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum CasterKind {
+    /// Closed, consistently oriented 2-manifold: silhouette edges of the facing bits.
+    Manifold,
+    /// Anything else: per-edge multiplicities, every triangle a two-sided occluder.
+    Multiplicity {
+        /// Why the mesh is not a closed manifold ([`Topology::describe_problem`]).
+        reason: String,
+    },
+}
+
+impl CasterKind {
+    pub fn path(&self) -> &'static str {
+        match self {
+            CasterKind::Manifold => "manifold",
+            CasterKind::Multiplicity { .. } => "multiplicity",
+        }
+    }
+}
+
+/// A shadow caster: welded mesh, topology and chunks.
 #[derive(Clone, Debug)]
 pub struct Caster {
     pub name: String,
+    pub kind: CasterKind,
+    /// Multiplicity casters only (empty otherwise): for every welded triangle, the id of the
+    /// group of triangles with exactly the same three welded vertices (any order, any
+    /// winding: duplicates and back-to-back pairs), or `u32::MAX` when it has no twin.
+    pub coincident: Vec<u32>,
     pub topology: Topology,
     pub chunks: Vec<Chunk>,
     /// For every welded triangle: (chunk, local triangle index).
@@ -72,15 +104,11 @@ impl Caster {
         assert!((4..=MAX_CHUNK_VERTICES).contains(&limit));
         mesh.validate(name)?;
         let topology = Topology::build(mesh);
-        if !topology.is_closed_manifold() {
-            return Err(Error::mesh(
-                name,
-                format!(
-                    "not a closed 2-manifold: {} (non-manifold casters are not supported yet)",
-                    topology.describe_problem()
-                ),
-            ));
-        }
+        let kind = if topology.is_closed_manifold() {
+            CasterKind::Manifold
+        } else {
+            CasterKind::Multiplicity { reason: topology.describe_problem() }
+        };
         let det = transform.determinant();
         if !(det.is_finite() && det != 0.0) {
             return Err(Error::mesh(name, "transform is singular"));
@@ -89,8 +117,14 @@ impl Caster {
         let apex = object_bounds.center();
         let (chunks, tri_chunk) = build_chunks(&topology.mesh, apex, limit);
         let max_local_vertices = chunks.iter().map(|c| c.vertices.len()).max().unwrap_or(0);
+        let coincident = match kind {
+            CasterKind::Manifold => Vec::new(),
+            CasterKind::Multiplicity { .. } => coincident_groups(&topology.mesh),
+        };
         Ok(Caster {
             name: name.to_string(),
+            kind,
+            coincident,
             triangle_count: topology.mesh.triangles.len(),
             topology,
             chunks,
@@ -104,6 +138,10 @@ impl Caster {
         })
     }
 
+    pub fn is_manifold(&self) -> bool {
+        self.kind == CasterKind::Manifold
+    }
+
     pub fn mesh(&self) -> &Mesh {
         &self.topology.mesh
     }
@@ -111,6 +149,38 @@ impl Caster {
     pub fn world_bounds(&self) -> Aabb {
         self.object_bounds.transformed(&self.transform)
     }
+}
+
+/// Groups of triangles with the same welded vertex set (see [`Caster::coincident`]).
+fn coincident_groups(mesh: &Mesh) -> Vec<u32> {
+    let mut keyed: Vec<([u32; 3], u32)> = mesh
+        .triangles
+        .iter()
+        .enumerate()
+        .map(|(t, tri)| {
+            let mut k = *tri;
+            k.sort_unstable();
+            (k, t as u32)
+        })
+        .collect();
+    keyed.sort_unstable();
+    let mut out = vec![u32::MAX; mesh.triangles.len()];
+    let mut group = 0u32;
+    let mut i = 0;
+    while i < keyed.len() {
+        let mut j = i + 1;
+        while j < keyed.len() && keyed[j].0 == keyed[i].0 {
+            j += 1;
+        }
+        if j - i > 1 {
+            for &(_, t) in &keyed[i..j] {
+                out[t as usize] = group;
+            }
+            group += 1;
+        }
+        i = j;
+    }
+    out
 }
 
 /// Greedy chunking in triangle order (mesh order usually has good locality).
@@ -166,12 +236,31 @@ mod tests {
     use crate::shadow::testmesh::{cube, uv_sphere};
 
     #[test]
-    fn rejects_open_mesh() {
+    fn open_mesh_takes_multiplicity_path() {
         let mut m = cube(Vec3::ZERO, 1.0);
         m.triangles.pop();
-        let e = Caster::new("boxy", &m, Mat4::IDENTITY).unwrap_err().to_string();
-        assert!(e.contains("boxy") && e.contains("not a closed 2-manifold: 3 boundary edges (open mesh)"), "{e}");
-        assert!(e.contains("non-manifold casters are not supported yet"));
+        let c = Caster::new("boxy", &m, Mat4::IDENTITY).unwrap();
+        assert_eq!(c.kind, CasterKind::Multiplicity { reason: "3 boundary edges (open mesh)".into() });
+        assert_eq!(c.kind.path(), "multiplicity");
+        assert!(c.coincident.iter().all(|&g| g == u32::MAX));
+        check_chunks(&c);
+        let closed = Caster::new("box", &cube(Vec3::ZERO, 1.0), Mat4::IDENTITY).unwrap();
+        assert_eq!(closed.kind, CasterKind::Manifold);
+        assert!(closed.is_manifold() && closed.coincident.is_empty());
+        // duplicated and back-to-back faces are grouped
+        let mut m = cube(Vec3::ZERO, 1.0);
+        let t0 = m.triangles[0];
+        m.triangles.push([t0[0], t0[2], t0[1]]);
+        m.triangles.push(t0);
+        let c = Caster::with_chunk_limit("dup", &m, Mat4::IDENTITY, 5).unwrap();
+        assert!(matches!(&c.kind, CasterKind::Multiplicity { reason } if reason.contains("shared by more than 2")));
+        let g = c.coincident[0];
+        assert!(g != u32::MAX && c.coincident[12] == g && c.coincident[13] == g);
+        assert_eq!(c.coincident.iter().filter(|&&x| x != u32::MAX).count(), 3);
+        check_chunks(&c);
+        // still rejected: empty meshes and singular transforms
+        assert!(Caster::new("e", &Mesh::default(), Mat4::IDENTITY).is_err());
+        assert!(Caster::new("s", &cube(Vec3::ZERO, 1.0), Mat4::from_scale(Vec3::new(1.0, 0.0, 1.0))).is_err());
     }
 
     fn check_chunks(c: &Caster) {

@@ -4,5 +4,5 @@ pub mod caster;
 pub mod plan;
 pub mod testmesh;
 
-pub use caster::{Caster, Chunk};
+pub use caster::{Caster, CasterKind, Chunk};
 pub use plan::{plan_light, Case, CasterPlan, ChunkDraw, DarkCap, LightPlan, Method, PlanInput};

@@ -11,8 +11,35 @@
 //!
 //! Every emitted triangle's front face points OUT of the shadow volume (tests prove it with
 //! directed-edge cancellation and a positive signed volume at finite extrusion).
+//!
+//! # Multiplicity casters (Kim, Kim & Turk 2008)
+//!
+//! Casters that are not closed 2-manifolds are the sum of one volume per triangle: `V_T` =
+//! the points whose segment to the light crosses `T`, whichever way `T` faces. Let `T'` be
+//! `T` oriented towards the light (`T` if its facing bit is set, else reversed). `V_T` is
+//! closed by the light cap `T'`, the dark cap `T'∞` reversed, and one side `(b, a, a∞, b∞)`
+//! per edge `a -> b` of `T'`; every face points out of `V_T`. The stencil count at a point is
+//! then the number of caster triangles between it and the light: zero iff lit.
+//! Summing the sides of all triangles per undirected edge `(v0 < v1)` gives its
+//! **multiplicity** `m = Σ_T s_T`, `s_T = (T walks v0->v1 ? +1 : -1) * (T light-facing ? +1 : -1)`;
+//! the side of `v0 -> v1` is emitted `m` times when `m > 0`, the side of `v1 -> v0` `-m` times
+//! when `m < 0`, nothing when `m = 0` (interior edges of a consistently facing patch). A
+//! closed manifold's silhouette edges get `|m| = 2` here (both the near and the far face
+//! occlude), which is why closed manifolds keep the classic path.
+//! Caps: the fan dark cap works per edge exactly as for manifolds (`|m|` copies of
+//! `(apex∞, b∞, a∞)` for the oriented edge a->b, point light strictly outside the AABB);
+//! otherwise every triangle's `T'∞` reversed (`DarkCap::AllFaces`).
+//! Light caps: the renderer's depth-NEVER light-cap pipeline counts a cap as if it were
+//! behind the visible surface. That holds for a triangle the G-buffer pass drew (front-facing
+//! to the eye: back faces are culled), since the visible surface is then at or in front of
+//! it; and drawing such caps with LESS instead would z-fight with the very surface they lie
+//! on (self-shadowing acne). An open mesh, though, can be seen THROUGH a triangle whose back
+//! faces the eye, and that cap may lie in front of the visible surface. So: caps of
+//! triangles that face the eye, or have an exact coincident twin that does (duplicates,
+//! back-to-back pairs), go to `light_cap` (NEVER, z-fail cases only); the caps of all other
+//! triangles go to `volume` (depth LESS) in z-pass and in the z-fail-with-light-cap case.
 
-use super::caster::Caster;
+use super::caster::{Caster, CasterKind};
 use crate::error::Error;
 use crate::geom::bounds::{
     box_distance, light_depth_bounds, light_scissor, shadow_volume_outside_frustum, Frustum, OcclusionPyramid,
@@ -98,6 +125,8 @@ pub enum DarkCap {
     FrontFaces,
     /// No dark cap (z-pass, or a directional light: all of infinity is one point).
     None,
+    /// Multiplicity casters: every triangle's w=0 copy, oriented away from the light.
+    AllFaces,
 }
 
 /// Which closed volume the geometry describes.
@@ -108,6 +137,8 @@ pub enum Formulation {
     Front,
     /// Occluders are the non-light-facing triangles (point light inside/on the caster AABB).
     Back,
+    /// Multiplicity casters: every triangle occludes, from both sides.
+    TwoSided,
 }
 
 pub struct PlanInput<'a> {
@@ -123,9 +154,10 @@ pub struct PlanInput<'a> {
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
 pub struct ChunkDraw {
     pub chunk: usize,
-    /// Sides then dark cap; drawn with depth test LESS.
+    /// Sides then dark cap (then, for multiplicity casters, the light caps that may lie in
+    /// front of the visible surface); drawn with depth test LESS.
     pub volume: Vec<u16>,
-    /// Light cap; drawn with depth compare NEVER.
+    /// Light cap; drawn with depth compare NEVER (z-fail cases only).
     pub light_cap: Vec<u16>,
 }
 
@@ -133,7 +165,12 @@ pub struct ChunkDraw {
 pub struct CasterPlan {
     pub caster: usize,
     pub case: Case,
+    /// `"manifold"` or `"multiplicity"` ([`CasterKind::path`]).
+    pub path: &'static str,
+    /// Silhouette edges (manifold) / edges of non-zero multiplicity.
     pub silhouette_edges: usize,
+    /// Largest |multiplicity| of an emitted side (1 for a manifold silhouette, 0 when none).
+    pub multiplicity_max: u32,
     /// Triangle counts actually emitted.
     pub sides: usize,
     pub dark_cap: usize,
@@ -213,6 +250,7 @@ pub fn emit(caster: &Caster, facing: &[bool], sil: &[SilhouetteEdge], e: Emit) -
         let (tri, corner, rev) = match e.formulation {
             Formulation::Front => (s.lit, s.lit_corner, false),
             Formulation::Back => (s.unlit, s.unlit_corner, true),
+            Formulation::TwoSided => unreachable!("multiplicity casters use emit_multiplicity"),
         };
         let (ci, li) = caster.tri_chunk[tri as usize];
         let ch = &caster.chunks[ci as usize];
@@ -261,6 +299,7 @@ pub fn emit(caster: &Caster, facing: &[bool], sil: &[SilhouetteEdge], e: Emit) -
                 }
             }
             DarkCap::None => {}
+            DarkCap::AllFaces => unreachable!("multiplicity casters use emit_multiplicity"),
         }
     }
     if e.light_cap {
@@ -285,6 +324,217 @@ pub fn emit(caster: &Caster, facing: &[bool], sil: &[SilhouetteEdge], e: Emit) -
     (draws, sides, dark, light)
 }
 
+/// The case a method picks for a caster whose world box is `wb` (same for both paths).
+fn select_case(method: Method, pyramid: &OcclusionPyramid, frustum: &Frustum, wb: &Aabb) -> Case {
+    match method {
+        Method::ZPass => Case::ZPass,
+        Method::ZFail | Method::EverittKilgard => Case::ZFailLightCap,
+        Method::Lengyel => {
+            if pyramid.intersects_box(wb) {
+                Case::ZFailLightCap
+            } else {
+                Case::ZPass
+            }
+        }
+        Method::McGuire => {
+            if !pyramid.intersects_box(wb) {
+                Case::ZPass
+            } else if !frustum.intersects_box(wb) {
+                Case::ZFail
+            } else {
+                Case::ZFailLightCap
+            }
+        }
+    }
+}
+
+/// Per-light facing data of a multiplicity caster.
+pub struct MultiplicityInput<'a> {
+    /// Light-facing bit of every triangle.
+    pub facing: &'a [bool],
+    /// Whether each triangle's light cap is known to be at or behind the visible surface
+    /// (the triangle, or an exact twin of it, is front-facing to the eye, so the G-buffer
+    /// pass drew it): such caps go to the depth-NEVER list.
+    pub shielded: &'a [bool],
+}
+
+/// Signed multiplicity of every undirected edge of the topology (`v[0] -> v[1]` positive).
+pub fn edge_multiplicities(caster: &Caster, facing: &[bool]) -> Vec<i32> {
+    let t = &caster.topology;
+    (0..t.edges.len())
+        .map(|e| {
+            t.edge_uses(e)
+                .iter()
+                .map(|u| if u.forward == facing[u.tri as usize] { 1 } else { -1 })
+                .sum()
+        })
+        .collect()
+}
+
+/// Emits a multiplicity caster's index lists; returns (draws, sides, dark cap, light cap,
+/// edges with m != 0, largest |m|).
+pub fn emit_multiplicity(
+    caster: &Caster,
+    mi: &MultiplicityInput,
+    mult: &[i32],
+    case: Case,
+    directional: bool,
+    dark_cap: DarkCap,
+) -> (Vec<ChunkDraw>, usize, usize, usize, usize, u32) {
+    let nch = caster.chunks.len();
+    let mut vol: Vec<Vec<u16>> = vec![Vec::new(); nch];
+    let mut cap: Vec<Vec<u16>> = vec![Vec::new(); nch];
+    let (mut sides, mut dark, mut light, mut edges, mut mmax) = (0, 0, 0, 0, 0u32);
+    let topo = &caster.topology;
+    // the oriented edge a->b (chunk-local, in the chunk of its first use) and |m|
+    let oriented = |e: usize, m: i32| {
+        let u = topo.edge_uses(e)[0];
+        let (ci, li) = caster.tri_chunk[u.tri as usize];
+        let ch = &caster.chunks[ci as usize];
+        let lt = ch.local_tris[li as usize];
+        let k = u.corner as usize;
+        // the use walks lt[k] -> lt[k+1]; it is v0 -> v1 iff forward
+        let (mut a, mut b) = (lt[k], lt[(k + 1) % 3]);
+        if u.forward != (m > 0) {
+            std::mem::swap(&mut a, &mut b);
+        }
+        (ci as usize, ch.n() as u16, a, b)
+    };
+    for (e, &m) in mult.iter().enumerate() {
+        if m == 0 {
+            continue;
+        }
+        edges += 1;
+        mmax = mmax.max(m.unsigned_abs());
+        let (ci, n, a, b) = oriented(e, m);
+        for _ in 0..m.unsigned_abs() {
+            if directional {
+                vol[ci].extend_from_slice(&[b, a, a + n]);
+                sides += 1;
+            } else {
+                vol[ci].extend_from_slice(&[b, a, a + n, b, a + n, b + n]);
+                sides += 2;
+            }
+        }
+    }
+    if !directional {
+        match dark_cap {
+            DarkCap::Fan => {
+                for (e, &m) in mult.iter().enumerate() {
+                    if m == 0 {
+                        continue;
+                    }
+                    let (ci, n, a, b) = oriented(e, m);
+                    let apex = caster.chunks[ci].apex();
+                    for _ in 0..m.unsigned_abs() {
+                        vol[ci].extend_from_slice(&[apex + n, b + n, a + n]);
+                        dark += 1;
+                    }
+                }
+            }
+            DarkCap::AllFaces => {
+                for (ci, ch) in caster.chunks.iter().enumerate() {
+                    let n = ch.n() as u16;
+                    for (lt, &g) in ch.local_tris.iter().zip(&ch.tri_ids) {
+                        let t = if mi.facing[g as usize] { [lt[0] + n, lt[2] + n, lt[1] + n] } else { [lt[0] + n, lt[1] + n, lt[2] + n] };
+                        vol[ci].extend_from_slice(&t);
+                        dark += 1;
+                    }
+                }
+            }
+            DarkCap::None => {}
+            DarkCap::FrontFaces | DarkCap::BackFaces => unreachable!("manifold dark caps on a multiplicity caster"),
+        }
+    }
+    if case != Case::ZFail {
+        for (ci, ch) in caster.chunks.iter().enumerate() {
+            for (lt, &g) in ch.local_tris.iter().zip(&ch.tri_ids) {
+                let t = if mi.facing[g as usize] { *lt } else { [lt[0], lt[2], lt[1]] };
+                if !mi.shielded[g as usize] {
+                    vol[ci].extend_from_slice(&t);
+                    light += 1;
+                } else if case == Case::ZFailLightCap {
+                    cap[ci].extend_from_slice(&t);
+                    light += 1;
+                }
+            }
+        }
+    }
+    let draws = vol
+        .into_iter()
+        .zip(cap)
+        .enumerate()
+        .filter(|(_, (v, c))| !v.is_empty() || !c.is_empty())
+        .map(|(chunk, (volume, light_cap))| ChunkDraw { chunk, volume, light_cap })
+        .collect();
+    (draws, sides, dark, light, edges, mmax)
+}
+
+/// Whether each triangle's light cap is at or behind the visible surface for an eye at
+/// `eye_obj` (object space): the triangle or an exact twin is front-facing to the eye.
+pub fn shielded_bits(caster: &Caster, eye_obj: glam::Vec3) -> Vec<bool> {
+    let mut s = facing_bits(caster.mesh(), eye_obj.extend(1.0), caster.mirrored);
+    if !caster.coincident.is_empty() {
+        let groups = caster.coincident.iter().filter(|&&g| g != u32::MAX).max().map_or(0, |&g| g as usize + 1);
+        let mut drawn = vec![false; groups];
+        for (t, &g) in caster.coincident.iter().enumerate() {
+            if g != u32::MAX && s[t] {
+                drawn[g as usize] = true;
+            }
+        }
+        for (t, &g) in caster.coincident.iter().enumerate() {
+            if g != u32::MAX && drawn[g as usize] {
+                s[t] = true;
+            }
+        }
+    }
+    s
+}
+
+fn plan_multiplicity(
+    input: &PlanInput,
+    caster: &Caster,
+    ci: usize,
+    l_obj: Vec4,
+    wb: &Aabb,
+    frustum: &Frustum,
+    pyramid: &OcclusionPyramid,
+) -> (CasterPlan, f64) {
+    let directional = l_obj.w == 0.0;
+    let ts = Instant::now();
+    let facing = facing_bits(caster.mesh(), l_obj, caster.mirrored);
+    let mult = edge_multiplicities(caster, &facing);
+    let t = ts.elapsed().as_secs_f64() * 1e3;
+    let eye_obj = object_light(caster, input.camera.eye.extend(1.0)).truncate();
+    let shielded = shielded_bits(caster, eye_obj);
+    let case = select_case(input.method, pyramid, frustum, wb);
+    let dark_cap_kind = if case == Case::ZPass || directional {
+        DarkCap::None
+    } else if input.method == Method::McGuire && !caster.object_bounds.contains(l_obj.truncate()) {
+        DarkCap::Fan
+    } else {
+        DarkCap::AllFaces
+    };
+    let mi = MultiplicityInput { facing: &facing, shielded: &shielded };
+    let (chunks, sides, dark_cap, light_cap, edges, mmax) =
+        emit_multiplicity(caster, &mi, &mult, case, directional, dark_cap_kind);
+    let plan = CasterPlan {
+        caster: ci,
+        case,
+        path: caster.kind.path(),
+        silhouette_edges: edges,
+        multiplicity_max: mmax,
+        sides,
+        dark_cap,
+        light_cap,
+        chunks,
+        dark_cap_kind,
+        formulation: Formulation::TwoSided,
+        light_object: l_obj.to_array(),
+    };
+    (plan, t)
+}
+
 /// Plans every caster's shadow volume for one light.
 pub fn plan_light(input: &PlanInput, casters: &[Caster]) -> LightPlan {
     let t0 = Instant::now();
@@ -301,7 +551,9 @@ pub fn plan_light(input: &PlanInput, casters: &[Caster]) -> LightPlan {
         let culled_plan = |case| CasterPlan {
             caster: ci,
             case,
+            path: caster.kind.path(),
             silhouette_edges: 0,
+            multiplicity_max: 0,
             sides: 0,
             dark_cap: 0,
             light_cap: 0,
@@ -316,6 +568,12 @@ pub fn plan_light(input: &PlanInput, casters: &[Caster]) -> LightPlan {
             plans.push(culled_plan(Case::Culled));
             continue;
         }
+        if let CasterKind::Multiplicity { .. } = caster.kind {
+            let (cp, t) = plan_multiplicity(input, caster, ci, l_obj, &wb, &frustum, &pyramid);
+            sil_time += t;
+            plans.push(cp);
+            continue;
+        }
         let ts = Instant::now();
         let facing = facing_bits(caster.mesh(), l_obj, caster.mirrored);
         let sil = possible_silhouette(&caster.topology.manifold_edges, &facing);
@@ -326,26 +584,7 @@ pub fn plan_light(input: &PlanInput, casters: &[Caster]) -> LightPlan {
         } else {
             Formulation::Front
         };
-        let case = match input.method {
-            Method::ZPass => Case::ZPass,
-            Method::ZFail | Method::EverittKilgard => Case::ZFailLightCap,
-            Method::Lengyel => {
-                if pyramid.intersects_box(&wb) {
-                    Case::ZFailLightCap
-                } else {
-                    Case::ZPass
-                }
-            }
-            Method::McGuire => {
-                if !pyramid.intersects_box(&wb) {
-                    Case::ZPass
-                } else if !frustum.intersects_box(&wb) {
-                    Case::ZFail
-                } else {
-                    Case::ZFailLightCap
-                }
-            }
-        };
+        let case = select_case(input.method, &pyramid, &frustum, &wb);
         let dark_cap_kind = if case == Case::ZPass || directional {
             DarkCap::None
         } else if formulation == Formulation::Back {
@@ -360,7 +599,9 @@ pub fn plan_light(input: &PlanInput, casters: &[Caster]) -> LightPlan {
         plans.push(CasterPlan {
             caster: ci,
             case,
+            path: caster.kind.path(),
             silhouette_edges: sil.len(),
+            multiplicity_max: u32::from(!sil.is_empty()),
             sides,
             dark_cap,
             light_cap,
