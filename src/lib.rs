@@ -4,6 +4,7 @@
 //! planning) -> [`gpu`] / [`render`]. [`reference`] is the exact CPU ground truth and shares
 //! nothing with the shadow algorithm but the camera model.
 #![warn(unsafe_op_in_unsafe_fn)]
+pub mod conform;
 pub mod error;
 pub mod geom;
 pub mod gpu;

@@ -67,6 +67,11 @@ enum Command {
         #[arg(long, default_value_t = 1e-4)]
         threshold: f64,
     },
+    /// The driver conformance suite for what shadow volumes rely on (reports into --out).
+    Conform {
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
 }
 
 impl Default for FrameArgs {
@@ -103,6 +108,7 @@ fn main() -> ExitCode {
         Command::Render { frame, out, stats, view, dump } => render(&frame, &out, stats.as_deref(), &view, dump.as_deref()),
         Command::Info { json } => info(json),
         Command::Check { dir, band, threshold } => check(&dir, band, threshold),
+        Command::Conform { out } => umbrage::conform::run(out),
     };
     match result {
         Ok(code) => code,
