@@ -114,3 +114,38 @@ pub fn expected_counts(tris: &[WinTri], delta: impl Fn(&WinTri) -> i64, width: u
     }
     (count.into_iter().map(|c| c.rem_euclid(256) as u8).collect(), judged)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tri(p: [[f64; 2]; 3]) -> WinTri {
+        WinTri { p: p.map(|q| DVec2::new(q[0], q[1])), z: [0.5; 3] }
+    }
+
+    #[test]
+    fn facing_follows_vulkan_area_sign() {
+        // Visually counter-clockwise on screen (y down) is front facing.
+        assert!(tri([[0.0, 0.0], [0.0, 4.0], [4.0, 4.0]]).front_facing());
+        assert!(!tri([[0.0, 0.0], [4.0, 4.0], [0.0, 4.0]]).front_facing());
+    }
+
+    #[test]
+    fn pixel_centres_and_edges() {
+        let t = tri([[0.0, 0.0], [0.0, 4.0], [4.0, 4.0]]);
+        assert_eq!(cover(&t, 0, 3), Cover::In);
+        assert_eq!(cover(&t, 3, 0), Cover::Out);
+        assert_eq!(cover(&t, 1, 1), Cover::Edge); // centre (1.5, 1.5) on the diagonal
+        let (c, judged) = expected_counts(&[t, t], |_| 1, 4, 4);
+        assert_eq!(c[3 * 4], 2);
+        assert!(!judged[4 + 1]);
+    }
+
+    #[test]
+    fn w0_vertex_lands_on_depth_one() {
+        let cam = crate::scene::Camera::default();
+        let m = cam.proj_infinite(1.5) * cam.view();
+        let (_, z) = to_window(m.as_dmat4() * DVec4::new(0.3, -0.2, -1.0, 0.0), 160, 120, 8);
+        assert!((z - 1.0).abs() < 1e-12);
+    }
+}
