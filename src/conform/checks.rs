@@ -79,7 +79,16 @@ pub fn w0_vertices_and_infinity(ctx: &Context) -> Result<CheckResult> {
     ];
     let mut numbers = serde_json::Map::new();
     let mut fails = Vec::new();
-    for (label, verts, check_depth) in [("w0_only", a, true), ("mixed_w", b, false)] {
+    // The dark caps through the renderer's format and through every other supported
+    // 8-bit-stencil depth format (D24: 1.0 within one 24-bit ulp).
+    let mut runs = vec![("w0_only".to_string(), a.clone(), true, format), ("mixed_w".to_string(), b, false, format)];
+    for other in [vk::Format::D24_UNORM_S8_UINT, vk::Format::D32_SFLOAT_S8_UINT] {
+        if other != format && harness::format_supported(ctx, other) {
+            runs.push((format!("w0_only_{other:?}"), a.clone(), true, other));
+        }
+    }
+    for (label, verts, check_depth, format) in runs {
+        let label = label.as_str();
         let tris = tri_list(verts.len() as u32 / 3);
         let wt = raster::window_tris(mvp, &verts, &tris, w, h, bits);
         let (expected, judged) = raster::expected_counts(&wt, |_| 1, w, h);
@@ -111,7 +120,7 @@ pub fn w0_vertices_and_infinity(ctx: &Context) -> Result<CheckResult> {
         numbers.insert(
             label.into(),
             json!({
-                "triangles": tris.len(), "covered_pixels": covered, "expected_covered_pixels": expected_covered,
+                "depth_format": format!("{format:?}"), "triangles": tris.len(), "covered_pixels": covered, "expected_covered_pixels": expected_covered,
                 "coverage_mismatches": mism, "edge_pixels_not_judged": unjudged,
                 "depth_min": dmin, "depth_max": dmax, "depth_not_exactly_1": if check_depth { json!(depth_not_one) } else { json!(null) },
             }),
@@ -129,7 +138,6 @@ pub fn w0_vertices_and_infinity(ctx: &Context) -> Result<CheckResult> {
             fails.push(format!("{label}: test geometry covers nothing"));
         }
     }
-    numbers.insert("depth_format".into(), json!(format!("{format:?}")));
     numbers.insert("subpixel_bits".into(), json!(bits));
     Ok(CheckResult::from_fails("w0_vertices_and_infinity", fails, numbers, "coverage exact, dark-cap depth exactly 1.0"))
 }
