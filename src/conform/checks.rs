@@ -57,7 +57,7 @@ fn view_camera() -> Camera {
     Camera { eye: Vec3::ZERO, target: Vec3::new(0.0, 0.0, -1.0), up: Vec3::Y, fov_y_deg: 60.0, near: 0.1 }
 }
 
-/// 1. w = 0 vertices through the infinite projection.
+/// Check 1: w = 0 vertices through the infinite projection.
 pub fn w0_vertices_and_infinity(ctx: &Context) -> Result<CheckResult> {
     let (w, h) = (160u32, 120u32);
     let cam = view_camera();
@@ -142,7 +142,7 @@ pub fn w0_vertices_and_infinity(ctx: &Context) -> Result<CheckResult> {
     Ok(CheckResult::from_fails("w0_vertices_and_infinity", fails, numbers, "coverage exact, dark-cap depth exactly 1.0"))
 }
 
-/// 2. Depth clamp: geometry beyond a finite far plane is clamped to depth 1, not clipped.
+/// Check 2: Depth clamp: geometry beyond a finite far plane is clamped to depth 1, not clipped.
 pub fn depth_clamp(ctx: &Context) -> Result<CheckResult> {
     if !ctx.features.depth_clamp {
         return Ok(CheckResult::skipped("depth_clamp", "skipped: not supported (depthClamp)"));
@@ -203,7 +203,7 @@ pub fn depth_clamp(ctx: &Context) -> Result<CheckResult> {
     Ok(CheckResult::from_fails("depth_clamp", fails, numbers, "beyond-far geometry rasterised at depth 1.0"))
 }
 
-/// 3. Watertight rasterisation: a 1000-triangle fan and a jittered grid mesh.
+/// Check 3: Watertight rasterisation: a 1000-triangle fan and a jittered grid mesh.
 pub fn watertight_fan(ctx: &Context) -> Result<CheckResult> {
     let (w, h) = (128u32, 128u32);
     let mvp = harness::pixel_ortho(w, h);
@@ -344,7 +344,7 @@ fn rect(out: &mut Vec<[f32; 4]>, r: [f32; 4], front: bool) {
     }
 }
 
-/// 4. Two-sided wrapping stencil in one draw.
+/// Check 4: Two-sided wrapping stencil in one draw.
 pub fn two_sided_stencil_wrap(ctx: &Context) -> Result<CheckResult> {
     let (w, h) = (96u32, 48u32);
     let mvp = harness::pixel_ortho(w, h);
@@ -397,7 +397,7 @@ pub fn two_sided_stencil_wrap(ctx: &Context) -> Result<CheckResult> {
     Ok(CheckResult::from_fails("two_sided_stencil_wrap", fails, numbers, "front INCR_WRAP / back DECR_WRAP counts and wrap exact"))
 }
 
-/// 5. Clear, write and read back the stencil aspect of D24S8 and D32S8.
+/// Check 5: Clear, write and read back the stencil aspect of D24S8 and D32S8.
 pub fn stencil_formats(ctx: &Context) -> Result<CheckResult> {
     let (w, h) = (48u32, 32u32);
     let mvp = harness::pixel_ortho(w, h);
@@ -437,7 +437,7 @@ pub fn stencil_formats(ctx: &Context) -> Result<CheckResult> {
     Ok(CheckResult::from_fails("stencil_formats", fails, numbers, "stencil aspect clears, writes and reads back"))
 }
 
-/// 6. Depth bounds: fragments whose stored depth is outside the bounds are rejected.
+/// Check 6: Depth bounds: fragments whose stored depth is outside the bounds are rejected.
 pub fn depth_bounds(ctx: &Context) -> Result<CheckResult> {
     if !ctx.features.depth_bounds {
         return Ok(CheckResult::skipped("depth_bounds", "skipped: not supported (depthBounds)"));
@@ -480,7 +480,7 @@ pub fn depth_bounds(ctx: &Context) -> Result<CheckResult> {
     Ok(CheckResult::from_fails("depth_bounds", fails, numbers, "only stored depth 0.5 passes bounds [0.4, 0.6]"))
 }
 
-/// 7. The same triangles through u32, u16, u8 (when supported) and no indices.
+/// Check 7: The same triangles through u32, u16, u8 (when supported) and no indices.
 pub fn index_types(ctx: &Context) -> Result<CheckResult> {
     let (w, h) = (64u32, 64u32);
     let mvp = harness::pixel_ortho(w, h);
@@ -540,7 +540,7 @@ pub const ZPASS_EXPECTED_FAILURES: &[&str] = &["hard/eye_in_volume", "hard/eye_i
 /// Threshold on the fraction of compared pixels outside the 1-pixel band.
 pub const PIPELINE_THRESHOLD: f64 = 1e-4;
 
-/// 8. The whole shadow pipeline on every `hard/*` scene and every method, against the CPU
+/// Check 8: The whole shadow pipeline on every `hard/*` scene and every method, against the CPU
 /// reference (through the same dump check as `umbrage check`).
 pub fn shadow_pipeline_hard_cases(new_context: &dyn Fn() -> Result<Context>, width: u32, height: u32) -> Result<CheckResult> {
     use crate::render::{RenderOptions, Renderer};
