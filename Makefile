@@ -17,5 +17,8 @@ test: deps
 bench: deps
 	$(CARGO) bench
 
+conform: deps
+	UMBRAGE_VALIDATION=1 $(CARGO) run -- conform --out conform-report
+
 clean:
 	$(CARGO) clean

@@ -6,6 +6,7 @@
 #![warn(unsafe_op_in_unsafe_fn)]
 pub mod accuracy;
 pub mod bench;
+pub mod conform;
 pub mod error;
 pub mod geom;
 pub mod gpu;

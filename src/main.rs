@@ -88,6 +88,11 @@ enum Command {
         #[arg(long, default_value_t = 1e-4)]
         threshold: f64,
     },
+    /// The driver conformance suite for what shadow volumes rely on (reports into --out).
+    Conform {
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
 }
 
 impl Default for FrameArgs {
@@ -127,6 +132,7 @@ fn main() -> ExitCode {
         Command::Bench { scenes, methods, frames, size, index_format, json, markdown } => {
             bench(scenes, methods, frames, size, &index_format, json.as_deref(), markdown.as_deref())
         }
+        Command::Conform { out } => umbrage::conform::run(out),
     };
     match result {
         Ok(code) => code,

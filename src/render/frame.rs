@@ -560,6 +560,12 @@ impl Renderer {
                     bytes_per_triangle: if ntris > 0 { (index_bytes + vertex_bytes) as f64 / ntris as f64 } else { 0.0 },
                     index_format: fmt_used.to_string(),
                     dark_cap_kind: format!("{:?}", cp.dark_cap_kind),
+                    path: cp.path.to_string(),
+                    path_reason: match &caster.kind {
+                        crate::shadow::CasterKind::Multiplicity { reason } => reason.clone(),
+                        _ => String::new(),
+                    },
+                    multiplicity_max: cp.multiplicity_max,
                 });
                 ldraws.push((cp.caster, cp.case, Vec4::from_array(cp.light_object), cdraws));
             }

@@ -32,6 +32,12 @@ pub struct CasterStats {
     pub bytes_per_triangle: f64,
     pub index_format: String,
     pub dark_cap_kind: String,
+    /// "manifold" (the three-case path) or "multiplicity" (open / non-manifold casters).
+    pub path: String,
+    /// Why the caster took the multiplicity path (empty for manifold casters).
+    pub path_reason: String,
+    /// Largest |edge multiplicity| drawn (1 for a manifold silhouette).
+    pub multiplicity_max: u32,
 }
 
 #[derive(Clone, Debug, Serialize)]

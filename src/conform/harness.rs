@@ -1,0 +1,248 @@
+//! A tiny offscreen harness for the conformance checks: one depth-stencil image of a chosen
+//! format, a list of draws through `shaders/shadow.vert` (the EXTRUDE shader, with the light at
+//! the origin so that `(xyz, 0)` vertices pass through unchanged), and a read-back of both
+//! aspects. Every Vulkan object it creates is destroyed before `render` returns.
+
+use crate::error::{Error, Result};
+use crate::gpu::pipeline::{self, PipelineDesc};
+use crate::gpu::resources::transition;
+use crate::gpu::{shaders, Buffer, Context, Image};
+use ash::vk;
+use glam::Mat4;
+use gpu_allocator::MemoryLocation;
+
+/// Fixed-function state of one draw.
+#[derive(Clone, Copy)]
+pub struct PipeSpec {
+    pub depth_test: bool,
+    pub depth_write: bool,
+    pub depth_compare: vk::CompareOp,
+    pub depth_clamp: bool,
+    /// Depth bounds test with these bounds (dynamic state).
+    pub depth_bounds: Option<(f32, f32)>,
+    pub front: vk::StencilOpState,
+    pub back: vk::StencilOpState,
+}
+
+impl PipeSpec {
+    /// No depth test, stencil `op` on both faces (compare ALWAYS).
+    pub fn stencil(front: vk::StencilOp, back: vk::StencilOp) -> PipeSpec {
+        PipeSpec {
+            depth_test: false,
+            depth_write: false,
+            depth_compare: vk::CompareOp::ALWAYS,
+            depth_clamp: false,
+            depth_bounds: None,
+            front: pipeline::stencil_ops(front, vk::StencilOp::KEEP),
+            back: pipeline::stencil_ops(back, vk::StencilOp::KEEP),
+        }
+    }
+    /// Stencil REPLACE with `reference` on both faces.
+    pub fn replace(reference: u32) -> PipeSpec {
+        let mut s = PipeSpec::stencil(vk::StencilOp::REPLACE, vk::StencilOp::REPLACE);
+        s.front.reference = reference;
+        s.back.reference = reference;
+        s
+    }
+}
+
+pub enum Indices {
+    None,
+    U8(Vec<u8>),
+    U16(Vec<u16>),
+    U32(Vec<u32>),
+}
+
+pub struct DrawCall {
+    pub spec: PipeSpec,
+    pub mvp: Mat4,
+    /// Homogeneous object-space vertices.
+    pub vertices: Vec<[f32; 4]>,
+    pub indices: Indices,
+}
+
+/// What came back: raw depth words (f32 bits for D32, 24-bit unorm in the low bits for D24)
+/// and stencil bytes, row-major from the top-left.
+pub struct Readback {
+    pub width: u32,
+    pub height: u32,
+    pub depth: Vec<u32>,
+    pub stencil: Vec<u8>,
+}
+
+fn vkerr(call: &'static str) -> impl Fn(vk::Result) -> Error {
+    move |r| Error::Vulkan { call, result: format!("{r:?}") }
+}
+
+/// Whether `format` can be a depth-stencil attachment and a transfer source (optimal tiling).
+pub fn format_supported(ctx: &Context, format: vk::Format) -> bool {
+    let needed = vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT | vk::FormatFeatureFlags::TRANSFER_SRC;
+    // SAFETY: a format query on the context's valid physical device.
+    let p = unsafe { ctx.instance.get_physical_device_format_properties(ctx.physical, format) };
+    p.optimal_tiling_features.contains(needed)
+}
+
+/// Depth word -> depth value for `format`.
+pub fn depth_value(format: vk::Format, word: u32) -> f64 {
+    if format == vk::Format::D24_UNORM_S8_UINT {
+        (word & 0x00ff_ffff) as f64 / 16_777_215.0
+    } else {
+        f32::from_bits(word) as f64
+    }
+}
+
+fn bytes<T: Copy>(v: &[T]) -> Vec<u8> {
+    // SAFETY: only called with plain numeric types (f32 arrays, u8/u16/u32) without padding.
+    unsafe { std::slice::from_raw_parts(v.as_ptr() as *const u8, std::mem::size_of_val(v)) }.to_vec()
+}
+
+/// Clears a `width` x `height` depth-stencil image of `format` to (`clear_depth`,
+/// `clear_stencil`), records `draws` in order, and reads both aspects back.
+pub fn render(ctx: &Context, format: vk::Format, width: u32, height: u32, clear_depth: f32, clear_stencil: u32, draws: &[DrawCall]) -> Result<Readback> {
+    let push_range = [vk::PushConstantRange { stage_flags: vk::ShaderStageFlags::VERTEX, offset: 0, size: 96 }];
+    let layout_info = vk::PipelineLayoutCreateInfo::default().push_constant_ranges(&push_range);
+    // SAFETY: valid device and create info; destroyed at the end of this function.
+    let layout = unsafe { ctx.device.create_pipeline_layout(&layout_info, None) }.map_err(vkerr("vkCreatePipelineLayout"))?;
+    let mut pipelines = Vec::new();
+    let mut buffers: Vec<Buffer> = Vec::new();
+    let mut image: Option<Image> = None;
+    let result = (|| -> Result<Readback> {
+        let extent = vk::Extent2D { width, height };
+        image = Some(Image::new_2d(
+            ctx,
+            "conform-ds",
+            format,
+            extent,
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
+            vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL,
+        )?);
+        let img = image.as_ref().expect("just created");
+        // Pipelines and geometry.
+        let mut recorded = Vec::new();
+        for d in draws {
+            let mut desc = PipelineDesc::new(shaders::SHADOW_VERT, layout, format);
+            desc.vertex_stride = 16;
+            desc.attributes = &[(0, vk::Format::R32G32B32A32_SFLOAT, 0)];
+            desc.depth_test = d.spec.depth_test;
+            desc.depth_write = d.spec.depth_write;
+            desc.depth_compare = d.spec.depth_compare;
+            desc.depth_clamp = d.spec.depth_clamp;
+            desc.depth_bounds = d.spec.depth_bounds.is_some();
+            desc.stencil = Some((d.spec.front, d.spec.back));
+            let p = pipeline::create(ctx, &desc)?;
+            pipelines.push(p);
+            let vb = Buffer::with_data(ctx, "conform-vertices", &bytes(&d.vertices), vk::BufferUsageFlags::VERTEX_BUFFER)?;
+            buffers.push(vb);
+            let vb_raw = buffers.last().expect("pushed").raw;
+            let index = match &d.indices {
+                Indices::None => None,
+                Indices::U8(i) => Some((bytes(i), vk::IndexType::UINT8_EXT, i.len())),
+                Indices::U16(i) => Some((bytes(i), vk::IndexType::UINT16, i.len())),
+                Indices::U32(i) => Some((bytes(i), vk::IndexType::UINT32, i.len())),
+            };
+            let ib = match index {
+                Some((data, ty, n)) => {
+                    buffers.push(Buffer::with_data(ctx, "conform-indices", &data, vk::BufferUsageFlags::INDEX_BUFFER)?);
+                    Some((buffers.last().expect("pushed").raw, ty, n as u32))
+                }
+                None => None,
+            };
+            let mut push = [0f32; 24];
+            push[..16].copy_from_slice(&d.mvp.to_cols_array());
+            push[16..20].copy_from_slice(&[0.0, 0.0, 0.0, 1.0]);
+            recorded.push((p, vb_raw, ib, d.vertices.len() as u32, bytes(&push), d.spec.depth_bounds));
+        }
+        let n = (width * height) as u64;
+        buffers.push(Buffer::new(ctx, "conform-depth-readback", n * 4, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?);
+        buffers.push(Buffer::new(ctx, "conform-stencil-readback", n, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?);
+        let (depth_buf, stencil_buf) = (buffers[buffers.len() - 2].raw, buffers[buffers.len() - 1].raw);
+        ctx.one_shot(|cb| {
+            transition(ctx, cb, img, vk::ImageLayout::UNDEFINED, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
+            let att = vk::RenderingAttachmentInfo::default()
+                .image_view(img.view)
+                .image_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
+                .load_op(vk::AttachmentLoadOp::CLEAR)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: clear_depth, stencil: clear_stencil } });
+            let area = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent };
+            let info = vk::RenderingInfo::default().render_area(area).layer_count(1).depth_attachment(&att).stencil_attachment(&att);
+            let viewport = vk::Viewport { x: 0.0, y: 0.0, width: width as f32, height: height as f32, min_depth: 0.0, max_depth: 1.0 };
+            // SAFETY: `cb` is recording (one_shot); every handle used was created above on this
+            // device and outlives the submission, which one_shot waits for.
+            unsafe {
+                let d = &ctx.device;
+                d.cmd_begin_rendering(cb, &info);
+                d.cmd_set_viewport(cb, 0, &[viewport]);
+                d.cmd_set_scissor(cb, 0, &[area]);
+                for (p, vb, ib, nv, push, bounds) in &recorded {
+                    d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, *p);
+                    d.cmd_push_constants(cb, layout, vk::ShaderStageFlags::VERTEX, 0, push);
+                    if let Some((lo, hi)) = bounds {
+                        d.cmd_set_depth_bounds(cb, *lo, *hi);
+                    }
+                    d.cmd_bind_vertex_buffers(cb, 0, &[*vb], &[0]);
+                    match ib {
+                        Some((ib, ty, count)) => {
+                            d.cmd_bind_index_buffer(cb, *ib, 0, *ty);
+                            d.cmd_draw_indexed(cb, *count, 1, 0, 0, 0);
+                        }
+                        None => d.cmd_draw(cb, *nv, 1, 0, 0),
+                    }
+                }
+                d.cmd_end_rendering(cb);
+            }
+            transition(ctx, cb, img, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+            let region = |aspect| vk::BufferImageCopy {
+                buffer_offset: 0,
+                buffer_row_length: 0,
+                buffer_image_height: 0,
+                image_subresource: vk::ImageSubresourceLayers { aspect_mask: aspect, mip_level: 0, base_array_layer: 0, layer_count: 1 },
+                image_offset: vk::Offset3D::default(),
+                image_extent: vk::Extent3D { width, height, depth: 1 },
+            };
+            // SAFETY: recording; the image is in TRANSFER_SRC_OPTIMAL and the buffers are large
+            // enough for one aspect each (4 bytes per depth texel, 1 per stencil texel).
+            unsafe {
+                ctx.device.cmd_copy_image_to_buffer(cb, img.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, depth_buf, &[region(vk::ImageAspectFlags::DEPTH)]);
+                ctx.device.cmd_copy_image_to_buffer(cb, img.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, stencil_buf, &[region(vk::ImageAspectFlags::STENCIL)]);
+            }
+            let b = [vk::MemoryBarrier2::default()
+                .src_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
+                .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
+                .dst_stage_mask(vk::PipelineStageFlags2::HOST)
+                .dst_access_mask(vk::AccessFlags2::HOST_READ)];
+            let dep = vk::DependencyInfo::default().memory_barriers(&b);
+            // SAFETY: recording.
+            unsafe { ctx.device.cmd_pipeline_barrier2(cb, &dep) };
+        })?;
+        let depth_bytes = buffers[buffers.len() - 2].read()?;
+        let depth = depth_bytes.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
+        let stencil = buffers[buffers.len() - 1].read()?.to_vec();
+        Ok(Readback { width, height, depth, stencil })
+    })();
+    // SAFETY: one_shot waited for the submission (or nothing was submitted): nothing in use.
+    unsafe {
+        let _ = ctx.device.device_wait_idle();
+        for p in pipelines {
+            ctx.device.destroy_pipeline(p, None);
+        }
+        ctx.device.destroy_pipeline_layout(layout, None);
+    }
+    for b in &mut buffers {
+        b.destroy(ctx);
+    }
+    if let Some(mut i) = image {
+        i.destroy(ctx);
+    }
+    result
+}
+
+/// Orthographic pixel mapping: object (x, y) in pixels (row 0 at the top), z as given -> depth.
+pub fn pixel_ortho(width: u32, height: u32) -> Mat4 {
+    Mat4::from_cols(
+        glam::Vec4::new(2.0 / width as f32, 0.0, 0.0, 0.0),
+        glam::Vec4::new(0.0, 2.0 / height as f32, 0.0, 0.0),
+        glam::Vec4::new(0.0, 0.0, 1.0, 0.0),
+        glam::Vec4::new(-1.0, -1.0, 0.0, 1.0),
+    )
+}
