@@ -18,6 +18,7 @@ layout(location = 3) out vec4 out_position;
 void main() {
     out_accum = vec4(v_color * pc.ambient.rgb, 1.0);
     out_albedo = vec4(v_color, 1.0);
-    out_normal = vec4(v_normal, 0.0);
+    // Two-sided meshes (open, non-manifold, inside-out) show back faces: shade the visible side.
+    out_normal = vec4(gl_FrontFacing ? v_normal : -v_normal, 0.0);
     out_position = vec4(v_pos, 1.0);
 }

@@ -5,7 +5,8 @@
 //!
 //! # The rule
 //!
-//! A surface point `P` with unit outward geometric normal `N` is *lit* by a light iff
+//! A surface point `P` with unit geometric normal `N` on its visible side (the face normal,
+//! turned towards the eye when the eye sees the back of the triangle) is *lit* by a light iff
 //! 1. it is within the light's range (`|L - P| <= radius`, point/spot lights with a radius;
 //!    otherwise [`LightState::OutOfRange`]),
 //! 2. for a spot light, it is inside the cone (angle between the spot direction and `P - L`
@@ -453,7 +454,12 @@ impl Reference {
                     Some(hit) => {
                         let t = &self.tris[hit.tri as usize];
                         let p = t[0] * (1.0 - hit.u - hit.v) + t[1] * hit.u + t[2] * hit.v;
+                        // The visible side of the surface: its geometric normal turned towards
+                        // the eye (a closed, outward mesh is only ever seen from the front, so
+                        // this changes nothing there; open and two-sided surfaces are lit on the
+                        // side the eye sees when that side faces the light).
                         let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
+                        let n = if n.dot(d) > 0.0 { -n } else { n };
                         let depth = (p - eye).length();
                         let r = self.tolerance.footprint_fraction * depth * pix_angle;
                         px.push(RefPixel {

@@ -194,6 +194,7 @@ struct GpuChunk {
 
 struct Pipelines {
     gbuffer: vk::Pipeline,
+    gbuffer_two_sided: vk::Pipeline,
     zpass: vk::Pipeline,
     zfail: vk::Pipeline,
     zfail_cap: vk::Pipeline,
@@ -212,6 +213,8 @@ pub struct Renderer {
     gpu_casters: Vec<Vec<GpuChunk>>,
     scene_vertices: Buffer,
     scene_vertex_count: u32,
+    /// The first `one_sided_count` scene vertices belong to closed outward meshes.
+    one_sided_count: u32,
     targets: Targets,
     set_layouts: [vk::DescriptorSetLayout; 2],
     layouts: [vk::PipelineLayout; 4],
@@ -270,10 +273,16 @@ impl Renderer {
             gpu_casters.push(chunks);
         }
 
-        // Scene geometry for the ambient pass: flat-shaded triangles, eye-relative.
+        // Scene geometry for the ambient pass: flat-shaded triangles, eye-relative. Closed,
+        // outward meshes first (drawn with back faces culled), then every other mesh (open,
+        // non-manifold, inside-out), drawn two-sided so that what the eye sees is what is there.
         let eye = scene.camera.eye.as_dvec3();
-        let mut verts: Vec<[f32; 9]> = Vec::new();
+        let mut one_sided: Vec<[f32; 9]> = Vec::new();
+        let mut two_sided: Vec<[f32; 9]> = Vec::new();
         for m in &scene.meshes {
+            let topo = crate::geom::topology::Topology::build(&m.mesh);
+            let outward = topo.is_closed_manifold() && signed_volume(&m.mesh) > 0.0;
+            let verts = if outward { &mut one_sided } else { &mut two_sided };
             let xf = m.transform.as_dmat4();
             for t in 0..m.mesh.triangles.len() {
                 let p = m.mesh.triangle(t).map(|v| xf.transform_point3(v.as_dvec3()));
@@ -288,6 +297,9 @@ impl Renderer {
                 }
             }
         }
+        let one_sided_count = one_sided.len() as u32;
+        let mut verts = one_sided;
+        verts.extend(two_sided);
         if verts.is_empty() {
             return Err(Error::Other(format!("scene '{}' has no triangle to draw", scene.name)));
         }
@@ -393,6 +405,7 @@ impl Renderer {
             shells,
             gpu_casters,
             scene_vertex_count: verts.len() as u32,
+            one_sided_count,
             scene_vertices,
             targets,
             set_layouts,
@@ -709,7 +722,11 @@ impl Renderer {
             push[16..19].copy_from_slice(&ambient.to_array());
             d.cmd_push_constants(cb, self.layouts[0], vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT, 0, bytes_of(&push));
             d.cmd_bind_vertex_buffers(cb, 0, &[self.scene_vertices.raw], &[0]);
-            d.cmd_draw(cb, self.scene_vertex_count, 1, 0, 0);
+            d.cmd_draw(cb, self.one_sided_count, 1, 0, 0);
+            if self.scene_vertex_count > self.one_sided_count {
+                d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.pipes.gbuffer_two_sided);
+                d.cmd_draw(cb, self.scene_vertex_count - self.one_sided_count, 1, self.one_sided_count, 0);
+            }
             d.cmd_end_rendering(cb);
             ts(vk::PipelineStageFlags2::ALL_COMMANDS, TS_DEPTH);
             for img in [&t.albedo, &t.normal, &t.position] {
@@ -1014,6 +1031,16 @@ impl Renderer {
     }
 }
 
+/// Six times the signed volume (positive for a closed mesh wound outward).
+fn signed_volume(mesh: &crate::geom::Mesh) -> f64 {
+    (0..mesh.triangles.len())
+        .map(|t| {
+            let [a, b, c] = mesh.triangle(t).map(|p| p.as_dvec3());
+            a.dot(b.cross(c))
+        })
+        .sum()
+}
+
 /// Connected components of a mesh (triangles sharing a vertex), by union-find.
 fn shell_count(mesh: &crate::geom::Mesh) -> usize {
     let mut parent: Vec<u32> = (0..mesh.positions.len() as u32).collect();
@@ -1100,6 +1127,8 @@ fn create_pipelines(ctx: &Context, layouts: &[vk::PipelineLayout; 4], depth_mode
     g.depth_compare = vk::CompareOp::LESS;
     g.cull = vk::CullModeFlags::BACK;
     let gbuffer = pipeline::create(ctx, &g)?;
+    g.cull = vk::CullModeFlags::NONE;
+    let gbuffer_two_sided = pipeline::create(ctx, &g)?;
 
     use vk::StencilOp as S;
     let mut s = PipelineDesc::new(shaders::SHADOW_VERT, layouts[1], df);
@@ -1141,7 +1170,7 @@ fn create_pipelines(ctx: &Context, layouts: &[vk::PipelineLayout; 4], depth_mode
     t.fragment = Some(shaders::TONEMAP_FRAG);
     t.color_formats = &out;
     let tonemap = pipeline::create(ctx, &t)?;
-    Ok(Pipelines { gbuffer, zpass, zfail, zfail_cap, illuminate, volumes, tonemap })
+    Ok(Pipelines { gbuffer, gbuffer_two_sided, zpass, zfail, zfail_cap, illuminate, volumes, tonemap })
 }
 
 impl Drop for Renderer {
@@ -1159,7 +1188,7 @@ impl Renderer {
             let _ = ctx.device.device_wait_idle();
             let d = &ctx.device;
             let p = &self.pipes;
-            for pipe in [p.gbuffer, p.zpass, p.zfail, p.zfail_cap, p.illuminate, p.volumes, p.tonemap] {
+            for pipe in [p.gbuffer, p.gbuffer_two_sided, p.zpass, p.zfail, p.zfail_cap, p.illuminate, p.volumes, p.tonemap] {
                 d.destroy_pipeline(pipe, None);
             }
             for l in self.layouts {

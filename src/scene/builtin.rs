@@ -11,6 +11,7 @@ pub const SCENES: &[(&str, &str)] = &[
     ("hard/big_caster", include_str!("../../scenes/hard/big_caster.toml")),
     ("hard/light_inside_caster", include_str!("../../scenes/hard/light_inside_caster.toml")),
     ("hard/nested_256", include_str!("../../scenes/hard/nested_256.toml")),
+    ("hard/open_casters", include_str!("../../scenes/hard/open_casters.toml")),
     ("hard/eye_in_volume", include_str!("../../scenes/hard/eye_in_volume.toml")),
     ("hard/eye_in_two_volumes", include_str!("../../scenes/hard/eye_in_two_volumes.toml")),
     ("hard/near_plane_cut", include_str!("../../scenes/hard/near_plane_cut.toml")),
@@ -29,8 +30,13 @@ pub const SCENES: &[(&str, &str)] = &[
 ];
 
 /// Embedded data files the built-in scenes reference, by repository-relative path.
-pub const DATA: &[(&str, &str)] =
-    &[("scenes/data/zero_area_cube.obj", include_str!("../../scenes/data/zero_area_cube.obj"))];
+pub const DATA: &[(&str, &str)] = &[
+    ("scenes/data/zero_area_cube.obj", include_str!("../../scenes/data/zero_area_cube.obj")),
+    ("scenes/data/open_box.obj", include_str!("../../scenes/data/open_box.obj")),
+    ("scenes/data/shared_wall_boxes.obj", include_str!("../../scenes/data/shared_wall_boxes.obj")),
+    ("scenes/data/inside_out_cube.obj", include_str!("../../scenes/data/inside_out_cube.obj")),
+    ("scenes/data/two_sided_card.obj", include_str!("../../scenes/data/two_sided_card.obj")),
+];
 
 pub fn scene(name: &str) -> Option<&'static str> {
     SCENES.iter().find(|(n, _)| *n == name).map(|(_, t)| *t)

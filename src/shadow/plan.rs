@@ -470,27 +470,6 @@ pub fn emit_multiplicity(
     (draws, sides, dark, light, edges, mmax)
 }
 
-/// Whether each triangle's light cap is at or behind the visible surface for an eye at
-/// `eye_obj` (object space): the triangle or an exact twin is front-facing to the eye.
-pub fn shielded_bits(caster: &Caster, eye_obj: glam::Vec3) -> Vec<bool> {
-    let mut s = facing_bits(caster.mesh(), eye_obj.extend(1.0), caster.mirrored);
-    if !caster.coincident.is_empty() {
-        let groups = caster.coincident.iter().filter(|&&g| g != u32::MAX).max().map_or(0, |&g| g as usize + 1);
-        let mut drawn = vec![false; groups];
-        for (t, &g) in caster.coincident.iter().enumerate() {
-            if g != u32::MAX && s[t] {
-                drawn[g as usize] = true;
-            }
-        }
-        for (t, &g) in caster.coincident.iter().enumerate() {
-            if g != u32::MAX && drawn[g as usize] {
-                s[t] = true;
-            }
-        }
-    }
-    s
-}
-
 fn plan_multiplicity(
     input: &PlanInput,
     caster: &Caster,
@@ -505,8 +484,10 @@ fn plan_multiplicity(
     let facing = facing_bits(caster.mesh(), l_obj, caster.mirrored);
     let mult = edge_multiplicities(caster, &facing);
     let t = ts.elapsed().as_secs_f64() * 1e3;
-    let eye_obj = object_light(caster, input.camera.eye.extend(1.0)).truncate();
-    let shielded = shielded_bits(caster, eye_obj);
+    // The renderer draws multiplicity casters two-sided in the G-buffer pass, so every light
+    // cap (a caster triangle itself) lies at or behind the visible surface along any ray that
+    // crosses it: all caps are drawn with depth compare NEVER, never z-fighting the surface.
+    let shielded = vec![true; caster.mesh().triangles.len()];
     let case = select_case(input.method, pyramid, frustum, wb);
     let dark_cap_kind = if case == Case::ZPass || directional {
         DarkCap::None
