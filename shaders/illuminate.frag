@@ -1,10 +1,15 @@
 #version 450
 // Per-light illumination (Blinn-Phong), drawn as a full-screen pass where the stencil count
 // is zero, added into the float accumulation target.
+// @variant COUNT FLOAT_COUNT
+// The COUNT variant reads the volume count from a float target instead of the stencil.
 layout(set = 0, binding = 0) uniform texture2D t_albedo;
 layout(set = 0, binding = 1) uniform texture2D t_normal;
 layout(set = 0, binding = 2) uniform texture2D t_position;
 layout(set = 0, binding = 3) uniform sampler s_nearest;
+#ifdef FLOAT_COUNT
+layout(set = 0, binding = 4) uniform texture2D t_count;
+#endif
 
 layout(push_constant) uniform Push {
     vec4 light_pos;   // xyz relative to the eye, w = 1; or xyz towards the light, w = 0
@@ -17,6 +22,11 @@ layout(location = 0) out vec4 out_color;
 
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
+#ifdef FLOAT_COUNT
+    if (abs(texelFetch(sampler2D(t_count, s_nearest), px, 0).r) > 0.5) {
+        discard;
+    }
+#endif
     vec4 pos = texelFetch(sampler2D(t_position, s_nearest), px, 0);
     if (pos.w == 0.0) {
         discard;

@@ -3,7 +3,7 @@
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use umbrage::render::{DepthMode, IndexFormat, RenderOptions, Renderer, View};
+use umbrage::render::{Counter, DepthMode, IndexFormat, RenderOptions, Renderer, View};
 use umbrage::shadow::Method;
 use umbrage::{Error, Result};
 
@@ -22,8 +22,9 @@ struct FrameArgs {
     /// Image size, WxH.
     #[arg(long, default_value = "960x540", value_parser = parse_size)]
     size: (u32, u32),
-    /// Shadow method: mcguire, lengyel, everitt-kilgard, zfail, zpass.
-    #[arg(long, default_value = "mcguire")]
+    /// Shadow method: auto (= mcguire, with open / non-manifold casters on the multiplicity
+    /// path), mcguire, lengyel, everitt-kilgard, zfail, zpass.
+    #[arg(long, default_value = "auto")]
     method: String,
     /// infinite (far plane at infinity) or clamp (finite far plane + depthClamp).
     #[arg(long, default_value = "infinite")]
@@ -31,6 +32,9 @@ struct FrameArgs {
     /// u32, u16, u8, auto, or naive (stream 4 x f32 per shadow vertex, no indices).
     #[arg(long, default_value = "auto")]
     index_format: String,
+    /// stencil (8-bit, wraps at 256 nested volumes) or float (32-bit float target, additive).
+    #[arg(long, default_value = "stencil")]
+    counter: String,
 }
 
 #[derive(Subcommand)]
@@ -100,9 +104,10 @@ impl Default for FrameArgs {
         FrameArgs {
             scene: "default".into(),
             size: (960, 540),
-            method: "mcguire".into(),
+            method: "auto".into(),
             depth_mode: "infinite".into(),
             index_format: "auto".into(),
+            counter: "stencil".into(),
         }
     }
 }
@@ -151,6 +156,7 @@ impl FrameArgs {
             method: self.method.parse::<Method>()?,
             depth_mode: self.depth_mode.parse::<DepthMode>()?,
             index_format: self.index_format.parse::<IndexFormat>()?,
+            counter: self.counter.parse::<Counter>()?,
             ..Default::default()
         })
     }

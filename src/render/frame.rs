@@ -86,6 +86,35 @@ impl IndexFormat {
     }
 }
 
+/// Where shadow volumes are counted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Counter {
+    /// The 8-bit stencil with wrapping increments (counts modulo 256).
+    Stencil,
+    /// A 32-bit float colour target with additive blending: no 8-bit wrap (exact to 2^24).
+    Float,
+}
+
+impl std::str::FromStr for Counter {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "stencil" => Ok(Counter::Stencil),
+            "float" => Ok(Counter::Float),
+            _ => Err(Error::UnknownName { what: "counter", name: s.into(), expected: "stencil, float".into() }),
+        }
+    }
+}
+
+impl Counter {
+    pub fn name(self) -> &'static str {
+        match self {
+            Counter::Stencil => "stencil",
+            Counter::Float => "float",
+        }
+    }
+}
+
 /// What the final image shows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum View {
@@ -117,6 +146,7 @@ pub struct RenderOptions {
     pub depth_mode: DepthMode,
     pub index_format: IndexFormat,
     pub view: View,
+    pub counter: Counter,
     /// Read back per-light stencil counts, positions and normals (dumps, tests).
     pub capture: bool,
 }
@@ -130,6 +160,7 @@ impl Default for RenderOptions {
             depth_mode: DepthMode::Infinite,
             index_format: IndexFormat::Auto,
             view: View::Shaded,
+            counter: Counter::Stencil,
             capture: false,
         }
     }
@@ -141,8 +172,11 @@ pub struct FrameOutput {
     pub height: u32,
     /// sRGB RGBA8, row-major from the top-left.
     pub color: Vec<u8>,
-    /// Per light: stencil count after its determination (captured frames only).
+    /// Per light: stencil count after its determination (captured frames only; with the float
+    /// counter, the exact count clamped to 0..=255).
     pub stencil: Vec<Vec<u8>>,
+    /// Per light: the exact signed count (float counter, captured frames only).
+    pub counts: Vec<Vec<i32>>,
     /// World position per pixel (NaN for background), captured frames only.
     pub positions: Vec<[f32; 3]>,
     /// Geometric face normal per pixel (NaN for background), captured frames only.
@@ -173,7 +207,10 @@ impl FrameOutput {
                         let in_range = light.radius.map(|r| l.w == 0.0 || to_light.length() < r).unwrap_or(true);
                         let in_cone = light.kind != LightKind::Spot
                             || (-to_light.normalize()).dot(light.direction.normalize()) > (light.cone_deg.to_radians() * 0.5).cos();
-                        let count = self.stencil.get(k).map(|s| s[i]).unwrap_or(0);
+                        let count = match self.counts.get(k) {
+                            Some(c) => c[i],
+                            None => self.stencil.get(k).map(|s| s[i] as i32).unwrap_or(0),
+                        };
                         if faces && in_range && in_cone && count == 0 {
                             255
                         } else {
@@ -198,7 +235,11 @@ struct Pipelines {
     zpass: vk::Pipeline,
     zfail: vk::Pipeline,
     zfail_cap: vk::Pipeline,
+    count_zpass: vk::Pipeline,
+    count_zfail: vk::Pipeline,
+    count_cap: vk::Pipeline,
     illuminate: vk::Pipeline,
+    illuminate_count: vk::Pipeline,
     volumes: vk::Pipeline,
     tonemap: vk::Pipeline,
 }
@@ -316,27 +357,24 @@ impl Renderer {
                     None,
                 )
                 .map_err(vkerr("vkCreateSampler"))?;
-            let mk_set_layout = |images: u32| {
-                let mut b: Vec<_> = (0..images)
-                    .map(|i| {
+            // Bindings in order; `true` = sampled image, `false` = sampler.
+            let mk_set_layout = |kinds: &[bool]| {
+                let b: Vec<_> = kinds
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &image)| {
                         vk::DescriptorSetLayoutBinding::default()
-                            .binding(i)
-                            .descriptor_type(vk::DescriptorType::SAMPLED_IMAGE)
+                            .binding(i as u32)
+                            .descriptor_type(if image { vk::DescriptorType::SAMPLED_IMAGE } else { vk::DescriptorType::SAMPLER })
                             .descriptor_count(1)
                             .stage_flags(vk::ShaderStageFlags::FRAGMENT)
                     })
                     .collect();
-                b.push(
-                    vk::DescriptorSetLayoutBinding::default()
-                        .binding(images)
-                        .descriptor_type(vk::DescriptorType::SAMPLER)
-                        .descriptor_count(1)
-                        .stage_flags(vk::ShaderStageFlags::FRAGMENT),
-                );
                 d.create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&b), None)
                     .map_err(vkerr("vkCreateDescriptorSetLayout"))
             };
-            let set_layouts = [mk_set_layout(3)?, mk_set_layout(1)?];
+            // set 0: albedo, normal, position, sampler, count; set 1: accumulation, sampler.
+            let set_layouts = [mk_set_layout(&[true, true, true, false, true])?, mk_set_layout(&[true, false])?];
             let mk_layout = |sets: &[vk::DescriptorSetLayout], push: u32, stages: vk::ShaderStageFlags| {
                 let ranges = [vk::PushConstantRange { stage_flags: stages, offset: 0, size: push }];
                 let info = vk::PipelineLayoutCreateInfo::default().set_layouts(sets).push_constant_ranges(if push > 0 { &ranges } else { &[] });
@@ -350,7 +388,7 @@ impl Renderer {
                 mk_layout(&set_layouts[1..2], 0, vk::ShaderStageFlags::FRAGMENT)?,
             ];
             let sizes = [
-                vk::DescriptorPoolSize { ty: vk::DescriptorType::SAMPLED_IMAGE, descriptor_count: 4 },
+                vk::DescriptorPoolSize { ty: vk::DescriptorType::SAMPLED_IMAGE, descriptor_count: 5 },
                 vk::DescriptorPoolSize { ty: vk::DescriptorType::SAMPLER, descriptor_count: 2 },
             ];
             let pool = d
@@ -365,6 +403,7 @@ impl Renderer {
             };
             let samp = [vk::DescriptorImageInfo { sampler, image_view: vk::ImageView::null(), image_layout: vk::ImageLayout::UNDEFINED }];
             let (a, n, p, acc) = (img(&targets.albedo), img(&targets.normal), img(&targets.position), img(&targets.accum));
+            let cnt = img(&targets.count);
             fn w(set: vk::DescriptorSet, binding: u32, ty: vk::DescriptorType, info: &[vk::DescriptorImageInfo]) -> vk::WriteDescriptorSet<'_> {
                 vk::WriteDescriptorSet::default().dst_set(set).dst_binding(binding).descriptor_type(ty).image_info(info)
             }
@@ -373,6 +412,7 @@ impl Renderer {
                 w(sets[0], 1, vk::DescriptorType::SAMPLED_IMAGE, &n),
                 w(sets[0], 2, vk::DescriptorType::SAMPLED_IMAGE, &p),
                 w(sets[0], 3, vk::DescriptorType::SAMPLER, &samp),
+                w(sets[0], 4, vk::DescriptorType::SAMPLED_IMAGE, &cnt),
                 w(sets[1], 0, vk::DescriptorType::SAMPLED_IMAGE, &acc),
                 w(sets[1], 1, vk::DescriptorType::SAMPLER, &samp),
             ];
@@ -618,7 +658,8 @@ impl Renderer {
         if capture {
             sizes.push(npx * 16); // positions
             sizes.push(npx * 16); // normals
-            sizes.extend(std::iter::repeat(npx).take(nlights)); // stencil per light
+            let per_light = if self.opts.counter == Counter::Float { npx * 4 } else { npx };
+            sizes.extend(std::iter::repeat(per_light).take(nlights)); // stencil or float count per light
         }
         if self.readback.len() != sizes.len() || self.readback.iter().zip(&sizes).any(|(b, &s)| b.size != s) {
             for mut b in self.readback.drain(..) {
@@ -745,19 +786,21 @@ impl Renderer {
                     .unwrap_or(full);
                 let bounds = if ctx.features.depth_bounds { plan.depth_bounds } else { None };
 
-                // Shadow determination: stencil cleared inside the scissor, volumes drawn.
+                // Shadow determination: the counter (stencil, or the float target) cleared inside
+                // the scissor, volumes drawn.
+                let float = self.opts.counter == Counter::Float;
                 let q0 = ts_next;
                 ts(vk::PipelineStageFlags2::ALL_COMMANDS, q0);
                 let depth_load = att(&t.depth, load, ds_clear);
                 let stencil_clear = att(&t.depth, vk::AttachmentLoadOp::CLEAR, ds_clear);
-                d.cmd_begin_rendering(
-                    cb,
-                    &vk::RenderingInfo::default()
-                        .render_area(scissor)
-                        .layer_count(1)
-                        .depth_attachment(&depth_load)
-                        .stencil_attachment(&stencil_clear),
-                );
+                let count_att = [att(&t.count, vk::AttachmentLoadOp::CLEAR, zero)];
+                if float {
+                    // Contents outside the scissor are never read (illumination is scissored too).
+                    transition(ctx, cb, &t.count, vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
+                }
+                let info = vk::RenderingInfo::default().render_area(scissor).layer_count(1).depth_attachment(&depth_load);
+                let info = if float { info.color_attachments(&count_att).stencil_attachment(&depth_load) } else { info.stencil_attachment(&stencil_clear) };
+                d.cmd_begin_rendering(cb, &info);
                 d.cmd_set_viewport(cb, 0, &[viewport]);
                 d.cmd_set_scissor(cb, 0, &[scissor]);
                 if ctx.features.depth_bounds {
@@ -772,12 +815,18 @@ impl Renderer {
                     let mut push = [0f32; 24];
                     push[..16].copy_from_slice(&caster_mvp[*ci].to_cols_array());
                     push[16..20].copy_from_slice(&light_obj.to_array());
+                    // Float counter: the sign a front face contributes (+1 z-pass, -1 z-fail).
+                    push[20] = if *case == Case::ZPass { 1.0 } else { -1.0 };
                     d.cmd_push_constants(cb, self.layouts[1], vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT, 0, bytes_of(&push));
                     for dr in cdraws {
-                        let pipe = match (case, dr.light_cap) {
-                            (Case::ZPass, _) => self.pipes.zpass,
-                            (_, false) => self.pipes.zfail,
-                            (_, true) => self.pipes.zfail_cap,
+                        let p = &self.pipes;
+                        let pipe = match (case, dr.light_cap, float) {
+                            (Case::ZPass, _, false) => p.zpass,
+                            (_, false, false) => p.zfail,
+                            (_, true, false) => p.zfail_cap,
+                            (Case::ZPass, _, true) => p.count_zpass,
+                            (_, false, true) => p.count_zfail,
+                            (_, true, true) => p.count_cap,
                         };
                         if pipe != bound_pipe {
                             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipe);
@@ -792,12 +841,22 @@ impl Renderer {
                 memory_barrier(ctx, cb, (frag_tests, ds_rw), (frag_tests, ds_rw));
 
                 if capture {
-                    transition(ctx, cb, &t.depth, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
-                    let region = vk::BufferImageCopy::default()
-                        .image_subresource(vk::ImageSubresourceLayers { aspect_mask: vk::ImageAspectFlags::STENCIL, mip_level: 0, base_array_layer: 0, layer_count: 1 })
-                        .image_extent(vk::Extent3D { width: w, height: h, depth: 1 });
-                    d.cmd_copy_image_to_buffer(cb, t.depth.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, self.readback[3 + li].raw, &[region]);
-                    transition(ctx, cb, &t.depth, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
+                    let region = |aspect| {
+                        vk::BufferImageCopy::default()
+                            .image_subresource(vk::ImageSubresourceLayers { aspect_mask: aspect, mip_level: 0, base_array_layer: 0, layer_count: 1 })
+                            .image_extent(vk::Extent3D { width: w, height: h, depth: 1 })
+                    };
+                    if float {
+                        transition(ctx, cb, &t.count, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+                        d.cmd_copy_image_to_buffer(cb, t.count.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, self.readback[3 + li].raw, &[region(vk::ImageAspectFlags::COLOR)]);
+                        transition(ctx, cb, &t.count, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
+                    } else {
+                        transition(ctx, cb, &t.depth, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+                        d.cmd_copy_image_to_buffer(cb, t.depth.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, self.readback[3 + li].raw, &[region(vk::ImageAspectFlags::STENCIL)]);
+                        transition(ctx, cb, &t.depth, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
+                    }
+                } else if float {
+                    transition(ctx, cb, &t.count, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
                 }
 
                 // Illumination where the count is zero.
@@ -815,7 +874,8 @@ impl Renderer {
                 );
                 d.cmd_set_viewport(cb, 0, &[viewport]);
                 d.cmd_set_scissor(cb, 0, &[scissor]);
-                d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.pipes.illuminate);
+                let illuminate = if float { self.pipes.illuminate_count } else { self.pipes.illuminate };
+                d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, illuminate);
                 if ctx.features.depth_bounds {
                     let (lo, hi) = bounds.unwrap_or((0.0, 1.0));
                     d.cmd_set_depth_bounds(cb, lo, hi);
@@ -929,7 +989,7 @@ impl Renderer {
 
         // 6. Read back.
         let color = self.readback[0].read()?.to_vec();
-        let (mut positions, mut normals, mut stencil) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut positions, mut normals, mut stencil, mut counts) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
         if capture {
             let floats = |b: &Buffer| -> Result<Vec<[f32; 4]>> {
                 Ok(b.read()?.chunks_exact(16).map(|c| std::array::from_fn(|k| f32::from_le_bytes([c[4 * k], c[4 * k + 1], c[4 * k + 2], c[4 * k + 3]]))).collect())
@@ -947,7 +1007,14 @@ impl Renderer {
                 }
             }
             for li in 0..nlights {
-                stencil.push(self.readback[3 + li].read()?.to_vec());
+                let raw = self.readback[3 + li].read()?;
+                if self.opts.counter == Counter::Float {
+                    let c: Vec<i32> = raw.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]).round() as i32).collect();
+                    stencil.push(c.iter().map(|&v| v.clamp(0, 255) as u8).collect());
+                    counts.push(c);
+                } else {
+                    stencil.push(raw.to_vec());
+                }
             }
         }
 
@@ -972,9 +1039,9 @@ impl Renderer {
         let mut warnings = Vec::new();
         for (li, plan) in plans.iter().enumerate() {
             let drawn: usize = plan.casters.iter().filter(|c| c.case != Case::Culled).map(|c| self.shells[c.caster]).sum();
-            if drawn > 255 {
+            if drawn > 255 && self.opts.counter == Counter::Stencil {
                 warnings.push(format!(
-                    "light {li}: {drawn} closed shells cast shadow volumes; pixels inside 256k of them wrap to 0 in the 8-bit stencil and read as lit"
+                    "light {li}: {drawn} closed shells cast shadow volumes; pixels inside 256k of them wrap to 0 in the 8-bit stencil and read as lit (use --counter float)"
                 ));
             }
         }
@@ -983,6 +1050,7 @@ impl Renderer {
             method: self.opts.method.to_string(),
             depth_mode: self.opts.depth_mode.name().into(),
             index_format: self.opts.index_format.name().into(),
+            counter: self.opts.counter.name().into(),
             width: w,
             height: h,
             lights: light_stats,
@@ -994,7 +1062,7 @@ impl Renderer {
             features_missing,
             warnings,
         };
-        let mut out = FrameOutput { width: w, height: h, color, stencil, positions, normals, stats };
+        let mut out = FrameOutput { width: w, height: h, color, stencil, counts, positions, normals, stats };
         if self.opts.view == View::Stencil {
             if let Some(s) = out.stencil.first() {
                 out.color = stencil_heatmap(s);
@@ -1145,6 +1213,21 @@ fn create_pipelines(ctx: &Context, layouts: &[vk::PipelineLayout; 4], depth_mode
     s.depth_compare = vk::CompareOp::NEVER;
     let zfail_cap = pipeline::create(ctx, &s)?;
 
+    // Float counter: the same volumes, counted in a float target by additive blending. The depth
+    // test selects exactly the fragments the stencil ops would act on.
+    let count_fmt = [COUNT_FORMAT];
+    let mut c = s.clone();
+    c.fragment = Some(shaders::COUNT_FRAG);
+    c.color_formats = &count_fmt;
+    c.blend = Blend::Additive;
+    c.stencil = None;
+    c.depth_compare = vk::CompareOp::LESS;
+    let count_zpass = pipeline::create(ctx, &c)?;
+    c.depth_compare = vk::CompareOp::GREATER_OR_EQUAL;
+    let count_zfail = pipeline::create(ctx, &c)?;
+    c.depth_compare = vk::CompareOp::ALWAYS;
+    let count_cap = pipeline::create(ctx, &c)?;
+
     let accum = [ACCUM_FORMAT];
     let mut v = PipelineDesc::new(shaders::SHADOW_VERT, layouts[1], df);
     v.fragment = Some(shaders::VOLUME_FRAG);
@@ -1164,13 +1247,16 @@ fn create_pipelines(ctx: &Context, layouts: &[vk::PipelineLayout; 4], depth_mode
     i.depth_bounds = depth_bounds;
     i.stencil = Some((pipeline::stencil_equal(0), pipeline::stencil_equal(0)));
     let illuminate = pipeline::create(ctx, &i)?;
+    i.fragment = Some(shaders::ILLUMINATE_COUNT_FRAG);
+    i.stencil = None;
+    let illuminate_count = pipeline::create(ctx, &i)?;
 
     let out = [OUTPUT_FORMAT];
     let mut t = PipelineDesc::new(shaders::FULLSCREEN_VERT, layouts[3], vk::Format::UNDEFINED);
     t.fragment = Some(shaders::TONEMAP_FRAG);
     t.color_formats = &out;
     let tonemap = pipeline::create(ctx, &t)?;
-    Ok(Pipelines { gbuffer, gbuffer_two_sided, zpass, zfail, zfail_cap, illuminate, volumes, tonemap })
+    Ok(Pipelines { gbuffer, gbuffer_two_sided, zpass, zfail, zfail_cap, count_zpass, count_zfail, count_cap, illuminate, illuminate_count, volumes, tonemap })
 }
 
 impl Drop for Renderer {
@@ -1188,7 +1274,7 @@ impl Renderer {
             let _ = ctx.device.device_wait_idle();
             let d = &ctx.device;
             let p = &self.pipes;
-            for pipe in [p.gbuffer, p.gbuffer_two_sided, p.zpass, p.zfail, p.zfail_cap, p.illuminate, p.volumes, p.tonemap] {
+            for pipe in [p.gbuffer, p.gbuffer_two_sided, p.zpass, p.zfail, p.zfail_cap, p.count_zpass, p.count_zfail, p.count_cap, p.illuminate, p.illuminate_count, p.volumes, p.tonemap] {
                 d.destroy_pipeline(pipe, None);
             }
             for l in self.layouts {

@@ -86,6 +86,8 @@ pub struct Stats {
     pub method: String,
     pub depth_mode: String,
     pub index_format: String,
+    /// "stencil" (8-bit, wraps at 256) or "float" (32-bit float target).
+    pub counter: String,
     pub width: u32,
     pub height: u32,
     pub lights: Vec<LightStats>,

@@ -10,6 +10,8 @@ pub const ALBEDO_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
 pub const NORMAL_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 pub const POSITION_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 pub const OUTPUT_FORMAT: vk::Format = vk::Format::R8G8B8A8_SRGB;
+/// The float shadow-volume counter (`--counter float`).
+pub const COUNT_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
 
 pub struct Targets {
     pub extent: vk::Extent2D,
@@ -19,6 +21,7 @@ pub struct Targets {
     pub position: Image,
     pub depth: Image,
     pub output: Image,
+    pub count: Image,
 }
 
 impl Targets {
@@ -40,6 +43,7 @@ impl Targets {
                 vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
                 vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL,
             )?,
+            count: Image::new_2d(ctx, "count", COUNT_FORMAT, extent, color, c)?,
             output: Image::new_2d(ctx, "output", OUTPUT_FORMAT, extent, vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC, c)?,
         })
     }
@@ -49,7 +53,7 @@ impl Targets {
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
-        for img in [&mut self.accum, &mut self.albedo, &mut self.normal, &mut self.position, &mut self.depth, &mut self.output] {
+        for img in [&mut self.accum, &mut self.albedo, &mut self.normal, &mut self.position, &mut self.depth, &mut self.output, &mut self.count] {
             img.destroy(ctx);
         }
     }

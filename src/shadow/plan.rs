@@ -87,10 +87,16 @@ impl std::fmt::Display for Method {
 impl std::str::FromStr for Method {
     type Err = Error;
     fn from_str(s: &str) -> Result<Method, Error> {
+        // `auto` is McGuire et al.'s three cases for closed manifold casters; every caster is
+        // classified once at load, and one that is not a closed 2-manifold takes the
+        // multiplicity path (Kim et al. 2008) whatever the method.
+        if s == "auto" {
+            return Ok(Method::McGuire);
+        }
         Method::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| Error::UnknownName {
             what: "method",
             name: s.to_string(),
-            expected: Method::ALL.map(|m| m.name()).join(", "),
+            expected: format!("auto, {}", Method::ALL.map(|m| m.name()).join(", ")),
         })
     }
 }
