@@ -3,7 +3,7 @@
 //! A shader error fails the build with the file, line and naga's message.
 //!
 //! Variants: a line `// @variant NAME DEFINE` in a shader also builds the module with
-//! `#define DEFINE 1` as `SHADER_<STEM>_<NAME>_<STAGE>` (naga has no specialisation constants).
+//! `#define DEFINE 1` (several: `DEF1,DEF2`) as `SHADER_<STEM>_<NAME>_<STAGE>` (naga has no specialisation constants).
 
 use std::{env, fmt::Write as _, fs, path::Path};
 
@@ -73,7 +73,7 @@ fn compile(path: &Path, define: Option<&str>) -> Result<Vec<u32>, String> {
         _ => naga::ShaderStage::Compute,
     };
     let mut options = naga::front::glsl::Options::from(stage);
-    if let Some(d) = define {
+    for d in define.into_iter().flat_map(|d| d.split(',')) {
         options.defines.insert(d.to_string(), "1".to_string());
     }
     let module = naga::front::glsl::Frontend::default()

@@ -2,6 +2,8 @@
 // Per-light illumination (Blinn-Phong), drawn as a full-screen pass where the stencil count
 // is zero, added into the float accumulation target.
 // @variant COUNT FLOAT_COUNT
+// @variant T TRANSMIT
+// @variant COUNT_T FLOAT_COUNT,TRANSMIT
 // The COUNT variant reads the volume count from a float target instead of the stencil.
 layout(set = 0, binding = 0) uniform texture2D t_albedo;
 layout(set = 0, binding = 1) uniform texture2D t_normal;
@@ -10,12 +12,16 @@ layout(set = 0, binding = 3) uniform sampler s_nearest;
 #ifdef FLOAT_COUNT
 layout(set = 0, binding = 4) uniform texture2D t_count;
 #endif
+#ifdef TRANSMIT
+// The T variants scale the light by the transparent casters' light-intensity map.
+layout(set = 0, binding = 5) uniform texture2D t_transmit;
+#endif
 
 layout(push_constant) uniform Push {
     vec4 light_pos;   // xyz relative to the eye, w = 1; or xyz towards the light, w = 0
     vec4 color;       // rgb = colour * intensity
     vec4 spot;        // xyz = travel direction, w = cos(half cone) (-2 when not a spot)
-    vec4 params;      // x = radius (0: unbounded)
+    vec4 params;      // x = radius (0: unbounded), y = 1 when the intensity map is in log space
 } pc;
 
 layout(location = 0) out vec4 out_color;
@@ -52,5 +58,10 @@ void main() {
     vec3 v = normalize(-pos.xyz);
     vec3 h = normalize(l + v);
     float spec = pow(max(dot(n, h), 0.0), 48.0) * 0.3;
-    out_color = vec4((albedo * ndotl + vec3(spec)) * pc.color.rgb * atten, 0.0);
+    vec3 light = pc.color.rgb * atten;
+#ifdef TRANSMIT
+    vec3 t = texelFetch(sampler2D(t_transmit, s_nearest), px, 0).rgb;
+    light *= pc.params.y > 0.5 ? exp(t) : t;
+#endif
+    out_color = vec4((albedo * ndotl + vec3(spec)) * light, 0.0);
 }

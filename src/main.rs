@@ -3,7 +3,7 @@
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use umbrage::render::{Counter, DepthMode, IndexFormat, RenderOptions, Renderer, View};
+use umbrage::render::{Counter, DepthMode, TransmitMode, IndexFormat, RenderOptions, Renderer, View};
 use umbrage::shadow::Method;
 use umbrage::{Error, Result};
 
@@ -35,6 +35,9 @@ struct FrameArgs {
     /// stencil (8-bit, wraps at 256 nested volumes) or float (32-bit float target, additive).
     #[arg(long, default_value = "stencil")]
     counter: String,
+    /// Transparent casters' light-intensity map: log16 (default), mul16, log32, mul32.
+    #[arg(long, default_value = "log16")]
+    transmit: String,
 }
 
 #[derive(Subcommand)]
@@ -108,6 +111,7 @@ impl Default for FrameArgs {
             depth_mode: "infinite".into(),
             index_format: "auto".into(),
             counter: "stencil".into(),
+            transmit: "log16".into(),
         }
     }
 }
@@ -157,6 +161,7 @@ impl FrameArgs {
             depth_mode: self.depth_mode.parse::<DepthMode>()?,
             index_format: self.index_format.parse::<IndexFormat>()?,
             counter: self.counter.parse::<Counter>()?,
+            transmit: self.transmit.parse::<TransmitMode>()?,
             ..Default::default()
         })
     }

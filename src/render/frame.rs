@@ -115,6 +115,52 @@ impl Counter {
     }
 }
 
+/// How transparent casters' light-intensity map is stored and accumulated (Kim et al. 2008).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TransmitMode {
+    /// RGBA32F (true) or RGBA16F (false).
+    pub fp32: bool,
+    /// Sum of +-log(t) (additive), or product of t and 1/t (multiplicative blending).
+    pub log: bool,
+}
+
+impl std::str::FromStr for TransmitMode {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s {
+            "mul16" => Ok(TransmitMode { fp32: false, log: false }),
+            "log16" => Ok(TransmitMode { fp32: false, log: true }),
+            "mul32" => Ok(TransmitMode { fp32: true, log: false }),
+            "log32" => Ok(TransmitMode { fp32: true, log: true }),
+            _ => Err(Error::UnknownName { what: "light-intensity map mode", name: s.into(), expected: "log16, mul16, log32, mul32".into() }),
+        }
+    }
+}
+
+impl TransmitMode {
+    pub const ALL: [TransmitMode; 4] = [
+        TransmitMode { fp32: false, log: false },
+        TransmitMode { fp32: false, log: true },
+        TransmitMode { fp32: true, log: false },
+        TransmitMode { fp32: true, log: true },
+    ];
+    pub fn name(self) -> &'static str {
+        match (self.log, self.fp32) {
+            (false, false) => "mul16",
+            (true, false) => "log16",
+            (false, true) => "mul32",
+            (true, true) => "log32",
+        }
+    }
+    fn format(self) -> vk::Format {
+        if self.fp32 {
+            vk::Format::R32G32B32A32_SFLOAT
+        } else {
+            vk::Format::R16G16B16A16_SFLOAT
+        }
+    }
+}
+
 /// What the final image shows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum View {
@@ -147,6 +193,8 @@ pub struct RenderOptions {
     pub index_format: IndexFormat,
     pub view: View,
     pub counter: Counter,
+    /// Transparent casters' light-intensity map: format fixed at creation, log/mul per frame.
+    pub transmit: TransmitMode,
     /// Read back per-light stencil counts, positions and normals (dumps, tests).
     pub capture: bool,
 }
@@ -161,6 +209,7 @@ impl Default for RenderOptions {
             index_format: IndexFormat::Auto,
             view: View::Shaded,
             counter: Counter::Stencil,
+            transmit: TransmitMode { fp32: false, log: true },
             capture: false,
         }
     }
@@ -177,6 +226,9 @@ pub struct FrameOutput {
     pub stencil: Vec<Vec<u8>>,
     /// Per light: the exact signed count (float counter, captured frames only).
     pub counts: Vec<Vec<i32>>,
+    /// Per light: the transparent casters' light fraction reaching each pixel (scenes with
+    /// transparent casters, captured frames only).
+    pub transmit: Vec<Vec<[f32; 3]>>,
     /// World position per pixel (NaN for background), captured frames only.
     pub positions: Vec<[f32; 3]>,
     /// Geometric face normal per pixel (NaN for background), captured frames only.
@@ -223,6 +275,28 @@ impl FrameOutput {
     }
 }
 
+impl FrameOutput {
+    /// Per light, per pixel: the RGB fraction of the light that reaches the visible surface:
+    /// 0 where an opaque caster shadows it (or it faces away, or is out of range / cone), the
+    /// transparent casters' transmittance otherwise (1 without them); NaN for background.
+    pub fn light_fractions(&self, scene: &Scene) -> Vec<Vec<[f32; 3]>> {
+        self.shadow_masks(scene)
+            .iter()
+            .enumerate()
+            .map(|(k, mask)| {
+                mask.iter()
+                    .enumerate()
+                    .map(|(i, &m)| match m {
+                        128 => [f32::NAN; 3],
+                        0 => [0.0; 3],
+                        _ => self.transmit.get(k).map(|t| t[i]).unwrap_or([1.0; 3]),
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+}
+
 /// A caster chunk on the GPU: the dual-length vertex buffer (n x (xyz,1) then n x (xyz,0)).
 struct GpuChunk {
     vertices: Buffer,
@@ -240,6 +314,12 @@ struct Pipelines {
     count_cap: vk::Pipeline,
     illuminate: vk::Pipeline,
     illuminate_count: vk::Pipeline,
+    illuminate_t: vk::Pipeline,
+    illuminate_count_t: vk::Pipeline,
+    /// [multiplicative, log] x [z-pass, z-fail] into the light-intensity map.
+    transmit: [[vk::Pipeline; 2]; 2],
+    transparent_over: vk::Pipeline,
+    transparent_light: vk::Pipeline,
     volumes: vk::Pipeline,
     tonemap: vk::Pipeline,
 }
@@ -250,15 +330,19 @@ pub struct Renderer {
     casters: Vec<Caster>,
     /// Per caster, its number of connected shells (for the stencil-overflow warning).
     shells: Vec<usize>,
+    /// Some caster is transparent: the light-intensity map pass runs.
+    has_transparent: bool,
     /// Per caster (same order as `casters`), its chunks' GPU buffers.
     gpu_casters: Vec<Vec<GpuChunk>>,
     scene_vertices: Buffer,
     scene_vertex_count: u32,
     /// The first `one_sided_count` scene vertices belong to closed outward meshes.
     one_sided_count: u32,
+    /// Opaque vertices (one- and two-sided) come first; transparent meshes' after them.
+    opaque_count: u32,
     targets: Targets,
     set_layouts: [vk::DescriptorSetLayout; 2],
-    layouts: [vk::PipelineLayout; 4],
+    layouts: [vk::PipelineLayout; 5],
     descriptor_pool: vk::DescriptorPool,
     sets: [vk::DescriptorSet; 2],
     sampler: vk::Sampler,
@@ -318,12 +402,19 @@ impl Renderer {
         // outward meshes first (drawn with back faces culled), then every other mesh (open,
         // non-manifold, inside-out), drawn two-sided so that what the eye sees is what is there.
         let eye = scene.camera.eye.as_dvec3();
-        let mut one_sided: Vec<[f32; 9]> = Vec::new();
-        let mut two_sided: Vec<[f32; 9]> = Vec::new();
+        let mut one_sided: Vec<[f32; 10]> = Vec::new();
+        let mut two_sided: Vec<[f32; 10]> = Vec::new();
+        let mut transparent: Vec<[f32; 10]> = Vec::new();
         for m in &scene.meshes {
             let topo = crate::geom::topology::Topology::build(&m.mesh);
             let outward = topo.is_closed_manifold() && signed_volume(&m.mesh) > 0.0;
-            let verts = if outward { &mut one_sided } else { &mut two_sided };
+            let verts = if m.opacity < 1.0 {
+                &mut transparent
+            } else if outward {
+                &mut one_sided
+            } else {
+                &mut two_sided
+            };
             let xf = m.transform.as_dmat4();
             for t in 0..m.mesh.triangles.len() {
                 let p = m.mesh.triangle(t).map(|v| xf.transform_point3(v.as_dvec3()));
@@ -334,18 +425,20 @@ impl Renderer {
                 let n = n.normalize().as_vec3();
                 for v in p {
                     let r = (v - eye).as_vec3();
-                    verts.push([r.x, r.y, r.z, n.x, n.y, n.z, m.color.x, m.color.y, m.color.z]);
+                    verts.push([r.x, r.y, r.z, n.x, n.y, n.z, m.color.x, m.color.y, m.color.z, m.opacity]);
                 }
             }
         }
         let one_sided_count = one_sided.len() as u32;
         let mut verts = one_sided;
         verts.extend(two_sided);
+        let opaque_count = verts.len() as u32;
+        verts.extend(transparent);
         if verts.is_empty() {
             return Err(Error::Other(format!("scene '{}' has no triangle to draw", scene.name)));
         }
         let scene_vertices = upload(&ctx, "scene", bytes_of(&verts), vk::BufferUsageFlags::VERTEX_BUFFER)?;
-        let targets = Targets::new(&ctx, opts.width, opts.height)?;
+        let targets = Targets::new(&ctx, opts.width, opts.height, opts.transmit.format())?;
 
         // Descriptors: set 0 = G-buffer for illumination, set 1 = accumulation for tone mapping.
         let d = &ctx.device;
@@ -373,8 +466,9 @@ impl Renderer {
                 d.create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&b), None)
                     .map_err(vkerr("vkCreateDescriptorSetLayout"))
             };
-            // set 0: albedo, normal, position, sampler, count; set 1: accumulation, sampler.
-            let set_layouts = [mk_set_layout(&[true, true, true, false, true])?, mk_set_layout(&[true, false])?];
+            // set 0: albedo, normal, position, sampler, count, light-intensity map;
+            // set 1: accumulation, sampler.
+            let set_layouts = [mk_set_layout(&[true, true, true, false, true, true])?, mk_set_layout(&[true, false])?];
             let mk_layout = |sets: &[vk::DescriptorSetLayout], push: u32, stages: vk::ShaderStageFlags| {
                 let ranges = [vk::PushConstantRange { stage_flags: stages, offset: 0, size: push }];
                 let info = vk::PipelineLayoutCreateInfo::default().set_layouts(sets).push_constant_ranges(if push > 0 { &ranges } else { &[] });
@@ -386,9 +480,10 @@ impl Renderer {
                 mk_layout(&[], 96, vf)?,
                 mk_layout(&set_layouts[0..1], 64, vk::ShaderStageFlags::FRAGMENT)?,
                 mk_layout(&set_layouts[1..2], 0, vk::ShaderStageFlags::FRAGMENT)?,
+                mk_layout(&[], 128, vf)?,
             ];
             let sizes = [
-                vk::DescriptorPoolSize { ty: vk::DescriptorType::SAMPLED_IMAGE, descriptor_count: 5 },
+                vk::DescriptorPoolSize { ty: vk::DescriptorType::SAMPLED_IMAGE, descriptor_count: 6 },
                 vk::DescriptorPoolSize { ty: vk::DescriptorType::SAMPLER, descriptor_count: 2 },
             ];
             let pool = d
@@ -404,6 +499,7 @@ impl Renderer {
             let samp = [vk::DescriptorImageInfo { sampler, image_view: vk::ImageView::null(), image_layout: vk::ImageLayout::UNDEFINED }];
             let (a, n, p, acc) = (img(&targets.albedo), img(&targets.normal), img(&targets.position), img(&targets.accum));
             let cnt = img(&targets.count);
+            let tr = img(&targets.transmit);
             fn w(set: vk::DescriptorSet, binding: u32, ty: vk::DescriptorType, info: &[vk::DescriptorImageInfo]) -> vk::WriteDescriptorSet<'_> {
                 vk::WriteDescriptorSet::default().dst_set(set).dst_binding(binding).descriptor_type(ty).image_info(info)
             }
@@ -413,6 +509,7 @@ impl Renderer {
                 w(sets[0], 2, vk::DescriptorType::SAMPLED_IMAGE, &p),
                 w(sets[0], 3, vk::DescriptorType::SAMPLER, &samp),
                 w(sets[0], 4, vk::DescriptorType::SAMPLED_IMAGE, &cnt),
+                w(sets[0], 5, vk::DescriptorType::SAMPLED_IMAGE, &tr),
                 w(sets[1], 0, vk::DescriptorType::SAMPLED_IMAGE, &acc),
                 w(sets[1], 1, vk::DescriptorType::SAMPLER, &samp),
             ];
@@ -420,7 +517,7 @@ impl Renderer {
             (sampler, set_layouts, layouts, pool, sets)
         };
 
-        let pipes = create_pipelines(&ctx, &layouts, opts.depth_mode, ctx.features.depth_bounds)?;
+        let pipes = create_pipelines(&ctx, &layouts, opts.depth_mode, ctx.features.depth_bounds, opts.transmit.format())?;
 
         // SAFETY: object creation on a valid device; destroyed in Drop.
         let (query_pool, cmd, fence) = unsafe {
@@ -438,14 +535,17 @@ impl Renderer {
         };
 
         let shells = casters.iter().map(|c| shell_count(c.mesh())).collect();
+        let has_transparent = casters.iter().any(|c| c.transmittance.is_some());
         Ok(Renderer {
             scene,
             opts,
             casters,
             shells,
+            has_transparent,
             gpu_casters,
             scene_vertex_count: verts.len() as u32,
             one_sided_count,
+            opaque_count,
             scene_vertices,
             targets,
             set_layouts,
@@ -660,6 +760,10 @@ impl Renderer {
             sizes.push(npx * 16); // normals
             let per_light = if self.opts.counter == Counter::Float { npx * 4 } else { npx };
             sizes.extend(std::iter::repeat(per_light).take(nlights)); // stencil or float count per light
+            if self.has_transparent {
+                let texel = if self.opts.transmit.fp32 { 16 } else { 8 };
+                sizes.extend(std::iter::repeat(npx * texel).take(nlights)); // light-intensity map per light
+            }
         }
         if self.readback.len() != sizes.len() || self.readback.iter().zip(&sizes).any(|(b, &s)| b.size != s) {
             for mut b in self.readback.drain(..) {
@@ -685,7 +789,8 @@ impl Renderer {
                     LightKind::Spot => l.direction.normalize().extend((l.cone_deg.to_radians() * 0.5).cos()),
                     _ => Vec4::new(0.0, 0.0, -1.0, -2.0),
                 };
-                [pos, (l.color * l.intensity).extend(1.0), spot, Vec4::new(l.radius.unwrap_or(0.0), 0.0, 0.0, 0.0)]
+                let log = if self.opts.transmit.log { 1.0 } else { 0.0 };
+                [pos, (l.color * l.intensity).extend(1.0), spot, Vec4::new(l.radius.unwrap_or(0.0), log, 0.0, 0.0)]
             })
             .collect();
         // Per caster: MVP (eye-relative, composed in f64) and the light in object space per light.
@@ -764,9 +869,9 @@ impl Renderer {
             d.cmd_push_constants(cb, self.layouts[0], vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT, 0, bytes_of(&push));
             d.cmd_bind_vertex_buffers(cb, 0, &[self.scene_vertices.raw], &[0]);
             d.cmd_draw(cb, self.one_sided_count, 1, 0, 0);
-            if self.scene_vertex_count > self.one_sided_count {
+            if self.opaque_count > self.one_sided_count {
                 d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.pipes.gbuffer_two_sided);
-                d.cmd_draw(cb, self.scene_vertex_count - self.one_sided_count, 1, self.one_sided_count, 0);
+                d.cmd_draw(cb, self.opaque_count - self.one_sided_count, 1, self.one_sided_count, 0);
             }
             d.cmd_end_rendering(cb);
             ts(vk::PipelineStageFlags2::ALL_COMMANDS, TS_DEPTH);
@@ -809,7 +914,7 @@ impl Renderer {
                 }
                 let mut bound_pipe = vk::Pipeline::null();
                 for (ci, case, light_obj, cdraws) in ldraws {
-                    if *case == Case::Culled {
+                    if *case == Case::Culled || self.casters[*ci].transmittance.is_some() {
                         continue;
                     }
                     let mut push = [0f32; 24];
@@ -859,6 +964,58 @@ impl Renderer {
                     transition(ctx, cb, &t.count, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
                 }
 
+                // Transparent casters: the light-intensity map (Kim et al. 2008), every volume face
+                // multiplying by t or 1/t (or adding +-log t), depth-tested like the float counter.
+                if self.has_transparent {
+                    let log = self.opts.transmit.log;
+                    let clear = vk::ClearValue { color: vk::ClearColorValue { float32: if log { [0.0; 4] } else { [1.0; 4] } } };
+                    transition(ctx, cb, &t.transmit, vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
+                    let map_att = [att(&t.transmit, vk::AttachmentLoadOp::CLEAR, clear)];
+                    d.cmd_begin_rendering(
+                        cb,
+                        &vk::RenderingInfo::default()
+                            .render_area(scissor)
+                            .layer_count(1)
+                            .color_attachments(&map_att)
+                            .depth_attachment(&depth_load)
+                            .stencil_attachment(&depth_load),
+                    );
+                    d.cmd_set_viewport(cb, 0, &[viewport]);
+                    d.cmd_set_scissor(cb, 0, &[scissor]);
+                    if ctx.features.depth_bounds {
+                        let (lo, hi) = bounds.unwrap_or((0.0, 1.0));
+                        d.cmd_set_depth_bounds(cb, lo, hi);
+                    }
+                    for (ci, case, light_obj, cdraws) in ldraws {
+                        let Some(tr) = self.casters[*ci].transmittance else { continue };
+                        if *case == Case::Culled {
+                            continue;
+                        }
+                        let zpass = *case == Case::ZPass;
+                        let mut push = [0f32; 24];
+                        push[..16].copy_from_slice(&caster_mvp[*ci].to_cols_array());
+                        push[16..20].copy_from_slice(&light_obj.to_array());
+                        push[20..24].copy_from_slice(&[if zpass { 1.0 } else { -1.0 }, tr.x, tr.y, tr.z]);
+                        d.cmd_push_constants(cb, self.layouts[1], vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT, 0, bytes_of(&push));
+                        d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.pipes.transmit[log as usize][(!zpass) as usize]);
+                        for dr in cdraws {
+                            // Transparent casters' caps are all in the volume list (not NEVER).
+                            self.record_draw(cb, *ci, dr, stream_raw);
+                        }
+                    }
+                    d.cmd_end_rendering(cb);
+                    if capture {
+                        transition(ctx, cb, &t.transmit, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+                        let region = vk::BufferImageCopy::default()
+                            .image_subresource(vk::ImageSubresourceLayers { aspect_mask: vk::ImageAspectFlags::COLOR, mip_level: 0, base_array_layer: 0, layer_count: 1 })
+                            .image_extent(vk::Extent3D { width: w, height: h, depth: 1 });
+                        d.cmd_copy_image_to_buffer(cb, t.transmit.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, self.readback[3 + nlights + li].raw, &[region]);
+                        transition(ctx, cb, &t.transmit, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
+                    } else {
+                        transition(ctx, cb, &t.transmit, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
+                    }
+                }
+
                 // Illumination where the count is zero.
                 let q1 = q0 + 2;
                 ts(vk::PipelineStageFlags2::ALL_COMMANDS, q1);
@@ -874,7 +1031,13 @@ impl Renderer {
                 );
                 d.cmd_set_viewport(cb, 0, &[viewport]);
                 d.cmd_set_scissor(cb, 0, &[scissor]);
-                let illuminate = if float { self.pipes.illuminate_count } else { self.pipes.illuminate };
+                let p = &self.pipes;
+                let illuminate = match (float, self.has_transparent) {
+                    (false, false) => p.illuminate,
+                    (true, false) => p.illuminate_count,
+                    (false, true) => p.illuminate_t,
+                    (true, true) => p.illuminate_count_t,
+                };
                 d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, illuminate);
                 if ctx.features.depth_bounds {
                     let (lo, hi) = bounds.unwrap_or((0.0, 1.0));
@@ -893,6 +1056,44 @@ impl Renderer {
                     (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT | frag_tests, color_rw | ds_rw),
                     (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT | frag_tests, color_rw | ds_rw),
                 );
+            }
+
+            // Transparent casters, forward over the lit scene: premultiplied "over" with the
+            // ambient term, then each light added (unsorted: an order-independent approximation;
+            // transparent surfaces receive no shadows).
+            if self.opaque_count < self.scene_vertex_count {
+                let accum_att = [att(&t.accum, load, zero)];
+                let depth_load = att(&t.depth, load, ds_clear);
+                d.cmd_begin_rendering(
+                    cb,
+                    &vk::RenderingInfo::default()
+                        .render_area(full)
+                        .layer_count(1)
+                        .color_attachments(&accum_att)
+                        .depth_attachment(&depth_load)
+                        .stencil_attachment(&depth_load),
+                );
+                d.cmd_set_viewport(cb, 0, &[viewport]);
+                d.cmd_set_scissor(cb, 0, &[full]);
+                d.cmd_bind_vertex_buffers(cb, 0, &[self.scene_vertices.raw], &[0]);
+                let n = self.scene_vertex_count - self.opaque_count;
+                let mut push = [0f32; 32];
+                push[..16].copy_from_slice(&vp_rel.to_cols_array());
+                push[20..23].copy_from_slice(&ambient.to_array());
+                let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
+                d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.pipes.transparent_over);
+                d.cmd_push_constants(cb, self.layouts[4], stages, 0, bytes_of(&push));
+                d.cmd_draw(cb, n, 1, self.opaque_count, 0);
+                d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.pipes.transparent_light);
+                for lu in &light_uniforms {
+                    for (k, v) in lu.iter().enumerate() {
+                        push[16 + 4 * k..20 + 4 * k].copy_from_slice(&v.to_array());
+                    }
+                    push[30] = 1.0; // params.z: light pass
+                    d.cmd_push_constants(cb, self.layouts[4], stages, 0, bytes_of(&push));
+                    d.cmd_draw(cb, n, 1, self.opaque_count, 0);
+                }
+                d.cmd_end_rendering(cb);
             }
 
             if self.opts.view == View::Volumes {
@@ -989,7 +1190,7 @@ impl Renderer {
 
         // 6. Read back.
         let color = self.readback[0].read()?.to_vec();
-        let (mut positions, mut normals, mut stencil, mut counts) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let (mut positions, mut normals, mut stencil, mut counts, mut transmit) = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
         if capture {
             let floats = |b: &Buffer| -> Result<Vec<[f32; 4]>> {
                 Ok(b.read()?.chunks_exact(16).map(|c| std::array::from_fn(|k| f32::from_le_bytes([c[4 * k], c[4 * k + 1], c[4 * k + 2], c[4 * k + 3]]))).collect())
@@ -1014,6 +1215,30 @@ impl Renderer {
                     counts.push(c);
                 } else {
                     stencil.push(raw.to_vec());
+                }
+                if self.has_transparent {
+                    let raw = self.readback[3 + nlights + li].read()?;
+                    let mode = self.opts.transmit;
+                    let texel = if mode.fp32 { 16 } else { 8 };
+                    let map: Vec<[f32; 3]> = raw
+                        .chunks_exact(texel)
+                        .map(|px| {
+                            let ch = |k: usize| {
+                                if mode.fp32 {
+                                    f32::from_le_bytes([px[4 * k], px[4 * k + 1], px[4 * k + 2], px[4 * k + 3]])
+                                } else {
+                                    f16_to_f32(u16::from_le_bytes([px[2 * k], px[2 * k + 1]]))
+                                }
+                            };
+                            let v = [ch(0), ch(1), ch(2)];
+                            if mode.log {
+                                v.map(f32::exp)
+                            } else {
+                                v
+                            }
+                        })
+                        .collect();
+                    transmit.push(map);
                 }
             }
         }
@@ -1051,6 +1276,7 @@ impl Renderer {
             depth_mode: self.opts.depth_mode.name().into(),
             index_format: self.opts.index_format.name().into(),
             counter: self.opts.counter.name().into(),
+            transmit: if self.has_transparent { Some(self.opts.transmit.name().into()) } else { None },
             width: w,
             height: h,
             lights: light_stats,
@@ -1062,7 +1288,7 @@ impl Renderer {
             features_missing,
             warnings,
         };
-        let mut out = FrameOutput { width: w, height: h, color, stencil, counts, positions, normals, stats };
+        let mut out = FrameOutput { width: w, height: h, color, stencil, counts, transmit, positions, normals, stats };
         if self.opts.view == View::Stencil {
             if let Some(s) = out.stencil.first() {
                 out.color = stencil_heatmap(s);
@@ -1133,6 +1359,24 @@ fn shell_count(mesh: &crate::geom::Mesh) -> usize {
     roots.len()
 }
 
+/// IEEE half to single precision (readback of RGBA16F targets).
+fn f16_to_f32(h: u16) -> f32 {
+    let sign = if h & 0x8000 != 0 { -1.0f32 } else { 1.0 };
+    let exp = ((h >> 10) & 0x1f) as i32;
+    let mant = (h & 0x3ff) as f32;
+    match exp {
+        0 => sign * mant * 2f32.powi(-24),
+        31 => {
+            if mant == 0.0 {
+                sign * f32::INFINITY
+            } else {
+                f32::NAN
+            }
+        }
+        e => sign * (1.0 + mant / 1024.0) * 2f32.powi(e - 15),
+    }
+}
+
 fn case_name(c: Case) -> &'static str {
     match c {
         Case::Culled => "culled",
@@ -1182,12 +1426,18 @@ fn upload(ctx: &Context, name: &str, data: &[u8], usage: vk::BufferUsageFlags) -
 /// `depth_bounds`: when the device has the feature, the determination and illumination
 /// pipelines test the stored depth against the light's depth range (set per light, dynamic
 /// state; [0, 1] when the light is unbounded, which passes everything).
-fn create_pipelines(ctx: &Context, layouts: &[vk::PipelineLayout; 4], depth_mode: DepthMode, depth_bounds: bool) -> Result<Pipelines> {
+fn create_pipelines(
+    ctx: &Context,
+    layouts: &[vk::PipelineLayout; 5],
+    depth_mode: DepthMode,
+    depth_bounds: bool,
+    transmit_format: vk::Format,
+) -> Result<Pipelines> {
     let df = ctx.depth_format;
     let gbuffer_formats = [ACCUM_FORMAT, ALBEDO_FORMAT, NORMAL_FORMAT, POSITION_FORMAT];
     let mut g = PipelineDesc::new(shaders::GBUFFER_VERT, layouts[0], df);
     g.fragment = Some(shaders::GBUFFER_FRAG);
-    g.vertex_stride = 36;
+    g.vertex_stride = 40;
     g.attributes = &[(0, vk::Format::R32G32B32_SFLOAT, 0), (1, vk::Format::R32G32B32_SFLOAT, 12), (2, vk::Format::R32G32B32_SFLOAT, 24)];
     g.color_formats = &gbuffer_formats;
     g.depth_test = true;
@@ -1250,13 +1500,68 @@ fn create_pipelines(ctx: &Context, layouts: &[vk::PipelineLayout; 4], depth_mode
     i.fragment = Some(shaders::ILLUMINATE_COUNT_FRAG);
     i.stencil = None;
     let illuminate_count = pipeline::create(ctx, &i)?;
+    i.fragment = Some(shaders::ILLUMINATE_COUNT_T_FRAG);
+    let illuminate_count_t = pipeline::create(ctx, &i)?;
+    i.fragment = Some(shaders::ILLUMINATE_T_FRAG);
+    i.stencil = Some((pipeline::stencil_equal(0), pipeline::stencil_equal(0)));
+    let illuminate_t = pipeline::create(ctx, &i)?;
+
+    // Transparent casters' light-intensity map: [multiplicative, log] x [z-pass, z-fail].
+    let map_fmt = [transmit_format];
+    let mut tm = c.clone();
+    tm.color_formats = &map_fmt;
+    let mut transmit = [[vk::Pipeline::null(); 2]; 2];
+    for (li, (frag, blend)) in [(shaders::TRANSMIT_FRAG, Blend::Multiply), (shaders::TRANSMIT_LOG_FRAG, Blend::Additive)].into_iter().enumerate() {
+        tm.fragment = Some(frag);
+        tm.blend = blend;
+        for (zi, cmp) in [vk::CompareOp::LESS, vk::CompareOp::GREATER_OR_EQUAL].into_iter().enumerate() {
+            tm.depth_compare = cmp;
+            transmit[li][zi] = pipeline::create(ctx, &tm)?;
+        }
+    }
+
+    // Transparent casters drawn forward over the lit scene.
+    let mut tp = PipelineDesc::new(shaders::TRANSPARENT_VERT, layouts[4], df);
+    tp.fragment = Some(shaders::TRANSPARENT_FRAG);
+    tp.vertex_stride = 40;
+    tp.attributes = &[
+        (0, vk::Format::R32G32B32_SFLOAT, 0),
+        (1, vk::Format::R32G32B32_SFLOAT, 12),
+        (2, vk::Format::R32G32B32_SFLOAT, 24),
+        (3, vk::Format::R32_SFLOAT, 36),
+    ];
+    tp.color_formats = &accum;
+    tp.depth_test = true;
+    tp.depth_compare = vk::CompareOp::LESS;
+    tp.blend = Blend::Over;
+    let transparent_over = pipeline::create(ctx, &tp)?;
+    tp.blend = Blend::Additive;
+    let transparent_light = pipeline::create(ctx, &tp)?;
 
     let out = [OUTPUT_FORMAT];
     let mut t = PipelineDesc::new(shaders::FULLSCREEN_VERT, layouts[3], vk::Format::UNDEFINED);
     t.fragment = Some(shaders::TONEMAP_FRAG);
     t.color_formats = &out;
     let tonemap = pipeline::create(ctx, &t)?;
-    Ok(Pipelines { gbuffer, gbuffer_two_sided, zpass, zfail, zfail_cap, count_zpass, count_zfail, count_cap, illuminate, illuminate_count, volumes, tonemap })
+    Ok(Pipelines {
+        gbuffer,
+        gbuffer_two_sided,
+        zpass,
+        zfail,
+        zfail_cap,
+        count_zpass,
+        count_zfail,
+        count_cap,
+        illuminate,
+        illuminate_count,
+        illuminate_t,
+        illuminate_count_t,
+        transmit,
+        transparent_over,
+        transparent_light,
+        volumes,
+        tonemap,
+    })
 }
 
 impl Drop for Renderer {
@@ -1274,7 +1579,26 @@ impl Renderer {
             let _ = ctx.device.device_wait_idle();
             let d = &ctx.device;
             let p = &self.pipes;
-            for pipe in [p.gbuffer, p.gbuffer_two_sided, p.zpass, p.zfail, p.zfail_cap, p.count_zpass, p.count_zfail, p.count_cap, p.illuminate, p.illuminate_count, p.volumes, p.tonemap] {
+            let mut all = vec![
+                p.gbuffer,
+                p.gbuffer_two_sided,
+                p.zpass,
+                p.zfail,
+                p.zfail_cap,
+                p.count_zpass,
+                p.count_zfail,
+                p.count_cap,
+                p.illuminate,
+                p.illuminate_count,
+                p.illuminate_t,
+                p.illuminate_count_t,
+                p.transparent_over,
+                p.transparent_light,
+                p.volumes,
+                p.tonemap,
+            ];
+            all.extend(p.transmit.iter().flatten());
+            for pipe in all {
                 d.destroy_pipeline(pipe, None);
             }
             for l in self.layouts {

@@ -18,5 +18,5 @@ pub mod frame;
 pub mod stats;
 pub mod targets;
 
-pub use frame::{Counter, DepthMode, FrameOutput, IndexFormat, RenderOptions, Renderer, View};
+pub use frame::{Counter, DepthMode, TransmitMode, FrameOutput, IndexFormat, RenderOptions, Renderer, View};
 pub use stats::Stats;

@@ -88,6 +88,9 @@ pub struct Stats {
     pub index_format: String,
     /// "stencil" (8-bit, wraps at 256) or "float" (32-bit float target).
     pub counter: String,
+    /// The transparent casters' light-intensity map mode (log16, mul16, log32, mul32), when
+    /// the scene has transparent casters.
+    pub transmit: Option<String>,
     pub width: u32,
     pub height: u32,
     pub lights: Vec<LightStats>,

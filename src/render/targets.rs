@@ -22,10 +22,12 @@ pub struct Targets {
     pub depth: Image,
     pub output: Image,
     pub count: Image,
+    pub transmit: Image,
 }
 
 impl Targets {
-    pub fn new(ctx: &Context, width: u32, height: u32) -> Result<Targets> {
+    /// `transmit_format`: the transparent casters' light-intensity map (RGBA16F or RGBA32F).
+    pub fn new(ctx: &Context, width: u32, height: u32, transmit_format: vk::Format) -> Result<Targets> {
         let extent = vk::Extent2D { width, height };
         let color = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
         let c = vk::ImageAspectFlags::COLOR;
@@ -44,6 +46,7 @@ impl Targets {
                 vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL,
             )?,
             count: Image::new_2d(ctx, "count", COUNT_FORMAT, extent, color, c)?,
+            transmit: Image::new_2d(ctx, "light-intensity map", transmit_format, extent, color, c)?,
             output: Image::new_2d(ctx, "output", OUTPUT_FORMAT, extent, vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC, c)?,
         })
     }
@@ -53,7 +56,7 @@ impl Targets {
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
-        for img in [&mut self.accum, &mut self.albedo, &mut self.normal, &mut self.position, &mut self.depth, &mut self.output, &mut self.count] {
+        for img in [&mut self.accum, &mut self.albedo, &mut self.normal, &mut self.position, &mut self.depth, &mut self.output, &mut self.count, &mut self.transmit] {
             img.destroy(ctx);
         }
     }

@@ -15,6 +15,9 @@ use glam::{Mat4, Vec3};
 /// Most vertices a chunk may hold INCLUDING its apex, so that `2n - 1` fits in a u16.
 pub const MAX_CHUNK_VERTICES: usize = 32768;
 
+/// Smallest per-surface transmittance: keeps 1/t and log(t) finite in the light-intensity map.
+pub const TRANSMITTANCE_FLOOR: f32 = 1e-4;
+
 /// A piece of a caster drawn with one dual-length vertex buffer: index `i` (`i < n`) is
 /// `(vertices[i], 1)`, index `i + n` is `(vertices[i], 0)`, `n = vertices.len()`.
 #[derive(Clone, Debug)]
@@ -69,6 +72,10 @@ impl CasterKind {
 #[derive(Clone, Debug)]
 pub struct Caster {
     pub name: String,
+    /// `Some(t)` for a transparent caster: the RGB fraction of light one of its surfaces lets
+    /// through, `(1 - opacity) * color`. Its volumes go to the light-intensity map, not the
+    /// opaque counter.
+    pub transmittance: Option<glam::Vec3>,
     pub kind: CasterKind,
     /// Multiplicity casters only (empty otherwise): for every welded triangle, the id of the
     /// group of triangles with exactly the same three welded vertices (any order, any
@@ -91,8 +98,21 @@ pub struct Caster {
 }
 
 impl Caster {
+    /// A caster for a scene mesh. A transparent mesh (opacity < 1) always takes the
+    /// multiplicity path, whose count is the number of surfaces crossed (Kim et al. 2008): each
+    /// one attenuates the light by `(1 - opacity) * color`.
     pub fn from_scene_mesh(m: &SceneMesh) -> Result<Caster> {
-        Caster::new(&m.name, &m.mesh, m.transform)
+        let mut c = Caster::new(&m.name, &m.mesh, m.transform)?;
+        if m.opacity < 1.0 {
+            if c.kind == CasterKind::Manifold {
+                c.kind = CasterKind::Multiplicity {
+                    reason: format!("transparent (opacity {}): every surface crossed attenuates the light", m.opacity),
+                };
+                c.coincident = coincident_groups(&c.topology.mesh);
+            }
+            c.transmittance = Some(((1.0 - m.opacity) * m.color).max(glam::Vec3::splat(TRANSMITTANCE_FLOOR)));
+        }
+        Ok(c)
     }
 
     pub fn new(name: &str, mesh: &Mesh, transform: Mat4) -> Result<Caster> {
@@ -123,6 +143,7 @@ impl Caster {
         };
         Ok(Caster {
             name: name.to_string(),
+            transmittance: None,
             kind,
             coincident,
             triangle_count: topology.mesh.triangles.len(),

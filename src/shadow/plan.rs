@@ -490,10 +490,12 @@ fn plan_multiplicity(
     let facing = facing_bits(caster.mesh(), l_obj, caster.mirrored);
     let mult = edge_multiplicities(caster, &facing);
     let t = ts.elapsed().as_secs_f64() * 1e3;
-    // The renderer draws multiplicity casters two-sided in the G-buffer pass, so every light
-    // cap (a caster triangle itself) lies at or behind the visible surface along any ray that
-    // crosses it: all caps are drawn with depth compare NEVER, never z-fighting the surface.
-    let shielded = vec![true; caster.mesh().triangles.len()];
+    // The renderer draws opaque multiplicity casters two-sided in the G-buffer pass, so every
+    // light cap (a caster triangle itself) lies at or behind the visible surface along any ray
+    // that crosses it: all caps are drawn with depth compare NEVER, never z-fighting the
+    // surface. Transparent casters are not in the depth buffer: their caps are real geometry
+    // in front of or behind the visible surface, depth-tested like the sides.
+    let shielded = vec![caster.transmittance.is_none(); caster.mesh().triangles.len()];
     let case = select_case(input.method, pyramid, frustum, wb);
     let dark_cap_kind = if case == Case::ZPass || directional {
         DarkCap::None
