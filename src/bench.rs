@@ -5,7 +5,7 @@
 use crate::accuracy::evaluate;
 use crate::error::{Error, Result};
 use crate::gpu::Context;
-use crate::render::{RenderOptions, Renderer};
+use crate::render::{Counter, RenderOptions, Renderer};
 use crate::shadow::Method;
 use serde::Serialize;
 
@@ -13,6 +13,7 @@ use serde::Serialize;
 pub struct BenchRow {
     pub scene: String,
     pub method: String,
+    pub counter: String,
     pub index_format: String,
     pub frames: usize,
     pub gpu_frame_ms: Option<f64>,
@@ -47,6 +48,8 @@ fn median(mut v: Vec<f64>) -> f64 {
 pub struct BenchConfig {
     pub scenes: Vec<String>,
     pub methods: Vec<Method>,
+    /// Each method runs with each counter (stencil, float), side by side.
+    pub counters: Vec<Counter>,
     pub frames: usize,
     pub opts: RenderOptions,
 }
@@ -63,7 +66,15 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         let scene = crate::scene::load(name)?;
         let c = ctx.take().ok_or_else(|| Error::Other("context lost".into()))?;
         let mut r = Renderer::new(c, scene, cfg.opts.clone())?;
-        let errors = evaluate(&mut r, name, &cfg.methods, 1)?;
+        let mut variants = Vec::new();
+        let mut errors = Vec::new();
+        for &counter in &cfg.counters {
+            r.opts.counter = counter;
+            for (m, e) in cfg.methods.iter().zip(evaluate(&mut r, name, &cfg.methods, 1)?) {
+                variants.push((*m, counter));
+                errors.push(e);
+            }
+        }
         // Round-robin over methods, frame by frame, so that drift (thermal, other load) hits
         // every method alike: the ratios are measured side by side.
         #[derive(Default)]
@@ -75,10 +86,11 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
             plan: Vec<f64>,
             last: Option<crate::render::Stats>,
         }
-        let mut acc: Vec<Acc> = cfg.methods.iter().map(|_| Acc::default()).collect();
+        let mut acc: Vec<Acc> = variants.iter().map(|_| Acc::default()).collect();
         for frame in 0..=cfg.frames {
-            for (k, &method) in cfg.methods.iter().enumerate() {
+            for (k, &(method, counter)) in variants.iter().enumerate() {
                 r.opts.method = method;
+                r.opts.counter = counter;
                 let f = r.render()?;
                 if frame == 0 {
                     continue; // warm-up: buffers sized, caches hot
@@ -94,12 +106,13 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 a.last = Some(f.stats);
             }
         }
-        for ((&method, err), a) in cfg.methods.iter().zip(&errors).zip(acc) {
+        for ((&(method, counter), err), a) in variants.iter().zip(&errors).zip(acc) {
             let s = a.last.ok_or_else(|| Error::Other("no frame".into()))?;
             let c = &s.totals.cases;
             let row = BenchRow {
                 scene: name.clone(),
                 method: method.to_string(),
+                counter: counter.name().to_string(),
                 index_format: s.index_format.clone(),
                 frames: cfg.frames,
                 gpu_frame_ms: (!a.gpu.is_empty()).then(|| median(a.gpu)),
@@ -126,14 +139,15 @@ impl BenchReport {
             "Device: {} ({}), {}x{}. Medians; error = mismatched pixels outside a 1-pixel band vs the CPU reference (worst light).\n\n",
             self.device, self.driver, self.width, self.height
         );
-        s += "| scene | method | GPU frame ms | GPU shadow ms | wall ms | plan ms | shadow tris | bytes | error | cases c/1/2/3 |\n";
-        s += "|---|---|---|---|---|---|---|---|---|---|\n";
+        s += "| scene | method | counter | GPU frame ms | GPU shadow ms | wall ms | plan ms | shadow tris | bytes | error | cases c/1/2/3 |\n";
+        s += "|---|---|---|---|---|---|---|---|---|---|---|\n";
         let f = |v: Option<f64>| v.map(|x| format!("{x:.2}")).unwrap_or_else(|| "—".into());
         for r in &self.rows {
             s += &format!(
-                "| {} | {} | {} | {} | {:.2} | {:.3} | {} | {} | {:.4}% | {}/{}/{}/{} |\n",
+                "| {} | {} | {} | {} | {} | {:.2} | {:.3} | {} | {} | {:.4}% | {}/{}/{}/{} |\n",
                 r.scene,
                 r.method,
+                r.counter,
                 f(r.gpu_frame_ms),
                 f(r.gpu_shadow_ms),
                 r.wall_ms,

@@ -78,6 +78,9 @@ enum Command {
         size: (u32, u32),
         #[arg(long, default_value = "auto")]
         index_format: String,
+        /// Comma-separated counters to compare (stencil, float).
+        #[arg(long, value_delimiter = ',', default_value = "stencil")]
+        counters: Vec<String>,
         /// Write the report as JSON.
         #[arg(long)]
         json: Option<PathBuf>,
@@ -138,8 +141,8 @@ fn main() -> ExitCode {
         Command::Render { frame, out, stats, view, dump } => render(&frame, &out, stats.as_deref(), &view, dump.as_deref()),
         Command::Info { json } => info(json),
         Command::Check { dir, band, threshold } => check(&dir, band, threshold),
-        Command::Bench { scenes, methods, frames, size, index_format, json, markdown } => {
-            bench(scenes, methods, frames, size, &index_format, json.as_deref(), markdown.as_deref())
+        Command::Bench { scenes, methods, frames, size, index_format, counters, json, markdown } => {
+            bench(scenes, methods, counters, frames, size, &index_format, json.as_deref(), markdown.as_deref())
         }
         Command::Conform { out } => umbrage::conform::run(out),
     };
@@ -220,9 +223,11 @@ fn check(dir: &Path, band: u32, threshold: f64) -> Result<ExitCode> {
     Ok(if report.passed(threshold) { ExitCode::SUCCESS } else { ExitCode::FAILURE })
 }
 
+#[allow(clippy::too_many_arguments)]
 fn bench(
     scenes: Vec<String>,
     methods: Vec<String>,
+    counters: Vec<String>,
     frames: usize,
     size: (u32, u32),
     index_format: &str,
@@ -237,12 +242,14 @@ fn bench(
     };
     let opts = RenderOptions { width: size.0, height: size.1, index_format: index_format.parse::<IndexFormat>()?, ..Default::default() };
     let ctx = umbrage::gpu::Context::new()?;
-    let cfg = umbrage::bench::BenchConfig { scenes, methods, frames, opts };
+    let counters = counters.iter().map(|c| c.parse::<Counter>()).collect::<Result<Vec<_>>>()?;
+    let cfg = umbrage::bench::BenchConfig { scenes, methods, counters, frames, opts };
     let report = umbrage::bench::run(ctx, &cfg, |r| {
         eprintln!(
-            "{:<14} {:<16} gpu {:>8} ms  shadow {:>8} ms  {:>8} tris  error {:.4}%",
+            "{:<14} {:<16} {:<8} gpu {:>8} ms  shadow {:>8} ms  {:>8} tris  error {:.4}%",
             r.scene,
             r.method,
+            r.counter,
             r.gpu_frame_ms.map(|v| format!("{v:.2}")).unwrap_or_else(|| "-".into()),
             r.gpu_shadow_ms.map(|v| format!("{v:.2}")).unwrap_or_else(|| "-".into()),
             r.shadow_triangles,
