@@ -45,7 +45,7 @@ fn strategy() -> impl Strategy<Value = Case> {
         prop::collection::vec((any::<u64>(), (-2.0f32..2.0, 0.6f32..2.5, -2.0f32..2.0), (0.0f32..6.3, 0.0f32..6.3, 0.0f32..6.3)), 1..4),
         (-4.0f32..4.0, 3.0f32..8.0, -4.0f32..4.0),
         any::<bool>(),
-        (0.0f32..6.28, 0.5f32..6.0, 4.0f32..9.0),
+        (0.0f32..std::f32::consts::TAU, 0.5f32..6.0, 4.0f32..9.0),
     )
         .prop_map(|(casters, light, directional, (cam_angle, cam_height, cam_dist))| Case {
             seeds: casters.iter().map(|c| c.0).collect(),
