@@ -697,4 +697,77 @@ mod tests {
         assert!(transmit_error(&bad[1..], &img, 0, 1).is_err());
         assert!(transmit_error(&bad, &img, 1, 1).is_err());
     }
+
+    #[test]
+    fn reference_transmit_depth_series() {
+        for k in [1u32, 4, 16, 64] {
+            let s = crate::scene::load(&format!("transparent/depth_{k}")).unwrap();
+            let r = Reference::from_scene(&s);
+            let mut want = [1.0f64; 3];
+            let mut slabs = 0;
+            for m in s.meshes.iter().filter(|m| m.casts_shadow) {
+                let boxes = m.mesh.triangles.len() as i32 / 12;
+                slabs += boxes;
+                let f = mesh_filter(m);
+                assert!(f.iter().all(|&c| c > 0.05 && c < 1.0), "{f:?}");
+                for c in 0..3 {
+                    want[c] *= f[c].powi(2 * boxes);
+                }
+            }
+            assert_eq!(slabs as u32, k);
+            assert!(want.iter().all(|&c| c > 0.05), "depth_{k}: {want:?}");
+            // A floor point in the common shadow of every slab.
+            let p = DVec3::new(1.0, 0.0, 0.4);
+            let l = &s.lights[0];
+            assert_eq!(r.crossed_triangles(p, DVec3::Y, l).len() as u32, 2 * k);
+            let v = r.transmittance_at(p, DVec3::Y, l, 1e-3).fraction().unwrap();
+            for c in 0..3 {
+                assert!((v[c] - want[c]).abs() < 1e-9 * want[c].max(1e-3), "depth_{k}: {v:?} {want:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn reference_transmit_scenes_have_transparent_casters() {
+        for name in crate::scene::builtin_names().into_iter().filter(|n| n.starts_with("transparent/")) {
+            let s = crate::scene::load(name).unwrap();
+            let transparent = s.meshes.iter().filter(|m| m.casts_shadow && m.opacity < 1.0).count();
+            assert!(transparent > 0, "{name}");
+        }
+        let s = crate::scene::load("transparent/balls_and_cubes").unwrap();
+        assert!(s.meshes.iter().any(|m| m.casts_shadow && m.opacity == 1.0 && m.mesh.triangles.len() > 2));
+        let s = crate::scene::load("transparent/inner_structure").unwrap();
+        assert!(s.meshes.iter().any(|m| m.casts_shadow && m.opacity == 1.0 && m.mesh.triangles.len() > 2));
+    }
+
+    /// Writes the reference light fraction of light 0 of every transparent scene as PNGs to
+    /// `$UMBRAGE_PREVIEW_DIR` (ambiguous magenta, background dark blue).
+    #[test]
+    #[ignore]
+    fn reference_transmit_preview() {
+        let Ok(dir) = std::env::var("UMBRAGE_PREVIEW_DIR") else {
+            return;
+        };
+        for name in crate::scene::builtin_names().into_iter().filter(|n| n.starts_with("transparent/")) {
+            let s = crate::scene::load(name).unwrap();
+            let r = Reference::from_scene(&s);
+            let (w, h) = (320u32, 240u32);
+            let img = r.render_transmittance(&s.camera, &s.lights[..1], w, h);
+            let mut buf = image::RgbImage::new(w, h);
+            for (i, v) in img.light_values(0).iter().enumerate() {
+                let px = match v {
+                    Transmit::Value(f) => {
+                        let m = s.meshes[img.pixels[i].mesh as usize].color.as_dvec3();
+                        let c = |k: usize| ((0.15 + 0.85 * f[k]) * m[k] * 255.0).round().clamp(0.0, 255.0) as u8;
+                        [c(0), c(1), c(2)]
+                    }
+                    Transmit::Ambiguous => [255, 0, 255],
+                    Transmit::Background => [10, 10, 40],
+                };
+                buf.put_pixel(i as u32 % w, i as u32 / w, image::Rgb(px));
+            }
+            let path = format!("{dir}/{}.png", name.replace('/', "_"));
+            buf.save(&path).unwrap();
+        }
+    }
 }
