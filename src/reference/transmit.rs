@@ -43,7 +43,7 @@ pub const TRANSMIT_EDGE_THRESHOLD: f64 = 1e-3;
 /// The filter of a scene mesh's triangles: `(1 - opacity) * color`, `[0; 3]` when opaque.
 pub fn mesh_filter(m: &SceneMesh) -> [f64; 3] {
     let a = m.opacity as f64;
-    if !(a < 1.0) {
+    if a.is_nan() || a >= 1.0 {
         return [0.0; 3];
     }
     let k = (1.0 - a).max(0.0);
@@ -722,22 +722,38 @@ mod tests {
             assert_eq!(r.crossed_triangles(p, DVec3::Y, l).len() as u32, 2 * k);
             let v = r.transmittance_at(p, DVec3::Y, l, 1e-3).fraction().unwrap();
             for c in 0..3 {
-                assert!((v[c] - want[c]).abs() < 1e-9 * want[c].max(1e-3), "depth_{k}: {v:?} {want:?}");
+                assert!(
+                    (v[c] - want[c]).abs() < 1e-9 * want[c].max(1e-3),
+                    "depth_{k}: {v:?} {want:?}"
+                );
             }
         }
     }
 
     #[test]
     fn reference_transmit_scenes_have_transparent_casters() {
-        for name in crate::scene::builtin_names().into_iter().filter(|n| n.starts_with("transparent/")) {
+        for name in crate::scene::builtin_names()
+            .into_iter()
+            .filter(|n| n.starts_with("transparent/"))
+        {
             let s = crate::scene::load(name).unwrap();
-            let transparent = s.meshes.iter().filter(|m| m.casts_shadow && m.opacity < 1.0).count();
+            let transparent = s
+                .meshes
+                .iter()
+                .filter(|m| m.casts_shadow && m.opacity < 1.0)
+                .count();
             assert!(transparent > 0, "{name}");
         }
         let s = crate::scene::load("transparent/balls_and_cubes").unwrap();
-        assert!(s.meshes.iter().any(|m| m.casts_shadow && m.opacity == 1.0 && m.mesh.triangles.len() > 2));
+        assert!(s
+            .meshes
+            .iter()
+            .any(|m| m.casts_shadow && m.opacity == 1.0 && m.mesh.triangles.len() > 2));
         let s = crate::scene::load("transparent/inner_structure").unwrap();
-        assert!(s.meshes.iter().any(|m| m.casts_shadow && m.opacity == 1.0 && m.mesh.triangles.len() > 2));
+        assert!(s
+            .meshes
+            .iter()
+            .any(|m| m.casts_shadow && m.opacity == 1.0 && m.mesh.triangles.len() > 2));
     }
 
     /// Writes the reference light fraction of light 0 of every transparent scene as PNGs to
@@ -748,7 +764,10 @@ mod tests {
         let Ok(dir) = std::env::var("UMBRAGE_PREVIEW_DIR") else {
             return;
         };
-        for name in crate::scene::builtin_names().into_iter().filter(|n| n.starts_with("transparent/")) {
+        for name in crate::scene::builtin_names()
+            .into_iter()
+            .filter(|n| n.starts_with("transparent/"))
+        {
             let s = crate::scene::load(name).unwrap();
             let r = Reference::from_scene(&s);
             let (w, h) = (320u32, 240u32);
@@ -758,7 +777,11 @@ mod tests {
                 let px = match v {
                     Transmit::Value(f) => {
                         let m = s.meshes[img.pixels[i].mesh as usize].color.as_dvec3();
-                        let c = |k: usize| ((0.15 + 0.85 * f[k]) * m[k] * 255.0).round().clamp(0.0, 255.0) as u8;
+                        let c = |k: usize| {
+                            ((0.15 + 0.85 * f[k]) * m[k] * 255.0)
+                                .round()
+                                .clamp(0.0, 255.0) as u8
+                        };
                         [c(0), c(1), c(2)]
                     }
                     Transmit::Ambiguous => [255, 0, 255],
