@@ -112,3 +112,50 @@ pub fn markdown_table(rows: &[Row], methods: &[Method]) -> String {
     }
     s
 }
+
+/// One transparent-shadow measurement: a scene, a light-intensity map mode, and the error of
+/// the GPU's light fraction against the CPU transmittance (worst light).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct TransmitRow {
+    pub scene: String,
+    pub mode: String,
+    pub metrics: Vec<crate::reference::TransmitMetrics>,
+    pub max_abs_error: f64,
+    pub p99_abs_error: f64,
+    pub mean_abs_error: f64,
+}
+
+/// Renders `renderer.scene` in each light-intensity mode with the renderer's map format
+/// (log and multiplicative accumulation switch per frame) and compares the light fraction
+/// reaching every pixel with the CPU transmittance reference.
+pub fn evaluate_transmit(renderer: &mut Renderer, scene_name: &str, band: u32) -> Result<Vec<TransmitRow>> {
+    use crate::reference::transmit::transmit_error;
+    let (w, h) = (renderer.opts.width, renderer.opts.height);
+    let reference = Reference::from_scene(&renderer.scene);
+    let image = reference.render_transmittance(&renderer.scene.camera, &renderer.scene.lights, w, h);
+    let capture = renderer.opts.capture;
+    renderer.opts.capture = true;
+    let fp32 = renderer.opts.transmit.fp32;
+    let mut rows = Vec::new();
+    for log in [false, true] {
+        renderer.opts.transmit.log = log;
+        let frame = renderer.render()?;
+        let fractions = frame.light_fractions(&renderer.scene);
+        let metrics = fractions
+            .iter()
+            .enumerate()
+            .map(|(k, f)| transmit_error(f, &image, k, band))
+            .collect::<Result<Vec<_>>>()?;
+        let worst = |f: fn(&crate::reference::TransmitMetrics) -> f64| metrics.iter().map(f).fold(0.0, f64::max);
+        rows.push(TransmitRow {
+            scene: scene_name.to_string(),
+            mode: crate::render::TransmitMode { fp32, log }.name().to_string(),
+            max_abs_error: worst(|m| m.max_abs_error),
+            p99_abs_error: worst(|m| m.p99_abs_error),
+            mean_abs_error: worst(|m| m.mean_abs_error),
+            metrics,
+        });
+    }
+    renderer.opts.capture = capture;
+    Ok(rows)
+}

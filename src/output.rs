@@ -25,11 +25,29 @@ pub fn write_frame_dump(dir: &Path, scene: &Scene, frame: &FrameOutput) -> Resul
     if frame.positions.is_empty() {
         return Err(Error::Other("frame was rendered without capture; cannot dump".into()));
     }
-    let mut triangles = Vec::new();
-    for m in scene.meshes.iter().filter(|m| m.casts_shadow) {
+    // world.obj: the opaque casters (what the binary shadow masks are about). Transparent
+    // casters attenuate rather than occlude; they go to transparent.obj, one group per mesh
+    // with its per-surface transmittance (1 - opacity) * colour.
+    let world = |m: &crate::scene::SceneMesh| -> Vec<[glam::Vec3; 3]> {
         let xf = m.transform.as_dmat4();
-        for t in 0..m.mesh.triangles.len() {
-            triangles.push(m.mesh.triangle(t).map(|p| xf.transform_point3(p.as_dvec3()).as_vec3()));
+        (0..m.mesh.triangles.len()).map(|t| m.mesh.triangle(t).map(|p| xf.transform_point3(p.as_dvec3()).as_vec3())).collect()
+    };
+    let mut triangles = Vec::new();
+    let mut transparent = String::from("# umbrage: transparent shadow casters, world space\n");
+    let mut nv = 0usize;
+    for m in scene.meshes.iter().filter(|m| m.casts_shadow) {
+        if m.opacity >= 1.0 {
+            triangles.extend(world(m));
+            continue;
+        }
+        let t = (1.0 - m.opacity) * m.color;
+        transparent += &format!("g {}\n# transmittance {} {} {}\n", m.name.replace(char::is_whitespace, "_"), t.x, t.y, t.z);
+        for tri in world(m) {
+            for v in tri {
+                transparent += &format!("v {} {} {}\n", v.x, v.y, v.z);
+            }
+            transparent += &format!("f {} {} {}\n", nv + 1, nv + 2, nv + 3);
+            nv += 3;
         }
     }
     let dump = Dump {
@@ -45,6 +63,10 @@ pub fn write_frame_dump(dir: &Path, scene: &Scene, frame: &FrameOutput) -> Resul
         extra: Default::default(),
     };
     write_dump(dir, &dump)?;
+    if nv > 0 {
+        let path = dir.join("transparent.obj");
+        std::fs::write(&path, transparent).map_err(|e| Error::io(path.display().to_string(), e))?;
+    }
     for (k, s) in frame.stencil.iter().enumerate() {
         write_grey_png(&dir.join(format!("stencil_{k}.png")), frame.width, frame.height, s)?;
     }

@@ -347,6 +347,63 @@ impl Bvh {
         false
     }
 
+    /// Calls `f` for every triangle hit with `t_min < t < t_max`, in no particular order
+    /// (each triangle at most once per call; coincident duplicate triangles are separate
+    /// triangles and are each reported). `f` returns `false` to stop the traversal early.
+    /// Returns `false` iff stopped early. `dir` need not be unit length.
+    pub fn all_hits(
+        &self,
+        origin: DVec3,
+        dir: DVec3,
+        t_min: f64,
+        t_max: f64,
+        mut f: impl FnMut(Hit) -> bool,
+    ) -> bool {
+        if self.nodes.is_empty() {
+            return true;
+        }
+        let ray = Ray::new(origin, dir);
+        // A growable stack: no depth limit, every triangle visited at most once.
+        let mut stack: Vec<u32> = Vec::with_capacity(64);
+        stack.push(0);
+        while let Some(node) = stack.pop() {
+            let nd = &self.nodes[node as usize];
+            if ray.slab(nd, t_min, t_max).is_none() {
+                continue;
+            }
+            if nd.count > 0 {
+                let s = nd.index as usize;
+                for k in s..s + nd.count as usize {
+                    if let Some((t, u, v)) = ray.intersect(&self.tris[k], t_min, t_max) {
+                        if !f(Hit {
+                            t,
+                            tri: self.ids[k],
+                            u,
+                            v,
+                        }) {
+                            return false;
+                        }
+                    }
+                }
+            } else {
+                stack.push(nd.index);
+                stack.push(node + 1);
+            }
+        }
+        true
+    }
+
+    /// Every hit with `t_min < t < t_max`, sorted by `t` (ties by triangle index).
+    pub fn collect_hits(&self, origin: DVec3, dir: DVec3, t_min: f64, t_max: f64) -> Vec<Hit> {
+        let mut v = Vec::new();
+        self.all_hits(origin, dir, t_min, t_max, |h| {
+            v.push(h);
+            true
+        });
+        v.sort_by(|a, b| a.t.total_cmp(&b.t).then(a.tri.cmp(&b.tri)));
+        v
+    }
+
     fn brute_closest(&self, origin: DVec3, dir: DVec3, t_min: f64, t_max: f64) -> Option<Hit> {
         let ray = Ray::new(origin, dir);
         let mut best: Option<Hit> = None;
@@ -542,6 +599,20 @@ mod tests {
                 bvh.any_hit(o, d, 0.0, f64::INFINITY, |_| false),
                 brute.is_some()
             );
+            let mut all: Vec<u32> = tris
+                .iter()
+                .enumerate()
+                .filter(|(_, t)| ray.intersect(t, 0.0, f64::INFINITY).is_some())
+                .map(|(i, _)| i as u32)
+                .collect();
+            all.sort();
+            let mut got: Vec<u32> = bvh
+                .collect_hits(o, d, 0.0, f64::INFINITY)
+                .iter()
+                .map(|h| h.tri)
+                .collect();
+            got.sort();
+            assert_eq!(got, all);
         }
     }
 }

@@ -37,6 +37,7 @@
 pub mod bvh;
 pub mod dump;
 pub mod metrics;
+pub mod transmit;
 
 use crate::error::Result;
 use crate::scene::{Camera, Light, LightKind, Scene};
@@ -46,6 +47,7 @@ use std::fmt;
 
 pub use dump::{read_dump, write_dump, Dump, DumpLight};
 pub use metrics::Metrics;
+pub use transmit::{Transmit, TransmitImage, TransmitMetrics};
 
 /// The reference's decision for one surface point and one light.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
@@ -199,6 +201,9 @@ pub struct Reference {
     occluders: Bvh,
     tris: Vec<[DVec3; 3]>,
     mesh_of: Vec<u32>,
+    /// Per triangle, the RGB fraction of light it lets through, `(1 - opacity) * color`
+    /// (0 for opaque casters); see [`transmit`].
+    filters: Vec<[f64; 3]>,
     scale: f64,
     pub tolerance: Tolerance,
 }
@@ -219,18 +224,35 @@ impl Reference {
     /// otherwise).
     /// Zero-area and non-finite triangles are dropped (they can neither be seen nor occlude).
     pub fn new(triangles: Vec<[DVec3; 3]>, flags: &[TriFlags]) -> Reference {
+        Reference::with_filters(triangles, flags, &[])
+    }
+
+    /// [`Reference::new`] with each triangle's light filter for [`Reference::transmittance_at`]:
+    /// `filters[i] = (1 - opacity) * color` of triangle `i` (`[0; 3]` for an opaque caster).
+    /// An empty `filters` means every triangle is opaque; otherwise it has one entry per
+    /// triangle (panics otherwise). Only shadow-casting triangles ever filter light.
+    pub fn with_filters(
+        triangles: Vec<[DVec3; 3]>,
+        flags: &[TriFlags],
+        filters: &[[f64; 3]],
+    ) -> Reference {
         assert_eq!(triangles.len(), flags.len(), "one TriFlags per triangle");
+        assert!(
+            filters.is_empty() || filters.len() == triangles.len(),
+            "one filter per triangle"
+        );
         let ok = |t: &[DVec3; 3]| {
             t.iter().all(|p| p.is_finite())
                 && (t[1] - t[0]).cross(t[2] - t[0]).length_squared() > 0.0
         };
         let mut tris = Vec::with_capacity(triangles.len());
         let mut mesh_of = Vec::with_capacity(triangles.len());
+        let mut kept_filters = Vec::with_capacity(triangles.len());
         let mut vis = Vec::new();
         let mut occ = Vec::new();
         let mut lo = DVec3::splat(f64::INFINITY);
         let mut hi = DVec3::splat(f64::NEG_INFINITY);
-        for (t, f) in triangles.into_iter().zip(flags) {
+        for (i, (t, f)) in triangles.into_iter().zip(flags).enumerate() {
             if !ok(&t) || !(f.visible || f.occluder) {
                 continue;
             }
@@ -240,6 +262,7 @@ impl Reference {
             }
             tris.push(t);
             mesh_of.push(f.mesh);
+            kept_filters.push(filters.get(i).copied().unwrap_or([0.0; 3]));
             vis.push(f.visible);
             occ.push(f.occluder);
         }
@@ -266,6 +289,7 @@ impl Reference {
             occluders: Bvh::build(&occ_tris),
             tris,
             mesh_of,
+            filters: kept_filters,
             scale,
             tolerance: Tolerance::default(),
         }
@@ -289,7 +313,9 @@ impl Reference {
     pub fn from_scene(scene: &Scene) -> Reference {
         let mut tris = Vec::new();
         let mut flags = Vec::new();
+        let mut filters = Vec::new();
         for (mi, m) in scene.meshes.iter().enumerate() {
+            let filter = transmit::mesh_filter(m);
             let xf = m.transform.as_dmat4();
             let pos: Vec<DVec3> = m
                 .mesh
@@ -301,13 +327,16 @@ impl Reference {
                 let g = |i: u32| pos.get(i as usize).copied().unwrap_or(DVec3::NAN);
                 tris.push([g(t[0]), g(t[1]), g(t[2])]);
                 flags.push(TriFlags {
-                    visible: true,
+                    // Transparent meshes are drawn over the scene, not as receivers: the
+                    // visible surface is the first opaque one (as in the renderer).
+                    visible: m.opacity >= 1.0,
                     occluder: m.casts_shadow,
                     mesh: mi as u32,
                 });
+                filters.push(filter);
             }
         }
-        Reference::new(tris, &flags)
+        Reference::with_filters(tris, &flags, &filters)
     }
 
     pub fn with_tolerance(mut self, tolerance: Tolerance) -> Reference {
@@ -340,60 +369,9 @@ impl Reference {
     /// only the grazing test can then give Ambiguous).
     pub fn shadow_at_radius(&self, p: DVec3, n: DVec3, light: &Light, radius: f64) -> LightState {
         let n = n.normalize_or_zero();
-        if n == DVec3::ZERO || !n.is_finite() || !p.is_finite() {
-            return LightState::Ambiguous;
-        }
         let r = radius.max(0.0);
-        let lpos = light.position.as_dvec3();
-        let ldir = light.direction.as_dvec3().normalize_or_zero();
-        // Direction to the light and distance.
-        let (to_l, dist) = match light.kind {
-            LightKind::Directional => {
-                if ldir == DVec3::ZERO {
-                    return LightState::Ambiguous;
-                }
-                (-ldir, f64::INFINITY)
-            }
-            _ => {
-                let d = lpos - p;
-                let len = d.length();
-                if len.is_nan() || len <= 0.0 {
-                    return LightState::Ambiguous;
-                }
-                (d / len, len)
-            }
-        };
-        if light.kind != LightKind::Directional {
-            if let Some(rad) = light.radius {
-                let rad = rad as f64;
-                if (dist - rad).abs() <= r {
-                    return LightState::Ambiguous;
-                }
-                if dist > rad {
-                    return LightState::OutOfRange;
-                }
-            }
-        }
-        if light.kind == LightKind::Spot {
-            if ldir == DVec3::ZERO {
-                return LightState::Ambiguous;
-            }
-            let half = (light.cone_deg as f64 * 0.5).to_radians();
-            let ang = (-to_l).dot(ldir).clamp(-1.0, 1.0).acos();
-            // Distance of P from the cone surface, approximately (angle difference * dist).
-            if (ang - half).abs() * dist <= r {
-                return LightState::Ambiguous;
-            }
-            if ang > half {
-                return LightState::OutsideCone;
-            }
-        }
-        let cos = n.dot(to_l);
-        if cos.abs() < self.tolerance.grazing_cos {
-            return LightState::Ambiguous;
-        }
-        if cos < 0.0 {
-            return LightState::BackFacing;
+        if let Some(state) = self.light_precheck(p, n, light, r) {
+            return state;
         }
         let centre = self.occluded(p, n, light);
         if r > 0.0 {
@@ -411,14 +389,77 @@ impl Reference {
         }
     }
 
-    /// Whether a shadow caster lies strictly between `p` (offset along `n`) and the light.
+    /// Rules 1-3 of the module docs and their ambiguity tests, for unit (or zero) `n` and
+    /// perturbation radius `r >= 0`: `Some(state)` when they decide (Ambiguous, OutOfRange,
+    /// OutsideCone, BackFacing), `None` when only the occlusion test is left.
+    fn light_precheck(&self, p: DVec3, n: DVec3, light: &Light, r: f64) -> Option<LightState> {
+        if n == DVec3::ZERO || !n.is_finite() || !p.is_finite() {
+            return Some(LightState::Ambiguous);
+        }
+        let lpos = light.position.as_dvec3();
+        let ldir = light.direction.as_dvec3().normalize_or_zero();
+        // Direction to the light and distance.
+        let (to_l, dist) = match light.kind {
+            LightKind::Directional => {
+                if ldir == DVec3::ZERO {
+                    return Some(LightState::Ambiguous);
+                }
+                (-ldir, f64::INFINITY)
+            }
+            _ => {
+                let d = lpos - p;
+                let len = d.length();
+                if len.is_nan() || len <= 0.0 {
+                    return Some(LightState::Ambiguous);
+                }
+                (d / len, len)
+            }
+        };
+        if light.kind != LightKind::Directional {
+            if let Some(rad) = light.radius {
+                let rad = rad as f64;
+                if (dist - rad).abs() <= r {
+                    return Some(LightState::Ambiguous);
+                }
+                if dist > rad {
+                    return Some(LightState::OutOfRange);
+                }
+            }
+        }
+        if light.kind == LightKind::Spot {
+            if ldir == DVec3::ZERO {
+                return Some(LightState::Ambiguous);
+            }
+            let half = (light.cone_deg as f64 * 0.5).to_radians();
+            let ang = (-to_l).dot(ldir).clamp(-1.0, 1.0).acos();
+            // Distance of P from the cone surface, approximately (angle difference * dist).
+            if (ang - half).abs() * dist <= r {
+                return Some(LightState::Ambiguous);
+            }
+            if ang > half {
+                return Some(LightState::OutsideCone);
+            }
+        }
+        let cos = n.dot(to_l);
+        if cos.abs() < self.tolerance.grazing_cos {
+            return Some(LightState::Ambiguous);
+        }
+        if cos < 0.0 {
+            return Some(LightState::BackFacing);
+        }
+        None
+    }
+
+    /// Whether an opaque shadow caster lies strictly between `p` (offset along `n`) and the
+    /// light. Transparent casters (non-zero filter) do not occlude: they attenuate, and are
+    /// judged by [`Reference::transmittance_at`].
     fn occluded(&self, p: DVec3, n: DVec3, light: &Light) -> bool {
         let off = self.tolerance.surface_offset_rel * self.scale;
         let o = p + n * off;
         match light.kind {
             LightKind::Directional => {
                 let d = -light.direction.as_dvec3().normalize();
-                self.occluders.any_hit(o, d, 0.0, f64::INFINITY, |_| false)
+                self.occluders.any_hit(o, d, 0.0, f64::INFINITY, |t| self.filter(t) != [0.0; 3])
             }
             _ => {
                 let to = light.position.as_dvec3() - o;
@@ -427,7 +468,7 @@ impl Reference {
                     return false;
                 }
                 self.occluders
-                    .any_hit(o, to / dist, 0.0, dist - off, |_| false)
+                    .any_hit(o, to / dist, 0.0, dist - off, |t| self.filter(t) != [0.0; 3])
             }
         }
     }
@@ -437,39 +478,17 @@ impl Reference {
     pub fn render(&self, camera: &Camera, lights: &[Light], width: u32, height: u32) -> RefImage {
         let (w, h) = (width as usize, height as usize);
         let nl = lights.len();
-        let eye = camera.eye.as_dvec3();
-        // Angular size of one pixel (vertical), for the footprint.
-        let pix_angle =
-            2.0 * ((camera.fov_y_deg as f64).to_radians() * 0.5).tan() / height.max(1) as f64;
         let rows: Vec<(Vec<RefPixel>, Vec<LightState>)> = par_rows(h, |y| {
             let mut px = Vec::with_capacity(w);
             let mut st = Vec::with_capacity(w * nl);
             for x in 0..w {
-                let (o, d) = camera.pixel_ray(x as u32, y as u32, width, height);
-                match self.visible.closest_hit(o, d, 0.0, f64::INFINITY) {
+                match self.surface_at_pixel(camera, x as u32, y as u32, width, height) {
                     None => {
                         px.push(RefPixel::BACKGROUND);
                         st.extend(std::iter::repeat(LightState::Background).take(nl));
                     }
-                    Some(hit) => {
-                        let t = &self.tris[hit.tri as usize];
-                        let p = t[0] * (1.0 - hit.u - hit.v) + t[1] * hit.u + t[2] * hit.v;
-                        // The visible side of the surface: its geometric normal turned towards
-                        // the eye (a closed, outward mesh is only ever seen from the front, so
-                        // this changes nothing there; open and two-sided surfaces are lit on the
-                        // side the eye sees when that side faces the light).
-                        let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
-                        let n = if n.dot(d) > 0.0 { -n } else { n };
-                        let depth = (p - eye).length();
-                        let r = self.tolerance.footprint_fraction * depth * pix_angle;
-                        px.push(RefPixel {
-                            hit: true,
-                            position: p.as_vec3(),
-                            normal: n.as_vec3(),
-                            depth: depth as f32,
-                            mesh: self.mesh_of[hit.tri as usize],
-                            tri: hit.tri,
-                        });
+                    Some((pixel, p, n, r)) => {
+                        px.push(pixel);
                         for l in lights {
                             st.push(self.shadow_at_radius(p, n, l, r));
                         }
@@ -491,6 +510,45 @@ impl Reference {
             pixels,
             states,
         }
+    }
+}
+
+impl Reference {
+    /// The visible surface at pixel (x, y): the pixel, its f64 position and unit normal of the
+    /// visible side, and the perturbation radius (`footprint_fraction` x pixel footprint).
+    pub(crate) fn surface_at_pixel(
+        &self,
+        camera: &Camera,
+        x: u32,
+        y: u32,
+        width: u32,
+        height: u32,
+    ) -> Option<(RefPixel, DVec3, DVec3, f64)> {
+        let eye = camera.eye.as_dvec3();
+        // Angular size of one pixel (vertical), for the footprint.
+        let pix_angle =
+            2.0 * ((camera.fov_y_deg as f64).to_radians() * 0.5).tan() / height.max(1) as f64;
+        let (o, d) = camera.pixel_ray(x, y, width, height);
+        let hit = self.visible.closest_hit(o, d, 0.0, f64::INFINITY)?;
+        let t = &self.tris[hit.tri as usize];
+        let p = t[0] * (1.0 - hit.u - hit.v) + t[1] * hit.u + t[2] * hit.v;
+        // The visible side of the surface: its geometric normal turned towards the eye (a
+        // closed, outward mesh is only ever seen from the front, so this changes nothing
+        // there; open and two-sided surfaces are lit on the side the eye sees when that side
+        // faces the light).
+        let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
+        let n = if n.dot(d) > 0.0 { -n } else { n };
+        let depth = (p - eye).length();
+        let r = self.tolerance.footprint_fraction * depth * pix_angle;
+        let pixel = RefPixel {
+            hit: true,
+            position: p.as_vec3(),
+            normal: n.as_vec3(),
+            depth: depth as f32,
+            mesh: self.mesh_of[hit.tri as usize],
+            tri: hit.tri,
+        };
+        Some((pixel, p, n, r))
     }
 }
 

@@ -27,6 +27,12 @@ pub const SCENES: &[(&str, &str)] = &[
     ("hard/staircase_300", include_str!("../../scenes/hard/staircase_300.toml")),
     ("hard/background", include_str!("../../scenes/hard/background.toml")),
     ("hard/look_at_light", include_str!("../../scenes/hard/look_at_light.toml")),
+    ("transparent/balls_and_cubes", include_str!("../../scenes/transparent/balls_and_cubes.toml")),
+    ("transparent/inner_structure", include_str!("../../scenes/transparent/inner_structure.toml")),
+    ("transparent/depth_1", include_str!("../../scenes/transparent/depth_1.toml")),
+    ("transparent/depth_4", include_str!("../../scenes/transparent/depth_4.toml")),
+    ("transparent/depth_16", include_str!("../../scenes/transparent/depth_16.toml")),
+    ("transparent/depth_64", include_str!("../../scenes/transparent/depth_64.toml")),
 ];
 
 /// Embedded data files the built-in scenes reference, by repository-relative path.
