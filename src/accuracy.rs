@@ -24,6 +24,7 @@ pub fn expected_failure(scene: &str, method: Method, counter: Counter) -> Option
         ("hard/eye_in_volume" | "hard/eye_in_two_volumes", Method::ZPass) => Some("z-pass with the eye inside a volume"),
         ("hard/near_plane_cut", Method::ZPass) => Some("z-pass with the near plane cutting a volume"),
         ("hard/look_at_light", Method::ZPass) => Some("z-pass with the eye in the caster's shadow"),
+        ("hard/camera_inside_caster", Method::ZPass) => Some("z-pass with the eye inside the caster (and its volume)"),
         ("hard/light_inside_caster", Method::ZPass) => Some("z-pass with the eye in the volume (all space outside the caster)"),
         _ => None,
     }

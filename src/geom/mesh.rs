@@ -118,3 +118,77 @@ impl Mesh {
         out
     }
 }
+
+impl Mesh {
+    /// Whether `p` lies inside this closed mesh (parity of crossings along a fixed, skewed ray,
+    /// in f64). Meaningful only for closed meshes; used to notice a camera inside a caster.
+    pub fn contains_point(&self, p: glam::DVec3) -> bool {
+        // A direction unlikely to graze edges of axis-aligned or symmetric meshes.
+        let d = glam::DVec3::new(0.5773, 0.6191, 0.5327).normalize();
+        let mut crossings = 0u32;
+        for t in 0..self.triangles.len() {
+            let [a, b, c] = self.triangle(t).map(|v| v.as_dvec3());
+            let (e1, e2) = (b - a, c - a);
+            let h = d.cross(e2);
+            let det = e1.dot(h);
+            if det.abs() < 1e-300 {
+                continue;
+            }
+            let s = p - a;
+            let u = s.dot(h) / det;
+            let q = s.cross(e1);
+            let v = d.dot(q) / det;
+            let tt = e2.dot(q) / det;
+            if u >= 0.0 && v >= 0.0 && u + v <= 1.0 && tt > 0.0 {
+                crossings += 1;
+            }
+        }
+        crossings % 2 == 1
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cube() -> Mesh {
+        let v = [
+            [-1.0, -1.0, -1.0],
+            [1.0, -1.0, -1.0],
+            [1.0, 1.0, -1.0],
+            [-1.0, 1.0, -1.0],
+            [-1.0, -1.0, 1.0],
+            [1.0, -1.0, 1.0],
+            [1.0, 1.0, 1.0],
+            [-1.0, 1.0, 1.0],
+        ];
+        let q = [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [3, 7, 6, 2], [0, 4, 7, 3], [1, 2, 6, 5]];
+        let mut tris = Vec::new();
+        for f in q {
+            tris.push([f[0], f[1], f[2]]);
+            tris.push([f[0], f[2], f[3]]);
+        }
+        Mesh::new(v.iter().map(|p| Vec3::from_array(*p)).collect(), tris)
+    }
+
+    #[test]
+    fn contains_point_by_parity() {
+        let c = cube();
+        assert!(c.contains_point(glam::DVec3::ZERO));
+        assert!(c.contains_point(glam::DVec3::new(0.9, -0.9, 0.5)));
+        assert!(!c.contains_point(glam::DVec3::new(1.5, 0.0, 0.0)));
+        assert!(!c.contains_point(glam::DVec3::new(0.0, 0.0, -3.0)));
+    }
+
+    #[test]
+    fn validate_rejects_bad_meshes() {
+        assert!(Mesh::default().validate("e").is_err());
+        let mut c = cube();
+        c.positions[2].y = f32::NAN;
+        assert!(c.validate("nan").unwrap_err().to_string().contains("non-finite"));
+        let mut c = cube();
+        c.triangles[0][1] = 99;
+        assert!(c.validate("idx").unwrap_err().to_string().contains("indexes vertex"));
+        assert!(cube().validate("ok").is_ok());
+    }
+}

@@ -407,7 +407,11 @@ impl Renderer {
         let mut transparent: Vec<[f32; 10]> = Vec::new();
         for m in &scene.meshes {
             let topo = crate::geom::topology::Topology::build(&m.mesh);
-            let outward = topo.is_closed_manifold() && signed_volume(&m.mesh) > 0.0;
+            // A camera inside a closed mesh sees its inside: draw that one two-sided too.
+            let eye_inside = topo.is_closed_manifold()
+                && m.world_bounds().contains(scene.camera.eye)
+                && m.mesh.contains_point(m.transform.as_dmat4().inverse().transform_point3(eye));
+            let outward = topo.is_closed_manifold() && signed_volume(&m.mesh) > 0.0 && !eye_inside;
             let verts = if m.opacity < 1.0 {
                 &mut transparent
             } else if outward {
