@@ -51,8 +51,8 @@ pub struct Context {
     pub entry: ash::Entry,
     pub instance: ash::Instance,
     debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+    /// Also the debug messenger's user data (`Arc::as_ptr`), alive until the messenger is gone.
     log: Arc<Mutex<ValidationLog>>,
-    _log_ptr: Box<Arc<Mutex<ValidationLog>>>,
     pub physical: vk::PhysicalDevice,
     pub device: ash::Device,
     pub queue: vk::Queue,
@@ -82,14 +82,14 @@ unsafe extern "system" fn debug_callback(
     user: *mut c_void,
 ) -> vk::Bool32 {
     // SAFETY: the loader passes a valid callback-data pointer for the duration of the call, and
-    // `user` is the boxed Arc we registered, alive until the messenger is destroyed.
+    // `user` is `Arc::as_ptr` of the context's log, alive until the messenger is destroyed.
     let (msg, log) = unsafe {
         let msg = if data.is_null() || (*data).p_message.is_null() {
             String::from("(no message)")
         } else {
             CStr::from_ptr((*data).p_message).to_string_lossy().into_owned()
         };
-        (msg, &*(user as *const Arc<Mutex<ValidationLog>>))
+        (msg, &*(user as *const Mutex<ValidationLog>))
     };
     if let Ok(mut log) = log.lock() {
         if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
@@ -147,7 +147,6 @@ impl Context {
         })?;
 
         let log = Arc::new(Mutex::new(ValidationLog::default()));
-        let log_ptr = Box::new(log.clone());
         let debug = if validation {
             let du = ash::ext::debug_utils::Instance::new(&entry, &instance);
             let info = vk::DebugUtilsMessengerCreateInfoEXT::default()
@@ -158,8 +157,8 @@ impl Context {
                         | vk::DebugUtilsMessageTypeFlagsEXT::PERFORMANCE,
                 )
                 .pfn_user_callback(Some(debug_callback))
-                .user_data(&*log_ptr as *const Arc<Mutex<ValidationLog>> as *mut c_void);
-            // SAFETY: the callback and the boxed user data outlive the messenger (both owned by self).
+                .user_data(Arc::as_ptr(&log) as *mut c_void);
+            // SAFETY: the callback and the log (user data) outlive the messenger (both owned by self).
             let m = unsafe { du.create_debug_utils_messenger(&info, None) }.map_err(vkerr("vkCreateDebugUtilsMessengerEXT"))?;
             Some((du, m))
         } else {
@@ -189,7 +188,6 @@ impl Context {
                     instance,
                     debug,
                     log,
-                    _log_ptr: log_ptr,
                     physical,
                     device,
                     queue,
