@@ -253,30 +253,22 @@ pub fn geo_samples(image: &RefImage) -> Vec<GeoSample> {
         .collect()
 }
 
+/// Checks that a GPU image of `len` pixels and light index `light` fit a `w` x `h` reference
+/// with `light_count` lights.
+pub fn check_sizes(what: &str, len: usize, w: usize, h: usize, light: usize, light_count: usize) -> Result<()> {
+    if len != w * h {
+        return Err(Error::input(what, format!("{what} has {len} pixels, reference {w}x{h} has {}", w * h)));
+    }
+    if light >= light_count {
+        return Err(Error::input(what, format!("light {light} but the reference has {light_count} lights")));
+    }
+    Ok(())
+}
+
 /// Compares the GPU mask of light `light` with a reference rendering, band of `band` pixels.
 pub fn compare(mask: &[u8], image: &RefImage, light: usize, band: u32) -> Result<Metrics> {
     let (w, h) = (image.width as usize, image.height as usize);
-    if mask.len() != w * h {
-        return Err(Error::input(
-            "mask",
-            format!(
-                "mask has {} pixels, reference {}x{} has {}",
-                mask.len(),
-                w,
-                h,
-                w * h
-            ),
-        ));
-    }
-    if light >= image.light_count {
-        return Err(Error::input(
-            "mask",
-            format!(
-                "light {light} but the reference has {} lights",
-                image.light_count
-            ),
-        ));
-    }
+    check_sizes("mask", mask.len(), w, h, light, image.light_count)?;
     let states = image.light_states(light);
     let geo = geometry_edges(&geo_samples(image), w, h);
     let band = band_mask(&states, &geo, w, h, band);

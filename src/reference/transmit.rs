@@ -27,7 +27,7 @@
 
 use super::metrics::{self, GeoSample};
 use super::{par_rows, tangent_basis, LightState, RefPixel, Reference};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::scene::{Camera, Light, LightKind, SceneMesh};
 use glam::DVec3;
 
@@ -367,27 +367,7 @@ pub fn transmit_error_tol(
     tolerance: f64,
 ) -> Result<TransmitMetrics> {
     let (w, h) = (reference.width as usize, reference.height as usize);
-    if gpu.len() != w * h {
-        return Err(Error::input(
-            "transmittance",
-            format!(
-                "GPU image has {} pixels, reference {}x{} has {}",
-                gpu.len(),
-                w,
-                h,
-                w * h
-            ),
-        ));
-    }
-    if light >= reference.light_count {
-        return Err(Error::input(
-            "transmittance",
-            format!(
-                "light {light} but the reference has {} lights",
-                reference.light_count
-            ),
-        ));
-    }
+    metrics::check_sizes("transmittance", gpu.len(), w, h, light, reference.light_count)?;
     let values = reference.light_values(light);
     let geo = metrics::geometry_edges(&geo_of(&reference.pixels), w, h);
     let band_mask = transmit_band(&values, &geo, w, h, band);

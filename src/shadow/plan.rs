@@ -205,6 +205,16 @@ pub struct LightPlan {
     pub plan_ms: f64,
 }
 
+/// Per-chunk index lists into draws, leaving out chunks with nothing to draw.
+fn chunk_draws(vol: Vec<Vec<u16>>, cap: Vec<Vec<u16>>) -> Vec<ChunkDraw> {
+    vol.into_iter()
+        .zip(cap)
+        .enumerate()
+        .filter(|(_, (v, c))| !v.is_empty() || !c.is_empty())
+        .map(|(chunk, (volume, light_cap))| ChunkDraw { chunk, volume, light_cap })
+        .collect()
+}
+
 /// The object-space homogeneous light (w exactly 1 or 0).
 pub fn object_light(caster: &Caster, light_h: Vec4) -> Vec4 {
     let inv = caster.transform.as_dmat4().inverse();
@@ -320,13 +330,7 @@ pub fn emit(caster: &Caster, facing: &[bool], sil: &[SilhouetteEdge], e: Emit) -
             }
         }
     }
-    let draws = vol
-        .into_iter()
-        .zip(cap)
-        .enumerate()
-        .filter(|(_, (v, c))| !v.is_empty() || !c.is_empty())
-        .map(|(chunk, (volume, light_cap))| ChunkDraw { chunk, volume, light_cap })
-        .collect();
+    let draws = chunk_draws(vol, cap);
     (draws, sides, dark, light)
 }
 
@@ -466,13 +470,7 @@ pub fn emit_multiplicity(
             }
         }
     }
-    let draws = vol
-        .into_iter()
-        .zip(cap)
-        .enumerate()
-        .filter(|(_, (v, c))| !v.is_empty() || !c.is_empty())
-        .map(|(chunk, (volume, light_cap))| ChunkDraw { chunk, volume, light_cap })
-        .collect();
+    let draws = chunk_draws(vol, cap);
     (draws, sides, dark, light, edges, mmax)
 }
 
