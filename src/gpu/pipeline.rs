@@ -41,6 +41,8 @@ pub struct PipelineDesc<'a> {
     pub depth_bounds: bool,
     pub stencil: Option<(vk::StencilOpState, vk::StencilOpState)>,
     pub cull: vk::CullModeFlags,
+    /// Constant and slope-scaled depth bias (shadow-map pass).
+    pub depth_bias: Option<(f32, f32)>,
     pub layout: vk::PipelineLayout,
 }
 
@@ -62,6 +64,7 @@ impl<'a> PipelineDesc<'a> {
             depth_bounds: false,
             stencil: None,
             cull: vk::CullModeFlags::NONE,
+            depth_bias: None,
             layout,
         }
     }
@@ -102,6 +105,9 @@ pub fn create(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline> {
         .cull_mode(d.cull)
         .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
         .depth_clamp_enable(d.depth_clamp)
+        .depth_bias_enable(d.depth_bias.is_some())
+        .depth_bias_constant_factor(d.depth_bias.map_or(0.0, |b| b.0))
+        .depth_bias_slope_factor(d.depth_bias.map_or(0.0, |b| b.1))
         .line_width(1.0);
     let ms = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
     let (front, back) = d.stencil.unwrap_or_default();
@@ -162,10 +168,11 @@ pub fn create(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline> {
         dynamic.push(vk::DynamicState::DEPTH_BOUNDS);
     }
     let dyn_state = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic);
+    let has_stencil = matches!(d.depth_format, vk::Format::D24_UNORM_S8_UINT | vk::Format::D32_SFLOAT_S8_UINT);
     let mut rendering = vk::PipelineRenderingCreateInfo::default()
         .color_attachment_formats(d.color_formats)
         .depth_attachment_format(d.depth_format)
-        .stencil_attachment_format(d.depth_format);
+        .stencil_attachment_format(if has_stencil { d.depth_format } else { vk::Format::UNDEFINED });
     let info = vk::GraphicsPipelineCreateInfo::default()
         .stages(&stages)
         .vertex_input_state(&vertex_input)

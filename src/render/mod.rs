@@ -15,6 +15,7 @@
 //! enclosing volume, with wrap ops so the order of faces does not matter.
 
 pub mod frame;
+pub mod shadowmap;
 pub mod stats;
 pub mod targets;
 

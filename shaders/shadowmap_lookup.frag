@@ -1,0 +1,69 @@
+#version 450
+// Shadow-map baseline, lookup: for each visible surface point (G-buffer), the fraction of
+// 3x3 percentage-closer-filtering taps that see an occluder nearer the light, written into
+// the float counter target (0 = lit). A point light has six faces in one atlas; one pass per
+// face handles the points whose direction from the light falls in that face.
+layout(set = 0, binding = 0) uniform texture2D t_albedo;
+layout(set = 0, binding = 1) uniform texture2D t_normal;
+layout(set = 0, binding = 2) uniform texture2D t_position;
+layout(set = 0, binding = 3) uniform sampler s_nearest;
+layout(set = 0, binding = 4) uniform texture2D t_count;
+layout(set = 0, binding = 5) uniform texture2D t_transmit;
+layout(set = 0, binding = 6) uniform texture2D t_map;
+
+layout(push_constant) uniform Push {
+    mat4 light_view_proj;  // eye-relative world -> this face's clip space
+    vec4 tile;             // atlas tile: x0, y0, width, height (texels)
+    vec4 light;            // xyz eye-relative light position (w = 1) or towards-light direction (w = 0)
+    vec4 params;           // x: face (0..5, -1 = single map), y: compare bias, z: normal offset
+} pc;
+
+layout(location = 0) out vec4 out_shadow;
+
+void main() {
+    ivec2 px = ivec2(gl_FragCoord.xy);
+    vec4 pos = texelFetch(sampler2D(t_position, s_nearest), px, 0);
+    if (pos.w == 0.0) {
+        discard;
+    }
+    vec3 n = normalize(texelFetch(sampler2D(t_normal, s_nearest), px, 0).xyz);
+    if (pc.params.x >= 0.0) {
+        // Cube face of the direction from the light: 0 +x, 1 -x, 2 +y, 3 -y, 4 +z, 5 -z.
+        vec3 d = pos.xyz - pc.light.xyz;
+        vec3 a = abs(d);
+        float face;
+        if (a.x >= a.y && a.x >= a.z) {
+            face = d.x > 0.0 ? 0.0 : 1.0;
+        } else if (a.y >= a.z) {
+            face = d.y > 0.0 ? 2.0 : 3.0;
+        } else {
+            face = d.z > 0.0 ? 4.0 : 5.0;
+        }
+        if (face != pc.params.x) {
+            discard;
+        }
+    }
+    vec4 q = pc.light_view_proj * vec4(pos.xyz + n * pc.params.z, 1.0);
+    if (q.w <= 0.0) {
+        out_shadow = vec4(0.0);
+        return;
+    }
+    vec3 ndc = q.xyz / q.w;
+    // Receivers beyond the map's far plane compare as if on it: any caster in front shadows them.
+    ndc.z = min(ndc.z, 1.0);
+    vec2 uv = ndc.xy * 0.5 + 0.5;
+    if (uv.x < 0.0 || uv.x > 1.0 || uv.y < 0.0 || uv.y > 1.0) {
+        out_shadow = vec4(0.0);
+        return;
+    }
+    vec2 texel = pc.tile.xy + uv * pc.tile.zw;
+    float shadowed = 0.0;
+    for (int j = -1; j <= 1; j++) {
+        for (int i = -1; i <= 1; i++) {
+            ivec2 t = ivec2(clamp(texel + vec2(float(i), float(j)), pc.tile.xy, pc.tile.xy + pc.tile.zw - 1.0));
+            float stored = texelFetch(sampler2D(t_map, s_nearest), t, 0).r;
+            shadowed += (ndc.z - pc.params.y > stored) ? 1.0 : 0.0;
+        }
+    }
+    out_shadow = vec4(shadowed / 9.0, 0.0, 0.0, 0.0);
+}
