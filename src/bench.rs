@@ -50,6 +50,8 @@ pub struct BenchConfig {
     pub methods: Vec<Method>,
     /// Each method runs with each counter (stencil, float), side by side.
     pub counters: Vec<Counter>,
+    /// Also measure the shadow-map baseline (PCF) with maps of this many texels a side.
+    pub shadow_map: Option<u32>,
     pub frames: usize,
     pub opts: RenderOptions,
 }
@@ -66,14 +68,21 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         let scene = crate::scene::load(name)?;
         let c = ctx.take().ok_or_else(|| Error::Other("context lost".into()))?;
         let mut r = Renderer::new(c, scene, cfg.opts.clone())?;
-        let mut variants = Vec::new();
+        // (method, counter, shadow-map size) variants, and their error against the reference.
+        let mut variants: Vec<(Method, Counter, Option<u32>)> = Vec::new();
         let mut errors = Vec::new();
         for &counter in &cfg.counters {
             r.opts.counter = counter;
             for (m, e) in cfg.methods.iter().zip(evaluate(&mut r, name, &cfg.methods, 1)?) {
-                variants.push((*m, counter));
+                variants.push((*m, counter, None));
                 errors.push(e);
             }
+        }
+        if let Some(size) = cfg.shadow_map {
+            r.opts.shadow_map = Some(size);
+            errors.extend(evaluate(&mut r, name, &[Method::McGuire], 1)?);
+            variants.push((Method::McGuire, Counter::Float, Some(size)));
+            r.opts.shadow_map = None;
         }
         // Round-robin over methods, frame by frame, so that drift (thermal, other load) hits
         // every method alike: the ratios are measured side by side.
@@ -88,9 +97,10 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         }
         let mut acc: Vec<Acc> = variants.iter().map(|_| Acc::default()).collect();
         for frame in 0..=cfg.frames {
-            for (k, &(method, counter)) in variants.iter().enumerate() {
+            for (k, &(method, counter, shadow_map)) in variants.iter().enumerate() {
                 r.opts.method = method;
                 r.opts.counter = counter;
+                r.opts.shadow_map = shadow_map;
                 let f = r.render()?;
                 if frame == 0 {
                     continue; // warm-up: buffers sized, caches hot
@@ -106,12 +116,16 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 a.last = Some(f.stats);
             }
         }
-        for ((&(method, counter), err), a) in variants.iter().zip(&errors).zip(acc) {
+        r.opts.shadow_map = None;
+        for ((&(method, counter, shadow_map), err), a) in variants.iter().zip(&errors).zip(acc) {
             let s = a.last.ok_or_else(|| Error::Other("no frame".into()))?;
             let c = &s.totals.cases;
             let row = BenchRow {
                 scene: name.clone(),
-                method: method.to_string(),
+                method: match shadow_map {
+                    Some(size) => format!("shadowmap-{size}"),
+                    None => method.to_string(),
+                },
                 counter: counter.name().to_string(),
                 index_format: s.index_format.clone(),
                 frames: cfg.frames,

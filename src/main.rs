@@ -23,7 +23,7 @@ struct FrameArgs {
     #[arg(long, default_value = "960x540", value_parser = parse_size)]
     size: (u32, u32),
     /// Shadow method: auto (= mcguire, with open / non-manifold casters on the multiplicity
-    /// path), mcguire, lengyel, everitt-kilgard, zfail, zpass.
+    /// path), mcguire, lengyel, everitt-kilgard, zfail, zpass; or shadowmap (the PCF baseline).
     #[arg(long, default_value = "auto")]
     method: String,
     /// infinite (far plane at infinity) or clamp (finite far plane + depthClamp).
@@ -38,6 +38,9 @@ struct FrameArgs {
     /// Transparent casters' light-intensity map: log16 (default), mul16, log32, mul32.
     #[arg(long, default_value = "log16")]
     transmit: String,
+    /// Texels per side of each shadow map (--method shadowmap).
+    #[arg(long, default_value_t = 2048)]
+    shadow_map_size: u32,
 }
 
 #[derive(Subcommand)]
@@ -81,6 +84,9 @@ enum Command {
         /// Comma-separated counters to compare (stencil, float).
         #[arg(long, value_delimiter = ',', default_value = "stencil")]
         counters: Vec<String>,
+        /// Also measure the shadow-map baseline with maps of this size (0: off).
+        #[arg(long, default_value_t = 2048)]
+        shadow_map_size: u32,
         /// Write the report as JSON.
         #[arg(long)]
         json: Option<PathBuf>,
@@ -115,6 +121,7 @@ impl Default for FrameArgs {
             index_format: "auto".into(),
             counter: "stencil".into(),
             transmit: "log16".into(),
+            shadow_map_size: 2048,
         }
     }
 }
@@ -141,8 +148,9 @@ fn main() -> ExitCode {
         Command::Render { frame, out, stats, view, dump } => render(&frame, &out, stats.as_deref(), &view, dump.as_deref()),
         Command::Info { json } => info(json),
         Command::Check { dir, band, threshold } => check(&dir, band, threshold),
-        Command::Bench { scenes, methods, frames, size, index_format, counters, json, markdown } => {
-            bench(scenes, methods, counters, frames, size, &index_format, json.as_deref(), markdown.as_deref())
+        Command::Bench { scenes, methods, frames, size, index_format, counters, shadow_map_size, json, markdown } => {
+            let sm = (shadow_map_size > 0).then_some(shadow_map_size);
+            bench(scenes, methods, counters, sm, frames, size, &index_format, json.as_deref(), markdown.as_deref())
         }
         Command::Conform { out } => umbrage::conform::run(out),
     };
@@ -160,7 +168,8 @@ impl FrameArgs {
         Ok(RenderOptions {
             width: self.size.0,
             height: self.size.1,
-            method: self.method.parse::<Method>()?,
+            method: if self.method == "shadowmap" { Method::McGuire } else { self.method.parse::<Method>()? },
+            shadow_map: (self.method == "shadowmap").then_some(self.shadow_map_size),
             depth_mode: self.depth_mode.parse::<DepthMode>()?,
             index_format: self.index_format.parse::<IndexFormat>()?,
             counter: self.counter.parse::<Counter>()?,
@@ -228,6 +237,7 @@ fn bench(
     scenes: Vec<String>,
     methods: Vec<String>,
     counters: Vec<String>,
+    shadow_map: Option<u32>,
     frames: usize,
     size: (u32, u32),
     index_format: &str,
@@ -243,7 +253,7 @@ fn bench(
     let opts = RenderOptions { width: size.0, height: size.1, index_format: index_format.parse::<IndexFormat>()?, ..Default::default() };
     let ctx = umbrage::gpu::Context::new()?;
     let counters = counters.iter().map(|c| c.parse::<Counter>()).collect::<Result<Vec<_>>>()?;
-    let cfg = umbrage::bench::BenchConfig { scenes, methods, counters, frames, opts };
+    let cfg = umbrage::bench::BenchConfig { scenes, methods, counters, shadow_map, frames, opts };
     let report = umbrage::bench::run(ctx, &cfg, |r| {
         eprintln!(
             "{:<14} {:<16} {:<8} gpu {:>8} ms  shadow {:>8} ms  {:>8} tris  error {:.4}%",

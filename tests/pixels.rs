@@ -94,3 +94,21 @@ fn eye_inside_two_volumes_counts_two_except_zpass() {
         ctx = r.into_context();
     }
 }
+
+/// The shadow-map baseline (PCF) renders under validation and lands close to the reference:
+/// not exact (that is the point of comparing), but within half a percent of the pixels on the
+/// built-in scenes with 1024-texel maps.
+#[test]
+fn shadow_map_baseline_is_close_to_the_reference() {
+    let Some(mut ctx) = common::context() else { return };
+    for name in ["default", "stairs", "spheres", "hard/light_inside_caster"] {
+        let scene = umbrage::scene::load(name).unwrap();
+        let opts = RenderOptions { width: 256, height: 192, shadow_map: Some(1024), ..Default::default() };
+        let mut r = Renderer::new(ctx, scene, opts).unwrap();
+        let rows = umbrage::accuracy::evaluate(&mut r, name, &[Method::McGuire], 1).unwrap();
+        assert_eq!(r.render().unwrap().stats.method, "shadowmap");
+        assert!(rows[0].fraction < 5e-3, "{name}: shadow map error {:.4}%", rows[0].fraction * 100.0);
+        r.ctx.check_validation().unwrap();
+        ctx = r.into_context();
+    }
+}

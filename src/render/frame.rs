@@ -195,6 +195,8 @@ pub struct RenderOptions {
     pub counter: Counter,
     /// Transparent casters' light-intensity map: format fixed at creation, log/mul per frame.
     pub transmit: TransmitMode,
+    /// `Some(texels)`: the shadow-map baseline (PCF) instead of shadow volumes.
+    pub shadow_map: Option<u32>,
     /// Read back per-light stencil counts, positions and normals (dumps, tests).
     pub capture: bool,
 }
@@ -210,6 +212,7 @@ impl Default for RenderOptions {
             view: View::Shaded,
             counter: Counter::Stencil,
             transmit: TransmitMode { fp32: false, log: true },
+            shadow_map: None,
             capture: false,
         }
     }
@@ -332,6 +335,8 @@ pub struct Renderer {
     shells: Vec<usize>,
     /// Some caster is transparent: the light-intensity map pass runs.
     has_transparent: bool,
+    /// The shadow-map baseline, created on the first frame that asks for it.
+    shadow_mapper: Option<super::shadowmap::ShadowMapper>,
     /// Per caster (same order as `casters`), its chunks' GPU buffers.
     gpu_casters: Vec<Vec<GpuChunk>>,
     scene_vertices: Buffer,
@@ -546,6 +551,7 @@ impl Renderer {
             casters,
             shells,
             has_transparent,
+            shadow_mapper: None,
             gpu_casters,
             scene_vertex_count: verts.len() as u32,
             one_sided_count,
@@ -625,7 +631,30 @@ impl Renderer {
         let vp_rel_d = proj.as_dmat4() * view_rel.as_dmat4();
         let vp_rel = vp_rel_d.as_mat4();
 
-        // 1. Plans (pure CPU).
+        // The shadow-map baseline replaces the volumes (created on first use, or re-created when
+        // the map size changes).
+        match self.opts.shadow_map {
+            Some(size) if self.shadow_mapper.as_ref().map(|m| m.size) != Some(size) => {
+                if let Some(mut old) = self.shadow_mapper.take() {
+                    // SAFETY: waiting for idle before destroying objects a frame may have used.
+                    unsafe { self.ctx.device.device_wait_idle() }.map_err(vkerr("vkDeviceWaitIdle"))?;
+                    old.destroy(&self.ctx);
+                }
+                self.shadow_mapper = Some(super::shadowmap::ShadowMapper::new(&self.ctx, &self.scene, &self.targets, size, self.sampler)?);
+            }
+            None => {
+                if let Some(mut old) = self.shadow_mapper.take() {
+                    // SAFETY: as above.
+                    unsafe { self.ctx.device.device_wait_idle() }.map_err(vkerr("vkDeviceWaitIdle"))?;
+                    old.destroy(&self.ctx);
+                }
+            }
+            _ => {}
+        }
+        let cam = &self.scene.camera;
+
+        // 1. Plans (pure CPU; no casters for the shadow-map baseline, only scissors).
+        let plan_casters: &[Caster] = if self.shadow_mapper.is_some() { &[] } else { &self.casters };
         let plans: Vec<LightPlan> = self
             .scene
             .lights
@@ -633,7 +662,7 @@ impl Renderer {
             .map(|light| {
                 shadow::plan_light(
                     &PlanInput { camera: cam, width: w, height: h, view_proj, light, method: self.opts.method },
-                    &self.casters,
+                    plan_casters,
                 )
             })
             .collect();
@@ -758,11 +787,12 @@ impl Renderer {
         let npx = (w * h) as u64;
         let nlights = self.scene.lights.len();
         let capture = self.opts.capture || self.opts.view == View::Stencil;
+        let float_counts = self.opts.counter == Counter::Float || self.opts.shadow_map.is_some();
         let mut sizes = vec![npx * 4];
         if capture {
             sizes.push(npx * 16); // positions
             sizes.push(npx * 16); // normals
-            let per_light = if self.opts.counter == Counter::Float { npx * 4 } else { npx };
+            let per_light = if float_counts { npx * 4 } else { npx };
             sizes.extend(std::iter::repeat(per_light).take(nlights)); // stencil or float count per light
             if self.has_transparent {
                 let texel = if self.opts.transmit.fp32 { 16 } else { 8 };
@@ -897,7 +927,7 @@ impl Renderer {
 
                 // Shadow determination: the counter (stencil, or the float target) cleared inside
                 // the scissor, volumes drawn.
-                let float = self.opts.counter == Counter::Float;
+                let float = self.opts.counter == Counter::Float || self.shadow_mapper.is_some();
                 let q0 = ts_next;
                 ts(vk::PipelineStageFlags2::ALL_COMMANDS, q0);
                 let depth_load = att(&t.depth, load, ds_clear);
@@ -907,44 +937,49 @@ impl Renderer {
                     // Contents outside the scissor are never read (illumination is scissored too).
                     transition(ctx, cb, &t.count, vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
                 }
-                let info = vk::RenderingInfo::default().render_area(scissor).layer_count(1).depth_attachment(&depth_load);
-                let info = if float { info.color_attachments(&count_att).stencil_attachment(&depth_load) } else { info.stencil_attachment(&stencil_clear) };
-                d.cmd_begin_rendering(cb, &info);
-                d.cmd_set_viewport(cb, 0, &[viewport]);
-                d.cmd_set_scissor(cb, 0, &[scissor]);
-                if ctx.features.depth_bounds {
-                    let (lo, hi) = bounds.unwrap_or((0.0, 1.0));
-                    d.cmd_set_depth_bounds(cb, lo, hi);
-                }
-                let mut bound_pipe = vk::Pipeline::null();
-                for (ci, case, light_obj, cdraws) in ldraws {
-                    if *case == Case::Culled || self.casters[*ci].transmittance.is_some() {
-                        continue;
+                if let Some(sm) = &self.shadow_mapper {
+                    // Shadow-map baseline: maps from the light, PCF lookup into the float counter.
+                    sm.record(ctx, cb, t, &self.scene.lights[li], eye, scissor);
+                } else {
+                    let info = vk::RenderingInfo::default().render_area(scissor).layer_count(1).depth_attachment(&depth_load);
+                    let info = if float { info.color_attachments(&count_att).stencil_attachment(&depth_load) } else { info.stencil_attachment(&stencil_clear) };
+                    d.cmd_begin_rendering(cb, &info);
+                    d.cmd_set_viewport(cb, 0, &[viewport]);
+                    d.cmd_set_scissor(cb, 0, &[scissor]);
+                    if ctx.features.depth_bounds {
+                        let (lo, hi) = bounds.unwrap_or((0.0, 1.0));
+                        d.cmd_set_depth_bounds(cb, lo, hi);
                     }
-                    let mut push = [0f32; 24];
-                    push[..16].copy_from_slice(&caster_mvp[*ci].to_cols_array());
-                    push[16..20].copy_from_slice(&light_obj.to_array());
-                    // Float counter: the sign a front face contributes (+1 z-pass, -1 z-fail).
-                    push[20] = if *case == Case::ZPass { 1.0 } else { -1.0 };
-                    d.cmd_push_constants(cb, self.layouts[1], vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT, 0, bytes_of(&push));
-                    for dr in cdraws {
-                        let p = &self.pipes;
-                        let pipe = match (case, dr.light_cap, float) {
-                            (Case::ZPass, _, false) => p.zpass,
-                            (_, false, false) => p.zfail,
-                            (_, true, false) => p.zfail_cap,
-                            (Case::ZPass, _, true) => p.count_zpass,
-                            (_, false, true) => p.count_zfail,
-                            (_, true, true) => p.count_cap,
-                        };
-                        if pipe != bound_pipe {
-                            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipe);
-                            bound_pipe = pipe;
+                    let mut bound_pipe = vk::Pipeline::null();
+                    for (ci, case, light_obj, cdraws) in ldraws {
+                        if *case == Case::Culled || self.casters[*ci].transmittance.is_some() {
+                            continue;
                         }
-                        self.record_draw(cb, *ci, dr, stream_raw);
+                        let mut push = [0f32; 24];
+                        push[..16].copy_from_slice(&caster_mvp[*ci].to_cols_array());
+                        push[16..20].copy_from_slice(&light_obj.to_array());
+                        // Float counter: the sign a front face contributes (+1 z-pass, -1 z-fail).
+                        push[20] = if *case == Case::ZPass { 1.0 } else { -1.0 };
+                        d.cmd_push_constants(cb, self.layouts[1], vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT, 0, bytes_of(&push));
+                        for dr in cdraws {
+                            let p = &self.pipes;
+                            let pipe = match (case, dr.light_cap, float) {
+                                (Case::ZPass, _, false) => p.zpass,
+                                (_, false, false) => p.zfail,
+                                (_, true, false) => p.zfail_cap,
+                                (Case::ZPass, _, true) => p.count_zpass,
+                                (_, false, true) => p.count_zfail,
+                                (_, true, true) => p.count_cap,
+                            };
+                            if pipe != bound_pipe {
+                                d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipe);
+                                bound_pipe = pipe;
+                            }
+                            self.record_draw(cb, *ci, dr, stream_raw);
+                        }
                     }
+                    d.cmd_end_rendering(cb);
                 }
-                d.cmd_end_rendering(cb);
                 ts(vk::PipelineStageFlags2::ALL_COMMANDS, q0 + 1);
                 ts_shadow.push((q0, q0 + 1));
                 memory_barrier(ctx, cb, (frag_tests, ds_rw), (frag_tests, ds_rw));
@@ -1213,7 +1248,7 @@ impl Renderer {
             }
             for li in 0..nlights {
                 let raw = self.readback[3 + li].read()?;
-                if self.opts.counter == Counter::Float {
+                if float_counts {
                     let c: Vec<i32> = raw.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]).round() as i32).collect();
                     stencil.push(c.iter().map(|&v| v.clamp(0, 255) as u8).collect());
                     counts.push(c);
@@ -1276,7 +1311,7 @@ impl Renderer {
         }
         let stats = Stats {
             device: ctx.info.name.clone(),
-            method: self.opts.method.to_string(),
+            method: if self.shadow_mapper.is_some() { "shadowmap".to_string() } else { self.opts.method.to_string() },
             depth_mode: self.opts.depth_mode.name().into(),
             index_format: self.opts.index_format.name().into(),
             counter: self.opts.counter.name().into(),
@@ -1616,6 +1651,9 @@ impl Renderer {
             d.destroy_query_pool(self.query_pool, None);
             d.destroy_fence(self.fence, None);
             d.free_command_buffers(ctx.pool, &[self.cmd]);
+        }
+        if let Some(mut sm) = self.shadow_mapper.take() {
+            sm.destroy(ctx);
         }
         self.targets.destroy(ctx);
         self.scene_vertices.destroy(ctx);
