@@ -65,7 +65,8 @@ pub fn evaluate(renderer: &mut Renderer, scene_name: &str, methods: &[Method], b
         let ok = fraction <= THRESHOLD;
         rows.push(Row {
             scene: scene_name.to_string(),
-            method: method.to_string(),
+            // The technique that actually ran ("edgequad", "shadowmap" or the method).
+            method: frame.stats.method.clone(),
             mismatches,
             compared,
             ambiguous: metrics.iter().map(|m| m.ambiguous).max().unwrap_or(0),
@@ -81,7 +82,7 @@ pub fn evaluate(renderer: &mut Renderer, scene_name: &str, methods: &[Method], b
 }
 
 /// The rows as a Markdown table (method columns, case rows).
-pub fn markdown_table(rows: &[Row], methods: &[Method]) -> String {
+pub fn markdown_table(rows: &[Row], methods: &[&str]) -> String {
     let mut scenes: Vec<&str> = Vec::new();
     for r in rows {
         if !scenes.contains(&r.scene.as_str()) {
@@ -98,7 +99,7 @@ pub fn markdown_table(rows: &[Row], methods: &[Method]) -> String {
     for sc in scenes {
         s += &format!("| `{sc}` |");
         for m in methods {
-            let cell = rows.iter().find(|r| r.scene == sc && r.method == m.to_string()).map(|r| {
+            let cell = rows.iter().find(|r| r.scene == sc && r.method == *m).map(|r| {
                 let mark = match (r.expected_failure.is_some(), r.passed) {
                     (true, true) => " (expected failure)",
                     (true, false) => " **UNEXPECTEDLY PASSED**",

@@ -52,6 +52,8 @@ pub struct BenchConfig {
     pub counters: Vec<Counter>,
     /// Also measure the shadow-map baseline (PCF) with maps of this many texels a side.
     pub shadow_map: Option<u32>,
+    /// Also measure the GPU-only edge-quad method (with the first counter).
+    pub edge_quads: bool,
     pub frames: usize,
     pub opts: RenderOptions,
 }
@@ -69,20 +71,28 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         let c = ctx.take().ok_or_else(|| Error::Other("context lost".into()))?;
         let mut r = Renderer::new(c, scene, cfg.opts.clone())?;
         // (method, counter, shadow-map size) variants, and their error against the reference.
-        let mut variants: Vec<(Method, Counter, Option<u32>)> = Vec::new();
+        let mut variants: Vec<(Method, Counter, Option<u32>, bool)> = Vec::new();
         let mut errors = Vec::new();
         for &counter in &cfg.counters {
             r.opts.counter = counter;
             for (m, e) in cfg.methods.iter().zip(evaluate(&mut r, name, &cfg.methods, 1)?) {
-                variants.push((*m, counter, None));
+                variants.push((*m, counter, None, false));
                 errors.push(e);
             }
         }
         if let Some(size) = cfg.shadow_map {
             r.opts.shadow_map = Some(size);
             errors.extend(evaluate(&mut r, name, &[Method::McGuire], 1)?);
-            variants.push((Method::McGuire, Counter::Float, Some(size)));
+            variants.push((Method::McGuire, Counter::Float, Some(size), false));
             r.opts.shadow_map = None;
+        }
+        if cfg.edge_quads {
+            let counter = cfg.counters.first().copied().unwrap_or(Counter::Stencil);
+            r.opts.counter = counter;
+            r.opts.edge_quads = true;
+            errors.extend(evaluate(&mut r, name, &[Method::McGuire], 1)?);
+            variants.push((Method::McGuire, counter, None, true));
+            r.opts.edge_quads = false;
         }
         // Round-robin over methods, frame by frame, so that drift (thermal, other load) hits
         // every method alike: the ratios are measured side by side.
@@ -97,10 +107,11 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         }
         let mut acc: Vec<Acc> = variants.iter().map(|_| Acc::default()).collect();
         for frame in 0..=cfg.frames {
-            for (k, &(method, counter, shadow_map)) in variants.iter().enumerate() {
+            for (k, &(method, counter, shadow_map, edge_quads)) in variants.iter().enumerate() {
                 r.opts.method = method;
                 r.opts.counter = counter;
                 r.opts.shadow_map = shadow_map;
+                r.opts.edge_quads = edge_quads;
                 let f = r.render()?;
                 if frame == 0 {
                     continue; // warm-up: buffers sized, caches hot
@@ -117,14 +128,16 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
             }
         }
         r.opts.shadow_map = None;
-        for ((&(method, counter, shadow_map), err), a) in variants.iter().zip(&errors).zip(acc) {
+        r.opts.edge_quads = false;
+        for ((&(method, counter, shadow_map, edge_quads), err), a) in variants.iter().zip(&errors).zip(acc) {
             let s = a.last.ok_or_else(|| Error::Other("no frame".into()))?;
             let c = &s.totals.cases;
             let row = BenchRow {
                 scene: name.clone(),
-                method: match shadow_map {
-                    Some(size) => format!("shadowmap-{size}"),
-                    None => method.to_string(),
+                method: match (shadow_map, edge_quads) {
+                    (Some(size), _) => format!("shadowmap-{size}"),
+                    (None, true) => "edgequad".to_string(),
+                    (None, false) => method.to_string(),
                 },
                 counter: counter.name().to_string(),
                 index_format: s.index_format.clone(),

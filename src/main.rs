@@ -23,7 +23,8 @@ struct FrameArgs {
     #[arg(long, default_value = "960x540", value_parser = parse_size)]
     size: (u32, u32),
     /// Shadow method: auto (= mcguire, with open / non-manifold casters on the multiplicity
-    /// path), mcguire, lengyel, everitt-kilgard, zfail, zpass; or shadowmap (the PCF baseline).
+    /// path), mcguire, lengyel, everitt-kilgard, zfail, zpass; edgequad (GPU-only silhouettes,
+    /// the Cg article); or shadowmap (the PCF baseline).
     #[arg(long, default_value = "auto")]
     method: String,
     /// infinite (far plane at infinity) or clamp (finite far plane + depthClamp).
@@ -168,7 +169,8 @@ impl FrameArgs {
         Ok(RenderOptions {
             width: self.size.0,
             height: self.size.1,
-            method: if self.method == "shadowmap" { Method::McGuire } else { self.method.parse::<Method>()? },
+            method: if matches!(self.method.as_str(), "shadowmap" | "edgequad") { Method::McGuire } else { self.method.parse::<Method>()? },
+            edge_quads: self.method == "edgequad",
             shadow_map: (self.method == "shadowmap").then_some(self.shadow_map_size),
             depth_mode: self.depth_mode.parse::<DepthMode>()?,
             index_format: self.index_format.parse::<IndexFormat>()?,
@@ -253,7 +255,7 @@ fn bench(
     let opts = RenderOptions { width: size.0, height: size.1, index_format: index_format.parse::<IndexFormat>()?, ..Default::default() };
     let ctx = umbrage::gpu::Context::new()?;
     let counters = counters.iter().map(|c| c.parse::<Counter>()).collect::<Result<Vec<_>>>()?;
-    let cfg = umbrage::bench::BenchConfig { scenes, methods, counters, shadow_map, frames, opts };
+    let cfg = umbrage::bench::BenchConfig { scenes, methods, counters, shadow_map, edge_quads: true, frames, opts };
     let report = umbrage::bench::run(ctx, &cfg, |r| {
         eprintln!(
             "{:<14} {:<16} {:<8} gpu {:>8} ms  shadow {:>8} ms  {:>8} tris  error {:.4}%",

@@ -27,10 +27,16 @@ fn every_method_on_every_hard_case_matches_the_reference() {
             let opts = RenderOptions { width: 256, height: 192, counter, ..Default::default() };
             let mut r = Renderer::new(ctx, scene, opts).unwrap();
             rows.extend(evaluate(&mut r, name, &Method::ALL, 1).unwrap());
+            // The GPU-only edge-quad method (closed opaque casters; the others keep their path).
+            r.opts.edge_quads = true;
+            rows.extend(evaluate(&mut r, name, &[Method::McGuire], 1).unwrap());
+            r.opts.edge_quads = false;
             r.ctx.check_validation().unwrap();
             ctx = r.into_context();
         }
-        let table = markdown_table(&rows, &Method::ALL);
+        let mut columns: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
+        columns.push("edgequad");
+        let table = markdown_table(&rows, &columns);
         doc += &format!("\n## Counter: {}\n\n{}\n", counter.name(), table);
         println!("{table}");
         failed.extend(rows.iter().filter(|r| !r.passed).map(|r| format!("{} {} {} {:.5}", counter.name(), r.scene, r.method, r.fraction)));

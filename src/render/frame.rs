@@ -197,6 +197,9 @@ pub struct RenderOptions {
     pub transmit: TransmitMode,
     /// `Some(texels)`: the shadow-map baseline (PCF) instead of shadow volumes.
     pub shadow_map: Option<u32>,
+    /// The GPU-only edge-quad method (Cg article) for closed opaque casters: no CPU
+    /// silhouettes, every face and edge quad drawn every frame.
+    pub edge_quads: bool,
     /// Read back per-light stencil counts, positions and normals (dumps, tests).
     pub capture: bool,
 }
@@ -213,6 +216,7 @@ impl Default for RenderOptions {
             counter: Counter::Stencil,
             transmit: TransmitMode { fp32: false, log: true },
             shadow_map: None,
+            edge_quads: false,
             capture: false,
         }
     }
@@ -300,6 +304,14 @@ impl FrameOutput {
     }
 }
 
+/// A caster's static edge-quad geometry (u32 indices: faces first, then quads).
+struct EdgeQuadGpu {
+    vertices: Buffer,
+    indices: Buffer,
+    face_indices: u32,
+    quad_indices: u32,
+}
+
 /// A caster chunk on the GPU: the dual-length vertex buffer (n x (xyz,1) then n x (xyz,0)).
 struct GpuChunk {
     vertices: Buffer,
@@ -315,6 +327,10 @@ struct Pipelines {
     count_zpass: vk::Pipeline,
     count_zfail: vk::Pipeline,
     count_cap: vk::Pipeline,
+    eq_faces: vk::Pipeline,
+    eq_sides: vk::Pipeline,
+    eq_faces_count: vk::Pipeline,
+    eq_sides_count: vk::Pipeline,
     illuminate: vk::Pipeline,
     illuminate_count: vk::Pipeline,
     illuminate_t: vk::Pipeline,
@@ -335,6 +351,8 @@ pub struct Renderer {
     shells: Vec<usize>,
     /// Some caster is transparent: the light-intensity map pass runs.
     has_transparent: bool,
+    /// Per caster, its static edge-quad geometry (closed opaque casters; built on first use).
+    edge_quads: Vec<Option<EdgeQuadGpu>>,
     /// The shadow-map baseline, created on the first frame that asks for it.
     shadow_mapper: Option<super::shadowmap::ShadowMapper>,
     /// Per caster (same order as `casters`), its chunks' GPU buffers.
@@ -552,6 +570,7 @@ impl Renderer {
             shells,
             has_transparent,
             shadow_mapper: None,
+            edge_quads: Vec::new(),
             gpu_casters,
             scene_vertex_count: verts.len() as u32,
             one_sided_count,
@@ -651,6 +670,24 @@ impl Renderer {
             }
             _ => {}
         }
+        if self.opts.edge_quads && self.edge_quads.is_empty() {
+            for c in &self.casters {
+                let eq = if c.kind == crate::shadow::CasterKind::Manifold && c.transmittance.is_none() {
+                    let m = crate::shadow::edgequad::EdgeQuadMesh::new(c);
+                    let mut idx = m.faces.clone();
+                    idx.extend_from_slice(&m.quads);
+                    Some(EdgeQuadGpu {
+                        vertices: upload(&self.ctx, "edge-quad vertices", bytes_of(&m.vertices), vk::BufferUsageFlags::VERTEX_BUFFER)?,
+                        indices: upload(&self.ctx, "edge-quad indices", bytes_of(&idx), vk::BufferUsageFlags::INDEX_BUFFER)?,
+                        face_indices: m.faces.len() as u32,
+                        quad_indices: m.quads.len() as u32,
+                    })
+                } else {
+                    None
+                };
+                self.edge_quads.push(eq);
+            }
+        }
         let cam = &self.scene.camera;
 
         // 1. Plans (pure CPU; no casters for the shadow-map baseline, only scissors).
@@ -660,9 +697,10 @@ impl Renderer {
             .lights
             .iter()
             .map(|light| {
-                shadow::plan_light(
+                shadow::plan_light_opts(
                     &PlanInput { camera: cam, width: w, height: h, view_proj, light, method: self.opts.method },
                     plan_casters,
+                    self.opts.edge_quads,
                 )
             })
             .collect();
@@ -672,7 +710,7 @@ impl Renderer {
         let u8_ok = self.ctx.features.index_type_uint8;
         let mut stream: Vec<u8> = Vec::new();
         // Per light, per caster: draws (chunk, stream offset, count, format, is_light_cap).
-        let mut draws: Vec<Vec<(usize, Case, Vec4, Vec<Draw>)>> = Vec::new();
+        let mut draws: Vec<Vec<CasterDraws>> = Vec::new();
         let mut light_stats = Vec::new();
         let mut totals = Totals::default();
         let mut cpu = CpuMs::default();
@@ -753,7 +791,7 @@ impl Renderer {
                     },
                     multiplicity_max: cp.multiplicity_max,
                 });
-                ldraws.push((cp.caster, cp.case, Vec4::from_array(cp.light_object), cdraws));
+                ldraws.push((cp.caster, cp.case, Vec4::from_array(cp.light_object), cdraws, cp.path == "edgequad"));
             }
             let light = &self.scene.lights[li];
             light_stats.push(LightStats {
@@ -951,7 +989,7 @@ impl Renderer {
                         d.cmd_set_depth_bounds(cb, lo, hi);
                     }
                     let mut bound_pipe = vk::Pipeline::null();
-                    for (ci, case, light_obj, cdraws) in ldraws {
+                    for (ci, case, light_obj, cdraws, edge_quad) in ldraws {
                         if *case == Case::Culled || self.casters[*ci].transmittance.is_some() {
                             continue;
                         }
@@ -961,6 +999,20 @@ impl Renderer {
                         // Float counter: the sign a front face contributes (+1 z-pass, -1 z-fail).
                         push[20] = if *case == Case::ZPass { 1.0 } else { -1.0 };
                         d.cmd_push_constants(cb, self.layouts[1], vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT, 0, bytes_of(&push));
+                        if *edge_quad {
+                            if let Some(eq) = self.edge_quads.get(*ci).and_then(|e| e.as_ref()) {
+                                let p = &self.pipes;
+                                let (faces, sides) = if float { (p.eq_faces_count, p.eq_sides_count) } else { (p.eq_faces, p.eq_sides) };
+                                d.cmd_bind_vertex_buffers(cb, 0, &[eq.vertices.raw], &[0]);
+                                d.cmd_bind_index_buffer(cb, eq.indices.raw, 0, vk::IndexType::UINT32);
+                                d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, faces);
+                                d.cmd_draw_indexed(cb, eq.face_indices, 1, 0, 0, 0);
+                                d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, sides);
+                                d.cmd_draw_indexed(cb, eq.quad_indices, 1, eq.face_indices, 0, 0);
+                                bound_pipe = sides;
+                            }
+                            continue;
+                        }
                         for dr in cdraws {
                             let p = &self.pipes;
                             let pipe = match (case, dr.light_cap, float) {
@@ -1025,7 +1077,7 @@ impl Renderer {
                         let (lo, hi) = bounds.unwrap_or((0.0, 1.0));
                         d.cmd_set_depth_bounds(cb, lo, hi);
                     }
-                    for (ci, case, light_obj, cdraws) in ldraws {
+                    for (ci, case, light_obj, cdraws, _) in ldraws {
                         let Some(tr) = self.casters[*ci].transmittance else { continue };
                         if *case == Case::Culled {
                             continue;
@@ -1151,7 +1203,7 @@ impl Renderer {
                 d.cmd_set_scissor(cb, 0, &[full]);
                 d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.pipes.volumes);
                 for ldraws in draws.iter() {
-                    for (ci, case, light_obj, cdraws) in ldraws {
+                    for (ci, case, light_obj, cdraws, _) in ldraws {
                         let color = match case {
                             Case::Culled => continue,
                             Case::ZPass => [0.2f32, 0.4, 1.0, 0.12],
@@ -1311,7 +1363,13 @@ impl Renderer {
         }
         let stats = Stats {
             device: ctx.info.name.clone(),
-            method: if self.shadow_mapper.is_some() { "shadowmap".to_string() } else { self.opts.method.to_string() },
+            method: if self.shadow_mapper.is_some() {
+                "shadowmap".to_string()
+            } else if self.opts.edge_quads {
+                "edgequad".to_string()
+            } else {
+                self.opts.method.to_string()
+            },
             depth_mode: self.opts.depth_mode.name().into(),
             index_format: self.opts.index_format.name().into(),
             counter: self.opts.counter.name().into(),
@@ -1425,6 +1483,10 @@ fn case_name(c: Case) -> &'static str {
     }
 }
 
+/// Per caster and light: caster index, case, object-space light, index-stream draws, and
+/// whether the GPU-only edge-quad method draws it instead.
+type CasterDraws = (usize, Case, Vec4, Vec<Draw>, bool);
+
 struct Draw {
     chunk: usize,
     offset: u64,
@@ -1517,6 +1579,25 @@ fn create_pipelines(
     c.depth_compare = vk::CompareOp::ALWAYS;
     let count_cap = pipeline::create(ctx, &c)?;
 
+    // GPU-only edge quads: faces like light caps (NEVER / ALWAYS), quads like sides.
+    let eq_attrs = [(0, vk::Format::R32G32B32_SFLOAT, 0), (1, vk::Format::R32G32B32A32_SFLOAT, 12)];
+    let mut e = s.clone();
+    e.vertex = shaders::EDGEQUAD_VERT;
+    e.vertex_stride = 32;
+    e.attributes = &eq_attrs;
+    e.depth_compare = vk::CompareOp::NEVER;
+    let eq_faces = pipeline::create(ctx, &e)?;
+    e.depth_compare = vk::CompareOp::LESS;
+    let eq_sides = pipeline::create(ctx, &e)?;
+    let mut ec = c.clone();
+    ec.vertex = shaders::EDGEQUAD_VERT;
+    ec.vertex_stride = 32;
+    ec.attributes = &eq_attrs;
+    ec.depth_compare = vk::CompareOp::ALWAYS;
+    let eq_faces_count = pipeline::create(ctx, &ec)?;
+    ec.depth_compare = vk::CompareOp::GREATER_OR_EQUAL;
+    let eq_sides_count = pipeline::create(ctx, &ec)?;
+
     let accum = [ACCUM_FORMAT];
     let mut v = PipelineDesc::new(shaders::SHADOW_VERT, layouts[1], df);
     v.fragment = Some(shaders::VOLUME_FRAG);
@@ -1591,6 +1672,10 @@ fn create_pipelines(
         count_zpass,
         count_zfail,
         count_cap,
+        eq_faces,
+        eq_sides,
+        eq_faces_count,
+        eq_sides_count,
         illuminate,
         illuminate_count,
         illuminate_t,
@@ -1627,6 +1712,10 @@ impl Renderer {
                 p.count_zpass,
                 p.count_zfail,
                 p.count_cap,
+                p.eq_faces,
+                p.eq_sides,
+                p.eq_faces_count,
+                p.eq_sides_count,
                 p.illuminate,
                 p.illuminate_count,
                 p.illuminate_t,
@@ -1654,6 +1743,10 @@ impl Renderer {
         }
         if let Some(mut sm) = self.shadow_mapper.take() {
             sm.destroy(ctx);
+        }
+        for mut eq in self.edge_quads.drain(..).flatten() {
+            eq.vertices.destroy(ctx);
+            eq.indices.destroy(ctx);
         }
         self.targets.destroy(ctx);
         self.scene_vertices.destroy(ctx);

@@ -1,8 +1,9 @@
 //! Shadow-volume planning (McGuire et al. 2003): casters prepared at load, and per light
 //! the culling, case selection and index lists the GPU side draws.
 pub mod caster;
+pub mod edgequad;
 pub mod plan;
 pub mod testmesh;
 
 pub use caster::{Caster, CasterKind, Chunk};
-pub use plan::{plan_light, Case, CasterPlan, ChunkDraw, DarkCap, LightPlan, Method, PlanInput};
+pub use plan::{plan_light, plan_light_opts, Case, CasterPlan, ChunkDraw, DarkCap, LightPlan, Method, PlanInput};

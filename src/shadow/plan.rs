@@ -524,6 +524,14 @@ fn plan_multiplicity(
 
 /// Plans every caster's shadow volume for one light.
 pub fn plan_light(input: &PlanInput, casters: &[Caster]) -> LightPlan {
+    plan_light_opts(input, casters, false)
+}
+
+/// [`plan_light`]; with `edge_quads`, closed opaque casters that are not culled are left to the
+/// GPU-only edge-quad method (no silhouette work here): their plan has path `"edgequad"`, case
+/// z-fail with caps, no index lists, and the static counts the GPU draws (two triangles per
+/// edge as sides; every face as a cap, light or dark as the GPU decides).
+pub fn plan_light_opts(input: &PlanInput, casters: &[Caster], edge_quads: bool) -> LightPlan {
     let t0 = Instant::now();
     let light = input.light;
     let light_h = light.homogeneous();
@@ -553,6 +561,16 @@ pub fn plan_light(input: &PlanInput, casters: &[Caster]) -> LightPlan {
             !directional && light.radius.is_some_and(|r| box_distance(&wb, light.position) > r);
         if out_of_radius || spot_culls(light, &wb) || shadow_volume_outside_frustum(&wb, light_h, &frustum) {
             plans.push(culled_plan(Case::Culled));
+            continue;
+        }
+        if edge_quads && caster.kind == CasterKind::Manifold && caster.transmittance.is_none() {
+            plans.push(CasterPlan {
+                case: Case::ZFailLightCap,
+                path: "edgequad",
+                sides: 2 * caster.topology.manifold_edges.len(),
+                light_cap: caster.triangle_count,
+                ..culled_plan(Case::ZFailLightCap)
+            });
             continue;
         }
         if let CasterKind::Multiplicity { .. } = caster.kind {
