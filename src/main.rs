@@ -38,6 +38,10 @@ struct FrameArgs {
     /// Transparent casters' light-intensity map: log16 (default), mul16, log32, mul32.
     #[arg(long, default_value = "log16")]
     transmit: String,
+    /// Partial self-shadowing of transparent casters (Kim et al. 2008): their forward light
+    /// passes read a light-intensity map built on the nearest transparent surface.
+    #[arg(long)]
+    self_shadow: bool,
 }
 
 #[derive(Subcommand)]
@@ -115,6 +119,7 @@ impl Default for FrameArgs {
             index_format: "auto".into(),
             counter: "stencil".into(),
             transmit: "log16".into(),
+            self_shadow: false,
         }
     }
 }
@@ -165,6 +170,7 @@ impl FrameArgs {
             index_format: self.index_format.parse::<IndexFormat>()?,
             counter: self.counter.parse::<Counter>()?,
             transmit: self.transmit.parse::<TransmitMode>()?,
+            self_shadow: self.self_shadow,
             ..Default::default()
         })
     }
