@@ -42,6 +42,10 @@ struct FrameArgs {
     /// Texels per side of each shadow map (--method shadowmap).
     #[arg(long, default_value_t = 2048)]
     shadow_map_size: u32,
+    /// Partial self-shadowing of transparent casters (Kim et al. 2008): their forward light
+    /// passes read a light-intensity map built on the nearest transparent surface.
+    #[arg(long)]
+    self_shadow: bool,
 }
 
 #[derive(Subcommand)]
@@ -123,6 +127,7 @@ impl Default for FrameArgs {
             counter: "stencil".into(),
             transmit: "log16".into(),
             shadow_map_size: 2048,
+            self_shadow: false,
         }
     }
 }
@@ -176,6 +181,7 @@ impl FrameArgs {
             index_format: self.index_format.parse::<IndexFormat>()?,
             counter: self.counter.parse::<Counter>()?,
             transmit: self.transmit.parse::<TransmitMode>()?,
+            self_shadow: self.self_shadow,
             ..Default::default()
         })
     }

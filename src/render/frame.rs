@@ -14,6 +14,11 @@ use glam::{DMat4, DVec3, Mat4, Vec3, Vec4};
 use gpu_allocator::MemoryLocation;
 use std::time::Instant;
 
+// --self-shadow: partial self-shadowing of transparent casters (a child module, so that it
+// records with the renderer's private state).
+#[path = "selfshadow.rs"]
+mod selfshadow;
+
 fn vkerr(call: &'static str) -> impl Fn(vk::Result) -> Error {
     move |r| Error::Vulkan { call, result: format!("{r:?}") }
 }
@@ -202,6 +207,9 @@ pub struct RenderOptions {
     pub edge_quads: bool,
     /// Read back per-light stencil counts, positions and normals (dumps, tests).
     pub capture: bool,
+    /// Partial self-shadowing of transparent casters (src/render/selfshadow.rs); no effect on
+    /// scenes without them.
+    pub self_shadow: bool,
 }
 
 impl Default for RenderOptions {
@@ -218,6 +226,7 @@ impl Default for RenderOptions {
             shadow_map: None,
             edge_quads: false,
             capture: false,
+            self_shadow: false,
         }
     }
 }
@@ -370,6 +379,8 @@ pub struct Renderer {
     sets: [vk::DescriptorSet; 2],
     sampler: vk::Sampler,
     pipes: Pipelines,
+    /// `--self-shadow` on a scene with transparent casters.
+    self_shadow: Option<selfshadow::SelfShadow>,
     stream: Option<Buffer>,
     readback: Vec<Buffer>,
     query_pool: vk::QueryPool,
@@ -561,6 +572,11 @@ impl Renderer {
             (qp, cmd, fence)
         };
 
+        let self_shadow = if opts.self_shadow && opaque_count < verts.len() as u32 {
+            Some(selfshadow::SelfShadow::new(&ctx, targets.extent, opts.transmit.format(), sampler, layouts[4])?)
+        } else {
+            None
+        };
         let shells = casters.iter().map(|c| shell_count(c.mesh())).collect();
         let has_transparent = casters.iter().any(|c| c.transmittance.is_some());
         Ok(Renderer {
@@ -583,6 +599,7 @@ impl Renderer {
             sets,
             sampler,
             pipes,
+            self_shadow,
             stream: None,
             readback: Vec::new(),
             query_pool,
@@ -1176,7 +1193,8 @@ impl Renderer {
                 d.cmd_push_constants(cb, self.layouts[4], stages, 0, bytes_of(&push));
                 d.cmd_draw(cb, n, 1, self.opaque_count, 0);
                 d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.pipes.transparent_light);
-                for lu in &light_uniforms {
+                // --self-shadow: the light passes are recorded by record_self_shadow below.
+                for lu in light_uniforms.iter().filter(|_| self.self_shadow.is_none()) {
                     for (k, v) in lu.iter().enumerate() {
                         push[16 + 4 * k..20 + 4 * k].copy_from_slice(&v.to_array());
                     }
@@ -1185,6 +1203,22 @@ impl Renderer {
                     d.cmd_draw(cb, n, 1, self.opaque_count, 0);
                 }
                 d.cmd_end_rendering(cb);
+                // --- self-shadowing (src/render/selfshadow.rs): steps 4-6 of Kim et al. ---
+                if let Some(ss) = &self.self_shadow {
+                    memory_barrier(ctx, cb, (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT, color_rw), (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT, color_rw));
+                    let frame = selfshadow::SelfShadowFrame {
+                        vp_rel,
+                        viewport,
+                        full,
+                        plans: &plans,
+                        draws: &draws,
+                        caster_mvp: &caster_mvp,
+                        light_uniforms: &light_uniforms,
+                        stream: stream_raw,
+                    };
+                    self.record_self_shadow(ss, cb, &frame);
+                }
+                // --- end self-shadowing ---
             }
 
             if self.opts.view == View::Volumes {
@@ -1374,6 +1408,7 @@ impl Renderer {
             index_format: self.opts.index_format.name().into(),
             counter: self.opts.counter.name().into(),
             transmit: if self.has_transparent { Some(self.opts.transmit.name().into()) } else { None },
+            self_shadow: self.self_shadow.is_some(),
             width: w,
             height: h,
             lights: light_stats,
@@ -1747,6 +1782,9 @@ impl Renderer {
         for mut eq in self.edge_quads.drain(..).flatten() {
             eq.vertices.destroy(ctx);
             eq.indices.destroy(ctx);
+        }
+        if let Some(mut ss) = self.self_shadow.take() {
+            ss.destroy(ctx);
         }
         self.targets.destroy(ctx);
         self.scene_vertices.destroy(ctx);

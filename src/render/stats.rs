@@ -91,6 +91,9 @@ pub struct Stats {
     /// The transparent casters' light-intensity map mode (log16, mul16, log32, mul32), when
     /// the scene has transparent casters.
     pub transmit: Option<String>,
+    /// Partial self-shadowing of transparent casters ran (`--self-shadow` on a scene that has
+    /// them).
+    pub self_shadow: bool,
     pub width: u32,
     pub height: u32,
     pub lights: Vec<LightStats>,
