@@ -40,10 +40,7 @@ fn main() {
                     let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
                     fs::write(Path::new(&out_dir).join(&file), bytes).expect("write SPIR-V");
                     let name = format!("{}{}_{}", stem.to_uppercase(), suffix, ext.to_uppercase());
-                    let _ = writeln!(
-                        generated,
-                        "pub const {name}: &[u8] = include_bytes!(concat!(env!(\"OUT_DIR\"), \"/{file}\"));"
-                    );
+                    let _ = writeln!(generated, "pub const {name}: &[u8] = include_bytes!(concat!(env!(\"OUT_DIR\"), \"/{file}\"));");
                     modules.push((format!("{stem}{}.{ext}", suffix.to_lowercase()), name));
                 }
                 Err(msg) => failures.push(msg),

@@ -10,7 +10,8 @@ use umbrage::geom::topology::Topology;
 use umbrage::shadow::testmesh::uv_sphere;
 
 fn bytes_of(t: &Topology) -> u64 {
-    (t.mesh.positions.len() * 12 + t.mesh.triangles.len() * 12 + t.manifold_edges.len() * std::mem::size_of_val(&t.manifold_edges[0])) as u64
+    (t.mesh.positions.len() * 12 + t.mesh.triangles.len() * 12 + t.manifold_edges.len() * std::mem::size_of_val(&t.manifold_edges[0]))
+        as u64
 }
 
 fn streaming_sum(t: &Topology) -> u64 {

@@ -60,7 +60,8 @@ pub fn evaluate(renderer: &mut Renderer, scene_name: &str, methods: &[Method], b
         let masks = frame.shadow_masks(&renderer.scene);
         let metrics = compare_all(&masks, &image, band)?;
         let worst = metrics.iter().max_by(|a, b| a.fraction_outside_band.total_cmp(&b.fraction_outside_band));
-        let (mismatches, compared, fraction) = worst.map(|m| (m.mismatches_outside_band, m.compared, m.fraction_outside_band)).unwrap_or((0, 0, 0.0));
+        let (mismatches, compared, fraction) =
+            worst.map(|m| (m.mismatches_outside_band, m.compared, m.fraction_outside_band)).unwrap_or((0, 0, 0.0));
         let expected = expected_failure(scene_name, method, renderer.opts.counter);
         let ok = fraction <= THRESHOLD;
         rows.push(Row {
@@ -143,11 +144,7 @@ pub fn evaluate_transmit(renderer: &mut Renderer, scene_name: &str, band: u32) -
         renderer.opts.transmit.log = log;
         let frame = renderer.render()?;
         let fractions = frame.light_fractions(&renderer.scene);
-        let metrics = fractions
-            .iter()
-            .enumerate()
-            .map(|(k, f)| transmit_error(f, &image, k, band))
-            .collect::<Result<Vec<_>>>()?;
+        let metrics = fractions.iter().enumerate().map(|(k, f)| transmit_error(f, &image, k, band)).collect::<Result<Vec<_>>>()?;
         let worst = |f: fn(&crate::reference::TransmitMetrics) -> f64| metrics.iter().map(f).fold(0.0, f64::max);
         rows.push(TransmitRow {
             scene: scene_name.to_string(),

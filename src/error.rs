@@ -15,9 +15,11 @@ pub enum Error {
     #[error("unknown {what} '{name}' (expected one of: {expected})")]
     UnknownName { what: &'static str, name: String, expected: String },
     /// No Vulkan loader, driver or usable device.
-    #[error("no usable Vulkan device: {0}\n  hint: on Debian/Ubuntu install the CPU driver with \
+    #[error(
+        "no usable Vulkan device: {0}\n  hint: on Debian/Ubuntu install the CPU driver with \
              `apt-get install libvulkan1 mesa-vulkan-drivers vulkan-validationlayers` (lavapipe), \
-             or run `make deps`")]
+             or run `make deps`"
+    )]
     NoDevice(String),
     /// A Vulkan call failed.
     #[error("Vulkan error in {call}: {result}")]

@@ -3,7 +3,7 @@
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use umbrage::render::{Counter, DepthMode, TransmitMode, IndexFormat, RenderOptions, Renderer, View};
+use umbrage::render::{Counter, DepthMode, IndexFormat, RenderOptions, Renderer, TransmitMode, View};
 use umbrage::shadow::Method;
 use umbrage::{Error, Result};
 
@@ -174,7 +174,11 @@ impl FrameArgs {
         Ok(RenderOptions {
             width: self.size.0,
             height: self.size.1,
-            method: if matches!(self.method.as_str(), "shadowmap" | "edgequad") { Method::McGuire } else { self.method.parse::<Method>()? },
+            method: if matches!(self.method.as_str(), "shadowmap" | "edgequad") {
+                Method::McGuire
+            } else {
+                self.method.parse::<Method>()?
+            },
             edge_quads: self.method == "edgequad",
             shadow_map: (self.method == "shadowmap").then_some(self.shadow_map_size),
             depth_mode: self.depth_mode.parse::<DepthMode>()?,
@@ -207,7 +211,11 @@ fn render(frame: &FrameArgs, out: &Path, stats: Option<&Path>, view: &str, dump:
     for w in &s.warnings {
         eprintln!("warning: {w}");
     }
-    let gpu = s.gpu_ms.as_ref().map(|g| format!(" (gpu {:.2} ms: shadow {:.2}, illuminate {:.2})", g.frame, g.shadow, g.illuminate)).unwrap_or_default();
+    let gpu = s
+        .gpu_ms
+        .as_ref()
+        .map(|g| format!(" (gpu {:.2} ms: shadow {:.2}, illuminate {:.2})", g.frame, g.shadow, g.illuminate))
+        .unwrap_or_default();
     println!(
         "{} | {}x{} | {} | frame {:.2} ms{} | {} shadow triangles | {}",
         s.device,
@@ -253,11 +261,8 @@ fn bench(
     markdown: Option<&Path>,
 ) -> Result<ExitCode> {
     let scenes = if scenes.is_empty() { vec!["bench/fill".into(), "bench/vertex".into(), "default".into()] } else { scenes };
-    let methods = if methods.is_empty() {
-        Method::ALL.to_vec()
-    } else {
-        methods.iter().map(|m| m.parse::<Method>()).collect::<Result<Vec<_>>>()?
-    };
+    let methods =
+        if methods.is_empty() { Method::ALL.to_vec() } else { methods.iter().map(|m| m.parse::<Method>()).collect::<Result<Vec<_>>>()? };
     let opts = RenderOptions { width: size.0, height: size.1, index_format: index_format.parse::<IndexFormat>()?, ..Default::default() };
     let ctx = umbrage::gpu::Context::new()?;
     let counters = counters.iter().map(|c| c.parse::<Counter>()).collect::<Result<Vec<_>>>()?;

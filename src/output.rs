@@ -86,10 +86,17 @@ pub fn info_report(ctx: &Context) -> InfoReport {
     let f = &ctx.features;
     let yes_no = |b: bool, y: &str, n: &str| if b { y.to_string() } else { n.to_string() };
     let paths = vec![
-        ("depthClamp".into(), yes_no(f.depth_clamp, "available: --depth-mode clamp (finite far plane, clamped) works", "missing: only --depth-mode infinite")),
+        (
+            "depthClamp".into(),
+            yes_no(f.depth_clamp, "available: --depth-mode clamp (finite far plane, clamped) works", "missing: only --depth-mode infinite"),
+        ),
         (
             "depthBounds".into(),
-            yes_no(f.depth_bounds, "used: illumination limited to each light's depth range", "missing: depth bounds test skipped (scissor only)"),
+            yes_no(
+                f.depth_bounds,
+                "used: illumination limited to each light's depth range",
+                "missing: depth bounds test skipped (scissor only)",
+            ),
         ),
         (
             "VK_EXT_depth_range_unrestricted".into(),
@@ -101,7 +108,11 @@ pub fn info_report(ctx: &Context) -> InfoReport {
         ),
         (
             "indexTypeUint8".into(),
-            yes_no(f.index_type_uint8, "used: 3-byte triangles for caster chunks of <= 128 vertices (--index-format auto|u8)", "missing: u16 indices (6 bytes per triangle)"),
+            yes_no(
+                f.index_type_uint8,
+                "used: 3-byte triangles for caster chunks of <= 128 vertices (--index-format auto|u8)",
+                "missing: u16 indices (6 bytes per triangle)",
+            ),
         ),
         ("pipelineStatisticsQuery".into(), yes_no(f.pipeline_statistics_query, "present", "missing")),
         ("timestamps".into(), yes_no(f.timestamps, "used: gpu_ms in --stats", "missing: gpu_ms omitted")),

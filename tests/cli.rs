@@ -64,7 +64,16 @@ fn render_stats_dump_and_check() {
     let stats = d.join("stats.json");
     let dump = d.join("dump");
     let out = umbrage(&[
-        "render", "--scene", "stairs", "--size", "160x120", "--out", png.to_str().unwrap(), "--stats", stats.to_str().unwrap(), "--dump",
+        "render",
+        "--scene",
+        "stairs",
+        "--size",
+        "160x120",
+        "--out",
+        png.to_str().unwrap(),
+        "--stats",
+        stats.to_str().unwrap(),
+        "--dump",
         dump.to_str().unwrap(),
     ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));

@@ -43,8 +43,13 @@ translate = [0.0, 2.4, 3.0]
 "#;
 
 fn render(ctx: umbrage::gpu::Context, toml: &str, name: &str, method: Method, fmt: IndexFormat) -> (Stats, Renderer) {
-    let scene = if toml.is_empty() { umbrage::scene::load(name).unwrap() } else { umbrage::scene::load_str(toml, name, std::path::Path::new(".")).unwrap() };
-    let mut r = Renderer::new(ctx, scene, RenderOptions { width: 320, height: 240, method, index_format: fmt, ..Default::default() }).unwrap();
+    let scene = if toml.is_empty() {
+        umbrage::scene::load(name).unwrap()
+    } else {
+        umbrage::scene::load_str(toml, name, std::path::Path::new(".")).unwrap()
+    };
+    let mut r =
+        Renderer::new(ctx, scene, RenderOptions { width: 320, height: 240, method, index_format: fmt, ..Default::default() }).unwrap();
     let out = r.render().unwrap();
     r.ctx.check_validation().unwrap();
     (out.stats, r)

@@ -6,10 +6,7 @@ use umbrage::scene::{Camera, Light, LightKind, Scene, SceneMesh};
 
 fn quad(size: f32) -> Mesh {
     let s = size * 0.5;
-    Mesh::new(
-        vec![Vec3::new(-s, 0.0, -s), Vec3::new(s, 0.0, -s), Vec3::new(s, 0.0, s), Vec3::new(-s, 0.0, s)],
-        vec![[0, 2, 1], [0, 3, 2]],
-    )
+    Mesh::new(vec![Vec3::new(-s, 0.0, -s), Vec3::new(s, 0.0, -s), Vec3::new(s, 0.0, s), Vec3::new(-s, 0.0, s)], vec![[0, 2, 1], [0, 3, 2]])
 }
 
 #[test]
@@ -18,8 +15,23 @@ fn ambient_and_light_without_casters() {
     let scene = Scene {
         name: "t".into(),
         camera: Camera { eye: Vec3::new(0.0, 5.0, 5.0), target: Vec3::ZERO, ..Default::default() },
-        lights: vec![Light { kind: LightKind::Point, position: Vec3::new(0.0, 4.0, 0.0), direction: Vec3::NEG_Y, color: Vec3::ONE, intensity: 1.0, radius: None, cone_deg: 45.0 }],
-        meshes: vec![SceneMesh { name: "floor".into(), mesh: quad(10.0), transform: Mat4::IDENTITY, color: Vec3::splat(0.8), opacity: 1.0, casts_shadow: false }],
+        lights: vec![Light {
+            kind: LightKind::Point,
+            position: Vec3::new(0.0, 4.0, 0.0),
+            direction: Vec3::NEG_Y,
+            color: Vec3::ONE,
+            intensity: 1.0,
+            radius: None,
+            cone_deg: 45.0,
+        }],
+        meshes: vec![SceneMesh {
+            name: "floor".into(),
+            mesh: quad(10.0),
+            transform: Mat4::IDENTITY,
+            color: Vec3::splat(0.8),
+            opacity: 1.0,
+            casts_shadow: false,
+        }],
         ambient: Vec3::splat(0.05),
     };
     let mut r = Renderer::new(ctx, scene, RenderOptions { width: 64, height: 48, capture: true, ..Default::default() }).unwrap();

@@ -79,10 +79,12 @@ fn stacked_boxes_give_count_two_and_dark_floor() {
 #[test]
 fn eye_inside_two_volumes_counts_two_except_zpass() {
     let Some(mut ctx) = common::context() else { return };
-    let toml = STACK.replace("eye = [0.0, 3.0, 6.0]", "eye = [0.1, 2.0, 0.1]").replace("target = [0.0, 0.0, 0.0]", "target = [1.5, 0.0, 0.0]");
+    let toml =
+        STACK.replace("eye = [0.0, 3.0, 6.0]", "eye = [0.1, 2.0, 0.1]").replace("target = [0.0, 0.0, 0.0]", "target = [1.5, 0.0, 0.0]");
     for method in Method::ALL {
         let scene = umbrage::scene::load_str(&toml, "eye-in", std::path::Path::new(".")).unwrap();
-        let mut r = Renderer::new(ctx, scene, RenderOptions { width: 160, height: 120, method, capture: true, ..Default::default() }).unwrap();
+        let mut r =
+            Renderer::new(ctx, scene, RenderOptions { width: 160, height: 120, method, capture: true, ..Default::default() }).unwrap();
         let out = r.render().unwrap();
         let p = project(&r, glam::Vec3::new(0.3, 0.0, 0.0));
         let count = out.stencil[0][p.1 * 160 + p.0];

@@ -80,9 +80,25 @@ fn scene(c: &Case) -> Scene {
     }
     let l = Vec3::new(c.light.0, c.light.1, c.light.2);
     let light = if c.directional {
-        Light { kind: LightKind::Directional, position: Vec3::ZERO, direction: -l.normalize(), color: Vec3::ONE, intensity: 1.0, radius: None, cone_deg: 45.0 }
+        Light {
+            kind: LightKind::Directional,
+            position: Vec3::ZERO,
+            direction: -l.normalize(),
+            color: Vec3::ONE,
+            intensity: 1.0,
+            radius: None,
+            cone_deg: 45.0,
+        }
     } else {
-        Light { kind: LightKind::Point, position: l, direction: Vec3::NEG_Y, color: Vec3::ONE, intensity: 1.0, radius: None, cone_deg: 45.0 }
+        Light {
+            kind: LightKind::Point,
+            position: l,
+            direction: Vec3::NEG_Y,
+            color: Vec3::ONE,
+            intensity: 1.0,
+            radius: None,
+            cone_deg: 45.0,
+        }
     };
     let eye = Vec3::new(c.cam_angle.cos() * c.cam_dist, c.cam_height, c.cam_angle.sin() * c.cam_dist);
     Scene {

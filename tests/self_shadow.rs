@@ -56,7 +56,8 @@ fn self_shadow_darkens_covered_transparent_surfaces_only() {
     let mut frames = Vec::new();
     for self_shadow in [false, true] {
         let scene = umbrage::scene::load_str(STACK, "stack", std::path::Path::new(".")).unwrap();
-        let mut r = Renderer::new(ctx, scene, RenderOptions { width: w, height: h, capture: true, self_shadow, ..Default::default() }).unwrap();
+        let mut r =
+            Renderer::new(ctx, scene, RenderOptions { width: w, height: h, capture: true, self_shadow, ..Default::default() }).unwrap();
         let out = r.render().unwrap();
         assert_eq!(out.stats.self_shadow, self_shadow);
         let fractions = out.light_fractions(&r.scene);
@@ -109,7 +110,9 @@ fn self_shadow_perf() {
     let (w, h) = (640u32, 480u32);
     let mut rows = Vec::new();
     let mut device = String::new();
-    for (label, all_opaque, self_shadow) in [("opaque", true, false), ("transparent (no s.s.)", false, false), ("transparent (s.s.)", false, true)] {
+    for (label, all_opaque, self_shadow) in
+        [("opaque", true, false), ("transparent (no s.s.)", false, false), ("transparent (s.s.)", false, true)]
+    {
         let mut scene = umbrage::scene::load(name).unwrap();
         if all_opaque {
             for m in &mut scene.meshes {

@@ -66,16 +66,30 @@ pub fn w0_vertices_and_infinity(ctx: &Context) -> Result<CheckResult> {
     let bits = subpixel_bits(ctx);
     // A: dark-cap-like triangles, every vertex at infinity (w = 0).
     let a: Vec<[f32; 4]> = vec![
-        [-0.5, -0.3, -1.0, 0.0], [0.05, 0.45, -1.0, 0.0], [0.4, -0.35, -1.0, 0.0],
-        [0.6, 0.1, -1.0, 0.0], [1.5, 0.2, -1.0, 0.0], [0.7, 0.9, -1.0, 0.0],
-        [-1.2, -0.4, -2.0, 0.0], [-0.3, -0.95, -2.0, 0.0], [-0.9, -1.1, -1.5, 0.0],
-        [-0.71, 0.52, -3.0, 0.0], [-0.70, 0.05, -1.0, 0.0], [-0.69, 0.51, -3.0, 0.0],
+        [-0.5, -0.3, -1.0, 0.0],
+        [0.05, 0.45, -1.0, 0.0],
+        [0.4, -0.35, -1.0, 0.0],
+        [0.6, 0.1, -1.0, 0.0],
+        [1.5, 0.2, -1.0, 0.0],
+        [0.7, 0.9, -1.0, 0.0],
+        [-1.2, -0.4, -2.0, 0.0],
+        [-0.3, -0.95, -2.0, 0.0],
+        [-0.9, -1.1, -1.5, 0.0],
+        [-0.71, 0.52, -3.0, 0.0],
+        [-0.70, 0.05, -1.0, 0.0],
+        [-0.69, 0.51, -3.0, 0.0],
     ];
     // B: side-quad-like triangles mixing finite (w = 1) and infinite (w = 0) vertices.
     let b: Vec<[f32; 4]> = vec![
-        [-0.8, -0.5, -2.0, 1.0], [-0.3, -0.6, -3.0, 1.0], [-0.2, -0.1, -1.0, 0.0],
-        [0.5, 0.5, -2.5, 1.0], [0.1, -0.2, -1.0, 0.0], [0.9, 0.6, -4.0, 1.0],
-        [-1.0, 0.6, -2.0, 1.0], [-0.4, 0.3, -1.0, 0.0], [-0.9, 0.1, -1.0, 0.0],
+        [-0.8, -0.5, -2.0, 1.0],
+        [-0.3, -0.6, -3.0, 1.0],
+        [-0.2, -0.1, -1.0, 0.0],
+        [0.5, 0.5, -2.5, 1.0],
+        [0.1, -0.2, -1.0, 0.0],
+        [0.9, 0.6, -4.0, 1.0],
+        [-1.0, 0.6, -2.0, 1.0],
+        [-0.4, 0.3, -1.0, 0.0],
+        [-0.9, 0.1, -1.0, 0.0],
     ];
     let mut numbers = serde_json::Map::new();
     let mut fails = Vec::new();
@@ -155,13 +169,19 @@ pub fn depth_clamp(ctx: &Context) -> Result<CheckResult> {
     let bits = subpixel_bits(ctx);
     // Beyond the far plane entirely (z = -20 .. -50), and one triangle crossing it.
     let beyond: Vec<[f32; 4]> = vec![
-        [-10.0, -6.0, -20.0, 1.0], [4.0, -7.0, -25.0, 1.0], [-2.0, 8.0, -30.0, 1.0],
-        [15.0, 10.0, -50.0, 1.0], [25.0, 3.0, -45.0, 1.0], [20.0, 20.0, -40.0, 1.0],
+        [-10.0, -6.0, -20.0, 1.0],
+        [4.0, -7.0, -25.0, 1.0],
+        [-2.0, 8.0, -30.0, 1.0],
+        [15.0, 10.0, -50.0, 1.0],
+        [25.0, 3.0, -45.0, 1.0],
+        [20.0, 20.0, -40.0, 1.0],
     ];
     let crossing: Vec<[f32; 4]> = vec![[-3.0, -2.0, -5.0, 1.0], [-1.0, -2.0, -5.0, 1.0], [-12.0, -15.0, -30.0, 1.0]];
     let mut numbers = serde_json::Map::new();
     let mut fails = Vec::new();
-    for (label, verts, clamp) in [("beyond_far_clamped", beyond.clone(), true), ("crossing_far_clamped", crossing, true), ("beyond_far_unclamped", beyond, false)] {
+    for (label, verts, clamp) in
+        [("beyond_far_clamped", beyond.clone(), true), ("crossing_far_clamped", crossing, true), ("beyond_far_unclamped", beyond, false)]
+    {
         let tris = tri_list(verts.len() as u32 / 3);
         let wt = raster::window_tris(mvp, &verts, &tris, w, h, bits);
         let (mut expected, judged) = raster::expected_counts(&wt, |_| 1, w, h);
@@ -268,7 +288,9 @@ pub fn watertight_fan(ctx: &Context) -> Result<CheckResult> {
             (1..verts.len()).map(|i| raster::window_tris(mvp, &verts, &[[i as u32, i as u32, i as u32]], w, h, bits)[0].p[0]).collect()
         } else {
             let c = [[gx0, gy0], [gx1, gy0], [gx1, gy1], [gx0, gy1]];
-            c.iter().map(|p| raster::to_window(mvp.as_dmat4() * glam::DVec4::new(p[0] as f64, p[1] as f64, 0.5, 1.0), w, h, bits).0).collect()
+            c.iter()
+                .map(|p| raster::to_window(mvp.as_dmat4() * glam::DVec4::new(p[0] as f64, p[1] as f64, 0.5, 1.0), w, h, bits).0)
+                .collect()
         };
         // Inside by the crossing rule (the snapped ring need not be exactly convex); not judged
         // within EDGE_EPS of a hull segment.
@@ -291,7 +313,15 @@ pub fn watertight_fan(ctx: &Context) -> Result<CheckResult> {
                 Some(inside)
             }
         };
-        let rb = harness::render(ctx, ctx.depth_format, w, h, 1.0, 0, &[DrawCall { spec: incr_both(), mvp, vertices: verts, indices: Indices::U32(tris.iter().flatten().copied().collect()) }])?;
+        let rb = harness::render(
+            ctx,
+            ctx.depth_format,
+            w,
+            h,
+            1.0,
+            0,
+            &[DrawCall { spec: incr_both(), mvp, vertices: verts, indices: Indices::U32(tris.iter().flatten().copied().collect()) }],
+        )?;
         let (mut zero_inside, mut double, mut outside_hits, mut inside, mut hull_edge) = (0u64, 0u64, 0u64, 0u64, 0u64);
         for y in 0..h {
             for x in 0..w {
@@ -414,7 +444,15 @@ pub fn stencil_formats(ctx: &Context) -> Result<CheckResult> {
         let mut v = Vec::new();
         rect(&mut v, [8.0, 8.0, 40.0, 24.0], true);
         rect(&mut v, [8.0, 8.0, 40.0, 24.0], false); // both faces write the same
-        let rb = harness::render(ctx, format, w, h, 0.25, 0x5a, &[DrawCall { spec: write_depth(PipeSpec::replace(0xc3)), mvp, vertices: v, indices: Indices::None }])?;
+        let rb = harness::render(
+            ctx,
+            format,
+            w,
+            h,
+            0.25,
+            0x5a,
+            &[DrawCall { spec: write_depth(PipeSpec::replace(0xc3)), mvp, vertices: v, indices: Indices::None }],
+        )?;
         let (mut bad_stencil, mut bad_depth) = (0u64, 0u64);
         for y in 0..h {
             for x in 0..w {
@@ -425,7 +463,10 @@ pub fn stencil_formats(ctx: &Context) -> Result<CheckResult> {
                 bad_depth += (!depth_is(format, rb.depth[i], wd)) as u64;
             }
         }
-        numbers.insert(name.clone(), json!({"stencil_mismatches": bad_stencil, "depth_mismatches": bad_depth, "cleared": "0x5a / 0.25", "written": "0xc3 / 0.5"}));
+        numbers.insert(
+            name.clone(),
+            json!({"stencil_mismatches": bad_stencil, "depth_mismatches": bad_depth, "cleared": "0x5a / 0.25", "written": "0xc3 / 0.5"}),
+        );
         if bad_stencil > 0 || bad_depth > 0 {
             fails.push(format!("{name}: {bad_stencil} stencil and {bad_depth} depth mismatches"));
         }
@@ -463,7 +504,10 @@ pub fn depth_bounds(ctx: &Context) -> Result<CheckResult> {
         h,
         1.0,
         0,
-        &[DrawCall { spec: keep, mvp, vertices: depth, indices: Indices::None }, DrawCall { spec: bounded, mvp, vertices: full, indices: Indices::None }],
+        &[
+            DrawCall { spec: keep, mvp, vertices: depth, indices: Indices::None },
+            DrawCall { spec: bounded, mvp, vertices: full, indices: Indices::None },
+        ],
     )?;
     let mut bad = 0u64;
     for y in 0..h {
@@ -505,7 +549,9 @@ pub fn index_types(ctx: &Context) -> Result<CheckResult> {
         }
     }
     let spec = PipeSpec::stencil(vk::StencilOp::INCREMENT_AND_WRAP, vk::StencilOp::DECREMENT_AND_WRAP);
-    let draw = |indices: Indices, vertices: Vec<[f32; 4]>| harness::render(ctx, ctx.depth_format, w, h, 1.0, 0, &[DrawCall { spec, mvp, vertices, indices }]);
+    let draw = |indices: Indices, vertices: Vec<[f32; 4]>| {
+        harness::render(ctx, ctx.depth_format, w, h, 1.0, 0, &[DrawCall { spec, mvp, vertices, indices }])
+    };
     let base = draw(Indices::U32(idx.clone()), verts.clone())?;
     let mut numbers = serde_json::Map::new();
     let mut fails = Vec::new();
@@ -603,7 +649,8 @@ pub fn shadow_pipeline_hard_cases(new_context: &dyn Fn() -> Result<Context>, wid
     numbers.insert("expected_failures".into(), json!(cases.iter().filter(|c| c.status == "expected-failure").count()));
     numbers.insert("unexpected_passes".into(), json!(flagged));
     numbers.insert("failed".into(), json!(cases.iter().filter(|c| c.status == "fail").count()));
-    let mut r = CheckResult::from_fails("shadow_pipeline_hard_cases", fails, numbers, "every hard scene x method within 0.01% outside the band");
+    let mut r =
+        CheckResult::from_fails("shadow_pipeline_hard_cases", fails, numbers, "every hard scene x method within 0.01% outside the band");
     if !flagged.is_empty() && r.status == Status::Pass {
         r.summary = format!("pass; FLAGGED unexpected passes: {}", flagged.join(", "));
     }

@@ -98,7 +98,15 @@ fn bytes<T: Copy>(v: &[T]) -> Vec<u8> {
 
 /// Clears a `width` x `height` depth-stencil image of `format` to (`clear_depth`,
 /// `clear_stencil`), records `draws` in order, and reads both aspects back.
-pub fn render(ctx: &Context, format: vk::Format, width: u32, height: u32, clear_depth: f32, clear_stencil: u32, draws: &[DrawCall]) -> Result<Readback> {
+pub fn render(
+    ctx: &Context,
+    format: vk::Format,
+    width: u32,
+    height: u32,
+    clear_depth: f32,
+    clear_stencil: u32,
+    draws: &[DrawCall],
+) -> Result<Readback> {
     let push_range = [vk::PushConstantRange { stage_flags: vk::ShaderStageFlags::VERTEX, offset: 0, size: 96 }];
     let layout_info = vk::PipelineLayoutCreateInfo::default().push_constant_ranges(&push_range);
     // SAFETY: valid device and create info; destroyed at the end of this function.
@@ -203,8 +211,20 @@ pub fn render(ctx: &Context, format: vk::Format, width: u32, height: u32, clear_
             // SAFETY: recording; the image is in TRANSFER_SRC_OPTIMAL and the buffers are large
             // enough for one aspect each (4 bytes per depth texel, 1 per stencil texel).
             unsafe {
-                ctx.device.cmd_copy_image_to_buffer(cb, img.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, depth_buf, &[region(vk::ImageAspectFlags::DEPTH)]);
-                ctx.device.cmd_copy_image_to_buffer(cb, img.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, stencil_buf, &[region(vk::ImageAspectFlags::STENCIL)]);
+                ctx.device.cmd_copy_image_to_buffer(
+                    cb,
+                    img.raw,
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    depth_buf,
+                    &[region(vk::ImageAspectFlags::DEPTH)],
+                );
+                ctx.device.cmd_copy_image_to_buffer(
+                    cb,
+                    img.raw,
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    stencil_buf,
+                    &[region(vk::ImageAspectFlags::STENCIL)],
+                );
             }
             let b = [vk::MemoryBarrier2::default()
                 .src_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)

@@ -82,7 +82,13 @@ impl CheckResult {
         CheckResult { name: name.into(), status: Status::Skipped, summary: why.into(), numbers: Default::default(), cases: Vec::new() }
     }
     fn error(name: &str, e: &Error) -> CheckResult {
-        CheckResult { name: name.into(), status: Status::Fail, summary: format!("error: {e}"), numbers: Default::default(), cases: Vec::new() }
+        CheckResult {
+            name: name.into(),
+            status: Status::Fail,
+            summary: format!("error: {e}"),
+            numbers: Default::default(),
+            cases: Vec::new(),
+        }
     }
 }
 

@@ -57,9 +57,7 @@ pub fn window_tris(mvp: Mat4, verts: &[[f32; 4]], tris: &[[u32; 3]], width: u32,
         .iter()
         .map(|v| to_window(m * DVec4::new(v[0] as f64, v[1] as f64, v[2] as f64, v[3] as f64), width, height, subpixel_bits))
         .collect();
-    tris.iter()
-        .map(|t| WinTri { p: t.map(|i| w[i as usize].0), z: t.map(|i| w[i as usize].1) })
-        .collect()
+    tris.iter().map(|t| WinTri { p: t.map(|i| w[i as usize].0), z: t.map(|i| w[i as usize].1) }).collect()
 }
 
 pub fn cover(t: &WinTri, x: u32, y: u32) -> Cover {

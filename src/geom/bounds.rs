@@ -286,7 +286,7 @@ mod tests {
         assert!(!f.intersects_box(&unit_box(Vec3::new(0.0, 0.0, 10.0)))); // behind
         assert!(!f.intersects_box(&unit_box(Vec3::new(100.0, 0.0, 0.0))));
         assert!(f.intersects_box(&unit_box(Vec3::new(0.0, 0.0, -1e6)))); // infinite far
-        // points at infinity: straight ahead is inside, straight behind outside
+                                                                         // points at infinity: straight ahead is inside, straight behind outside
         let ahead = DVec4::new(0.0, 0.0, -1.0, 0.0);
         assert!(f.planes.iter().all(|p| p.dot(ahead) >= 0.0));
         assert!(f.all_outside_one_plane(&[DVec4::new(0.0, 0.0, 1.0, 0.0)]));
@@ -318,7 +318,7 @@ mod tests {
         assert!(p.intersects_box(&unit_box(Vec3::ZERO))); // between light and eye
         assert!(!p.intersects_box(&unit_box(Vec3::new(3.0, 0.0, 0.0))));
         assert!(!p.intersects_box(&unit_box(Vec3::new(0.0, 0.0, -8.0)))); // beyond the light
-        // directional from -z (light direction xyz points towards the light = -z)
+                                                                          // directional from -z (light direction xyz points towards the light = -z)
         let d = OcclusionPyramid::new(Vec4::new(0.0, 0.0, -1.0, 0.0), vp);
         assert!(d.intersects_box(&unit_box(Vec3::new(0.0, 0.0, -100.0))));
         assert!(!d.intersects_box(&unit_box(Vec3::new(2.0, 0.0, 0.0))));
@@ -335,15 +335,7 @@ mod tests {
     }
 
     fn point_light(pos: Vec3, r: Option<f32>) -> Light {
-        Light {
-            kind: LightKind::Point,
-            position: pos,
-            direction: Vec3::NEG_Y,
-            color: Vec3::ONE,
-            intensity: 1.0,
-            radius: r,
-            cone_deg: 45.0,
-        }
+        Light { kind: LightKind::Point, position: pos, direction: Vec3::NEG_Y, color: Vec3::ONE, intensity: 1.0, radius: r, cone_deg: 45.0 }
     }
 
     #[test]

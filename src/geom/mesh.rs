@@ -106,10 +106,8 @@ impl Mesh {
     /// Applies an affine transform to every vertex (winding flips if the determinant is negative:
     /// the caller decides whether to swap, see [`Mesh::transformed`]).
     pub fn transformed(&self, m: &glam::Mat4) -> Mesh {
-        let mut out = Mesh {
-            positions: self.positions.iter().map(|p| m.transform_point3(*p)).collect(),
-            triangles: self.triangles.clone(),
-        };
+        let mut out =
+            Mesh { positions: self.positions.iter().map(|p| m.transform_point3(*p)).collect(), triangles: self.triangles.clone() };
         if m.determinant() < 0.0 {
             for t in &mut out.triangles {
                 t.swap(1, 2);

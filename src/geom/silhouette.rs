@@ -41,8 +41,7 @@ pub fn facing_bits(mesh: &Mesh, l: Vec4, flip: bool) -> Vec<bool> {
     let work = |tris: &[[u32; 3]], out: &mut [bool]| {
         let p = &mesh.positions;
         for (o, t) in out.iter_mut().zip(tris) {
-            let (a, b, c): (DVec3, DVec3, DVec3) =
-                (p[t[0] as usize].as_dvec3(), p[t[1] as usize].as_dvec3(), p[t[2] as usize].as_dvec3());
+            let (a, b, c): (DVec3, DVec3, DVec3) = (p[t[0] as usize].as_dvec3(), p[t[1] as usize].as_dvec3(), p[t[2] as usize].as_dvec3());
             *o = if flip { facing_f64(a, c, b, l) } else { facing_f64(a, b, c, l) };
         }
     };

@@ -115,8 +115,8 @@ impl Context {
     pub fn with_validation(validation: bool) -> Result<Context> {
         // SAFETY: loading the Vulkan loader library; we keep `entry` alive in the context for as
         // long as any object created from it.
-        let entry = unsafe { ash::Entry::load() }
-            .map_err(|e| Error::NoDevice(format!("cannot load the Vulkan loader (libvulkan.so.1): {e}")))?;
+        let entry =
+            unsafe { ash::Entry::load() }.map_err(|e| Error::NoDevice(format!("cannot load the Vulkan loader (libvulkan.so.1): {e}")))?;
 
         let layer_name = c"VK_LAYER_KHRONOS_validation";
         let mut layers = Vec::new();
@@ -127,24 +127,19 @@ impl Context {
             let has = available.iter().any(|l| l.layer_name_as_c_str().map(|n| n == layer_name).unwrap_or(false));
             if !has {
                 return Err(Error::NoDevice(
-                    "UMBRAGE_VALIDATION=1 but VK_LAYER_KHRONOS_validation is not installed (apt-get install vulkan-validationlayers)".into(),
+                    "UMBRAGE_VALIDATION=1 but VK_LAYER_KHRONOS_validation is not installed (apt-get install vulkan-validationlayers)"
+                        .into(),
                 ));
             }
             layers.push(layer_name.as_ptr());
             extensions.push(ash::ext::debug_utils::NAME.as_ptr());
         }
-        let app = vk::ApplicationInfo::default()
-            .application_name(c"umbrage")
-            .engine_name(c"umbrage")
-            .api_version(vk::API_VERSION_1_3);
-        let create = vk::InstanceCreateInfo::default()
-            .application_info(&app)
-            .enabled_layer_names(&layers)
-            .enabled_extension_names(&extensions);
+        let app = vk::ApplicationInfo::default().application_name(c"umbrage").engine_name(c"umbrage").api_version(vk::API_VERSION_1_3);
+        let create =
+            vk::InstanceCreateInfo::default().application_info(&app).enabled_layer_names(&layers).enabled_extension_names(&extensions);
         // SAFETY: all pointers in `create` refer to locals alive for this call.
-        let instance = unsafe { entry.create_instance(&create, None) }.map_err(|e| {
-            Error::NoDevice(format!("vkCreateInstance failed ({e:?}): no Vulkan driver installed?"))
-        })?;
+        let instance = unsafe { entry.create_instance(&create, None) }
+            .map_err(|e| Error::NoDevice(format!("vkCreateInstance failed ({e:?}): no Vulkan driver installed?")))?;
 
         let log = Arc::new(Mutex::new(ValidationLog::default()));
         let debug = if validation {
@@ -264,7 +259,8 @@ impl Context {
         let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
         let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13);
         // SAFETY: enumeration of extensions on a valid physical device.
-        let exts = unsafe { instance.enumerate_device_extension_properties(physical) }.map_err(vkerr("vkEnumerateDeviceExtensionProperties"))?;
+        let exts =
+            unsafe { instance.enumerate_device_extension_properties(physical) }.map_err(vkerr("vkEnumerateDeviceExtensionProperties"))?;
         let has_ext = |n: &CStr| exts.iter().any(|e| e.extension_name_as_c_str().map(|x| x == n).unwrap_or(false));
         let has_u8_ext = has_ext(ash::ext::index_type_uint8::NAME);
         let has_dru = has_ext(ash::ext::depth_range_unrestricted::NAME);

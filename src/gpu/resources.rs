@@ -26,7 +26,13 @@ impl Buffer {
         let requirements = unsafe { ctx.device.get_buffer_memory_requirements(raw) };
         let allocation = ctx
             .allocator()
-            .allocate(&AllocationCreateDesc { name, requirements, location, linear: true, allocation_scheme: AllocationScheme::GpuAllocatorManaged })
+            .allocate(&AllocationCreateDesc {
+                name,
+                requirements,
+                location,
+                linear: true,
+                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+            })
             .map_err(|e| Error::Other(format!("allocating {name} ({size} bytes): {e}")))?;
         // SAFETY: memory and offset come from an allocation made for these requirements.
         unsafe { ctx.device.bind_buffer_memory(raw, allocation.memory(), allocation.offset()) }.map_err(vkerr("vkBindBufferMemory"))?;
@@ -41,11 +47,8 @@ impl Buffer {
     }
 
     pub fn write(&mut self, offset: usize, data: &[u8]) -> Result<()> {
-        let slice = self
-            .allocation
-            .as_mut()
-            .and_then(|a| a.mapped_slice_mut())
-            .ok_or_else(|| Error::Other("buffer is not host visible".into()))?;
+        let slice =
+            self.allocation.as_mut().and_then(|a| a.mapped_slice_mut()).ok_or_else(|| Error::Other("buffer is not host visible".into()))?;
         let end = offset + data.len();
         if end > slice.len() {
             return Err(Error::Other(format!("buffer write out of range: {end} > {}", slice.len())));
@@ -113,11 +116,10 @@ impl Image {
             .map_err(|e| Error::Other(format!("allocating image {name}: {e}")))?;
         // SAFETY: the allocation satisfies the image's requirements.
         unsafe { ctx.device.bind_image_memory(raw, allocation.memory(), allocation.offset()) }.map_err(vkerr("vkBindImageMemory"))?;
-        let view_info = vk::ImageViewCreateInfo::default()
-            .image(raw)
-            .view_type(vk::ImageViewType::TYPE_2D)
-            .format(format)
-            .subresource_range(vk::ImageSubresourceRange { aspect_mask: aspect, base_mip_level: 0, level_count: 1, base_array_layer: 0, layer_count: 1 });
+        let view_info =
+            vk::ImageViewCreateInfo::default().image(raw).view_type(vk::ImageViewType::TYPE_2D).format(format).subresource_range(
+                vk::ImageSubresourceRange { aspect_mask: aspect, base_mip_level: 0, level_count: 1, base_array_layer: 0, layer_count: 1 },
+            );
         // SAFETY: `raw` is bound to memory; the view covers its single subresource.
         let view = unsafe { ctx.device.create_image_view(&view_info, None) }.map_err(vkerr("vkCreateImageView"))?;
         Ok(Image { raw, view, format, extent, aspect, allocation: Some(allocation) })

@@ -52,10 +52,7 @@ struct Bounds {
 }
 
 impl Bounds {
-    const EMPTY: Bounds = Bounds {
-        min: DVec3::splat(f64::INFINITY),
-        max: DVec3::splat(f64::NEG_INFINITY),
-    };
+    const EMPTY: Bounds = Bounds { min: DVec3::splat(f64::INFINITY), max: DVec3::splat(f64::NEG_INFINITY) };
     fn grow(&mut self, o: &Bounds) {
         self.min = self.min.min(o.min);
         self.max = self.max.max(o.max);
@@ -89,18 +86,10 @@ impl Bvh {
             .map(|(i, t)| {
                 let mut b = Bounds::EMPTY;
                 t.iter().for_each(|p| b.grow_p(*p));
-                Prim {
-                    c: (b.min + b.max) * 0.5,
-                    b,
-                    id: i as u32,
-                }
+                Prim { c: (b.min + b.max) * 0.5, b, id: i as u32 }
             })
             .collect();
-        let mut bvh = Bvh {
-            nodes: Vec::with_capacity(prims.len() / 2 + 1),
-            tris: Vec::new(),
-            ids: Vec::new(),
-        };
+        let mut bvh = Bvh { nodes: Vec::with_capacity(prims.len() / 2 + 1), tris: Vec::new(), ids: Vec::new() };
         if prims.is_empty() {
             return bvh;
         }
@@ -127,12 +116,7 @@ impl Bvh {
             b.grow(&p.b);
             cb.grow_p(p.c);
         }
-        self.nodes.push(Node {
-            min: b.min,
-            max: b.max,
-            index: start as u32,
-            count: (end - start) as u32,
-        });
+        self.nodes.push(Node { min: b.min, max: b.max, index: start as u32, count: (end - start) as u32 });
         let n = end - start;
         if n <= MAX_LEAF {
             return me;
@@ -210,23 +194,12 @@ impl Bvh {
                 prims.swap(i, j);
             }
         }
-        let mid = if i == start || i == end {
-            start + n / 2
-        } else {
-            i
-        };
+        let mid = if i == start || i == end { start + n / 2 } else { i };
         self.split_children(prims, me, start, mid, end);
         me
     }
 
-    fn split_children(
-        &mut self,
-        prims: &mut [Prim],
-        me: usize,
-        start: usize,
-        mid: usize,
-        end: usize,
-    ) {
+    fn split_children(&mut self, prims: &mut [Prim], me: usize, start: usize, mid: usize, end: usize) {
         self.build_rec(prims, start, mid);
         let right = self.build_rec(prims, mid, end);
         self.nodes[me].index = right as u32;
@@ -251,12 +224,7 @@ impl Bvh {
                 for k in s..s + nd.count as usize {
                     if let Some((t, u, v)) = ray.intersect(&self.tris[k], t_min, t_far) {
                         t_far = t;
-                        best = Some(Hit {
-                            t,
-                            tri: self.ids[k],
-                            u,
-                            v,
-                        });
+                        best = Some(Hit { t, tri: self.ids[k], u, v });
                     }
                 }
             } else {
@@ -304,14 +272,7 @@ impl Bvh {
 
     /// Whether any triangle not rejected by `ignore` (called with the original triangle
     /// index) is hit with `t_min < t < t_max`.
-    pub fn any_hit(
-        &self,
-        origin: DVec3,
-        dir: DVec3,
-        t_min: f64,
-        t_max: f64,
-        ignore: impl Fn(u32) -> bool,
-    ) -> bool {
+    pub fn any_hit(&self, origin: DVec3, dir: DVec3, t_min: f64, t_max: f64, ignore: impl Fn(u32) -> bool) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
@@ -330,8 +291,7 @@ impl Bvh {
             if nd.count > 0 {
                 let s = nd.index as usize;
                 for k in s..s + nd.count as usize {
-                    if ray.intersect(&self.tris[k], t_min, t_max).is_some() && !ignore(self.ids[k])
-                    {
+                    if ray.intersect(&self.tris[k], t_min, t_max).is_some() && !ignore(self.ids[k]) {
                         return true;
                     }
                 }
@@ -351,14 +311,7 @@ impl Bvh {
     /// (each triangle at most once per call; coincident duplicate triangles are separate
     /// triangles and are each reported). `f` returns `false` to stop the traversal early.
     /// Returns `false` iff stopped early. `dir` need not be unit length.
-    pub fn all_hits(
-        &self,
-        origin: DVec3,
-        dir: DVec3,
-        t_min: f64,
-        t_max: f64,
-        mut f: impl FnMut(Hit) -> bool,
-    ) -> bool {
+    pub fn all_hits(&self, origin: DVec3, dir: DVec3, t_min: f64, t_max: f64, mut f: impl FnMut(Hit) -> bool) -> bool {
         if self.nodes.is_empty() {
             return true;
         }
@@ -375,12 +328,7 @@ impl Bvh {
                 let s = nd.index as usize;
                 for k in s..s + nd.count as usize {
                     if let Some((t, u, v)) = ray.intersect(&self.tris[k], t_min, t_max) {
-                        if !f(Hit {
-                            t,
-                            tri: self.ids[k],
-                            u,
-                            v,
-                        }) {
+                        if !f(Hit { t, tri: self.ids[k], u, v }) {
                             return false;
                         }
                     }
@@ -411,30 +359,15 @@ impl Bvh {
         for (k, t) in self.tris.iter().enumerate() {
             if let Some((t, u, v)) = ray.intersect(t, t_min, t_far) {
                 t_far = t;
-                best = Some(Hit {
-                    t,
-                    tri: self.ids[k],
-                    u,
-                    v,
-                });
+                best = Some(Hit { t, tri: self.ids[k], u, v });
             }
         }
         best
     }
 
-    fn brute_any(
-        &self,
-        origin: DVec3,
-        dir: DVec3,
-        t_min: f64,
-        t_max: f64,
-        ignore: &impl Fn(u32) -> bool,
-    ) -> bool {
+    fn brute_any(&self, origin: DVec3, dir: DVec3, t_min: f64, t_max: f64, ignore: &impl Fn(u32) -> bool) -> bool {
         let ray = Ray::new(origin, dir);
-        self.tris
-            .iter()
-            .zip(&self.ids)
-            .any(|(t, &id)| ray.intersect(t, t_min, t_max).is_some() && !ignore(id))
+        self.tris.iter().zip(&self.ids).any(|(t, &id)| ray.intersect(t, t_min, t_max).is_some() && !ignore(id))
     }
 }
 
@@ -465,16 +398,7 @@ impl Ray {
         if d[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
-        Ray {
-            o,
-            inv: d.recip(),
-            kx,
-            ky,
-            kz,
-            sx: d[kx] / d[kz],
-            sy: d[ky] / d[kz],
-            sz: 1.0 / d[kz],
-        }
+        Ray { o, inv: d.recip(), kx, ky, kz, sx: d[kx] / d[kz], sy: d[ky] / d[kz], sz: 1.0 / d[kz] }
     }
 
     /// Entry distance into the node's box within [t0, t1], conservative (Ize 2013 padding).
@@ -535,10 +459,7 @@ mod tests {
 
     fn quad(z: f64) -> Vec<[DVec3; 3]> {
         let p = |x, y| DVec3::new(x, y, z);
-        vec![
-            [p(0.0, 0.0), p(1.0, 0.0), p(1.0, 1.0)],
-            [p(0.0, 0.0), p(1.0, 1.0), p(0.0, 1.0)],
-        ]
+        vec![[p(0.0, 0.0), p(1.0, 0.0), p(1.0, 1.0)], [p(0.0, 0.0), p(1.0, 1.0), p(0.0, 1.0)]]
     }
 
     #[test]
@@ -546,25 +467,16 @@ mod tests {
         let mut tris = quad(1.0);
         tris.extend(quad(2.0));
         let bvh = Bvh::build(&tris);
-        let h = bvh
-            .closest_hit(DVec3::new(0.3, 0.6, 0.0), DVec3::Z, 0.0, f64::INFINITY)
-            .unwrap();
+        let h = bvh.closest_hit(DVec3::new(0.3, 0.6, 0.0), DVec3::Z, 0.0, f64::INFINITY).unwrap();
         assert!((h.t - 1.0).abs() < 1e-12 && h.tri == 1);
         // Exactly on the shared diagonal: never slips through.
-        let h = bvh
-            .closest_hit(DVec3::new(0.5, 0.5, 0.0), DVec3::Z, 0.0, f64::INFINITY)
-            .unwrap();
+        let h = bvh.closest_hit(DVec3::new(0.5, 0.5, 0.0), DVec3::Z, 0.0, f64::INFINITY).unwrap();
         assert!((h.t - 1.0).abs() < 1e-12);
         assert!(bvh.any_hit(DVec3::new(0.5, 0.5, 0.0), DVec3::Z, 0.0, 1.5, |_| false));
         assert!(!bvh.any_hit(DVec3::new(0.5, 0.5, 0.0), DVec3::Z, 0.0, 1.0, |_| false));
         assert!(bvh.any_hit(DVec3::new(0.2, 0.7, 0.0), DVec3::Z, 0.0, 3.0, |t| t == 1));
-        assert!(
-            !bvh.any_hit(DVec3::new(0.2, 0.7, 0.0), DVec3::Z, 0.0, 3.0, |t| t == 1
-                || t == 3)
-        );
-        assert!(bvh
-            .closest_hit(DVec3::new(1.5, 0.5, 0.0), DVec3::Z, 0.0, f64::INFINITY)
-            .is_none());
+        assert!(!bvh.any_hit(DVec3::new(0.2, 0.7, 0.0), DVec3::Z, 0.0, 3.0, |t| t == 1 || t == 3));
+        assert!(bvh.closest_hit(DVec3::new(1.5, 0.5, 0.0), DVec3::Z, 0.0, f64::INFINITY).is_none());
     }
 
     #[test]
@@ -595,22 +507,11 @@ mod tests {
                 .min_by(|a, b| a.0.total_cmp(&b.0));
             let h = bvh.closest_hit(o, d, 0.0, f64::INFINITY);
             assert_eq!(h.map(|h| h.tri as usize), brute.map(|b| b.1));
-            assert_eq!(
-                bvh.any_hit(o, d, 0.0, f64::INFINITY, |_| false),
-                brute.is_some()
-            );
-            let mut all: Vec<u32> = tris
-                .iter()
-                .enumerate()
-                .filter(|(_, t)| ray.intersect(t, 0.0, f64::INFINITY).is_some())
-                .map(|(i, _)| i as u32)
-                .collect();
+            assert_eq!(bvh.any_hit(o, d, 0.0, f64::INFINITY, |_| false), brute.is_some());
+            let mut all: Vec<u32> =
+                tris.iter().enumerate().filter(|(_, t)| ray.intersect(t, 0.0, f64::INFINITY).is_some()).map(|(i, _)| i as u32).collect();
             all.sort();
-            let mut got: Vec<u32> = bvh
-                .collect_hits(o, d, 0.0, f64::INFINITY)
-                .iter()
-                .map(|h| h.tri)
-                .collect();
+            let mut got: Vec<u32> = bvh.collect_hits(o, d, 0.0, f64::INFINITY).iter().map(|h| h.tri).collect();
             got.sort();
             assert_eq!(got, all);
         }

@@ -37,13 +37,7 @@ pub struct DumpLight {
 impl DumpLight {
     /// Only the required homogeneous position.
     pub fn homogeneous(position: Vec4) -> DumpLight {
-        DumpLight {
-            position,
-            kind: None,
-            direction: None,
-            cone_deg: None,
-            radius: None,
-        }
+        DumpLight { position, kind: None, direction: None, cone_deg: None, radius: None }
     }
     /// Everything needed for an exact check.
     pub fn from_light(l: &Light) -> DumpLight {
@@ -60,16 +54,9 @@ impl DumpLight {
     pub fn to_light(&self) -> Result<Light> {
         let p = self.position;
         if !p.is_finite() {
-            return Err(Error::input(
-                "frame.json",
-                format!("light position {p:?} is not finite"),
-            ));
+            return Err(Error::input("frame.json", format!("light position {p:?} is not finite")));
         }
-        let kind = self.kind.unwrap_or(if p.w == 0.0 {
-            LightKind::Directional
-        } else {
-            LightKind::Point
-        });
+        let kind = self.kind.unwrap_or(if p.w == 0.0 { LightKind::Directional } else { LightKind::Point });
         let mut light = Light {
             kind,
             position: Vec3::ZERO,
@@ -82,20 +69,14 @@ impl DumpLight {
         match kind {
             LightKind::Directional => {
                 if p.w != 0.0 || p.truncate().length_squared() == 0.0 {
-                    return Err(Error::input(
-                        "frame.json",
-                        format!("directional light needs w = 0 and a nonzero direction, got {p:?}"),
-                    ));
+                    return Err(Error::input("frame.json", format!("directional light needs w = 0 and a nonzero direction, got {p:?}")));
                 }
                 light.direction = -p.truncate().normalize();
                 light.radius = None;
             }
             _ => {
                 if p.w == 0.0 {
-                    return Err(Error::input(
-                        "frame.json",
-                        format!("{kind:?} light with w = 0: {p:?}"),
-                    ));
+                    return Err(Error::input("frame.json", format!("{kind:?} light with w = 0: {p:?}")));
                 }
                 light.position = p.truncate() / p.w;
             }
@@ -104,10 +85,7 @@ impl DumpLight {
             match (self.direction, self.cone_deg) {
                 (Some(d), Some(_)) if d.length_squared() > 0.0 => light.direction = d.normalize(),
                 _ => {
-                    return Err(Error::input(
-                        "frame.json",
-                        "spot light needs \"direction\" and \"cone_deg\"",
-                    ));
+                    return Err(Error::input("frame.json", "spot light needs \"direction\" and \"cone_deg\""));
                 }
             }
         }
@@ -183,51 +161,26 @@ impl Dump {
     pub fn validate(&self, location: &str) -> Result<()> {
         let px = self.width as usize * self.height as usize;
         if px == 0 {
-            return Err(Error::input(
-                location,
-                format!("empty image {}x{}", self.width, self.height),
-            ));
+            return Err(Error::input(location, format!("empty image {}x{}", self.width, self.height)));
         }
         if self.positions.len() != px * 3 {
             return Err(Error::input(
                 location,
-                format!(
-                    "positions has {} floats, expected {}x{}x3 = {}",
-                    self.positions.len(),
-                    self.width,
-                    self.height,
-                    px * 3
-                ),
+                format!("positions has {} floats, expected {}x{}x3 = {}", self.positions.len(), self.width, self.height, px * 3),
             ));
         }
         if self.normals.len() != px * 3 {
             return Err(Error::input(
                 location,
-                format!(
-                    "normals has {} floats, expected {}x{}x3 = {}",
-                    self.normals.len(),
-                    self.width,
-                    self.height,
-                    px * 3
-                ),
+                format!("normals has {} floats, expected {}x{}x3 = {}", self.normals.len(), self.width, self.height, px * 3),
             ));
         }
         if self.shadow.len() != self.lights.len() {
-            return Err(Error::input(
-                location,
-                format!(
-                    "{} shadow masks for {} lights",
-                    self.shadow.len(),
-                    self.lights.len()
-                ),
-            ));
+            return Err(Error::input(location, format!("{} shadow masks for {} lights", self.shadow.len(), self.lights.len())));
         }
         for (k, s) in self.shadow.iter().enumerate() {
             if s.len() != px {
-                return Err(Error::input(
-                    location,
-                    format!("shadow mask {k} has {} pixels, expected {px}", s.len()),
-                ));
+                return Err(Error::input(location, format!("shadow mask {k} has {} pixels, expected {px}", s.len())));
             }
         }
         Ok(())
@@ -273,8 +226,7 @@ pub fn write_dump(dir: impl AsRef<Path>, dump: &Dump) -> Result<()> {
         extra: dump.extra.clone(),
     };
     let p = dir.join("frame.json");
-    let json = serde_json::to_string_pretty(&frame)
-        .map_err(|e| Error::input(p.display().to_string(), e.to_string()))?;
+    let json = serde_json::to_string_pretty(&frame).map_err(|e| Error::input(p.display().to_string(), e.to_string()))?;
     io(&p, std::fs::write(&p, json))?;
 
     let mut obj = String::with_capacity(dump.triangles.len() * 100);
@@ -297,13 +249,8 @@ pub fn write_dump(dir: impl AsRef<Path>, dump: &Dump) -> Result<()> {
 
     for (k, s) in dump.shadow.iter().enumerate() {
         let p = dir.join(format!("shadow_{k}.png"));
-        let img =
-            image::GrayImage::from_raw(dump.width, dump.height, s.clone()).ok_or_else(|| {
-                Error::input(
-                    p.display().to_string(),
-                    "mask size does not match the image",
-                )
-            })?;
+        let img = image::GrayImage::from_raw(dump.width, dump.height, s.clone())
+            .ok_or_else(|| Error::input(p.display().to_string(), "mask size does not match the image"))?;
         img.save_with_format(&p, image::ImageFormat::Png)
             .map_err(|e| Error::input(p.display().to_string(), format!("cannot write PNG: {e}")))?;
     }
@@ -320,26 +267,14 @@ pub fn write_dump(dir: impl AsRef<Path>, dump: &Dump) -> Result<()> {
 }
 
 fn read_f32s(path: &Path, expected: usize, what: &str) -> Result<Vec<f32>> {
-    let bytes = std::fs::read(path).map_err(|e| {
-        Error::input(
-            path.display().to_string(),
-            format!("cannot read {what}: {e}"),
-        )
-    })?;
+    let bytes = std::fs::read(path).map_err(|e| Error::input(path.display().to_string(), format!("cannot read {what}: {e}")))?;
     if bytes.len() != expected * 4 {
         return Err(Error::input(
             path.display().to_string(),
-            format!(
-                "{what} has {} bytes, expected W*H*3*4 = {}",
-                bytes.len(),
-                expected * 4
-            ),
+            format!("{what} has {} bytes, expected W*H*3*4 = {}", bytes.len(), expected * 4),
         ));
     }
-    Ok(bytes
-        .chunks_exact(4)
-        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-        .collect())
+    Ok(bytes.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect())
 }
 
 /// Parses the OBJ subset of `world.obj` into triangles.
@@ -354,10 +289,7 @@ pub fn parse_obj(text: &str, location: &str) -> Result<Vec<[Vec3; 3]>> {
             Some("v") => {
                 let c: Vec<&str> = it.collect();
                 if c.len() < 3 || c.len() > 4 {
-                    return Err(Error::input(
-                        loc(),
-                        format!("vertex needs 3 coordinates, got {}", c.len()),
-                    ));
+                    return Err(Error::input(loc(), format!("vertex needs 3 coordinates, got {}", c.len())));
                 }
                 let mut xyz = [0f32; 3];
                 for k in 0..3 {
@@ -365,9 +297,7 @@ pub fn parse_obj(text: &str, location: &str) -> Result<Vec<[Vec3; 3]>> {
                         .parse::<f32>()
                         .ok()
                         .filter(|f| f.is_finite())
-                        .ok_or_else(|| {
-                            Error::input(loc(), format!("bad vertex coordinate '{}'", c[k]))
-                        })?;
+                        .ok_or_else(|| Error::input(loc(), format!("bad vertex coordinate '{}'", c[k])))?;
                 }
                 verts.push(Vec3::from_array(xyz));
             }
@@ -375,24 +305,16 @@ pub fn parse_obj(text: &str, location: &str) -> Result<Vec<[Vec3; 3]>> {
                 let mut idx = Vec::new();
                 for tok in it {
                     let first = tok.split('/').next().unwrap_or("");
-                    let i: i64 = first
-                        .parse()
-                        .map_err(|_| Error::input(loc(), format!("bad face index '{tok}'")))?;
+                    let i: i64 = first.parse().map_err(|_| Error::input(loc(), format!("bad face index '{tok}'")))?;
                     let n = verts.len() as i64;
                     let r = if i > 0 { i - 1 } else { n + i };
                     if i == 0 || r < 0 || r >= n {
-                        return Err(Error::input(
-                            loc(),
-                            format!("face index {i} out of range ({n} vertices defined so far)"),
-                        ));
+                        return Err(Error::input(loc(), format!("face index {i} out of range ({n} vertices defined so far)")));
                     }
                     idx.push(verts[r as usize]);
                 }
                 if idx.len() < 3 {
-                    return Err(Error::input(
-                        loc(),
-                        format!("face with {} vertices", idx.len()),
-                    ));
+                    return Err(Error::input(loc(), format!("face with {} vertices", idx.len())));
                 }
                 for k in 1..idx.len() - 1 {
                     tris.push([idx[0], idx[k], idx[k + 1]]);
@@ -408,17 +330,12 @@ pub fn parse_obj(text: &str, location: &str) -> Result<Vec<[Vec3; 3]>> {
 pub fn read_dump(dir: impl AsRef<Path>) -> Result<Dump> {
     let dir = dir.as_ref();
     if !dir.is_dir() {
-        return Err(Error::input(
-            dir.display().to_string(),
-            "dump directory does not exist",
-        ));
+        return Err(Error::input(dir.display().to_string(), "dump directory does not exist"));
     }
     let p = dir.join("frame.json");
     let loc = p.display().to_string();
-    let text =
-        std::fs::read_to_string(&p).map_err(|e| Error::input(&loc, format!("cannot read: {e}")))?;
-    let frame: FrameJson = serde_json::from_str(&text)
-        .map_err(|e| Error::input(&loc, format!("bad frame.json: {e}")))?;
+    let text = std::fs::read_to_string(&p).map_err(|e| Error::input(&loc, format!("cannot read: {e}")))?;
+    let frame: FrameJson = serde_json::from_str(&text).map_err(|e| Error::input(&loc, format!("bad frame.json: {e}")))?;
     let (w, h) = (frame.width, frame.height);
     if w == 0 || h == 0 {
         return Err(Error::input(&loc, format!("empty image {w}x{h}")));
@@ -443,8 +360,7 @@ pub fn read_dump(dir: impl AsRef<Path>) -> Result<Dump> {
             cone_deg: l.cone_deg,
             radius: l.radius,
         };
-        dl.to_light()
-            .map_err(|e| Error::input(&loc, format!("light {k}: {e}")))?;
+        dl.to_light().map_err(|e| Error::input(&loc, format!("light {k}: {e}")))?;
         lights.push(dl);
     }
     let camera = frame.camera.map(|c| Camera {
@@ -456,12 +372,7 @@ pub fn read_dump(dir: impl AsRef<Path>) -> Result<Dump> {
     });
 
     let p = dir.join("world.obj");
-    let text = std::fs::read_to_string(&p).map_err(|e| {
-        Error::input(
-            p.display().to_string(),
-            format!("cannot read world.obj: {e}"),
-        )
-    })?;
+    let text = std::fs::read_to_string(&p).map_err(|e| Error::input(p.display().to_string(), format!("cannot read world.obj: {e}")))?;
     let triangles = parse_obj(&text, &p.display().to_string())?;
 
     let positions = read_f32s(&dir.join("positions.f32"), px * 3, "positions.f32")?;
@@ -474,24 +385,12 @@ pub fn read_dump(dir: impl AsRef<Path>) -> Result<Dump> {
         if !p.is_file() {
             return Err(Error::input(
                 &ploc,
-                format!(
-                    "missing: frame.json lists {} lights, so shadow_0..shadow_{} are expected",
-                    lights.len(),
-                    lights.len() - 1
-                ),
+                format!("missing: frame.json lists {} lights, so shadow_0..shadow_{} are expected", lights.len(), lights.len() - 1),
             ));
         }
-        let img =
-            image::open(&p).map_err(|e| Error::input(&ploc, format!("cannot read PNG: {e}")))?;
+        let img = image::open(&p).map_err(|e| Error::input(&ploc, format!("cannot read PNG: {e}")))?;
         if img.width() != w || img.height() != h {
-            return Err(Error::input(
-                &ploc,
-                format!(
-                    "image is {}x{}, frame.json says {w}x{h}",
-                    img.width(),
-                    img.height()
-                ),
-            ));
+            return Err(Error::input(&ploc, format!("image is {}x{}, frame.json says {w}x{h}", img.width(), img.height())));
         }
         shadow.push(img.into_luma8().into_raw());
     }
@@ -499,10 +398,7 @@ pub fn read_dump(dir: impl AsRef<Path>) -> Result<Dump> {
     if extra_png.exists() {
         return Err(Error::input(
             extra_png.display().to_string(),
-            format!(
-                "more shadow masks than the {} lights listed in frame.json",
-                lights.len()
-            ),
+            format!("more shadow masks than the {} lights listed in frame.json", lights.len()),
         ));
     }
     Ok(Dump {

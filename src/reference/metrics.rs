@@ -43,12 +43,7 @@ pub struct Metrics {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum GeoSample {
     Background,
-    Surface {
-        position: DVec3,
-        normal: DVec3,
-        depth: f64,
-        mesh: Option<u32>,
-    },
+    Surface { position: DVec3, normal: DVec3, depth: f64, mesh: Option<u32> },
 }
 
 /// Normal change above which neighbours are a discontinuity (degrees).
@@ -60,20 +55,7 @@ fn discontinuous(a: &GeoSample, b: &GeoSample) -> bool {
     match (a, b) {
         (GeoSample::Background, GeoSample::Background) => false,
         (GeoSample::Background, _) | (_, GeoSample::Background) => true,
-        (
-            GeoSample::Surface {
-                normal: na,
-                depth: da,
-                mesh: ma,
-                ..
-            },
-            GeoSample::Surface {
-                normal: nb,
-                depth: db,
-                mesh: mb,
-                ..
-            },
-        ) => {
+        (GeoSample::Surface { normal: na, depth: da, mesh: ma, .. }, GeoSample::Surface { normal: nb, depth: db, mesh: mb, .. }) => {
             if let (Some(x), Some(y)) = (ma, mb) {
                 if x != y {
                     return true;
@@ -156,13 +138,7 @@ pub fn dilate(mask: &[bool], w: usize, h: usize, n: u32) -> Vec<bool> {
 }
 
 /// The band: shadow edges of `states` plus `geo_edges`, dilated by `n`.
-pub fn band_mask(
-    states: &[LightState],
-    geo_edges: &[bool],
-    w: usize,
-    h: usize,
-    n: u32,
-) -> Vec<bool> {
+pub fn band_mask(states: &[LightState], geo_edges: &[bool], w: usize, h: usize, n: u32) -> Vec<bool> {
     let mut e = shadow_edges(states, w, h);
     for (a, b) in e.iter_mut().zip(geo_edges) {
         *a |= *b;
@@ -189,10 +165,7 @@ fn classify(v: u8) -> MaskValue {
 
 /// Compares a mask with reference states given a precomputed band (all the same length).
 pub fn compare_states(mask: &[u8], states: &[LightState], band: &[bool]) -> Metrics {
-    let mut m = Metrics {
-        pixels: states.len() as u64,
-        ..Metrics::default()
-    };
+    let mut m = Metrics { pixels: states.len() as u64, ..Metrics::default() };
     for i in 0..states.len() {
         let in_band = band[i];
         m.band_pixels += in_band as u64;
@@ -225,11 +198,7 @@ pub fn compare_states(mask: &[u8], states: &[LightState], band: &[bool]) -> Metr
             m.mismatches_outside_band += 1;
         }
     }
-    m.fraction_outside_band = if m.compared == 0 {
-        0.0
-    } else {
-        m.mismatches_outside_band as f64 / m.compared as f64
-    };
+    m.fraction_outside_band = if m.compared == 0 { 0.0 } else { m.mismatches_outside_band as f64 / m.compared as f64 };
     m
 }
 
@@ -278,14 +247,7 @@ pub fn compare(mask: &[u8], image: &RefImage, light: usize, band: u32) -> Result
 /// [`compare`] for every light at once (`masks[k]` for light k).
 pub fn compare_all(masks: &[Vec<u8>], image: &RefImage, band: u32) -> Result<Vec<Metrics>> {
     if masks.len() != image.light_count {
-        return Err(Error::input(
-            "mask",
-            format!("{} masks for {} lights", masks.len(), image.light_count),
-        ));
+        return Err(Error::input("mask", format!("{} masks for {} lights", masks.len(), image.light_count)));
     }
-    masks
-        .iter()
-        .enumerate()
-        .map(|(k, m)| compare(m, image, k, band))
-        .collect()
+    masks.iter().enumerate().map(|(k, m)| compare(m, image, k, band)).collect()
 }

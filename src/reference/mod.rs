@@ -75,10 +75,7 @@ impl LightState {
     pub fn lit(self) -> Option<bool> {
         match self {
             LightState::Lit => Some(true),
-            LightState::Shadowed
-            | LightState::BackFacing
-            | LightState::OutsideCone
-            | LightState::OutOfRange => Some(false),
+            LightState::Shadowed | LightState::BackFacing | LightState::OutsideCone | LightState::OutOfRange => Some(false),
             LightState::Ambiguous | LightState::Background => None,
         }
     }
@@ -108,12 +105,7 @@ pub struct Tolerance {
 
 impl Default for Tolerance {
     fn default() -> Self {
-        Tolerance {
-            grazing_cos: 1e-3,
-            footprint_fraction: 0.05,
-            min_radius_rel: 1e-5,
-            surface_offset_rel: 2e-5,
-        }
+        Tolerance { grazing_cos: 1e-3, footprint_fraction: 0.05, min_radius_rel: 1e-5, surface_offset_rel: 2e-5 }
     }
 }
 
@@ -134,14 +126,8 @@ pub struct RefPixel {
 }
 
 impl RefPixel {
-    pub const BACKGROUND: RefPixel = RefPixel {
-        hit: false,
-        position: Vec3::NAN,
-        normal: Vec3::NAN,
-        depth: f32::INFINITY,
-        mesh: u32::MAX,
-        tri: u32::MAX,
-    };
+    pub const BACKGROUND: RefPixel =
+        RefPixel { hit: false, position: Vec3::NAN, normal: Vec3::NAN, depth: f32::INFINITY, mesh: u32::MAX, tri: u32::MAX };
 }
 
 /// A reference rendering: per pixel the visible surface and per light its [`LightState`].
@@ -165,30 +151,19 @@ impl RefImage {
     }
     /// All pixel states of one light, row-major.
     pub fn light_states(&self, light: usize) -> Vec<LightState> {
-        (0..self.pixels.len())
-            .map(|i| self.states[i * self.light_count + light])
-            .collect()
+        (0..self.pixels.len()).map(|i| self.states[i * self.light_count + light]).collect()
     }
     /// The reference as a GPU-style mask (255 lit, 0 not lit or ambiguous, 128 background).
     pub fn mask(&self, light: usize) -> Vec<u8> {
-        self.light_states(light)
-            .into_iter()
-            .map(LightState::mask_value)
-            .collect()
+        self.light_states(light).into_iter().map(LightState::mask_value).collect()
     }
     /// Positions as W*H*3 f32 (NaN for background), the dump layout.
     pub fn positions_f32(&self) -> Vec<f32> {
-        self.pixels
-            .iter()
-            .flat_map(|p| p.position.to_array())
-            .collect()
+        self.pixels.iter().flat_map(|p| p.position.to_array()).collect()
     }
     /// Normals as W*H*3 f32 (NaN for background), the dump layout.
     pub fn normals_f32(&self) -> Vec<f32> {
-        self.pixels
-            .iter()
-            .flat_map(|p| p.normal.to_array())
-            .collect()
+        self.pixels.iter().flat_map(|p| p.normal.to_array()).collect()
     }
 }
 
@@ -231,20 +206,10 @@ impl Reference {
     /// `filters[i] = (1 - opacity) * color` of triangle `i` (`[0; 3]` for an opaque caster).
     /// An empty `filters` means every triangle is opaque; otherwise it has one entry per
     /// triangle (panics otherwise). Only shadow-casting triangles ever filter light.
-    pub fn with_filters(
-        triangles: Vec<[DVec3; 3]>,
-        flags: &[TriFlags],
-        filters: &[[f64; 3]],
-    ) -> Reference {
+    pub fn with_filters(triangles: Vec<[DVec3; 3]>, flags: &[TriFlags], filters: &[[f64; 3]]) -> Reference {
         assert_eq!(triangles.len(), flags.len(), "one TriFlags per triangle");
-        assert!(
-            filters.is_empty() || filters.len() == triangles.len(),
-            "one filter per triangle"
-        );
-        let ok = |t: &[DVec3; 3]| {
-            t.iter().all(|p| p.is_finite())
-                && (t[1] - t[0]).cross(t[2] - t[0]).length_squared() > 0.0
-        };
+        assert!(filters.is_empty() || filters.len() == triangles.len(), "one filter per triangle");
+        let ok = |t: &[DVec3; 3]| t.iter().all(|p| p.is_finite()) && (t[1] - t[0]).cross(t[2] - t[0]).length_squared() > 0.0;
         let mut tris = Vec::with_capacity(triangles.len());
         let mut mesh_of = Vec::with_capacity(triangles.len());
         let mut kept_filters = Vec::with_capacity(triangles.len());
@@ -269,21 +234,9 @@ impl Reference {
         // Build each BVH over the full list but with non-members replaced by NaN triangles,
         // which `Bvh::build` skips: ids stay global triangle indices.
         let nan = [DVec3::NAN; 3];
-        let vis_tris: Vec<[DVec3; 3]> = tris
-            .iter()
-            .zip(&vis)
-            .map(|(t, &v)| if v { *t } else { nan })
-            .collect();
-        let occ_tris: Vec<[DVec3; 3]> = tris
-            .iter()
-            .zip(&occ)
-            .map(|(t, &o)| if o { *t } else { nan })
-            .collect();
-        let scale = if tris.is_empty() {
-            1.0
-        } else {
-            (hi - lo).length().max(1e-30)
-        };
+        let vis_tris: Vec<[DVec3; 3]> = tris.iter().zip(&vis).map(|(t, &v)| if v { *t } else { nan }).collect();
+        let occ_tris: Vec<[DVec3; 3]> = tris.iter().zip(&occ).map(|(t, &o)| if o { *t } else { nan }).collect();
+        let scale = if tris.is_empty() { 1.0 } else { (hi - lo).length().max(1e-30) };
         Reference {
             visible: Bvh::build(&vis_tris),
             occluders: Bvh::build(&occ_tris),
@@ -297,14 +250,7 @@ impl Reference {
 
     /// All triangles visible, all occluding, mesh 0.
     pub fn from_triangles(triangles: Vec<[DVec3; 3]>) -> Reference {
-        let flags = vec![
-            TriFlags {
-                visible: true,
-                occluder: true,
-                mesh: 0
-            };
-            triangles.len()
-        ];
+        let flags = vec![TriFlags { visible: true, occluder: true, mesh: 0 }; triangles.len()];
         Reference::new(triangles, &flags)
     }
 
@@ -317,12 +263,7 @@ impl Reference {
         for (mi, m) in scene.meshes.iter().enumerate() {
             let filter = transmit::mesh_filter(m);
             let xf = m.transform.as_dmat4();
-            let pos: Vec<DVec3> = m
-                .mesh
-                .positions
-                .iter()
-                .map(|p| xf.transform_point3(p.as_dvec3()))
-                .collect();
+            let pos: Vec<DVec3> = m.mesh.positions.iter().map(|p| xf.transform_point3(p.as_dvec3())).collect();
             for t in &m.mesh.triangles {
                 let g = |i: u32| pos.get(i as usize).copied().unwrap_or(DVec3::NAN);
                 tris.push([g(t[0]), g(t[1]), g(t[2])]);
@@ -467,8 +408,7 @@ impl Reference {
                 if dist.is_nan() || dist <= off {
                     return false;
                 }
-                self.occluders
-                    .any_hit(o, to / dist, 0.0, dist - off, |t| self.filter(t) != [0.0; 3])
+                self.occluders.any_hit(o, to / dist, 0.0, dist - off, |t| self.filter(t) != [0.0; 3])
             }
         }
     }
@@ -503,13 +443,7 @@ impl Reference {
             pixels.extend(p);
             states.extend(s);
         }
-        RefImage {
-            width,
-            height,
-            light_count: nl,
-            pixels,
-            states,
-        }
+        RefImage { width, height, light_count: nl, pixels, states }
     }
 }
 
@@ -526,8 +460,7 @@ impl Reference {
     ) -> Option<(RefPixel, DVec3, DVec3, f64)> {
         let eye = camera.eye.as_dvec3();
         // Angular size of one pixel (vertical), for the footprint.
-        let pix_angle =
-            2.0 * ((camera.fov_y_deg as f64).to_radians() * 0.5).tan() / height.max(1) as f64;
+        let pix_angle = 2.0 * ((camera.fov_y_deg as f64).to_radians() * 0.5).tan() / height.max(1) as f64;
         let (o, d) = camera.pixel_ray(x, y, width, height);
         let hit = self.visible.closest_hit(o, d, 0.0, f64::INFINITY)?;
         let t = &self.tris[hit.tri as usize];
@@ -557,18 +490,12 @@ fn tangent_basis(n: DVec3) -> (DVec3, DVec3) {
     let s = 1f64.copysign(n.z);
     let a = -1.0 / (s + n.z);
     let b = n.x * n.y * a;
-    (
-        DVec3::new(1.0 + s * n.x * n.x * a, s * b, -s * n.x),
-        DVec3::new(b, s + n.y * n.y * a, -n.y),
-    )
+    (DVec3::new(1.0 + s * n.x * n.x * a, s * b, -s * n.x), DVec3::new(b, s + n.y * n.y * a, -n.y))
 }
 
 /// Runs `f(row)` for rows `0..h` over the available cores; results in row order.
 pub(crate) fn par_rows<T: Send>(h: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
-    let threads = std::thread::available_parallelism()
-        .map(|n| n.get())
-        .unwrap_or(1)
-        .min(h.max(1));
+    let threads = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1).min(h.max(1));
     if threads <= 1 {
         return (0..h).map(&f).collect();
     }
@@ -627,17 +554,12 @@ pub struct CheckReport {
 impl CheckReport {
     /// The largest `fraction_outside_band` over the lights (0 with no lights).
     pub fn worst_fraction(&self) -> f64 {
-        self.lights
-            .iter()
-            .map(|l| l.metrics.fraction_outside_band)
-            .fold(0.0, f64::max)
+        self.lights.iter().map(|l| l.metrics.fraction_outside_band).fold(0.0, f64::max)
     }
     /// True iff every light has `fraction_outside_band <= threshold_fraction` (background
     /// mismatches outside the band count in that fraction).
     pub fn passed(&self, threshold_fraction: f64) -> bool {
-        self.lights
-            .iter()
-            .all(|l| l.metrics.fraction_outside_band <= threshold_fraction)
+        self.lights.iter().all(|l| l.metrics.fraction_outside_band <= threshold_fraction)
     }
 }
 
@@ -670,11 +592,7 @@ impl fmt::Display for CheckReport {
                 m.band_pixels
             )?;
         }
-        write!(
-            f,
-            "  worst fraction outside band: {:.6}",
-            self.worst_fraction()
-        )
+        write!(f, "  worst fraction outside band: {:.6}", self.worst_fraction())
     }
 }
 
@@ -687,43 +605,17 @@ impl fmt::Display for CheckReport {
 pub fn check_dump(dir: impl AsRef<std::path::Path>, band: u32) -> Result<CheckReport> {
     let dir = dir.as_ref();
     let dump = read_dump(dir)?;
-    let lights: Vec<Light> = dump
-        .lights
-        .iter()
-        .map(|l| l.to_light())
-        .collect::<Result<_>>()?;
-    let reference = Reference::from_triangles(
-        dump.triangles
-            .iter()
-            .map(|t| [t[0].as_dvec3(), t[1].as_dvec3(), t[2].as_dvec3()])
-            .collect(),
-    );
+    let lights: Vec<Light> = dump.lights.iter().map(|l| l.to_light()).collect::<Result<_>>()?;
+    let reference = Reference::from_triangles(dump.triangles.iter().map(|t| [t[0].as_dvec3(), t[1].as_dvec3(), t[2].as_dvec3()]).collect());
     let (w, h) = (dump.width as usize, dump.height as usize);
-    let pos = |i: usize| {
-        DVec3::new(
-            dump.positions[3 * i] as f64,
-            dump.positions[3 * i + 1] as f64,
-            dump.positions[3 * i + 2] as f64,
-        )
-    };
-    let nrm = |i: usize| {
-        DVec3::new(
-            dump.normals[3 * i] as f64,
-            dump.normals[3 * i + 1] as f64,
-            dump.normals[3 * i + 2] as f64,
-        )
-    };
+    let pos = |i: usize| DVec3::new(dump.positions[3 * i] as f64, dump.positions[3 * i + 1] as f64, dump.positions[3 * i + 2] as f64);
+    let nrm = |i: usize| DVec3::new(dump.normals[3 * i] as f64, dump.normals[3 * i + 1] as f64, dump.normals[3 * i + 2] as f64);
     let cam = dump.camera_pos.as_dvec3();
     let geo: Vec<metrics::GeoSample> = (0..w * h)
         .map(|i| {
             let p = pos(i);
             if p.is_finite() {
-                metrics::GeoSample::Surface {
-                    position: p,
-                    normal: nrm(i),
-                    depth: (p - cam).length(),
-                    mesh: None,
-                }
+                metrics::GeoSample::Surface { position: p, normal: nrm(i), depth: (p - cam).length(), mesh: None }
             } else {
                 metrics::GeoSample::Background
             }

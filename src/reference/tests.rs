@@ -27,14 +27,7 @@ fn box_mesh(min: Vec3, max: Vec3) -> Mesh {
             )
         })
         .collect();
-    let faces = [
-        [0, 1, 3, 2],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 3, 7, 6],
-        [0, 2, 6, 4],
-        [1, 3, 7, 5],
-    ];
+    let faces = [[0, 1, 3, 2], [4, 5, 7, 6], [0, 1, 5, 4], [2, 3, 7, 6], [0, 2, 6, 4], [1, 3, 7, 5]];
     let mut tris = Vec::new();
     for f in faces {
         tris.push([f[0], f[1], f[2]]);
@@ -45,12 +38,7 @@ fn box_mesh(min: Vec3, max: Vec3) -> Mesh {
 
 /// Ground plane y = 0, |x|,|z| <= s, normal +y.
 fn plane(s: f32) -> Mesh {
-    let p = vec![
-        Vec3::new(-s, 0.0, -s),
-        Vec3::new(s, 0.0, -s),
-        Vec3::new(s, 0.0, s),
-        Vec3::new(-s, 0.0, s),
-    ];
+    let p = vec![Vec3::new(-s, 0.0, -s), Vec3::new(s, 0.0, -s), Vec3::new(s, 0.0, s), Vec3::new(-s, 0.0, s)];
     let m = Mesh::new(p, vec![[0, 1, 2], [0, 2, 3]]);
     outward(m, Vec3::new(0.0, -1.0, 0.0))
 }
@@ -118,24 +106,11 @@ fn icosphere(centre: Vec3, r: f32, subdiv: u32) -> Mesh {
 }
 
 fn point_light(p: Vec3) -> Light {
-    Light {
-        kind: LightKind::Point,
-        position: p,
-        direction: Vec3::NEG_Y,
-        color: Vec3::ONE,
-        intensity: 1.0,
-        radius: None,
-        cone_deg: 45.0,
-    }
+    Light { kind: LightKind::Point, position: p, direction: Vec3::NEG_Y, color: Vec3::ONE, intensity: 1.0, radius: None, cone_deg: 45.0 }
 }
 
 fn dir_light(d: Vec3) -> Light {
-    Light {
-        kind: LightKind::Directional,
-        position: Vec3::ZERO,
-        direction: d.normalize(),
-        ..point_light(Vec3::ZERO)
-    }
+    Light { kind: LightKind::Directional, position: Vec3::ZERO, direction: d.normalize(), ..point_light(Vec3::ZERO) }
 }
 
 fn scene(meshes: Vec<(Mesh, bool)>, lights: Vec<Light>, camera: Camera) -> Scene {
@@ -160,26 +135,14 @@ fn scene(meshes: Vec<(Mesh, bool)>, lights: Vec<Light>, camera: Camera) -> Scene
 }
 
 fn top_camera() -> Camera {
-    Camera {
-        eye: Vec3::new(0.0, 10.0, 0.0),
-        target: Vec3::ZERO,
-        up: Vec3::NEG_Z,
-        fov_y_deg: 40.0,
-        near: 0.1,
-    }
+    Camera { eye: Vec3::new(0.0, 10.0, 0.0), target: Vec3::ZERO, up: Vec3::NEG_Z, fov_y_deg: 40.0, near: 0.1 }
 }
 
 /// Unit box y in [1, 2] above the plane, light at (0, 4, 0): the shadow is the projection of
 /// the top face, the square |x|, |z| < 1.
 fn box_scene() -> Scene {
     scene(
-        vec![
-            (plane(10.0), true),
-            (
-                box_mesh(Vec3::new(-0.5, 1.0, -0.5), Vec3::new(0.5, 2.0, 0.5)),
-                true,
-            ),
-        ],
+        vec![(plane(10.0), true), (box_mesh(Vec3::new(-0.5, 1.0, -0.5), Vec3::new(0.5, 2.0, 0.5)), true)],
         vec![point_light(Vec3::new(0.0, 4.0, 0.0))],
         top_camera(),
     )
@@ -192,83 +155,35 @@ fn reference_box_shadow_at() {
     let l = &s.lights[0];
     let up = DVec3::Y;
     let at = |x: f64, z: f64| r.shadow_at(DVec3::new(x, 0.0, z), up, l);
-    for (x, z) in [
-        (0.0, 0.0),
-        (0.9, 0.9),
-        (-0.95, 0.5),
-        (0.99, -0.99),
-        (0.5, 0.97),
-    ] {
+    for (x, z) in [(0.0, 0.0), (0.9, 0.9), (-0.95, 0.5), (0.99, -0.99), (0.5, 0.97)] {
         assert_eq!(at(x, z), LightState::Shadowed, "({x}, {z})");
     }
-    for (x, z) in [
-        (1.01, 0.0),
-        (1.05, 1.05),
-        (-3.0, 2.0),
-        (0.0, -1.02),
-        (9.0, 9.0),
-    ] {
+    for (x, z) in [(1.01, 0.0), (1.05, 1.05), (-3.0, 2.0), (0.0, -1.02), (9.0, 9.0)] {
         assert_eq!(at(x, z), LightState::Lit, "({x}, {z})");
     }
     // Top face lit, bottom face and sides facing away.
-    assert_eq!(
-        r.shadow_at(DVec3::new(0.1, 2.0, 0.2), up, l),
-        LightState::Lit
-    );
-    assert_eq!(
-        r.shadow_at(DVec3::new(0.1, 1.0, 0.2), -up, l),
-        LightState::BackFacing
-    );
-    assert_eq!(
-        r.shadow_at(DVec3::new(0.5, 1.5, 0.0), DVec3::X, l),
-        LightState::BackFacing
-    );
+    assert_eq!(r.shadow_at(DVec3::new(0.1, 2.0, 0.2), up, l), LightState::Lit);
+    assert_eq!(r.shadow_at(DVec3::new(0.1, 1.0, 0.2), -up, l), LightState::BackFacing);
+    assert_eq!(r.shadow_at(DVec3::new(0.5, 1.5, 0.0), DVec3::X, l), LightState::BackFacing);
     // On the edge with a visible perturbation radius: ambiguous.
-    assert_eq!(
-        r.shadow_at_radius(DVec3::new(1.0, 0.0, 0.3), up, l, 0.01),
-        LightState::Ambiguous
-    );
-    assert_eq!(
-        r.shadow_at_radius(DVec3::new(1.02, 0.0, 0.3), up, l, 0.01),
-        LightState::Lit
-    );
+    assert_eq!(r.shadow_at_radius(DVec3::new(1.0, 0.0, 0.3), up, l, 0.01), LightState::Ambiguous);
+    assert_eq!(r.shadow_at_radius(DVec3::new(1.02, 0.0, 0.3), up, l, 0.01), LightState::Lit);
     // Grazing.
-    assert_eq!(
-        r.shadow_at(DVec3::new(3.0, 4.0, 0.0), up, l),
-        LightState::Ambiguous
-    );
+    assert_eq!(r.shadow_at(DVec3::new(3.0, 4.0, 0.0), up, l), LightState::Ambiguous);
     // Slightly below the surface (f32 GPU positions): still no self-shadowing.
-    assert_eq!(
-        r.shadow_at(DVec3::new(3.0, -1e-6, 0.0), up, l),
-        LightState::Lit
-    );
+    assert_eq!(r.shadow_at(DVec3::new(3.0, -1e-6, 0.0), up, l), LightState::Lit);
     // Range and cone.
     let mut lr = l.clone();
     lr.radius = Some(5.0);
-    assert_eq!(
-        r.shadow_at(DVec3::new(2.0, 0.0, 0.0), up, &lr),
-        LightState::Lit
-    );
-    assert_eq!(
-        r.shadow_at(DVec3::new(4.0, 0.0, 0.0), up, &lr),
-        LightState::OutOfRange
-    );
+    assert_eq!(r.shadow_at(DVec3::new(2.0, 0.0, 0.0), up, &lr), LightState::Lit);
+    assert_eq!(r.shadow_at(DVec3::new(4.0, 0.0, 0.0), up, &lr), LightState::OutOfRange);
     let mut sp = l.clone();
     sp.kind = LightKind::Spot;
     sp.direction = Vec3::NEG_Y;
     sp.cone_deg = 90.0; // half angle 45 deg: lit disc of radius 4 on the plane
-    assert_eq!(
-        r.shadow_at(DVec3::new(3.5, 0.0, 0.0), up, &sp),
-        LightState::Lit
-    );
-    assert_eq!(
-        r.shadow_at(DVec3::new(4.5, 0.0, 0.0), up, &sp),
-        LightState::OutsideCone
-    );
-    assert_eq!(
-        r.shadow_at(DVec3::new(0.5, 0.0, 0.0), up, &sp),
-        LightState::Shadowed
-    );
+    assert_eq!(r.shadow_at(DVec3::new(3.5, 0.0, 0.0), up, &sp), LightState::Lit);
+    assert_eq!(r.shadow_at(DVec3::new(4.5, 0.0, 0.0), up, &sp), LightState::OutsideCone);
+    assert_eq!(r.shadow_at(DVec3::new(0.5, 0.0, 0.0), up, &sp), LightState::Shadowed);
 }
 
 #[test]
@@ -285,10 +200,7 @@ fn reference_box_render_top_view() {
             let st = img.state(x, y, 0);
             if p.mesh == 1 {
                 boxpx += 1;
-                assert!(
-                    (p.position.y - 2.0).abs() < 1e-5,
-                    "top view sees the box top"
-                );
+                assert!((p.position.y - 2.0).abs() < 1e-5, "top view sees the box top");
                 assert_eq!(st, LightState::Lit);
                 continue;
             }
@@ -303,10 +215,7 @@ fn reference_box_render_top_view() {
             }
         }
     }
-    assert!(
-        shadowed > 100 && lit > 1000 && boxpx > 100,
-        "{shadowed} {lit} {boxpx}"
-    );
+    assert!(shadowed > 100 && lit > 1000 && boxpx > 100, "{shadowed} {lit} {boxpx}");
     // Image orientation: row 0 is the top; up = -Z, so row 0 sees negative z, and x grows
     // to the right.
     assert!(img.pixel(0, 0).position.z < 0.0 && img.pixel(0, 0).position.x < 0.0);
@@ -321,21 +230,11 @@ fn reference_non_caster_does_not_shadow() {
     let mut s = box_scene();
     s.meshes[1].casts_shadow = false;
     let r = Reference::from_scene(&s);
-    assert_eq!(
-        r.shadow_at(DVec3::ZERO, DVec3::Y, &s.lights[0]),
-        LightState::Lit
-    );
+    assert_eq!(r.shadow_at(DVec3::ZERO, DVec3::Y, &s.lights[0]), LightState::Lit);
 }
 
 fn sphere_scene(dir: Vec3) -> Scene {
-    scene(
-        vec![
-            (plane(10.0), true),
-            (icosphere(Vec3::new(0.0, 3.0, 0.0), 1.0, 4), true),
-        ],
-        vec![dir_light(dir)],
-        top_camera(),
-    )
+    scene(vec![(plane(10.0), true), (icosphere(Vec3::new(0.0, 3.0, 0.0), 1.0, 4), true)], vec![dir_light(dir)], top_camera())
 }
 
 #[test]
@@ -347,16 +246,8 @@ fn reference_sphere_disc_shadow() {
     for k in 0..32 {
         let a = k as f64 * std::f64::consts::TAU / 32.0;
         let d = DVec3::new(a.cos(), 0.0, a.sin());
-        assert_eq!(
-            r.shadow_at(d * 0.98, DVec3::Y, l),
-            LightState::Shadowed,
-            "angle {a}"
-        );
-        assert_eq!(
-            r.shadow_at(d * 1.01, DVec3::Y, l),
-            LightState::Lit,
-            "angle {a}"
-        );
+        assert_eq!(r.shadow_at(d * 0.98, DVec3::Y, l), LightState::Shadowed, "angle {a}");
+        assert_eq!(r.shadow_at(d * 1.01, DVec3::Y, l), LightState::Lit, "angle {a}");
     }
     // Rendered: the fraction of shadowed plane pixels matches the disc area.
     let img = r.render(&s.camera, &s.lights, 96, 96);
@@ -375,10 +266,7 @@ fn reference_sphere_disc_shadow() {
                 }
             } else {
                 // Upper hemisphere faces the light, lower one is back-facing (never seen).
-                assert!(
-                    matches!(st, LightState::Lit | LightState::Ambiguous),
-                    "{st:?}"
-                );
+                assert!(matches!(st, LightState::Lit | LightState::Ambiguous), "{st:?}");
             }
         }
     }
@@ -393,26 +281,14 @@ fn reference_sphere_disc_shadow() {
     for k in 0..32 {
         let a = k as f64 * std::f64::consts::TAU / 32.0;
         let e = |f: f64| DVec3::new(1.5 + f * ax * a.cos(), 0.0, f * az * a.sin());
-        assert_eq!(
-            r.shadow_at(e(0.98), DVec3::Y, l),
-            LightState::Shadowed,
-            "angle {a}"
-        );
-        assert_eq!(
-            r.shadow_at(e(1.01), DVec3::Y, l),
-            LightState::Lit,
-            "angle {a}"
-        );
+        assert_eq!(r.shadow_at(e(0.98), DVec3::Y, l), LightState::Shadowed, "angle {a}");
+        assert_eq!(r.shadow_at(e(1.01), DVec3::Y, l), LightState::Lit, "angle {a}");
     }
 }
 
 fn dump_from(img: &RefImage, s: &Scene) -> Dump {
-    let r_tris: Vec<[Vec3; 3]> = s
-        .meshes
-        .iter()
-        .filter(|m| m.casts_shadow)
-        .flat_map(|m| (0..m.mesh.triangles.len()).map(move |t| m.mesh.triangle(t)))
-        .collect();
+    let r_tris: Vec<[Vec3; 3]> =
+        s.meshes.iter().filter(|m| m.casts_shadow).flat_map(|m| (0..m.mesh.triangles.len()).map(move |t| m.mesh.triangle(t))).collect();
     Dump {
         width: img.width,
         height: img.height,
@@ -436,19 +312,12 @@ fn tmpdir(name: &str) -> std::path::PathBuf {
 #[test]
 fn reference_dump_round_trip_and_check() {
     let mut s = box_scene();
-    s.camera = Camera {
-        eye: Vec3::new(3.0, 6.0, 5.0),
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        fov_y_deg: 50.0,
-        near: 0.1,
-    };
+    s.camera = Camera { eye: Vec3::new(3.0, 6.0, 5.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 50.0, near: 0.1 };
     s.lights.push(dir_light(Vec3::new(-0.3, -1.0, 0.2)));
     let r = Reference::from_scene(&s);
     let img = r.render(&s.camera, &s.lights, 64, 48);
     let mut dump = dump_from(&img, &s);
-    dump.extra
-        .insert("method".into(), serde_json::json!("zfail"));
+    dump.extra.insert("method".into(), serde_json::json!("zfail"));
     let dir = tmpdir("rt");
     write_dump(&dir, &dump).unwrap();
     let back = read_dump(&dir).unwrap();
@@ -461,10 +330,7 @@ fn reference_dump_round_trip_and_check() {
     assert_eq!(back.lights, dump.lights);
     assert_eq!(back.camera, dump.camera);
     assert_eq!(back.extra, dump.extra);
-    assert_eq!(
-        (back.width, back.height, back.camera_pos),
-        (dump.width, dump.height, dump.camera_pos)
-    );
+    assert_eq!((back.width, back.height, back.camera_pos), (dump.width, dump.height, dump.camera_pos));
 
     // The check at the dump's own positions passes.
     let rep = check_dump(&dir, 1).unwrap();
@@ -505,10 +371,7 @@ fn reference_dump_round_trip_and_check() {
 
 fn write_shadows(dir: &std::path::Path, d: &Dump) {
     for (k, s) in d.shadow.iter().enumerate() {
-        image::GrayImage::from_raw(d.width, d.height, s.clone())
-            .unwrap()
-            .save(dir.join(format!("shadow_{k}.png")))
-            .unwrap();
+        image::GrayImage::from_raw(d.width, d.height, s.clone()).unwrap().save(dir.join(format!("shadow_{k}.png"))).unwrap();
     }
 }
 
@@ -537,11 +400,7 @@ fn reference_read_dump_errors() {
     std::fs::write(dir.join("frame.json"), "{\"width\": 8,").unwrap();
     assert!(err("bad json").contains("frame.json"));
     fresh();
-    std::fs::write(
-        dir.join("frame.json"),
-        r#"{"width": 8, "height": 6, "lights": []}"#,
-    )
-    .unwrap();
+    std::fs::write(dir.join("frame.json"), r#"{"width": 8, "height": 6, "lights": []}"#).unwrap();
     assert!(err("missing key").contains("camera_pos"));
     fresh();
     std::fs::write(dir.join("positions.f32"), [0u8; 10]).unwrap();
@@ -556,9 +415,7 @@ fn reference_read_dump_errors() {
     std::fs::copy(dir.join("shadow_0.png"), dir.join("shadow_1.png")).unwrap();
     assert!(err("extra shadow").contains("shadow_1"));
     fresh();
-    image::GrayImage::new(3, 3)
-        .save(dir.join("shadow_0.png"))
-        .unwrap();
+    image::GrayImage::new(3, 3).save(dir.join("shadow_0.png")).unwrap();
     assert!(err("wrong png size").contains("3x3"));
     fresh();
     std::fs::write(dir.join("shadow_0.png"), b"not a png").unwrap();
@@ -573,11 +430,8 @@ fn reference_read_dump_errors() {
     std::fs::remove_file(dir.join("world.obj")).unwrap();
     assert!(err("missing obj").contains("world.obj"));
     fresh();
-    std::fs::write(
-        dir.join("frame.json"),
-        r#"{"width": 8, "height": 6, "camera_pos": [0,0,0], "lights": [{"position": [0,0,0,0]}]}"#,
-    )
-    .unwrap();
+    std::fs::write(dir.join("frame.json"), r#"{"width": 8, "height": 6, "camera_pos": [0,0,0], "lights": [{"position": [0,0,0,0]}]}"#)
+        .unwrap();
     assert!(err("zero directional").contains("light 0"));
     // Writing an inconsistent dump is refused too.
     let mut bad = dump.clone();
@@ -639,12 +493,7 @@ fn reference_metrics_band() {
                 metrics::GeoSample::Background
             } else {
                 let n = if i % w < 4 { DVec3::X } else { DVec3::Y };
-                metrics::GeoSample::Surface {
-                    position: DVec3::ZERO,
-                    normal: n,
-                    depth: 1.0,
-                    mesh: Some(0),
-                }
+                metrics::GeoSample::Surface { position: DVec3::ZERO, normal: n, depth: 1.0, mesh: Some(0) }
             }
         })
         .collect();
@@ -666,13 +515,7 @@ fn reference_homogeneous_light_round_trip() {
     let back = d.to_light().unwrap();
     assert!((back.direction - l.direction).length() < 1e-6);
     let p = point_light(Vec3::new(1.0, 2.0, 3.0));
-    assert_eq!(
-        DumpLight::homogeneous(Vec4::new(2.0, 4.0, 6.0, 2.0))
-            .to_light()
-            .unwrap()
-            .position,
-        p.position
-    );
+    assert_eq!(DumpLight::homogeneous(Vec4::new(2.0, 4.0, 6.0, 2.0)).to_light().unwrap().position, p.position);
 }
 
 /// Timing check (run with `cargo test --lib reference_perf -- --ignored --nocapture`):
@@ -685,40 +528,14 @@ fn reference_perf_512() {
         let c = Vec3::new(-4.0 + 2.0 * k as f32, 1.5, (k as f32 - 2.0) * 0.7);
         meshes.push((icosphere(c, 0.9, 5), true));
     }
-    let cam = Camera {
-        eye: Vec3::new(0.0, 7.0, 9.0),
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        fov_y_deg: 60.0,
-        near: 0.1,
-    };
-    let s = scene(
-        meshes,
-        vec![
-            point_light(Vec3::new(1.0, 6.0, 1.0)),
-            dir_light(Vec3::new(0.3, -1.0, -0.4)),
-        ],
-        cam,
-    );
+    let cam = Camera { eye: Vec3::new(0.0, 7.0, 9.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0, near: 0.1 };
+    let s = scene(meshes, vec![point_light(Vec3::new(1.0, 6.0, 1.0)), dir_light(Vec3::new(0.3, -1.0, -0.4))], cam);
     let t0 = std::time::Instant::now();
     let r = Reference::from_scene(&s);
     let t1 = std::time::Instant::now();
     let img = r.render(&s.camera, &s.lights, 512, 512);
     let t2 = std::time::Instant::now();
-    let amb = img
-        .states
-        .iter()
-        .filter(|s| **s == LightState::Ambiguous)
-        .count();
-    let sh = img
-        .states
-        .iter()
-        .filter(|s| **s == LightState::Shadowed)
-        .count();
-    eprintln!(
-        "{} tris: build {:?}, render 512x512x2 lights {:?}; shadowed {sh}, ambiguous {amb}",
-        r.triangle_count(),
-        t1 - t0,
-        t2 - t1
-    );
+    let amb = img.states.iter().filter(|s| **s == LightState::Ambiguous).count();
+    let sh = img.states.iter().filter(|s| **s == LightState::Shadowed).count();
+    eprintln!("{} tris: build {:?}, render 512x512x2 lights {:?}; shadowed {sh}, ambiguous {amb}", r.triangle_count(), t1 - t0, t2 - t1);
 }

@@ -158,25 +158,14 @@ impl Reference {
                 (to / dist, dist - off)
             }
         };
-        let mut v: Vec<u32> = self
-            .occluders
-            .collect_hits(o, d, 0.0, t_max)
-            .iter()
-            .map(|h| h.tri)
-            .collect();
+        let mut v: Vec<u32> = self.occluders.collect_hits(o, d, 0.0, t_max).iter().map(|h| h.tri).collect();
         v.sort_unstable();
         v
     }
 
     /// Renders the light fraction of every light at the visible surface of every pixel
     /// (the [`Reference::render`] camera model and footprint-based perturbation radius).
-    pub fn render_transmittance(
-        &self,
-        camera: &Camera,
-        lights: &[Light],
-        width: u32,
-        height: u32,
-    ) -> TransmitImage {
+    pub fn render_transmittance(&self, camera: &Camera, lights: &[Light], width: u32, height: u32) -> TransmitImage {
         let (w, h) = (width as usize, height as usize);
         let nl = lights.len();
         let rows: Vec<(Vec<RefPixel>, Vec<Transmit>)> = par_rows(h, |y| {
@@ -204,13 +193,7 @@ impl Reference {
             pixels.extend(p);
             values.extend(v);
         }
-        TransmitImage {
-            width,
-            height,
-            light_count: nl,
-            pixels,
-            values,
-        }
+        TransmitImage { width, height, light_count: nl, pixels, values }
     }
 }
 
@@ -233,16 +216,11 @@ impl TransmitImage {
     }
     /// All pixel values of one light, row-major.
     pub fn light_values(&self, light: usize) -> Vec<Transmit> {
-        (0..self.pixels.len())
-            .map(|i| self.values[i * self.light_count + light])
-            .collect()
+        (0..self.pixels.len()).map(|i| self.values[i * self.light_count + light]).collect()
     }
     /// One light's fractions as f32 RGB, row-major; NaN for background and ambiguous pixels.
     pub fn fractions_f32(&self, light: usize) -> Vec<[f32; 3]> {
-        self.light_values(light)
-            .into_iter()
-            .map(Transmit::to_f32)
-            .collect()
+        self.light_values(light).into_iter().map(Transmit::to_f32).collect()
     }
 }
 
@@ -315,13 +293,7 @@ fn geo_of(pixels: &[RefPixel]) -> Vec<GeoSample> {
 
 /// The band of one light's reference fractions: edges (see [`TransmitMetrics`]) plus
 /// `geo_edges`, dilated by `n` pixels.
-pub fn transmit_band(
-    values: &[Transmit],
-    geo_edges: &[bool],
-    w: usize,
-    h: usize,
-    n: u32,
-) -> Vec<bool> {
+pub fn transmit_band(values: &[Transmit], geo_edges: &[bool], w: usize, h: usize, n: u32) -> Vec<bool> {
     let mut e = vec![false; w * h];
     let differ = |i: usize, j: usize| match (values[i].fraction(), values[j].fraction()) {
         (Some(a), Some(b)) => (0..3).any(|k| (a[k] - b[k]).abs() > TRANSMIT_EDGE_THRESHOLD),
@@ -349,33 +321,18 @@ pub fn transmit_band(
 /// Compares the GPU light fractions of light `light` (`gpu[pixel]`, row-major, NaN in any
 /// channel for background) with a reference rendering, band of `band` pixels, with the
 /// default tolerance [`TRANSMIT_TOLERANCE`].
-pub fn transmit_error(
-    gpu: &[[f32; 3]],
-    reference: &TransmitImage,
-    light: usize,
-    band: u32,
-) -> Result<TransmitMetrics> {
+pub fn transmit_error(gpu: &[[f32; 3]], reference: &TransmitImage, light: usize, band: u32) -> Result<TransmitMetrics> {
     transmit_error_tol(gpu, reference, light, band, TRANSMIT_TOLERANCE)
 }
 
 /// [`transmit_error`] with an explicit tolerance.
-pub fn transmit_error_tol(
-    gpu: &[[f32; 3]],
-    reference: &TransmitImage,
-    light: usize,
-    band: u32,
-    tolerance: f64,
-) -> Result<TransmitMetrics> {
+pub fn transmit_error_tol(gpu: &[[f32; 3]], reference: &TransmitImage, light: usize, band: u32, tolerance: f64) -> Result<TransmitMetrics> {
     let (w, h) = (reference.width as usize, reference.height as usize);
     metrics::check_sizes("transmittance", gpu.len(), w, h, light, reference.light_count)?;
     let values = reference.light_values(light);
     let geo = metrics::geometry_edges(&geo_of(&reference.pixels), w, h);
     let band_mask = transmit_band(&values, &geo, w, h, band);
-    let mut m = TransmitMetrics {
-        pixels: (w * h) as u64,
-        tolerance,
-        ..TransmitMetrics::default()
-    };
+    let mut m = TransmitMetrics { pixels: (w * h) as u64, tolerance, ..TransmitMetrics::default() };
     let mut errors = Vec::new();
     let (mut sum, mut sum2) = (0.0f64, 0.0f64);
     for i in 0..w * h {
@@ -401,9 +358,7 @@ pub fn transmit_error_tol(
             continue;
         }
         let rv = r.fraction().unwrap_or([0.0; 3]);
-        let e = (0..3)
-            .map(|k| (g[k] as f64 - rv[k]).abs())
-            .fold(0.0, f64::max);
+        let e = (0..3).map(|k| (g[k] as f64 - rv[k]).abs()).fold(0.0, f64::max);
         if in_band {
             m.max_abs_error_in_band = m.max_abs_error_in_band.max(e);
             continue;
@@ -424,11 +379,7 @@ pub fn transmit_error_tol(
     }
     m.errors = errors;
     m.over_tolerance = m.pixels_over_tolerance(tolerance) + m.background_mismatch_outside_band;
-    m.fraction_over_tolerance = if m.compared == 0 {
-        0.0
-    } else {
-        m.over_tolerance as f64 / m.compared as f64
-    };
+    m.fraction_over_tolerance = if m.compared == 0 { 0.0 } else { m.over_tolerance as f64 / m.compared as f64 };
     Ok(m)
 }
 
@@ -450,43 +401,18 @@ mod tests {
         }
     }
 
-    fn mesh(
-        mesh: crate::geom::Mesh,
-        at: Vec3,
-        color: Vec3,
-        opacity: f32,
-        casts: bool,
-    ) -> SceneMesh {
-        SceneMesh {
-            name: "m".into(),
-            mesh,
-            transform: Mat4::from_translation(at),
-            color,
-            opacity,
-            casts_shadow: casts,
-        }
+    fn mesh(mesh: crate::geom::Mesh, at: Vec3, color: Vec3, opacity: f32, casts: bool) -> SceneMesh {
+        SceneMesh { name: "m".into(), mesh, transform: Mat4::from_translation(at), color, opacity, casts_shadow: casts }
     }
 
     fn floor() -> SceneMesh {
-        mesh(
-            shapes::plane(Vec2::splat(20.0)),
-            Vec3::ZERO,
-            Vec3::ONE,
-            1.0,
-            false,
-        )
+        mesh(shapes::plane(Vec2::splat(20.0)), Vec3::ZERO, Vec3::ONE, 1.0, false)
     }
 
     fn scene(meshes: Vec<SceneMesh>) -> Scene {
         Scene {
             name: "t".into(),
-            camera: Camera {
-                eye: Vec3::new(0.0, 8.0, 0.01),
-                target: Vec3::ZERO,
-                up: Vec3::Y,
-                fov_y_deg: 60.0,
-                near: 0.1,
-            },
+            camera: Camera { eye: Vec3::new(0.0, 8.0, 0.01), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0, near: 0.1 },
             lights: vec![point_light(Vec3::new(0.0, 6.0, 0.0))],
             meshes,
             ambient: Vec3::splat(0.08),
@@ -513,54 +439,25 @@ mod tests {
     #[test]
     fn reference_transmit_quad() {
         // An open transparent quad above the floor: one surface.
-        let s = scene(vec![
-            floor(),
-            mesh(
-                shapes::plane(Vec2::splat(2.0)),
-                Vec3::new(0.0, 2.0, 0.0),
-                TINT,
-                0.5,
-                true,
-            ),
-        ]);
+        let s = scene(vec![floor(), mesh(shapes::plane(Vec2::splat(2.0)), Vec3::new(0.0, 2.0, 0.0), TINT, 0.5, true)]);
         let r = Reference::from_scene(&s);
         close(at_origin(&r, &s), [0.5, 0.25, 0.125]);
         // Outside its shadow: fully lit.
         let l = &s.lights[0];
-        close(
-            r.transmittance_at(DVec3::new(5.0, 0.0, 0.0), DVec3::Y, l, 1e-4),
-            [1.0; 3],
-        );
+        close(r.transmittance_at(DVec3::new(5.0, 0.0, 0.0), DVec3::Y, l, 1e-4), [1.0; 3]);
         // Facing away: nothing.
-        close(
-            r.transmittance_at(DVec3::new(5.0, 0.0, 0.0), -DVec3::Y, l, 1e-4),
-            [0.0; 3],
-        );
+        close(r.transmittance_at(DVec3::new(5.0, 0.0, 0.0), -DVec3::Y, l, 1e-4), [0.0; 3]);
         // The quad's edge (shadow at x = 1.5 on the floor) is ambiguous.
-        assert_eq!(
-            r.transmittance_at(DVec3::new(1.5, 0.0, 0.3), DVec3::Y, l, 1e-3),
-            Transmit::Ambiguous
-        );
+        assert_eq!(r.transmittance_at(DVec3::new(1.5, 0.0, 0.3), DVec3::Y, l, 1e-3), Transmit::Ambiguous);
         // The binary shadow state counts opaque casters only: a transparent one attenuates.
         assert_eq!(r.shadow_at(P, DVec3::Y, l), LightState::Lit);
         // Exactly below the quad's diagonal: the segment crosses both triangles' shared edge.
-        assert_eq!(
-            r.transmittance_at(DVec3::ZERO, DVec3::Y, l, 1e-4),
-            Transmit::Ambiguous
-        );
+        assert_eq!(r.transmittance_at(DVec3::ZERO, DVec3::Y, l, 1e-4), Transmit::Ambiguous);
     }
 
     #[test]
     fn reference_transmit_boxes() {
-        let bx = |y: f32, opacity: f32| {
-            mesh(
-                shapes::cuboid(Vec3::splat(1.0)),
-                Vec3::new(0.0, y, 0.0),
-                TINT,
-                opacity,
-                true,
-            )
-        };
+        let bx = |y: f32, opacity: f32| mesh(shapes::cuboid(Vec3::splat(1.0)), Vec3::new(0.0, y, 0.0), TINT, opacity, true);
         let one: [f64; 3] = [0.5, 0.25, 0.125];
         let pow = |k: i32| one.map(|c: f64| c.powi(k));
         // A closed transparent box: two surfaces.
@@ -591,75 +488,37 @@ mod tests {
         let s = scene(vec![floor(), bx(2.0, 0.5), b]);
         let r = Reference::from_scene(&s);
         let c: [f64; 3] = [0.25 * 0.2, 0.25, 0.25];
-        close(
-            at_origin(&r, &s),
-            [
-                one[0].powi(2) * c[0].powi(2),
-                one[1].powi(2) * c[1].powi(2),
-                one[2].powi(2) * c[2].powi(2),
-            ],
-        );
+        close(at_origin(&r, &s), [one[0].powi(2) * c[0].powi(2), one[1].powi(2) * c[1].powi(2), one[2].powi(2) * c[2].powi(2)]);
     }
 
     #[test]
     fn reference_transmit_duplicates_and_directional() {
         // Two coincident copies of the same transparent quad: each counts.
-        let q = || {
-            mesh(
-                shapes::plane(Vec2::splat(2.0)),
-                Vec3::new(0.0, 2.0, 0.0),
-                TINT,
-                0.5,
-                true,
-            )
-        };
+        let q = || mesh(shapes::plane(Vec2::splat(2.0)), Vec3::new(0.0, 2.0, 0.0), TINT, 0.5, true);
         let s = scene(vec![floor(), q(), q()]);
         let r = Reference::from_scene(&s);
         close(at_origin(&r, &s), [0.25, 0.0625, 0.015625]);
-        let d = Light {
-            kind: LightKind::Directional,
-            direction: Vec3::NEG_Y,
-            ..point_light(Vec3::ZERO)
-        };
-        close(
-            r.transmittance_at(DVec3::new(0.3, 0.0, 0.2), DVec3::Y, &d, 1e-4),
-            [0.25, 0.0625, 0.015625],
-        );
+        let d = Light { kind: LightKind::Directional, direction: Vec3::NEG_Y, ..point_light(Vec3::ZERO) };
+        close(r.transmittance_at(DVec3::new(0.3, 0.0, 0.2), DVec3::Y, &d, 1e-4), [0.25, 0.0625, 0.015625]);
     }
 
     #[test]
     fn reference_transmit_render_and_metrics() {
-        let s = scene(vec![
-            floor(),
-            mesh(
-                shapes::cuboid(Vec3::splat(1.0)),
-                Vec3::new(0.0, 2.0, 0.0),
-                TINT,
-                0.5,
-                true,
-            ),
-        ]);
+        let s = scene(vec![floor(), mesh(shapes::cuboid(Vec3::splat(1.0)), Vec3::new(0.0, 2.0, 0.0), TINT, 0.5, true)]);
         let r = Reference::from_scene(&s);
         // A low light: a wide shadow ring around the box as seen from above.
         let lights = vec![point_light(Vec3::new(0.0, 3.5, 0.0))];
         let img = r.render_transmittance(&s.camera, &lights, 64, 48);
         assert_eq!(img.values.len(), 64 * 48);
         // The box is seen from above at the centre; its top faces the light: lit fully.
-        let shadow_pixels = img
-            .light_values(0)
-            .iter()
-            .filter(|v| v.fraction().is_some_and(|f| (f[0] - 0.25).abs() < 1e-9))
-            .count();
+        let shadow_pixels = img.light_values(0).iter().filter(|v| v.fraction().is_some_and(|f| (f[0] - 0.25).abs() < 1e-9)).count();
         // Shadow of the box on the floor is mostly hidden by the box from straight above,
         // but the ring around it (magnified shadow) is visible.
         assert!(shadow_pixels > 20, "{shadow_pixels}");
         // Self-comparison: zero error.
         let gpu = img.fractions_f32(0);
         let m = transmit_error(&gpu, &img, 0, 1).unwrap();
-        assert!(
-            m.compared > 0 && m.max_abs_error < 1e-6 && m.over_tolerance == 0,
-            "{m:?}"
-        );
+        assert!(m.compared > 0 && m.max_abs_error < 1e-6 && m.over_tolerance == 0, "{m:?}");
         // A GPU that ignores transparency (shadow = black) is far off in the ring.
         let bad: Vec<[f32; 3]> = img
             .light_values(0)
@@ -702,38 +561,22 @@ mod tests {
             assert_eq!(r.crossed_triangles(p, DVec3::Y, l).len() as u32, 2 * k);
             let v = r.transmittance_at(p, DVec3::Y, l, 1e-3).fraction().unwrap();
             for c in 0..3 {
-                assert!(
-                    (v[c] - want[c]).abs() < 1e-9 * want[c].max(1e-3),
-                    "depth_{k}: {v:?} {want:?}"
-                );
+                assert!((v[c] - want[c]).abs() < 1e-9 * want[c].max(1e-3), "depth_{k}: {v:?} {want:?}");
             }
         }
     }
 
     #[test]
     fn reference_transmit_scenes_have_transparent_casters() {
-        for name in crate::scene::builtin_names()
-            .into_iter()
-            .filter(|n| n.starts_with("transparent/"))
-        {
+        for name in crate::scene::builtin_names().into_iter().filter(|n| n.starts_with("transparent/")) {
             let s = crate::scene::load(name).unwrap();
-            let transparent = s
-                .meshes
-                .iter()
-                .filter(|m| m.casts_shadow && m.opacity < 1.0)
-                .count();
+            let transparent = s.meshes.iter().filter(|m| m.casts_shadow && m.opacity < 1.0).count();
             assert!(transparent > 0, "{name}");
         }
         let s = crate::scene::load("transparent/balls_and_cubes").unwrap();
-        assert!(s
-            .meshes
-            .iter()
-            .any(|m| m.casts_shadow && m.opacity == 1.0 && m.mesh.triangles.len() > 2));
+        assert!(s.meshes.iter().any(|m| m.casts_shadow && m.opacity == 1.0 && m.mesh.triangles.len() > 2));
         let s = crate::scene::load("transparent/inner_structure").unwrap();
-        assert!(s
-            .meshes
-            .iter()
-            .any(|m| m.casts_shadow && m.opacity == 1.0 && m.mesh.triangles.len() > 2));
+        assert!(s.meshes.iter().any(|m| m.casts_shadow && m.opacity == 1.0 && m.mesh.triangles.len() > 2));
     }
 
     /// Writes the reference light fraction of light 0 of every transparent scene as PNGs to
@@ -744,10 +587,7 @@ mod tests {
         let Ok(dir) = std::env::var("UMBRAGE_PREVIEW_DIR") else {
             return;
         };
-        for name in crate::scene::builtin_names()
-            .into_iter()
-            .filter(|n| n.starts_with("transparent/"))
-        {
+        for name in crate::scene::builtin_names().into_iter().filter(|n| n.starts_with("transparent/")) {
             let s = crate::scene::load(name).unwrap();
             let r = Reference::from_scene(&s);
             let (w, h) = (320u32, 240u32);
@@ -757,11 +597,7 @@ mod tests {
                 let px = match v {
                     Transmit::Value(f) => {
                         let m = s.meshes[img.pixels[i].mesh as usize].color.as_dvec3();
-                        let c = |k: usize| {
-                            ((0.15 + 0.85 * f[k]) * m[k] * 255.0)
-                                .round()
-                                .clamp(0.0, 255.0) as u8
-                        };
+                        let c = |k: usize| ((0.15 + 0.85 * f[k]) * m[k] * 255.0).round().clamp(0.0, 255.0) as u8;
                         [c(0), c(1), c(2)]
                     }
                     Transmit::Ambiguous => [255, 0, 255],

@@ -137,7 +137,9 @@ impl std::str::FromStr for TransmitMode {
             "log16" => Ok(TransmitMode { fp32: false, log: true }),
             "mul32" => Ok(TransmitMode { fp32: true, log: false }),
             "log32" => Ok(TransmitMode { fp32: true, log: true }),
-            _ => Err(Error::UnknownName { what: "light-intensity map mode", name: s.into(), expected: "log16, mul16, log32, mul32".into() }),
+            _ => {
+                Err(Error::UnknownName { what: "light-intensity map mode", name: s.into(), expected: "log16, mul16, log32, mul32".into() })
+            }
         }
     }
 }
@@ -483,10 +485,7 @@ impl Renderer {
         // SAFETY: plain object creation on a valid device; everything is destroyed in Drop.
         let (sampler, set_layouts, layouts, descriptor_pool, sets) = unsafe {
             let sampler = d
-                .create_sampler(
-                    &vk::SamplerCreateInfo::default().mag_filter(vk::Filter::NEAREST).min_filter(vk::Filter::NEAREST),
-                    None,
-                )
+                .create_sampler(&vk::SamplerCreateInfo::default().mag_filter(vk::Filter::NEAREST).min_filter(vk::Filter::NEAREST), None)
                 .map_err(vkerr("vkCreateSampler"))?;
             // Bindings in order; `true` = sampled image, `false` = sampler.
             let mk_set_layout = |kinds: &[bool]| {
@@ -509,7 +508,8 @@ impl Renderer {
             let set_layouts = [mk_set_layout(&[true, true, true, false, true, true])?, mk_set_layout(&[true, false])?];
             let mk_layout = |sets: &[vk::DescriptorSetLayout], push: u32, stages: vk::ShaderStageFlags| {
                 let ranges = [vk::PushConstantRange { stage_flags: stages, offset: 0, size: push }];
-                let info = vk::PipelineLayoutCreateInfo::default().set_layouts(sets).push_constant_ranges(if push > 0 { &ranges } else { &[] });
+                let info =
+                    vk::PipelineLayoutCreateInfo::default().set_layouts(sets).push_constant_ranges(if push > 0 { &ranges } else { &[] });
                 d.create_pipeline_layout(&info, None).map_err(vkerr("vkCreatePipelineLayout"))
             };
             let vf = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
@@ -532,13 +532,22 @@ impl Renderer {
                 .map_err(vkerr("vkAllocateDescriptorSets"))?;
             let sets = [sets[0], sets[1]];
             let img = |i: &crate::gpu::Image| {
-                [vk::DescriptorImageInfo { sampler: vk::Sampler::null(), image_view: i.view, image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL }]
+                [vk::DescriptorImageInfo {
+                    sampler: vk::Sampler::null(),
+                    image_view: i.view,
+                    image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                }]
             };
             let samp = [vk::DescriptorImageInfo { sampler, image_view: vk::ImageView::null(), image_layout: vk::ImageLayout::UNDEFINED }];
             let (a, n, p, acc) = (img(&targets.albedo), img(&targets.normal), img(&targets.position), img(&targets.accum));
             let cnt = img(&targets.count);
             let tr = img(&targets.transmit);
-            fn w(set: vk::DescriptorSet, binding: u32, ty: vk::DescriptorType, info: &[vk::DescriptorImageInfo]) -> vk::WriteDescriptorSet<'_> {
+            fn w(
+                set: vk::DescriptorSet,
+                binding: u32,
+                ty: vk::DescriptorType,
+                info: &[vk::DescriptorImageInfo],
+            ) -> vk::WriteDescriptorSet<'_> {
                 vk::WriteDescriptorSet::default().dst_set(set).dst_binding(binding).descriptor_type(ty).image_info(info)
             }
             let writes = [
@@ -639,14 +648,8 @@ impl Renderer {
             DepthMode::Clamp => {
                 // Far plane just beyond the scene: everything further is clamped to depth 1.
                 let eye = self.scene.camera.eye;
-                let far = self
-                    .scene
-                    .meshes
-                    .iter()
-                    .flat_map(|m| m.world_bounds().corners())
-                    .map(|c| c.distance(eye))
-                    .fold(1.0f32, f32::max)
-                    * 1.5;
+                let far =
+                    self.scene.meshes.iter().flat_map(|m| m.world_bounds().corners()).map(|c| c.distance(eye)).fold(1.0f32, f32::max) * 1.5;
                 self.scene.camera.proj_finite(aspect, far.max(self.scene.camera.near * 2.0))
             }
         }
@@ -859,7 +862,13 @@ impl Renderer {
                 b.destroy(&self.ctx);
             }
             for (i, &s) in sizes.iter().enumerate() {
-                self.readback.push(Buffer::new(&self.ctx, &format!("readback {i}"), s, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?);
+                self.readback.push(Buffer::new(
+                    &self.ctx,
+                    &format!("readback {i}"),
+                    s,
+                    vk::BufferUsageFlags::TRANSFER_DST,
+                    MemoryLocation::GpuToCpu,
+                )?);
             }
         }
 
@@ -883,11 +892,8 @@ impl Renderer {
             })
             .collect();
         // Per caster: MVP (eye-relative, composed in f64) and the light in object space per light.
-        let caster_mvp: Vec<Mat4> = self
-            .casters
-            .iter()
-            .map(|c| (vp_rel_d * DMat4::from_translation(-eye) * c.transform.as_dmat4()).as_mat4())
-            .collect();
+        let caster_mvp: Vec<Mat4> =
+            self.casters.iter().map(|c| (vp_rel_d * DMat4::from_translation(-eye) * c.transform.as_dmat4()).as_mat4()).collect();
 
         let ctx = &self.ctx;
         let d = &ctx.device;
@@ -975,7 +981,10 @@ impl Renderer {
                 let plan = &plans[li];
                 let scissor = plan
                     .scissor
-                    .map(|[x, y, sw, sh]| vk::Rect2D { offset: vk::Offset2D { x: x as i32, y: y as i32 }, extent: vk::Extent2D { width: sw, height: sh } })
+                    .map(|[x, y, sw, sh]| vk::Rect2D {
+                        offset: vk::Offset2D { x: x as i32, y: y as i32 },
+                        extent: vk::Extent2D { width: sw, height: sh },
+                    })
                     .filter(|r| r.extent.width > 0 && r.extent.height > 0)
                     .unwrap_or(full);
                 let bounds = if ctx.features.depth_bounds { plan.depth_bounds } else { None };
@@ -997,7 +1006,11 @@ impl Renderer {
                     sm.record(ctx, cb, t, &self.scene.lights[li], eye, scissor);
                 } else {
                     let info = vk::RenderingInfo::default().render_area(scissor).layer_count(1).depth_attachment(&depth_load);
-                    let info = if float { info.color_attachments(&count_att).stencil_attachment(&depth_load) } else { info.stencil_attachment(&stencil_clear) };
+                    let info = if float {
+                        info.color_attachments(&count_att).stencil_attachment(&depth_load)
+                    } else {
+                        info.stencil_attachment(&stencil_clear)
+                    };
                     d.cmd_begin_rendering(cb, &info);
                     d.cmd_set_viewport(cb, 0, &[viewport]);
                     d.cmd_set_scissor(cb, 0, &[scissor]);
@@ -1015,7 +1028,13 @@ impl Renderer {
                         push[16..20].copy_from_slice(&light_obj.to_array());
                         // Float counter: the sign a front face contributes (+1 z-pass, -1 z-fail).
                         push[20] = if *case == Case::ZPass { 1.0 } else { -1.0 };
-                        d.cmd_push_constants(cb, self.layouts[1], vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT, 0, bytes_of(&push));
+                        d.cmd_push_constants(
+                            cb,
+                            self.layouts[1],
+                            vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                            0,
+                            bytes_of(&push),
+                        );
                         if *edge_quad {
                             if let Some(eq) = self.edge_quads.get(*ci).and_then(|e| e.as_ref()) {
                                 let p = &self.pipes;
@@ -1056,17 +1075,46 @@ impl Renderer {
                 if capture {
                     let region = |aspect| {
                         vk::BufferImageCopy::default()
-                            .image_subresource(vk::ImageSubresourceLayers { aspect_mask: aspect, mip_level: 0, base_array_layer: 0, layer_count: 1 })
+                            .image_subresource(vk::ImageSubresourceLayers {
+                                aspect_mask: aspect,
+                                mip_level: 0,
+                                base_array_layer: 0,
+                                layer_count: 1,
+                            })
                             .image_extent(vk::Extent3D { width: w, height: h, depth: 1 })
                     };
                     if float {
                         transition(ctx, cb, &t.count, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
-                        d.cmd_copy_image_to_buffer(cb, t.count.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, self.readback[3 + li].raw, &[region(vk::ImageAspectFlags::COLOR)]);
+                        d.cmd_copy_image_to_buffer(
+                            cb,
+                            t.count.raw,
+                            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                            self.readback[3 + li].raw,
+                            &[region(vk::ImageAspectFlags::COLOR)],
+                        );
                         transition(ctx, cb, &t.count, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
                     } else {
-                        transition(ctx, cb, &t.depth, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
-                        d.cmd_copy_image_to_buffer(cb, t.depth.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, self.readback[3 + li].raw, &[region(vk::ImageAspectFlags::STENCIL)]);
-                        transition(ctx, cb, &t.depth, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
+                        transition(
+                            ctx,
+                            cb,
+                            &t.depth,
+                            vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
+                            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                        );
+                        d.cmd_copy_image_to_buffer(
+                            cb,
+                            t.depth.raw,
+                            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                            self.readback[3 + li].raw,
+                            &[region(vk::ImageAspectFlags::STENCIL)],
+                        );
+                        transition(
+                            ctx,
+                            cb,
+                            &t.depth,
+                            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                            vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
+                        );
                     }
                 } else if float {
                     transition(ctx, cb, &t.count, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
@@ -1104,7 +1152,13 @@ impl Renderer {
                         push[..16].copy_from_slice(&caster_mvp[*ci].to_cols_array());
                         push[16..20].copy_from_slice(&light_obj.to_array());
                         push[20..24].copy_from_slice(&[if zpass { 1.0 } else { -1.0 }, tr.x, tr.y, tr.z]);
-                        d.cmd_push_constants(cb, self.layouts[1], vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT, 0, bytes_of(&push));
+                        d.cmd_push_constants(
+                            cb,
+                            self.layouts[1],
+                            vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                            0,
+                            bytes_of(&push),
+                        );
                         d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.pipes.transmit[log as usize][(!zpass) as usize]);
                         for dr in cdraws {
                             // Transparent casters' caps are all in the volume list (not NEVER).
@@ -1115,12 +1169,29 @@ impl Renderer {
                     if capture {
                         transition(ctx, cb, &t.transmit, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
                         let region = vk::BufferImageCopy::default()
-                            .image_subresource(vk::ImageSubresourceLayers { aspect_mask: vk::ImageAspectFlags::COLOR, mip_level: 0, base_array_layer: 0, layer_count: 1 })
+                            .image_subresource(vk::ImageSubresourceLayers {
+                                aspect_mask: vk::ImageAspectFlags::COLOR,
+                                mip_level: 0,
+                                base_array_layer: 0,
+                                layer_count: 1,
+                            })
                             .image_extent(vk::Extent3D { width: w, height: h, depth: 1 });
-                        d.cmd_copy_image_to_buffer(cb, t.transmit.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, self.readback[3 + nlights + li].raw, &[region]);
+                        d.cmd_copy_image_to_buffer(
+                            cb,
+                            t.transmit.raw,
+                            vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                            self.readback[3 + nlights + li].raw,
+                            &[region],
+                        );
                         transition(ctx, cb, &t.transmit, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
                     } else {
-                        transition(ctx, cb, &t.transmit, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
+                        transition(
+                            ctx,
+                            cb,
+                            &t.transmit,
+                            vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
+                            vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                        );
                     }
                 }
 
@@ -1205,7 +1276,12 @@ impl Renderer {
                 d.cmd_end_rendering(cb);
                 // --- self-shadowing (src/render/selfshadow.rs): steps 4-6 of Kim et al. ---
                 if let Some(ss) = &self.self_shadow {
-                    memory_barrier(ctx, cb, (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT, color_rw), (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT, color_rw));
+                    memory_barrier(
+                        ctx,
+                        cb,
+                        (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT, color_rw),
+                        (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT, color_rw),
+                    );
                     let frame = selfshadow::SelfShadowFrame {
                         vp_rel,
                         viewport,
@@ -1248,7 +1324,13 @@ impl Renderer {
                         push[..16].copy_from_slice(&caster_mvp[*ci].to_cols_array());
                         push[16..20].copy_from_slice(&light_obj.to_array());
                         push[20..24].copy_from_slice(&color);
-                        d.cmd_push_constants(cb, self.layouts[1], vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT, 0, bytes_of(&push));
+                        d.cmd_push_constants(
+                            cb,
+                            self.layouts[1],
+                            vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                            0,
+                            bytes_of(&push),
+                        );
                         for dr in cdraws.iter().filter(|dr| !dr.light_cap) {
                             self.record_draw(cb, *ci, dr, stream_raw);
                         }
@@ -1274,17 +1356,39 @@ impl Renderer {
             transition(ctx, cb, &t.output, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
             let color_region = |aspect| {
                 vk::BufferImageCopy::default()
-                    .image_subresource(vk::ImageSubresourceLayers { aspect_mask: aspect, mip_level: 0, base_array_layer: 0, layer_count: 1 })
+                    .image_subresource(vk::ImageSubresourceLayers {
+                        aspect_mask: aspect,
+                        mip_level: 0,
+                        base_array_layer: 0,
+                        layer_count: 1,
+                    })
                     .image_extent(vk::Extent3D { width: w, height: h, depth: 1 })
             };
-            d.cmd_copy_image_to_buffer(cb, t.output.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, self.readback[0].raw, &[color_region(vk::ImageAspectFlags::COLOR)]);
+            d.cmd_copy_image_to_buffer(
+                cb,
+                t.output.raw,
+                vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                self.readback[0].raw,
+                &[color_region(vk::ImageAspectFlags::COLOR)],
+            );
             if capture {
                 for (img, buf) in [(&t.position, 1), (&t.normal, 2)] {
                     transition(ctx, cb, img, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
-                    d.cmd_copy_image_to_buffer(cb, img.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, self.readback[buf].raw, &[color_region(vk::ImageAspectFlags::COLOR)]);
+                    d.cmd_copy_image_to_buffer(
+                        cb,
+                        img.raw,
+                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                        self.readback[buf].raw,
+                        &[color_region(vk::ImageAspectFlags::COLOR)],
+                    );
                 }
             }
-            memory_barrier(ctx, cb, (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE), (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ));
+            memory_barrier(
+                ctx,
+                cb,
+                (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE),
+                (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
+            );
             d.end_command_buffer(cb).map_err(vkerr("vkEndCommandBuffer"))?;
             cpu.record = record_start.elapsed().as_secs_f64() * 1e3;
 
@@ -1302,7 +1406,8 @@ impl Renderer {
             // SAFETY: the fence wait above guarantees the queries are available.
             unsafe { d.get_query_pool_results(self.query_pool, 0, &mut raw, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT) }
                 .map_err(vkerr("vkGetQueryPoolResults"))?;
-            let ms = |a: u32, b: u32| (raw[b as usize].wrapping_sub(raw[a as usize])) as f64 * ctx.features.timestamp_period_ns as f64 * 1e-6;
+            let ms =
+                |a: u32, b: u32| (raw[b as usize].wrapping_sub(raw[a as usize])) as f64 * ctx.features.timestamp_period_ns as f64 * 1e-6;
             Some(GpuMs {
                 depth: ms(TS_BEGIN, TS_DEPTH),
                 shadow: ts_shadow.iter().map(|&(a, b)| ms(a, b)).sum(),
@@ -1315,10 +1420,14 @@ impl Renderer {
 
         // 6. Read back.
         let color = self.readback[0].read()?.to_vec();
-        let (mut positions, mut normals, mut stencil, mut counts, mut transmit) = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let (mut positions, mut normals, mut stencil, mut counts, mut transmit) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
         if capture {
             let floats = |b: &Buffer| -> Result<Vec<[f32; 4]>> {
-                Ok(b.read()?.chunks_exact(16).map(|c| std::array::from_fn(|k| f32::from_le_bytes([c[4 * k], c[4 * k + 1], c[4 * k + 2], c[4 * k + 3]]))).collect())
+                Ok(b.read()?
+                    .chunks_exact(16)
+                    .map(|c| std::array::from_fn(|k| f32::from_le_bytes([c[4 * k], c[4 * k + 1], c[4 * k + 2], c[4 * k + 3]])))
+                    .collect())
             };
             let pos = floats(&self.readback[1])?;
             let nrm = floats(&self.readback[2])?;
@@ -1374,7 +1483,11 @@ impl Renderer {
         for (name, has, used) in [
             ("depthClamp", f.depth_clamp, self.opts.depth_mode == DepthMode::Clamp),
             ("depthBounds", f.depth_bounds, f.depth_bounds),
-            ("indexTypeUint8", f.index_type_uint8, f.index_type_uint8 && matches!(self.opts.index_format, IndexFormat::U8 | IndexFormat::Auto)),
+            (
+                "indexTypeUint8",
+                f.index_type_uint8,
+                f.index_type_uint8 && matches!(self.opts.index_format, IndexFormat::U8 | IndexFormat::Auto),
+            ),
             ("timestamps", f.timestamps, f.timestamps),
         ] {
             if used {
@@ -1553,7 +1666,14 @@ fn upload(ctx: &Context, name: &str, data: &[u8], usage: vk::BufferUsageFlags) -
     let dst = Buffer::new(ctx, name, data.len() as u64, usage | vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuOnly)?;
     let r = ctx.one_shot(|cb| {
         // SAFETY: both buffers are at least `data.len()` bytes and alive until after the wait.
-        unsafe { ctx.device.cmd_copy_buffer(cb, staging.raw, dst.raw, &[vk::BufferCopy { src_offset: 0, dst_offset: 0, size: data.len() as u64 }]) };
+        unsafe {
+            ctx.device.cmd_copy_buffer(
+                cb,
+                staging.raw,
+                dst.raw,
+                &[vk::BufferCopy { src_offset: 0, dst_offset: 0, size: data.len() as u64 }],
+            )
+        };
     });
     staging.destroy(ctx);
     r.map(|_| dst)
@@ -1666,7 +1786,9 @@ fn create_pipelines(
     let mut tm = c.clone();
     tm.color_formats = &map_fmt;
     let mut transmit = [[vk::Pipeline::null(); 2]; 2];
-    for (li, (frag, blend)) in [(shaders::TRANSMIT_FRAG, Blend::Multiply), (shaders::TRANSMIT_LOG_FRAG, Blend::Additive)].into_iter().enumerate() {
+    for (li, (frag, blend)) in
+        [(shaders::TRANSMIT_FRAG, Blend::Multiply), (shaders::TRANSMIT_LOG_FRAG, Blend::Additive)].into_iter().enumerate()
+    {
         tm.fragment = Some(frag);
         tm.blend = blend;
         for (zi, cmp) in [vk::CompareOp::LESS, vk::CompareOp::GREATER_OR_EQUAL].into_iter().enumerate() {

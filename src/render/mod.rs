@@ -19,5 +19,5 @@ pub mod shadowmap;
 pub mod stats;
 pub mod targets;
 
-pub use frame::{Counter, DepthMode, TransmitMode, FrameOutput, IndexFormat, RenderOptions, Renderer, View};
+pub use frame::{Counter, DepthMode, FrameOutput, IndexFormat, RenderOptions, Renderer, TransmitMode, View};
 pub use stats::Stats;

@@ -70,46 +70,25 @@ impl SelfShadow {
             vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
             vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL,
         )?;
-        let count = Image::new_2d(
-            ctx,
-            "self-shadow opaque count",
-            COUNT_FORMAT,
-            extent,
-            color,
-            c,
-        )?;
-        let map = Image::new_2d(
-            ctx,
-            "self-shadow light-intensity map",
-            transmit_format,
-            extent,
-            color,
-            c,
-        )?;
+        let count = Image::new_2d(ctx, "self-shadow opaque count", COUNT_FORMAT, extent, color, c)?;
+        let map = Image::new_2d(ctx, "self-shadow light-intensity map", transmit_format, extent, color, c)?;
         let d = &ctx.device;
         // SAFETY: plain object creation on a valid device; every object is destroyed in
         // `destroy` (called from Renderer::destroy_resources).
         let (set_layout, layout, pool, set) = unsafe {
-            let bindings: Vec<_> = [
-                vk::DescriptorType::SAMPLED_IMAGE,
-                vk::DescriptorType::SAMPLED_IMAGE,
-                vk::DescriptorType::SAMPLER,
-            ]
-            .iter()
-            .enumerate()
-            .map(|(i, &ty)| {
-                vk::DescriptorSetLayoutBinding::default()
-                    .binding(i as u32)
-                    .descriptor_type(ty)
-                    .descriptor_count(1)
-                    .stage_flags(vk::ShaderStageFlags::FRAGMENT)
-            })
-            .collect();
+            let bindings: Vec<_> = [vk::DescriptorType::SAMPLED_IMAGE, vk::DescriptorType::SAMPLED_IMAGE, vk::DescriptorType::SAMPLER]
+                .iter()
+                .enumerate()
+                .map(|(i, &ty)| {
+                    vk::DescriptorSetLayoutBinding::default()
+                        .binding(i as u32)
+                        .descriptor_type(ty)
+                        .descriptor_count(1)
+                        .stage_flags(vk::ShaderStageFlags::FRAGMENT)
+                })
+                .collect();
             let set_layout = d
-                .create_descriptor_set_layout(
-                    &vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings),
-                    None,
-                )
+                .create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None)
                 .map_err(vkerr("vkCreateDescriptorSetLayout"))?;
             let ranges = [vk::PushConstantRange {
                 stage_flags: vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
@@ -119,36 +98,19 @@ impl SelfShadow {
             let set_layouts = [set_layout];
             let layout = d
                 .create_pipeline_layout(
-                    &vk::PipelineLayoutCreateInfo::default()
-                        .set_layouts(&set_layouts)
-                        .push_constant_ranges(&ranges),
+                    &vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts).push_constant_ranges(&ranges),
                     None,
                 )
                 .map_err(vkerr("vkCreatePipelineLayout"))?;
             let sizes = [
-                vk::DescriptorPoolSize {
-                    ty: vk::DescriptorType::SAMPLED_IMAGE,
-                    descriptor_count: 2,
-                },
-                vk::DescriptorPoolSize {
-                    ty: vk::DescriptorType::SAMPLER,
-                    descriptor_count: 1,
-                },
+                vk::DescriptorPoolSize { ty: vk::DescriptorType::SAMPLED_IMAGE, descriptor_count: 2 },
+                vk::DescriptorPoolSize { ty: vk::DescriptorType::SAMPLER, descriptor_count: 1 },
             ];
             let pool = d
-                .create_descriptor_pool(
-                    &vk::DescriptorPoolCreateInfo::default()
-                        .max_sets(1)
-                        .pool_sizes(&sizes),
-                    None,
-                )
+                .create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), None)
                 .map_err(vkerr("vkCreateDescriptorPool"))?;
             let set = d
-                .allocate_descriptor_sets(
-                    &vk::DescriptorSetAllocateInfo::default()
-                        .descriptor_pool(pool)
-                        .set_layouts(&set_layouts),
-                )
+                .allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&set_layouts))
                 .map_err(vkerr("vkAllocateDescriptorSets"))?[0];
             let img = |i: &Image| {
                 [vk::DescriptorImageInfo {
@@ -158,22 +120,9 @@ impl SelfShadow {
                 }]
             };
             let (ci, mi) = (img(&count), img(&map));
-            let si = [vk::DescriptorImageInfo {
-                sampler,
-                image_view: vk::ImageView::null(),
-                image_layout: vk::ImageLayout::UNDEFINED,
-            }];
-            fn w(
-                set: vk::DescriptorSet,
-                b: u32,
-                ty: vk::DescriptorType,
-                info: &[vk::DescriptorImageInfo],
-            ) -> vk::WriteDescriptorSet<'_> {
-                vk::WriteDescriptorSet::default()
-                    .dst_set(set)
-                    .dst_binding(b)
-                    .descriptor_type(ty)
-                    .image_info(info)
+            let si = [vk::DescriptorImageInfo { sampler, image_view: vk::ImageView::null(), image_layout: vk::ImageLayout::UNDEFINED }];
+            fn w(set: vk::DescriptorSet, b: u32, ty: vk::DescriptorType, info: &[vk::DescriptorImageInfo]) -> vk::WriteDescriptorSet<'_> {
+                vk::WriteDescriptorSet::default().dst_set(set).dst_binding(b).descriptor_type(ty).image_info(info)
             }
             let writes = [
                 w(set, 0, vk::DescriptorType::SAMPLED_IMAGE, &ci),
@@ -190,11 +139,7 @@ impl SelfShadow {
             (2, vk::Format::R32G32B32_SFLOAT, 24),
             (3, vk::Format::R32_SFLOAT, 36),
         ];
-        let mut p = PipelineDesc::new(
-            shaders::TRANSPARENT_BIAS_VERT,
-            forward_layout,
-            ctx.depth_format,
-        );
+        let mut p = PipelineDesc::new(shaders::TRANSPARENT_BIAS_VERT, forward_layout, ctx.depth_format);
         p.vertex_stride = 40;
         p.attributes = &attrs;
         p.depth_test = true;
@@ -211,17 +156,7 @@ impl SelfShadow {
         l.depth_compare = vk::CompareOp::LESS;
         l.blend = Blend::Additive;
         let light_pipe = pipeline::create(ctx, &l)?;
-        Ok(SelfShadow {
-            depth,
-            count,
-            map,
-            set_layout,
-            layout,
-            pool,
-            set,
-            depth_pipe,
-            light_pipe,
-        })
+        Ok(SelfShadow { depth, count, map, set_layout, layout, pool, set, depth_pipe, light_pipe })
     }
 
     /// The caller waits for the device first.
@@ -258,23 +193,15 @@ impl Renderer {
     /// Steps 4-6, recorded after the transparent casters' "over" pass (outside any rendering
     /// instance): the transparent depth, then per light the two maps and the light's forward
     /// pass over the transparent casters.
-    pub(super) fn record_self_shadow(
-        &self,
-        ss: &SelfShadow,
-        cb: vk::CommandBuffer,
-        f: &SelfShadowFrame,
-    ) {
+    pub(super) fn record_self_shadow(&self, ss: &SelfShadow, cb: vk::CommandBuffer, f: &SelfShadowFrame) {
         let ctx = &self.ctx;
         let d = &ctx.device;
         let t = &self.targets;
         let n = self.scene_vertex_count - self.opaque_count;
         let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
-        let frag_tests = vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS
-            | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS;
-        let ds_rw = vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ
-            | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE;
-        let color_rw =
-            vk::AccessFlags2::COLOR_ATTACHMENT_READ | vk::AccessFlags2::COLOR_ATTACHMENT_WRITE;
+        let frag_tests = vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS;
+        let ds_rw = vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE;
+        let color_rw = vk::AccessFlags2::COLOR_ATTACHMENT_READ | vk::AccessFlags2::COLOR_ATTACHMENT_WRITE;
         let att = |img: &Image, load: vk::AttachmentLoadOp, clear: vk::ClearValue| {
             let layout = if img.aspect == vk::ImageAspectFlags::COLOR {
                 vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL
@@ -288,23 +215,12 @@ impl Renderer {
                 .store_op(vk::AttachmentStoreOp::STORE)
                 .clear_value(clear)
         };
-        let ds_clear = vk::ClearValue {
-            depth_stencil: vk::ClearDepthStencilValue {
-                depth: 1.0,
-                stencil: 0,
-            },
-        };
-        let zero = vk::ClearValue {
-            color: vk::ClearColorValue { float32: [0.0; 4] },
-        };
+        let ds_clear = vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } };
+        let zero = vk::ClearValue { color: vk::ClearColorValue { float32: [0.0; 4] } };
         let load = vk::AttachmentLoadOp::LOAD;
         let clear = vk::AttachmentLoadOp::CLEAR;
         let log = self.opts.transmit.log;
-        let map_clear = vk::ClearValue {
-            color: vk::ClearColorValue {
-                float32: if log { [0.0; 4] } else { [1.0; 4] },
-            },
-        };
+        let map_clear = vk::ClearValue { color: vk::ClearColorValue { float32: if log { [0.0; 4] } else { [1.0; 4] } } };
         let mut forward_push = [0f32; 32];
         forward_push[..16].copy_from_slice(&f.vp_rel.to_cols_array());
 
@@ -312,21 +228,11 @@ impl Renderer {
         // device and lives until Drop; image layouts are tracked in the order written.
         unsafe {
             // 4. Nearest transparent surface per pixel.
-            transition(
-                ctx,
-                cb,
-                &ss.depth,
-                vk::ImageLayout::UNDEFINED,
-                vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
-            );
+            transition(ctx, cb, &ss.depth, vk::ImageLayout::UNDEFINED, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
             let ss_depth = att(&ss.depth, clear, ds_clear);
             d.cmd_begin_rendering(
                 cb,
-                &vk::RenderingInfo::default()
-                    .render_area(f.full)
-                    .layer_count(1)
-                    .depth_attachment(&ss_depth)
-                    .stencil_attachment(&ss_depth),
+                &vk::RenderingInfo::default().render_area(f.full).layer_count(1).depth_attachment(&ss_depth).stencil_attachment(&ss_depth),
             );
             d.cmd_set_viewport(cb, 0, &[f.viewport]);
             d.cmd_set_scissor(cb, 0, &[f.full]);
@@ -342,14 +248,8 @@ impl Renderer {
                 let scissor = f.plans[li]
                     .scissor
                     .map(|[x, y, sw, sh]| vk::Rect2D {
-                        offset: vk::Offset2D {
-                            x: x as i32,
-                            y: y as i32,
-                        },
-                        extent: vk::Extent2D {
-                            width: sw,
-                            height: sh,
-                        },
+                        offset: vk::Offset2D { x: x as i32, y: y as i32 },
+                        extent: vk::Extent2D { width: sw, height: sh },
                     })
                     .filter(|r| r.extent.width > 0 && r.extent.height > 0)
                     .unwrap_or(f.full);
@@ -372,13 +272,7 @@ impl Renderer {
                 };
 
                 // 5a. Opaque casters' volumes, counted against the transparent depth.
-                transition(
-                    ctx,
-                    cb,
-                    &ss.count,
-                    vk::ImageLayout::UNDEFINED,
-                    vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                );
+                transition(ctx, cb, &ss.count, vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
                 begin(&[att(&ss.count, clear, zero)]);
                 for (ci, case, light_obj, cdraws, _) in ldraws {
                     if *case == Case::Culled || self.casters[*ci].transmittance.is_some() {
@@ -395,33 +289,17 @@ impl Renderer {
                     d.cmd_bind_pipeline(
                         cb,
                         vk::PipelineBindPoint::GRAPHICS,
-                        if zpass {
-                            self.pipes.count_zpass
-                        } else {
-                            self.pipes.count_zfail
-                        },
+                        if zpass { self.pipes.count_zpass } else { self.pipes.count_zfail },
                     );
                     for dr in cdraws {
                         self.record_draw(cb, *ci, dr, f.stream);
                     }
                 }
                 d.cmd_end_rendering(cb);
-                transition(
-                    ctx,
-                    cb,
-                    &ss.count,
-                    vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                    vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-                );
+                transition(ctx, cb, &ss.count, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
 
                 // 5b. Transparent casters' volumes: the light-intensity map on the casters.
-                transition(
-                    ctx,
-                    cb,
-                    &ss.map,
-                    vk::ImageLayout::UNDEFINED,
-                    vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                );
+                transition(ctx, cb, &ss.map, vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
                 begin(&[att(&ss.map, clear, map_clear)]);
                 for (ci, case, light_obj, cdraws, _) in ldraws {
                     let Some(tr) = self.casters[*ci].transmittance else {
@@ -434,30 +312,15 @@ impl Renderer {
                     let mut push = [0f32; 24];
                     push[..16].copy_from_slice(&f.caster_mvp[*ci].to_cols_array());
                     push[16..20].copy_from_slice(&light_obj.to_array());
-                    push[20..24].copy_from_slice(&[
-                        if zpass { 1.0 } else { -1.0 },
-                        tr.x,
-                        tr.y,
-                        tr.z,
-                    ]);
+                    push[20..24].copy_from_slice(&[if zpass { 1.0 } else { -1.0 }, tr.x, tr.y, tr.z]);
                     d.cmd_push_constants(cb, self.layouts[1], stages, 0, bytes_of(&push));
-                    d.cmd_bind_pipeline(
-                        cb,
-                        vk::PipelineBindPoint::GRAPHICS,
-                        self.pipes.transmit[log as usize][(!zpass) as usize],
-                    );
+                    d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.pipes.transmit[log as usize][(!zpass) as usize]);
                     for dr in cdraws {
                         self.record_draw(cb, *ci, dr, f.stream);
                     }
                 }
                 d.cmd_end_rendering(cb);
-                transition(
-                    ctx,
-                    cb,
-                    &ss.map,
-                    vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL,
-                    vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-                );
+                transition(ctx, cb, &ss.map, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
 
                 // 6. This light over the transparent casters, scaled by both maps.
                 let accum_att = [att(&t.accum, load, zero)];
@@ -474,14 +337,7 @@ impl Renderer {
                 d.cmd_set_viewport(cb, 0, &[f.viewport]);
                 d.cmd_set_scissor(cb, 0, &[scissor]);
                 d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, ss.light_pipe);
-                d.cmd_bind_descriptor_sets(
-                    cb,
-                    vk::PipelineBindPoint::GRAPHICS,
-                    ss.layout,
-                    0,
-                    &[ss.set],
-                    &[],
-                );
+                d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, ss.layout, 0, &[ss.set], &[]);
                 for (k, v) in f.light_uniforms[li].iter().enumerate() {
                     forward_push[16 + 4 * k..20 + 4 * k].copy_from_slice(&v.to_array());
                 }
@@ -493,14 +349,9 @@ impl Renderer {
                 memory_barrier(
                     ctx,
                     cb,
+                    (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT | frag_tests, color_rw | ds_rw),
                     (
-                        vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT | frag_tests,
-                        color_rw | ds_rw,
-                    ),
-                    (
-                        vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT
-                            | frag_tests
-                            | vk::PipelineStageFlags2::FRAGMENT_SHADER,
+                        vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT | frag_tests | vk::PipelineStageFlags2::FRAGMENT_SHADER,
                         color_rw | ds_rw | vk::AccessFlags2::SHADER_READ,
                     ),
                 );

@@ -168,7 +168,10 @@ impl ShadowMapper {
                 .create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().push_constant_ranges(&map_push), None)
                 .map_err(vkerr("vkCreatePipelineLayout"))?;
             let l1 = d
-                .create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts_arr).push_constant_ranges(&lookup_push), None)
+                .create_pipeline_layout(
+                    &vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts_arr).push_constant_ranges(&lookup_push),
+                    None,
+                )
                 .map_err(vkerr("vkCreatePipelineLayout"))?;
             (set_layout, pool, set, [l0, l1])
         };
@@ -237,7 +240,8 @@ impl ShadowMapper {
                 };
                 dirs.into_iter()
                     .map(|(d, fov, face)| {
-                        let cam = Camera { eye: l.as_vec3(), target: (l + d).as_vec3(), up: any_up(d), fov_y_deg: fov as f32, near: near as f32 };
+                        let cam =
+                            Camera { eye: l.as_vec3(), target: (l + d).as_vec3(), up: any_up(d), fov_y_deg: fov as f32, near: near as f32 };
                         let tile = if face < 0.0 { [0, 0] } else { [(face as u32 % 3) * self.size, (face as u32 / 3) * self.size] };
                         let texel_world = (2.0 * dist * (fov.to_radians() * 0.5).tan() / s) as f32;
                         Face { view_proj: cam.proj_finite(1.0, far as f32) * cam.view(), tile, face, texel_world }
@@ -249,7 +253,15 @@ impl ShadowMapper {
 
     /// Renders light `light`'s maps and writes its shadow fractions into `targets.count`
     /// (which must be in COLOR_ATTACHMENT_OPTIMAL; it is left there).
-    pub fn record(&self, ctx: &Context, cb: vk::CommandBuffer, targets: &Targets, light: &crate::scene::Light, eye: DVec3, scissor: vk::Rect2D) {
+    pub fn record(
+        &self,
+        ctx: &Context,
+        cb: vk::CommandBuffer,
+        targets: &Targets,
+        light: &crate::scene::Light,
+        eye: DVec3,
+        scissor: vk::Rect2D,
+    ) {
         let d = &ctx.device;
         let faces = self.faces(light, eye);
         let full = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: self.atlas.extent };
@@ -268,14 +280,21 @@ impl ShadowMapper {
                 d.cmd_bind_vertex_buffers(cb, 0, &[b.raw], &[0]);
                 for f in &faces {
                     let sz = self.size as f32;
-                    let vp = vk::Viewport { x: f.tile[0] as f32, y: f.tile[1] as f32, width: sz, height: sz, min_depth: 0.0, max_depth: 1.0 };
+                    let vp =
+                        vk::Viewport { x: f.tile[0] as f32, y: f.tile[1] as f32, width: sz, height: sz, min_depth: 0.0, max_depth: 1.0 };
                     let sc = vk::Rect2D {
                         offset: vk::Offset2D { x: f.tile[0] as i32, y: f.tile[1] as i32 },
                         extent: vk::Extent2D { width: self.size, height: self.size },
                     };
                     d.cmd_set_viewport(cb, 0, &[vp]);
                     d.cmd_set_scissor(cb, 0, &[sc]);
-                    d.cmd_push_constants(cb, self.layouts[0], vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT, 0, bytes_of(&f.view_proj.to_cols_array()));
+                    d.cmd_push_constants(
+                        cb,
+                        self.layouts[0],
+                        vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                        0,
+                        bytes_of(&f.view_proj.to_cols_array()),
+                    );
                     d.cmd_draw(cb, self.caster_vertices, 1, 0, 0);
                 }
             }
@@ -319,7 +338,10 @@ impl ShadowMapper {
             ctx,
             cb,
             (vk::PipelineStageFlags2::FRAGMENT_SHADER, vk::AccessFlags2::SHADER_SAMPLED_READ),
-            (vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS, vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE),
+            (
+                vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS,
+                vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE,
+            ),
         );
     }
 

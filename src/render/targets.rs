@@ -47,7 +47,14 @@ impl Targets {
             )?,
             count: Image::new_2d(ctx, "count", COUNT_FORMAT, extent, color, c)?,
             transmit: Image::new_2d(ctx, "light-intensity map", transmit_format, extent, color, c)?,
-            output: Image::new_2d(ctx, "output", OUTPUT_FORMAT, extent, vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC, c)?,
+            output: Image::new_2d(
+                ctx,
+                "output",
+                OUTPUT_FORMAT,
+                extent,
+                vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
+                c,
+            )?,
         })
     }
 
@@ -56,7 +63,16 @@ impl Targets {
     }
 
     pub fn destroy(&mut self, ctx: &Context) {
-        for img in [&mut self.accum, &mut self.albedo, &mut self.normal, &mut self.position, &mut self.depth, &mut self.output, &mut self.count, &mut self.transmit] {
+        for img in [
+            &mut self.accum,
+            &mut self.albedo,
+            &mut self.normal,
+            &mut self.position,
+            &mut self.depth,
+            &mut self.output,
+            &mut self.count,
+            &mut self.transmit,
+        ] {
             img.destroy(ctx);
         }
     }

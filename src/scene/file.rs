@@ -190,9 +190,7 @@ impl Ctx<'_> {
         let out = match v {
             None => default.to_vec(),
             Some(NumOrVec::Vec(a)) => self.vecn(span, key, a, default.len())?,
-            Some(NumOrVec::Num(_)) => {
-                return Err(self.key_err(span, key, format!("expected an array of {} numbers", default.len())))
-            }
+            Some(NumOrVec::Num(_)) => return Err(self.key_err(span, key, format!("expected an array of {} numbers", default.len()))),
         };
         if out.iter().any(|&x| x <= 0.0) {
             return Err(self.key_err(span, key, "every component must be > 0"));
@@ -302,15 +300,7 @@ pub(crate) fn parse(src: &str, origin: &str, objs: ObjSource<'_>) -> Result<Scen
         if positional && position == camera.eye {
             return Err(cx.key_err(&s, "position", "a light must not coincide with the camera eye"));
         }
-        lights.push(Light {
-            kind,
-            position,
-            direction,
-            color: cx.color(&s, "color", l.color, Vec3::ONE)?,
-            intensity,
-            radius,
-            cone_deg,
-        });
+        lights.push(Light { kind, position, direction, color: cx.color(&s, "color", l.color, Vec3::ONE)?, intensity, radius, cone_deg });
     }
 
     // meshes
@@ -319,9 +309,9 @@ pub(crate) fn parse(src: &str, origin: &str, objs: ObjSource<'_>) -> Result<Scen
         meshes.push(mesh(&cx, i, &sm.span(), sm.get_ref(), &objs)?);
     }
 
-    let name = file.name.unwrap_or_else(|| {
-        Path::new(origin).file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| origin.to_string())
-    });
+    let name = file
+        .name
+        .unwrap_or_else(|| Path::new(origin).file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| origin.to_string()));
     Ok(Scene { name, camera, lights, meshes, ambient })
 }
 
@@ -369,9 +359,7 @@ fn mesh(cx: &Ctx, i: usize, s: &Range<usize>, m: &FileMesh, objs: &ObjSource) ->
     let table_line = line_of(cx.src, s.start);
     let params = present_params(m);
     let (object, kind): (Mesh, String) = match (&m.obj, &m.shape) {
-        (Some(_), Some(_)) | (None, None) => {
-            return Err(cx.at(table_line, format!("mesh {i}: give exactly one of `obj` or `shape`")))
-        }
+        (Some(_), Some(_)) | (None, None) => return Err(cx.at(table_line, format!("mesh {i}: give exactly one of `obj` or `shape`"))),
         (Some(path), None) => {
             if let Some(k) = params.first() {
                 return Err(cx.key_err(s, k, "shape parameters do not apply to an obj mesh"));
@@ -384,8 +372,7 @@ fn mesh(cx: &Ctx, i: usize, s: &Range<usize>, m: &FileMesh, objs: &ObjSource) ->
                 }
                 ObjSource::Builtin(dir) => {
                     let key = join_lexical(dir, path);
-                    let text = builtin::obj(&key)
-                        .ok_or_else(|| cx.key_err(s, "obj", format!("mesh {i}: no embedded file {key}")))?;
+                    let text = builtin::obj(&key).ok_or_else(|| cx.key_err(s, "obj", format!("mesh {i}: no embedded file {key}")))?;
                     obj::load_obj_str(text, &key).map_err(wrap)?
                 }
             };
@@ -406,11 +393,7 @@ fn mesh(cx: &Ctx, i: usize, s: &Range<usize>, m: &FileMesh, objs: &ObjSource) ->
                 });
             };
             if let Some(k) = params.iter().find(|k| !allowed.contains(k)) {
-                return Err(cx.key_err(
-                    s,
-                    k,
-                    format!("not a parameter of shape '{shape}' (it takes: {})", allowed.join(", ")),
-                ));
+                return Err(cx.key_err(s, k, format!("not a parameter of shape '{shape}' (it takes: {})", allowed.join(", "))));
             }
             (build_shape(cx, s, shape, m)?, shape.clone())
         }
@@ -435,9 +418,8 @@ fn mesh(cx: &Ctx, i: usize, s: &Range<usize>, m: &FileMesh, objs: &ObjSource) ->
     if scale.cmpeq(Vec3::ZERO).any() {
         return Err(cx.key_err(s, "scale", "scale factors must be nonzero"));
     }
-    let r = Mat4::from_rotation_z(rot.z.to_radians())
-        * Mat4::from_rotation_y(rot.y.to_radians())
-        * Mat4::from_rotation_x(rot.x.to_radians());
+    let r =
+        Mat4::from_rotation_z(rot.z.to_radians()) * Mat4::from_rotation_y(rot.y.to_radians()) * Mat4::from_rotation_x(rot.x.to_radians());
     let transform = Mat4::from_translation(translate) * r * Mat4::from_scale(scale);
     if !transform.is_finite() {
         return Err(cx.at(table_line, format!("mesh {i}: transform is not finite")));
@@ -490,12 +472,7 @@ fn build_shape(cx: &Ctx, s: &Range<usize>, shape: &str, m: &FileMesh) -> Result<
             if minor >= major {
                 return Err(cx.key_err(s, "minor_radius", "must be smaller than major_radius"));
             }
-            shapes::torus(
-                major,
-                minor,
-                cx.int(s, "segments", m.segments, 32, 3, MAX_SEG)?,
-                cx.int(s, "sides", m.sides, 16, 3, MAX_SEG)?,
-            )
+            shapes::torus(major, minor, cx.int(s, "segments", m.segments, 32, 3, MAX_SEG)?, cx.int(s, "sides", m.sides, 16, 3, MAX_SEG)?)
         }
         "cylinder" => shapes::cylinder(
             cx.positive(s, "radius", m.radius, 0.5)?,
@@ -588,9 +565,7 @@ mod tests {
     #[test]
     fn every_builtin_loads_and_validates() {
         let names = builtin_names();
-        for want in
-            ["default", "stairs", "cubes", "spheres", "hard/eye_in_volume", "hard/staircase_300", "hard/look_at_light"]
-        {
+        for want in ["default", "stairs", "cubes", "spheres", "hard/eye_in_volume", "hard/staircase_300", "hard/look_at_light"] {
             assert!(names.contains(&want), "{want} missing");
         }
         assert!(names.len() >= 4 + 15);
@@ -708,9 +683,7 @@ mod tests {
 
     #[test]
     fn transform_conventions() {
-        let t = format!(
-            "{CAM}[[mesh]]\nshape = \"box\"\ntranslate = [1, 2, 3]\nrotate_deg = [10, 20, 30]\nscale = [2, 3, 4]\n"
-        );
+        let t = format!("{CAM}[[mesh]]\nshape = \"box\"\ntranslate = [1, 2, 3]\nrotate_deg = [10, 20, 30]\nscale = [2, 3, 4]\n");
         let s = load_str(&t, "t.toml", Path::new(".")).unwrap();
         let r = Mat4::from_euler(glam::EulerRot::ZYX, 30f32.to_radians(), 20f32.to_radians(), 10f32.to_radians());
         let want = Mat4::from_translation(Vec3::new(1.0, 2.0, 3.0)) * r * Mat4::from_scale(Vec3::new(2.0, 3.0, 4.0));
@@ -745,10 +718,7 @@ mod tests {
         check(&format!("{CAM}[[mesh]]\nshape = \"box\"\ncolour = [1, 1, 1]\n"), &["bad.toml:6", "colour"]);
         check(&format!("colour = 1\n{CAM}"), &["bad.toml:1", "colour"]);
         check(&format!("{CAM}[[mesh]]\nshape = \"box\"\nrings = 3\n"), &["bad.toml:6", "rings"]);
-        check(
-            &format!("{CAM}[[light]]\nkind = \"point\"\nposition = [0, 1, 0]\ncone_deg = 30\n"),
-            &["bad.toml:7", "cone_deg"],
-        );
+        check(&format!("{CAM}[[light]]\nkind = \"point\"\nposition = [0, 1, 0]\ncone_deg = 30\n"), &["bad.toml:7", "cone_deg"]);
     }
 
     #[test]
@@ -779,9 +749,7 @@ mod tests {
         assert!(matches!(e, Error::UnknownName { what: "shape", .. }));
         let e = e.to_string();
         assert!(e.contains("hexagon") && e.contains("torus") && e.contains("bad.toml:5"), "{e}");
-        let e =
-            load_str(&format!("{CAM}[[light]]\nkind = \"area\"\nposition = [0, 1, 0]\n"), "bad.toml", Path::new("."))
-                .unwrap_err();
+        let e = load_str(&format!("{CAM}[[light]]\nkind = \"area\"\nposition = [0, 1, 0]\n"), "bad.toml", Path::new(".")).unwrap_err();
         assert!(matches!(e, Error::UnknownName { what: "light kind", .. }));
         assert!(e.to_string().contains("bad.toml:5"));
         let e = load("no_such_scene").unwrap_err();
@@ -815,17 +783,11 @@ mod tests {
         check("[camera]\neye = [0, 2, 0]\ntarget = [0, 0, 0]\n", &["bad.toml", "up"]);
         check("[camera]\neye = [0, 2, 5]\ntarget = [0, 0, 0]\nfov_y_deg = 180\n", &["bad.toml:4", "fov_y_deg"]);
         check("[camera]\neye = [0, 2, 5]\ntarget = [0, 0, 0]\nnear = 0\n", &["bad.toml:4", "near"]);
-        check(
-            &format!("{CAM}[[light]]\nkind = \"directional\"\ndirection = [0, 0, 0]\n"),
-            &["bad.toml:6", "direction"],
-        );
+        check(&format!("{CAM}[[light]]\nkind = \"directional\"\ndirection = [0, 0, 0]\n"), &["bad.toml:6", "direction"]);
         check(&format!("{CAM}[[light]]\nkind = \"spot\"\ndirection = [0, -1, 0]\n"), &["bad.toml:4", "position"]);
         check(&format!("{CAM}[[light]]\nkind = \"point\"\n"), &["bad.toml:4", "position"]);
         check(&format!("{CAM}[[light]]\nkind = \"point\"\nposition = [0, 2, 5]\n"), &["bad.toml:6", "eye"]);
-        check(
-            &format!("{CAM}[[light]]\nkind = \"point\"\nposition = [0, 2, 1]\nradius = 0\n"),
-            &["bad.toml:7", "radius"],
-        );
+        check(&format!("{CAM}[[light]]\nkind = \"point\"\nposition = [0, 2, 1]\nradius = 0\n"), &["bad.toml:7", "radius"]);
         check(
             &format!("{CAM}[[light]]\nkind = \"spot\"\nposition = [0, 2, 1]\ndirection = [0, -1, 0]\ncone_deg = 180\n"),
             &["bad.toml:8", "cone_deg"],

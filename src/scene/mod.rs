@@ -163,8 +163,7 @@ pub fn load(spec: &str) -> Result<Scene> {
     }
     let path = Path::new(spec);
     if path.is_file() || spec.ends_with(".toml") {
-        let text =
-            std::fs::read_to_string(path).map_err(|e| Error::input(spec, format!("cannot read scene file: {e}")))?;
+        let text = std::fs::read_to_string(path).map_err(|e| Error::input(spec, format!("cannot read scene file: {e}")))?;
         let dir = path.parent().unwrap_or(Path::new(""));
         return load_str(&text, spec, dir);
     }

@@ -78,14 +78,7 @@ fn load_obj_reader(reader: &mut impl BufRead, name: &str) -> Result<Mesh> {
             if !p.is_finite() {
                 return Err(Error::input(
                     name,
-                    format!(
-                        "vertex {} of object '{}' has a non-finite coordinate ({}, {}, {})",
-                        i + 1,
-                        model.name,
-                        c[0],
-                        c[1],
-                        c[2]
-                    ),
+                    format!("vertex {} of object '{}' has a non-finite coordinate ({}, {}, {})", i + 1, model.name, c[0], c[1], c[2]),
                 ));
             }
             let key = [p.x.to_bits(), p.y.to_bits(), p.z.to_bits()];
@@ -105,10 +98,7 @@ fn load_obj_reader(reader: &mut impl BufRead, name: &str) -> Result<Mesh> {
             let mut tri = [0u32; 3];
             for (k, &i) in t.iter().enumerate() {
                 tri[k] = *map.get(i as usize).ok_or_else(|| {
-                    Error::input(
-                        name,
-                        format!("malformed OBJ: face index {} out of range in object '{}'", i + 1, model.name),
-                    )
+                    Error::input(name, format!("malformed OBJ: face index {} out of range in object '{}'", i + 1, model.name))
                 })?;
             }
             triangles.push(tri);

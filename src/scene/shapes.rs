@@ -44,8 +44,7 @@ impl Builder {
             );
             self.v(p);
         }
-        const FACES: [[u32; 4]; 6] =
-            [[0, 4, 6, 2], [1, 3, 7, 5], [0, 1, 5, 4], [2, 6, 7, 3], [0, 2, 3, 1], [4, 5, 7, 6]];
+        const FACES: [[u32; 4]; 6] = [[0, 4, 6, 2], [1, 3, 7, 5], [0, 1, 5, 4], [2, 6, 7, 3], [0, 2, 3, 1], [4, 5, 7, 6]];
         for f in FACES {
             self.quad(base + f[0], base + f[1], base + f[2], base + f[3]);
         }
@@ -282,9 +281,7 @@ pub fn box_stack(count: u32, size: Vec3, offset: Vec3) -> Mesh {
 pub fn bumpy_slab(size: Vec3, divisions: u32, bump: f32) -> Mesh {
     let n = divisions;
     let mut b = Builder::default();
-    let pos = |i: u32, j: u32| {
-        Vec2::new(-size.x * 0.5 + size.x * i as f32 / n as f32, -size.z * 0.5 + size.z * j as f32 / n as f32)
-    };
+    let pos = |i: u32, j: u32| Vec2::new(-size.x * 0.5 + size.x * i as f32 / n as f32, -size.z * 0.5 + size.z * j as f32 / n as f32);
     let g = |i: u32, j: u32| i * (n + 1) + j;
     for i in 0..=n {
         for j in 0..=n {

@@ -41,9 +41,7 @@
 
 use super::caster::{Caster, CasterKind};
 use crate::error::Error;
-use crate::geom::bounds::{
-    box_distance, light_depth_bounds, light_scissor, shadow_volume_outside_frustum, Frustum, OcclusionPyramid,
-};
+use crate::geom::bounds::{box_distance, light_depth_bounds, light_scissor, shadow_volume_outside_frustum, Frustum, OcclusionPyramid};
 use crate::geom::silhouette::{facing_bits, possible_silhouette, SilhouetteEdge};
 use crate::geom::Aabb;
 use crate::scene::{Camera, Light, LightKind};
@@ -371,14 +369,7 @@ pub struct MultiplicityInput<'a> {
 /// Signed multiplicity of every undirected edge of the topology (`v[0] -> v[1]` positive).
 pub fn edge_multiplicities(caster: &Caster, facing: &[bool]) -> Vec<i32> {
     let t = &caster.topology;
-    (0..t.edges.len())
-        .map(|e| {
-            t.edge_uses(e)
-                .iter()
-                .map(|u| if u.forward == facing[u.tri as usize] { 1 } else { -1 })
-                .sum()
-        })
-        .collect()
+    (0..t.edges.len()).map(|e| t.edge_uses(e).iter().map(|u| if u.forward == facing[u.tri as usize] { 1 } else { -1 }).sum()).collect()
 }
 
 /// Emits a multiplicity caster's index lists; returns (draws, sides, dark cap, light cap,
@@ -503,8 +494,7 @@ fn plan_multiplicity(
         DarkCap::AllFaces
     };
     let mi = MultiplicityInput { facing: &facing, shielded: &shielded };
-    let (chunks, sides, dark_cap, light_cap, edges, mmax) =
-        emit_multiplicity(caster, &mi, &mult, case, directional, dark_cap_kind);
+    let (chunks, sides, dark_cap, light_cap, edges, mmax) = emit_multiplicity(caster, &mi, &mult, case, directional, dark_cap_kind);
     let plan = CasterPlan {
         caster: ci,
         case,
@@ -557,8 +547,7 @@ pub fn plan_light_opts(input: &PlanInput, casters: &[Caster], edge_quads: bool) 
             formulation: Formulation::Front,
             light_object: l_obj.to_array(),
         };
-        let out_of_radius =
-            !directional && light.radius.is_some_and(|r| box_distance(&wb, light.position) > r);
+        let out_of_radius = !directional && light.radius.is_some_and(|r| box_distance(&wb, light.position) > r);
         if out_of_radius || spot_culls(light, &wb) || shadow_volume_outside_frustum(&wb, light_h, &frustum) {
             plans.push(culled_plan(Case::Culled));
             continue;
@@ -584,11 +573,8 @@ pub fn plan_light_opts(input: &PlanInput, casters: &[Caster], edge_quads: bool) 
         let sil = possible_silhouette(&caster.topology.manifold_edges, &facing);
         sil_time += ts.elapsed().as_secs_f64() * 1e3;
 
-        let formulation = if !directional && caster.object_bounds.contains(l_obj.truncate()) {
-            Formulation::Back
-        } else {
-            Formulation::Front
-        };
+        let formulation =
+            if !directional && caster.object_bounds.contains(l_obj.truncate()) { Formulation::Back } else { Formulation::Front };
         let case = select_case(input.method, &pyramid, &frustum, &wb);
         let dark_cap_kind = if case == Case::ZPass || directional {
             DarkCap::None

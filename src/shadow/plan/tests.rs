@@ -1,6 +1,6 @@
 use super::*;
-use crate::shadow::testmesh::{cube, signed_volume, torus, uv_sphere};
 use crate::geom::Mesh;
+use crate::shadow::testmesh::{cube, signed_volume, torus, uv_sphere};
 use glam::{DVec3, Vec3};
 use std::collections::HashMap;
 
@@ -189,9 +189,12 @@ fn all_tris(p: &CasterPlan) -> Vec<(usize, [u16; 3])> {
     out
 }
 
+/// A vertex of the emitted volume: (welded vertex, at infinity).
+type VolumeVertex = (u32, bool);
+
 /// Every directed edge of the emitted volume cancels.
 fn assert_closed(caster: &Caster, p: &CasterPlan, directional: bool) {
-    let mut m: HashMap<((u32, bool), (u32, bool)), i32> = HashMap::new();
+    let mut m: HashMap<(VolumeVertex, VolumeVertex), i32> = HashMap::new();
     for (c, t) in all_tris(p) {
         for k in 0..3 {
             let (u, v) = (key(caster, c, t[k], directional), key(caster, c, t[(k + 1) % 3], directional));
@@ -272,7 +275,11 @@ fn sil_side_normals(caster: &Caster, p: &CasterPlan, l: Vec3) -> Vec<f64> {
             let q = |i: u16| {
                 let i = i as usize;
                 let v = ch.vertices[i % n].as_dvec3();
-                if i >= n { v + (v - l) * 20.0 } else { v }
+                if i >= n {
+                    v + (v - l) * 20.0
+                } else {
+                    v
+                }
             };
             let (a, b, c) = (q(t[0]), q(t[1]), q(t[2]));
             let nrm = (b - a).cross(c - a);
@@ -397,7 +404,13 @@ fn plan_digest(h: &mut u64, p: &CasterPlan) {
     };
     let head = format!(
         "{:?}|{}|{}|{}|{}|{:?}|{:?}|{:?}|",
-        p.case, p.silhouette_edges, p.sides, p.dark_cap, p.light_cap, p.dark_cap_kind, p.formulation,
+        p.case,
+        p.silhouette_edges,
+        p.sides,
+        p.dark_cap,
+        p.light_cap,
+        p.dark_cap_kind,
+        p.formulation,
         p.light_object.map(f32::to_bits)
     );
     eat(head.as_bytes());
@@ -438,7 +451,12 @@ fn closed_manifold_plans_unchanged() {
         let dist = [0.2f32, 1.0, 1.5, 4.0, 30.0][i % 5];
         let p = Vec3::new(r(), r(), r()).normalize_or(Vec3::X) * dist;
         let light = if i % 7 == 0 { dir(-p) } else { point(p) };
-        let cams = [cam1(), cam2(), cam3(), Camera { up: Vec3::Y, ..camera(-p.normalize_or(Vec3::X) * 6.0 + Vec3::new(0.01, 0.02, 0.0), Vec3::ZERO) }];
+        let cams = [
+            cam1(),
+            cam2(),
+            cam3(),
+            Camera { up: Vec3::Y, ..camera(-p.normalize_or(Vec3::X) * 6.0 + Vec3::new(0.01, 0.02, 0.0), Vec3::ZERO) },
+        ];
         for cam in &cams {
             for method in Method::ALL {
                 for cp in &plan(cam, &light, method, &casters).casters {
@@ -732,9 +750,12 @@ fn multiplicity_counts_equal_occluders() {
                             truth
                         };
                         assert_eq!(
-                            count, expect,
+                            count,
+                            expect,
                             "{name} ({}) {method} {:?} light {lh:?} cam {cam:?} p {p:?} dark {:?} plan {cp:?}",
-                            caster.chunks.len(), cp.case, cp.dark_cap_kind
+                            caster.chunks.len(),
+                            cp.case,
+                            cp.dark_cap_kind
                         );
                         n += 1;
                         *checked.entry(format!("{:?}/{:?}", cp.case, cp.dark_cap_kind)).or_default() += 1;
@@ -796,7 +817,7 @@ fn multiplicity_rules() {
     assert_eq!(m_of(0, 1), -4); // welded ids = cube ids here
     assert_eq!(m_of(2, 3).abs(), 3);
     assert_eq!(m_of(0, 3), 0); // the -z diagonal
-    // a closed box on the multiplicity path: every silhouette edge twice (near + far face)
+                               // a closed box on the multiplicity path: every silhouette edge twice (near + far face)
     let p = one("inside-out box", &above, &cam3(), Method::McGuire);
     assert_eq!((p.silhouette_edges, p.multiplicity_max, p.sides), (4, 2, 16));
     // McGuire case 2 (caster out of view): no light cap at all
