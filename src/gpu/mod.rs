@@ -1,6 +1,7 @@
 //! Thin wrappers over ash: context, memory, images, pipelines. Knows nothing about shadows.
 //! All of the crate's `unsafe` lives under this module and `render`.
 pub mod context;
+pub mod descriptors;
 pub mod pipeline;
 pub mod resources;
 pub mod shaders {

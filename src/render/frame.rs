@@ -4,6 +4,7 @@
 use super::stats::*;
 use super::targets::*;
 use crate::error::{Error, Result};
+use crate::gpu::descriptors::{pipeline_layout, Binding, DescriptorSet};
 use crate::gpu::pipeline::{self, Blend, PipelineDesc};
 use crate::gpu::resources::{memory_barrier, transition};
 use crate::gpu::{shaders, Buffer, Context};
@@ -375,10 +376,8 @@ pub struct Renderer {
     /// Opaque vertices (one- and two-sided) come first; transparent meshes' after them.
     opaque_count: u32,
     targets: Targets,
-    set_layouts: [vk::DescriptorSetLayout; 2],
     layouts: [vk::PipelineLayout; 5],
-    descriptor_pool: vk::DescriptorPool,
-    sets: [vk::DescriptorSet; 2],
+    sets: [DescriptorSet; 2],
     sampler: vk::Sampler,
     pipes: Pipelines,
     /// `--self-shadow` on a scene with transparent casters.
@@ -480,92 +479,42 @@ impl Renderer {
         let scene_vertices = upload(&ctx, "scene", bytes_of(&verts), vk::BufferUsageFlags::VERTEX_BUFFER)?;
         let targets = Targets::new(&ctx, opts.width, opts.height, opts.transmit.format())?;
 
-        // Descriptors: set 0 = G-buffer for illumination, set 1 = accumulation for tone mapping.
-        let d = &ctx.device;
-        // SAFETY: plain object creation on a valid device; everything is destroyed in Drop.
-        let (sampler, set_layouts, layouts, descriptor_pool, sets) = unsafe {
-            let sampler = d
+        // Descriptors: set 0 = G-buffer (albedo, normal, position, sampler, float count,
+        // light-intensity map) for illumination; set 1 = accumulation for tone mapping.
+        // SAFETY: plain object creation on a valid device; destroyed in `destroy_resources`.
+        let sampler = unsafe {
+            ctx.device
                 .create_sampler(&vk::SamplerCreateInfo::default().mag_filter(vk::Filter::NEAREST).min_filter(vk::Filter::NEAREST), None)
-                .map_err(vkerr("vkCreateSampler"))?;
-            // Bindings in order; `true` = sampled image, `false` = sampler.
-            let mk_set_layout = |kinds: &[bool]| {
-                let b: Vec<_> = kinds
-                    .iter()
-                    .enumerate()
-                    .map(|(i, &image)| {
-                        vk::DescriptorSetLayoutBinding::default()
-                            .binding(i as u32)
-                            .descriptor_type(if image { vk::DescriptorType::SAMPLED_IMAGE } else { vk::DescriptorType::SAMPLER })
-                            .descriptor_count(1)
-                            .stage_flags(vk::ShaderStageFlags::FRAGMENT)
-                    })
-                    .collect();
-                d.create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&b), None)
-                    .map_err(vkerr("vkCreateDescriptorSetLayout"))
-            };
-            // set 0: albedo, normal, position, sampler, count, light-intensity map;
-            // set 1: accumulation, sampler.
-            let set_layouts = [mk_set_layout(&[true, true, true, false, true, true])?, mk_set_layout(&[true, false])?];
-            let mk_layout = |sets: &[vk::DescriptorSetLayout], push: u32, stages: vk::ShaderStageFlags| {
-                let ranges = [vk::PushConstantRange { stage_flags: stages, offset: 0, size: push }];
-                let info =
-                    vk::PipelineLayoutCreateInfo::default().set_layouts(sets).push_constant_ranges(if push > 0 { &ranges } else { &[] });
-                d.create_pipeline_layout(&info, None).map_err(vkerr("vkCreatePipelineLayout"))
-            };
-            let vf = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
-            let layouts = [
-                mk_layout(&[], 80, vf)?,
-                mk_layout(&[], 96, vf)?,
-                mk_layout(&set_layouts[0..1], 64, vk::ShaderStageFlags::FRAGMENT)?,
-                mk_layout(&set_layouts[1..2], 0, vk::ShaderStageFlags::FRAGMENT)?,
-                mk_layout(&[], 128, vf)?,
-            ];
-            let sizes = [
-                vk::DescriptorPoolSize { ty: vk::DescriptorType::SAMPLED_IMAGE, descriptor_count: 6 },
-                vk::DescriptorPoolSize { ty: vk::DescriptorType::SAMPLER, descriptor_count: 2 },
-            ];
-            let pool = d
-                .create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(2).pool_sizes(&sizes), None)
-                .map_err(vkerr("vkCreateDescriptorPool"))?;
-            let sets = d
-                .allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&set_layouts))
-                .map_err(vkerr("vkAllocateDescriptorSets"))?;
-            let sets = [sets[0], sets[1]];
-            let img = |i: &crate::gpu::Image| {
-                [vk::DescriptorImageInfo {
-                    sampler: vk::Sampler::null(),
-                    image_view: i.view,
-                    image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-                }]
-            };
-            let samp = [vk::DescriptorImageInfo { sampler, image_view: vk::ImageView::null(), image_layout: vk::ImageLayout::UNDEFINED }];
-            let (a, n, p, acc) = (img(&targets.albedo), img(&targets.normal), img(&targets.position), img(&targets.accum));
-            let cnt = img(&targets.count);
-            let tr = img(&targets.transmit);
-            fn w(
-                set: vk::DescriptorSet,
-                binding: u32,
-                ty: vk::DescriptorType,
-                info: &[vk::DescriptorImageInfo],
-            ) -> vk::WriteDescriptorSet<'_> {
-                vk::WriteDescriptorSet::default().dst_set(set).dst_binding(binding).descriptor_type(ty).image_info(info)
-            }
-            let writes = [
-                w(sets[0], 0, vk::DescriptorType::SAMPLED_IMAGE, &a),
-                w(sets[0], 1, vk::DescriptorType::SAMPLED_IMAGE, &n),
-                w(sets[0], 2, vk::DescriptorType::SAMPLED_IMAGE, &p),
-                w(sets[0], 3, vk::DescriptorType::SAMPLER, &samp),
-                w(sets[0], 4, vk::DescriptorType::SAMPLED_IMAGE, &cnt),
-                w(sets[0], 5, vk::DescriptorType::SAMPLED_IMAGE, &tr),
-                w(sets[1], 0, vk::DescriptorType::SAMPLED_IMAGE, &acc),
-                w(sets[1], 1, vk::DescriptorType::SAMPLER, &samp),
-            ];
-            d.update_descriptor_sets(&writes, &[]);
-            (sampler, set_layouts, layouts, pool, sets)
-        };
+        }
+        .map_err(vkerr("vkCreateSampler"))?;
+        let t = &targets;
+        let sets = [
+            DescriptorSet::new(
+                &ctx,
+                &[
+                    Binding::Image(t.albedo.view),
+                    Binding::Image(t.normal.view),
+                    Binding::Image(t.position.view),
+                    Binding::Sampler(sampler),
+                    Binding::Image(t.count.view),
+                    Binding::Image(t.transmit.view),
+                ],
+            )?,
+            DescriptorSet::new(&ctx, &[Binding::Image(t.accum.view), Binding::Sampler(sampler)])?,
+        ];
+        let vf = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
+        let frag = vk::ShaderStageFlags::FRAGMENT;
+        let layouts = [
+            pipeline_layout(&ctx, &[], 80, vf)?,
+            pipeline_layout(&ctx, &[], 96, vf)?,
+            pipeline_layout(&ctx, &[sets[0].layout], 64, frag)?,
+            pipeline_layout(&ctx, &[sets[1].layout], 0, frag)?,
+            pipeline_layout(&ctx, &[], 128, vf)?,
+        ];
 
         let pipes = create_pipelines(&ctx, &layouts, opts.depth_mode, ctx.features.depth_bounds, opts.transmit.format())?;
 
+        let d = &ctx.device;
         // SAFETY: object creation on a valid device; destroyed in Drop.
         let (query_pool, cmd, fence) = unsafe {
             let qp = d
@@ -602,9 +551,7 @@ impl Renderer {
             opaque_count,
             scene_vertices,
             targets,
-            set_layouts,
             layouts,
-            descriptor_pool,
             sets,
             sampler,
             pipes,
@@ -1222,7 +1169,7 @@ impl Renderer {
                     let (lo, hi) = bounds.unwrap_or((0.0, 1.0));
                     d.cmd_set_depth_bounds(cb, lo, hi);
                 }
-                d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, self.layouts[2], 0, &[self.sets[0]], &[]);
+                d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, self.layouts[2], 0, &[self.sets[0].set], &[]);
                 d.cmd_push_constants(cb, self.layouts[2], vk::ShaderStageFlags::FRAGMENT, 0, bytes_of(&light_uniforms[li]));
                 d.cmd_draw(cb, 3, 1, 0, 0);
                 d.cmd_end_rendering(cb);
@@ -1347,7 +1294,7 @@ impl Renderer {
             d.cmd_set_viewport(cb, 0, &[viewport]);
             d.cmd_set_scissor(cb, 0, &[full]);
             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.pipes.tonemap);
-            d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, self.layouts[3], 0, &[self.sets[1]], &[]);
+            d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, self.layouts[3], 0, &[self.sets[1].set], &[]);
             d.cmd_draw(cb, 3, 1, 0, 0);
             d.cmd_end_rendering(cb);
             ts(vk::PipelineStageFlags2::ALL_COMMANDS, TS_END);
@@ -1889,14 +1836,13 @@ impl Renderer {
             for l in self.layouts {
                 d.destroy_pipeline_layout(l, None);
             }
-            d.destroy_descriptor_pool(self.descriptor_pool, None);
-            for l in self.set_layouts {
-                d.destroy_descriptor_set_layout(l, None);
-            }
             d.destroy_sampler(self.sampler, None);
             d.destroy_query_pool(self.query_pool, None);
             d.destroy_fence(self.fence, None);
             d.free_command_buffers(ctx.pool, &[self.cmd]);
+        }
+        for set in &mut self.sets {
+            set.destroy(ctx);
         }
         if let Some(mut sm) = self.shadow_mapper.take() {
             sm.destroy(ctx);

@@ -42,10 +42,8 @@ pub(super) struct SelfShadow {
     count: Image,
     /// Transparent casters' light-intensity map on the transparent surfaces.
     map: Image,
-    set_layout: vk::DescriptorSetLayout,
     layout: vk::PipelineLayout,
-    pool: vk::DescriptorPool,
-    set: vk::DescriptorSet,
+    set: DescriptorSet,
     /// Depth pre-pass: transparent.vert (BIAS), no colour, two-sided, LESS + write.
     depth_pipe: vk::Pipeline,
     /// Forward light pass sampling `count` and `map`: transparent.frag (SS), additive.
@@ -72,66 +70,8 @@ impl SelfShadow {
         )?;
         let count = Image::new_2d(ctx, "self-shadow opaque count", COUNT_FORMAT, extent, color, c)?;
         let map = Image::new_2d(ctx, "self-shadow light-intensity map", transmit_format, extent, color, c)?;
-        let d = &ctx.device;
-        // SAFETY: plain object creation on a valid device; every object is destroyed in
-        // `destroy` (called from Renderer::destroy_resources).
-        let (set_layout, layout, pool, set) = unsafe {
-            let bindings: Vec<_> = [vk::DescriptorType::SAMPLED_IMAGE, vk::DescriptorType::SAMPLED_IMAGE, vk::DescriptorType::SAMPLER]
-                .iter()
-                .enumerate()
-                .map(|(i, &ty)| {
-                    vk::DescriptorSetLayoutBinding::default()
-                        .binding(i as u32)
-                        .descriptor_type(ty)
-                        .descriptor_count(1)
-                        .stage_flags(vk::ShaderStageFlags::FRAGMENT)
-                })
-                .collect();
-            let set_layout = d
-                .create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None)
-                .map_err(vkerr("vkCreateDescriptorSetLayout"))?;
-            let ranges = [vk::PushConstantRange {
-                stage_flags: vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                offset: 0,
-                size: 128,
-            }];
-            let set_layouts = [set_layout];
-            let layout = d
-                .create_pipeline_layout(
-                    &vk::PipelineLayoutCreateInfo::default().set_layouts(&set_layouts).push_constant_ranges(&ranges),
-                    None,
-                )
-                .map_err(vkerr("vkCreatePipelineLayout"))?;
-            let sizes = [
-                vk::DescriptorPoolSize { ty: vk::DescriptorType::SAMPLED_IMAGE, descriptor_count: 2 },
-                vk::DescriptorPoolSize { ty: vk::DescriptorType::SAMPLER, descriptor_count: 1 },
-            ];
-            let pool = d
-                .create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), None)
-                .map_err(vkerr("vkCreateDescriptorPool"))?;
-            let set = d
-                .allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&set_layouts))
-                .map_err(vkerr("vkAllocateDescriptorSets"))?[0];
-            let img = |i: &Image| {
-                [vk::DescriptorImageInfo {
-                    sampler: vk::Sampler::null(),
-                    image_view: i.view,
-                    image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-                }]
-            };
-            let (ci, mi) = (img(&count), img(&map));
-            let si = [vk::DescriptorImageInfo { sampler, image_view: vk::ImageView::null(), image_layout: vk::ImageLayout::UNDEFINED }];
-            fn w(set: vk::DescriptorSet, b: u32, ty: vk::DescriptorType, info: &[vk::DescriptorImageInfo]) -> vk::WriteDescriptorSet<'_> {
-                vk::WriteDescriptorSet::default().dst_set(set).dst_binding(b).descriptor_type(ty).image_info(info)
-            }
-            let writes = [
-                w(set, 0, vk::DescriptorType::SAMPLED_IMAGE, &ci),
-                w(set, 1, vk::DescriptorType::SAMPLED_IMAGE, &mi),
-                w(set, 2, vk::DescriptorType::SAMPLER, &si),
-            ];
-            d.update_descriptor_sets(&writes, &[]);
-            (set_layout, layout, pool, set)
-        };
+        let set = DescriptorSet::new(ctx, &[Binding::Image(count.view), Binding::Image(map.view), Binding::Sampler(sampler)])?;
+        let layout = pipeline_layout(ctx, &[set.layout], 128, vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)?;
 
         let attrs = [
             (0, vk::Format::R32G32B32_SFLOAT, 0),
@@ -156,7 +96,7 @@ impl SelfShadow {
         l.depth_compare = vk::CompareOp::LESS;
         l.blend = Blend::Additive;
         let light_pipe = pipeline::create(ctx, &l)?;
-        Ok(SelfShadow { depth, count, map, set_layout, layout, pool, set, depth_pipe, light_pipe })
+        Ok(SelfShadow { depth, count, map, layout, set, depth_pipe, light_pipe })
     }
 
     /// The caller waits for the device first.
@@ -168,9 +108,8 @@ impl SelfShadow {
             d.destroy_pipeline(self.depth_pipe, None);
             d.destroy_pipeline(self.light_pipe, None);
             d.destroy_pipeline_layout(self.layout, None);
-            d.destroy_descriptor_pool(self.pool, None);
-            d.destroy_descriptor_set_layout(self.set_layout, None);
         }
+        self.set.destroy(ctx);
         for img in [&mut self.depth, &mut self.count, &mut self.map] {
             img.destroy(ctx);
         }
@@ -337,7 +276,7 @@ impl Renderer {
                 d.cmd_set_viewport(cb, 0, &[f.viewport]);
                 d.cmd_set_scissor(cb, 0, &[scissor]);
                 d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, ss.light_pipe);
-                d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, ss.layout, 0, &[ss.set], &[]);
+                d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, ss.layout, 0, &[ss.set.set], &[]);
                 for (k, v) in f.light_uniforms[li].iter().enumerate() {
                     forward_push[16 + 4 * k..20 + 4 * k].copy_from_slice(&v.to_array());
                 }

@@ -13,16 +13,13 @@
 
 use super::targets::{Targets, COUNT_FORMAT};
 use crate::error::{Error, Result};
+use crate::gpu::descriptors::{pipeline_layout, Binding, DescriptorSet};
 use crate::gpu::pipeline::{self, Blend, PipelineDesc};
 use crate::gpu::resources::{memory_barrier, transition};
 use crate::gpu::{shaders, Buffer, Context, Image};
 use crate::scene::{Camera, LightKind, Scene};
 use ash::vk;
 use glam::{DVec3, Mat4, Vec3, Vec4};
-
-fn vkerr(call: &'static str) -> impl Fn(vk::Result) -> Error {
-    move |r| Error::Vulkan { call, result: format!("{r:?}") }
-}
 
 pub const MAP_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 
@@ -35,9 +32,7 @@ pub struct ShadowMapper {
     caster_vertices: u32,
     /// Casters' bounding sphere, eye-relative.
     bounds: (DVec3, f64),
-    set_layout: vk::DescriptorSetLayout,
-    pool: vk::DescriptorPool,
-    set: vk::DescriptorSet,
+    set: DescriptorSet,
     layouts: [vk::PipelineLayout; 2],
     map_pipeline: vk::Pipeline,
     lookup_pipeline: vk::Pipeline,
@@ -99,82 +94,22 @@ impl ShadowMapper {
             vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
             vk::ImageAspectFlags::DEPTH,
         )?;
-        let d = &ctx.device;
-        // SAFETY: object creation on a valid device; everything is destroyed in `destroy`.
-        let (set_layout, pool, set, layouts) = unsafe {
-            let kinds = [true, true, true, false, true, true, true];
-            let b: Vec<_> = kinds
-                .iter()
-                .enumerate()
-                .map(|(i, &image)| {
-                    vk::DescriptorSetLayoutBinding::default()
-                        .binding(i as u32)
-                        .descriptor_type(if image { vk::DescriptorType::SAMPLED_IMAGE } else { vk::DescriptorType::SAMPLER })
-                        .descriptor_count(1)
-                        .stage_flags(vk::ShaderStageFlags::FRAGMENT)
-                })
-                .collect();
-            let set_layout = d
-                .create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&b), None)
-                .map_err(vkerr("vkCreateDescriptorSetLayout"))?;
-            let sizes = [
-                vk::DescriptorPoolSize { ty: vk::DescriptorType::SAMPLED_IMAGE, descriptor_count: 6 },
-                vk::DescriptorPoolSize { ty: vk::DescriptorType::SAMPLER, descriptor_count: 1 },
-            ];
-            let pool = d
-                .create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), None)
-                .map_err(vkerr("vkCreateDescriptorPool"))?;
-            let layouts_arr = [set_layout];
-            let set = d
-                .allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts_arr))
-                .map_err(vkerr("vkAllocateDescriptorSets"))?[0];
-            let ro = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
-            let views = [
-                targets.albedo.view,
-                targets.normal.view,
-                targets.position.view,
-                vk::ImageView::null(),
-                targets.count.view,
-                targets.transmit.view,
-                atlas.view,
-            ];
-            let infos: Vec<[vk::DescriptorImageInfo; 1]> = views
-                .iter()
-                .enumerate()
-                .map(|(i, &v)| {
-                    if i == 3 {
-                        [vk::DescriptorImageInfo { sampler, image_view: vk::ImageView::null(), image_layout: vk::ImageLayout::UNDEFINED }]
-                    } else {
-                        [vk::DescriptorImageInfo { sampler: vk::Sampler::null(), image_view: v, image_layout: ro }]
-                    }
-                })
-                .collect();
-            let writes: Vec<_> = infos
-                .iter()
-                .enumerate()
-                .map(|(i, info)| {
-                    vk::WriteDescriptorSet::default()
-                        .dst_set(set)
-                        .dst_binding(i as u32)
-                        .descriptor_type(if i == 3 { vk::DescriptorType::SAMPLER } else { vk::DescriptorType::SAMPLED_IMAGE })
-                        .image_info(info)
-                })
-                .collect();
-            d.update_descriptor_sets(&writes, &[]);
-            let vf = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
-            let map_push = [vk::PushConstantRange { stage_flags: vf, offset: 0, size: 64 }];
-            let lookup_push = [vk::PushConstantRange { stage_flags: vk::ShaderStageFlags::FRAGMENT, offset: 0, size: 112 }];
-            let l0 = d
-                .create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().push_constant_ranges(&map_push), None)
-                .map_err(vkerr("vkCreatePipelineLayout"))?;
-            let l1 = d
-                .create_pipeline_layout(
-                    &vk::PipelineLayoutCreateInfo::default().set_layouts(&layouts_arr).push_constant_ranges(&lookup_push),
-                    None,
-                )
-                .map_err(vkerr("vkCreatePipelineLayout"))?;
-            (set_layout, pool, set, [l0, l1])
-        };
+        let set = DescriptorSet::new(
+            ctx,
+            &[
+                Binding::Image(targets.albedo.view),
+                Binding::Image(targets.normal.view),
+                Binding::Image(targets.position.view),
+                Binding::Sampler(sampler),
+                Binding::Image(targets.count.view),
+                Binding::Image(targets.transmit.view),
+                Binding::Image(atlas.view),
+            ],
+        )?;
+        let layouts = [
+            pipeline_layout(ctx, &[], 64, vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)?,
+            pipeline_layout(ctx, &[set.layout], 112, vk::ShaderStageFlags::FRAGMENT)?,
+        ];
         let mut m = PipelineDesc::new(shaders::SHADOWMAP_VERT, layouts[0], MAP_FORMAT);
         m.vertex_stride = 12;
         m.attributes = &[(0, vk::Format::R32G32B32_SFLOAT, 0)];
@@ -189,19 +124,7 @@ impl ShadowMapper {
         l.color_formats = &count;
         l.blend = Blend::Additive;
         let lookup_pipeline = pipeline::create(ctx, &l)?;
-        Ok(ShadowMapper {
-            size,
-            atlas,
-            caster_vertices: pos.len() as u32,
-            casters,
-            bounds,
-            set_layout,
-            pool,
-            set,
-            layouts,
-            map_pipeline,
-            lookup_pipeline,
-        })
+        Ok(ShadowMapper { size, atlas, caster_vertices: pos.len() as u32, casters, bounds, set, layouts, map_pipeline, lookup_pipeline })
     }
 
     /// The maps one light needs, in eye-relative coordinates.
@@ -321,7 +244,7 @@ impl ShadowMapper {
             d.cmd_set_viewport(cb, 0, &[vk::Viewport { x: 0.0, y: 0.0, width: w, height: h, min_depth: 0.0, max_depth: 1.0 }]);
             d.cmd_set_scissor(cb, 0, &[scissor]);
             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.lookup_pipeline);
-            d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, self.layouts[1], 0, &[self.set], &[]);
+            d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, self.layouts[1], 0, &[self.set.set], &[]);
             for f in &faces {
                 let mut push = [0f32; 28];
                 push[..16].copy_from_slice(&f.view_proj.to_cols_array());
@@ -354,9 +277,8 @@ impl ShadowMapper {
             for l in self.layouts {
                 d.destroy_pipeline_layout(l, None);
             }
-            d.destroy_descriptor_pool(self.pool, None);
-            d.destroy_descriptor_set_layout(self.set_layout, None);
         }
+        self.set.destroy(ctx);
         self.atlas.destroy(ctx);
         if let Some(mut b) = self.casters.take() {
             b.destroy(ctx);

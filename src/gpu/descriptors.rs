@@ -1,0 +1,109 @@
+//! One-shot descriptor sets for full-screen passes: a layout, an exactly-sized pool and one set,
+//! written once (images in SHADER_READ_ONLY_OPTIMAL, fragment stage).
+
+use super::context::Context;
+use crate::error::{Error, Result};
+use ash::vk;
+
+fn vkerr(call: &'static str) -> impl Fn(vk::Result) -> Error {
+    move |r| Error::Vulkan { call, result: format!("{r:?}") }
+}
+
+/// What a binding holds, in binding order.
+#[derive(Clone, Copy)]
+pub enum Binding {
+    Image(vk::ImageView),
+    Sampler(vk::Sampler),
+}
+
+pub struct DescriptorSet {
+    pub layout: vk::DescriptorSetLayout,
+    pub set: vk::DescriptorSet,
+    pool: vk::DescriptorPool,
+}
+
+impl DescriptorSet {
+    pub fn new(ctx: &Context, bindings: &[Binding]) -> Result<DescriptorSet> {
+        let ty = |b: &Binding| match b {
+            Binding::Image(_) => vk::DescriptorType::SAMPLED_IMAGE,
+            Binding::Sampler(_) => vk::DescriptorType::SAMPLER,
+        };
+        let layout_bindings: Vec<_> = bindings
+            .iter()
+            .enumerate()
+            .map(|(i, b)| {
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(i as u32)
+                    .descriptor_type(ty(b))
+                    .descriptor_count(1)
+                    .stage_flags(vk::ShaderStageFlags::FRAGMENT)
+            })
+            .collect();
+        let images = bindings.iter().filter(|b| matches!(b, Binding::Image(_))).count() as u32;
+        let samplers = bindings.len() as u32 - images;
+        let sizes: Vec<_> = [(vk::DescriptorType::SAMPLED_IMAGE, images), (vk::DescriptorType::SAMPLER, samplers)]
+            .into_iter()
+            .filter(|&(_, n)| n > 0)
+            .map(|(ty, descriptor_count)| vk::DescriptorPoolSize { ty, descriptor_count })
+            .collect();
+        let d = &ctx.device;
+        // SAFETY: creation on a valid device with create infos built from locals; the objects
+        // are destroyed in `destroy` (pool before layout, the set with its pool).
+        unsafe {
+            let layout = d
+                .create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&layout_bindings), None)
+                .map_err(vkerr("vkCreateDescriptorSetLayout"))?;
+            let pool = d
+                .create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(1).pool_sizes(&sizes), None)
+                .map_err(vkerr("vkCreateDescriptorPool"))?;
+            let layouts = [layout];
+            let set = d
+                .allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(pool).set_layouts(&layouts))
+                .map_err(vkerr("vkAllocateDescriptorSets"))?[0];
+            let infos: Vec<[vk::DescriptorImageInfo; 1]> = bindings
+                .iter()
+                .map(|b| match *b {
+                    Binding::Image(view) => [vk::DescriptorImageInfo {
+                        sampler: vk::Sampler::null(),
+                        image_view: view,
+                        image_layout: vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                    }],
+                    Binding::Sampler(sampler) => {
+                        [vk::DescriptorImageInfo { sampler, image_view: vk::ImageView::null(), image_layout: vk::ImageLayout::UNDEFINED }]
+                    }
+                })
+                .collect();
+            let writes: Vec<_> = bindings
+                .iter()
+                .zip(&infos)
+                .enumerate()
+                .map(|(i, (b, info))| {
+                    vk::WriteDescriptorSet::default().dst_set(set).dst_binding(i as u32).descriptor_type(ty(b)).image_info(info)
+                })
+                .collect();
+            d.update_descriptor_sets(&writes, &[]);
+            Ok(DescriptorSet { layout, set, pool })
+        }
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: the owner waited for the device to be idle; freeing the pool frees the set.
+        unsafe {
+            ctx.device.destroy_descriptor_pool(self.pool, None);
+            ctx.device.destroy_descriptor_set_layout(self.layout, None);
+        }
+    }
+}
+
+/// A pipeline layout with the given set layouts and one push-constant range (0 bytes: none).
+pub fn pipeline_layout(
+    ctx: &Context,
+    sets: &[vk::DescriptorSetLayout],
+    push_bytes: u32,
+    stages: vk::ShaderStageFlags,
+) -> Result<vk::PipelineLayout> {
+    let ranges = [vk::PushConstantRange { stage_flags: stages, offset: 0, size: push_bytes }];
+    let info = vk::PipelineLayoutCreateInfo::default().set_layouts(sets).push_constant_ranges(if push_bytes > 0 { &ranges } else { &[] });
+    // SAFETY: valid device; the create info points at locals alive for the call.
+    unsafe { ctx.device.create_pipeline_layout(&info, None) }.map_err(vkerr("vkCreatePipelineLayout"))
+}
