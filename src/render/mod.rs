@@ -15,9 +15,11 @@
 //! enclosing volume, with wrap ops so the order of faces does not matter.
 
 pub mod frame;
+pub mod options;
 pub mod shadowmap;
 pub mod stats;
 pub mod targets;
 
-pub use frame::{Counter, DepthMode, FrameOutput, IndexFormat, RenderOptions, Renderer, TransmitMode, View};
+pub use frame::{FrameOutput, Renderer};
+pub use options::{Counter, DepthMode, IndexFormat, RenderOptions, TransmitMode, View};
 pub use stats::Stats;
