@@ -465,119 +465,7 @@ impl Renderer {
 
         // 2. Shadow geometry stream for the frame.
         let record_start = Instant::now();
-        let u8_ok = self.ctx.features.index_type_uint8;
-        let mut stream: Vec<u8> = Vec::new();
-        // Per light, per caster: draws (chunk, stream offset, count, format, is_light_cap).
-        let mut draws: Vec<Vec<CasterDraws>> = Vec::new();
-        let mut light_stats = Vec::new();
-        let mut totals = Totals::default();
-        let mut cpu = CpuMs::default();
-        for (li, plan) in plans.iter().enumerate() {
-            cpu.silhouettes += plan.silhouette_ms;
-            cpu.plan += plan.plan_ms;
-            let mut ldraws = Vec::new();
-            let mut cstats = Vec::new();
-            for cp in &plan.casters {
-                let caster = &self.casters[cp.caster];
-                let mut cdraws = Vec::new();
-                let mut index_bytes = 0u64;
-                let mut vertex_bytes = 0u64;
-                let mut fmt_used = "none";
-                for cd in &cp.chunks {
-                    let chunk = &caster.chunks[cd.chunk];
-                    let n = chunk.vertices.len();
-                    for (indices, cap) in [(&cd.volume, false), (&cd.light_cap, true)] {
-                        if indices.is_empty() {
-                            continue;
-                        }
-                        let fmt = match self.opts.index_format {
-                            IndexFormat::Auto | IndexFormat::U8 if u8_ok && 2 * n <= 256 => IndexFormat::U8,
-                            IndexFormat::Auto | IndexFormat::U8 => IndexFormat::U16,
-                            f => f,
-                        };
-                        fmt_used = fmt.name();
-                        align(&mut stream, 16);
-                        let offset = stream.len() as u64;
-                        match fmt {
-                            IndexFormat::U8 => stream.extend(indices.iter().map(|&i| i as u8)),
-                            IndexFormat::U16 => stream.extend(indices.iter().flat_map(|&i| i.to_le_bytes())),
-                            IndexFormat::U32 => stream.extend(indices.iter().flat_map(|&i| (i as u32).to_le_bytes())),
-                            IndexFormat::Naive | IndexFormat::Auto => {
-                                for &i in indices.iter() {
-                                    let i = i as usize;
-                                    let (v, wv) = if i < n { (chunk.vertices[i], 1.0f32) } else { (chunk.vertices[i - n], 0.0) };
-                                    for f in [v.x, v.y, v.z, wv] {
-                                        stream.extend(f.to_le_bytes());
-                                    }
-                                }
-                            }
-                        }
-                        let bytes = stream.len() as u64 - offset;
-                        if fmt == IndexFormat::Naive {
-                            vertex_bytes += bytes;
-                        } else {
-                            index_bytes += bytes;
-                        }
-                        cdraws.push(Draw { chunk: cd.chunk, offset, count: indices.len() as u32, format: fmt, light_cap: cap });
-                    }
-                }
-                let tris = Triangles { sides: cp.sides as u64, dark_cap: cp.dark_cap as u64, light_cap: cp.light_cap as u64 };
-                let ntris = tris.total();
-                totals.triangles.add(&tris);
-                totals.index_bytes += index_bytes;
-                totals.vertex_bytes += vertex_bytes;
-                match cp.case {
-                    Case::Culled => totals.cases.culled += 1,
-                    Case::ZPass => totals.cases.zpass += 1,
-                    Case::ZFail => totals.cases.zfail += 1,
-                    Case::ZFailLightCap => totals.cases.zfail_light_cap += 1,
-                }
-                cstats.push(CasterStats {
-                    name: caster.name.clone(),
-                    case: case_name(cp.case).to_string(),
-                    silhouette_edges: cp.silhouette_edges as u64,
-                    triangles: tris,
-                    index_bytes,
-                    vertex_bytes,
-                    bytes_per_triangle: if ntris > 0 { (index_bytes + vertex_bytes) as f64 / ntris as f64 } else { 0.0 },
-                    index_format: fmt_used.to_string(),
-                    dark_cap_kind: format!("{:?}", cp.dark_cap_kind),
-                    path: cp.path.to_string(),
-                    path_reason: match &caster.kind {
-                        crate::shadow::CasterKind::Multiplicity { reason } => reason.clone(),
-                        _ => String::new(),
-                    },
-                    multiplicity_max: cp.multiplicity_max,
-                });
-                ldraws.push((cp.caster, cp.case, Vec4::from_array(cp.light_object), cdraws, cp.path == "edgequad"));
-            }
-            let light = &self.scene.lights[li];
-            light_stats.push(LightStats {
-                index: li,
-                kind: format!("{:?}", light.kind).to_lowercase(),
-                scissor: plan.scissor,
-                depth_bounds: if self.ctx.features.depth_bounds { plan.depth_bounds.map(|(a, b)| [a, b]) } else { None },
-                casters: cstats,
-            });
-            draws.push(ldraws);
-        }
-        align(&mut stream, 16);
-        if self.stream.as_ref().map(|b| b.size < stream.len() as u64).unwrap_or(true) {
-            if let Some(mut old) = self.stream.take() {
-                old.destroy(&self.ctx);
-            }
-            let size = (stream.len() as u64).max(1 << 16).next_power_of_two();
-            self.stream = Some(Buffer::new(
-                &self.ctx,
-                "shadow stream",
-                size,
-                vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::VERTEX_BUFFER,
-                MemoryLocation::CpuToGpu,
-            )?);
-        }
-        let stream_buf = self.stream.as_mut().ok_or_else(|| Error::Other("no stream buffer".into()))?;
-        stream_buf.write(0, &stream)?;
-        let stream_raw = stream_buf.raw;
+        let StreamedFrame { draws, light_stats, totals, mut cpu, stream: stream_raw } = self.build_stream(&plans)?;
 
         // 3. Readback buffers.
         let npx = (w * h) as u64;
@@ -1157,63 +1045,7 @@ impl Renderer {
         };
 
         // 6. Read back.
-        let color = self.readback[0].read()?.to_vec();
-        let (mut positions, mut normals, mut stencil, mut counts, mut transmit) =
-            (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
-        if capture {
-            let floats = |b: &Buffer| -> Result<Vec<[f32; 4]>> {
-                Ok(b.read()?
-                    .chunks_exact(16)
-                    .map(|c| std::array::from_fn(|k| f32::from_le_bytes([c[4 * k], c[4 * k + 1], c[4 * k + 2], c[4 * k + 3]])))
-                    .collect())
-            };
-            let pos = floats(&self.readback[1])?;
-            let nrm = floats(&self.readback[2])?;
-            for (p, n) in pos.iter().zip(&nrm) {
-                if p[3] == 0.0 {
-                    positions.push([f32::NAN; 3]);
-                    normals.push([f32::NAN; 3]);
-                } else {
-                    let wp = DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64) + eye;
-                    positions.push(wp.as_vec3().to_array());
-                    normals.push([n[0], n[1], n[2]]);
-                }
-            }
-            for li in 0..nlights {
-                let raw = self.readback[3 + li].read()?;
-                if float_counts {
-                    let c: Vec<i32> = raw.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]).round() as i32).collect();
-                    stencil.push(c.iter().map(|&v| v.clamp(0, 255) as u8).collect());
-                    counts.push(c);
-                } else {
-                    stencil.push(raw.to_vec());
-                }
-                if self.has_transparent {
-                    let raw = self.readback[3 + nlights + li].read()?;
-                    let mode = self.opts.transmit;
-                    let texel = if mode.fp32 { 16 } else { 8 };
-                    let map: Vec<[f32; 3]> = raw
-                        .chunks_exact(texel)
-                        .map(|px| {
-                            let ch = |k: usize| {
-                                if mode.fp32 {
-                                    f32::from_le_bytes([px[4 * k], px[4 * k + 1], px[4 * k + 2], px[4 * k + 3]])
-                                } else {
-                                    f16_to_f32(u16::from_le_bytes([px[2 * k], px[2 * k + 1]]))
-                                }
-                            };
-                            let v = [ch(0), ch(1), ch(2)];
-                            if mode.log {
-                                v.map(f32::exp)
-                            } else {
-                                v
-                            }
-                        })
-                        .collect();
-                    transmit.push(map);
-                }
-            }
-        }
+        let Captured { color, positions, normals, stencil, counts, transmit } = self.read_back(capture, float_counts, eye)?;
 
         let mut features_used = Vec::new();
         let mut features_missing = Vec::new();
@@ -1278,6 +1110,190 @@ impl Renderer {
             }
         }
         Ok(out)
+    }
+
+    /// Turns the plans into this frame's shadow-geometry stream (indices in the chosen format,
+    /// or naive vertices), uploads it, and gathers the per-caster statistics.
+    fn build_stream(&mut self, plans: &[LightPlan]) -> Result<StreamedFrame> {
+        let u8_ok = self.ctx.features.index_type_uint8;
+        let mut stream: Vec<u8> = Vec::new();
+        // Per light, per caster: draws (chunk, stream offset, count, format, is_light_cap).
+        let mut draws: Vec<Vec<CasterDraws>> = Vec::new();
+        let mut light_stats = Vec::new();
+        let mut totals = Totals::default();
+        let mut cpu = CpuMs::default();
+        for (li, plan) in plans.iter().enumerate() {
+            cpu.silhouettes += plan.silhouette_ms;
+            cpu.plan += plan.plan_ms;
+            let mut ldraws = Vec::new();
+            let mut cstats = Vec::new();
+            for cp in &plan.casters {
+                let caster = &self.casters[cp.caster];
+                let mut cdraws = Vec::new();
+                let mut index_bytes = 0u64;
+                let mut vertex_bytes = 0u64;
+                let mut fmt_used = "none";
+                for cd in &cp.chunks {
+                    let chunk = &caster.chunks[cd.chunk];
+                    let n = chunk.vertices.len();
+                    for (indices, cap) in [(&cd.volume, false), (&cd.light_cap, true)] {
+                        if indices.is_empty() {
+                            continue;
+                        }
+                        let fmt = match self.opts.index_format {
+                            IndexFormat::Auto | IndexFormat::U8 if u8_ok && 2 * n <= 256 => IndexFormat::U8,
+                            IndexFormat::Auto | IndexFormat::U8 => IndexFormat::U16,
+                            f => f,
+                        };
+                        fmt_used = fmt.name();
+                        align(&mut stream, 16);
+                        let offset = stream.len() as u64;
+                        match fmt {
+                            IndexFormat::U8 => stream.extend(indices.iter().map(|&i| i as u8)),
+                            IndexFormat::U16 => stream.extend(indices.iter().flat_map(|&i| i.to_le_bytes())),
+                            IndexFormat::U32 => stream.extend(indices.iter().flat_map(|&i| (i as u32).to_le_bytes())),
+                            IndexFormat::Naive | IndexFormat::Auto => {
+                                for &i in indices.iter() {
+                                    let i = i as usize;
+                                    let (v, wv) = if i < n { (chunk.vertices[i], 1.0f32) } else { (chunk.vertices[i - n], 0.0) };
+                                    for f in [v.x, v.y, v.z, wv] {
+                                        stream.extend(f.to_le_bytes());
+                                    }
+                                }
+                            }
+                        }
+                        let bytes = stream.len() as u64 - offset;
+                        if fmt == IndexFormat::Naive {
+                            vertex_bytes += bytes;
+                        } else {
+                            index_bytes += bytes;
+                        }
+                        cdraws.push(Draw { chunk: cd.chunk, offset, count: indices.len() as u32, format: fmt, light_cap: cap });
+                    }
+                }
+                let tris = Triangles { sides: cp.sides as u64, dark_cap: cp.dark_cap as u64, light_cap: cp.light_cap as u64 };
+                let ntris = tris.total();
+                totals.triangles.add(&tris);
+                totals.index_bytes += index_bytes;
+                totals.vertex_bytes += vertex_bytes;
+                match cp.case {
+                    Case::Culled => totals.cases.culled += 1,
+                    Case::ZPass => totals.cases.zpass += 1,
+                    Case::ZFail => totals.cases.zfail += 1,
+                    Case::ZFailLightCap => totals.cases.zfail_light_cap += 1,
+                }
+                cstats.push(CasterStats {
+                    name: caster.name.clone(),
+                    case: case_name(cp.case).to_string(),
+                    silhouette_edges: cp.silhouette_edges as u64,
+                    triangles: tris,
+                    index_bytes,
+                    vertex_bytes,
+                    bytes_per_triangle: if ntris > 0 { (index_bytes + vertex_bytes) as f64 / ntris as f64 } else { 0.0 },
+                    index_format: fmt_used.to_string(),
+                    dark_cap_kind: format!("{:?}", cp.dark_cap_kind),
+                    path: cp.path.to_string(),
+                    path_reason: match &caster.kind {
+                        crate::shadow::CasterKind::Multiplicity { reason } => reason.clone(),
+                        _ => String::new(),
+                    },
+                    multiplicity_max: cp.multiplicity_max,
+                });
+                ldraws.push((cp.caster, cp.case, Vec4::from_array(cp.light_object), cdraws, cp.path == "edgequad"));
+            }
+            let light = &self.scene.lights[li];
+            light_stats.push(LightStats {
+                index: li,
+                kind: format!("{:?}", light.kind).to_lowercase(),
+                scissor: plan.scissor,
+                depth_bounds: if self.ctx.features.depth_bounds { plan.depth_bounds.map(|(a, b)| [a, b]) } else { None },
+                casters: cstats,
+            });
+            draws.push(ldraws);
+        }
+        align(&mut stream, 16);
+        if self.stream.as_ref().map(|b| b.size < stream.len() as u64).unwrap_or(true) {
+            if let Some(mut old) = self.stream.take() {
+                old.destroy(&self.ctx);
+            }
+            let size = (stream.len() as u64).max(1 << 16).next_power_of_two();
+            self.stream = Some(Buffer::new(
+                &self.ctx,
+                "shadow stream",
+                size,
+                vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::VERTEX_BUFFER,
+                MemoryLocation::CpuToGpu,
+            )?);
+        }
+        let stream_buf = self.stream.as_mut().ok_or_else(|| Error::Other("no stream buffer".into()))?;
+        stream_buf.write(0, &stream)?;
+        let stream_raw = stream_buf.raw;
+        Ok(StreamedFrame { draws, light_stats, totals, cpu, stream: stream_raw })
+    }
+
+    /// Reads the frame's readback buffers: colour always; positions (world, NaN for
+    /// background), normals, per-light counts and light-intensity maps when captured.
+    fn read_back(&self, capture: bool, float_counts: bool, eye: DVec3) -> Result<Captured> {
+        let nlights = self.scene.lights.len();
+        let color = self.readback[0].read()?.to_vec();
+        let (mut positions, mut normals, mut stencil, mut counts, mut transmit) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        if capture {
+            let floats = |b: &Buffer| -> Result<Vec<[f32; 4]>> {
+                Ok(b.read()?
+                    .chunks_exact(16)
+                    .map(|c| std::array::from_fn(|k| f32::from_le_bytes([c[4 * k], c[4 * k + 1], c[4 * k + 2], c[4 * k + 3]])))
+                    .collect())
+            };
+            let pos = floats(&self.readback[1])?;
+            let nrm = floats(&self.readback[2])?;
+            for (p, n) in pos.iter().zip(&nrm) {
+                if p[3] == 0.0 {
+                    positions.push([f32::NAN; 3]);
+                    normals.push([f32::NAN; 3]);
+                } else {
+                    let wp = DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64) + eye;
+                    positions.push(wp.as_vec3().to_array());
+                    normals.push([n[0], n[1], n[2]]);
+                }
+            }
+            for li in 0..nlights {
+                let raw = self.readback[3 + li].read()?;
+                if float_counts {
+                    let c: Vec<i32> = raw.chunks_exact(4).map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]).round() as i32).collect();
+                    stencil.push(c.iter().map(|&v| v.clamp(0, 255) as u8).collect());
+                    counts.push(c);
+                } else {
+                    stencil.push(raw.to_vec());
+                }
+                if self.has_transparent {
+                    let raw = self.readback[3 + nlights + li].read()?;
+                    let mode = self.opts.transmit;
+                    let texel = if mode.fp32 { 16 } else { 8 };
+                    let map: Vec<[f32; 3]> = raw
+                        .chunks_exact(texel)
+                        .map(|px| {
+                            let ch = |k: usize| {
+                                if mode.fp32 {
+                                    f32::from_le_bytes([px[4 * k], px[4 * k + 1], px[4 * k + 2], px[4 * k + 3]])
+                                } else {
+                                    f16_to_f32(u16::from_le_bytes([px[2 * k], px[2 * k + 1]]))
+                                }
+                            };
+                            let v = [ch(0), ch(1), ch(2)];
+                            if mode.log {
+                                v.map(f32::exp)
+                            } else {
+                                v
+                            }
+                        })
+                        .collect();
+                    transmit.push(map);
+                }
+            }
+        }
+
+        Ok(Captured { color, positions, normals, stencil, counts, transmit })
     }
 
     /// Binds the chunk's vertices (or the streamed naive vertices) and draws.
@@ -1367,6 +1383,26 @@ fn case_name(c: Case) -> &'static str {
         Case::ZFail => "zfail",
         Case::ZFailLightCap => "zfail_light_cap",
     }
+}
+
+/// What [`Renderer::read_back`] returns (see [`FrameOutput`] for each field).
+struct Captured {
+    color: Vec<u8>,
+    positions: Vec<[f32; 3]>,
+    normals: Vec<[f32; 3]>,
+    stencil: Vec<Vec<u8>>,
+    counts: Vec<Vec<i32>>,
+    transmit: Vec<Vec<[f32; 3]>>,
+}
+
+/// What [`Renderer::build_stream`] hands to the recording.
+struct StreamedFrame {
+    /// Per light, per caster.
+    draws: Vec<Vec<CasterDraws>>,
+    light_stats: Vec<LightStats>,
+    totals: Totals,
+    cpu: CpuMs,
+    stream: vk::Buffer,
 }
 
 /// Per caster and light: caster index, case, object-space light, index-stream draws, and
