@@ -5,7 +5,7 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::{Vec3, Vec4};
 use std::hint::black_box;
-use umbrage::geom::silhouette::{facing_bits, possible_silhouette, possible_silhouette_serial};
+use umbrage::geom::silhouette::{facing_bits, facing_bits_threads, possible_silhouette, possible_silhouette_serial};
 use umbrage::geom::topology::Topology;
 use umbrage::shadow::testmesh::uv_sphere;
 
@@ -46,6 +46,12 @@ fn bench(c: &mut Criterion) {
                 let f = facing_bits(&topo.mesh, black_box(light), false);
                 black_box(possible_silhouette(&topo.manifold_edges, &f).len())
             })
+        });
+        g.bench_function(BenchmarkId::new("facing_serial", tris), |b| {
+            b.iter(|| black_box(facing_bits_threads(&topo.mesh, black_box(light), false, 1).len()))
+        });
+        g.bench_function(BenchmarkId::new("facing", tris), |b| {
+            b.iter(|| black_box(facing_bits(&topo.mesh, black_box(light), false).len()))
         });
         let f = facing_bits(&topo.mesh, light, false);
         g.bench_function(BenchmarkId::new("edge_scan_serial", tris), |b| {
