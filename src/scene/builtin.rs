@@ -13,6 +13,7 @@ pub const SCENES: &[(&str, &str)] = &[
     ("hard/nested_256", include_str!("../../scenes/hard/nested_256.toml")),
     ("hard/open_casters", include_str!("../../scenes/hard/open_casters.toml")),
     ("hard/camera_inside_caster", include_str!("../../scenes/hard/camera_inside_caster.toml")),
+    ("hard/light_at_vertex", include_str!("../../scenes/hard/light_at_vertex.toml")),
     ("hard/eye_in_volume", include_str!("../../scenes/hard/eye_in_volume.toml")),
     ("hard/eye_in_two_volumes", include_str!("../../scenes/hard/eye_in_two_volumes.toml")),
     ("hard/near_plane_cut", include_str!("../../scenes/hard/near_plane_cut.toml")),

@@ -224,6 +224,27 @@ pub fn object_light(caster: &Caster, light_h: Vec4) -> Vec4 {
     }
 }
 
+/// A point light exactly on (or within rounding of) a caster vertex would send that vertex's
+/// w=0 copy to `(0, 0, 0, 0)`, which is no point at all, and the volume would rasterise as
+/// garbage. Such a light is moved away from the caster's centre by a distance far below a pixel
+/// (1e-5 of the caster's size): the shadow is then exact to that distance, and every extrusion
+/// direction is defined. Other lights are returned unchanged.
+pub fn avoid_vertex(caster: &Caster, l_obj: Vec4) -> Vec4 {
+    if l_obj.w == 0.0 {
+        return l_obj;
+    }
+    let b = caster.object_bounds;
+    let size = b.extent().length().max(f32::MIN_POSITIVE);
+    let eps = size * 1e-5;
+    let l = l_obj.truncate();
+    let near_box = l.cmpge(b.min - eps).all() && l.cmple(b.max + eps).all();
+    if !near_box || !caster.mesh().positions.iter().any(|p| p.distance(l) <= eps) {
+        return l_obj;
+    }
+    let away = (l - b.center()).try_normalize().unwrap_or(glam::Vec3::Y);
+    (l + away * (4.0 * eps)).extend(1.0)
+}
+
 fn spot_culls(light: &Light, b: &Aabb) -> bool {
     if light.kind != LightKind::Spot {
         return false;
@@ -532,7 +553,7 @@ pub fn plan_light_opts(input: &PlanInput, casters: &[Caster], edge_quads: bool) 
     let mut plans = Vec::with_capacity(casters.len());
     for (ci, caster) in casters.iter().enumerate() {
         let wb = caster.world_bounds();
-        let l_obj = object_light(caster, light_h);
+        let l_obj = avoid_vertex(caster, object_light(caster, light_h));
         let culled_plan = |case| CasterPlan {
             caster: ci,
             case,

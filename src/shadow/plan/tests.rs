@@ -135,8 +135,16 @@ fn light_inside_uses_back_faces() {
     assert_eq!(cp.dark_cap_kind, DarkCap::BackFaces);
     assert_eq!(counts(cp), (Case::ZFailLightCap, 0, 12, 12));
     assert_closed(&c[0], cp, false);
-    // a light exactly on the box (corner) is also treated with back faces
-    let p = plan(&cam3(), &point(Vec3::new(0.5, 0.5, 0.5)), Method::McGuire, &c);
+    // a light exactly on a vertex (the corner) is moved off it by a tiny distance, away from
+    // the box (no w=0 copy may be (0,0,0,0)), and the volume is closed
+    let corner = Vec3::new(0.5, 0.5, 0.5);
+    let p = plan(&cam3(), &point(corner), Method::McGuire, &c);
+    let moved = Vec4::from_array(p.casters[0].light_object).truncate();
+    assert!(moved != corner && moved.distance(corner) < 1e-4, "{moved:?}");
+    assert!(!c[0].object_bounds.contains(moved));
+    assert_closed(&c[0], &p.casters[0], false);
+    // a light on a face (not a vertex) stays where it is and uses back faces
+    let p = plan(&cam3(), &point(Vec3::new(0.5, 0.1, 0.2)), Method::McGuire, &c);
     assert_eq!(p.casters[0].formulation, Formulation::Back);
     assert_closed(&c[0], &p.casters[0], false);
     // light in the AABB but outside a (non-convex) torus
