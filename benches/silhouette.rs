@@ -3,7 +3,7 @@
 //! indices + edge records) in the same run, so throughput can be compared to memory speed.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use glam::{Vec3, Vec4};
+use glam::Vec4;
 use std::hint::black_box;
 use umbrage::geom::silhouette::{facing_bits, facing_bits_threads, possible_silhouette, possible_silhouette_serial};
 use umbrage::geom::topology::Topology;
@@ -61,7 +61,6 @@ fn bench(c: &mut Criterion) {
             b.iter(|| black_box(possible_silhouette(&topo.manifold_edges, black_box(&f)).len()))
         });
         g.finish();
-        let _ = Vec3::ZERO;
     }
 }
 

@@ -118,7 +118,6 @@ struct EdgeQuadGpu {
 /// A caster chunk on the GPU: the dual-length vertex buffer (n x (xyz,1) then n x (xyz,0)).
 struct GpuChunk {
     vertices: Buffer,
-    n: u32,
 }
 
 struct Pipelines {
@@ -219,7 +218,7 @@ impl Renderer {
                 data.extend(ch.vertices.iter().map(|v| [v.x, v.y, v.z, 1.0]));
                 data.extend(ch.vertices.iter().map(|v| [v.x, v.y, v.z, 0.0]));
                 let vertices = upload(&ctx, &format!("caster {}", c.name), bytes_of(&data), vk::BufferUsageFlags::VERTEX_BUFFER)?;
-                chunks.push(GpuChunk { vertices, n: ch.vertices.len() as u32 });
+                chunks.push(GpuChunk { vertices });
             }
             gpu_casters.push(chunks);
         }
@@ -1314,7 +1313,6 @@ impl Renderer {
                         IndexFormat::U32 => vk::IndexType::UINT32,
                         _ => vk::IndexType::UINT16,
                     };
-                    let _ = chunk.n;
                     d.cmd_bind_vertex_buffers(cb, 0, &[chunk.vertices.raw], &[0]);
                     d.cmd_bind_index_buffer(cb, stream, dr.offset, ty);
                     d.cmd_draw_indexed(cb, dr.count, 1, 0, 0, 0);
