@@ -116,6 +116,14 @@ pub fn info_report(ctx: &Context) -> InfoReport {
         ),
         ("pipelineStatisticsQuery".into(), yes_no(f.pipeline_statistics_query, "present", "missing")),
         ("timestamps".into(), yes_no(f.timestamps, "used: gpu_ms in --stats", "missing: gpu_ms omitted")),
+        (
+            "R32_SFLOAT blending".into(),
+            yes_no(f.r32f_blend, "available: --counter float, shadow maps, --self-shadow", "missing: --counter stencil only"),
+        ),
+        (
+            "RGBA32F blending".into(),
+            yes_no(f.rgba32f_blend, "available: --transmit log32|mul32", "missing: fp16 light-intensity maps only"),
+        ),
         ("depth-stencil format".into(), format!("{} (8 stencil bits, wrap increments)", f.depth_stencil_format)),
     ];
     InfoReport { device: ctx.info.clone(), features: f.clone(), validation: ctx.validation, paths }

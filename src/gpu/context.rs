@@ -27,6 +27,11 @@ pub struct Features {
     pub timestamp_period_ns: f32,
     pub depth_stencil_format: String,
     pub geometry_shader: bool,
+    /// R32_SFLOAT can be blended as a colour attachment (optional in Vulkan): `--counter float`
+    /// and the shadow-map baseline need it.
+    pub r32f_blend: bool,
+    /// R32G32B32A32_SFLOAT can be blended (optional): the fp32 light-intensity map needs it.
+    pub rgba32f_blend: bool,
 }
 
 #[derive(Clone, Debug, serde::Serialize)]
@@ -290,6 +295,11 @@ impl Context {
             })
             .ok_or_else(|| Error::Unsupported(format!("{name}: no depth-stencil format with 8 stencil bits (D32S8 or D24S8)")))?;
 
+        let blendable = |f: vk::Format| {
+            // SAFETY: format query on a valid physical device.
+            let p = unsafe { instance.get_physical_device_format_properties(physical, f) };
+            p.optimal_tiling_features.contains(vk::FormatFeatureFlags::COLOR_ATTACHMENT_BLEND)
+        };
         let features = Features {
             depth_clamp: base.depth_clamp == vk::TRUE,
             depth_bounds: base.depth_bounds == vk::TRUE,
@@ -300,6 +310,8 @@ impl Context {
             timestamp_period_ns: props.limits.timestamp_period,
             depth_stencil_format: format!("{depth_format:?}"),
             geometry_shader: base.geometry_shader == vk::TRUE,
+            r32f_blend: blendable(vk::Format::R32_SFLOAT),
+            rgba32f_blend: blendable(vk::Format::R32G32B32A32_SFLOAT),
         };
 
         let enabled = vk::PhysicalDeviceFeatures::default()

@@ -197,12 +197,7 @@ impl Renderer {
         if opts.width == 0 || opts.height == 0 || opts.width > 16384 || opts.height > 16384 {
             return Err(Error::Other(format!("invalid image size {}x{} (1..=16384 each)", opts.width, opts.height)));
         }
-        if opts.depth_mode == DepthMode::Clamp && !ctx.features.depth_clamp {
-            return Err(Error::Unsupported("--depth-mode clamp needs the depthClamp feature; use --depth-mode infinite".into()));
-        }
-        if opts.index_format == IndexFormat::U8 && !ctx.features.index_type_uint8 {
-            return Err(Error::Unsupported("--index-format u8 needs VK_EXT_index_type_uint8; use auto or u16".into()));
-        }
+        check_options(&ctx, &opts)?;
         // Casters: CPU preparation (welding, topology, chunks) then the dual-length buffers.
         let mut casters = Vec::new();
         for m in &scene.meshes {
@@ -394,6 +389,7 @@ impl Renderer {
 
     /// Plans every light (CPU), then records, submits and reads back one frame.
     pub fn render(&mut self) -> Result<FrameOutput> {
+        check_options(&self.ctx, &self.opts)?;
         let wall = Instant::now();
         let (w, h) = (self.opts.width, self.opts.height);
         let proj = self.projection();
@@ -1354,6 +1350,28 @@ fn shell_count(mesh: &crate::geom::Mesh) -> usize {
     roots.sort_unstable();
     roots.dedup();
     roots.len()
+}
+
+/// The options this device can honour (checked at creation and before every frame, since
+/// benchmarks switch methods and counters between frames).
+fn check_options(ctx: &Context, opts: &RenderOptions) -> Result<()> {
+    if opts.depth_mode == DepthMode::Clamp && !ctx.features.depth_clamp {
+        return Err(Error::Unsupported("--depth-mode clamp needs the depthClamp feature; use --depth-mode infinite".into()));
+    }
+    if opts.index_format == IndexFormat::U8 && !ctx.features.index_type_uint8 {
+        return Err(Error::Unsupported("--index-format u8 needs VK_EXT_index_type_uint8; use auto or u16".into()));
+    }
+    if (opts.counter == Counter::Float || opts.shadow_map.is_some() || opts.self_shadow) && !ctx.features.r32f_blend {
+        return Err(Error::Unsupported(
+        "--counter float, --method shadowmap and --self-shadow need R32_SFLOAT colour blending, which this device lacks; use --counter stencil".into(),
+        ));
+    }
+    if opts.transmit.fp32 && !ctx.features.rgba32f_blend {
+        return Err(Error::Unsupported(
+            "--transmit log32/mul32 need R32G32B32A32_SFLOAT blending, which this device lacks; use log16".into(),
+        ));
+    }
+    Ok(())
 }
 
 /// IEEE half to single precision (readback of RGBA16F targets).
