@@ -50,14 +50,23 @@ fn ambient_and_light_without_casters() {
 #[test]
 fn default_scene_with_every_view_tears_down_cleanly() {
     let Some(mut ctx) = common::context() else { return };
+    let mut images = Vec::new();
     for view in [View::Shaded, View::Volumes, View::Stencil] {
         let scene = umbrage::scene::load("default").unwrap();
         let mut r = Renderer::new(ctx, scene, RenderOptions { width: 96, height: 64, view, ..Default::default() }).unwrap();
         let out = r.render().unwrap();
         assert_eq!(out.color.len(), 96 * 64 * 4);
+        images.push(out.color);
         r.ctx.check_validation().unwrap();
         ctx = r.into_context();
     }
+    // The debug views really draw: volumes tint part of the shaded image (the default scene's
+    // casters are all z-pass, drawn blue), and the stencil heat map is not the shaded image.
+    let differ = |a: &[u8], b: &[u8]| a.chunks(4).zip(b.chunks(4)).filter(|(p, q)| p != q).count();
+    let bluer = images[0].chunks(4).zip(images[1].chunks(4)).filter(|(p, q)| q[2] as i32 - q[0] as i32 > p[2] as i32 - p[0] as i32).count();
+    assert!(differ(&images[0], &images[1]) > 96 * 64 / 10, "volumes view draws nothing");
+    assert!(bluer > 96 * 64 / 10, "z-pass volumes should tint blue ({bluer} pixels)");
+    assert!(differ(&images[0], &images[2]) > 96 * 64 / 2, "stencil view is the shaded image");
     let log = ctx.validation_log();
     drop(ctx);
     let errors = log.lock().unwrap().errors.clone();
