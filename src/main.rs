@@ -71,6 +71,10 @@ enum Command {
     Info {
         #[arg(long)]
         json: bool,
+        /// Also classify this scene's casters: which path each takes (three-case manifold or
+        /// multiplicity) and why, with their triangles and chunks.
+        #[arg(long)]
+        scene: Option<String>,
     },
     /// Speed against error: every method on each scene, side by side on this device.
     Bench {
@@ -152,7 +156,7 @@ fn main() -> ExitCode {
         dump: None,
     }) {
         Command::Render { frame, out, stats, view, dump } => render(&frame, &out, stats.as_deref(), &view, dump.as_deref()),
-        Command::Info { json } => info(json),
+        Command::Info { json, scene } => info(json, scene.as_deref()),
         Command::Check { dir, band, threshold } => check(&dir, band, threshold),
         Command::Bench { scenes, methods, frames, size, index_format, counters, shadow_map_size, json, markdown } => {
             let sm = (shadow_map_size > 0).then_some(shadow_map_size);
@@ -231,13 +235,31 @@ fn render(frame: &FrameArgs, out: &Path, stats: Option<&Path>, view: &str, dump:
     Ok(ExitCode::SUCCESS)
 }
 
-fn info(json: bool) -> Result<ExitCode> {
+fn info(json: bool, scene: Option<&str>) -> Result<ExitCode> {
+    let casters = match scene {
+        Some(s) => Some(umbrage::output::caster_report(&umbrage::scene::load(s)?)?),
+        None => None,
+    };
     let ctx = umbrage::gpu::Context::new()?;
     let report = umbrage::output::info_report(&ctx);
     if json {
-        println!("{}", serde_json::to_string_pretty(&report).map_err(|e| Error::Other(e.to_string()))?);
+        let mut value = serde_json::to_value(&report).map_err(|e| Error::Other(e.to_string()))?;
+        if let (Some(obj), Some(c)) = (value.as_object_mut(), casters) {
+            obj.insert("casters".into(), serde_json::to_value(c).map_err(|e| Error::Other(e.to_string()))?);
+        }
+        println!("{}", serde_json::to_string_pretty(&value).map_err(|e| Error::Other(e.to_string()))?);
     } else {
         println!("{}", umbrage::output::info_text(&report));
+        for c in casters.iter().flatten() {
+            println!(
+                "  caster {:<24} {:<12} {:>8} triangles {:>3} chunk(s){}",
+                c.name,
+                c.path,
+                c.triangles,
+                c.chunks,
+                if c.reason.is_empty() { String::new() } else { format!("  ({})", c.reason) }
+            );
+        }
     }
     Ok(ExitCode::SUCCESS)
 }

@@ -144,3 +144,39 @@ pub fn info_text(r: &InfoReport) -> String {
     }
     s
 }
+
+/// How one caster of a scene is handled, as classified once at load.
+#[derive(serde::Serialize)]
+pub struct CasterInfo {
+    pub name: String,
+    /// "manifold" (McGuire's three cases) or "multiplicity" (Kim et al.).
+    pub path: String,
+    /// Why a caster takes the multiplicity path (empty for manifold casters).
+    pub reason: String,
+    pub triangles: usize,
+    pub chunks: usize,
+    pub transparent: bool,
+}
+
+/// Classifies every shadow-casting mesh of `scene` (no GPU needed).
+pub fn caster_report(scene: &Scene) -> Result<Vec<CasterInfo>> {
+    scene
+        .meshes
+        .iter()
+        .filter(|m| m.casts_shadow)
+        .map(|m| {
+            let c = crate::shadow::Caster::from_scene_mesh(m)?;
+            Ok(CasterInfo {
+                name: c.name.clone(),
+                path: c.kind.path().to_string(),
+                reason: match &c.kind {
+                    crate::shadow::CasterKind::Multiplicity { reason } => reason.clone(),
+                    _ => String::new(),
+                },
+                triangles: c.triangle_count,
+                chunks: c.chunks.len(),
+                transparent: c.transmittance.is_some(),
+            })
+        })
+        .collect()
+}

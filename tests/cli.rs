@@ -97,8 +97,14 @@ fn render_stats_dump_and_check() {
     assert_eq!(std::fs::metadata(dump.join("positions.f32")).unwrap().len(), 160 * 120 * 3 * 4);
     let check = umbrage(&["check", dump.to_str().unwrap()]);
     assert!(check.status.success(), "{}", String::from_utf8_lossy(&check.stdout));
-    let info = umbrage(&["info", "--json"]);
+    let info = umbrage(&["info", "--json", "--scene", "hard/open_casters"]);
     assert!(info.status.success());
     let v: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
     assert!(v["features"].get("depth_clamp").is_some());
+    // info says which path each caster takes, and why
+    let casters = v["casters"].as_array().unwrap();
+    let open_box = casters.iter().find(|c| c["name"] == "open_box").unwrap();
+    assert_eq!(open_box["path"], "multiplicity");
+    assert!(open_box["reason"].as_str().unwrap().contains("boundary"));
+    assert!(casters.iter().any(|c| c["path"] == "manifold"));
 }
