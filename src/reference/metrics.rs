@@ -202,10 +202,9 @@ pub fn compare_states(mask: &[u8], states: &[LightState], band: &[bool]) -> Metr
     m
 }
 
-/// The geometric samples of a reference rendering (mesh ids known).
-pub fn geo_samples(image: &RefImage) -> Vec<GeoSample> {
-    image
-        .pixels
+/// The geometric samples of a reference rendering's pixels (mesh ids known).
+pub fn geo_samples(pixels: &[super::RefPixel]) -> Vec<GeoSample> {
+    pixels
         .iter()
         .map(|p| {
             if p.hit {
@@ -239,7 +238,7 @@ pub fn compare(mask: &[u8], image: &RefImage, light: usize, band: u32) -> Result
     let (w, h) = (image.width as usize, image.height as usize);
     check_sizes("mask", mask.len(), w, h, light, image.light_count)?;
     let states = image.light_states(light);
-    let geo = geometry_edges(&geo_samples(image), w, h);
+    let geo = geometry_edges(&geo_samples(&image.pixels), w, h);
     let band = band_mask(&states, &geo, w, h, band);
     Ok(compare_states(mask, &states, &band))
 }

@@ -395,20 +395,25 @@ impl Reference {
     /// light. Transparent casters (non-zero filter) do not occlude: they attenuate, and are
     /// judged by [`Reference::transmittance_at`].
     fn occluded(&self, p: DVec3, n: DVec3, light: &Light) -> bool {
+        self.shadow_segment(p, n, light)
+            .is_some_and(|(o, d, t_max)| self.occluders.any_hit(o, d, 0.0, t_max, |t| self.filter(t) != [0.0; 3]))
+    }
+
+    /// The shadow ray of surface point `p` (offset along `n`): origin, unit direction towards
+    /// the light, and the distance to stop at (short of a point light by the same offset).
+    /// `None` when a point light is closer than the offset.
+    pub(crate) fn shadow_segment(&self, p: DVec3, n: DVec3, light: &Light) -> Option<(DVec3, DVec3, f64)> {
         let off = self.tolerance.surface_offset_rel * self.scale;
         let o = p + n * off;
         match light.kind {
-            LightKind::Directional => {
-                let d = -light.direction.as_dvec3().normalize();
-                self.occluders.any_hit(o, d, 0.0, f64::INFINITY, |t| self.filter(t) != [0.0; 3])
-            }
+            LightKind::Directional => Some((o, -light.direction.as_dvec3().normalize(), f64::INFINITY)),
             _ => {
                 let to = light.position.as_dvec3() - o;
                 let dist = to.length();
                 if dist.is_nan() || dist <= off {
-                    return false;
+                    return None;
                 }
-                self.occluders.any_hit(o, to / dist, 0.0, dist - off, |t| self.filter(t) != [0.0; 3])
+                Some((o, to / dist, dist - off))
             }
         }
     }

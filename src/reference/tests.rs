@@ -521,7 +521,7 @@ fn reference_homogeneous_light_round_trip() {
 /// Timing check (run with `cargo test --lib reference_perf -- --ignored --nocapture`):
 /// ~100k triangles, 512x512, two lights.
 #[test]
-#[ignore]
+#[ignore = "timing: ~100k triangles at 512x512; run with -- --ignored --nocapture"]
 fn reference_perf_512() {
     let mut meshes = vec![(plane(10.0), true)];
     for k in 0..5 {

@@ -25,10 +25,10 @@
 //! triangle of the same mesh, e.g. across a tessellation edge, is not a change, but one that
 //! crosses a different number of surfaces, or another mesh's, is).
 
-use super::metrics::{self, GeoSample};
+use super::metrics;
 use super::{par_rows, tangent_basis, LightState, RefPixel, Reference};
 use crate::error::Result;
-use crate::scene::{Camera, Light, LightKind, SceneMesh};
+use crate::scene::{Camera, Light, SceneMesh};
 use glam::DVec3;
 
 /// Two light fractions are the same decision when every channel agrees to this.
@@ -117,19 +117,7 @@ impl Reference {
     /// The product of the filters of every caster crossed by the shadow segment of `p`
     /// (offset along unit `n`), stopping early at 0.
     fn segment_fraction(&self, p: DVec3, n: DVec3, light: &Light) -> [f64; 3] {
-        let off = self.tolerance.surface_offset_rel * self.scale;
-        let o = p + n * off;
-        let (d, t_max) = match light.kind {
-            LightKind::Directional => (-light.direction.as_dvec3().normalize(), f64::INFINITY),
-            _ => {
-                let to = light.position.as_dvec3() - o;
-                let dist = to.length();
-                if dist.is_nan() || dist <= off {
-                    return [1.0; 3];
-                }
-                (to / dist, dist - off)
-            }
-        };
+        let Some((o, d, t_max)) = self.shadow_segment(p, n, light) else { return [1.0; 3] };
         let mut f = [1.0f64; 3];
         self.occluders.all_hits(o, d, 0.0, t_max, |h| {
             let g = self.filter(h.tri);
@@ -145,19 +133,7 @@ impl Reference {
     /// (for tests and diagnostics).
     pub fn crossed_triangles(&self, p: DVec3, n: DVec3, light: &Light) -> Vec<u32> {
         let n = n.normalize_or_zero();
-        let off = self.tolerance.surface_offset_rel * self.scale;
-        let o = p + n * off;
-        let (d, t_max) = match light.kind {
-            LightKind::Directional => (-light.direction.as_dvec3().normalize(), f64::INFINITY),
-            _ => {
-                let to = light.position.as_dvec3() - o;
-                let dist = to.length();
-                if dist.is_nan() || dist <= off {
-                    return Vec::new();
-                }
-                (to / dist, dist - off)
-            }
-        };
+        let Some((o, d, t_max)) = self.shadow_segment(p, n, light) else { return Vec::new() };
         let mut v: Vec<u32> = self.occluders.collect_hits(o, d, 0.0, t_max).iter().map(|h| h.tri).collect();
         v.sort_unstable();
         v
@@ -273,24 +249,6 @@ impl TransmitMetrics {
     }
 }
 
-fn geo_of(pixels: &[RefPixel]) -> Vec<GeoSample> {
-    pixels
-        .iter()
-        .map(|p| {
-            if p.hit {
-                GeoSample::Surface {
-                    position: p.position.as_dvec3(),
-                    normal: p.normal.as_dvec3(),
-                    depth: p.depth as f64,
-                    mesh: Some(p.mesh),
-                }
-            } else {
-                GeoSample::Background
-            }
-        })
-        .collect()
-}
-
 /// The band of one light's reference fractions: edges (see [`TransmitMetrics`]) plus
 /// `geo_edges`, dilated by `n` pixels.
 pub fn transmit_band(values: &[Transmit], geo_edges: &[bool], w: usize, h: usize, n: u32) -> Vec<bool> {
@@ -330,7 +288,7 @@ pub fn transmit_error_tol(gpu: &[[f32; 3]], reference: &TransmitImage, light: us
     let (w, h) = (reference.width as usize, reference.height as usize);
     metrics::check_sizes("transmittance", gpu.len(), w, h, light, reference.light_count)?;
     let values = reference.light_values(light);
-    let geo = metrics::geometry_edges(&geo_of(&reference.pixels), w, h);
+    let geo = metrics::geometry_edges(&metrics::geo_samples(&reference.pixels), w, h);
     let band_mask = transmit_band(&values, &geo, w, h, band);
     let mut m = TransmitMetrics { pixels: (w * h) as u64, tolerance, ..TransmitMetrics::default() };
     let mut errors = Vec::new();
@@ -386,7 +344,7 @@ pub fn transmit_error_tol(gpu: &[[f32; 3]], reference: &TransmitImage, light: us
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::{shapes, Scene};
+    use crate::scene::{shapes, LightKind, Scene};
     use glam::{Mat4, Vec2, Vec3};
 
     fn point_light(p: Vec3) -> Light {
@@ -582,7 +540,7 @@ mod tests {
     /// Writes the reference light fraction of light 0 of every transparent scene as PNGs to
     /// `$UMBRAGE_PREVIEW_DIR` (ambiguous magenta, background dark blue).
     #[test]
-    #[ignore]
+    #[ignore = "writes PNG previews to $UMBRAGE_PREVIEW_DIR on request; run with -- --ignored"]
     fn reference_transmit_preview() {
         let Ok(dir) = std::env::var("UMBRAGE_PREVIEW_DIR") else {
             return;

@@ -567,17 +567,7 @@ impl Renderer {
             // Ambient pass.
             let colors: Vec<_> = t.gbuffer().iter().map(|i| att(i, vk::AttachmentLoadOp::CLEAR, zero)).collect();
             let depth_att = att(&t.depth, vk::AttachmentLoadOp::CLEAR, ds_clear);
-            d.cmd_begin_rendering(
-                cb,
-                &vk::RenderingInfo::default()
-                    .render_area(full)
-                    .layer_count(1)
-                    .color_attachments(&colors)
-                    .depth_attachment(&depth_att)
-                    .stencil_attachment(&depth_att),
-            );
-            d.cmd_set_viewport(cb, 0, &[viewport]);
-            d.cmd_set_scissor(cb, 0, &[full]);
+            begin_pass(d, cb, full, viewport, &colors, Some(&depth_att));
             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.pipes.gbuffer);
             let mut push = [0f32; 20];
             push[..16].copy_from_slice(&vp_rel.to_cols_array());
@@ -748,17 +738,7 @@ impl Renderer {
                     let clear = vk::ClearValue { color: vk::ClearColorValue { float32: if log { [0.0; 4] } else { [1.0; 4] } } };
                     transition(ctx, cb, &t.transmit, vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
                     let map_att = [att(&t.transmit, vk::AttachmentLoadOp::CLEAR, clear)];
-                    d.cmd_begin_rendering(
-                        cb,
-                        &vk::RenderingInfo::default()
-                            .render_area(scissor)
-                            .layer_count(1)
-                            .color_attachments(&map_att)
-                            .depth_attachment(&depth_load)
-                            .stencil_attachment(&depth_load),
-                    );
-                    d.cmd_set_viewport(cb, 0, &[viewport]);
-                    d.cmd_set_scissor(cb, 0, &[scissor]);
+                    begin_pass(d, cb, scissor, viewport, &map_att, Some(&depth_load));
                     if ctx.features.depth_bounds {
                         let (lo, hi) = bounds.unwrap_or((0.0, 1.0));
                         d.cmd_set_depth_bounds(cb, lo, hi);
@@ -820,17 +800,7 @@ impl Renderer {
                 let q1 = q0 + 2;
                 ts(vk::PipelineStageFlags2::ALL_COMMANDS, q1);
                 let accum_att = [att(&t.accum, load, zero)];
-                d.cmd_begin_rendering(
-                    cb,
-                    &vk::RenderingInfo::default()
-                        .render_area(scissor)
-                        .layer_count(1)
-                        .color_attachments(&accum_att)
-                        .depth_attachment(&depth_load)
-                        .stencil_attachment(&depth_load),
-                );
-                d.cmd_set_viewport(cb, 0, &[viewport]);
-                d.cmd_set_scissor(cb, 0, &[scissor]);
+                begin_pass(d, cb, scissor, viewport, &accum_att, Some(&depth_load));
                 let p = &self.pipes;
                 let illuminate = match (float, self.has_transparent) {
                     (false, false) => p.illuminate,
@@ -864,17 +834,7 @@ impl Renderer {
             if self.opaque_count < self.scene_vertex_count {
                 let accum_att = [att(&t.accum, load, zero)];
                 let depth_load = att(&t.depth, load, ds_clear);
-                d.cmd_begin_rendering(
-                    cb,
-                    &vk::RenderingInfo::default()
-                        .render_area(full)
-                        .layer_count(1)
-                        .color_attachments(&accum_att)
-                        .depth_attachment(&depth_load)
-                        .stencil_attachment(&depth_load),
-                );
-                d.cmd_set_viewport(cb, 0, &[viewport]);
-                d.cmd_set_scissor(cb, 0, &[full]);
+                begin_pass(d, cb, full, viewport, &accum_att, Some(&depth_load));
                 d.cmd_bind_vertex_buffers(cb, 0, &[self.scene_vertices.raw], &[0]);
                 let n = self.scene_vertex_count - self.opaque_count;
                 let mut push = [0f32; 32];
@@ -921,17 +881,7 @@ impl Renderer {
             if self.opts.view == View::Volumes {
                 let accum_att = [att(&t.accum, load, zero)];
                 let depth_load = att(&t.depth, load, ds_clear);
-                d.cmd_begin_rendering(
-                    cb,
-                    &vk::RenderingInfo::default()
-                        .render_area(full)
-                        .layer_count(1)
-                        .color_attachments(&accum_att)
-                        .depth_attachment(&depth_load)
-                        .stencil_attachment(&depth_load),
-                );
-                d.cmd_set_viewport(cb, 0, &[viewport]);
-                d.cmd_set_scissor(cb, 0, &[full]);
+                begin_pass(d, cb, full, viewport, &accum_att, Some(&depth_load));
                 d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.pipes.volumes);
                 for ldraws in draws.iter() {
                     for (ci, case, light_obj, cdraws, _) in ldraws {
@@ -964,9 +914,7 @@ impl Renderer {
             transition(ctx, cb, &t.accum, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
             transition(ctx, cb, &t.output, vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
             let out_att = [att(&t.output, vk::AttachmentLoadOp::DONT_CARE, zero)];
-            d.cmd_begin_rendering(cb, &vk::RenderingInfo::default().render_area(full).layer_count(1).color_attachments(&out_att));
-            d.cmd_set_viewport(cb, 0, &[viewport]);
-            d.cmd_set_scissor(cb, 0, &[full]);
+            begin_pass(d, cb, full, viewport, &out_att, None);
             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.pipes.tonemap);
             d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, self.layouts[3], 0, &[self.sets[1].set], &[]);
             d.cmd_draw(cb, 3, 1, 0, 0);
@@ -1350,6 +1298,33 @@ fn shell_count(mesh: &crate::geom::Mesh) -> usize {
     roots.sort_unstable();
     roots.dedup();
     roots.len()
+}
+
+/// Begins a dynamic-rendering instance over `area` with colour attachments and an optional
+/// depth-stencil attachment (used for both aspects, as lavapipe needs), and sets the viewport
+/// and a scissor equal to `area`.
+///
+/// # Safety
+/// `cb` must be recording outside any rendering instance, and every attachment's image must be
+/// in the layout its info names.
+unsafe fn begin_pass(
+    d: &ash::Device,
+    cb: vk::CommandBuffer,
+    area: vk::Rect2D,
+    viewport: vk::Viewport,
+    colors: &[vk::RenderingAttachmentInfo],
+    depth_stencil: Option<&vk::RenderingAttachmentInfo>,
+) {
+    let mut info = vk::RenderingInfo::default().render_area(area).layer_count(1).color_attachments(colors);
+    if let Some(ds) = depth_stencil {
+        info = info.depth_attachment(ds).stencil_attachment(ds);
+    }
+    // SAFETY: forwarded to the caller's contract above.
+    unsafe {
+        d.cmd_begin_rendering(cb, &info);
+        d.cmd_set_viewport(cb, 0, &[viewport]);
+        d.cmd_set_scissor(cb, 0, &[area]);
+    }
 }
 
 /// The options this device can honour (checked at creation and before every frame, since

@@ -264,17 +264,7 @@ impl Renderer {
                 // 6. This light over the transparent casters, scaled by both maps.
                 let accum_att = [att(&t.accum, load, zero)];
                 let depth_load = att(&t.depth, load, ds_clear);
-                d.cmd_begin_rendering(
-                    cb,
-                    &vk::RenderingInfo::default()
-                        .render_area(scissor)
-                        .layer_count(1)
-                        .color_attachments(&accum_att)
-                        .depth_attachment(&depth_load)
-                        .stencil_attachment(&depth_load),
-                );
-                d.cmd_set_viewport(cb, 0, &[f.viewport]);
-                d.cmd_set_scissor(cb, 0, &[scissor]);
+                begin_pass(d, cb, scissor, f.viewport, &accum_att, Some(&depth_load));
                 d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, ss.light_pipe);
                 d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, ss.layout, 0, &[ss.set.set], &[]);
                 for (k, v) in f.light_uniforms[li].iter().enumerate() {
