@@ -21,9 +21,26 @@ pub enum Error {
              or run `make deps`"
     )]
     NoDevice(String),
-    /// A Vulkan call failed.
-    #[error("Vulkan error in {call}: {result}")]
-    Vulkan { call: &'static str, result: String },
+    /// A Vulkan call failed: `call` names the entry point, `result` is what it returned.
+    #[error("Vulkan error in {call}: {result:?}")]
+    Vulkan {
+        /// The Vulkan entry point, e.g. `vkCreateBuffer`.
+        call: &'static str,
+        /// What the call returned.
+        #[source]
+        result: ash::vk::Result,
+    },
+    /// gpu-allocator could not allocate memory for `name` (`size` bytes).
+    #[error("allocating {name} ({size} bytes): {source}")]
+    Allocation {
+        /// What the memory was for.
+        name: String,
+        /// Requested size in bytes.
+        size: u64,
+        /// gpu-allocator's error.
+        #[source]
+        source: gpu_allocator::AllocationError,
+    },
     /// A device feature a requested path needs is missing.
     #[error("unsupported on this device: {0}")]
     Unsupported(String),
@@ -44,6 +61,10 @@ impl Error {
     }
     pub fn mesh(name: impl Into<String>, msg: impl Into<String>) -> Self {
         Error::Mesh { name: name.into(), msg: msg.into() }
+    }
+    /// Maps a failed Vulkan call to [`Error::Vulkan`]: `.map_err(Error::vk("vkCreateBuffer"))`.
+    pub fn vk(call: &'static str) -> impl Fn(ash::vk::Result) -> Error {
+        move |result| Error::Vulkan { call, result }
     }
     pub fn io(path: impl Into<String>, source: std::io::Error) -> Self {
         Error::Io { path: path.into(), source }

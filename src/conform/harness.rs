@@ -71,7 +71,7 @@ pub struct Readback {
 }
 
 fn vkerr(call: &'static str) -> impl Fn(vk::Result) -> Error {
-    move |r| Error::Vulkan { call, result: format!("{r:?}") }
+    Error::vk(call)
 }
 
 /// Whether `format` can be a depth-stencil attachment and a transfer source (optimal tiling).

@@ -62,7 +62,9 @@ pub struct Context {
     pub device: ash::Device,
     pub queue: vk::Queue,
     pub queue_family: u32,
-    pub allocator: std::mem::ManuallyDrop<Mutex<gpu_allocator::vulkan::Allocator>>,
+    /// Shared with embedded components ([`crate::pass::ShadowPass`] takes a clone); dropped
+    /// before the device in `Drop`, so every clone must be gone by then.
+    pub allocator: std::mem::ManuallyDrop<Arc<Mutex<gpu_allocator::vulkan::Allocator>>>,
     pub pool: vk::CommandPool,
     pub features: Features,
     pub info: DeviceInfo,
@@ -77,7 +79,7 @@ pub fn validation_requested() -> bool {
 }
 
 fn vkerr(call: &'static str) -> impl Fn(vk::Result) -> Error {
-    move |r| Error::Vulkan { call, result: format!("{r:?}") }
+    Error::vk(call)
 }
 
 unsafe extern "system" fn debug_callback(
@@ -177,7 +179,7 @@ impl Context {
                     buffer_device_address: false,
                     allocation_sizes: Default::default(),
                 })
-                .map_err(|e| Error::Other(format!("gpu-allocator: {e}")))?;
+                .map_err(|source| Error::Allocation { name: "gpu-allocator".into(), size: 0, source })?;
                 let pool_info = vk::CommandPoolCreateInfo::default()
                     .queue_family_index(queue_family)
                     .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
@@ -192,7 +194,7 @@ impl Context {
                     device,
                     queue,
                     queue_family,
-                    allocator: std::mem::ManuallyDrop::new(Mutex::new(allocator)),
+                    allocator: std::mem::ManuallyDrop::new(Arc::new(Mutex::new(allocator))),
                     pool,
                     features,
                     info,
@@ -377,11 +379,10 @@ impl Context {
         }
     }
 
+    /// The allocator, locked (a poisoned lock is recovered: the allocator's state is only
+    /// changed inside its own calls).
     pub fn allocator(&self) -> std::sync::MutexGuard<'_, gpu_allocator::vulkan::Allocator> {
-        match self.allocator.lock() {
-            Ok(g) => g,
-            Err(p) => p.into_inner(),
-        }
+        lock_allocator(&self.allocator)
     }
 
     /// Records commands into a fresh primary command buffer, submits, and waits.
@@ -409,6 +410,33 @@ impl Context {
             r
         };
         result
+    }
+}
+
+/// Locks a shared allocator, recovering a poisoned lock.
+pub fn lock_allocator(a: &Mutex<gpu_allocator::vulkan::Allocator>) -> std::sync::MutexGuard<'_, gpu_allocator::vulkan::Allocator> {
+    match a.lock() {
+        Ok(g) => g,
+        Err(p) => p.into_inner(),
+    }
+}
+
+/// What the resource helpers ([`super::Buffer`], [`super::Image`], pipelines, descriptor
+/// sets) need from a device: umbrage's own [`Context`], or a host engine's device and
+/// allocator handed to [`crate::pass::ShadowPass`].
+pub trait GpuDevice {
+    /// The logical device.
+    fn device(&self) -> &ash::Device;
+    /// The memory allocator, locked.
+    fn allocator(&self) -> std::sync::MutexGuard<'_, gpu_allocator::vulkan::Allocator>;
+}
+
+impl GpuDevice for Context {
+    fn device(&self) -> &ash::Device {
+        &self.device
+    }
+    fn allocator(&self) -> std::sync::MutexGuard<'_, gpu_allocator::vulkan::Allocator> {
+        lock_allocator(&self.allocator)
     }
 }
 

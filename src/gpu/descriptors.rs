@@ -1,12 +1,12 @@
 //! One-shot descriptor sets for full-screen passes: a layout, an exactly-sized pool and one set,
 //! written once (images in SHADER_READ_ONLY_OPTIMAL, fragment stage).
 
-use super::context::Context;
+use super::context::GpuDevice;
 use crate::error::{Error, Result};
 use ash::vk;
 
 fn vkerr(call: &'static str) -> impl Fn(vk::Result) -> Error {
-    move |r| Error::Vulkan { call, result: format!("{r:?}") }
+    Error::vk(call)
 }
 
 /// What a binding holds, in binding order.
@@ -23,7 +23,7 @@ pub struct DescriptorSet {
 }
 
 impl DescriptorSet {
-    pub fn new(ctx: &Context, bindings: &[Binding]) -> Result<DescriptorSet> {
+    pub fn new(ctx: &impl GpuDevice, bindings: &[Binding]) -> Result<DescriptorSet> {
         let ty = |b: &Binding| match b {
             Binding::Image(_) => vk::DescriptorType::SAMPLED_IMAGE,
             Binding::Sampler(_) => vk::DescriptorType::SAMPLER,
@@ -46,7 +46,7 @@ impl DescriptorSet {
             .filter(|&(_, n)| n > 0)
             .map(|(ty, descriptor_count)| vk::DescriptorPoolSize { ty, descriptor_count })
             .collect();
-        let d = &ctx.device;
+        let d = ctx.device();
         // SAFETY: creation on a valid device with create infos built from locals; the objects
         // are destroyed in `destroy` (pool before layout, the set with its pool).
         unsafe {
@@ -86,18 +86,18 @@ impl DescriptorSet {
         }
     }
 
-    pub fn destroy(&mut self, ctx: &Context) {
+    pub fn destroy(&mut self, ctx: &impl GpuDevice) {
         // SAFETY: the owner waited for the device to be idle; freeing the pool frees the set.
         unsafe {
-            ctx.device.destroy_descriptor_pool(self.pool, None);
-            ctx.device.destroy_descriptor_set_layout(self.layout, None);
+            ctx.device().destroy_descriptor_pool(self.pool, None);
+            ctx.device().destroy_descriptor_set_layout(self.layout, None);
         }
     }
 }
 
 /// A pipeline layout with the given set layouts and one push-constant range (0 bytes: none).
 pub fn pipeline_layout(
-    ctx: &Context,
+    ctx: &impl GpuDevice,
     sets: &[vk::DescriptorSetLayout],
     push_bytes: u32,
     stages: vk::ShaderStageFlags,
@@ -105,5 +105,5 @@ pub fn pipeline_layout(
     let ranges = [vk::PushConstantRange { stage_flags: stages, offset: 0, size: push_bytes }];
     let info = vk::PipelineLayoutCreateInfo::default().set_layouts(sets).push_constant_ranges(if push_bytes > 0 { &ranges } else { &[] });
     // SAFETY: valid device; the create info points at locals alive for the call.
-    unsafe { ctx.device.create_pipeline_layout(&info, None) }.map_err(vkerr("vkCreatePipelineLayout"))
+    unsafe { ctx.device().create_pipeline_layout(&info, None) }.map_err(vkerr("vkCreatePipelineLayout"))
 }

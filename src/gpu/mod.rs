@@ -8,5 +8,5 @@ pub mod shaders {
     //! The naga-compiled SPIR-V of every shader in `shaders/` (see build.rs).
     include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
 }
-pub use context::{Context, DeviceInfo, Features};
+pub use context::{Context, DeviceInfo, Features, GpuDevice};
 pub use resources::{Buffer, Image};

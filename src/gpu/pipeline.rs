@@ -1,12 +1,12 @@
 //! Graphics pipelines for dynamic rendering, described by a plain struct so that every
 //! pipeline of the renderer reads as a table of its fixed-function state.
 
-use super::context::Context;
+use super::context::GpuDevice;
 use crate::error::{Error, Result};
 use ash::vk;
 
 fn vkerr(call: &'static str) -> impl Fn(vk::Result) -> Error {
-    move |r| Error::Vulkan { call, result: format!("{r:?}") }
+    Error::vk(call)
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -70,14 +70,14 @@ impl<'a> PipelineDesc<'a> {
     }
 }
 
-pub fn shader_module(ctx: &Context, spirv: &[u8]) -> Result<vk::ShaderModule> {
+pub fn shader_module(ctx: &impl GpuDevice, spirv: &[u8]) -> Result<vk::ShaderModule> {
     let words: Vec<u32> = spirv.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
     let info = vk::ShaderModuleCreateInfo::default().code(&words);
     // SAFETY: `words` is SPIR-V produced and validated by naga in build.rs.
-    unsafe { ctx.device.create_shader_module(&info, None) }.map_err(vkerr("vkCreateShaderModule"))
+    unsafe { ctx.device().create_shader_module(&info, None) }.map_err(vkerr("vkCreateShaderModule"))
 }
 
-pub fn create(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline> {
+pub fn create(ctx: &impl GpuDevice, d: &PipelineDesc) -> Result<vk::Pipeline> {
     let vs = shader_module(ctx, d.vertex)?;
     let fs = match d.fragment {
         Some(f) => Some(shader_module(ctx, f)?),
@@ -187,15 +187,15 @@ pub fn create(ctx: &Context, d: &PipelineDesc) -> Result<vk::Pipeline> {
         .push_next(&mut rendering);
     // SAFETY: every pointer in `info` refers to locals alive for this call; the modules are
     // destroyed right after, which Vulkan allows once the pipeline exists.
-    let result = unsafe { ctx.device.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) };
+    let result = unsafe { ctx.device().create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) };
     // SAFETY: modules are no longer needed after pipeline creation.
     unsafe {
-        ctx.device.destroy_shader_module(vs, None);
+        ctx.device().destroy_shader_module(vs, None);
         if let Some(fs) = fs {
-            ctx.device.destroy_shader_module(fs, None);
+            ctx.device().destroy_shader_module(fs, None);
         }
     }
-    result.map(|p| p[0]).map_err(|(_, e)| Error::Vulkan { call: "vkCreateGraphicsPipelines", result: format!("{e:?}") })
+    result.map(|p| p[0]).map_err(|(_, e)| Error::Vulkan { call: "vkCreateGraphicsPipelines", result: e })
 }
 
 /// A stencil op state with wrap ops, for the shadow volume passes.

@@ -1,14 +1,14 @@
 //! Buffers and images with gpu-allocator memory. Destroyed explicitly through the context
 //! (`destroy`), in the owner's `Drop`, after the device is idle.
 
-use super::context::Context;
+use super::context::GpuDevice;
 use crate::error::{Error, Result};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
 use gpu_allocator::MemoryLocation;
 
 fn vkerr(call: &'static str) -> impl Fn(vk::Result) -> Error {
-    move |r| Error::Vulkan { call, result: format!("{r:?}") }
+    Error::vk(call)
 }
 
 pub struct Buffer {
@@ -18,14 +18,13 @@ pub struct Buffer {
 }
 
 impl Buffer {
-    pub fn new(ctx: &Context, name: &str, size: u64, usage: vk::BufferUsageFlags, location: MemoryLocation) -> Result<Buffer> {
+    pub fn new(ctx: &impl GpuDevice, name: &str, size: u64, usage: vk::BufferUsageFlags, location: MemoryLocation) -> Result<Buffer> {
         let info = vk::BufferCreateInfo::default().size(size.max(4)).usage(usage).sharing_mode(vk::SharingMode::EXCLUSIVE);
         // SAFETY: valid device and create info.
-        let raw = unsafe { ctx.device.create_buffer(&info, None) }.map_err(vkerr("vkCreateBuffer"))?;
+        let raw = unsafe { ctx.device().create_buffer(&info, None) }.map_err(vkerr("vkCreateBuffer"))?;
         // SAFETY: `raw` was just created on this device.
-        let requirements = unsafe { ctx.device.get_buffer_memory_requirements(raw) };
-        let allocation = ctx
-            .allocator()
+        let requirements = unsafe { ctx.device().get_buffer_memory_requirements(raw) };
+        let allocation = GpuDevice::allocator(ctx)
             .allocate(&AllocationCreateDesc {
                 name,
                 requirements,
@@ -33,14 +32,14 @@ impl Buffer {
                 linear: true,
                 allocation_scheme: AllocationScheme::GpuAllocatorManaged,
             })
-            .map_err(|e| Error::Other(format!("allocating {name} ({size} bytes): {e}")))?;
+            .map_err(|source| Error::Allocation { name: name.to_string(), size, source })?;
         // SAFETY: memory and offset come from an allocation made for these requirements.
-        unsafe { ctx.device.bind_buffer_memory(raw, allocation.memory(), allocation.offset()) }.map_err(vkerr("vkBindBufferMemory"))?;
+        unsafe { ctx.device().bind_buffer_memory(raw, allocation.memory(), allocation.offset()) }.map_err(vkerr("vkBindBufferMemory"))?;
         Ok(Buffer { raw, size, allocation: Some(allocation) })
     }
 
     /// A host-visible buffer filled with `data`.
-    pub fn with_data(ctx: &Context, name: &str, data: &[u8], usage: vk::BufferUsageFlags) -> Result<Buffer> {
+    pub fn with_data(ctx: &impl GpuDevice, name: &str, data: &[u8], usage: vk::BufferUsageFlags) -> Result<Buffer> {
         let mut b = Buffer::new(ctx, name, data.len() as u64, usage, MemoryLocation::CpuToGpu)?;
         b.write(0, data)?;
         Ok(b)
@@ -62,12 +61,12 @@ impl Buffer {
         Ok(&s[..self.size as usize])
     }
 
-    pub fn destroy(&mut self, ctx: &Context) {
+    pub fn destroy(&mut self, ctx: &impl GpuDevice) {
         if let Some(a) = self.allocation.take() {
-            let _ = ctx.allocator().free(a);
+            let _ = GpuDevice::allocator(ctx).free(a);
         }
         // SAFETY: the owner guarantees the GPU no longer uses the buffer (device idle).
-        unsafe { ctx.device.destroy_buffer(self.raw, None) };
+        unsafe { ctx.device().destroy_buffer(self.raw, None) };
         self.raw = vk::Buffer::null();
     }
 }
@@ -83,7 +82,7 @@ pub struct Image {
 
 impl Image {
     pub fn new_2d(
-        ctx: &Context,
+        ctx: &impl GpuDevice,
         name: &str,
         format: vk::Format,
         extent: vk::Extent2D,
@@ -101,11 +100,10 @@ impl Image {
             .usage(usage)
             .initial_layout(vk::ImageLayout::UNDEFINED);
         // SAFETY: valid create info on a valid device.
-        let raw = unsafe { ctx.device.create_image(&info, None) }.map_err(vkerr("vkCreateImage"))?;
+        let raw = unsafe { ctx.device().create_image(&info, None) }.map_err(vkerr("vkCreateImage"))?;
         // SAFETY: `raw` is a new image of this device.
-        let requirements = unsafe { ctx.device.get_image_memory_requirements(raw) };
-        let allocation = ctx
-            .allocator()
+        let requirements = unsafe { ctx.device().get_image_memory_requirements(raw) };
+        let allocation = GpuDevice::allocator(ctx)
             .allocate(&AllocationCreateDesc {
                 name,
                 requirements,
@@ -113,15 +111,15 @@ impl Image {
                 linear: false,
                 allocation_scheme: AllocationScheme::GpuAllocatorManaged,
             })
-            .map_err(|e| Error::Other(format!("allocating image {name}: {e}")))?;
+            .map_err(|source| Error::Allocation { name: format!("image {name}"), size: requirements.size, source })?;
         // SAFETY: the allocation satisfies the image's requirements.
-        unsafe { ctx.device.bind_image_memory(raw, allocation.memory(), allocation.offset()) }.map_err(vkerr("vkBindImageMemory"))?;
+        unsafe { ctx.device().bind_image_memory(raw, allocation.memory(), allocation.offset()) }.map_err(vkerr("vkBindImageMemory"))?;
         let view_info =
             vk::ImageViewCreateInfo::default().image(raw).view_type(vk::ImageViewType::TYPE_2D).format(format).subresource_range(
                 vk::ImageSubresourceRange { aspect_mask: aspect, base_mip_level: 0, level_count: 1, base_array_layer: 0, layer_count: 1 },
             );
         // SAFETY: `raw` is bound to memory; the view covers its single subresource.
-        let view = unsafe { ctx.device.create_image_view(&view_info, None) }.map_err(vkerr("vkCreateImageView"))?;
+        let view = unsafe { ctx.device().create_image_view(&view_info, None) }.map_err(vkerr("vkCreateImageView"))?;
         Ok(Image { raw, view, format, extent, aspect, allocation: Some(allocation) })
     }
 
@@ -129,21 +127,21 @@ impl Image {
         vk::ImageSubresourceRange { aspect_mask: self.aspect, base_mip_level: 0, level_count: 1, base_array_layer: 0, layer_count: 1 }
     }
 
-    pub fn destroy(&mut self, ctx: &Context) {
+    pub fn destroy(&mut self, ctx: &impl GpuDevice) {
         // SAFETY: the owner guarantees the GPU no longer uses the image (device idle).
         unsafe {
-            ctx.device.destroy_image_view(self.view, None);
-            ctx.device.destroy_image(self.raw, None);
+            ctx.device().destroy_image_view(self.view, None);
+            ctx.device().destroy_image(self.raw, None);
         }
         if let Some(a) = self.allocation.take() {
-            let _ = ctx.allocator().free(a);
+            let _ = GpuDevice::allocator(ctx).free(a);
         }
     }
 }
 
 /// A full-pipeline image layout transition (synchronization2). Conservative stage masks:
 /// the frame has a handful of these, never in an inner loop.
-pub fn transition(ctx: &Context, cb: vk::CommandBuffer, image: &Image, from: vk::ImageLayout, to: vk::ImageLayout) {
+pub fn transition(ctx: &impl GpuDevice, cb: vk::CommandBuffer, image: &Image, from: vk::ImageLayout, to: vk::ImageLayout) {
     let barrier = vk::ImageMemoryBarrier2::default()
         .src_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
         .src_access_mask(vk::AccessFlags2::MEMORY_WRITE)
@@ -156,12 +154,12 @@ pub fn transition(ctx: &Context, cb: vk::CommandBuffer, image: &Image, from: vk:
     let barriers = [barrier];
     let dep = vk::DependencyInfo::default().image_memory_barriers(&barriers);
     // SAFETY: `cb` is recording; the image belongs to this device.
-    unsafe { ctx.device.cmd_pipeline_barrier2(cb, &dep) };
+    unsafe { ctx.device().cmd_pipeline_barrier2(cb, &dep) };
 }
 
 /// A global memory barrier between two groups of stages.
 pub fn memory_barrier(
-    ctx: &Context,
+    ctx: &impl GpuDevice,
     cb: vk::CommandBuffer,
     src: (vk::PipelineStageFlags2, vk::AccessFlags2),
     dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
@@ -169,5 +167,5 @@ pub fn memory_barrier(
     let b = [vk::MemoryBarrier2::default().src_stage_mask(src.0).src_access_mask(src.1).dst_stage_mask(dst.0).dst_access_mask(dst.1)];
     let dep = vk::DependencyInfo::default().memory_barriers(&b);
     // SAFETY: `cb` is recording.
-    unsafe { ctx.device.cmd_pipeline_barrier2(cb, &dep) };
+    unsafe { ctx.device().cmd_pipeline_barrier2(cb, &dep) };
 }

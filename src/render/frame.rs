@@ -22,7 +22,7 @@ use std::time::Instant;
 mod selfshadow;
 
 fn vkerr(call: &'static str) -> impl Fn(vk::Result) -> Error {
-    move |r| Error::Vulkan { call, result: format!("{r:?}") }
+    Error::vk(call)
 }
 
 /// What a frame produced.
