@@ -63,8 +63,8 @@ fn main() -> umbrage::Result<()> {
     let ctx = umbrage::gpu::Context::new()?;
     let mut renderer = Renderer::new(ctx, scene, RenderOptions { width: w, height: h, capture: true, ..Default::default() })?;
     let frame = renderer.render()?;
-    let reference = Reference::from_scene(&renderer.scene).render(&renderer.scene.camera, &renderer.scene.lights, w, h);
-    let metrics = compare_all(&frame.shadow_masks(&renderer.scene), &reference, 1)?;
+    let reference = Reference::from_scene(renderer.scene()).render(&renderer.scene().camera, &renderer.scene().lights, w, h);
+    let metrics = compare_all(&frame.shadow_masks(renderer.scene()), &reference, 1)?;
     umbrage::output::write_png(std::path::Path::new("embed.png"), w, h, &frame.color)?;
     println!(
         "{}: frame {:.2} ms, {} mismatched pixels outside the 1-pixel band of {} compared; wrote embed.png",

@@ -1,39 +1,64 @@
 //! `umbrage bench`: every method's speed *against its error*, measured side by side in one run
 //! on one device: per scene and method, the median of N frames (GPU timestamps and wall
 //! clock), the shadow geometry sent, and the mismatch fraction against the CPU reference.
+#![warn(missing_docs)]
 
 use crate::accuracy::evaluate;
 use crate::error::{Error, Result};
 use crate::gpu::Context;
-use crate::render::{Counter, RenderOptions, Renderer};
-use crate::shadow::Method;
+use crate::render::{Counter, RenderOptions, Renderer, Technique};
 use serde::Serialize;
 
+/// One (scene, method, counter) measurement: medians over the measured frames.
 #[derive(Clone, Debug, Serialize)]
 pub struct BenchRow {
+    /// Scene name or path, as given.
     pub scene: String,
+    /// Method name ([`crate::shadow::Method::name`]), or `shadowmap-<size>` / `edgequad` for the baselines.
     pub method: String,
+    /// Shadow counter: `stencil` or `float`.
     pub counter: String,
+    /// Index format the renderer actually used (`u8`, `u16`, `u32`, ...).
     pub index_format: String,
+    /// Frames measured (after one warm-up frame).
     pub frames: usize,
+    /// Median GPU time of the whole frame, ms (`None` without timestamp queries).
     pub gpu_frame_ms: Option<f64>,
+    /// Median GPU time of the shadow determination (all lights), ms.
     pub gpu_shadow_ms: Option<f64>,
+    /// Median GPU time of the illumination passes (all lights), ms.
     pub gpu_illuminate_ms: Option<f64>,
+    /// Median wall-clock time of `Renderer::render` (plan, record, submit, wait, read back), ms.
     pub wall_ms: f64,
+    /// Median CPU planning time (silhouettes included), ms.
     pub cpu_plan_ms: f64,
+    /// Frames per second rendered back to back with `frames_in_flight` frames overlapping
+    /// ([`Renderer::throughput`]); `1000 / wall_ms` is the one-at-a-time rate.
+    pub throughput_fps: f64,
+    /// Frames in flight during the throughput run.
+    pub frames_in_flight: usize,
+    /// Shadow-volume triangles drawn in one frame (all lights, sides + caps).
     pub shadow_triangles: u64,
+    /// Index and vertex bytes uploaded for the shadow volumes in one frame.
     pub shadow_bytes: u64,
     /// Worst light's mismatches outside a 1-pixel band / compared pixels.
     pub error_fraction: f64,
+    /// (caster, light) pairs per case in one frame: `[culled, z-pass, z-fail, z-fail + light cap]`.
     pub cases: [u64; 4],
 }
 
+/// A whole `umbrage bench` run: the device and every row (the JSON `--out` writes).
 #[derive(Clone, Debug, Serialize)]
 pub struct BenchReport {
+    /// Vulkan device name.
     pub device: String,
+    /// Driver name and driver info string.
     pub driver: String,
+    /// Frame width, pixels.
     pub width: u32,
+    /// Frame height, pixels.
     pub height: u32,
+    /// One row per scene and variant, in the order measured.
     pub rows: Vec<BenchRow>,
 }
 
@@ -45,19 +70,32 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
+/// What to measure.
 pub struct BenchConfig {
+    /// Scenes, by built-in name or path ([`crate::scene::load`]).
     pub scenes: Vec<String>,
-    pub methods: Vec<Method>,
-    /// Each method runs with each counter (stencil, float), side by side.
+    /// Techniques to compare: volume methods, edge quads, shadow maps (each size its own).
+    pub techniques: Vec<Technique>,
+    /// Each volume technique runs with each counter (stencil, float), side by side; shadow
+    /// maps run once (they count in the float target).
     pub counters: Vec<Counter>,
-    /// Also measure the shadow-map baseline (PCF) with maps of this many texels a side.
-    pub shadow_map: Option<u32>,
-    /// Also measure the GPU-only edge-quad method (with the first counter).
-    pub edge_quads: bool,
+    /// Frames measured per variant (at least 1), round-robin over the variants.
     pub frames: usize,
+    /// Renderer options for everything else (size, depth mode, ...).
     pub opts: RenderOptions,
 }
 
+/// The name of a bench row's technique.
+fn technique_label(t: Technique) -> String {
+    match t {
+        Technique::ShadowMap { size } => format!("shadowmap-{size}"),
+        t => t.name().to_string(),
+    }
+}
+
+/// Runs the benchmark on `ctx`: per scene, first every variant's error against the reference,
+/// then `cfg.frames` frames of each variant interleaved (latency), then each variant's
+/// throughput with frames in flight; `progress` sees each row as it is done.
 pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow)) -> Result<BenchReport> {
     if cfg.frames == 0 {
         return Err(Error::Other("--frames must be at least 1".into()));
@@ -70,32 +108,19 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         let scene = crate::scene::load(name)?;
         let c = ctx.take().ok_or_else(|| Error::Other("context lost".into()))?;
         let mut r = Renderer::new(c, scene, cfg.opts.clone())?;
-        // (method, counter, shadow-map size) variants, and their error against the reference.
-        let mut variants: Vec<(Method, Counter, Option<u32>, bool)> = Vec::new();
-        let mut errors = Vec::new();
+        // (technique, counter) variants, and their error against the reference.
+        let mut variants: Vec<(Technique, Counter)> = Vec::new();
         for &counter in &cfg.counters {
-            r.opts.counter = counter;
-            for (m, e) in cfg.methods.iter().zip(evaluate(&mut r, name, &cfg.methods, 1)?) {
-                variants.push((*m, counter, None, false));
-                errors.push(e);
-            }
+            variants.extend(cfg.techniques.iter().filter(|t| !matches!(t, Technique::ShadowMap { .. })).map(|&t| (t, counter)));
         }
-        if let Some(size) = cfg.shadow_map {
-            r.opts.shadow_map = Some(size);
-            errors.extend(evaluate(&mut r, name, &[Method::McGuire], 1)?);
-            variants.push((Method::McGuire, Counter::Float, Some(size), false));
-            r.opts.shadow_map = None;
+        variants.extend(cfg.techniques.iter().filter(|t| matches!(t, Technique::ShadowMap { .. })).map(|&t| (t, Counter::Float)));
+        let mut errors = Vec::new();
+        for &(technique, counter) in &variants {
+            r.settings.counter = counter;
+            errors.extend(evaluate(&mut r, name, &[technique], 1)?);
         }
-        if cfg.edge_quads {
-            let counter = cfg.counters.first().copied().unwrap_or(Counter::Stencil);
-            r.opts.counter = counter;
-            r.opts.edge_quads = true;
-            errors.extend(evaluate(&mut r, name, &[Method::McGuire], 1)?);
-            variants.push((Method::McGuire, counter, None, true));
-            r.opts.edge_quads = false;
-        }
-        // Round-robin over methods, frame by frame, so that drift (thermal, other load) hits
-        // every method alike: the ratios are measured side by side.
+        // Round-robin over variants, frame by frame, so that drift (thermal, other load) hits
+        // every variant alike: the ratios are measured side by side.
         #[derive(Default)]
         struct Acc {
             gpu: Vec<f64>,
@@ -107,11 +132,9 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         }
         let mut acc: Vec<Acc> = variants.iter().map(|_| Acc::default()).collect();
         for frame in 0..=cfg.frames {
-            for (k, &(method, counter, shadow_map, edge_quads)) in variants.iter().enumerate() {
-                r.opts.method = method;
-                r.opts.counter = counter;
-                r.opts.shadow_map = shadow_map;
-                r.opts.edge_quads = edge_quads;
+            for (k, &(technique, counter)) in variants.iter().enumerate() {
+                r.settings.technique = technique;
+                r.settings.counter = counter;
                 let f = r.render()?;
                 if frame == 0 {
                     continue; // warm-up: buffers sized, caches hot
@@ -127,18 +150,15 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 a.last = Some(f.stats);
             }
         }
-        r.opts.shadow_map = None;
-        r.opts.edge_quads = false;
-        for ((&(method, counter, shadow_map, edge_quads), err), a) in variants.iter().zip(&errors).zip(acc) {
+        for ((&(technique, counter), err), a) in variants.iter().zip(&errors).zip(acc) {
+            r.settings.technique = technique;
+            r.settings.counter = counter;
+            let throughput = r.throughput(cfg.frames.max(2))?;
             let s = a.last.ok_or_else(|| Error::Other("no frame".into()))?;
             let c = &s.totals.cases;
             let row = BenchRow {
                 scene: name.clone(),
-                method: match (shadow_map, edge_quads) {
-                    (Some(size), _) => format!("shadowmap-{size}"),
-                    (None, true) => "edgequad".to_string(),
-                    (None, false) => method.to_string(),
-                },
+                method: technique_label(technique),
                 counter: counter.name().to_string(),
                 index_format: s.index_format.clone(),
                 frames: cfg.frames,
@@ -147,6 +167,8 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 gpu_illuminate_ms: (!a.illum.is_empty()).then(|| median(a.illum)),
                 wall_ms: median(a.wall),
                 cpu_plan_ms: median(a.plan),
+                throughput_fps: throughput.fps,
+                frames_in_flight: r.config().frames_in_flight,
                 shadow_triangles: s.totals.triangles.total(),
                 shadow_bytes: s.totals.index_bytes + s.totals.vertex_bytes,
                 error_fraction: err.fraction,
@@ -161,23 +183,25 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
 }
 
 impl BenchReport {
+    /// The report as a Markdown table (docs/bench-*.md).
     pub fn markdown(&self) -> String {
         let mut s = format!(
-            "Device: {} ({}), {}x{}. Medians; error = mismatched pixels outside a 1-pixel band vs the CPU reference (worst light).\n\n",
+            "Device: {} ({}), {}x{}. Medians; wall ms = one frame at a time (latency), fps = throughput with frames in flight; error = mismatched pixels outside a 1-pixel band vs the CPU reference (worst light).\n\n",
             self.device, self.driver, self.width, self.height
         );
-        s += "| scene | method | counter | GPU frame ms | GPU shadow ms | wall ms | plan ms | shadow tris | bytes | error | cases c/1/2/3 |\n";
-        s += "|---|---|---|---|---|---|---|---|---|---|---|\n";
+        s += "| scene | method | counter | GPU frame ms | GPU shadow ms | wall ms | fps | plan ms | shadow tris | bytes | error | cases c/1/2/3 |\n";
+        s += "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
         let f = |v: Option<f64>| v.map(|x| format!("{x:.2}")).unwrap_or_else(|| "—".into());
         for r in &self.rows {
             s += &format!(
-                "| {} | {} | {} | {} | {} | {:.2} | {:.3} | {} | {} | {:.4}% | {}/{}/{}/{} |\n",
+                "| {} | {} | {} | {} | {} | {:.2} | {:.1} | {:.3} | {} | {} | {:.4}% | {}/{}/{}/{} |\n",
                 r.scene,
                 r.method,
                 r.counter,
                 f(r.gpu_frame_ms),
                 f(r.gpu_shadow_ms),
                 r.wall_ms,
+                r.throughput_fps,
                 r.cpu_plan_ms,
                 r.shadow_triangles,
                 r.shadow_bytes,

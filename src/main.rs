@@ -1,10 +1,9 @@
 //! The `umbrage` command line: render | info | check | conform | bench.
 
-use clap::{Parser, Subcommand};
+use clap::{Parser, Subcommand, ValueEnum};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use umbrage::render::{Counter, DepthMode, IndexFormat, RenderOptions, Renderer, TransmitMode, View};
-use umbrage::shadow::Method;
+use umbrage::render::{Counter, DepthMode, IndexFormat, RenderOptions, Renderer, Technique, TransmitMode, View};
 use umbrage::{Error, Result};
 
 #[derive(Parser)]
@@ -25,20 +24,20 @@ struct FrameArgs {
     /// Shadow method: auto (= mcguire, with open / non-manifold casters on the multiplicity
     /// path), mcguire, lengyel, everitt-kilgard, zfail, zpass; edgequad (GPU-only silhouettes,
     /// the Cg article); or shadowmap (the PCF baseline).
-    #[arg(long, default_value = "auto")]
-    method: String,
+    #[arg(long, value_enum, default_value = "auto")]
+    method: MethodArg,
     /// infinite (far plane at infinity) or clamp (finite far plane + depthClamp).
-    #[arg(long, default_value = "infinite")]
-    depth_mode: String,
+    #[arg(long, value_enum, default_value = "infinite")]
+    depth_mode: DepthMode,
     /// u32, u16, u8, auto, or naive (stream 4 x f32 per shadow vertex, no indices).
-    #[arg(long, default_value = "auto")]
-    index_format: String,
+    #[arg(long, value_enum, default_value = "auto")]
+    index_format: IndexFormat,
     /// stencil (8-bit, wraps at 256 nested volumes) or float (32-bit float target, additive).
-    #[arg(long, default_value = "stencil")]
-    counter: String,
+    #[arg(long, value_enum, default_value = "stencil")]
+    counter: Counter,
     /// Transparent casters' light-intensity map: log16 (default), mul16, log32, mul32.
-    #[arg(long, default_value = "log16")]
-    transmit: String,
+    #[arg(long, value_enum, default_value = "log16")]
+    transmit: TransmitArg,
     /// Texels per side of each shadow map (--method shadowmap).
     #[arg(long, default_value_t = 2048)]
     shadow_map_size: u32,
@@ -46,6 +45,63 @@ struct FrameArgs {
     /// passes read a light-intensity map built on the nearest transparent surface.
     #[arg(long)]
     self_shadow: bool,
+}
+
+/// `--method`: every technique `render` and `bench` accept.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum MethodArg {
+    /// McGuire's three cases (open / non-manifold casters on the multiplicity path).
+    Auto,
+    /// McGuire et al. 2003: z-pass / z-fail / z-fail with light cap per caster.
+    Mcguire,
+    /// Lengyel: z-fail only where the near plane may cut the volume.
+    Lengyel,
+    /// Everitt-Kilgard: z-fail everywhere.
+    #[value(name = "everitt-kilgard")]
+    EverittKilgard,
+    /// Carmack's z-fail everywhere.
+    Zfail,
+    /// z-pass everywhere (wrong with the eye in a volume).
+    Zpass,
+    /// The Cg article's GPU-only edge quads.
+    Edgequad,
+    /// The shadow-map baseline (PCF 3x3).
+    Shadowmap,
+}
+
+impl MethodArg {
+    fn technique(self, shadow_map_size: u32) -> Technique {
+        use umbrage::shadow::Method as M;
+        match self {
+            MethodArg::Auto | MethodArg::Mcguire => Technique::Volumes(M::McGuire),
+            MethodArg::Lengyel => Technique::Volumes(M::Lengyel),
+            MethodArg::EverittKilgard => Technique::Volumes(M::EverittKilgard),
+            MethodArg::Zfail => Technique::Volumes(M::ZFail),
+            MethodArg::Zpass => Technique::Volumes(M::ZPass),
+            MethodArg::Edgequad => Technique::EdgeQuads,
+            MethodArg::Shadowmap => Technique::ShadowMap { size: shadow_map_size },
+        }
+    }
+}
+
+/// `--transmit`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum TransmitArg {
+    Log16,
+    Mul16,
+    Log32,
+    Mul32,
+}
+
+impl TransmitArg {
+    fn mode(self) -> TransmitMode {
+        match self {
+            TransmitArg::Log16 => TransmitMode { fp32: false, log: true },
+            TransmitArg::Mul16 => TransmitMode { fp32: false, log: false },
+            TransmitArg::Log32 => TransmitMode { fp32: true, log: true },
+            TransmitArg::Mul32 => TransmitMode { fp32: true, log: false },
+        }
+    }
 }
 
 #[derive(Subcommand)]
@@ -61,8 +117,8 @@ enum Command {
         #[arg(long)]
         stats: Option<PathBuf>,
         /// shaded, volumes (shadow volumes coloured by case) or stencil (counts of light 0).
-        #[arg(long, default_value = "shaded")]
-        view: String,
+        #[arg(long, value_enum, default_value = "shaded")]
+        view: View,
         /// Write a frame dump (frame.json, world.obj, positions/normals, masks) into DIR.
         #[arg(long)]
         dump: Option<PathBuf>,
@@ -81,19 +137,24 @@ enum Command {
         /// Scenes (repeatable); default: the fill-rate and vertex-rate bench scenes plus default.
         #[arg(long = "scene")]
         scenes: Vec<String>,
-        /// Comma-separated methods (default: all).
-        #[arg(long, value_delimiter = ',')]
-        methods: Vec<String>,
+        /// Comma-separated techniques, every one `render --method` accepts (default: the five
+        /// volume methods, edgequad and shadowmap).
+        #[arg(long, value_enum, value_delimiter = ',')]
+        methods: Vec<MethodArg>,
         #[arg(long, default_value_t = 10)]
         frames: usize,
         #[arg(long, default_value = "960x540", value_parser = parse_size)]
         size: (u32, u32),
-        #[arg(long, default_value = "auto")]
-        index_format: String,
+        #[arg(long, value_enum, default_value = "auto")]
+        index_format: IndexFormat,
         /// Comma-separated counters to compare (stencil, float).
-        #[arg(long, value_delimiter = ',', default_value = "stencil")]
-        counters: Vec<String>,
-        /// Also measure the shadow-map baseline with maps of this size (0: off).
+        #[arg(long, value_enum, value_delimiter = ',', default_value = "stencil")]
+        counters: Vec<Counter>,
+        /// Frames in flight for the throughput measurement.
+        #[arg(long, default_value_t = 2)]
+        frames_in_flight: usize,
+        /// Shadow-map size when the shadowmap technique runs (0: leave shadowmap out of the
+        /// default technique list).
         #[arg(long, default_value_t = 2048)]
         shadow_map_size: u32,
         /// Write the report as JSON.
@@ -125,11 +186,11 @@ impl Default for FrameArgs {
         FrameArgs {
             scene: "default".into(),
             size: (960, 540),
-            method: "auto".into(),
-            depth_mode: "infinite".into(),
-            index_format: "auto".into(),
-            counter: "stencil".into(),
-            transmit: "log16".into(),
+            method: MethodArg::Auto,
+            depth_mode: DepthMode::Infinite,
+            index_format: IndexFormat::Auto,
+            counter: Counter::Stencil,
+            transmit: TransmitArg::Log16,
             shadow_map_size: 2048,
             self_shadow: false,
         }
@@ -152,15 +213,16 @@ fn main() -> ExitCode {
         frame: FrameArgs::default(),
         out: "umbrage.png".into(),
         stats: None,
-        view: "shaded".into(),
+        view: View::Shaded,
         dump: None,
     }) {
-        Command::Render { frame, out, stats, view, dump } => render(&frame, &out, stats.as_deref(), &view, dump.as_deref()),
+        Command::Render { frame, out, stats, view, dump } => render(&frame, &out, stats.as_deref(), view, dump.as_deref()),
         Command::Info { json, scene } => info(json, scene.as_deref()),
         Command::Check { dir, band, threshold } => check(&dir, band, threshold),
-        Command::Bench { scenes, methods, frames, size, index_format, counters, shadow_map_size, json, markdown } => {
-            let sm = (shadow_map_size > 0).then_some(shadow_map_size);
-            bench(scenes, methods, counters, sm, frames, size, &index_format, json.as_deref(), markdown.as_deref())
+        Command::Bench { scenes, methods, frames, size, index_format, counters, frames_in_flight, shadow_map_size, json, markdown } => {
+            let techniques = bench_techniques(&methods, shadow_map_size);
+            let opts = RenderOptions { width: size.0, height: size.1, index_format, frames_in_flight, ..Default::default() };
+            bench(scenes, techniques, counters, frames, opts, json.as_deref(), markdown.as_deref())
         }
         Command::Conform { out } => umbrage::conform::run(out),
     };
@@ -178,26 +240,20 @@ impl FrameArgs {
         Ok(RenderOptions {
             width: self.size.0,
             height: self.size.1,
-            method: if matches!(self.method.as_str(), "shadowmap" | "edgequad") {
-                Method::McGuire
-            } else {
-                self.method.parse::<Method>()?
-            },
-            edge_quads: self.method == "edgequad",
-            shadow_map: (self.method == "shadowmap").then_some(self.shadow_map_size),
-            depth_mode: self.depth_mode.parse::<DepthMode>()?,
-            index_format: self.index_format.parse::<IndexFormat>()?,
-            counter: self.counter.parse::<Counter>()?,
-            transmit: self.transmit.parse::<TransmitMode>()?,
+            technique: self.method.technique(self.shadow_map_size),
+            depth_mode: self.depth_mode,
+            index_format: self.index_format,
+            counter: self.counter,
+            transmit: self.transmit.mode(),
             self_shadow: self.self_shadow,
             ..Default::default()
         })
     }
 }
 
-fn render(frame: &FrameArgs, out: &Path, stats: Option<&Path>, view: &str, dump: Option<&Path>) -> Result<ExitCode> {
+fn render(frame: &FrameArgs, out: &Path, stats: Option<&Path>, view: View, dump: Option<&Path>) -> Result<ExitCode> {
     let mut opts = frame.options()?;
-    opts.view = view.parse::<View>()?;
+    opts.view = view;
     opts.capture = dump.is_some();
     let scene = umbrage::scene::load(&frame.scene)?;
     let ctx = umbrage::gpu::Context::new()?;
@@ -209,7 +265,7 @@ fn render(frame: &FrameArgs, out: &Path, stats: Option<&Path>, view: &str, dump:
         std::fs::write(path, json).map_err(|e| Error::io(path.display().to_string(), e))?;
     }
     if let Some(dir) = dump {
-        umbrage::output::write_frame_dump(dir, &renderer.scene, &frame_out)?;
+        umbrage::output::write_frame_dump(dir, renderer.scene(), &frame_out)?;
     }
     let s = &frame_out.stats;
     for w in &s.warnings {
@@ -231,7 +287,7 @@ fn render(frame: &FrameArgs, out: &Path, stats: Option<&Path>, view: &str, dump:
         s.totals.triangles.total(),
         out.display()
     );
-    renderer.ctx.check_validation()?;
+    renderer.context().check_validation()?;
     Ok(ExitCode::SUCCESS)
 }
 
@@ -270,33 +326,49 @@ fn check(dir: &Path, band: u32, threshold: f64) -> Result<ExitCode> {
     Ok(if report.passed(threshold) { ExitCode::SUCCESS } else { ExitCode::FAILURE })
 }
 
-#[allow(clippy::too_many_arguments)]
+/// The bench's techniques: the given ones, or every volume method, edge quads and (size > 0)
+/// shadow maps.
+fn bench_techniques(methods: &[MethodArg], shadow_map_size: u32) -> Vec<Technique> {
+    let size = if shadow_map_size > 0 { shadow_map_size } else { 2048 };
+    let mut out: Vec<Technique> = Vec::new();
+    if methods.is_empty() {
+        out.extend(umbrage::shadow::Method::ALL.map(Technique::Volumes));
+        out.push(Technique::EdgeQuads);
+        if shadow_map_size > 0 {
+            out.push(Technique::ShadowMap { size });
+        }
+    } else {
+        for m in methods {
+            let t = m.technique(size);
+            if !out.contains(&t) {
+                out.push(t);
+            }
+        }
+    }
+    out
+}
+
 fn bench(
     scenes: Vec<String>,
-    methods: Vec<String>,
-    counters: Vec<String>,
-    shadow_map: Option<u32>,
+    techniques: Vec<Technique>,
+    counters: Vec<Counter>,
     frames: usize,
-    size: (u32, u32),
-    index_format: &str,
+    opts: RenderOptions,
     json: Option<&Path>,
     markdown: Option<&Path>,
 ) -> Result<ExitCode> {
     let scenes = if scenes.is_empty() { vec!["bench/fill".into(), "bench/vertex".into(), "default".into()] } else { scenes };
-    let methods =
-        if methods.is_empty() { Method::ALL.to_vec() } else { methods.iter().map(|m| m.parse::<Method>()).collect::<Result<Vec<_>>>()? };
-    let opts = RenderOptions { width: size.0, height: size.1, index_format: index_format.parse::<IndexFormat>()?, ..Default::default() };
     let ctx = umbrage::gpu::Context::new()?;
-    let counters = counters.iter().map(|c| c.parse::<Counter>()).collect::<Result<Vec<_>>>()?;
-    let cfg = umbrage::bench::BenchConfig { scenes, methods, counters, shadow_map, edge_quads: true, frames, opts };
+    let cfg = umbrage::bench::BenchConfig { scenes, techniques, counters, frames, opts };
     let report = umbrage::bench::run(ctx, &cfg, |r| {
         eprintln!(
-            "{:<14} {:<16} {:<8} gpu {:>8} ms  shadow {:>8} ms  {:>8} tris  error {:.4}%",
+            "{:<14} {:<16} {:<8} gpu {:>8} ms  shadow {:>8} ms  {:>7.1} fps  {:>8} tris  error {:.4}%",
             r.scene,
             r.method,
             r.counter,
             r.gpu_frame_ms.map(|v| format!("{v:.2}")).unwrap_or_else(|| "-".into()),
             r.gpu_shadow_ms.map(|v| format!("{v:.2}")).unwrap_or_else(|| "-".into()),
+            r.throughput_fps,
             r.shadow_triangles,
             r.error_fraction * 100.0
         )

@@ -1,4 +1,5 @@
 //! Files a frame turns into: PNGs, frame dumps, and the `info` report.
+#![warn(missing_docs)]
 
 use crate::error::{Error, Result};
 use crate::gpu::Context;
@@ -73,15 +74,20 @@ pub fn write_frame_dump(dir: &Path, scene: &Scene, frame: &FrameOutput) -> Resul
     write_png(&dir.join("color.png"), frame.width, frame.height, &frame.color)
 }
 
+/// What `umbrage info` prints: the device, its probed features and the code paths they select.
 #[derive(serde::Serialize)]
 pub struct InfoReport {
+    /// The chosen device and driver.
     pub device: crate::gpu::DeviceInfo,
+    /// Optional capabilities as probed.
     pub features: crate::gpu::Features,
+    /// Whether the validation layers are on (`UMBRAGE_VALIDATION=1`).
     pub validation: bool,
     /// Feature -> the code path it selects on this device.
     pub paths: Vec<(String, String)>,
 }
 
+/// The report for the device of `ctx`.
 pub fn info_report(ctx: &Context) -> InfoReport {
     let f = &ctx.features;
     let yes_no = |b: bool, y: &str, n: &str| if b { y.to_string() } else { n.to_string() };
@@ -129,6 +135,7 @@ pub fn info_report(ctx: &Context) -> InfoReport {
     InfoReport { device: ctx.info.clone(), features: f.clone(), validation: ctx.validation, paths }
 }
 
+/// The report as the human-readable text `umbrage info` prints.
 pub fn info_text(r: &InfoReport) -> String {
     let mut s = format!(
         "device:  {} ({})\ndriver:  {} {}\nVulkan:  {}\nvalidation: {}\n",
@@ -148,13 +155,17 @@ pub fn info_text(r: &InfoReport) -> String {
 /// How one caster of a scene is handled, as classified once at load.
 #[derive(serde::Serialize)]
 pub struct CasterInfo {
+    /// The mesh's name in the scene.
     pub name: String,
     /// "manifold" (McGuire's three cases) or "multiplicity" (Kim et al.).
     pub path: String,
     /// Why a caster takes the multiplicity path (empty for manifold casters).
     pub reason: String,
+    /// Triangles after welding.
     pub triangles: usize,
+    /// GPU chunks (pieces of at most 32768 vertices, 16-bit indices).
     pub chunks: usize,
+    /// Opacity below 1: the volumes go to the light-intensity map.
     pub transparent: bool,
 }
 

@@ -48,10 +48,20 @@ fn render(ctx: umbrage::gpu::Context, toml: &str, name: &str, method: Method, fm
     } else {
         umbrage::scene::load_str(toml, name, std::path::Path::new(".")).unwrap()
     };
-    let mut r =
-        Renderer::new(ctx, scene, RenderOptions { width: 320, height: 240, method, index_format: fmt, ..Default::default() }).unwrap();
+    let mut r = Renderer::new(
+        ctx,
+        scene,
+        RenderOptions {
+            width: 320,
+            height: 240,
+            technique: umbrage::render::Technique::Volumes(method),
+            index_format: fmt,
+            ..Default::default()
+        },
+    )
+    .unwrap();
     let out = r.render().unwrap();
-    r.ctx.check_validation().unwrap();
+    r.context().check_validation().unwrap();
     (out.stats, r)
 }
 
@@ -59,7 +69,7 @@ fn render(ctx: umbrage::gpu::Context, toml: &str, name: &str, method: Method, fm
 fn check_formulas(stats: &Stats, r: &Renderer) -> Vec<String> {
     let mut seen = Vec::new();
     for ls in &stats.lights {
-        let light = &r.scene.lights[ls.index];
+        let light = &r.scene().lights[ls.index];
         for cs in &ls.casters {
             let caster = r.casters().iter().find(|c| c.name == cs.name).unwrap();
             let s = cs.silhouette_edges;

@@ -39,9 +39,9 @@ fn ambient_and_light_without_casters() {
     let c = (24 * 64 + 32) * 4;
     assert!(out.color[c] > 100, "centre should be lit: {:?}", &out.color[c..c + 4]);
     assert!(out.positions[24 * 64 + 32][1].abs() < 1e-4);
-    r.ctx.check_validation().unwrap();
+    r.context().check_validation().unwrap();
     // Teardown: every object destroyed, in order; validation reports leaks at device destruction.
-    let log = r.ctx.validation_log();
+    let log = r.context().validation_log();
     drop(r);
     let errors = log.lock().unwrap().errors.clone();
     assert!(errors.is_empty(), "validation errors during teardown: {errors:#?}");
@@ -57,7 +57,7 @@ fn default_scene_with_every_view_tears_down_cleanly() {
         let out = r.render().unwrap();
         assert_eq!(out.color.len(), 96 * 64 * 4);
         images.push(out.color);
-        r.ctx.check_validation().unwrap();
+        r.context().check_validation().unwrap();
         ctx = r.into_context();
     }
     // The debug views really draw: volumes tint part of the shaded image (the default scene's

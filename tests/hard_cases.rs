@@ -3,7 +3,7 @@
 //! Methods expected to fail on a case must fail there.
 mod common;
 use umbrage::accuracy::{evaluate, markdown_table, Row};
-use umbrage::render::{Counter, RenderOptions, Renderer};
+use umbrage::render::{Counter, RenderOptions, Renderer, Technique};
 use umbrage::shadow::Method;
 
 #[test]
@@ -26,12 +26,10 @@ fn every_method_on_every_hard_case_matches_the_reference() {
             let scene = umbrage::scene::load(name).unwrap();
             let opts = RenderOptions { width: 256, height: 192, counter, ..Default::default() };
             let mut r = Renderer::new(ctx, scene, opts).unwrap();
-            rows.extend(evaluate(&mut r, name, &Method::ALL, 1).unwrap());
+            rows.extend(evaluate(&mut r, name, &Technique::all_volumes(), 1).unwrap());
             // The GPU-only edge-quad method (closed opaque casters; the others keep their path).
-            r.opts.edge_quads = true;
-            rows.extend(evaluate(&mut r, name, &[Method::McGuire], 1).unwrap());
-            r.opts.edge_quads = false;
-            r.ctx.check_validation().unwrap();
+            rows.extend(evaluate(&mut r, name, &[Technique::EdgeQuads], 1).unwrap());
+            r.context().check_validation().unwrap();
             ctx = r.into_context();
         }
         let mut columns: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();

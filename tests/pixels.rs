@@ -2,7 +2,7 @@
 //! counts read back are the expected ones (one box = 1, two stacked boxes = 2), for every
 //! method that should handle the view, including the eye inside the volumes.
 mod common;
-use umbrage::render::{DepthMode, RenderOptions, Renderer};
+use umbrage::render::{DepthMode, RenderOptions, Renderer, Technique};
 use umbrage::shadow::Method;
 
 /// Two boxes stacked above a floor, a point light straight above, camera looking down at the
@@ -34,8 +34,8 @@ translate = [0.0, 6.0, 0.0]
 
 /// The image pixel at which a world point appears.
 fn project(r: &Renderer, p: glam::Vec3) -> (usize, usize) {
-    let (w, h) = (r.opts.width as f32, r.opts.height as f32);
-    let vp = r.scene.camera.proj_infinite(w / h) * r.scene.camera.view();
+    let (w, h) = (r.config().width as f32, r.config().height as f32);
+    let vp = r.scene().camera.proj_infinite(w / h) * r.scene().camera.view();
     let c = vp * p.extend(1.0);
     let ndc = c.truncate() / c.w;
     (((ndc.x + 1.0) * 0.5 * w) as usize, ((ndc.y + 1.0) * 0.5 * h) as usize)
@@ -55,7 +55,14 @@ fn stacked_boxes_give_count_two_and_dark_floor() {
         }
         for method in umbrage::shadow::Method::ALL {
             let scene = umbrage::scene::load_str(STACK, "stack", std::path::Path::new(".")).unwrap();
-            let opts = RenderOptions { width: 200, height: 150, method, depth_mode, capture: true, ..Default::default() };
+            let opts = RenderOptions {
+                width: 200,
+                height: 150,
+                technique: Technique::Volumes(method),
+                depth_mode,
+                capture: true,
+                ..Default::default()
+            };
             let mut r = Renderer::new(ctx, scene, opts).unwrap();
             let out = r.render().unwrap();
             let w = 200;
@@ -69,7 +76,7 @@ fn stacked_boxes_give_count_two_and_dark_floor() {
             // Shadowed = ambient only (0.05): under a third of the lit floor's brightness.
             assert!(dark * 3 < bright, "{label}: shadowed floor {dark} should be far darker than lit floor {bright}");
             assert!(bright > 400, "{label}: lit floor should be bright, got {bright}");
-            r.ctx.check_validation().unwrap();
+            r.context().check_validation().unwrap();
             ctx = r.into_context();
         }
     }
@@ -83,8 +90,12 @@ fn eye_inside_two_volumes_counts_two_except_zpass() {
         STACK.replace("eye = [0.0, 3.0, 6.0]", "eye = [0.1, 2.0, 0.1]").replace("target = [0.0, 0.0, 0.0]", "target = [1.5, 0.0, 0.0]");
     for method in Method::ALL {
         let scene = umbrage::scene::load_str(&toml, "eye-in", std::path::Path::new(".")).unwrap();
-        let mut r =
-            Renderer::new(ctx, scene, RenderOptions { width: 160, height: 120, method, capture: true, ..Default::default() }).unwrap();
+        let mut r = Renderer::new(
+            ctx,
+            scene,
+            RenderOptions { width: 160, height: 120, technique: Technique::Volumes(method), capture: true, ..Default::default() },
+        )
+        .unwrap();
         let out = r.render().unwrap();
         let p = project(&r, glam::Vec3::new(0.3, 0.0, 0.0));
         let count = out.stencil[0][p.1 * 160 + p.0];
@@ -105,12 +116,13 @@ fn shadow_map_baseline_is_close_to_the_reference() {
     let Some(mut ctx) = common::context() else { return };
     for name in ["default", "stairs", "spheres", "hard/light_inside_caster"] {
         let scene = umbrage::scene::load(name).unwrap();
-        let opts = RenderOptions { width: 256, height: 192, shadow_map: Some(1024), ..Default::default() };
+        let sm = Technique::ShadowMap { size: 1024 };
+        let opts = RenderOptions { width: 256, height: 192, technique: sm, ..Default::default() };
         let mut r = Renderer::new(ctx, scene, opts).unwrap();
-        let rows = umbrage::accuracy::evaluate(&mut r, name, &[Method::McGuire], 1).unwrap();
+        let rows = umbrage::accuracy::evaluate(&mut r, name, &[sm], 1).unwrap();
         assert_eq!(r.render().unwrap().stats.method, "shadowmap");
         assert!(rows[0].fraction < 5e-3, "{name}: shadow map error {:.4}%", rows[0].fraction * 100.0);
-        r.ctx.check_validation().unwrap();
+        r.context().check_validation().unwrap();
         ctx = r.into_context();
     }
 }

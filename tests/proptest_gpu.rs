@@ -115,14 +115,14 @@ fn random_closed_casters_match_the_reference() {
     let Some(ctx) = common::context() else { return };
     let ctx = RefCell::new(Some(ctx));
     let mut runner = TestRunner::new(Config { cases: 24, failure_persistence: None, ..Config::default() });
-    let methods = [Method::McGuire, Method::ZFail, Method::Lengyel];
+    let methods = [Method::McGuire, Method::ZFail, Method::Lengyel].map(umbrage::render::Technique::Volumes);
     let drawn = std::cell::Cell::new(0u64);
     runner
         .run(&strategy(), |case| {
             let c = ctx.borrow_mut().take().expect("context");
             let mut r = Renderer::new(c, scene(&case), RenderOptions { width: 128, height: 96, ..Default::default() }).expect("renderer");
             let rows = evaluate(&mut r, "proptest", &methods, 1).expect("evaluate");
-            r.ctx.check_validation().expect("validation");
+            r.context().check_validation().expect("validation");
             *ctx.borrow_mut() = Some(r.into_context());
             for row in rows {
                 drawn.set(drawn.get() + row.shadow_triangles);

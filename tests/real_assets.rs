@@ -4,7 +4,6 @@
 mod common;
 use umbrage::accuracy::evaluate;
 use umbrage::render::{Counter, RenderOptions, Renderer};
-use umbrage::shadow::Method;
 
 fn scene(obj: &str, scale: f32, lift: f32, eye: [f32; 3]) -> String {
     format!(
@@ -47,7 +46,7 @@ fn real_open_and_non_manifold_assets_match_the_reference() {
             let stats = r.render().unwrap().stats;
             let asset = stats.lights[0].casters.iter().find(|c| c.name == "asset").unwrap();
             assert_eq!(asset.path, "multiplicity", "{file}: {}", asset.path_reason);
-            for row in evaluate(&mut r, file, &Method::ALL, 1).unwrap() {
+            for row in evaluate(&mut r, file, &umbrage::render::Technique::all_volumes(), 1).unwrap() {
                 assert!(
                     row.passed,
                     "{file} {} {:?}: {} mismatches of {} ({:.4}%)",
@@ -58,7 +57,7 @@ fn real_open_and_non_manifold_assets_match_the_reference() {
                     row.fraction * 100.0
                 );
             }
-            r.ctx.check_validation().unwrap();
+            r.context().check_validation().unwrap();
             ctx = r.into_context();
         }
     }

@@ -60,8 +60,8 @@ fn self_shadow_darkens_covered_transparent_surfaces_only() {
             Renderer::new(ctx, scene, RenderOptions { width: w, height: h, capture: true, self_shadow, ..Default::default() }).unwrap();
         let out = r.render().unwrap();
         assert_eq!(out.stats.self_shadow, self_shadow);
-        let fractions = out.light_fractions(&r.scene);
-        let cam = r.scene.camera.clone();
+        let fractions = out.light_fractions(r.scene());
+        let cam = r.scene().camera.clone();
         frames.push((out.color, fractions));
         ctx = r.into_context();
         if self_shadow {

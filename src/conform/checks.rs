@@ -587,7 +587,7 @@ pub const PIPELINE_THRESHOLD: f64 = crate::accuracy::THRESHOLD;
 /// Check 8: The whole shadow pipeline on every `hard/*` scene and every method, against the CPU
 /// reference (through the same dump check as `umbrage check`).
 pub fn shadow_pipeline_hard_cases(new_context: &dyn Fn() -> Result<Context>, width: u32, height: u32) -> Result<CheckResult> {
-    use crate::render::{RenderOptions, Renderer};
+    use crate::render::{RenderOptions, Renderer, Technique};
     use crate::shadow::Method;
     let tmp = std::env::temp_dir().join(format!("umbrage-conform-{}", std::process::id()));
     let mut cases = Vec::new();
@@ -597,12 +597,12 @@ pub fn shadow_pipeline_hard_cases(new_context: &dyn Fn() -> Result<Context>, wid
         for method in Method::ALL {
             let scene = crate::scene::load(name)?;
             let ctx = new_context()?;
-            let opts = RenderOptions { width, height, method, capture: true, ..Default::default() };
+            let opts = RenderOptions { width, height, technique: Technique::Volumes(method), capture: true, ..Default::default() };
             let mut renderer = Renderer::new(ctx, scene, opts)?;
             let frame = renderer.render()?;
-            let validation = renderer.ctx.take_validation_errors();
+            let validation = renderer.context().take_validation_errors();
             let dir = tmp.join(format!("{}-{}", name.replace('/', "_"), method.name()));
-            crate::output::write_frame_dump(&dir, &renderer.scene, &frame)?;
+            crate::output::write_frame_dump(&dir, renderer.scene(), &frame)?;
             drop(renderer);
             let report = crate::reference::check_dump(&dir, 1)?;
             let _ = std::fs::remove_dir_all(&dir);

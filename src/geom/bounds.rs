@@ -5,13 +5,14 @@
 //! is only answered when certain (up to f64 rounding on f32 inputs).
 
 use super::mesh::Aabb;
-use crate::scene::{Light, LightKind};
+use crate::geom::{Light, LightKind};
 use glam::{DMat4, DVec3, DVec4, Mat4, Vec3, Vec4};
 
 /// Clip planes of a view-projection matrix in world space; a homogeneous point `p` is
 /// inside plane `k` iff `planes[k] . p >= 0`. Points at infinity (w = 0) work directly.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Frustum {
+    /// Left, right, bottom, top, near (and far when finite) as `(a, b, c, d)`, unnormalised.
     pub planes: Vec<DVec4>,
 }
 
@@ -94,6 +95,8 @@ pub struct OcclusionPyramid {
 }
 
 impl OcclusionPyramid {
+    /// The pyramid for the homogeneous light `light_h` (w = 1 point, w = 0 directional, as
+    /// [`Light::homogeneous`]) and the camera's `view_proj`.
     pub fn new(light_h: Vec4, view_proj: Mat4) -> OcclusionPyramid {
         OcclusionPyramid { planes: Self::build(light_h.as_dvec4(), view_proj) }
     }
@@ -266,7 +269,7 @@ pub fn box_distance(b: &Aabb, p: Vec3) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::Camera;
+    use crate::geom::Camera;
 
     fn cam(eye: Vec3, target: Vec3) -> (Camera, Mat4) {
         let c = Camera { eye, target, up: Vec3::Y, fov_y_deg: 60.0, near: 0.1 };

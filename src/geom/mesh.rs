@@ -7,20 +7,26 @@ use glam::Vec3;
 /// outside (outward normal = (p1-p0) x (p2-p0)).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {
+    /// Vertex positions, object space.
     pub positions: Vec<Vec3>,
+    /// Vertex indices into `positions`, three per triangle, counter-clockwise seen from outside.
     pub triangles: Vec<[u32; 3]>,
 }
 
 /// Axis-aligned bounding box. An empty box has `min > max`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
+    /// Smallest x, y and z of the box (inclusive).
     pub min: Vec3,
+    /// Largest x, y and z of the box (inclusive).
     pub max: Vec3,
 }
 
 impl Aabb {
+    /// The empty box (`min = +inf`, `max = -inf`): the identity of [`union`](Aabb::union) and [`extend`](Aabb::extend).
     pub const EMPTY: Aabb = Aabb { min: Vec3::splat(f32::INFINITY), max: Vec3::splat(f32::NEG_INFINITY) };
 
+    /// The smallest box containing every point ([`Aabb::EMPTY`] for none).
     pub fn from_points<'a>(points: impl IntoIterator<Item = &'a Vec3>) -> Aabb {
         let mut b = Aabb::EMPTY;
         for p in points {
@@ -28,22 +34,28 @@ impl Aabb {
         }
         b
     }
+    /// Grows the box to contain `p`.
     pub fn extend(&mut self, p: Vec3) {
         self.min = self.min.min(p);
         self.max = self.max.max(p);
     }
+    /// The smallest box containing both boxes.
     pub fn union(self, o: Aabb) -> Aabb {
         Aabb { min: self.min.min(o.min), max: self.max.max(o.max) }
     }
+    /// True iff the box contains no point (`min > max` on some axis).
     pub fn is_empty(&self) -> bool {
         self.min.x > self.max.x || self.min.y > self.max.y || self.min.z > self.max.z
     }
+    /// The centre `(min + max) / 2` (the apex of the dark-cap fan is the caster's object-space centre).
     pub fn center(&self) -> Vec3 {
         (self.min + self.max) * 0.5
     }
+    /// Edge lengths `max - min`.
     pub fn extent(&self) -> Vec3 {
         self.max - self.min
     }
+    /// The eight corners; bit 0 of the index picks max x, bit 1 max y, bit 2 max z.
     pub fn corners(&self) -> [Vec3; 8] {
         let (a, b) = (self.min, self.max);
         [
@@ -57,6 +69,7 @@ impl Aabb {
             Vec3::new(b.x, b.y, b.z),
         ]
     }
+    /// True iff `p` is inside or on the box.
     pub fn contains(&self, p: Vec3) -> bool {
         p.cmpge(self.min).all() && p.cmple(self.max).all()
     }
@@ -67,15 +80,19 @@ impl Aabb {
 }
 
 impl Mesh {
+    /// A mesh from positions and triangles, unchecked (see [`Mesh::validate`]).
     pub fn new(positions: Vec<Vec3>, triangles: Vec<[u32; 3]>) -> Mesh {
         Mesh { positions, triangles }
     }
+    /// True iff the mesh has no triangles.
     pub fn is_empty(&self) -> bool {
         self.triangles.is_empty()
     }
+    /// The object-space bounding box of the positions (all of them, used or not).
     pub fn bounds(&self) -> Aabb {
         Aabb::from_points(self.positions.iter())
     }
+    /// The three corner positions of triangle `t`, in winding order. Panics when out of range.
     pub fn triangle(&self, t: usize) -> [Vec3; 3] {
         let [a, b, c] = self.triangles[t];
         [self.positions[a as usize], self.positions[b as usize], self.positions[c as usize]]

@@ -1,7 +1,10 @@
 //! Pure CPU geometry: no Vulkan, no `unsafe`. The heart of the shadow algorithm.
+#![warn(missing_docs)]
 pub mod mesh;
 pub use mesh::{Aabb, Mesh};
 pub mod bounds;
+pub mod light;
+pub use light::{Camera, Light, LightKind};
 pub mod predicates;
 pub mod silhouette;
 pub mod topology;

@@ -17,11 +17,17 @@ pub const PARALLEL_EDGE_THRESHOLD: usize = 8_000_000;
 /// (corner `lit_corner`); `unlit` walks it `b -> a` (corner `unlit_corner`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SilhouetteEdge {
+    /// Start vertex (welded index) in the light-facing triangle's winding.
     pub a: u32,
+    /// End vertex (welded index) in the light-facing triangle's winding.
     pub b: u32,
+    /// The light-facing triangle.
     pub lit: u32,
+    /// Corner of `lit` where `a -> b` starts.
     pub lit_corner: u8,
+    /// The triangle facing away from the light.
     pub unlit: u32,
+    /// Corner of `unlit` where `b -> a` starts.
     pub unlit_corner: u8,
 }
 

@@ -11,6 +11,7 @@ use std::collections::HashMap;
 /// One use of an undirected edge by a triangle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct EdgeUse {
+    /// The triangle (index into the welded mesh's triangles).
     pub tri: u32,
     /// Corner k: the edge goes from `triangles[tri][k]` to `triangles[tri][(k+1)%3]`.
     pub corner: u8,
@@ -21,20 +22,28 @@ pub struct EdgeUse {
 /// An undirected edge (`v[0] < v[1]`, welded vertex indices) with its uses.
 #[derive(Clone, Debug)]
 pub struct Edge {
+    /// Its two welded vertices, smaller index first.
     pub v: [u32; 2],
     /// Range into [`Topology::uses`].
     pub first_use: u32,
+    /// Number of triangles using it: 1 on a boundary, 2 for a manifold (or inconsistent) edge, 3+ non-manifold.
     pub use_count: u32,
 }
 
 /// A manifold edge: `t0` walks a->b (corner `c0`), `t1` walks b->a (corner `c1`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ManifoldEdge {
+    /// Smaller welded vertex index.
     pub a: u32,
+    /// Larger welded vertex index.
     pub b: u32,
+    /// The triangle that walks a -> b.
     pub t0: u32,
+    /// Corner of `t0` the edge starts at.
     pub c0: u8,
+    /// The triangle that walks b -> a.
     pub t1: u32,
+    /// Corner of `t1` the edge starts at.
     pub c1: u8,
 }
 
@@ -45,12 +54,17 @@ pub struct Topology {
     pub mesh: Mesh,
     /// Original vertex index -> welded vertex index.
     pub remap: Vec<u32>,
+    /// Every undirected edge once, sorted by `(v[0], v[1])`; degenerate (a == a) edges are left out.
     pub edges: Vec<Edge>,
+    /// The uses of all edges, grouped by edge (see [`Edge::first_use`], [`Topology::edge_uses`]).
     pub uses: Vec<EdgeUse>,
     /// Every edge with exactly two uses in opposite directions (all edges when closed).
     pub manifold_edges: Vec<ManifoldEdge>,
+    /// Edges used by one triangle only (holes, open meshes).
     pub boundary_edges: usize,
+    /// Edges used by three or more triangles.
     pub non_manifold_edges: usize,
+    /// Edges used by two triangles walking them the same way (inconsistent winding).
     pub inconsistent_edges: usize,
     /// Triangles that use the same vertex twice after welding (they have a degenerate edge).
     pub collapsed_triangles: usize,
@@ -128,6 +142,7 @@ impl Topology {
         Topology::build_with(mesh, Weld::Exact)
     }
 
+    /// Welding by `mode`, then the edge table.
     pub fn build_with(mesh: &Mesh, mode: Weld) -> Topology {
         let (positions, remap) = weld(&mesh.positions, mode);
         let triangles: Vec<[u32; 3]> =
@@ -202,6 +217,7 @@ impl Topology {
         }
     }
 
+    /// The triangles using edge `e` (an index into [`Topology::edges`]).
     pub fn edge_uses(&self, e: usize) -> &[EdgeUse] {
         let e = &self.edges[e];
         &self.uses[e.first_use as usize..(e.first_use + e.use_count) as usize]

@@ -5,7 +5,7 @@
 //! - Every optional feature the shadow algorithm can use is *probed* and enabled only when
 //!   present; [`Features`] records what was found, and the renderer picks its code path from
 //!   it (and says so in `umbrage info` and the stats JSON).
-//! - Validation messages of severity ERROR are collected in [`Context::validation_errors`]; tests
+//! - Validation messages of severity ERROR are collected in `Context::validation_errors`; tests
 //!   (which always run with `UMBRAGE_VALIDATION=1`) fail when any was reported.
 //! - Teardown order: device idle -> allocator -> pool -> device -> messenger -> instance.
 
@@ -15,7 +15,8 @@ use std::ffi::{c_void, CStr};
 use std::sync::{Arc, Mutex};
 
 /// Optional device capabilities, as probed.
-#[derive(Clone, Debug, Default, serde::Serialize)]
+#[derive(Clone, Debug, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Features {
     pub depth_clamp: bool,
     pub depth_bounds: bool,
@@ -34,7 +35,8 @@ pub struct Features {
     pub rgba32f_blend: bool,
 }
 
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct DeviceInfo {
     pub name: String,
     pub kind: String,

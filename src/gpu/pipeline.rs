@@ -30,6 +30,10 @@ pub struct PipelineDesc<'a> {
     /// Vertex stride and (location, format, offset) attributes; stride 0 = no vertex input.
     pub vertex_stride: u32,
     pub attributes: &'a [(u32, vk::Format, u32)],
+    /// A second, per-instance binding (1): stride and (location, format, offset) attributes;
+    /// stride 0 = none.
+    pub instance_stride: u32,
+    pub instance_attributes: &'a [(u32, vk::Format, u32)],
     pub color_formats: &'a [vk::Format],
     pub blend: Blend,
     pub color_write: bool,
@@ -53,6 +57,8 @@ impl<'a> PipelineDesc<'a> {
             fragment: None,
             vertex_stride: 0,
             attributes: &[],
+            instance_stride: 0,
+            instance_attributes: &[],
             color_formats: &[],
             blend: Blend::None,
             color_write: true,
@@ -87,12 +93,26 @@ pub fn create(ctx: &impl GpuDevice, d: &PipelineDesc) -> Result<vk::Pipeline> {
     if let Some(fs) = fs {
         stages.push(vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::FRAGMENT).module(fs).name(c"main"));
     }
-    let bindings = [vk::VertexInputBindingDescription { binding: 0, stride: d.vertex_stride, input_rate: vk::VertexInputRate::VERTEX }];
-    let attrs: Vec<_> = d
+    let mut bindings =
+        vec![vk::VertexInputBindingDescription { binding: 0, stride: d.vertex_stride, input_rate: vk::VertexInputRate::VERTEX }];
+    let mut attrs: Vec<_> = d
         .attributes
         .iter()
         .map(|&(location, format, offset)| vk::VertexInputAttributeDescription { location, binding: 0, format, offset })
         .collect();
+    if d.instance_stride > 0 {
+        bindings.push(vk::VertexInputBindingDescription {
+            binding: 1,
+            stride: d.instance_stride,
+            input_rate: vk::VertexInputRate::INSTANCE,
+        });
+        attrs.extend(d.instance_attributes.iter().map(|&(location, format, offset)| vk::VertexInputAttributeDescription {
+            location,
+            binding: 1,
+            format,
+            offset,
+        }));
+    }
     let vertex_input = if d.vertex_stride == 0 {
         vk::PipelineVertexInputStateCreateInfo::default()
     } else {
@@ -168,7 +188,8 @@ pub fn create(ctx: &impl GpuDevice, d: &PipelineDesc) -> Result<vk::Pipeline> {
         dynamic.push(vk::DynamicState::DEPTH_BOUNDS);
     }
     let dyn_state = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic);
-    let has_stencil = matches!(d.depth_format, vk::Format::D24_UNORM_S8_UINT | vk::Format::D32_SFLOAT_S8_UINT);
+    let has_stencil =
+        matches!(d.depth_format, vk::Format::D16_UNORM_S8_UINT | vk::Format::D24_UNORM_S8_UINT | vk::Format::D32_SFLOAT_S8_UINT);
     let mut rendering = vk::PipelineRenderingCreateInfo::default()
         .color_attachment_formats(d.color_formats)
         .depth_attachment_format(d.depth_format)

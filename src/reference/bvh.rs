@@ -18,6 +18,7 @@ pub struct Hit {
     pub tri: u32,
     /// Barycentric weights of vertices 1 and 2 (vertex 0 has `1 - u - v`).
     pub u: f64,
+    /// Barycentric weight of vertex 2.
     pub v: f64,
 }
 
@@ -104,6 +105,7 @@ impl Bvh {
     pub fn len(&self) -> usize {
         self.ids.len()
     }
+    /// True iff the hierarchy holds no triangle.
     pub fn is_empty(&self) -> bool {
         self.ids.is_empty()
     }

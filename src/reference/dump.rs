@@ -4,7 +4,7 @@
 //! * `frame.json`: `{"width": W, "height": H, "camera_pos": [x,y,z],
 //!   "lights": [{"position": [x,y,z,w]}, ...]}` — w=1: point/spot at xyz; w=0: directional,
 //!   xyz points towards the light. Optional extra keys written here and understood by the
-//!   reader: per light `"kind"` ("point"|"spot"|"directional"), `"direction"` [x,y,z] (the
+//!   reader: per light `"kind"` ("point"|"spot"|"directional"), `"direction"` `[x,y,z]` (the
 //!   direction the light travels), `"cone_deg"`, `"radius"`; top level `"camera"`
 //!   `{"eye","target","up","fov_y_deg","near"}`. Any other top-level key is kept in
 //!   [`Dump::extra`]. Readers accept dumps with only the required keys.
@@ -27,10 +27,13 @@ use std::path::Path;
 pub struct DumpLight {
     /// (xyz, 1) point/spot; (towards-light direction, 0) directional.
     pub position: Vec4,
+    /// Point, spot or directional when the dump says (else inferred from `position.w`).
     pub kind: Option<LightKind>,
     /// Direction the light travels (spot; directional is implied by `position`).
     pub direction: Option<Vec3>,
+    /// Full cone angle of a spot light, degrees.
     pub cone_deg: Option<f32>,
+    /// Attenuation range, world units (`None`: unbounded).
     pub radius: Option<f32>,
 }
 
@@ -96,9 +99,13 @@ impl DumpLight {
 /// A frame dump in memory.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Dump {
+    /// Image width, pixels.
     pub width: u32,
+    /// Image height, pixels.
     pub height: u32,
+    /// World-space eye position.
     pub camera_pos: Vec3,
+    /// Every light, with its mask in the dump directory.
     pub lights: Vec<DumpLight>,
     /// World-space shadow-casting triangles.
     pub triangles: Vec<[Vec3; 3]>,

@@ -36,14 +36,26 @@ pub struct Metrics {
     pub ambiguous: u64,
     /// Pixels in the band.
     pub band_pixels: u64,
+    /// `mismatches_outside_band / compared` (0 when nothing was compared).
     pub fraction_outside_band: f64,
 }
 
 /// What a pixel sees, for the discontinuity part of the band.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum GeoSample {
+    /// The ray hits nothing.
     Background,
-    Surface { position: DVec3, normal: DVec3, depth: f64, mesh: Option<u32> },
+    /// The ray hits a surface.
+    Surface {
+        /// World position of the hit.
+        position: DVec3,
+        /// Unit geometric normal there.
+        normal: DVec3,
+        /// Distance from the eye.
+        depth: f64,
+        /// Index of the scene mesh hit, when known.
+        mesh: Option<u32>,
+    },
 }
 
 /// Normal change above which neighbours are a discontinuity (degrees).

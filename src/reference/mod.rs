@@ -34,6 +34,7 @@
 //!
 //! A non-finite or zero normal is also Ambiguous.
 
+#![warn(missing_docs)]
 pub mod bvh;
 pub mod dump;
 pub mod metrics;
@@ -112,6 +113,7 @@ impl Default for Tolerance {
 /// One pixel of a [`RefImage`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RefPixel {
+    /// The pixel's centre ray hit a surface (false: background).
     pub hit: bool,
     /// World position of the visible surface (NaN for background).
     pub position: Vec3,
@@ -126,6 +128,7 @@ pub struct RefPixel {
 }
 
 impl RefPixel {
+    /// A pixel whose ray hits nothing.
     pub const BACKGROUND: RefPixel =
         RefPixel { hit: false, position: Vec3::NAN, normal: Vec3::NAN, depth: f32::INFINITY, mesh: u32::MAX, tri: u32::MAX };
 }
@@ -133,8 +136,11 @@ impl RefPixel {
 /// A reference rendering: per pixel the visible surface and per light its [`LightState`].
 #[derive(Clone, Debug)]
 pub struct RefImage {
+    /// Width, pixels.
     pub width: u32,
+    /// Height, pixels.
     pub height: u32,
+    /// Number of lights (the stride of `states`).
     pub light_count: usize,
     /// Row-major from the top-left.
     pub pixels: Vec<RefPixel>,
@@ -143,9 +149,11 @@ pub struct RefImage {
 }
 
 impl RefImage {
+    /// The visible surface at pixel (x, y), row 0 at the top.
     pub fn pixel(&self, x: u32, y: u32) -> &RefPixel {
         &self.pixels[(y * self.width + x) as usize]
     }
+    /// What light `light` does at pixel (x, y).
     pub fn state(&self, x: u32, y: u32, light: usize) -> LightState {
         self.states[(y * self.width + x) as usize * self.light_count + light]
     }
@@ -180,6 +188,7 @@ pub struct Reference {
     /// (0 for opaque casters); see [`transmit`].
     filters: Vec<[f64; 3]>,
     scale: f64,
+    /// How close to a shadow boundary a point may be before it is called ambiguous.
     pub tolerance: Tolerance,
 }
 
@@ -280,6 +289,7 @@ impl Reference {
         Reference::with_filters(tris, &flags, &filters)
     }
 
+    /// The same reference with another [`Tolerance`].
     pub fn with_tolerance(mut self, tolerance: Tolerance) -> Reference {
         self.tolerance = tolerance;
         self
@@ -537,22 +547,30 @@ pub(crate) fn par_rows<T: Send>(h: usize, f: impl Fn(usize) -> T + Sync) -> Vec<
 /// Per-light result of [`check_dump`].
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct LightCheck {
+    /// The light's index in the dump.
     pub index: usize,
     /// Homogeneous position as in frame.json.
     pub position: [f32; 4],
     /// "point", "spot" or "directional" (as used for the check).
     pub kind: String,
+    /// The dumped mask compared with the reference's.
     pub metrics: Metrics,
 }
 
 /// The result of checking a frame dump against the reference.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct CheckReport {
+    /// The dump directory checked.
     pub dir: String,
+    /// Image width, pixels.
     pub width: u32,
+    /// Image height, pixels.
     pub height: u32,
+    /// Width in pixels of the band around reference shadow edges left out of the comparison.
     pub band: u32,
+    /// Triangles the reference was built from.
     pub triangles: usize,
+    /// One result per light.
     pub lights: Vec<LightCheck>,
 }
 

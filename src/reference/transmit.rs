@@ -177,8 +177,11 @@ impl Reference {
 /// [`Transmit`].
 #[derive(Clone, Debug)]
 pub struct TransmitImage {
+    /// Width, pixels.
     pub width: u32,
+    /// Height, pixels.
     pub height: u32,
+    /// Number of lights (the stride of `values`).
     pub light_count: usize,
     /// Row-major from the top-left.
     pub pixels: Vec<RefPixel>,
@@ -187,6 +190,7 @@ pub struct TransmitImage {
 }
 
 impl TransmitImage {
+    /// What reaches pixel (x, y) from light `light`.
     pub fn value(&self, x: u32, y: u32, light: usize) -> Transmit {
         self.values[(y * self.width + x) as usize * self.light_count + light]
     }
@@ -224,9 +228,13 @@ pub struct TransmitMetrics {
     pub band_pixels: u64,
     /// Compared pixels outside the band with a surface on both sides: the error samples.
     pub compared_outside_band: u64,
+    /// Largest absolute error of the light fraction outside the band.
     pub max_abs_error: f64,
+    /// Mean absolute error outside the band.
     pub mean_abs_error: f64,
+    /// Root-mean-square error outside the band.
     pub rms_error: f64,
+    /// 99th percentile of the absolute error outside the band.
     pub p99_abs_error: f64,
     /// Largest error inside the band (informative).
     pub max_abs_error_in_band: f64,

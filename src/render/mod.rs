@@ -15,11 +15,58 @@
 //! enclosing volume, with wrap ops so the order of faces does not matter.
 
 pub mod frame;
+mod frame_output;
 pub mod options;
+pub(crate) mod passes;
+mod pipelines;
+pub mod push;
+mod readback;
+mod scene_gpu;
+mod selfshadow;
 pub mod shadowmap;
 pub mod stats;
 pub mod targets;
+mod timing;
 
-pub use frame::{FrameOutput, Renderer};
-pub use options::{Counter, DepthMode, IndexFormat, RenderOptions, TransmitMode, View};
+pub use frame::{FrameTicket, Renderer, Throughput};
+pub use frame_output::FrameOutput;
+pub use options::{Counter, DepthMode, FrameSettings, IndexFormat, RenderConfig, RenderOptions, Technique, TransmitMode, View};
+pub use passes::debug::stencil_heatmap;
 pub use stats::Stats;
+
+use crate::error::Result;
+use crate::gpu::{Buffer, Context};
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+
+/// Uploads `data` into a device-local buffer through a staging buffer (waits for the copy).
+pub(crate) fn upload(ctx: &Context, name: &str, data: &[u8], usage: vk::BufferUsageFlags) -> Result<Buffer> {
+    let mut staging = Buffer::with_data(ctx, "staging", data, vk::BufferUsageFlags::TRANSFER_SRC)?;
+    let dst = match Buffer::new(ctx, name, data.len() as u64, usage | vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuOnly) {
+        Ok(b) => b,
+        Err(e) => {
+            staging.destroy(ctx);
+            return Err(e);
+        }
+    };
+    let r = ctx.one_shot(|cb| {
+        // SAFETY: both buffers are at least `data.len()` bytes and alive until after the wait.
+        unsafe {
+            ctx.device.cmd_copy_buffer(
+                cb,
+                staging.raw,
+                dst.raw,
+                &[vk::BufferCopy { src_offset: 0, dst_offset: 0, size: data.len() as u64 }],
+            )
+        };
+    });
+    staging.destroy(ctx);
+    match r {
+        Ok(()) => Ok(dst),
+        Err(e) => {
+            let mut dst = dst;
+            dst.destroy(ctx);
+            Err(e)
+        }
+    }
+}

@@ -1,78 +1,16 @@
 //! What a frame is asked to do: the options of [`Renderer`](super::Renderer) and the CLI.
 
 use crate::error::{Error, Result};
+use crate::named_enum::named_enum;
+pub use crate::pass::{Counter, DepthMode, IndexFormat};
 use crate::shadow::Method;
 use ash::vk;
-
-/// An enum of named options: `name()`, `FromStr` (an unknown name lists the valid ones), `ALL`.
-macro_rules! named_enum {
-    ($(#[$m:meta])* $name:ident, $what:literal, { $($(#[$vm:meta])* $variant:ident => $s:literal),+ $(,)? }) => {
-        $(#[$m])*
-        #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-        pub enum $name {
-            $($(#[$vm])* $variant),+
-        }
-
-        impl $name {
-            pub const ALL: &'static [$name] = &[$($name::$variant),+];
-            pub fn name(self) -> &'static str {
-                match self {
-                    $($name::$variant => $s),+
-                }
-            }
-        }
-
-        impl std::str::FromStr for $name {
-            type Err = Error;
-            fn from_str(s: &str) -> Result<Self> {
-                Self::ALL.iter().copied().find(|v| v.name() == s).ok_or_else(|| Error::UnknownName {
-                    what: $what,
-                    name: s.into(),
-                    expected: Self::ALL.iter().map(|v| v.name()).collect::<Vec<_>>().join(", "),
-                })
-            }
-        }
-    };
-}
-
-named_enum!(
-    /// How z-fail keeps the far plane out of the way.
-    DepthMode, "depth mode", {
-        /// Far plane at infinity (w = 0 vertices land exactly on depth 1).
-        Infinite => "infinite",
-        /// A finite far plane beyond the scene, with `depthClamp` on the shadow pipelines.
-        Clamp => "clamp",
-    }
-);
-
-named_enum!(
-    /// How shadow geometry reaches the GPU each frame.
-    IndexFormat, "index format", {
-        U32 => "u32",
-        U16 => "u16",
-        /// 8-bit indices for chunks of at most 128 vertices (needs `indexTypeUint8`), else u16.
-        U8 => "u8",
-        /// u8 where possible, else u16.
-        Auto => "auto",
-        /// No indices: every shadow-triangle vertex streamed as 4 x f32 (the naive baseline).
-        Naive => "naive",
-    }
-);
-
-named_enum!(
-    /// Where shadow volumes are counted.
-    Counter, "counter", {
-        /// The 8-bit stencil with wrapping increments (counts modulo 256).
-        Stencil => "stencil",
-        /// A 32-bit float colour target with additive blending: no 8-bit wrap (exact to 2^24).
-        Float => "float",
-    }
-);
 
 named_enum!(
     /// What the final image shows.
     View, "view", {
         /// The lit scene.
+        #[default]
         Shaded => "shaded",
         /// Shadow volumes translucent over the scene, coloured by case.
         Volumes => "volumes",
@@ -129,27 +67,148 @@ impl TransmitMode {
     }
 }
 
+/// How the frame's shadows are computed: one enum for every technique.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Technique {
+    /// Stencil shadow volumes from CPU possible silhouettes, with one of the papers' case rules.
+    Volumes(Method),
+    /// The Cg article's GPU-only edge quads for closed opaque casters.
+    EdgeQuads,
+    /// The shadow-map baseline (PCF 3x3) with maps of `size` texels a side.
+    ShadowMap {
+        /// Texels per side of one map (16..=8192).
+        size: u32,
+    },
+}
+
+impl Technique {
+    /// The name in `--stats` and the bench (`mcguire`, `edgequad`, `shadowmap`...).
+    pub fn name(self) -> &'static str {
+        match self {
+            Technique::Volumes(m) => m.name(),
+            Technique::EdgeQuads => "edgequad",
+            Technique::ShadowMap { .. } => "shadowmap",
+        }
+    }
+    /// The five volume methods (z-pass, z-fail, Everitt-Kilgard, Lengyel, McGuire).
+    pub fn all_volumes() -> Vec<Technique> {
+        Method::ALL.iter().map(|&m| Technique::Volumes(m)).collect()
+    }
+    /// The technique the shadow pass runs (`None` for shadow maps).
+    pub fn pass_technique(self) -> Option<crate::pass::Technique> {
+        match self {
+            Technique::Volumes(m) => Some(crate::pass::Technique::Volumes(m)),
+            Technique::EdgeQuads => Some(crate::pass::Technique::EdgeQuads),
+            Technique::ShadowMap { .. } => None,
+        }
+    }
+    /// Parses a `--method` value: `auto` (= mcguire), a volume method, `edgequad`, or
+    /// `shadowmap` (with maps of `shadow_map_size` texels).
+    pub fn parse(s: &str, shadow_map_size: u32) -> Result<Technique> {
+        match s {
+            "edgequad" => Ok(Technique::EdgeQuads),
+            "shadowmap" => Ok(Technique::ShadowMap { size: shadow_map_size }),
+            _ => s.parse::<Method>().map(Technique::Volumes).map_err(|_| Error::UnknownName {
+                what: "method",
+                name: s.into(),
+                expected: format!("auto, {}, edgequad, shadowmap", Method::ALL.map(|m| m.name()).join(", ")),
+            }),
+        }
+    }
+}
+
+impl Default for Technique {
+    fn default() -> Self {
+        Technique::Volumes(Method::McGuire)
+    }
+}
+
+/// What a [`Renderer`](super::Renderer) is built for: fixed at creation (targets and
+/// pipelines are made for it).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RenderConfig {
+    /// Image width in pixels (1..=16384).
+    pub width: u32,
+    /// Image height in pixels (1..=16384).
+    pub height: u32,
+    /// Infinite far plane, or finite with depth clamp.
+    pub depth_mode: DepthMode,
+    /// The light-intensity map's format: RGBA32F (true) or RGBA16F.
+    pub transmit_fp32: bool,
+    /// Partial self-shadowing of transparent casters (src/render/selfshadow.rs).
+    pub self_shadow: bool,
+    /// Frames the renderer keeps in flight (command buffers, fences, readbacks per slot).
+    pub frames_in_flight: usize,
+}
+
+/// What may change from one frame to the next.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FrameSettings {
+    /// Volumes (with a method), edge quads or shadow maps.
+    pub technique: Technique,
+    /// Stencil or float counting.
+    pub counter: Counter,
+    /// Index format of the shadow streams.
+    pub index_format: IndexFormat,
+    /// Shaded, volumes overlay, or the stencil heat map.
+    pub view: View,
+    /// Log-space or multiplicative light-intensity map (its format is fixed at creation).
+    pub transmit_log: bool,
+    /// Read back per-light counts, positions and normals (dumps, tests).
+    pub capture: bool,
+}
+
+/// Everything a renderer is created with: its [`RenderConfig`] and first [`FrameSettings`].
 #[derive(Clone, Debug)]
 pub struct RenderOptions {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
-    pub method: Method,
+    /// Volumes, edge quads or shadow maps.
+    pub technique: Technique,
+    /// Infinite far plane, or finite with depth clamp.
     pub depth_mode: DepthMode,
+    /// Index format of the shadow streams.
     pub index_format: IndexFormat,
+    /// What the final image shows.
     pub view: View,
+    /// Stencil or float counting.
     pub counter: Counter,
     /// Transparent casters' light-intensity map: format fixed at creation, log/mul per frame.
     pub transmit: TransmitMode,
-    /// `Some(texels)`: the shadow-map baseline (PCF) instead of shadow volumes.
-    pub shadow_map: Option<u32>,
-    /// The GPU-only edge-quad method (Cg article) for closed opaque casters: no CPU
-    /// silhouettes, every face and edge quad drawn every frame.
-    pub edge_quads: bool,
     /// Read back per-light stencil counts, positions and normals (dumps, tests).
     pub capture: bool,
     /// Partial self-shadowing of transparent casters (src/render/selfshadow.rs); no effect on
     /// scenes without them.
     pub self_shadow: bool,
+    /// Frames in flight (at least 1).
+    pub frames_in_flight: usize,
+}
+
+impl RenderOptions {
+    /// The fixed half.
+    pub fn config(&self) -> RenderConfig {
+        RenderConfig {
+            width: self.width,
+            height: self.height,
+            depth_mode: self.depth_mode,
+            transmit_fp32: self.transmit.fp32,
+            self_shadow: self.self_shadow,
+            frames_in_flight: self.frames_in_flight,
+        }
+    }
+    /// The per-frame half.
+    pub fn settings(&self) -> FrameSettings {
+        FrameSettings {
+            technique: self.technique,
+            counter: self.counter,
+            index_format: self.index_format,
+            view: self.view,
+            transmit_log: self.transmit.log,
+            capture: self.capture,
+        }
+    }
 }
 
 impl Default for RenderOptions {
@@ -157,16 +216,15 @@ impl Default for RenderOptions {
         RenderOptions {
             width: 960,
             height: 540,
-            method: Method::McGuire,
+            technique: Technique::default(),
             depth_mode: DepthMode::Infinite,
             index_format: IndexFormat::Auto,
             view: View::Shaded,
             counter: Counter::Stencil,
             transmit: TransmitMode { fp32: false, log: true },
-            shadow_map: None,
-            edge_quads: false,
             capture: false,
             self_shadow: false,
+            frames_in_flight: 2,
         }
     }
 }

@@ -2,82 +2,29 @@
 
 use serde::Serialize;
 
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct Triangles {
-    pub sides: u64,
-    pub dark_cap: u64,
-    pub light_cap: u64,
-}
-
-impl Triangles {
-    pub fn total(&self) -> u64 {
-        self.sides + self.dark_cap + self.light_cap
-    }
-    pub fn add(&mut self, o: &Triangles) {
-        self.sides += o.sides;
-        self.dark_cap += o.dark_cap;
-        self.light_cap += o.light_cap;
-    }
-}
-
-#[derive(Clone, Debug, Serialize)]
-pub struct CasterStats {
-    pub name: String,
-    pub case: String,
-    pub silhouette_edges: u64,
-    pub triangles: Triangles,
-    pub index_bytes: u64,
-    pub vertex_bytes: u64,
-    /// Bytes per shadow triangle actually sent this frame (index + streamed vertex bytes).
-    pub bytes_per_triangle: f64,
-    pub index_format: String,
-    pub dark_cap_kind: String,
-    /// "manifold" (the three-case path) or "multiplicity" (open / non-manifold casters).
-    pub path: String,
-    /// Why the caster took the multiplicity path (empty for manifold casters).
-    pub path_reason: String,
-    /// Largest |edge multiplicity| drawn (1 for a manifold silhouette).
-    pub multiplicity_max: u32,
-}
-
-#[derive(Clone, Debug, Serialize)]
-pub struct LightStats {
-    pub index: usize,
-    pub kind: String,
-    pub scissor: Option<[u32; 4]>,
-    pub depth_bounds: Option<[f32; 2]>,
-    pub casters: Vec<CasterStats>,
-}
-
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct Cases {
-    pub culled: u64,
-    pub zpass: u64,
-    pub zfail: u64,
-    pub zfail_light_cap: u64,
-}
-
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct Totals {
-    pub triangles: Triangles,
-    pub index_bytes: u64,
-    pub vertex_bytes: u64,
-    pub cases: Cases,
-}
-
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct CpuMs {
-    pub silhouettes: f64,
-    pub plan: f64,
-    pub record: f64,
-}
+pub use crate::pass::stats::{Cases, CasterStats, CpuMs, LightStats, Totals, Triangles};
 
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct GpuMs {
+    /// The G-buffer pass.
     pub depth: f64,
+    /// Every light's determination, summed.
     pub shadow: f64,
+    /// Every light's illumination, summed.
     pub illuminate: f64,
+    /// The whole frame.
     pub frame: f64,
+    /// Per light, in the frame's light order.
+    pub per_light: Vec<LightGpuMs>,
+}
+
+/// One light's GPU time.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct LightGpuMs {
+    /// Its determination (and the shadow-map passes for the baseline).
+    pub shadow: f64,
+    /// Its illumination.
+    pub illuminate: f64,
 }
 
 #[derive(Clone, Debug, Serialize)]

@@ -11,7 +11,7 @@ pub const NORMAL_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 pub const POSITION_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 pub const OUTPUT_FORMAT: vk::Format = vk::Format::R8G8B8A8_SRGB;
 /// The float shadow-volume counter (`--counter float`).
-pub const COUNT_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
+pub use crate::pass::COUNT_FORMAT;
 
 pub struct Targets {
     pub extent: vk::Extent2D,

@@ -46,10 +46,12 @@ pub const DATA: &[(&str, &str)] = &[
     ("scenes/data/two_sided_card.obj", include_str!("../../scenes/data/two_sided_card.obj")),
 ];
 
+/// The TOML text of built-in scene `name`, if there is one.
 pub fn scene(name: &str) -> Option<&'static str> {
     SCENES.iter().find(|(n, _)| *n == name).map(|(_, t)| *t)
 }
 
+/// The text of an embedded OBJ file by its repository-relative path ([`DATA`]), if embedded.
 pub fn obj(path: &str) -> Option<&'static str> {
     DATA.iter().find(|(n, _)| *n == path).map(|(_, t)| *t)
 }

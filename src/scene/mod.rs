@@ -1,133 +1,52 @@
 //! Scenes: camera, lights and meshes, from a TOML file, an OBJ, or a built-in name.
 //!
-//! The camera model here (pixel centres, Vulkan clip space, infinite far plane) is the one
-//! both the GPU renderer and the CPU reference use; it is the only code they share.
+//! The camera and light models ([`Camera`], [`Light`]) are defined in [`geom::light`](crate::geom::light)
+//! and re-exported here.
+
+#![warn(missing_docs)]
 
 use crate::geom::{Aabb, Mesh};
-use glam::{Mat4, Vec3, Vec4};
+use glam::{Mat4, Vec3};
 
-/// A pinhole camera, right-handed, looking from `eye` to `target`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Camera {
-    pub eye: Vec3,
-    pub target: Vec3,
-    pub up: Vec3,
-    pub fov_y_deg: f32,
-    pub near: f32,
-}
-
-impl Default for Camera {
-    fn default() -> Self {
-        Camera { eye: Vec3::new(0.0, 2.0, 6.0), target: Vec3::ZERO, up: Vec3::Y, fov_y_deg: 60.0, near: 0.1 }
-    }
-}
-
-impl Camera {
-    /// World -> view (right-handed, looking down -Z).
-    pub fn view(&self) -> Mat4 {
-        glam::camera::rh::view::look_at_mat4(self.eye, self.target, self.up.normalize())
-    }
-    /// View -> Vulkan clip space with the far plane at infinity: depth 0 at `near`, 1 at
-    /// infinity; y points down in the framebuffer (row 0 is the top of the image).
-    pub fn proj_infinite(&self, aspect: f32) -> Mat4 {
-        let f = 1.0 / (self.fov_y_deg.to_radians() * 0.5).tan();
-        Mat4::from_cols(
-            Vec4::new(f / aspect, 0.0, 0.0, 0.0),
-            Vec4::new(0.0, -f, 0.0, 0.0),
-            Vec4::new(0.0, 0.0, -1.0, -1.0),
-            Vec4::new(0.0, 0.0, -self.near, 0.0),
-        )
-    }
-    /// Same with a finite far plane (used with depth clamp, `--depth-mode clamp`).
-    pub fn proj_finite(&self, aspect: f32, far: f32) -> Mat4 {
-        let f = 1.0 / (self.fov_y_deg.to_radians() * 0.5).tan();
-        let n = self.near;
-        let r = far / (n - far);
-        Mat4::from_cols(
-            Vec4::new(f / aspect, 0.0, 0.0, 0.0),
-            Vec4::new(0.0, -f, 0.0, 0.0),
-            Vec4::new(0.0, 0.0, r, -1.0),
-            Vec4::new(0.0, 0.0, r * n, 0.0),
-        )
-    }
-    /// The world-space ray through the centre of pixel (x, y) of a `width` x `height` image
-    /// (row 0 at the top): origin on the near plane, unit direction. f64 for the reference.
-    pub fn pixel_ray(&self, x: u32, y: u32, width: u32, height: u32) -> (glam::DVec3, glam::DVec3) {
-        let aspect = width as f64 / height as f64;
-        let ndc_x = (x as f64 + 0.5) / width as f64 * 2.0 - 1.0;
-        let ndc_y = (y as f64 + 0.5) / height as f64 * 2.0 - 1.0;
-        let t = (self.fov_y_deg as f64).to_radians() * 0.5;
-        let t = t.tan();
-        // view space: x right, y up, looking down -z; ndc y points down.
-        let dir_v = glam::DVec3::new(ndc_x * t * aspect, -ndc_y * t, -1.0);
-        let eye = self.eye.as_dvec3();
-        let fwd = (self.target.as_dvec3() - eye).normalize();
-        let right = fwd.cross(self.up.as_dvec3()).normalize();
-        let up = right.cross(fwd);
-        let d = right * dir_v.x + up * dir_v.y + fwd * (-dir_v.z);
-        let origin = eye + d * self.near as f64;
-        (origin, d.normalize())
-    }
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum LightKind {
-    Point,
-    Spot,
-    Directional,
-}
-
-/// A light. `direction` is the unit direction the light travels (directional, spot).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Light {
-    pub kind: LightKind,
-    pub position: Vec3,
-    pub direction: Vec3,
-    pub color: Vec3,
-    pub intensity: f32,
-    /// Attenuation range: beyond it the light contributes nothing (and casters are culled).
-    pub radius: Option<f32>,
-    /// Full cone angle of a spot light, degrees.
-    pub cone_deg: f32,
-}
-
-impl Light {
-    /// Homogeneous position: (position, 1) for point and spot, (-direction, 0) for directional
-    /// (xyz pointing towards the light), as in McGuire et al. and the dump format.
-    pub fn homogeneous(&self) -> Vec4 {
-        match self.kind {
-            LightKind::Directional => (-self.direction.normalize()).extend(0.0),
-            _ => self.position.extend(1.0),
-        }
-    }
-}
+/// The camera and light models live in [`geom`](crate::geom) (the planner needs them and must not
+/// depend on scenes); they are re-exported here so `scene::Light` etc. keep working.
+pub use crate::geom::{Camera, Light, LightKind};
 
 /// One mesh instance of a scene.
 #[derive(Clone, Debug)]
 pub struct SceneMesh {
+    /// The mesh's name (the scene file's `name`, else `mesh<i>-<kind>`), used in messages and stats.
     pub name: String,
     /// Object-space mesh, validated, CCW outward in world space after `transform`
     /// (a mirroring transform has its winding swapped at load).
     pub mesh: Mesh,
     /// Object -> world.
     pub transform: Mat4,
+    /// Linear RGB albedo; for a transparent mesh also the filter colour of the light it lets through.
     pub color: Vec3,
+    /// 1 = opaque; below 1 every surface lets `(1 - opacity) * color` of the light through.
     pub opacity: f32,
+    /// Whether the mesh casts shadows (every mesh receives them).
     pub casts_shadow: bool,
 }
 
 impl SceneMesh {
+    /// World-space box of the object bounds' transformed corners (conservative).
     pub fn world_bounds(&self) -> Aabb {
         self.mesh.bounds().transformed(&self.transform)
     }
 }
 
+/// A whole scene: one camera, any number of lights and meshes.
 #[derive(Clone, Debug)]
 pub struct Scene {
+    /// The scene file's `name`, else its file stem; used in reports.
     pub name: String,
+    /// The camera the frame is rendered from.
     pub camera: Camera,
+    /// Every light, each with its own shadow determination and illumination pass.
     pub lights: Vec<Light>,
+    /// Every mesh instance, casters and receivers alike.
     pub meshes: Vec<SceneMesh>,
     /// Ambient light colour (default 0.08 grey).
     pub ambient: Vec3,

@@ -9,6 +9,7 @@
 use crate::error::{Error, Result};
 use crate::geom::topology::Topology;
 use crate::geom::{Aabb, Mesh};
+#[cfg(feature = "cli")]
 use crate::scene::SceneMesh;
 use glam::{Mat4, Vec3};
 
@@ -34,6 +35,7 @@ pub struct Chunk {
 }
 
 impl Chunk {
+    /// `n`, the number of vertices (apex included); the dual-length buffer holds `2n`.
     pub fn n(&self) -> usize {
         self.vertices.len()
     }
@@ -60,6 +62,7 @@ pub enum CasterKind {
 }
 
 impl CasterKind {
+    /// `"manifold"` or `"multiplicity"`, as in the stats JSON and `umbrage info`.
     pub fn path(&self) -> &'static str {
         match self {
             CasterKind::Manifold => "manifold",
@@ -71,25 +74,33 @@ impl CasterKind {
 /// A shadow caster: welded mesh, topology and chunks.
 #[derive(Clone, Debug)]
 pub struct Caster {
+    /// The mesh's name, for messages and stats.
     pub name: String,
     /// `Some(t)` for a transparent caster: the RGB fraction of light one of its surfaces lets
     /// through, `(1 - opacity) * color`. Its volumes go to the light-intensity map, not the
     /// opaque counter.
     pub transmittance: Option<glam::Vec3>,
+    /// Classic (closed manifold) or multiplicity path.
     pub kind: CasterKind,
     /// Multiplicity casters only (empty otherwise): for every welded triangle, the id of the
     /// group of triangles with exactly the same three welded vertices (any order, any
     /// winding: duplicates and back-to-back pairs), or `u32::MAX` when it has no twin.
     pub coincident: Vec<u32>,
+    /// Welded mesh and its edge table (object space).
     pub topology: Topology,
+    /// The welded mesh split into pieces of at most [`MAX_CHUNK_VERTICES`] vertices.
     pub chunks: Vec<Chunk>,
     /// For every welded triangle: (chunk, local triangle index).
     pub tri_chunk: Vec<(u32, u32)>,
+    /// Bounding box of the welded mesh, object space.
     pub object_bounds: Aabb,
+    /// Object -> world.
     pub transform: Mat4,
+    /// World -> object (`transform.inverse()`).
     pub inverse: Mat4,
     /// The transform mirrors (negative determinant): object-space orientation is reversed.
     pub mirrored: bool,
+    /// Triangles of the welded mesh.
     pub triangle_count: usize,
     /// Largest chunk vertex count (apex included); `<= 128` means 8-bit indices everywhere.
     pub max_local_vertices: usize,
@@ -101,6 +112,7 @@ impl Caster {
     /// A caster for a scene mesh. A transparent mesh (opacity < 1) always takes the
     /// multiplicity path, whose count is the number of surfaces crossed (Kim et al. 2008): each
     /// one attenuates the light by `(1 - opacity) * color`.
+    #[cfg(feature = "cli")]
     pub fn from_scene_mesh(m: &SceneMesh) -> Result<Caster> {
         let mut c = Caster::new(&m.name, &m.mesh, m.transform)?;
         if m.opacity < 1.0 {
@@ -115,6 +127,9 @@ impl Caster {
         Ok(c)
     }
 
+    /// A caster for `mesh` placed by `transform` (object -> world): validates the mesh, welds it,
+    /// classifies it (manifold or multiplicity) and splits it into chunks. Fails on an invalid
+    /// mesh or a singular transform.
     pub fn new(name: &str, mesh: &Mesh, transform: Mat4) -> Result<Caster> {
         Caster::with_chunk_limit(name, mesh, transform, MAX_CHUNK_VERTICES)
     }
@@ -159,14 +174,17 @@ impl Caster {
         })
     }
 
+    /// True iff the caster takes the classic closed-manifold path.
     pub fn is_manifold(&self) -> bool {
         self.kind == CasterKind::Manifold
     }
 
+    /// The welded object-space mesh (what chunks and plans index).
     pub fn mesh(&self) -> &Mesh {
         &self.topology.mesh
     }
 
+    /// World-space box of the object bounds' transformed corners (conservative).
     pub fn world_bounds(&self) -> Aabb {
         self.object_bounds.transformed(&self.transform)
     }
@@ -249,6 +267,34 @@ fn build_chunks(mesh: &Mesh, apex: Vec3, limit: usize) -> (Vec<Chunk>, Vec<(u32,
         finish(cur, &mut chunks);
     }
     (chunks, tri_chunk)
+}
+
+impl Caster {
+    /// Re-derives what depends on vertex positions after they changed in place (same
+    /// topology): called by the shadow pass for deforming casters, after the welded positions,
+    /// the chunks' vertices and the bounds were updated.
+    pub fn refresh_after_positions_changed(&mut self) {}
+
+    /// Sets object -> world (finite and invertible; checked by the caller).
+    pub fn set_transform(&mut self, transform: Mat4) {
+        self.transform = transform;
+        self.inverse = transform.inverse();
+        self.mirrored = transform.determinant() < 0.0;
+    }
+}
+
+impl Caster {
+    /// This caster as a transparent one letting `transmittance` (RGB, per surface crossed)
+    /// through: it takes the multiplicity path whatever its topology, since its count must be
+    /// the number of surfaces crossed (Kim et al. 2008).
+    pub fn into_transparent(mut self, transmittance: glam::Vec3) -> Caster {
+        if self.kind == CasterKind::Manifold {
+            self.kind = CasterKind::Multiplicity { reason: "transparent: every surface crossed attenuates the light".into() };
+            self.coincident = coincident_groups(&self.topology.mesh);
+        }
+        self.transmittance = Some(transmittance.max(glam::Vec3::splat(TRANSMITTANCE_FLOOR)));
+        self
+    }
 }
 
 #[cfg(test)]

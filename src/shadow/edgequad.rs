@@ -15,8 +15,11 @@ use super::caster::Caster;
 /// (drawn with depth compare NEVER, like light caps: each is a light or a dark cap) and the
 /// edge quads (the sides, depth test LESS), as u32 indices.
 pub struct EdgeQuadMesh {
+    /// Three per face: position, then the face plane `(n, d)` (`n . p + d = 0`), then 0.
     pub vertices: Vec<[f32; 8]>,
+    /// Every face's three vertices, in order (`3t, 3t + 1, 3t + 2`).
     pub faces: Vec<u32>,
+    /// Two triangles per manifold edge, joining the two faces' copies of its end points.
     pub quads: Vec<u32>,
 }
 
@@ -52,6 +55,7 @@ impl EdgeQuadMesh {
         EdgeQuadMesh { vertices, faces, quads }
     }
 
+    /// Triangle counts `(faces, quad triangles)` the GPU draws every frame.
     pub fn triangles(&self) -> (usize, usize) {
         (self.faces.len() / 3, self.quads.len() / 3)
     }

@@ -44,27 +44,39 @@ use crate::error::Error;
 use crate::geom::bounds::{box_distance, light_depth_bounds, light_scissor, shadow_volume_outside_frustum, Frustum, OcclusionPyramid};
 use crate::geom::silhouette::{facing_bits, possible_silhouette, SilhouetteEdge};
 use crate::geom::Aabb;
-use crate::scene::{Camera, Light, LightKind};
+use crate::geom::{Camera, Light, LightKind};
 use glam::{Mat4, Vec4};
 use std::time::Instant;
 
 /// Which shadow-volume algorithm to plan for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub enum Method {
-    #[serde(rename = "zpass")]
+    /// Heidmann's z-pass for every caster: sides only ([`Case::ZPass`]); wrong wherever a volume
+    /// crosses the near plane.
+    #[cfg_attr(feature = "serde", serde(rename = "zpass"))]
     ZPass,
-    #[serde(rename = "zfail")]
+    /// Carmack's z-fail for every caster: sides, light cap and the classic O(f) dark cap
+    /// ([`Case::ZFailLightCap`], [`DarkCap::FrontFaces`]).
+    #[cfg_attr(feature = "serde", serde(rename = "zfail"))]
     ZFail,
-    #[serde(rename = "everitt-kilgard")]
+    /// Everitt & Kilgard's robust z-fail (infinite far plane): planned exactly as [`Method::ZFail`].
+    #[cfg_attr(feature = "serde", serde(rename = "everitt-kilgard"))]
     EverittKilgard,
-    #[serde(rename = "lengyel")]
+    /// Lengyel's choice: z-pass when the caster's box misses the occlusion pyramid, else z-fail
+    /// with light cap and the O(f) dark cap.
+    #[cfg_attr(feature = "serde", serde(rename = "lengyel"))]
     Lengyel,
-    #[serde(rename = "mcguire")]
+    /// McGuire et al. 2003: per caster the cheapest correct of the three [`Case`]s (occlusion
+    /// pyramid, then view frustum) and the O(s) fan dark cap.
+    #[cfg_attr(feature = "serde", serde(rename = "mcguire"))]
     McGuire,
 }
 
 impl Method {
+    /// Every method, in the order the CLI and the tables list them.
     pub const ALL: [Method; 5] = [Method::ZPass, Method::ZFail, Method::EverittKilgard, Method::Lengyel, Method::McGuire];
+    /// The CLI / JSON name (`zpass`, `zfail`, `everitt-kilgard`, `lengyel`, `mcguire`); [`FromStr`](std::str::FromStr) parses it back.
     pub fn name(self) -> &'static str {
         match self {
             Method::ZPass => "zpass",
@@ -100,25 +112,27 @@ impl std::str::FromStr for Method {
 }
 
 /// How one caster's volume is drawn for one light.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub enum Case {
     /// Nothing drawn (outside the light's radius or cone, or the volume is off screen).
-    #[serde(rename = "culled")]
+    #[cfg_attr(feature = "serde", serde(rename = "culled"))]
     Culled,
     /// Case 1: z-pass, sides only.
-    #[serde(rename = "zpass")]
+    #[cfg_attr(feature = "serde", serde(rename = "zpass"))]
     ZPass,
     /// Case 2: z-fail, sides + dark cap, no light cap.
-    #[serde(rename = "zfail")]
+    #[cfg_attr(feature = "serde", serde(rename = "zfail"))]
     ZFail,
     /// Case 3 (and Carmack / Everitt-Kilgard / Lengyel z-fail): sides + dark cap + light cap.
-    #[serde(rename = "zfail_light_cap")]
+    #[cfg_attr(feature = "serde", serde(rename = "zfail_light_cap"))]
     ZFailLightCap,
 }
 
 /// Which dark cap was emitted.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum DarkCap {
     /// Fan from the apex at infinity over the silhouette: s triangles.
     Fan,
@@ -134,8 +148,9 @@ pub enum DarkCap {
 }
 
 /// Which closed volume the geometry describes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum Formulation {
     /// Occluders are the light-facing triangles.
     Front,
@@ -145,18 +160,28 @@ pub enum Formulation {
     TwoSided,
 }
 
+/// What [`plan_light`] needs besides the casters: the view, the viewport and one light.
 pub struct PlanInput<'a> {
+    /// The camera `view_proj` was built from (the planner itself reads only `view_proj`).
     pub camera: &'a Camera,
+    /// Viewport width, pixels (for the light scissor).
     pub width: u32,
+    /// Viewport height, pixels (for the light scissor).
     pub height: u32,
+    /// World -> Vulkan clip space of the frame (e.g. `camera.proj_infinite(aspect) * camera.view()`):
+    /// frustum, occlusion pyramid, scissor and depth bounds are all derived from it.
     pub view_proj: Mat4,
+    /// The light to plan for.
     pub light: &'a Light,
+    /// The algorithm whose cases and caps to emit.
     pub method: Method,
 }
 
 /// Index lists for one chunk of a caster (indices into its dual-length vertex buffer).
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct ChunkDraw {
+    /// Index into the caster's [`Caster::chunks`].
     pub chunk: usize,
     /// Sides then dark cap (then, for multiplicity casters, the light caps that may lie in
     /// front of the visible surface); drawn with depth test LESS.
@@ -165,9 +190,13 @@ pub struct ChunkDraw {
     pub light_cap: Vec<u16>,
 }
 
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+/// One caster's shadow volume for one light: the case chosen, what was emitted, and the index lists.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct CasterPlan {
+    /// Index of the caster in the slice given to [`plan_light`].
     pub caster: usize,
+    /// How the volume is drawn (culled, z-pass, z-fail with or without light cap).
     pub case: Case,
     /// `"manifold"` or `"multiplicity"` ([`CasterKind::path`]).
     pub path: &'static str,
@@ -177,11 +206,15 @@ pub struct CasterPlan {
     pub multiplicity_max: u32,
     /// Triangle counts actually emitted.
     pub sides: usize,
+    /// Dark-cap triangles (at infinity) emitted.
     pub dark_cap: usize,
+    /// Light-cap triangles emitted.
     pub light_cap: usize,
     /// Only chunks with at least one index.
     pub chunks: Vec<ChunkDraw>,
+    /// Which dark cap was emitted.
     pub dark_cap_kind: DarkCap,
+    /// Which triangles occlude (front, back or two-sided).
     pub formulation: Formulation,
     /// Object-space homogeneous light the facing bits were decided for (the GPU must use the
     /// same value in EXTRUDE).
@@ -189,17 +222,27 @@ pub struct CasterPlan {
 }
 
 impl CasterPlan {
+    /// Every triangle emitted: sides + dark cap + light cap.
     pub fn triangles(&self) -> usize {
         self.sides + self.dark_cap + self.light_cap
     }
 }
 
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+/// Every caster's plan for one light, with the light's scissor and depth bounds (Lengyel 2002).
 pub struct LightPlan {
+    /// `[x, y, width, height]` in pixels (row 0 at the top) bounding the light's range on screen;
+    /// `None` = the whole viewport (see [`light_scissor`]).
     pub scissor: Option<[u32; 4]>,
+    /// `(min, max)` depth of the light's range for the depth-bounds test; `None` = unbounded
+    /// (see [`light_depth_bounds`]).
     pub depth_bounds: Option<(f32, f32)>,
+    /// One plan per caster, in the order of the casters given (culled ones included).
     pub casters: Vec<CasterPlan>,
+    /// Wall time spent on facing bits and silhouette extraction, milliseconds.
     pub silhouette_ms: f64,
+    /// Wall time of the whole plan (silhouettes included), milliseconds.
     pub plan_ms: f64,
 }
 
@@ -268,9 +311,13 @@ fn spot_culls(light: &Light, b: &Aabb) -> bool {
 /// What to emit for one caster.
 #[derive(Clone, Copy, Debug)]
 pub struct Emit {
+    /// Which triangles occlude (front or back; two-sided goes through [`emit_multiplicity`]).
     pub formulation: Formulation,
+    /// The light is directional: one side triangle per silhouette edge (all of infinity is one point).
     pub directional: bool,
+    /// The dark cap to emit.
     pub dark_cap: DarkCap,
+    /// Emit the light cap (case 3 and the classic z-fail methods).
     pub light_cap: bool,
 }
 

@@ -38,6 +38,7 @@ fn counts(p: &CasterPlan) -> (Case, usize, usize, usize) {
 }
 
 #[test]
+#[cfg(feature = "cli")] // serde_json
 fn method_names() {
     for m in Method::ALL {
         assert_eq!(m.to_string().parse::<Method>().unwrap(), m);

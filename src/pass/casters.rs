@@ -1,0 +1,304 @@
+//! The pass's casters: CPU preparation (welding, topology, chunks), their GPU-resident
+//! dual-length vertex buffers, uploads recorded into the host's command buffer, and deferred
+//! release once every frame in flight that could use a buffer has retired.
+
+use super::device::PassDevice;
+use crate::error::{Error, Result};
+use crate::geom::Mesh;
+use crate::gpu::Buffer;
+use crate::shadow::{Caster, CasterKind};
+use ash::vk;
+use glam::{DMat4, Vec3};
+use gpu_allocator::MemoryLocation;
+
+/// A caster added to a [`ShadowPass`](super::ShadowPass). Ids are never reused: an id of a
+/// removed caster is refused with an error, never confused with a newer caster.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct CasterId {
+    pub(crate) index: u32,
+    pub(crate) generation: u32,
+}
+
+/// A copy from a staging buffer into a device-local buffer, recorded by `cmd_upload`.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Upload {
+    pub src: vk::Buffer,
+    pub dst: vk::Buffer,
+    pub size: u64,
+}
+
+/// A caster's static edge-quad geometry (u32 indices: faces first, then quads).
+pub(crate) struct EdgeQuadGpu {
+    pub vertices: Buffer,
+    pub indices: Buffer,
+    pub face_indices: u32,
+    pub quad_indices: u32,
+}
+
+/// One live caster.
+pub(crate) struct GpuCaster {
+    pub id: CasterId,
+    /// Object -> world, f64 (composed with the view in f64 every frame).
+    pub transform: DMat4,
+    /// Connected shells (for the 8-bit stencil overflow warning).
+    pub shells: usize,
+    /// Per chunk, its dual-length vertex buffer (n x (xyz,1) then n x (xyz,0)), device local.
+    pub chunks: Vec<Buffer>,
+    /// Edge quads, built the first time a frame asks for them (closed opaque casters only).
+    pub edge_quads: Option<EdgeQuadGpu>,
+}
+
+/// Buffers waiting for the frames in flight that may use them to retire: bit `s` of `mask`
+/// is set while ring slot `s` has not been prepared again since the buffers were retired.
+struct Grave {
+    buffers: Vec<Buffer>,
+    mask: u64,
+}
+
+/// All casters, in insertion order (the order their volumes are drawn in).
+pub(crate) struct CasterTable {
+    /// The planner's view of the live casters (a slice, as `shadow::plan_light` takes it).
+    pub cpu: Vec<Caster>,
+    /// Their GPU side, index for index.
+    pub live: Vec<GpuCaster>,
+    /// Per id index: its current generation and dense position in `live` (None: removed).
+    slots: Vec<(u32, Option<usize>)>,
+    /// Staging copies not yet handed to a frame.
+    pub pending: Vec<(Buffer, Upload)>,
+    graves: Vec<Grave>,
+}
+
+/// The dual-length vertex data of a chunk: every vertex with w = 1, then again with w = 0.
+fn dual_length(vertices: &[Vec3]) -> Vec<[f32; 4]> {
+    let mut data: Vec<[f32; 4]> = Vec::with_capacity(vertices.len() * 2);
+    data.extend(vertices.iter().map(|v| [v.x, v.y, v.z, 1.0]));
+    data.extend(vertices.iter().map(|v| [v.x, v.y, v.z, 0.0]));
+    data
+}
+
+impl CasterTable {
+    pub fn new() -> CasterTable {
+        CasterTable { cpu: Vec::new(), live: Vec::new(), slots: Vec::new(), pending: Vec::new(), graves: Vec::new() }
+    }
+
+    /// Dense index of a live id.
+    pub fn find(&self, id: CasterId) -> Result<usize> {
+        match self.slots.get(id.index as usize) {
+            Some(&(generation, Some(i))) if generation == id.generation => Ok(i),
+            _ => Err(Error::Other(format!("unknown or removed caster id {}:{}", id.index, id.generation))),
+        }
+    }
+
+    /// A device-local buffer filled through a staging copy that the next frame records.
+    fn staged(&mut self, dev: &PassDevice, name: &str, data: &[u8], usage: vk::BufferUsageFlags) -> Result<Buffer> {
+        let staging = Buffer::with_data(dev, &format!("{name} (staging)"), data, vk::BufferUsageFlags::TRANSFER_SRC)?;
+        let dst = match Buffer::new(dev, name, data.len() as u64, usage | vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuOnly) {
+            Ok(b) => b,
+            Err(e) => {
+                let mut staging = staging;
+                staging.destroy(dev);
+                return Err(e);
+            }
+        };
+        let up = Upload { src: staging.raw, dst: dst.raw, size: data.len() as u64 };
+        self.pending.push((staging, up));
+        Ok(dst)
+    }
+
+    fn upload_chunks(&mut self, dev: &PassDevice, caster: &Caster) -> Result<Vec<Buffer>> {
+        let mut out: Vec<Buffer> = Vec::new();
+        for ch in &caster.chunks {
+            let data = dual_length(&ch.vertices);
+            match self.staged(dev, &format!("caster {}", caster.name), bytemuck::cast_slice(&data), vk::BufferUsageFlags::VERTEX_BUFFER) {
+                Ok(b) => out.push(b),
+                Err(e) => {
+                    for mut b in out {
+                        b.destroy(dev);
+                    }
+                    return Err(e);
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    pub fn add(&mut self, dev: &PassDevice, caster: Caster, transform: DMat4) -> Result<CasterId> {
+        let chunks = self.upload_chunks(dev, &caster)?;
+        let index = self.slots.len() as u32;
+        let id = CasterId { index, generation: 0 };
+        self.slots.push((0, Some(self.live.len())));
+        let shells = shell_count(caster.mesh());
+        self.cpu.push(caster);
+        self.live.push(GpuCaster { id, transform, shells, chunks, edge_quads: None });
+        Ok(id)
+    }
+
+    /// Retires a caster's buffers until every slot has been prepared again.
+    pub fn remove(&mut self, id: CasterId, all_slots: u64) -> Result<()> {
+        let i = self.find(id)?;
+        let mut c = self.live.remove(i);
+        self.cpu.remove(i);
+        self.slots[id.index as usize] = (id.generation.wrapping_add(1), None);
+        for s in self.slots.iter_mut() {
+            if let (_, Some(j)) = s {
+                if *j > i {
+                    *j -= 1;
+                }
+            }
+        }
+        let mut buffers: Vec<Buffer> = c.chunks.drain(..).collect();
+        if let Some(eq) = c.edge_quads.take() {
+            buffers.push(eq.vertices);
+            buffers.push(eq.indices);
+        }
+        self.graves.push(Grave { buffers, mask: all_slots });
+        Ok(())
+    }
+
+    /// New object-space positions for a caster (same vertex count and triangles as the mesh
+    /// it was added with): its chunks are rebuilt and re-uploaded, the old buffers retired.
+    pub fn update_positions(&mut self, dev: &PassDevice, id: CasterId, positions: &[Vec3], all_slots: u64) -> Result<()> {
+        let i = self.find(id)?;
+        let c = &self.cpu[i];
+        let remap = &c.topology.remap;
+        if positions.len() != remap.len() {
+            return Err(Error::mesh(
+                &c.name,
+                format!("update_positions: {} positions for a mesh of {} vertices", positions.len(), remap.len()),
+            ));
+        }
+        if let Some(k) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(Error::mesh(&c.name, format!("update_positions: vertex {k} is not finite ({:?})", positions[k])));
+        }
+        // Welded vertices must stay welded: two input vertices that were one welded vertex
+        // must move together, or the topology (edge table, closedness) would no longer hold.
+        let mut welded = vec![None::<Vec3>; c.topology.mesh.positions.len()];
+        for (k, (&p, &w)) in positions.iter().zip(remap).enumerate() {
+            match welded[w as usize] {
+                None => welded[w as usize] = Some(p),
+                Some(q) if q == p => {}
+                Some(q) => {
+                    return Err(Error::mesh(
+                        &c.name,
+                        format!("update_positions: vertex {k} ({p:?}) and another copy of the same welded vertex ({q:?}) moved apart; the topology must stay the same"),
+                    ))
+                }
+            }
+        }
+        let mut caster = c.clone();
+        for (dst, w) in caster.topology.mesh.positions.iter_mut().zip(welded) {
+            if let Some(p) = w {
+                *dst = p;
+            }
+        }
+        caster.object_bounds = caster.topology.mesh.bounds();
+        let apex = caster.object_bounds.center();
+        for ch in &mut caster.chunks {
+            for (v, &g) in ch.vertices.iter_mut().zip(&ch.global_ids) {
+                *v = if g == u32::MAX { apex } else { caster.topology.mesh.positions[g as usize] };
+            }
+        }
+        caster.refresh_after_positions_changed();
+        let chunks = self.upload_chunks(dev, &caster)?;
+        let entry = &mut self.live[i];
+        let mut old: Vec<Buffer> = std::mem::replace(&mut entry.chunks, chunks);
+        if let Some(eq) = entry.edge_quads.take() {
+            old.push(eq.vertices);
+            old.push(eq.indices);
+        }
+        self.cpu[i] = caster;
+        self.graves.push(Grave { buffers: old, mask: all_slots });
+        Ok(())
+    }
+
+    /// Builds the edge-quad geometry of every closed opaque caster that lacks it.
+    pub fn ensure_edge_quads(&mut self, dev: &PassDevice) -> Result<()> {
+        for i in 0..self.live.len() {
+            let c = &self.cpu[i];
+            if self.live[i].edge_quads.is_some() || c.kind != CasterKind::Manifold || c.transmittance.is_some() {
+                continue;
+            }
+            let m = crate::shadow::edgequad::EdgeQuadMesh::new(c);
+            let mut idx = m.faces.clone();
+            idx.extend_from_slice(&m.quads);
+            let vertices =
+                self.staged(dev, "edge-quad vertices", bytemuck::cast_slice(&m.vertices), vk::BufferUsageFlags::VERTEX_BUFFER)?;
+            let indices = self.staged(dev, "edge-quad indices", bytemuck::cast_slice(&idx), vk::BufferUsageFlags::INDEX_BUFFER)?;
+            self.live[i].edge_quads =
+                Some(EdgeQuadGpu { vertices, indices, face_indices: m.faces.len() as u32, quad_indices: m.quads.len() as u32 });
+        }
+        Ok(())
+    }
+
+    /// Ring slot `slot` is being prepared, so its previous frame has retired: frees what
+    /// waited only for it.
+    pub fn slot_retired(&mut self, dev: &PassDevice, slot: usize) {
+        let bit = 1u64 << slot;
+        for g in &mut self.graves {
+            g.mask &= !bit;
+        }
+        let (done, keep): (Vec<Grave>, Vec<Grave>) = std::mem::take(&mut self.graves).into_iter().partition(|g| g.mask == 0);
+        self.graves = keep;
+        for g in done {
+            for mut b in g.buffers {
+                b.destroy(dev);
+            }
+        }
+    }
+
+    /// Frees everything (the host guarantees the device no longer uses any of it).
+    pub fn destroy(&mut self, dev: &PassDevice) {
+        for c in &mut self.live {
+            for b in &mut c.chunks {
+                b.destroy(dev);
+            }
+            if let Some(mut eq) = c.edge_quads.take() {
+                eq.vertices.destroy(dev);
+                eq.indices.destroy(dev);
+            }
+        }
+        self.live.clear();
+        self.cpu.clear();
+        for (mut b, _) in self.pending.drain(..) {
+            b.destroy(dev);
+        }
+        for g in self.graves.drain(..) {
+            for mut b in g.buffers {
+                b.destroy(dev);
+            }
+        }
+    }
+}
+
+/// Validates a caster transform: finite and invertible.
+pub(crate) fn check_transform(name: &str, m: &DMat4) -> Result<()> {
+    let det = m.determinant();
+    if !(m.is_finite() && det.is_finite() && det != 0.0) {
+        return Err(Error::mesh(name, format!("transform is not finite or singular (determinant {det})")));
+    }
+    Ok(())
+}
+
+/// Connected components of a mesh (triangles sharing a vertex), by union-find.
+pub(crate) fn shell_count(mesh: &Mesh) -> usize {
+    let mut parent: Vec<u32> = (0..mesh.positions.len() as u32).collect();
+    fn find(p: &mut [u32], mut i: u32) -> u32 {
+        while p[i as usize] != i {
+            p[i as usize] = p[p[i as usize] as usize];
+            i = p[i as usize];
+        }
+        i
+    }
+    for t in &mesh.triangles {
+        for k in 1..3 {
+            let (a, b) = (find(&mut parent, t[0]), find(&mut parent, t[k]));
+            if a != b {
+                parent[a as usize] = b;
+            }
+        }
+    }
+    let mut roots: Vec<u32> = mesh.triangles.iter().map(|t| find(&mut parent, t[0])).collect();
+    roots.sort_unstable();
+    roots.dedup();
+    roots.len()
+}

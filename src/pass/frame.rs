@@ -1,0 +1,373 @@
+//! One frame's CPU work: per light the plan (culling, cases, possible silhouettes, index
+//! lists), packed into the ring slot's stream, and the statistics `--stats` reports.
+
+use super::casters::{CasterTable, Upload};
+use super::desc::{Counter, IndexFormat, PassSettings, Technique};
+use super::stats::{CasterStats, CpuMs, LightStats, Totals, Triangles};
+use crate::error::{Error, Result};
+use crate::geom::{Camera, Light, LightKind};
+use crate::shadow::{self, Case, CasterKind, LightPlan, PlanInput};
+use ash::vk;
+use glam::{DMat4, DVec3, Mat4, Vec3, Vec4};
+use std::cell::Cell;
+
+/// The host's camera for one frame, as the pass needs it to land its volumes exactly on the
+/// host's depth values: the eye in f64 and the host's eye-relative view and projection (the
+/// host draws its scene with `proj * view * (world - eye)`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowView {
+    /// The eye in world space (f64: scenes far from the origin keep their precision).
+    pub eye: DVec3,
+    /// World directions -> view space: the view matrix without its translation.
+    pub view: Mat4,
+    /// View -> Vulkan clip space (infinite far plane for [`DepthMode::Infinite`](super::DepthMode),
+    /// finite for `Clamp`).
+    pub proj: Mat4,
+    /// The target's size in pixels (scissor rectangles are computed for it).
+    pub width: u32,
+    /// The target's height in pixels.
+    pub height: u32,
+}
+
+impl ShadowView {
+    /// World -> clip, composed in f64 (the planner's frustum and scissor tests).
+    pub fn world_view_proj(&self) -> Mat4 {
+        (self.proj.as_dmat4() * self.view.as_dmat4() * DMat4::from_translation(-self.eye)).as_mat4()
+    }
+    pub(crate) fn check(&self) -> Result<()> {
+        if !(self.eye.is_finite() && self.view.is_finite() && self.proj.is_finite()) {
+            return Err(Error::Other("ShadowView: eye, view or projection is not finite".into()));
+        }
+        if self.width == 0 || self.height == 0 {
+            return Err(Error::Other(format!("ShadowView: empty target {}x{}", self.width, self.height)));
+        }
+        Ok(())
+    }
+}
+
+/// One index-stream draw of a caster chunk.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Draw {
+    /// The chunk's dual-length vertex buffer.
+    pub vertices: vk::Buffer,
+    /// Byte offset of the indices (or naive vertices) in the frame's stream.
+    pub offset: u64,
+    pub count: u32,
+    pub format: IndexFormat,
+    /// A light cap (drawn with the depth-NEVER pipeline by the stencil counter).
+    pub light_cap: bool,
+}
+
+/// Edge-quad geometry of a caster (static buffers).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct EdgeQuadDraw {
+    pub vertices: vk::Buffer,
+    pub indices: vk::Buffer,
+    pub face_indices: u32,
+    pub quad_indices: u32,
+}
+
+/// One caster's volume for one light.
+#[derive(Clone, Debug)]
+pub(crate) struct CasterDraw {
+    pub case: Case,
+    pub mvp: Mat4,
+    pub light_object: Vec4,
+    /// `Some(t)` for a transparent caster (light-intensity map, not the opaque counter).
+    pub transmittance: Option<Vec3>,
+    pub draws: Vec<Draw>,
+    pub edge_quad: Option<EdgeQuadDraw>,
+}
+
+/// One light of a prepared frame.
+#[derive(Clone, Debug)]
+pub struct LightFrame {
+    /// The light's scissor rectangle (the whole target when unbounded): the determination
+    /// clears and draws only inside it, and the host's lighting pass should use it too.
+    pub scissor: vk::Rect2D,
+    /// The light's depth range when the pass uses depth bounds; `(0, 1)` passes everything.
+    pub depth_bounds: Option<(f32, f32)>,
+    /// What `--stats` reports for this light.
+    pub stats: LightStats,
+    /// The plan as the planner made it (cases, silhouettes, counts per caster).
+    pub plan: LightPlan,
+    pub(crate) casters: Vec<CasterDraw>,
+}
+
+impl LightFrame {
+    /// Whether any opaque volume is drawn for this light (else the stencil stays 0 inside
+    /// the scissor and every pixel there is lit).
+    pub fn has_opaque_volumes(&self) -> bool {
+        self.casters.iter().any(|c| c.case != Case::Culled && c.transmittance.is_none())
+    }
+    /// Whether any transparent caster's volume is drawn (the light-intensity map is needed).
+    pub fn has_transparent_volumes(&self) -> bool {
+        self.casters.iter().any(|c| c.case != Case::Culled && c.transmittance.is_some())
+    }
+}
+
+/// The CPU work of one frame ([`ShadowPass::prepare`](super::ShadowPass::prepare)): what the
+/// recording calls draw. It refers to buffers of ring slot [`slot`](Self::slot), valid until
+/// that slot is prepared again.
+#[derive(Debug)]
+pub struct PreparedFrame {
+    pub(crate) slot: usize,
+    pub(crate) serial: u64,
+    pub(crate) stream: vk::Buffer,
+    pub(crate) uploads: Vec<Upload>,
+    pub(crate) uploads_recorded: Cell<bool>,
+    /// Per light, in the order given to `prepare`.
+    pub lights: Vec<LightFrame>,
+    /// Totals over all lights (triangles, bytes, cases).
+    pub totals: Totals,
+    /// CPU time of this frame's planning (the recording adds `record` on the host's side).
+    pub cpu_ms: CpuMs,
+    /// The settings the frame was prepared with.
+    pub settings: PassSettings,
+    /// Things the host should tell its user (e.g. a possible 8-bit stencil overflow).
+    pub warnings: Vec<String>,
+    pub(crate) extent: vk::Extent2D,
+}
+
+impl PreparedFrame {
+    /// The ring slot this frame uses.
+    pub fn slot(&self) -> usize {
+        self.slot
+    }
+    /// The target size the frame was prepared for.
+    pub fn extent(&self) -> vk::Extent2D {
+        self.extent
+    }
+    /// How many frames were prepared before this one.
+    pub fn serial(&self) -> u64 {
+        self.serial
+    }
+    /// Caster buffers this frame must copy before any volume is drawn (recorded by
+    /// [`ShadowPass::cmd_upload`](super::ShadowPass::cmd_upload)).
+    pub fn pending_uploads(&self) -> usize {
+        if self.uploads_recorded.get() {
+            0
+        } else {
+            self.uploads.len()
+        }
+    }
+}
+
+/// The plans, packed: what `prepare` builds before writing the slot's stream.
+pub(crate) struct Packed {
+    pub stream: Vec<u8>,
+    pub lights: Vec<LightFrame>,
+    pub totals: Totals,
+    pub cpu: CpuMs,
+}
+
+/// Inputs of [`pack`].
+pub(crate) struct PackInput<'a> {
+    pub view: &'a ShadowView,
+    pub lights: &'a [Light],
+    pub settings: PassSettings,
+    pub u8_ok: bool,
+    pub depth_bounds: bool,
+    /// Plan the casters (false: every caster culled, scissors only).
+    pub casters: bool,
+}
+
+/// Plans every light and packs the index streams (or naive vertices) into one byte stream.
+pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
+    let view = input.view;
+    let view_proj = view.world_view_proj();
+    let vp_rel_d = view.proj.as_dmat4() * view.view.as_dmat4();
+    let camera = Camera { eye: view.eye.as_vec3(), ..Camera::default() };
+    let edge_quads = input.settings.technique == Technique::EdgeQuads;
+    let method = input.settings.technique.method();
+    let mvps: Vec<Mat4> = table.live.iter().map(|g| (vp_rel_d * DMat4::from_translation(-view.eye) * g.transform).as_mat4()).collect();
+    let full = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: vk::Extent2D { width: view.width, height: view.height } };
+
+    let mut stream: Vec<u8> = Vec::new();
+    let mut totals = Totals::default();
+    let mut cpu = CpuMs::default();
+    let mut lights = Vec::with_capacity(input.lights.len());
+    for (li, light) in input.lights.iter().enumerate() {
+        let plan = shadow::plan_light_opts(
+            &PlanInput { camera: &camera, width: view.width, height: view.height, view_proj, light, method },
+            if input.casters { &table.cpu } else { &[] },
+            edge_quads,
+        );
+        cpu.silhouettes += plan.silhouette_ms;
+        cpu.plan += plan.plan_ms;
+        let mut casters = Vec::with_capacity(plan.casters.len());
+        let mut cstats = Vec::with_capacity(plan.casters.len());
+        for cp in &plan.casters {
+            let caster = &table.cpu[cp.caster];
+            let gpu = &table.live[cp.caster];
+            let mut draws = Vec::new();
+            let mut index_bytes = 0u64;
+            let mut vertex_bytes = 0u64;
+            let mut fmt_used = "none";
+            for cd in &cp.chunks {
+                let chunk = &caster.chunks[cd.chunk];
+                let n = chunk.vertices.len();
+                for (indices, cap) in [(&cd.volume, false), (&cd.light_cap, true)] {
+                    if indices.is_empty() {
+                        continue;
+                    }
+                    let fmt = match input.settings.index_format {
+                        IndexFormat::Auto | IndexFormat::U8 if input.u8_ok && 2 * n <= 256 => IndexFormat::U8,
+                        IndexFormat::Auto | IndexFormat::U8 => IndexFormat::U16,
+                        f => f,
+                    };
+                    fmt_used = fmt.name();
+                    align(&mut stream, 16);
+                    let offset = stream.len() as u64;
+                    match fmt {
+                        IndexFormat::U8 => stream.extend(indices.iter().map(|&i| i as u8)),
+                        IndexFormat::U16 => stream.extend(indices.iter().flat_map(|&i| i.to_le_bytes())),
+                        IndexFormat::U32 => stream.extend(indices.iter().flat_map(|&i| (i as u32).to_le_bytes())),
+                        IndexFormat::Naive | IndexFormat::Auto => {
+                            for &i in indices.iter() {
+                                let i = i as usize;
+                                let (v, wv) = if i < n { (chunk.vertices[i], 1.0f32) } else { (chunk.vertices[i - n], 0.0) };
+                                for f in [v.x, v.y, v.z, wv] {
+                                    stream.extend(f.to_le_bytes());
+                                }
+                            }
+                        }
+                    }
+                    let bytes = stream.len() as u64 - offset;
+                    if fmt == IndexFormat::Naive {
+                        vertex_bytes += bytes;
+                    } else {
+                        index_bytes += bytes;
+                    }
+                    draws.push(Draw {
+                        vertices: gpu.chunks[cd.chunk].raw,
+                        offset,
+                        count: indices.len() as u32,
+                        format: fmt,
+                        light_cap: cap,
+                    });
+                }
+            }
+            let tris = Triangles { sides: cp.sides as u64, dark_cap: cp.dark_cap as u64, light_cap: cp.light_cap as u64 };
+            let ntris = tris.total();
+            totals.triangles.add(&tris);
+            totals.index_bytes += index_bytes;
+            totals.vertex_bytes += vertex_bytes;
+            match cp.case {
+                Case::Culled => totals.cases.culled += 1,
+                Case::ZPass => totals.cases.zpass += 1,
+                Case::ZFail => totals.cases.zfail += 1,
+                Case::ZFailLightCap => totals.cases.zfail_light_cap += 1,
+            }
+            cstats.push(CasterStats {
+                name: caster.name.clone(),
+                case: case_name(cp.case).to_string(),
+                silhouette_edges: cp.silhouette_edges as u64,
+                triangles: tris,
+                index_bytes,
+                vertex_bytes,
+                bytes_per_triangle: if ntris > 0 { (index_bytes + vertex_bytes) as f64 / ntris as f64 } else { 0.0 },
+                index_format: fmt_used.to_string(),
+                dark_cap_kind: format!("{:?}", cp.dark_cap_kind),
+                path: cp.path.to_string(),
+                path_reason: match &caster.kind {
+                    CasterKind::Multiplicity { reason } => reason.clone(),
+                    _ => String::new(),
+                },
+                multiplicity_max: cp.multiplicity_max,
+            });
+            let edge_quad = match (&gpu.edge_quads, cp.path == "edgequad") {
+                (Some(eq), true) => Some(EdgeQuadDraw {
+                    vertices: eq.vertices.raw,
+                    indices: eq.indices.raw,
+                    face_indices: eq.face_indices,
+                    quad_indices: eq.quad_indices,
+                }),
+                _ => None,
+            };
+            casters.push(CasterDraw {
+                case: cp.case,
+                mvp: mvps[cp.caster],
+                light_object: Vec4::from_array(cp.light_object),
+                transmittance: caster.transmittance,
+                draws,
+                edge_quad,
+            });
+        }
+        let scissor = plan
+            .scissor
+            .map(|[x, y, sw, sh]| vk::Rect2D {
+                offset: vk::Offset2D { x: x as i32, y: y as i32 },
+                extent: vk::Extent2D { width: sw, height: sh },
+            })
+            .filter(|r| r.extent.width > 0 && r.extent.height > 0)
+            .unwrap_or(full);
+        let depth_bounds = if input.depth_bounds { plan.depth_bounds } else { None };
+        let stats = LightStats {
+            index: li,
+            kind: light_kind_name(light.kind).to_string(),
+            scissor: plan.scissor,
+            depth_bounds: depth_bounds.map(|(a, b)| [a, b]),
+            casters: cstats,
+        };
+        lights.push(LightFrame { scissor, depth_bounds, stats, plan, casters });
+    }
+    align(&mut stream, 16);
+    totals.bytes_sent = totals.index_bytes + totals.vertex_bytes;
+    Packed { stream, lights, totals, cpu }
+}
+
+/// 8-bit stencil counts wrap at 256: a pixel inside a multiple of 256 volumes reads as lit.
+/// Flags lights whose drawn casters could nest that deep (a heuristic: one caster folding 256
+/// times over itself is not detected).
+pub(crate) fn overflow_warnings(table: &CasterTable, lights: &[LightFrame], counter: Counter) -> Vec<String> {
+    let mut warnings = Vec::new();
+    if counter != Counter::Stencil {
+        return warnings;
+    }
+    for (li, l) in lights.iter().enumerate() {
+        let drawn: usize = l.plan.casters.iter().filter(|c| c.case != Case::Culled).map(|c| table.live[c.caster].shells).sum();
+        if drawn > 255 {
+            warnings.push(format!(
+                "light {li}: {drawn} closed shells cast shadow volumes; pixels inside 256k of them wrap to 0 in the 8-bit stencil and read as lit (use --counter float)"
+            ));
+        }
+    }
+    warnings
+}
+
+/// Rejects lights the planner cannot use (NaN or infinite values, a zero direction).
+pub(crate) fn check_lights(lights: &[Light]) -> Result<()> {
+    for (i, l) in lights.iter().enumerate() {
+        let finite = l.position.is_finite() && l.direction.is_finite() && l.color.is_finite() && l.intensity.is_finite();
+        let dir_ok = l.kind == LightKind::Point || l.direction.length_squared() > 0.0;
+        if !finite || !dir_ok || l.radius.is_some_and(|r| !(r > 0.0)) {
+            return Err(Error::Other(format!("light {i}: not finite, zero direction or non-positive radius ({l:?})")));
+        }
+    }
+    Ok(())
+}
+
+/// The `--stats` name of a case.
+pub fn case_name(c: Case) -> &'static str {
+    match c {
+        Case::Culled => "culled",
+        Case::ZPass => "zpass",
+        Case::ZFail => "zfail",
+        Case::ZFailLightCap => "zfail_light_cap",
+    }
+}
+
+fn light_kind_name(k: LightKind) -> &'static str {
+    match k {
+        LightKind::Point => "point",
+        LightKind::Spot => "spot",
+        LightKind::Directional => "directional",
+    }
+}
+
+fn align(v: &mut Vec<u8>, a: usize) {
+    while v.len() % a != 0 {
+        v.push(0);
+    }
+}

@@ -1,0 +1,378 @@
+//! [`ShadowPass`]: the shadow determination of McGuire et al. 2003 (and Kim et al. 2008 for
+//! open, non-manifold and transparent casters) as a component that records into a host
+//! engine's command buffer.
+//!
+//! # The embedding contract
+//!
+//! Modelled on the embeddable ash renderers engines already use (imgui-rs-vulkan-renderer,
+//! egui-ash-renderer): the pass takes the host's device and allocator, and **only records**
+//! into command buffers the host supplies. It submits nothing, waits on nothing and owns no
+//! queue, image or command pool.
+//!
+//! | who | owns |
+//! |---|---|
+//! | host | instance, device, queue, command buffers, the depth-stencil image, fences, the lighting pass |
+//! | pass | its pipelines, the casters' vertex buffers, one index stream per ring slot |
+//!
+//! A frame:
+//! 1. the host waits until the frame that last used ring slot `s` has retired (its fence);
+//! 2. [`ShadowPass::prepare`]`(s, view, lights)`: the CPU work (cases, silhouettes, index
+//!    streams written into slot `s`);
+//! 3. the host records its depth pre-pass / G-buffer into its depth-stencil image;
+//! 4. [`ShadowPass::cmd_upload`] (new or deformed casters' vertex copies; also recorded by the
+//!    first `cmd_determine` of the frame when the host did not call it);
+//! 5. per light: [`ShadowPass::cmd_determine`] leaves the count in the stencil (cleared inside
+//!    the light's scissor), then the host's lighting pass tests `stencil == 0`
+//!    ([`lit_stencil_state`]), with the light's [`LightFrame::scissor`] and depth bounds;
+//! 6. the host submits; a later `prepare(s, ..)` may only come after that submission retired.
+//!
+//! **Frames in flight:** the ring has [`ShadowPassDesc::frames_in_flight`] slots; the host
+//! passes the slot of the frame it records. Removing a caster or changing its positions
+//! releases its old buffers only once every slot has been prepared again (so no frame in
+//! flight can still read them).
+//!
+//! **Synchronisation:** inside `cmd_determine` the pass reads the depth and writes the stencil
+//! of the host's image between `vkCmdBeginRendering` and `vkCmdEndRendering`. The host makes
+//! its depth writes visible before (a barrier from late fragment tests to early fragment
+//! tests, depth-stencil read), and makes the stencil writes visible to its lighting pass after.
+//! `cmd_upload` records transfer writes followed by a barrier to vertex-attribute and
+//! index reads.
+//!
+//! **Drop order:** drop the pass while its device and allocator are alive, after every command
+//! buffer that uses it has completed (it does not wait for the device: the host owns the
+//! device's lifetime).
+
+mod casters;
+mod desc;
+mod device;
+mod frame;
+mod pipelines;
+pub mod push;
+mod record;
+pub mod stats;
+
+pub use casters::CasterId;
+pub use desc::{Capabilities, Counter, DepthMode, EnabledFeatures, IndexFormat, PassSettings, ShadowPassDesc, Technique};
+pub use frame::{case_name, LightFrame, PreparedFrame, ShadowView};
+pub use pipelines::COUNT_FORMAT;
+pub use record::{lit_stencil_state, DepthStencilTarget, VolumeKind};
+
+use crate::error::{Error, Result};
+use crate::geom::Light;
+use crate::geom::Mesh;
+use crate::gpu::Buffer;
+use crate::shadow::{Caster, CasterKind};
+use ash::vk;
+use casters::CasterTable;
+use device::PassDevice;
+use frame::{check_lights, overflow_warnings, pack, PackInput};
+use glam::{DMat4, Vec3};
+use gpu_allocator::vulkan::Allocator;
+use gpu_allocator::MemoryLocation;
+use pipelines::Pipelines;
+use std::cell::Cell;
+use std::sync::{Arc, Mutex};
+use std::time::Instant;
+
+/// One ring slot: the index stream of the frame recorded in it, and the staging buffers whose
+/// copies that frame records.
+struct Slot {
+    stream: Option<Buffer>,
+    staging: Vec<Buffer>,
+}
+
+/// The shadow determination as an embeddable component (see the [module docs](self) for the
+/// contract).
+pub struct ShadowPass {
+    dev: PassDevice,
+    caps: Capabilities,
+    desc: ShadowPassDesc,
+    settings: PassSettings,
+    pipes: Pipelines,
+    casters: CasterTable,
+    slots: Vec<Slot>,
+    serial: u64,
+}
+
+impl ShadowPass {
+    /// Creates the pass on the host's device. `allocator` is the host's gpu-allocator (shared:
+    /// the pass allocates its caster buffers and streams from it). Optional features are the
+    /// host's [`ShadowPassDesc::features`] intersected with what `physical_device` reports.
+    ///
+    /// Errors: a depth-stencil format without depth or 8 stencil bits, `frames_in_flight` of 0
+    /// or over 64, [`DepthMode::Clamp`] without depthClamp, a failed Vulkan call.
+    pub fn new(
+        instance: &ash::Instance,
+        physical_device: vk::PhysicalDevice,
+        device: &ash::Device,
+        allocator: Arc<Mutex<Allocator>>,
+        desc: &ShadowPassDesc,
+    ) -> Result<ShadowPass> {
+        desc::check_depth_stencil_format(desc.depth_stencil_format)?;
+        if desc.frames_in_flight == 0 || desc.frames_in_flight > 64 {
+            return Err(Error::Other(format!("ShadowPassDesc::frames_in_flight must be 1..=64, got {}", desc.frames_in_flight)));
+        }
+        // SAFETY: plain queries on a valid physical device of `instance`.
+        let (features, ds_props, r32f) = unsafe {
+            (
+                instance.get_physical_device_features(physical_device),
+                instance.get_physical_device_format_properties(physical_device, desc.depth_stencil_format),
+                instance.get_physical_device_format_properties(physical_device, COUNT_FORMAT),
+            )
+        };
+        if !ds_props.optimal_tiling_features.contains(vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT) {
+            return Err(Error::Unsupported(format!(
+                "{:?} is not a depth-stencil attachment format on this device",
+                desc.depth_stencil_format
+            )));
+        }
+        let caps = Capabilities {
+            depth_clamp: desc.features.depth_clamp && features.depth_clamp == vk::TRUE,
+            depth_bounds: desc.features.depth_bounds && features.depth_bounds == vk::TRUE,
+            index_type_uint8: desc.features.index_type_uint8 && index_type_uint8_supported(instance, physical_device),
+            r32f_blend: r32f.optimal_tiling_features.contains(vk::FormatFeatureFlags::COLOR_ATTACHMENT_BLEND),
+        };
+        if desc.depth_mode == DepthMode::Clamp && !caps.depth_clamp {
+            return Err(Error::Unsupported(
+                "--depth-mode clamp needs the depthClamp feature (present and enabled on the device); use --depth-mode infinite".into(),
+            ));
+        }
+        desc.settings.check(&caps)?;
+        let dev = PassDevice { device: device.clone(), allocator };
+        let pipes = Pipelines::new(&dev, desc, caps.depth_clamp, caps.depth_bounds, caps.r32f_blend)?;
+        let slots = (0..desc.frames_in_flight).map(|_| Slot { stream: None, staging: Vec::new() }).collect();
+        Ok(ShadowPass { dev, caps, desc: desc.clone(), settings: desc.settings, pipes, casters: CasterTable::new(), slots, serial: 0 })
+    }
+
+    /// What the pass uses on this device.
+    pub fn capabilities(&self) -> Capabilities {
+        self.caps
+    }
+
+    /// What the pass was created for.
+    pub fn desc(&self) -> &ShadowPassDesc {
+        &self.desc
+    }
+
+    /// The settings the next [`prepare`](Self::prepare) uses.
+    pub fn settings(&self) -> PassSettings {
+        self.settings
+    }
+
+    /// Changes the per-frame settings (technique, counter, index format) for the next frame;
+    /// refused when the device cannot honour them.
+    pub fn set_settings(&mut self, settings: PassSettings) -> Result<()> {
+        settings.check(&self.caps)?;
+        self.settings = settings;
+        Ok(())
+    }
+
+    /// Adds an opaque caster: the mesh is validated (NaN, empty), welded, classified (closed
+    /// 2-manifold: McGuire's three cases; anything else: Kim et al.'s multiplicities) and
+    /// split into chunks of at most 32768 vertices (16-bit indices), never refused for size.
+    /// Its vertex buffers are copied by the next frame's [`cmd_upload`](Self::cmd_upload).
+    pub fn add_caster(&mut self, name: &str, mesh: &Mesh, transform: DMat4) -> Result<CasterId> {
+        casters::check_transform(name, &transform)?;
+        let caster = Caster::new(name, mesh, transform.as_mat4())?;
+        self.casters.add(&self.dev, caster, transform)
+    }
+
+    /// Adds a transparent caster letting `transmittance` (RGB, per surface crossed) through:
+    /// it always takes the multiplicity path, and its volumes go to the light-intensity map
+    /// ([`VolumeKind::Transmit`]), not the opaque count. Needs [`ShadowPassDesc::transmit_format`].
+    pub fn add_transparent_caster(&mut self, name: &str, mesh: &Mesh, transform: DMat4, transmittance: Vec3) -> Result<CasterId> {
+        if self.pipes.transmit.is_none() {
+            return Err(Error::Other(format!("caster '{name}': transparent casters need ShadowPassDesc::transmit_format")));
+        }
+        if !transmittance.is_finite() {
+            return Err(Error::mesh(name, format!("transmittance {transmittance} is not finite")));
+        }
+        casters::check_transform(name, &transform)?;
+        let caster = Caster::new(name, mesh, transform.as_mat4())?.into_transparent(transmittance);
+        self.casters.add(&self.dev, caster, transform)
+    }
+
+    /// Adds a caster prepared by the caller (e.g. [`Caster::from_scene_mesh`]).
+    pub fn add_prepared_caster(&mut self, caster: Caster, transform: DMat4) -> Result<CasterId> {
+        casters::check_transform(&caster.name, &transform)?;
+        if caster.transmittance.is_some() && self.pipes.transmit.is_none() {
+            return Err(Error::Other(format!("caster '{}': transparent casters need ShadowPassDesc::transmit_format", caster.name)));
+        }
+        self.casters.add(&self.dev, caster, transform)
+    }
+
+    /// Moves a caster (object -> world, f64): takes effect from the next `prepare`; nothing is
+    /// re-created.
+    pub fn set_transform(&mut self, id: CasterId, transform: DMat4) -> Result<()> {
+        let i = self.casters.find(id)?;
+        casters::check_transform(&self.casters.cpu[i].name, &transform)?;
+        self.casters.cpu[i].set_transform(transform.as_mat4());
+        self.casters.live[i].transform = transform;
+        Ok(())
+    }
+
+    /// New object-space positions for a deforming caster: the same vertices (in the order of
+    /// the mesh it was added with) and triangles. The new dual-length copies are uploaded by
+    /// the next frame; the old ones are released once the frames in flight have retired.
+    pub fn update_positions(&mut self, id: CasterId, positions: &[Vec3]) -> Result<()> {
+        let all = self.all_slots();
+        self.casters.update_positions(&self.dev, id, positions, all)
+    }
+
+    /// Removes a caster; its buffers are released once every frame in flight that may use
+    /// them has retired.
+    pub fn remove_caster(&mut self, id: CasterId) -> Result<()> {
+        let all = self.all_slots();
+        self.casters.remove(id, all)
+    }
+
+    /// The prepared casters, in draw order (the planner's view).
+    pub fn casters(&self) -> &[Caster] {
+        &self.casters.cpu
+    }
+
+    /// The id of the caster at `index` of [`casters`](Self::casters).
+    pub fn caster_id(&self, index: usize) -> Option<CasterId> {
+        self.casters.live.get(index).map(|c| c.id)
+    }
+
+    fn all_slots(&self) -> u64 {
+        if self.slots.len() == 64 {
+            u64::MAX
+        } else {
+            (1u64 << self.slots.len()) - 1
+        }
+    }
+
+    /// The CPU work of one frame into ring slot `slot`: per light culling, cases, possible
+    /// silhouettes and index streams. The host guarantees that the frame that last used
+    /// `slot` has retired (its buffers are rewritten and its retired buffers freed).
+    pub fn prepare(&mut self, slot: usize, view: &ShadowView, lights: &[Light]) -> Result<PreparedFrame> {
+        self.prepare_with(slot, view, lights, true)
+    }
+
+    /// As [`prepare`](Self::prepare), with every caster culled: only the lights' scissors and
+    /// depth bounds (and pending uploads). For hosts that determine this frame's shadows
+    /// another way (umbrage's shadow-map baseline) but keep the pass's per-light state.
+    pub fn prepare_culled(&mut self, slot: usize, view: &ShadowView, lights: &[Light]) -> Result<PreparedFrame> {
+        self.prepare_with(slot, view, lights, false)
+    }
+
+    fn prepare_with(&mut self, slot: usize, view: &ShadowView, lights: &[Light], casters: bool) -> Result<PreparedFrame> {
+        if slot >= self.slots.len() {
+            return Err(Error::Other(format!("ring slot {slot} out of range (frames_in_flight = {})", self.slots.len())));
+        }
+        view.check()?;
+        check_lights(lights)?;
+        self.settings.check(&self.caps)?;
+        if self.casters.cpu.iter().any(|c| c.transmittance.is_some()) && self.pipes.transmit.is_none() {
+            return Err(Error::Other("transparent casters need ShadowPassDesc::transmit_format".into()));
+        }
+        // The slot's previous frame has retired: free its staging copies and what waited for it.
+        for mut b in self.slots[slot].staging.drain(..) {
+            b.destroy(&self.dev);
+        }
+        self.casters.slot_retired(&self.dev, slot);
+        if self.settings.technique == Technique::EdgeQuads {
+            self.casters.ensure_edge_quads(&self.dev)?;
+        }
+        let mut uploads = Vec::new();
+        let mut upload_bytes = 0;
+        for (b, up) in self.casters.pending.drain(..) {
+            upload_bytes += up.size;
+            uploads.push(up);
+            self.slots[slot].staging.push(b);
+        }
+
+        let packed = pack(
+            &self.casters,
+            &PackInput {
+                view,
+                lights,
+                settings: self.settings,
+                u8_ok: self.caps.index_type_uint8,
+                depth_bounds: self.caps.depth_bounds,
+                casters,
+            },
+        );
+        let record_start = Instant::now();
+        let stream = self.write_stream(slot, &packed.stream)?;
+        let mut cpu = packed.cpu;
+        cpu.record = record_start.elapsed().as_secs_f64() * 1e3;
+        let mut totals = packed.totals;
+        totals.bytes_sent += upload_bytes;
+        let warnings = overflow_warnings(&self.casters, &packed.lights, self.settings.counter);
+        let serial = self.serial;
+        self.serial += 1;
+        Ok(PreparedFrame {
+            slot,
+            serial,
+            stream,
+            uploads,
+            uploads_recorded: Cell::new(false),
+            lights: packed.lights,
+            totals,
+            cpu_ms: cpu,
+            settings: self.settings,
+            warnings,
+            extent: vk::Extent2D { width: view.width, height: view.height },
+        })
+    }
+
+    /// Writes the stream into the slot's buffer (grown to the next power of two when short).
+    fn write_stream(&mut self, slot: usize, data: &[u8]) -> Result<vk::Buffer> {
+        let s = &mut self.slots[slot];
+        if s.stream.as_ref().map(|b| b.size < data.len() as u64).unwrap_or(true) {
+            if let Some(mut old) = s.stream.take() {
+                old.destroy(&self.dev);
+            }
+            let size = (data.len() as u64).max(1 << 16).next_power_of_two();
+            s.stream = Some(Buffer::new(
+                &self.dev,
+                &format!("shadow stream {slot}"),
+                size,
+                vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::VERTEX_BUFFER,
+                MemoryLocation::CpuToGpu,
+            )?);
+        }
+        let buf = s.stream.as_mut().ok_or_else(|| Error::Other("no stream buffer".into()))?;
+        buf.write(0, data)?;
+        Ok(buf.raw)
+    }
+
+    /// Whether a caster is on the multiplicity path (open, non-manifold or transparent).
+    pub fn caster_kind(&self, id: CasterId) -> Result<&CasterKind> {
+        Ok(&self.casters.cpu[self.casters.find(id)?].kind)
+    }
+}
+
+fn index_type_uint8_supported(instance: &ash::Instance, pd: vk::PhysicalDevice) -> bool {
+    // SAFETY: enumeration on a valid physical device.
+    let exts = unsafe { instance.enumerate_device_extension_properties(pd) }.unwrap_or_default();
+    let named = |n: &std::ffi::CStr| exts.iter().any(|e| e.extension_name_as_c_str().map(|x| x == n).unwrap_or(false));
+    if !named(ash::ext::index_type_uint8::NAME) && !named(ash::khr::index_type_uint8::NAME) {
+        return false;
+    }
+    let mut u8f = vk::PhysicalDeviceIndexTypeUint8FeaturesEXT::default();
+    let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut u8f);
+    // SAFETY: a feature query on a valid physical device with a well-formed pNext chain.
+    unsafe { instance.get_physical_device_features2(pd, &mut f2) };
+    u8f.index_type_uint8 == vk::TRUE
+}
+
+impl Drop for ShadowPass {
+    fn drop(&mut self) {
+        // SAFETY: the embedding contract (module docs): the host drops the pass only after
+        // every command buffer that used it has completed, while the device is alive.
+        unsafe { self.pipes.destroy(&self.dev.device) };
+        self.casters.destroy(&self.dev);
+        for s in &mut self.slots {
+            if let Some(mut b) = s.stream.take() {
+                b.destroy(&self.dev);
+            }
+            for mut b in s.staging.drain(..) {
+                b.destroy(&self.dev);
+            }
+        }
+    }
+}

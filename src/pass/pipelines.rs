@@ -1,0 +1,202 @@
+//! The shadow pass's pipelines: every way a volume face is counted, as a table of
+//! fixed-function state (stencil ops, depth compare). Destroyed exactly as created.
+
+use super::desc::{DepthMode, ShadowPassDesc};
+use super::push::VolumePush;
+use crate::error::Result;
+use crate::gpu::descriptors::pipeline_layout;
+use crate::gpu::pipeline::{self, Blend, PipelineDesc};
+use crate::gpu::{shaders, GpuDevice};
+use ash::vk;
+
+/// The float counter's format: 32-bit float, additive (exact integer counts to 2^24).
+pub const COUNT_FORMAT: vk::Format = vk::Format::R32_SFLOAT;
+
+/// Stencil counting (two-sided, wrapping).
+pub(crate) struct StencilPipes {
+    /// Case 1: INCR_WRAP front / DECR_WRAP back on depth pass.
+    pub zpass: vk::Pipeline,
+    /// Cases 2 and 3: DECR_WRAP front / INCR_WRAP back on depth fail.
+    pub zfail: vk::Pipeline,
+    /// Light caps: z-fail ops with depth compare NEVER (a cap lies at or behind the visible
+    /// surface, so it always fails).
+    pub zfail_cap: vk::Pipeline,
+    /// Edge quads: faces (light or dark caps) like light caps, quads like sides.
+    pub eq_faces: vk::Pipeline,
+    pub eq_sides: vk::Pipeline,
+}
+
+/// Float counting: the depth test picks exactly the faces the stencil ops would count.
+pub(crate) struct CountPipes {
+    /// LESS (z-pass).
+    pub zpass: vk::Pipeline,
+    /// GREATER_OR_EQUAL: the faces that fail LESS (z-fail).
+    pub zfail: vk::Pipeline,
+    /// ALWAYS: the NEVER light caps, always counted.
+    pub cap: vk::Pipeline,
+    pub eq_faces: vk::Pipeline,
+    pub eq_sides: vk::Pipeline,
+}
+
+pub(crate) struct Pipelines {
+    pub layout: vk::PipelineLayout,
+    pub stencil: StencilPipes,
+    /// `None` when R32_SFLOAT does not blend on this device.
+    pub count: Option<CountPipes>,
+    /// Light-intensity map, `[multiplicative, log][z-pass, z-fail]`.
+    pub transmit: Option<[[vk::Pipeline; 2]; 2]>,
+    /// Debug overlay (alpha-blended volumes, depth LESS).
+    pub overlay: Option<vk::Pipeline>,
+}
+
+impl Pipelines {
+    pub fn new(dev: &impl GpuDevice, desc: &ShadowPassDesc, depth_clamp: bool, depth_bounds: bool, r32f_blend: bool) -> Result<Pipelines> {
+        let layout = pipeline_layout(dev, &[], VolumePush::SIZE, vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)?;
+        let mut made = Vec::new();
+        let r =
+            Self::create_all(dev, desc, layout, depth_clamp && desc.depth_mode == DepthMode::Clamp, depth_bounds, r32f_blend, &mut made);
+        if r.is_err() {
+            // SAFETY: the pipelines and the layout were just created and never used.
+            unsafe {
+                for p in made {
+                    dev.device().destroy_pipeline(p, None);
+                }
+                dev.device().destroy_pipeline_layout(layout, None);
+            }
+        }
+        r
+    }
+
+    fn create_all(
+        dev: &impl GpuDevice,
+        desc: &ShadowPassDesc,
+        layout: vk::PipelineLayout,
+        depth_clamp: bool,
+        depth_bounds: bool,
+        r32f_blend: bool,
+        made: &mut Vec<vk::Pipeline>,
+    ) -> Result<Pipelines> {
+        let mut create = |d: &PipelineDesc| -> Result<vk::Pipeline> {
+            let p = pipeline::create(dev, d)?;
+            made.push(p);
+            Ok(p)
+        };
+        use vk::StencilOp as S;
+        let df = desc.depth_stencil_format;
+        let mut s = PipelineDesc::new(shaders::SHADOW_VERT, layout, df);
+        s.vertex_stride = 16;
+        s.attributes = &[(0, vk::Format::R32G32B32A32_SFLOAT, 0)];
+        s.depth_test = true;
+        s.depth_compare = vk::CompareOp::LESS;
+        s.depth_clamp = depth_clamp;
+        s.depth_bounds = depth_bounds;
+        s.stencil = Some((pipeline::stencil_ops(S::INCREMENT_AND_WRAP, S::KEEP), pipeline::stencil_ops(S::DECREMENT_AND_WRAP, S::KEEP)));
+        let zpass = create(&s)?;
+        s.stencil = Some((pipeline::stencil_ops(S::KEEP, S::DECREMENT_AND_WRAP), pipeline::stencil_ops(S::KEEP, S::INCREMENT_AND_WRAP)));
+        let zfail = create(&s)?;
+        s.depth_compare = vk::CompareOp::NEVER;
+        let zfail_cap = create(&s)?;
+
+        let eq_attrs = [(0, vk::Format::R32G32B32_SFLOAT, 0), (1, vk::Format::R32G32B32A32_SFLOAT, 12)];
+        let mut e = s.clone();
+        e.vertex = shaders::EDGEQUAD_VERT;
+        e.vertex_stride = 32;
+        e.attributes = &eq_attrs;
+        e.depth_compare = vk::CompareOp::NEVER;
+        let eq_faces = create(&e)?;
+        e.depth_compare = vk::CompareOp::LESS;
+        let eq_sides = create(&e)?;
+        let stencil = StencilPipes { zpass, zfail, zfail_cap, eq_faces, eq_sides };
+
+        let count_fmt = [COUNT_FORMAT];
+        let mut c = s.clone();
+        c.fragment = Some(shaders::COUNT_FRAG);
+        c.color_formats = &count_fmt;
+        c.blend = Blend::Additive;
+        c.stencil = None;
+        let count = if r32f_blend {
+            c.depth_compare = vk::CompareOp::LESS;
+            let zpass = create(&c)?;
+            c.depth_compare = vk::CompareOp::GREATER_OR_EQUAL;
+            let zfail = create(&c)?;
+            c.depth_compare = vk::CompareOp::ALWAYS;
+            let cap = create(&c)?;
+            let mut ec = c.clone();
+            ec.vertex = shaders::EDGEQUAD_VERT;
+            ec.vertex_stride = 32;
+            ec.attributes = &eq_attrs;
+            ec.depth_compare = vk::CompareOp::ALWAYS;
+            let eq_faces = create(&ec)?;
+            ec.depth_compare = vk::CompareOp::GREATER_OR_EQUAL;
+            let eq_sides = create(&ec)?;
+            Some(CountPipes { zpass, zfail, cap, eq_faces, eq_sides })
+        } else {
+            None
+        };
+
+        let transmit = match desc.transmit_format {
+            Some(format) => {
+                let map_fmt = [format];
+                let mut tm = c.clone();
+                tm.color_formats = &map_fmt;
+                let mut t = [[vk::Pipeline::null(); 2]; 2];
+                for (li, (frag, blend)) in
+                    [(shaders::TRANSMIT_FRAG, Blend::Multiply), (shaders::TRANSMIT_LOG_FRAG, Blend::Additive)].into_iter().enumerate()
+                {
+                    tm.fragment = Some(frag);
+                    tm.blend = blend;
+                    for (zi, cmp) in [vk::CompareOp::LESS, vk::CompareOp::GREATER_OR_EQUAL].into_iter().enumerate() {
+                        tm.depth_compare = cmp;
+                        t[li][zi] = create(&tm)?;
+                    }
+                }
+                Some(t)
+            }
+            None => None,
+        };
+
+        let overlay = match desc.debug_color_format {
+            Some(format) => {
+                let fmt = [format];
+                let mut v = PipelineDesc::new(shaders::SHADOW_VERT, layout, df);
+                v.fragment = Some(shaders::VOLUME_FRAG);
+                v.vertex_stride = 16;
+                v.attributes = &[(0, vk::Format::R32G32B32A32_SFLOAT, 0)];
+                v.color_formats = &fmt;
+                v.blend = Blend::Alpha;
+                v.depth_test = true;
+                v.depth_compare = vk::CompareOp::LESS;
+                v.depth_clamp = depth_clamp;
+                Some(create(&v)?)
+            }
+            None => None,
+        };
+        Ok(Pipelines { layout, stencil, count, transmit, overlay })
+    }
+
+    /// Every pipeline, once.
+    fn all(&self) -> Vec<vk::Pipeline> {
+        let s = &self.stencil;
+        let mut v = vec![s.zpass, s.zfail, s.zfail_cap, s.eq_faces, s.eq_sides];
+        if let Some(c) = &self.count {
+            v.extend([c.zpass, c.zfail, c.cap, c.eq_faces, c.eq_sides]);
+        }
+        if let Some(t) = &self.transmit {
+            v.extend(t.iter().flatten());
+        }
+        v.extend(self.overlay);
+        v
+    }
+
+    /// # Safety
+    /// No command buffer that uses these pipelines may be pending.
+    pub unsafe fn destroy(&mut self, device: &ash::Device) {
+        // SAFETY: forwarded to the caller's contract.
+        unsafe {
+            for p in self.all() {
+                device.destroy_pipeline(p, None);
+            }
+            device.destroy_pipeline_layout(self.layout, None);
+        }
+    }
+}

@@ -1,0 +1,110 @@
+//! What one frame of the shadow pass did, per light and caster: the `--stats` JSON's
+//! `lights` and `totals` (a contract other tools read: keys as in issue #3, more keys welcome).
+
+#[derive(Clone, Debug, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct Triangles {
+    /// Side quads' triangles (two per silhouette edge for a point light, one for a directional).
+    pub sides: u64,
+    /// Dark-cap triangles (at infinity).
+    pub dark_cap: u64,
+    /// Light-cap triangles (the caster's own faces, z-fail cases).
+    pub light_cap: u64,
+}
+
+impl Triangles {
+    /// All shadow triangles.
+    pub fn total(&self) -> u64 {
+        self.sides + self.dark_cap + self.light_cap
+    }
+    /// Adds `o` into `self`.
+    pub fn add(&mut self, o: &Triangles) {
+        self.sides += o.sides;
+        self.dark_cap += o.dark_cap;
+        self.light_cap += o.light_cap;
+    }
+}
+
+#[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct CasterStats {
+    /// The caster's name (the scene mesh's, or the one given to `add_caster`).
+    pub name: String,
+    /// `culled`, `zpass`, `zfail` or `zfail_light_cap` (McGuire et al.'s cases 1-3).
+    pub case: String,
+    /// Possible silhouette edges found for this light.
+    pub silhouette_edges: u64,
+    /// Shadow triangles drawn.
+    pub triangles: Triangles,
+    /// Index bytes the GPU reads from this frame's stream.
+    pub index_bytes: u64,
+    /// Vertex bytes streamed (the naive format only; 0 otherwise).
+    pub vertex_bytes: u64,
+    /// Bytes per shadow triangle actually sent this frame (index + streamed vertex bytes).
+    pub bytes_per_triangle: f64,
+    /// `u8`, `u16`, `u32`, `naive` or `none`.
+    pub index_format: String,
+    /// Which dark cap was emitted (`Fan`, `BackFaces`, ...).
+    pub dark_cap_kind: String,
+    /// "manifold" (the three-case path) or "multiplicity" (open / non-manifold casters).
+    pub path: String,
+    /// Why the caster took the multiplicity path (empty for manifold casters).
+    pub path_reason: String,
+    /// Largest |edge multiplicity| drawn (1 for a manifold silhouette).
+    pub multiplicity_max: u32,
+}
+
+#[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct LightStats {
+    /// The light's index in the frame's light list.
+    pub index: usize,
+    /// `point`, `spot` or `directional`.
+    pub kind: String,
+    /// The light's scissor rectangle `[x, y, width, height]` in pixels (`None`: whole target).
+    pub scissor: Option<[u32; 4]>,
+    /// The light's depth bounds `[min, max]` when the device tests them.
+    pub depth_bounds: Option<[f32; 2]>,
+    /// One entry per caster.
+    pub casters: Vec<CasterStats>,
+}
+
+#[derive(Clone, Debug, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct Cases {
+    /// Casters culled (outside range, cone or view).
+    pub culled: u64,
+    /// Case 1: z-pass.
+    pub zpass: u64,
+    /// Case 2: z-fail without a light cap.
+    pub zfail: u64,
+    /// Case 3: z-fail with a light cap.
+    pub zfail_light_cap: u64,
+}
+
+#[derive(Clone, Debug, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct Totals {
+    /// Shadow triangles over all lights and casters.
+    pub triangles: Triangles,
+    /// Index bytes the GPU reads.
+    pub index_bytes: u64,
+    /// Streamed vertex bytes (naive format).
+    pub vertex_bytes: u64,
+    /// Geometry bytes the CPU wrote for this frame: the streams plus any caster uploads
+    /// (new, moved-by-deformation casters); 0 for static casters under a GPU-only technique.
+    pub bytes_sent: u64,
+    /// Caster-light pairs per case.
+    pub cases: Cases,
+}
+
+#[derive(Clone, Debug, Default)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct CpuMs {
+    /// Facing bits and possible silhouettes.
+    pub silhouettes: f64,
+    /// Culling, cases and index emission.
+    pub plan: f64,
+    /// Stream building and command recording.
+    pub record: f64,
+}

@@ -1,0 +1,66 @@
+//! 2a. Per light, the shadow determination, recorded by the [`ShadowPass`]: the count in the
+//!     stencil (cleared inside the light's scissor), or in the float target; with capture,
+//!     the count is copied out for the dumps and tests.
+
+use super::{Rec, DS_RW, FRAG_TESTS};
+use crate::pass::{DepthStencilTarget, PreparedFrame, ShadowPass};
+use crate::render::readback::Range;
+use crate::render::targets::Targets;
+use ash::vk;
+
+/// How the light's count is produced.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum CountInto {
+    /// The 8-bit stencil.
+    Stencil,
+    /// The R32F count target, by the shadow pass.
+    Float,
+    /// The R32F count target, written by the caller (the shadow-map lookup): only the layout
+    /// transitions and the capture happen here.
+    External,
+}
+
+/// Makes the count target writable (float counting).
+pub(crate) fn begin_float(rec: &Rec, t: &Targets) {
+    // Contents outside the scissor are never read (illumination is scissored too).
+    rec.transition(&t.count, vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
+}
+
+/// # Safety
+/// `rec.cb` is recording outside a rendering instance, the depth-stencil target is in
+/// attachment layout with the G-buffer's depth written; `frame` was prepared by `pass` for
+/// this slot.
+pub(crate) unsafe fn record(
+    rec: &Rec,
+    pass: &ShadowPass,
+    frame: &PreparedFrame,
+    light: usize,
+    t: &Targets,
+    into: CountInto,
+    capture: Option<Range>,
+) {
+    let target = DepthStencilTarget { view: t.depth.view, extent: t.extent };
+    // SAFETY: the caller's contract, which is `ShadowPass`'s.
+    unsafe {
+        match into {
+            CountInto::Stencil => pass.cmd_determine(rec.cb, frame, light, &target),
+            CountInto::Float => {
+                begin_float(rec, t);
+                pass.cmd_count_float(rec.cb, frame, light, &target, t.count.view);
+            }
+            CountInto::External => {}
+        }
+    }
+    rec.barrier((FRAG_TESTS, DS_RW), (FRAG_TESTS, DS_RW));
+    let float = into != CountInto::Stencil;
+    if let Some(range) = capture {
+        if float {
+            rec.copy_out(&t.count, vk::ImageAspectFlags::COLOR, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, range);
+        } else {
+            rec.copy_out(&t.depth, vk::ImageAspectFlags::STENCIL, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL, range);
+        }
+    }
+    if float {
+        rec.transition(&t.count, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
+    }
+}

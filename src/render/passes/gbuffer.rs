@@ -1,0 +1,61 @@
+//! 1. The ambient / G-buffer pass: every opaque mesh, depth LESS, writing the ambient term
+//!    into the float accumulation target and albedo, face normal and eye-relative position
+//!    into the G-buffer. Closed outward meshes are drawn with back faces culled, every other
+//!    opaque mesh two-sided.
+
+use super::{att, Rec, DS_CLEAR, ZERO};
+use crate::render::pipelines::FramePipelines;
+use crate::render::push::GBufferPush;
+use crate::render::scene_gpu::{SceneGeometry, Sidedness};
+use crate::render::targets::Targets;
+use ash::vk;
+use glam::{Mat4, Vec3};
+
+/// # Safety
+/// `rec.cb` is recording outside a rendering instance; `instances` is this slot's instance
+/// buffer, written for this frame.
+pub(crate) unsafe fn record(
+    rec: &Rec,
+    t: &Targets,
+    p: &FramePipelines,
+    geo: &SceneGeometry,
+    instances: vk::Buffer,
+    vp_rel: Mat4,
+    ambient: Vec3,
+) {
+    for img in t.gbuffer() {
+        rec.transition(img, vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
+    }
+    rec.transition(&t.depth, vk::ImageLayout::UNDEFINED, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
+    let colors: Vec<_> = t.gbuffer().iter().map(|i| att(i, vk::AttachmentLoadOp::CLEAR, ZERO)).collect();
+    let depth = att(&t.depth, vk::AttachmentLoadOp::CLEAR, DS_CLEAR);
+    let d = &rec.ctx.device;
+    let cb = rec.cb;
+    let push = GBufferPush { view_proj: vp_rel.to_cols_array(), ambient: ambient.extend(0.0).to_array() };
+    // SAFETY: the caller's contract; the images were just transitioned to attachment layouts.
+    unsafe {
+        rec.begin(rec.full, &colors, Some(&depth));
+        d.cmd_push_constants(
+            cb,
+            p.layouts.gbuffer,
+            vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+            0,
+            bytemuck::bytes_of(&push),
+        );
+        d.cmd_bind_vertex_buffers(cb, 0, &[geo.vertices.raw, instances], &[0, 0]);
+        for (side, pipe) in [(Sidedness::OneSided, p.gbuffer), (Sidedness::TwoSided, p.gbuffer_two_sided)] {
+            let mut bound = false;
+            for r in geo.of(side) {
+                if !bound {
+                    d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipe);
+                    bound = true;
+                }
+                d.cmd_draw(cb, r.count, 1, r.first, r.mesh);
+            }
+        }
+        d.cmd_end_rendering(cb);
+    }
+    for img in [&t.albedo, &t.normal, &t.position] {
+        rec.transition(img, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
+    }
+}

@@ -1,0 +1,45 @@
+//! 2c. Per light, illumination where the count is zero: a full-screen triangle over the
+//!     light's scissor, Blinn-Phong from the G-buffer, scaled by the light-intensity map,
+//!     added into the float target.
+
+use super::{att, Rec, COLOR_RW, DS_CLEAR, DS_RW, FRAG_TESTS, ZERO};
+use crate::pass::{PreparedFrame, ShadowPass};
+use crate::render::pipelines::FramePipelines;
+use crate::render::push::LightPush;
+use crate::render::targets::Targets;
+use ash::vk;
+
+/// # Safety
+/// `rec.cb` is recording outside a rendering instance; the G-buffer, the count target (float)
+/// and the intensity map (`transmit`) are in shader-read layout.
+#[allow(clippy::too_many_arguments)]
+pub(crate) unsafe fn record(
+    rec: &Rec,
+    pass: &ShadowPass,
+    frame: &PreparedFrame,
+    light: usize,
+    t: &Targets,
+    p: &FramePipelines,
+    float: bool,
+    transmit: bool,
+    push: &LightPush,
+) {
+    let load = vk::AttachmentLoadOp::LOAD;
+    let accum = [att(&t.accum, load, ZERO)];
+    let depth = att(&t.depth, load, DS_CLEAR);
+    let d = &rec.ctx.device;
+    let cb = rec.cb;
+    let scissor = frame.lights[light].scissor;
+    // SAFETY: the caller's contract.
+    unsafe {
+        rec.begin(scissor, &accum, Some(&depth));
+        d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, p.illuminate[float as usize][transmit as usize]);
+        pass.cmd_light_state(cb, frame, light, t.extent);
+        d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, p.layouts.illuminate, 0, &[p.gbuffer_set.set], &[]);
+        d.cmd_push_constants(cb, p.layouts.illuminate, vk::ShaderStageFlags::FRAGMENT, 0, bytemuck::bytes_of(push));
+        d.cmd_draw(cb, 3, 1, 0, 0);
+        d.cmd_end_rendering(cb);
+    }
+    let stages = vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT | FRAG_TESTS;
+    rec.barrier((stages, COLOR_RW | DS_RW), (stages, COLOR_RW | DS_RW));
+}

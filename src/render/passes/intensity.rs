@@ -1,0 +1,30 @@
+//! 2b. Per light, the transparent casters' light-intensity map (Kim et al. 2008), recorded
+//!     by the [`ShadowPass`]: every counted volume face multiplies by `t` or `1/t` (or adds
+//!     `±log t`), depth-tested like the float counter.
+
+use super::Rec;
+use crate::pass::{DepthStencilTarget, PreparedFrame, ShadowPass};
+use crate::render::readback::Range;
+use crate::render::targets::Targets;
+use ash::vk;
+
+/// # Safety
+/// As [`super::determine::record`].
+pub(crate) unsafe fn record(
+    rec: &Rec,
+    pass: &ShadowPass,
+    frame: &PreparedFrame,
+    light: usize,
+    t: &Targets,
+    log: bool,
+    capture: Option<Range>,
+) {
+    rec.transition(&t.transmit, vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
+    let target = DepthStencilTarget { view: t.depth.view, extent: t.extent };
+    // SAFETY: the caller's contract, which is `ShadowPass`'s.
+    unsafe { pass.cmd_light_intensity(rec.cb, frame, light, &target, t.transmit.view, log) };
+    if let Some(range) = capture {
+        rec.copy_out(&t.transmit, vk::ImageAspectFlags::COLOR, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, range);
+    }
+    rec.transition(&t.transmit, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
+}

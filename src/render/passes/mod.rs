@@ -1,0 +1,110 @@
+//! The frame's passes, one file each, in the order [`Renderer::render`](super::Renderer) runs
+//! them: G-buffer, per light determination (+ light-intensity map) and illumination, the
+//! transparent casters, the debug views, the tone map.
+
+pub(crate) mod debug;
+pub(crate) mod determine;
+pub(crate) mod gbuffer;
+pub(crate) mod illuminate;
+pub(crate) mod intensity;
+pub(crate) mod tonemap;
+pub(crate) mod transparent;
+
+use super::readback::Range;
+use super::timing::{Span, Timer};
+use crate::gpu::resources::{memory_barrier, transition};
+use crate::gpu::{Context, Image};
+use ash::vk;
+
+/// What every pass records with.
+pub(crate) struct Rec<'a> {
+    pub ctx: &'a Context,
+    pub cb: vk::CommandBuffer,
+    pub full: vk::Rect2D,
+    pub viewport: vk::Viewport,
+    pub timer: &'a Timer,
+    /// The slot's readback buffer.
+    pub readback: vk::Buffer,
+}
+
+pub(crate) const ZERO: vk::ClearValue = vk::ClearValue { color: vk::ClearColorValue { float32: [0.0; 4] } };
+pub(crate) const DS_CLEAR: vk::ClearValue = vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } };
+pub(crate) const FRAG_TESTS: vk::PipelineStageFlags2 = vk::PipelineStageFlags2::from_raw(
+    vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS.as_raw() | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS.as_raw(),
+);
+pub(crate) const DS_RW: vk::AccessFlags2 = vk::AccessFlags2::from_raw(
+    vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ.as_raw() | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE.as_raw(),
+);
+pub(crate) const COLOR_RW: vk::AccessFlags2 =
+    vk::AccessFlags2::from_raw(vk::AccessFlags2::COLOR_ATTACHMENT_READ.as_raw() | vk::AccessFlags2::COLOR_ATTACHMENT_WRITE.as_raw());
+
+/// An attachment of `img` in its attachment layout.
+pub(crate) fn att(img: &Image, load: vk::AttachmentLoadOp, clear: vk::ClearValue) -> vk::RenderingAttachmentInfo<'static> {
+    vk::RenderingAttachmentInfo::default()
+        .image_view(img.view)
+        .image_layout(if img.aspect == vk::ImageAspectFlags::COLOR {
+            vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL
+        } else {
+            vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL
+        })
+        .load_op(load)
+        .store_op(vk::AttachmentStoreOp::STORE)
+        .clear_value(clear)
+}
+
+impl Rec<'_> {
+    /// Begins a dynamic-rendering instance over `area` with colour attachments and an
+    /// optional depth-stencil attachment (used for both aspects, as lavapipe needs), and sets
+    /// the viewport and a scissor equal to `area`.
+    ///
+    /// # Safety
+    /// `self.cb` is recording outside any rendering instance, and every attachment's image is
+    /// in the layout its info names.
+    pub unsafe fn begin(
+        &self,
+        area: vk::Rect2D,
+        colors: &[vk::RenderingAttachmentInfo],
+        depth_stencil: Option<&vk::RenderingAttachmentInfo>,
+    ) {
+        let mut info = vk::RenderingInfo::default().render_area(area).layer_count(1).color_attachments(colors);
+        if let Some(ds) = depth_stencil {
+            info = info.depth_attachment(ds).stencil_attachment(ds);
+        }
+        let d = &self.ctx.device;
+        // SAFETY: forwarded to the caller's contract above.
+        unsafe {
+            d.cmd_begin_rendering(self.cb, &info);
+            d.cmd_set_viewport(self.cb, 0, &[self.viewport]);
+            d.cmd_set_scissor(self.cb, 0, &[area]);
+        }
+    }
+
+    pub fn transition(&self, img: &Image, from: vk::ImageLayout, to: vk::ImageLayout) {
+        transition(self.ctx, self.cb, img, from, to);
+    }
+
+    pub fn barrier(&self, src: (vk::PipelineStageFlags2, vk::AccessFlags2), dst: (vk::PipelineStageFlags2, vk::AccessFlags2)) {
+        memory_barrier(self.ctx, self.cb, src, dst);
+    }
+
+    /// Copies one aspect of `img` (in `layout`) into `range` of the readback buffer, and
+    /// returns it to `layout`.
+    pub fn copy_out(&self, img: &Image, aspect: vk::ImageAspectFlags, layout: vk::ImageLayout, range: Range) {
+        let region = vk::BufferImageCopy::default()
+            .buffer_offset(range.offset)
+            .image_subresource(vk::ImageSubresourceLayers { aspect_mask: aspect, mip_level: 0, base_array_layer: 0, layer_count: 1 })
+            .image_extent(vk::Extent3D { width: img.extent.width, height: img.extent.height, depth: 1 });
+        self.transition(img, layout, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+        // SAFETY: `cb` is recording outside a rendering instance; the range was sized for
+        // this image's aspect when the readback buffer was laid out.
+        unsafe {
+            self.ctx.device.cmd_copy_image_to_buffer(self.cb, img.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, self.readback, &[region])
+        };
+        self.transition(img, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, layout);
+    }
+}
+
+/// A span from two stamps.
+pub(crate) fn timing_span(begin: Option<u32>, end: Option<u32>) -> Span {
+    Span { begin, end }
+}

@@ -1,0 +1,61 @@
+//! 3. Transparent casters, forward over the lit scene: premultiplied "over" with the ambient
+//!    term, then each light added (unsorted: an order-independent approximation; without
+//!    `--self-shadow` transparent surfaces receive no shadows).
+
+use super::{att, Rec, DS_CLEAR, ZERO};
+use crate::render::pipelines::FramePipelines;
+use crate::render::push::{ForwardPush, LightPush};
+use crate::render::scene_gpu::{SceneGeometry, Sidedness};
+use crate::render::targets::Targets;
+use ash::vk;
+use glam::{Mat4, Vec3};
+
+/// Draws every transparent mesh with `push` (the caller binds the pipeline).
+///
+/// # Safety
+/// `rec.cb` is recording inside a rendering instance with a scene pipeline of the forward
+/// layout `layout` bound.
+pub(crate) unsafe fn draw_meshes(rec: &Rec, layout: vk::PipelineLayout, geo: &SceneGeometry, instances: vk::Buffer, push: &ForwardPush) {
+    let d = &rec.ctx.device;
+    // SAFETY: the caller's contract.
+    unsafe {
+        d.cmd_push_constants(rec.cb, layout, vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT, 0, bytemuck::bytes_of(push));
+        d.cmd_bind_vertex_buffers(rec.cb, 0, &[geo.vertices.raw, instances], &[0, 0]);
+        for r in geo.of(Sidedness::Transparent) {
+            d.cmd_draw(rec.cb, r.count, 1, r.first, r.mesh);
+        }
+    }
+}
+
+/// `lights`: the per-light forward passes (empty with `--self-shadow`, whose light passes
+/// are recorded by the self-shadowing pass).
+///
+/// # Safety
+/// `rec.cb` is recording outside a rendering instance; accumulation and depth in attachment layout.
+#[allow(clippy::too_many_arguments)]
+pub(crate) unsafe fn record(
+    rec: &Rec,
+    t: &Targets,
+    p: &FramePipelines,
+    geo: &SceneGeometry,
+    instances: vk::Buffer,
+    vp_rel: Mat4,
+    ambient: Vec3,
+    lights: &[LightPush],
+) {
+    let load = vk::AttachmentLoadOp::LOAD;
+    let accum = [att(&t.accum, load, ZERO)];
+    let depth = att(&t.depth, load, DS_CLEAR);
+    let d = &rec.ctx.device;
+    // SAFETY: the caller's contract.
+    unsafe {
+        rec.begin(rec.full, &accum, Some(&depth));
+        d.cmd_bind_pipeline(rec.cb, vk::PipelineBindPoint::GRAPHICS, p.transparent_over);
+        draw_meshes(rec, p.layouts.forward, geo, instances, &ForwardPush::ambient(vp_rel, ambient));
+        d.cmd_bind_pipeline(rec.cb, vk::PipelineBindPoint::GRAPHICS, p.transparent_light);
+        for l in lights {
+            draw_meshes(rec, p.layouts.forward, geo, instances, &ForwardPush::light(vp_rel, l));
+        }
+        d.cmd_end_rendering(rec.cb);
+    }
+}

@@ -1,0 +1,175 @@
+//! The frame's own pipelines (everything but the shadow determination, which is the
+//! [`ShadowPass`](crate::pass::ShadowPass)'s), their layouts and descriptor sets: a set that
+//! destroys exactly what it created.
+
+use super::push::{ForwardPush, GBufferPush, LightPush};
+use super::scene_gpu::{INSTANCE_ATTRIBUTES, INSTANCE_STRIDE, VERTEX_ATTRIBUTES, VERTEX_STRIDE};
+use super::targets::*;
+use crate::error::Result;
+use crate::gpu::descriptors::{pipeline_layout, Binding, DescriptorSet};
+use crate::gpu::pipeline::{self, Blend, PipelineDesc};
+use crate::gpu::{shaders, Context};
+use ash::vk;
+
+/// Layouts, by what they serve.
+pub(crate) struct Layouts {
+    /// G-buffer: [`GBufferPush`].
+    pub gbuffer: vk::PipelineLayout,
+    /// Illumination: the G-buffer set + [`LightPush`].
+    pub illuminate: vk::PipelineLayout,
+    /// Tone map: the accumulation set.
+    pub tonemap: vk::PipelineLayout,
+    /// Transparent forward passes: [`ForwardPush`].
+    pub forward: vk::PipelineLayout,
+}
+
+pub(crate) struct FramePipelines {
+    pub layouts: Layouts,
+    /// Set 0 of illumination: albedo, normal, position, sampler, float count, intensity map.
+    pub gbuffer_set: DescriptorSet,
+    /// Set 0 of the tone map: accumulation, sampler.
+    pub accum_set: DescriptorSet,
+    pub sampler: vk::Sampler,
+    pub gbuffer: vk::Pipeline,
+    pub gbuffer_two_sided: vk::Pipeline,
+    /// `[stencil, float count][without, with the light-intensity map]`.
+    pub illuminate: [[vk::Pipeline; 2]; 2],
+    pub transparent_over: vk::Pipeline,
+    pub transparent_light: vk::Pipeline,
+    pub tonemap: vk::Pipeline,
+    made: Vec<vk::Pipeline>,
+}
+
+/// A scene-geometry pipeline description (vertex + instance bindings).
+pub(crate) fn scene_pipeline<'a>(vertex: &'a [u8], layout: vk::PipelineLayout, depth_format: vk::Format) -> PipelineDesc<'a> {
+    let mut p = PipelineDesc::new(vertex, layout, depth_format);
+    p.vertex_stride = VERTEX_STRIDE;
+    p.attributes = &VERTEX_ATTRIBUTES;
+    p.instance_stride = INSTANCE_STRIDE;
+    p.instance_attributes = &INSTANCE_ATTRIBUTES;
+    p
+}
+
+impl FramePipelines {
+    /// `depth_bounds`: illumination tests the stored depth against the light's depth range
+    /// (dynamic state) when the device has the feature.
+    pub fn new(ctx: &Context, targets: &Targets, depth_bounds: bool) -> Result<FramePipelines> {
+        let d = &ctx.device;
+        // SAFETY: plain object creation on a valid device; destroyed in `destroy`.
+        let sampler = unsafe {
+            d.create_sampler(&vk::SamplerCreateInfo::default().mag_filter(vk::Filter::NEAREST).min_filter(vk::Filter::NEAREST), None)
+        }
+        .map_err(crate::Error::vk("vkCreateSampler"))?;
+        let t = targets;
+        let gbuffer_set = DescriptorSet::new(
+            ctx,
+            &[
+                Binding::Image(t.albedo.view),
+                Binding::Image(t.normal.view),
+                Binding::Image(t.position.view),
+                Binding::Sampler(sampler),
+                Binding::Image(t.count.view),
+                Binding::Image(t.transmit.view),
+            ],
+        )?;
+        let accum_set = DescriptorSet::new(ctx, &[Binding::Image(t.accum.view), Binding::Sampler(sampler)])?;
+        let vf = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
+        let frag = vk::ShaderStageFlags::FRAGMENT;
+        let size = |n: usize| n as u32;
+        let layouts = Layouts {
+            gbuffer: pipeline_layout(ctx, &[], size(std::mem::size_of::<GBufferPush>()), vf)?,
+            illuminate: pipeline_layout(ctx, &[gbuffer_set.layout], size(std::mem::size_of::<LightPush>()), frag)?,
+            tonemap: pipeline_layout(ctx, &[accum_set.layout], 0, frag)?,
+            forward: pipeline_layout(ctx, &[], size(std::mem::size_of::<ForwardPush>()), vf)?,
+        };
+        let mut made = Vec::new();
+        let mut create = |desc: &PipelineDesc| -> Result<vk::Pipeline> {
+            let p = pipeline::create(ctx, desc)?;
+            made.push(p);
+            Ok(p)
+        };
+        let df = ctx.depth_format;
+        let gbuffer_formats = [ACCUM_FORMAT, ALBEDO_FORMAT, NORMAL_FORMAT, POSITION_FORMAT];
+        let mut g = scene_pipeline(shaders::GBUFFER_VERT, layouts.gbuffer, df);
+        g.fragment = Some(shaders::GBUFFER_FRAG);
+        g.attributes = &VERTEX_ATTRIBUTES[..3];
+        g.color_formats = &gbuffer_formats;
+        g.depth_test = true;
+        g.depth_write = true;
+        g.depth_compare = vk::CompareOp::LESS;
+        g.cull = vk::CullModeFlags::BACK;
+        let gbuffer = create(&g)?;
+        g.cull = vk::CullModeFlags::NONE;
+        let gbuffer_two_sided = create(&g)?;
+
+        let accum = [ACCUM_FORMAT];
+        let mut i = PipelineDesc::new(shaders::FULLSCREEN_VERT, layouts.illuminate, df);
+        i.color_formats = &accum;
+        i.blend = Blend::Additive;
+        i.depth_bounds = depth_bounds;
+        let lit = Some((crate::pass::lit_stencil_state(), crate::pass::lit_stencil_state()));
+        let mut illuminate = [[vk::Pipeline::null(); 2]; 2];
+        for (ci, counted) in [false, true].into_iter().enumerate() {
+            for (ti, transmit) in [false, true].into_iter().enumerate() {
+                i.fragment = Some(match (counted, transmit) {
+                    (false, false) => shaders::ILLUMINATE_FRAG,
+                    (false, true) => shaders::ILLUMINATE_T_FRAG,
+                    (true, false) => shaders::ILLUMINATE_COUNT_FRAG,
+                    (true, true) => shaders::ILLUMINATE_COUNT_T_FRAG,
+                });
+                i.stencil = if counted { None } else { lit };
+                illuminate[ci][ti] = create(&i)?;
+            }
+        }
+
+        let mut tp = scene_pipeline(shaders::TRANSPARENT_VERT, layouts.forward, df);
+        tp.fragment = Some(shaders::TRANSPARENT_FRAG);
+        tp.color_formats = &accum;
+        tp.depth_test = true;
+        tp.depth_compare = vk::CompareOp::LESS;
+        tp.blend = Blend::Over;
+        let transparent_over = create(&tp)?;
+        tp.blend = Blend::Additive;
+        let transparent_light = create(&tp)?;
+
+        let out = [OUTPUT_FORMAT];
+        let mut tm = PipelineDesc::new(shaders::FULLSCREEN_VERT, layouts.tonemap, vk::Format::UNDEFINED);
+        tm.fragment = Some(shaders::TONEMAP_FRAG);
+        tm.color_formats = &out;
+        let tonemap = create(&tm)?;
+        Ok(FramePipelines {
+            layouts,
+            gbuffer_set,
+            accum_set,
+            sampler,
+            gbuffer,
+            gbuffer_two_sided,
+            illuminate,
+            transparent_over,
+            transparent_light,
+            tonemap,
+            made,
+        })
+    }
+
+    /// Destroys every pipeline, layout, set and the sampler this created.
+    ///
+    /// # Safety
+    /// No pending command buffer uses them.
+    pub unsafe fn destroy(&mut self, ctx: &Context) {
+        let d = &ctx.device;
+        // SAFETY: forwarded to the caller's contract; each handle is destroyed once.
+        unsafe {
+            for p in self.made.drain(..) {
+                d.destroy_pipeline(p, None);
+            }
+            let l = &self.layouts;
+            for layout in [l.gbuffer, l.illuminate, l.tonemap, l.forward] {
+                d.destroy_pipeline_layout(layout, None);
+            }
+            d.destroy_sampler(self.sampler, None);
+        }
+        self.gbuffer_set.destroy(ctx);
+        self.accum_set.destroy(ctx);
+    }
+}

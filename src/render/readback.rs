@@ -1,0 +1,85 @@
+//! Readback: one host-visible buffer per ring slot, laid out in named ranges (colour, then
+//! the captured positions, normals, per-light counts and light-intensity maps).
+
+use crate::error::Result;
+use crate::gpu::{Buffer, Context};
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+
+/// A byte range of the readback buffer.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub(crate) struct Range {
+    pub offset: u64,
+    pub size: u64,
+}
+
+/// Where each image of a frame lands.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Layout {
+    pub color: Range,
+    pub positions: Option<Range>,
+    pub normals: Option<Range>,
+    /// Per light: the stencil (1 byte a pixel) or the float count (4 bytes).
+    pub counts: Vec<Range>,
+    /// Per light: the light-intensity map (8 or 16 bytes a pixel).
+    pub transmit: Vec<Range>,
+    pub total: u64,
+}
+
+impl Layout {
+    /// `capture`: positions, normals and per-light counts / maps too.
+    pub fn new(pixels: u64, capture: bool, lights: usize, float_counts: bool, transmit_texel: Option<u64>) -> Layout {
+        let mut next = 0u64;
+        let mut take = |size: u64| {
+            let r = Range { offset: next, size };
+            next += size.div_ceil(16) * 16;
+            r
+        };
+        let color = take(pixels * 4);
+        let mut l = Layout { color, ..Layout::default() };
+        if capture {
+            l.positions = Some(take(pixels * 16));
+            l.normals = Some(take(pixels * 16));
+            let per_light = if float_counts { pixels * 4 } else { pixels };
+            l.counts = (0..lights).map(|_| take(per_light)).collect();
+            if let Some(texel) = transmit_texel {
+                l.transmit = (0..lights).map(|_| take(pixels * texel)).collect();
+            }
+        }
+        l.total = next;
+        l
+    }
+}
+
+/// A slot's readback buffer, grown when a frame needs more.
+pub(crate) struct Readback {
+    pub buffer: Option<Buffer>,
+}
+
+impl Readback {
+    /// A buffer of at least `size` bytes (the slot's previous frame has retired).
+    pub fn ensure(&mut self, ctx: &Context, slot: usize, size: u64) -> Result<vk::Buffer> {
+        if self.buffer.as_ref().map(|b| b.size < size).unwrap_or(true) {
+            if let Some(mut b) = self.buffer.take() {
+                b.destroy(ctx);
+            }
+            self.buffer =
+                Some(Buffer::new(ctx, &format!("readback {slot}"), size, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?);
+        }
+        Ok(self.buffer.as_ref().map(|b| b.raw).unwrap_or_default())
+    }
+
+    /// The bytes of `range`.
+    pub fn bytes(&self, range: Range) -> Result<&[u8]> {
+        let b = self.buffer.as_ref().ok_or_else(|| crate::Error::Other("no readback buffer".into()))?;
+        let all = b.read()?;
+        all.get(range.offset as usize..(range.offset + range.size) as usize)
+            .ok_or_else(|| crate::Error::Other(format!("readback range {range:?} outside {} bytes", all.len())))
+    }
+
+    pub fn destroy(&mut self, ctx: &Context) {
+        if let Some(mut b) = self.buffer.take() {
+            b.destroy(ctx);
+        }
+    }
+}
