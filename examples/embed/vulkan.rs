@@ -1,0 +1,409 @@
+//! The host's Vulkan plumbing: validation messenger, device choice and creation, buffers and
+//! images from the gpu-allocator, shader modules, pipelines, barriers.
+
+use ash::vk;
+use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme, Allocator};
+use gpu_allocator::MemoryLocation;
+use std::ffi::{c_void, CStr};
+use std::sync::Mutex;
+
+pub(super) fn vkerr(call: &'static str) -> impl Fn(vk::Result) -> String {
+    move |e| format!("{call} failed: {e:?}")
+}
+
+pub(super) fn validation_requested() -> bool {
+    std::env::var("UMBRAGE_VALIDATION").map(|v| v == "1" || v.eq_ignore_ascii_case("true")).unwrap_or(false)
+}
+
+/// Collects validation ERRORs into the `Mutex<Vec<String>>` passed as user data.
+///
+/// # Safety
+/// Called by the validation layer only, with the user data the messenger was created with.
+pub(super) unsafe extern "system" fn debug_callback(
+    severity: vk::DebugUtilsMessageSeverityFlagsEXT,
+    _types: vk::DebugUtilsMessageTypeFlagsEXT,
+    data: *const vk::DebugUtilsMessengerCallbackDataEXT<'_>,
+    user: *mut c_void,
+) -> vk::Bool32 {
+    // SAFETY: the loader passes valid callback data for the duration of the call; `user` is
+    // `Arc::as_ptr` of the host's log, which outlives the messenger (destroyed first).
+    let (msg, log) = unsafe {
+        let msg = if data.is_null() || (*data).p_message.is_null() {
+            String::from("(no message)")
+        } else {
+            CStr::from_ptr((*data).p_message).to_string_lossy().into_owned()
+        };
+        (msg, &*(user as *const Mutex<Vec<String>>))
+    };
+    if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
+        eprintln!("[vulkan validation] {msg}");
+        if let Ok(mut l) = log.lock() {
+            l.push(msg);
+        }
+    }
+    vk::FALSE
+}
+
+/// A buffer and its memory from the host's allocator.
+pub(super) struct Buf {
+    pub(super) raw: vk::Buffer,
+    pub(super) alloc: Option<Allocation>,
+}
+
+/// An image, its view and its memory.
+pub(super) struct Img {
+    pub(super) raw: vk::Image,
+    pub(super) view: vk::ImageView,
+    pub(super) alloc: Option<Allocation>,
+}
+
+/// The physical device the host picked, and what it found on it.
+pub(super) struct Picked {
+    pub(super) physical: vk::PhysicalDevice,
+    pub(super) name: String,
+    pub(super) queue_family: u32,
+    pub(super) ds_format: vk::Format,
+    pub(super) depth_clamp: bool,
+    pub(super) depth_bounds: bool,
+    pub(super) index_type_uint8: bool,
+}
+
+pub(super) fn lock(a: &Mutex<Allocator>) -> std::sync::MutexGuard<'_, Allocator> {
+    a.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+/// The first Vulkan 1.3 device with a graphics queue, dynamicRendering, synchronization2 and
+/// a depth-stencil attachment format with 8 stencil bits: discrete before integrated before
+/// virtual before CPU (`UMBRAGE_DEVICE=<name substring>` picks one).
+pub(super) fn pick_device(instance: &ash::Instance) -> Result<Picked, String> {
+    // SAFETY: enumeration on a valid instance.
+    let physicals = unsafe { instance.enumerate_physical_devices() }.map_err(vkerr("vkEnumeratePhysicalDevices"))?;
+    let wanted = std::env::var("UMBRAGE_DEVICE").ok().map(|s| s.to_lowercase());
+    let mut best: Option<(u32, Picked)> = None;
+    for pd in physicals {
+        // SAFETY: `pd` comes from the enumeration above (and so below).
+        let props = unsafe { instance.get_physical_device_properties(pd) };
+        let name = props.device_name_as_c_str().map(|c| c.to_string_lossy().into_owned()).unwrap_or_default();
+        if props.api_version < vk::API_VERSION_1_3 || wanted.as_ref().is_some_and(|w| !name.to_lowercase().contains(w)) {
+            continue;
+        }
+        // SAFETY: as above.
+        let families = unsafe { instance.get_physical_device_queue_family_properties(pd) };
+        let Some(qf) = families.iter().position(|f| f.queue_flags.contains(vk::QueueFlags::GRAPHICS)) else { continue };
+        let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
+        let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13);
+        // SAFETY: the pNext chain points at a local alive for the call.
+        unsafe { instance.get_physical_device_features2(pd, &mut f2) };
+        let base = f2.features;
+        if f13.dynamic_rendering != vk::TRUE || f13.synchronization2 != vk::TRUE {
+            continue;
+        }
+        let needed = vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT | vk::FormatFeatureFlags::TRANSFER_SRC;
+        let ds_format = [vk::Format::D32_SFLOAT_S8_UINT, vk::Format::D24_UNORM_S8_UINT].into_iter().find(|&f| {
+            // SAFETY: a format query on a valid physical device.
+            let p = unsafe { instance.get_physical_device_format_properties(pd, f) };
+            p.optimal_tiling_features.contains(needed)
+        });
+        let Some(ds_format) = ds_format else { continue };
+        // SAFETY: as above.
+        let exts = unsafe { instance.enumerate_device_extension_properties(pd) }.map_err(vkerr("vkEnumerateDeviceExtensionProperties"))?;
+        let has_u8_ext = exts.iter().any(|e| e.extension_name_as_c_str().map(|n| n == ash::ext::index_type_uint8::NAME).unwrap_or(false));
+        let index_type_uint8 = has_u8_ext && {
+            let mut u8f = vk::PhysicalDeviceIndexTypeUint8FeaturesEXT::default();
+            let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut u8f);
+            // SAFETY: as above.
+            unsafe { instance.get_physical_device_features2(pd, &mut f2) };
+            u8f.index_type_uint8 == vk::TRUE
+        };
+        let rank = match props.device_type {
+            vk::PhysicalDeviceType::DISCRETE_GPU => 0,
+            vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
+            vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
+            vk::PhysicalDeviceType::CPU => 3,
+            _ => 4,
+        };
+        if best.as_ref().map(|(r, _)| rank < *r).unwrap_or(true) {
+            let picked = Picked {
+                physical: pd,
+                name,
+                queue_family: qf as u32,
+                ds_format,
+                depth_clamp: base.depth_clamp == vk::TRUE,
+                depth_bounds: base.depth_bounds == vk::TRUE,
+                index_type_uint8,
+            };
+            best = Some((rank, picked));
+        }
+    }
+    best.map(|(_, p)| p)
+        .ok_or_else(|| "no Vulkan 1.3 device with graphics, dynamicRendering, synchronization2 and a D32S8/D24S8 attachment".into())
+}
+
+/// The logical device: one graphics queue, Vulkan 1.3's dynamicRendering and
+/// synchronization2, depthClamp / depthBounds / indexTypeUint8 where present.
+pub(super) fn create_device(instance: &ash::Instance, p: &Picked) -> Result<ash::Device, String> {
+    let enabled = vk::PhysicalDeviceFeatures::default().depth_clamp(p.depth_clamp).depth_bounds(p.depth_bounds);
+    let mut f13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true);
+    let mut u8f = vk::PhysicalDeviceIndexTypeUint8FeaturesEXT::default().index_type_uint8(true);
+    let mut exts = Vec::new();
+    if p.index_type_uint8 {
+        exts.push(ash::ext::index_type_uint8::NAME.as_ptr());
+    }
+    let prio = [1.0f32];
+    let queues = [vk::DeviceQueueCreateInfo::default().queue_family_index(p.queue_family).queue_priorities(&prio)];
+    let mut info = vk::DeviceCreateInfo::default()
+        .queue_create_infos(&queues)
+        .enabled_features(&enabled)
+        .enabled_extension_names(&exts)
+        .push_next(&mut f13);
+    if p.index_type_uint8 {
+        info = info.push_next(&mut u8f);
+    }
+    // SAFETY: every pointer in `info` refers to locals alive for the call.
+    unsafe { instance.create_device(p.physical, &info, None) }.map_err(vkerr("vkCreateDevice"))
+}
+
+pub(super) fn create_buffer(
+    device: &ash::Device,
+    allocator: &Mutex<Allocator>,
+    name: &str,
+    size: u64,
+    usage: vk::BufferUsageFlags,
+    location: MemoryLocation,
+) -> Result<Buf, String> {
+    let info = vk::BufferCreateInfo::default().size(size.max(4)).usage(usage).sharing_mode(vk::SharingMode::EXCLUSIVE);
+    // SAFETY: a valid create info on a valid device.
+    let raw = unsafe { device.create_buffer(&info, None) }.map_err(vkerr("vkCreateBuffer"))?;
+    // SAFETY: `raw` was just created on this device.
+    let requirements = unsafe { device.get_buffer_memory_requirements(raw) };
+    let desc =
+        AllocationCreateDesc { name, requirements, location, linear: true, allocation_scheme: AllocationScheme::GpuAllocatorManaged };
+    let alloc = match lock(allocator).allocate(&desc) {
+        Ok(a) => a,
+        Err(e) => {
+            // SAFETY: the buffer was never used.
+            unsafe { device.destroy_buffer(raw, None) };
+            return Err(format!("allocating {name}: {e}"));
+        }
+    };
+    let buf = Buf { raw, alloc: Some(alloc) };
+    let a = buf.alloc.as_ref().ok_or("no allocation")?;
+    // SAFETY: the allocation was made for this buffer's requirements.
+    if let Err(e) = unsafe { device.bind_buffer_memory(raw, a.memory(), a.offset()) } {
+        free_buffer(device, allocator, buf);
+        return Err(format!("vkBindBufferMemory failed: {e:?}"));
+    }
+    Ok(buf)
+}
+
+pub(super) fn free_buffer(device: &ash::Device, allocator: &Mutex<Allocator>, mut b: Buf) {
+    // SAFETY: the caller guarantees the GPU no longer uses the buffer.
+    unsafe { device.destroy_buffer(b.raw, None) };
+    if let Some(a) = b.alloc.take() {
+        let _ = lock(allocator).free(a);
+    }
+}
+
+pub(super) fn write_buffer(b: &mut Buf, data: &[u8]) -> Result<(), String> {
+    let slice = b.alloc.as_mut().and_then(|a| a.mapped_slice_mut()).ok_or("buffer is not host visible")?;
+    if data.len() > slice.len() {
+        return Err(format!("buffer write of {} bytes into {}", data.len(), slice.len()));
+    }
+    slice[..data.len()].copy_from_slice(data);
+    Ok(())
+}
+
+/// A host-visible buffer filled with `data` (the meshes are small; an engine would stage).
+pub(super) fn upload(
+    device: &ash::Device,
+    allocator: &Mutex<Allocator>,
+    name: &str,
+    data: &[u8],
+    usage: vk::BufferUsageFlags,
+) -> Result<Buf, String> {
+    let mut b = create_buffer(device, allocator, name, data.len() as u64, usage, MemoryLocation::CpuToGpu)?;
+    if let Err(e) = write_buffer(&mut b, data) {
+        free_buffer(device, allocator, b);
+        return Err(e);
+    }
+    Ok(b)
+}
+
+pub(super) fn create_image(
+    device: &ash::Device,
+    allocator: &Mutex<Allocator>,
+    name: &str,
+    format: vk::Format,
+    extent: vk::Extent2D,
+    usage: vk::ImageUsageFlags,
+    aspect: vk::ImageAspectFlags,
+) -> Result<Img, String> {
+    let info = vk::ImageCreateInfo::default()
+        .image_type(vk::ImageType::TYPE_2D)
+        .format(format)
+        .extent(vk::Extent3D { width: extent.width, height: extent.height, depth: 1 })
+        .mip_levels(1)
+        .array_layers(1)
+        .samples(vk::SampleCountFlags::TYPE_1)
+        .tiling(vk::ImageTiling::OPTIMAL)
+        .usage(usage)
+        .initial_layout(vk::ImageLayout::UNDEFINED);
+    // SAFETY: a valid create info on a valid device.
+    let raw = unsafe { device.create_image(&info, None) }.map_err(vkerr("vkCreateImage"))?;
+    // SAFETY: `raw` is a new image of this device.
+    let requirements = unsafe { device.get_image_memory_requirements(raw) };
+    let desc = AllocationCreateDesc {
+        name,
+        requirements,
+        location: MemoryLocation::GpuOnly,
+        linear: false,
+        allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+    };
+    let alloc = match lock(allocator).allocate(&desc) {
+        Ok(a) => a,
+        Err(e) => {
+            // SAFETY: the image was never used.
+            unsafe { device.destroy_image(raw, None) };
+            return Err(format!("allocating image {name}: {e}"));
+        }
+    };
+    let range = vk::ImageSubresourceRange { aspect_mask: aspect, base_mip_level: 0, level_count: 1, base_array_layer: 0, layer_count: 1 };
+    let view_info =
+        vk::ImageViewCreateInfo::default().image(raw).view_type(vk::ImageViewType::TYPE_2D).format(format).subresource_range(range);
+    // SAFETY: the allocation satisfies the image's requirements; the view covers its only
+    // subresource once the memory is bound.
+    let view =
+        unsafe { device.bind_image_memory(raw, alloc.memory(), alloc.offset()).and_then(|_| device.create_image_view(&view_info, None)) };
+    match view {
+        Ok(view) => Ok(Img { raw, view, alloc: Some(alloc) }),
+        Err(e) => {
+            // SAFETY: the image was never used.
+            unsafe { device.destroy_image(raw, None) };
+            let _ = lock(allocator).free(alloc);
+            Err(format!("binding / viewing image {name}: {e:?}"))
+        }
+    }
+}
+
+pub(super) fn shader_module(device: &ash::Device, spirv: &[u8]) -> Result<vk::ShaderModule, String> {
+    let words: Vec<u32> = spirv.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
+    // SAFETY: `words` is SPIR-V compiled and validated by naga in umbrage's build script.
+    unsafe { device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&words), None) }.map_err(vkerr("vkCreateShaderModule"))
+}
+
+/// What differs between the host's two pipelines.
+pub(super) struct PipelineState {
+    pub(super) vs: vk::ShaderModule,
+    pub(super) fs: Option<vk::ShaderModule>,
+    pub(super) color: Option<vk::Format>,
+    pub(super) depth_compare: vk::CompareOp,
+    pub(super) depth_write: bool,
+    pub(super) stencil: Option<vk::StencilOpState>,
+    pub(super) depth_bounds: bool,
+}
+
+/// A dynamic-rendering pipeline (depth AND stencil formats), vertex input `vec4 pos` at
+/// location 0, two-sided, dynamic viewport and scissor (and depth bounds when used).
+pub(super) fn create_pipeline(
+    device: &ash::Device,
+    layout: vk::PipelineLayout,
+    ds_format: vk::Format,
+    s: &PipelineState,
+) -> Result<vk::Pipeline, String> {
+    let mut stages = vec![vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(s.vs).name(c"main")];
+    if let Some(fs) = s.fs {
+        stages.push(vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::FRAGMENT).module(fs).name(c"main"));
+    }
+    let bindings = [vk::VertexInputBindingDescription { binding: 0, stride: 16, input_rate: vk::VertexInputRate::VERTEX }];
+    let attrs = [vk::VertexInputAttributeDescription { location: 0, binding: 0, format: vk::Format::R32G32B32A32_SFLOAT, offset: 0 }];
+    let vertex_input =
+        vk::PipelineVertexInputStateCreateInfo::default().vertex_binding_descriptions(&bindings).vertex_attribute_descriptions(&attrs);
+    let ia = vk::PipelineInputAssemblyStateCreateInfo::default().topology(vk::PrimitiveTopology::TRIANGLE_LIST);
+    let vp = vk::PipelineViewportStateCreateInfo::default().viewport_count(1).scissor_count(1);
+    let rs = vk::PipelineRasterizationStateCreateInfo::default()
+        .polygon_mode(vk::PolygonMode::FILL)
+        .cull_mode(vk::CullModeFlags::NONE)
+        .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
+        .line_width(1.0);
+    let ms = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
+    let st = s.stencil.unwrap_or_default();
+    let ds = vk::PipelineDepthStencilStateCreateInfo::default()
+        .depth_test_enable(true)
+        .depth_write_enable(s.depth_write)
+        .depth_compare_op(s.depth_compare)
+        .depth_bounds_test_enable(s.depth_bounds)
+        .min_depth_bounds(0.0)
+        .max_depth_bounds(1.0)
+        .stencil_test_enable(s.stencil.is_some())
+        .front(st)
+        .back(st);
+    let blend = [vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA)];
+    let formats: Vec<vk::Format> = s.color.into_iter().collect();
+    let cb = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend[..formats.len()]);
+    let mut dynamic = vec![vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
+    if s.depth_bounds {
+        dynamic.push(vk::DynamicState::DEPTH_BOUNDS);
+    }
+    let dyn_state = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic);
+    let mut rendering = vk::PipelineRenderingCreateInfo::default()
+        .color_attachment_formats(&formats)
+        .depth_attachment_format(ds_format)
+        .stencil_attachment_format(ds_format);
+    let info = vk::GraphicsPipelineCreateInfo::default()
+        .stages(&stages)
+        .vertex_input_state(&vertex_input)
+        .input_assembly_state(&ia)
+        .viewport_state(&vp)
+        .rasterization_state(&rs)
+        .multisample_state(&ms)
+        .depth_stencil_state(&ds)
+        .color_blend_state(&cb)
+        .dynamic_state(&dyn_state)
+        .layout(layout)
+        .push_next(&mut rendering);
+    // SAFETY: every pointer in `info` refers to locals alive for the call.
+    unsafe { device.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) }
+        .map(|p| p[0])
+        .map_err(|(_, e)| format!("vkCreateGraphicsPipelines failed: {e:?}"))
+}
+
+/// An image layout transition (synchronization2) of one image's whole subresource.
+pub(super) fn image_barrier(
+    device: &ash::Device,
+    cb: vk::CommandBuffer,
+    image: vk::Image,
+    aspect: vk::ImageAspectFlags,
+    layouts: (vk::ImageLayout, vk::ImageLayout),
+    src: (vk::PipelineStageFlags2, vk::AccessFlags2),
+    dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
+) {
+    let b = [vk::ImageMemoryBarrier2::default()
+        .src_stage_mask(src.0)
+        .src_access_mask(src.1)
+        .dst_stage_mask(dst.0)
+        .dst_access_mask(dst.1)
+        .old_layout(layouts.0)
+        .new_layout(layouts.1)
+        .image(image)
+        .subresource_range(vk::ImageSubresourceRange {
+            aspect_mask: aspect,
+            base_mip_level: 0,
+            level_count: 1,
+            base_array_layer: 0,
+            layer_count: 1,
+        })];
+    // SAFETY: `cb` is recording outside a rendering instance; the image belongs to this device.
+    unsafe { device.cmd_pipeline_barrier2(cb, &vk::DependencyInfo::default().image_memory_barriers(&b)) };
+}
+
+/// A global memory barrier (synchronization2).
+pub(super) fn memory_barrier(
+    device: &ash::Device,
+    cb: vk::CommandBuffer,
+    src: (vk::PipelineStageFlags2, vk::AccessFlags2),
+    dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
+) {
+    let b = [vk::MemoryBarrier2::default().src_stage_mask(src.0).src_access_mask(src.1).dst_stage_mask(dst.0).dst_access_mask(dst.1)];
+    // SAFETY: `cb` is recording outside a rendering instance.
+    unsafe { device.cmd_pipeline_barrier2(cb, &vk::DependencyInfo::default().memory_barriers(&b)) };
+}
