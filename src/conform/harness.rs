@@ -14,13 +14,19 @@ use gpu_allocator::MemoryLocation;
 /// Fixed-function state of one draw.
 #[derive(Clone, Copy)]
 pub struct PipeSpec {
+    /// Depth test enabled.
     pub depth_test: bool,
+    /// Depth writes enabled.
     pub depth_write: bool,
+    /// Depth compare op (when `depth_test`).
     pub depth_compare: vk::CompareOp,
+    /// `depthClampEnable`: fragments beyond the far plane are clamped to depth 1, not clipped.
     pub depth_clamp: bool,
     /// Depth bounds test with these bounds (dynamic state).
     pub depth_bounds: Option<(f32, f32)>,
+    /// Stencil state of front-facing (counter-clockwise in Vulkan's sense) triangles.
     pub front: vk::StencilOpState,
+    /// Stencil state of back-facing triangles.
     pub back: vk::StencilOpState,
 }
 
@@ -46,27 +52,40 @@ impl PipeSpec {
     }
 }
 
+/// The index buffer of a draw.
 pub enum Indices {
+    /// Non-indexed: `vkCmdDraw` over the vertices in order.
     None,
+    /// `VK_INDEX_TYPE_UINT8_EXT` (needs `VK_EXT_index_type_uint8`).
     U8(Vec<u8>),
+    /// `VK_INDEX_TYPE_UINT16`.
     U16(Vec<u16>),
+    /// `VK_INDEX_TYPE_UINT32`.
     U32(Vec<u32>),
 }
 
+/// One draw of a [`render`]: triangles through their own pipeline.
 pub struct DrawCall {
+    /// The fixed-function state.
     pub spec: PipeSpec,
+    /// Object -> clip transform (the shader's model-view-projection).
     pub mvp: Mat4,
     /// Homogeneous object-space vertices.
     pub vertices: Vec<[f32; 4]>,
+    /// The index buffer (triangle list).
     pub indices: Indices,
 }
 
 /// What came back: raw depth words (f32 bits for D32, 24-bit unorm in the low bits for D24)
 /// and stencil bytes, row-major from the top-left.
 pub struct Readback {
+    /// Width, pixels.
     pub width: u32,
+    /// Height, pixels.
     pub height: u32,
+    /// One raw depth word per pixel (see [`depth_value`]).
     pub depth: Vec<u32>,
+    /// One stencil byte per pixel.
     pub stencil: Vec<u8>,
 }
 

@@ -18,6 +18,8 @@
 //!
 //! A check also fails when the validation layers reported an error during it.
 
+#![warn(missing_docs)]
+
 pub mod checks;
 pub mod harness;
 pub mod raster;
@@ -29,14 +31,19 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+/// The outcome of one check.
 #[serde(rename_all = "lowercase")]
 pub enum Status {
+    /// Every expectation held (and the validation layers reported nothing).
     Pass,
+    /// An expectation failed, the check returned an error, or the validation layers reported one.
     Fail,
+    /// The device lacks the feature the check exercises (e.g. `depthClamp`, `depthBounds`).
     Skipped,
 }
 
 impl Status {
+    /// The lowercase name used in the reports: `pass`, `fail` or `skipped`.
     pub fn name(self) -> &'static str {
         match self {
             Status::Pass => "pass",
@@ -49,35 +56,51 @@ impl Status {
 /// One (scene, method) case of `shadow_pipeline_hard_cases`.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct CaseResult {
+    /// The built-in scene name (`hard/...`).
     pub scene: String,
+    /// The shadow-volume method's name ([`crate::shadow::Method::name`]).
     pub method: String,
+    /// Number of lights in the scene (one mask compared per light).
     pub lights: usize,
-    /// Summed over lights.
+    /// Pixels compared with the reference, summed over lights.
     pub compared: u64,
+    /// Pixels whose mask differs from the reference outside the 1-pixel edge band, summed over lights.
     pub mismatches_outside_band: u64,
+    /// The largest per-light fraction (0..1) of compared pixels mismatched outside the band.
     pub worst_fraction_outside_band: f64,
+    /// Pixels the reference called ambiguous (not judged), summed over lights.
     pub ambiguous: u64,
+    /// Pixels inside the edge band (not judged), summed over lights.
     pub band_pixels: u64,
+    /// Whether [`crate::accuracy::expected_failure`] lists this (scene, method) as a known failure.
     pub expected_failure: bool,
     /// pass | fail | expected-failure | unexpected-pass
     pub status: String,
 }
 
+/// The result of one check.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct CheckResult {
+    /// The check's name, as in the module table (e.g. `watertight_fan`).
     pub name: String,
+    /// Pass, fail or skipped.
     pub status: Status,
+    /// One line: what held on a pass, the failures joined by `; ` otherwise.
     pub summary: String,
+    /// The measured numbers (pixel counts, depths, probes), written to `conform.json`.
     pub numbers: serde_json::Map<String, serde_json::Value>,
+    /// Per-case results (only `shadow_pipeline_hard_cases` has any).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub cases: Vec<CaseResult>,
 }
 
 impl CheckResult {
+    /// Pass with `what` as the summary when `fails` is empty, else Fail with the failures joined.
     pub fn from_fails(name: &str, fails: Vec<String>, numbers: serde_json::Map<String, serde_json::Value>, what: &str) -> CheckResult {
         let (status, summary) = if fails.is_empty() { (Status::Pass, what.to_string()) } else { (Status::Fail, fails.join("; ")) };
         CheckResult { name: name.into(), status, summary, numbers, cases: Vec::new() }
     }
+    /// A skipped check; `why` names the missing feature.
     pub fn skipped(name: &str, why: &str) -> CheckResult {
         CheckResult { name: name.into(), status: Status::Skipped, summary: why.into(), numbers: Default::default(), cases: Vec::new() }
     }
@@ -92,16 +115,23 @@ impl CheckResult {
     }
 }
 
+/// The whole suite's result on one device (`conform.json`).
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct Report {
+    /// The physical device and driver the suite ran on.
     pub device: DeviceInfo,
+    /// The optional features found (which decide the skipped checks).
     pub features: Features,
+    /// Whether the validation layers were on (their errors fail the check they occur in).
     pub validation: bool,
+    /// `VkPhysicalDeviceLimits::subPixelPrecisionBits`, the grid the CPU coverage predictions snap to.
     pub subpixel_bits: u32,
+    /// One result per check, in the order of the module table.
     pub checks: Vec<CheckResult>,
 }
 
 impl Report {
+    /// The checks that failed.
     pub fn failed(&self) -> Vec<&CheckResult> {
         self.checks.iter().filter(|c| c.status == Status::Fail).collect()
     }
@@ -168,6 +198,8 @@ pub fn summary_table(report: &Report) -> String {
     s
 }
 
+/// The full Markdown report (`conform.md`): device, features, the summary table, then each
+/// check's numbers and cases.
 pub fn markdown(report: &Report) -> String {
     let d = &report.device;
     let mut s = String::new();

@@ -10,7 +10,9 @@ pub const EDGE_EPS: f64 = 1e-4;
 /// A triangle in window coordinates (pixels, row 0 at the top) with its window depths.
 #[derive(Clone, Copy, Debug)]
 pub struct WinTri {
+    /// Window positions, pixels, snapped to the sub-pixel grid.
     pub p: [DVec2; 3],
+    /// Window depths: NDC z (the harness viewport's depth range is [0, 1], so unchanged).
     pub z: [f64; 3],
 }
 
@@ -25,6 +27,7 @@ impl WinTri {
         }
         -0.5 * s
     }
+    /// Front facing under `VK_FRONT_FACE_COUNTER_CLOCKWISE` (positive [`WinTri::vk_area`]).
     pub fn front_facing(&self) -> bool {
         self.vk_area() > 0.0
     }
@@ -33,7 +36,9 @@ impl WinTri {
 /// Coverage of one pixel centre by one triangle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Cover {
+    /// The pixel centre is strictly inside: the rasteriser must cover it.
     In,
+    /// Strictly outside (or a degenerate triangle): it must not.
     Out,
     /// Within [`EDGE_EPS`] of an edge: the tie-breaking rule decides, not judged.
     Edge,
@@ -60,6 +65,8 @@ pub fn window_tris(mvp: Mat4, verts: &[[f32; 4]], tris: &[[u32; 3]], width: u32,
     tris.iter().map(|t| WinTri { p: t.map(|i| w[i as usize].0), z: t.map(|i| w[i as usize].1) }).collect()
 }
 
+/// Whether triangle `t` covers the centre of pixel (x, y) by the pixel-centre rule, with
+/// centres within [`EDGE_EPS`] of an edge reported as [`Cover::Edge`].
 pub fn cover(t: &WinTri, x: u32, y: u32) -> Cover {
     let c = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
     let area = t.vk_area();
