@@ -42,6 +42,8 @@
 //! buffer that uses it has completed (it does not wait for the device: the host owns the
 //! device's lifetime).
 
+#![warn(missing_docs)]
+
 mod casters;
 mod desc;
 mod device;

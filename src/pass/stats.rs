@@ -3,6 +3,7 @@
 
 #[derive(Clone, Debug, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
+/// Shadow-volume triangles by part.
 pub struct Triangles {
     /// Side quads' triangles (two per silhouette edge for a point light, one for a directional).
     pub sides: u64,
@@ -27,6 +28,7 @@ impl Triangles {
 
 #[derive(Clone, Debug)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
+/// One caster's volume for one light.
 pub struct CasterStats {
     /// The caster's name (the scene mesh's, or the one given to `add_caster`).
     pub name: String,
@@ -56,6 +58,7 @@ pub struct CasterStats {
 
 #[derive(Clone, Debug)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
+/// One light of a frame.
 pub struct LightStats {
     /// The light's index in the frame's light list.
     pub index: usize,
@@ -71,6 +74,7 @@ pub struct LightStats {
 
 #[derive(Clone, Debug, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
+/// Caster-light pairs per McGuire case.
 pub struct Cases {
     /// Casters culled (outside range, cone or view).
     pub culled: u64,
@@ -84,6 +88,7 @@ pub struct Cases {
 
 #[derive(Clone, Debug, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
+/// A frame's totals over lights and casters.
 pub struct Totals {
     /// Shadow triangles over all lights and casters.
     pub triangles: Triangles,
@@ -100,6 +105,7 @@ pub struct Totals {
 
 #[derive(Clone, Debug, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
+/// CPU time of a frame by stage, ms.
 pub struct CpuMs {
     /// Facing bits and possible silhouettes.
     pub silhouettes: f64,

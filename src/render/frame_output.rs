@@ -10,7 +10,9 @@ use glam::{DVec3, Vec3};
 
 /// What a frame produced.
 pub struct FrameOutput {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// sRGB RGBA8, row-major from the top-left.
     pub color: Vec<u8>,
@@ -26,6 +28,7 @@ pub struct FrameOutput {
     pub positions: Vec<[f32; 3]>,
     /// Geometric face normal per pixel (NaN for background), captured frames only.
     pub normals: Vec<[f32; 3]>,
+    /// What the frame did (`--stats`).
     pub stats: Stats,
 }
 

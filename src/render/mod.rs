@@ -14,6 +14,8 @@
 //! increments on back faces and decrements on front faces when it fails. Both give +1 per
 //! enclosing volume, with wrap ops so the order of faces does not matter.
 
+#![warn(missing_docs)]
+
 pub mod frame;
 mod frame_output;
 pub mod options;

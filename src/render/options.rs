@@ -44,12 +44,14 @@ impl std::str::FromStr for TransmitMode {
 }
 
 impl TransmitMode {
+    /// The four modes.
     pub const ALL: [TransmitMode; 4] = [
         TransmitMode { fp32: false, log: false },
         TransmitMode { fp32: false, log: true },
         TransmitMode { fp32: true, log: false },
         TransmitMode { fp32: true, log: true },
     ];
+    /// `mul16`, `log16`, `mul32` or `log32`.
     pub fn name(self) -> &'static str {
         match (self.log, self.fp32) {
             (false, false) => "mul16",

@@ -21,6 +21,7 @@ use crate::scene::{Camera, LightKind, Scene};
 use ash::vk;
 use glam::{DVec3, Mat4, Vec3, Vec4};
 
+/// The shadow maps' depth format.
 pub const MAP_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 
 /// The shadow-map baseline's GPU objects.
@@ -54,6 +55,8 @@ struct Face {
 }
 
 impl ShadowMapper {
+    /// Maps of `size` texels a side (16..=8192) for the scene's opaque casters, as placed now
+    /// relative to the camera (rebuilt by the renderer when either moves).
     pub fn new(ctx: &Context, scene: &Scene, targets: &Targets, size: u32, sampler: vk::Sampler) -> Result<ShadowMapper> {
         if !(16..=8192).contains(&size) {
             return Err(Error::Other(format!("shadow map size {size} out of range (16..=8192)")));
@@ -268,6 +271,7 @@ impl ShadowMapper {
         );
     }
 
+    /// Destroys the atlas, pipelines and buffers (the owner waited for the device).
     pub fn destroy(&mut self, ctx: &Context) {
         // SAFETY: the owner waited for the device to be idle.
         unsafe {

@@ -4,6 +4,7 @@ use serde::Serialize;
 
 pub use crate::pass::stats::{Cases, CasterStats, CpuMs, LightStats, Totals, Triangles};
 
+/// GPU time of a frame by pass, ms (timestamps outside rendering instances).
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct GpuMs {
     /// The G-buffer pass.
@@ -27,11 +28,16 @@ pub struct LightGpuMs {
     pub illuminate: f64,
 }
 
+/// The `--stats` JSON of one frame.
 #[derive(Clone, Debug, Serialize)]
 pub struct Stats {
+    /// The device's name.
     pub device: String,
+    /// The technique that ran (`mcguire`, ..., `edgequad`, `shadowmap`).
     pub method: String,
+    /// `infinite` or `clamp`.
     pub depth_mode: String,
+    /// The requested index format (`auto`, `u16`, ...).
     pub index_format: String,
     /// "stencil" (8-bit, wraps at 256) or "float" (32-bit float target).
     pub counter: String,
@@ -41,16 +47,23 @@ pub struct Stats {
     /// Partial self-shadowing of transparent casters ran (`--self-shadow` on a scene that has
     /// them).
     pub self_shadow: bool,
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
+    /// Per light, in scene order.
     pub lights: Vec<LightStats>,
+    /// Totals over lights and casters.
     pub totals: Totals,
+    /// CPU time by stage.
     pub cpu_ms: CpuMs,
     /// `None` when the device has no timestamps.
     pub gpu_ms: Option<GpuMs>,
+    /// Submit to read-back, ms.
     pub wall_ms: f64,
     /// Which optional features were used and which were missing (so skipped).
     pub features_used: Vec<String>,
+    /// Optional features the device lacks (their paths were skipped).
     pub features_missing: Vec<String>,
     /// Things the user should know about this frame (e.g. possible 8-bit stencil overflow).
     pub warnings: Vec<String>,

@@ -4,29 +4,43 @@ use crate::error::Result;
 use crate::gpu::{Context, Image};
 use ash::vk;
 
+/// The float accumulation target (ambient + every light).
 pub const ACCUM_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+/// Albedo in the G-buffer.
 pub const ALBEDO_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
 /// Normals and positions in full f32: the dump's positions/normals come straight from here.
 pub const NORMAL_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+/// Eye-relative positions, f32.
 pub const POSITION_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+/// The tone-mapped output.
 pub const OUTPUT_FORMAT: vk::Format = vk::Format::R8G8B8A8_SRGB;
 /// The float shadow-volume counter (`--counter float`).
 pub use crate::pass::COUNT_FORMAT;
 
+/// The renderer's offscreen targets, all of one size.
 pub struct Targets {
+    /// Their size.
     pub extent: vk::Extent2D,
+    /// Float accumulation (RGBA16F).
     pub accum: Image,
+    /// G-buffer albedo.
     pub albedo: Image,
+    /// G-buffer face normal (f32).
     pub normal: Image,
+    /// G-buffer eye-relative position (f32; w = 0 where nothing was drawn).
     pub position: Image,
+    /// Depth-stencil (the device's D32S8 or D24S8).
     pub depth: Image,
+    /// sRGB output.
     pub output: Image,
+    /// The float counter (R32F).
     pub count: Image,
+    /// The transparent casters' light-intensity map.
     pub transmit: Image,
 }
 
 impl Targets {
-    /// `transmit_format`: the transparent casters' light-intensity map (RGBA16F or RGBA32F).
+    /// All targets; `transmit_format`: the transparent casters' light-intensity map (RGBA16F or RGBA32F).
     pub fn new(ctx: &Context, width: u32, height: u32, transmit_format: vk::Format) -> Result<Targets> {
         let extent = vk::Extent2D { width, height };
         let color = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
@@ -58,10 +72,12 @@ impl Targets {
         })
     }
 
+    /// The G-buffer pass's colour attachments, in attachment order.
     pub fn gbuffer(&self) -> [&Image; 4] {
         [&self.accum, &self.albedo, &self.normal, &self.position]
     }
 
+    /// Destroys every target (the owner waited for the device).
     pub fn destroy(&mut self, ctx: &Context) {
         for img in [
             &mut self.accum,

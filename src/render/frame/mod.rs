@@ -12,13 +12,15 @@ use super::readback::{Layout, Readback};
 use super::scene_gpu::{SceneGeometry, Sidedness};
 use super::selfshadow::SelfShadow;
 use super::shadowmap::ShadowMapper;
-use super::stats::*;
 use super::targets::*;
 use super::timing::{Span, Timer};
+mod motion;
+mod stats;
+
 use crate::error::{Error, Result};
 use crate::gpu::Context;
 use crate::pass::{self as sp, CasterId, PassSettings, PreparedFrame, ShadowPass, ShadowPassDesc, ShadowView};
-use crate::scene::{Camera, Light, Scene};
+use crate::scene::Scene;
 use crate::shadow::Caster;
 use ash::vk;
 use glam::{Mat4, Vec3};
@@ -210,38 +212,6 @@ impl Renderer {
     /// The prepared casters (shadow-casting meshes, in scene order).
     pub fn casters(&self) -> &[Caster] {
         self.pass.casters()
-    }
-
-    /// Moves the camera (from the next frame).
-    pub fn set_camera(&mut self, camera: Camera) -> Result<()> {
-        if !(camera.eye.is_finite() && camera.target.is_finite() && camera.up.is_finite()) || camera.eye == camera.target {
-            return Err(Error::Other(format!("invalid camera {camera:?}")));
-        }
-        self.scene.camera = camera;
-        self.scene_version += 1;
-        Ok(())
-    }
-    /// Replaces the lights (any number; from the next frame).
-    pub fn set_lights(&mut self, lights: Vec<Light>) {
-        self.scene.lights = lights;
-    }
-    /// Moves mesh `index` (object -> world; from the next frame). A transform must keep the
-    /// mesh's handedness (its winding was fixed at load).
-    pub fn set_mesh_transform(&mut self, index: usize, transform: Mat4) -> Result<()> {
-        let m = self.scene.meshes.get(index).ok_or_else(|| Error::Other(format!("no mesh {index}")))?;
-        let det = transform.determinant();
-        if !(transform.is_finite() && det.is_finite() && det != 0.0) {
-            return Err(Error::mesh(&m.name, "transform is not finite or singular"));
-        }
-        if (det < 0.0) != (m.transform.determinant() < 0.0) {
-            return Err(Error::mesh(&m.name, "a new transform may not mirror a mesh that was loaded unmirrored (or the reverse)"));
-        }
-        if let Some(id) = self.caster_ids[index] {
-            self.pass.set_transform(id, transform.as_dmat4())?;
-        }
-        self.scene.meshes[index].transform = transform;
-        self.scene_version += 1;
-        Ok(())
     }
 
     /// World -> clip with the configured depth mode (used by the planner for its frustum tests).
@@ -476,71 +446,6 @@ impl Renderer {
             self.wait(&t)?;
         }
         Ok(())
-    }
-
-    /// The frame's `--stats`.
-    fn stats(&self, ticket: &FrameTicket, f: &InFlight) -> Result<Stats> {
-        let ctx = &self.ctx;
-        let caps = self.pass.capabilities();
-        let gpu_ms = match ctx.features.timestamps {
-            true => {
-                let raw = self.slots[ticket.slot].timer.read(ctx)?;
-                let p = ctx.features.timestamp_period_ns;
-                let per_light: Vec<LightGpuMs> = f
-                    .spans
-                    .shadow
-                    .iter()
-                    .zip(&f.spans.illuminate)
-                    .map(|(s, i)| LightGpuMs { shadow: s.ms(&raw, p), illuminate: i.ms(&raw, p) })
-                    .collect();
-                Some(GpuMs {
-                    depth: f.spans.depth.ms(&raw, p),
-                    shadow: per_light.iter().map(|l| l.shadow).sum(),
-                    illuminate: per_light.iter().map(|l| l.illuminate).sum(),
-                    frame: f.spans.frame.ms(&raw, p),
-                    per_light,
-                })
-            }
-            false => None,
-        };
-        let (mut features_used, mut features_missing) = (Vec::new(), Vec::new());
-        let fe = &ctx.features;
-        let u8_used = caps.index_type_uint8 && matches!(f.settings.index_format, IndexFormat::U8 | IndexFormat::Auto);
-        for (name, has, used) in [
-            ("depthClamp", fe.depth_clamp, self.config.depth_mode == DepthMode::Clamp),
-            ("depthBounds", caps.depth_bounds, caps.depth_bounds),
-            ("indexTypeUint8", caps.index_type_uint8, u8_used),
-            ("timestamps", fe.timestamps, fe.timestamps),
-        ] {
-            if used {
-                features_used.push(name.to_string());
-            } else if !has {
-                features_missing.push(name.to_string());
-            }
-        }
-        let mut cpu = f.frame.cpu_ms.clone();
-        cpu.record += f.record_ms;
-        Ok(Stats {
-            device: ctx.info.name.clone(),
-            method: f.settings.technique.name().to_string(),
-            depth_mode: self.config.depth_mode.name().into(),
-            index_format: f.settings.index_format.name().into(),
-            counter: f.settings.counter.name().into(),
-            transmit: self
-                .has_transparent
-                .then(|| TransmitMode { fp32: self.config.transmit_fp32, log: f.settings.transmit_log }.name().into()),
-            self_shadow: self.self_shadow.is_some(),
-            width: self.config.width,
-            height: self.config.height,
-            lights: f.frame.lights.iter().map(|l| l.stats.clone()).collect(),
-            totals: f.frame.totals.clone(),
-            cpu_ms: cpu,
-            gpu_ms,
-            wall_ms: f.wall.elapsed().as_secs_f64() * 1e3,
-            features_used,
-            features_missing,
-            warnings: f.frame.warnings.clone(),
-        })
     }
 
     /// (Re)builds the shadow-map baseline when asked for, or when its size or the scene's

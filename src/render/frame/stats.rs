@@ -1,0 +1,74 @@
+//! A finished frame's `--stats`: the pass's per-light plans and totals, GPU timestamps per
+//! pass and light, CPU times, and which optional features ran.
+
+use super::{FrameTicket, InFlight, Renderer};
+use crate::error::Result;
+use crate::render::options::{DepthMode, IndexFormat, TransmitMode};
+use crate::render::stats::{GpuMs, LightGpuMs, Stats};
+
+impl Renderer {
+    /// The frame's `--stats`.
+    pub(super) fn stats(&self, ticket: &FrameTicket, f: &InFlight) -> Result<Stats> {
+        let ctx = &self.ctx;
+        let caps = self.pass.capabilities();
+        let gpu_ms = match ctx.features.timestamps {
+            true => {
+                let raw = self.slots[ticket.slot].timer.read(ctx)?;
+                let p = ctx.features.timestamp_period_ns;
+                let per_light: Vec<LightGpuMs> = f
+                    .spans
+                    .shadow
+                    .iter()
+                    .zip(&f.spans.illuminate)
+                    .map(|(s, i)| LightGpuMs { shadow: s.ms(&raw, p), illuminate: i.ms(&raw, p) })
+                    .collect();
+                Some(GpuMs {
+                    depth: f.spans.depth.ms(&raw, p),
+                    shadow: per_light.iter().map(|l| l.shadow).sum(),
+                    illuminate: per_light.iter().map(|l| l.illuminate).sum(),
+                    frame: f.spans.frame.ms(&raw, p),
+                    per_light,
+                })
+            }
+            false => None,
+        };
+        let (mut features_used, mut features_missing) = (Vec::new(), Vec::new());
+        let fe = &ctx.features;
+        let u8_used = caps.index_type_uint8 && matches!(f.settings.index_format, IndexFormat::U8 | IndexFormat::Auto);
+        for (name, has, used) in [
+            ("depthClamp", fe.depth_clamp, self.config.depth_mode == DepthMode::Clamp),
+            ("depthBounds", caps.depth_bounds, caps.depth_bounds),
+            ("indexTypeUint8", caps.index_type_uint8, u8_used),
+            ("timestamps", fe.timestamps, fe.timestamps),
+        ] {
+            if used {
+                features_used.push(name.to_string());
+            } else if !has {
+                features_missing.push(name.to_string());
+            }
+        }
+        let mut cpu = f.frame.cpu_ms.clone();
+        cpu.record += f.record_ms;
+        Ok(Stats {
+            device: ctx.info.name.clone(),
+            method: f.settings.technique.name().to_string(),
+            depth_mode: self.config.depth_mode.name().into(),
+            index_format: f.settings.index_format.name().into(),
+            counter: f.settings.counter.name().into(),
+            transmit: self
+                .has_transparent
+                .then(|| TransmitMode { fp32: self.config.transmit_fp32, log: f.settings.transmit_log }.name().into()),
+            self_shadow: self.self_shadow.is_some(),
+            width: self.config.width,
+            height: self.config.height,
+            lights: f.frame.lights.iter().map(|l| l.stats.clone()).collect(),
+            totals: f.frame.totals.clone(),
+            cpu_ms: cpu,
+            gpu_ms,
+            wall_ms: f.wall.elapsed().as_secs_f64() * 1e3,
+            features_used,
+            features_missing,
+            warnings: f.frame.warnings.clone(),
+        })
+    }
+}
