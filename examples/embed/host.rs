@@ -17,8 +17,10 @@
 //!    slot's fence; when the slot comes round again its readback becomes per light the masks
 //!    (128 background, 255 lit, 0 shadowed), compared with the exact CPU reference.
 //!
-//! `examples/embed/main.rs` prints the result; `tests/embed.rs` includes this file and checks
-//! it against the reference and umbrage's own renderer.
+//! This file holds the scene, the host's setup and its teardown; `frame.rs` records, submits
+//! and reads back a frame; `vulkan.rs` is the Vulkan plumbing (device choice, allocations,
+//! pipelines, barriers). `examples/embed/main.rs` prints the result; `tests/embed.rs` includes
+//! this file and checks it against the reference and umbrage's own renderer.
 #![allow(dead_code)]
 
 use ash::vk;
