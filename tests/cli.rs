@@ -108,3 +108,43 @@ fn render_stats_dump_and_check() {
     assert!(open_box["reason"].as_str().unwrap().contains("boundary"));
     assert!(casters.iter().any(|c| c["path"] == "manifold"));
 }
+
+/// `bench --methods` accepts every technique `render --method` accepts (clap value enums on
+/// both), and reports throughput beside latency.
+#[test]
+fn bench_accepts_every_render_method() {
+    let d = tmp("bench");
+    let json = d.join("bench.json");
+    let out = umbrage(&[
+        "bench",
+        "--scene",
+        "default",
+        "--methods",
+        "edgequad,mcguire,shadowmap,auto",
+        "--frames",
+        "2",
+        "--size",
+        "96x64",
+        "--shadow-map-size",
+        "256",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let rows = v["rows"].as_array().unwrap();
+    let methods: Vec<&str> = rows.iter().map(|r| r["method"].as_str().unwrap()).collect();
+    assert_eq!(methods, ["edgequad", "mcguire", "shadowmap-256"], "auto is mcguire, listed once");
+    for r in rows {
+        assert!(r["throughput_fps"].as_f64().unwrap() > 0.0, "{r}");
+        assert!(r["wall_ms"].as_f64().unwrap() > 0.0, "{r}");
+    }
+    fails_with(&umbrage(&["bench", "--methods", "magic"]), "magic");
+    for m in ["zpass", "zfail", "everitt-kilgard", "lengyel", "mcguire", "auto", "edgequad", "shadowmap"] {
+        let png = d.join(format!("{m}.png"));
+        let stats = d.join(format!("{m}.json"));
+        let out =
+            umbrage(&["render", "--method", m, "--size", "64x48", "--out", png.to_str().unwrap(), "--stats", stats.to_str().unwrap()]);
+        assert!(out.status.success(), "{m}: {}", String::from_utf8_lossy(&out.stderr));
+    }
+}
