@@ -40,6 +40,14 @@ fn main() {
                     let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
                     fs::write(Path::new(&out_dir).join(&file), bytes).expect("write SPIR-V");
                     let name = format!("{}{}_{}", stem.to_uppercase(), suffix, ext.to_uppercase());
+                    let _ = match &define {
+                        None => writeln!(generated, "/// SPIR-V of `shaders/{stem}.{ext}`."),
+                        Some(d) => {
+                            let defines: Vec<String> = d.split(',').map(|d| format!("`{d}`")).collect();
+                            let variant = suffix.trim_start_matches('_');
+                            writeln!(generated, "/// SPIR-V of `shaders/{stem}.{ext}` (variant {variant}: defines {}).", defines.join(", "))
+                        }
+                    };
                     let _ = writeln!(generated, "pub const {name}: &[u8] = include_bytes!(concat!(env!(\"OUT_DIR\"), \"/{file}\"));");
                     modules.push((format!("{stem}{}.{ext}", suffix.to_lowercase()), name));
                 }
@@ -47,6 +55,7 @@ fn main() {
             }
         }
     }
+    let _ = writeln!(generated, "/// Every module above as (`<stem>[_<variant>].<stage>`, SPIR-V), sorted by source file.");
     let _ = writeln!(generated, "pub const ALL: &[(&str, &[u8])] = &[");
     for (display, constant) in &modules {
         let _ = writeln!(generated, "    (\"{display}\", {constant}),");

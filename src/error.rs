@@ -1,19 +1,38 @@
 //! One error type for the whole crate (gpu-allocator style): every failure a user can cause
 //! is a variant with a message that names the file, the mesh or the missing feature.
 
+#![warn(missing_docs)]
+
 /// Everything that can go wrong in umbrage.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     /// Bad user input in a file: scene TOML, OBJ, dump directory. `location` is
     /// `path` or `path:line` where a line is known.
     #[error("{location}: {msg}")]
-    Input { location: String, msg: String },
+    Input {
+        /// `path` or `path:line` of the offending input.
+        location: String,
+        /// What is wrong with it.
+        msg: String,
+    },
     /// A mesh that cannot be used as asked (NaN, empty, non-manifold in the manifold path...).
     #[error("mesh '{name}': {msg}")]
-    Mesh { name: String, msg: String },
+    Mesh {
+        /// The mesh's name (as in the scene or OBJ file).
+        name: String,
+        /// Why it cannot be used.
+        msg: String,
+    },
     /// Unknown built-in scene, method, shape or view name.
     #[error("unknown {what} '{name}' (expected one of: {expected})")]
-    UnknownName { what: &'static str, name: String, expected: String },
+    UnknownName {
+        /// The kind of name, e.g. `"scene"` or `"method"`.
+        what: &'static str,
+        /// The name that was given.
+        name: String,
+        /// The accepted names, comma-separated.
+        expected: String,
+    },
     /// No Vulkan loader, driver or usable device.
     #[error(
         "no usable Vulkan device: {0}\n  hint: on Debian/Ubuntu install the CPU driver with \
@@ -46,19 +65,34 @@ pub enum Error {
     Unsupported(String),
     /// Validation layers reported errors (only when validation is on).
     #[error("Vulkan validation reported {count} error(s); first: {first}")]
-    Validation { count: usize, first: String },
+    Validation {
+        /// Number of ERROR-severity messages since the log was last drained.
+        count: usize,
+        /// The first of them, verbatim.
+        first: String,
+    },
+    /// Any other failure (invalid argument, misuse of an API, ...), described by its message.
     #[error("{0}")]
     Other(String),
+    /// Reading or writing a file failed.
     #[error("I/O error on {path}: {source}")]
-    Io { path: String, source: std::io::Error },
+    Io {
+        /// The file or directory.
+        path: String,
+        /// The underlying error.
+        source: std::io::Error,
+    },
 }
 
+/// `std::result::Result` with umbrage's [`Error`] as the default error type.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
 impl Error {
+    /// An [`Error::Input`]: `location` is `path` or `path:line`.
     pub fn input(location: impl Into<String>, msg: impl Into<String>) -> Self {
         Error::Input { location: location.into(), msg: msg.into() }
     }
+    /// An [`Error::Mesh`] for the mesh called `name`.
     pub fn mesh(name: impl Into<String>, msg: impl Into<String>) -> Self {
         Error::Mesh { name: name.into(), msg: msg.into() }
     }
@@ -66,6 +100,7 @@ impl Error {
     pub fn vk(call: &'static str) -> impl Fn(ash::vk::Result) -> Error {
         move |result| Error::Vulkan { call, result }
     }
+    /// An [`Error::Io`] on `path`.
     pub fn io(path: impl Into<String>, source: std::io::Error) -> Self {
         Error::Io { path: path.into(), source }
     }

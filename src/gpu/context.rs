@@ -18,15 +18,27 @@ use std::sync::{Arc, Mutex};
 #[derive(Clone, Debug, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Features {
+    /// `depthClamp` is supported (and enabled on the device): `--depth-mode clamp` (finite far
+    /// plane, geometry beyond it clamped to depth 1.0 instead of clipped).
     pub depth_clamp: bool,
+    /// `depthBounds` is supported (and enabled): pipelines may use the depth-bounds test.
     pub depth_bounds: bool,
+    /// `VK_EXT_depth_range_unrestricted` is available (and enabled).
     pub depth_range_unrestricted: bool,
+    /// `VK_EXT_index_type_uint8` with its `indexTypeUint8` feature (both enabled when present):
+    /// 8-bit index buffers can be bound.
     pub index_type_uint8: bool,
+    /// `pipelineStatisticsQuery` is supported (and enabled).
     pub pipeline_statistics_query: bool,
+    /// The graphics queue writes timestamps (`timestampValidBits > 0`) and the device reports a
+    /// non-zero `timestampPeriod`.
     pub timestamps: bool,
-    /// Nanoseconds per timestamp tick.
+    /// Nanoseconds per timestamp tick (`VkPhysicalDeviceLimits::timestampPeriod`).
     pub timestamp_period_ns: f32,
+    /// The chosen depth-stencil format, as its `Debug` name (`D32_SFLOAT_S8_UINT` or
+    /// `D24_UNORM_S8_UINT`); the format itself is [`Context::depth_format`].
     pub depth_stencil_format: String,
+    /// `geometryShader` is supported (probed and reported only; never enabled).
     pub geometry_shader: bool,
     /// R32_SFLOAT can be blended as a colour attachment (optional in Vulkan): `--counter float`
     /// and the shadow-map baseline need it.
@@ -35,47 +47,81 @@ pub struct Features {
     pub rgba32f_blend: bool,
 }
 
+/// Identification of the chosen physical device, for `umbrage info`, logs and the stats JSON.
 #[derive(Clone, Debug)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct DeviceInfo {
+    /// `deviceName`, e.g. `llvmpipe (LLVM 15.0.7, 256 bits)`.
     pub name: String,
+    /// The device type as its `Debug` name: `DISCRETE_GPU`, `INTEGRATED_GPU`, `VIRTUAL_GPU`, `CPU`, ...
     pub kind: String,
+    /// `driverName` from `VkPhysicalDeviceDriverProperties` (empty if the driver leaves it empty).
     pub driver: String,
+    /// `driverInfo` from `VkPhysicalDeviceDriverProperties`, typically the driver's version string.
     pub driver_info: String,
+    /// The device's Vulkan version, `major.minor.patch` (at least 1.3.0).
     pub api_version: String,
+    /// PCI vendor id (`vendorID`).
     pub vendor_id: u32,
+    /// Vendor-specific device id (`deviceID`).
     pub device_id: u32,
 }
 
-/// Shared sink for validation messages.
+/// Shared sink for validation messages, filled by the debug messenger (only when validation is on).
 #[derive(Default)]
 pub struct ValidationLog {
+    /// ERROR-severity messages, in the order reported, until drained by
+    /// [`Context::take_validation_errors`] or [`Context::check_validation`].
     pub errors: Vec<String>,
+    /// How many WARNING-severity messages were reported (printed only with `UMBRAGE_VERBOSE`).
     pub warnings: usize,
 }
 
+/// umbrage's own Vulkan context: instance, one physical and logical device with a single
+/// graphics queue, the memory allocator and a command pool. Everything is destroyed in `Drop`
+/// (after `vkDeviceWaitIdle`), so every object created from it must be destroyed before it is
+/// dropped.
 pub struct Context {
+    /// The loaded Vulkan loader; kept alive as long as the instance.
     pub entry: ash::Entry,
+    /// The instance (Vulkan 1.3; with `VK_LAYER_KHRONOS_validation` and `VK_EXT_debug_utils`
+    /// when [`Context::validation`] is set).
     pub instance: ash::Instance,
     debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     /// Also the debug messenger's user data (`Arc::as_ptr`), alive until the messenger is gone.
     log: Arc<Mutex<ValidationLog>>,
+    /// The chosen physical device: the best-ranked Vulkan 1.3 device with a graphics queue
+    /// (discrete > integrated > virtual > CPU, ties in enumeration order) among those whose
+    /// name contains `UMBRAGE_DEVICE` (case-insensitive) when that is set.
     pub physical: vk::PhysicalDevice,
+    /// The logical device, with `dynamicRendering` and `synchronization2` and the optional
+    /// features recorded in [`Context::features`] enabled.
     pub device: ash::Device,
+    /// Queue 0 of [`Context::queue_family`]. Not synchronised: submissions from several
+    /// threads must be serialised by the caller.
     pub queue: vk::Queue,
+    /// Index of the graphics queue family [`Context::queue`] and [`Context::pool`] belong to.
     pub queue_family: u32,
     /// Shared with embedded components ([`crate::pass::ShadowPass`] takes a clone); dropped
     /// before the device in `Drop`, so every clone must be gone by then.
     pub allocator: std::mem::ManuallyDrop<Arc<Mutex<gpu_allocator::vulkan::Allocator>>>,
+    /// Command pool of [`Context::queue_family`], created with `RESET_COMMAND_BUFFER`. Like any
+    /// Vulkan pool it is externally synchronised: use it from one thread at a time.
     pub pool: vk::CommandPool,
+    /// The optional capabilities that were probed (and enabled where present).
     pub features: Features,
+    /// Names and versions of the chosen device.
     pub info: DeviceInfo,
+    /// Depth-stencil format with 8 stencil bits, usable as attachment and transfer source
+    /// (optimal tiling): `D32_SFLOAT_S8_UINT` if supported, else `D24_UNORM_S8_UINT`.
     pub depth_format: vk::Format,
+    /// The physical device's limits, as reported.
     pub limits: vk::PhysicalDeviceLimits,
+    /// Whether the validation layer and debug messenger are active.
     pub validation: bool,
 }
 
-/// Whether validation is requested through `UMBRAGE_VALIDATION=1`.
+/// Whether validation is requested through `UMBRAGE_VALIDATION=1` (or `true`, any case).
 pub fn validation_requested() -> bool {
     std::env::var("UMBRAGE_VALIDATION").map(|v| v == "1" || v.eq_ignore_ascii_case("true")).unwrap_or(false)
 }
@@ -84,6 +130,14 @@ fn vkerr(call: &'static str) -> impl Fn(vk::Result) -> Error {
     Error::vk(call)
 }
 
+/// The `VK_EXT_debug_utils` messenger callback: records ERROR messages in the
+/// [`ValidationLog`] (and prints them) and counts WARNING messages.
+///
+/// # Safety
+///
+/// Called only by the Vulkan loader: `data` must be null or point at valid callback data for
+/// the duration of the call, and `user` must be `Arc::as_ptr` of a live
+/// `Arc<Mutex<ValidationLog>>`.
 unsafe extern "system" fn debug_callback(
     severity: vk::DebugUtilsMessageSeverityFlagsEXT,
     _types: vk::DebugUtilsMessageTypeFlagsEXT,
@@ -121,6 +175,13 @@ impl Context {
         Self::with_validation(validation_requested())
     }
 
+    /// Creates the context with validation on or off regardless of `UMBRAGE_VALIDATION`;
+    /// `UMBRAGE_DEVICE` still chooses the device.
+    ///
+    /// Fails with [`Error::NoDevice`] when there is no loader, driver or Vulkan 1.3 device with a
+    /// graphics queue, or when validation is asked for but the layer is not installed, and with
+    /// [`Error::Unsupported`] when the device lacks `dynamicRendering`, `synchronization2` or a
+    /// depth-stencil format with 8 stencil bits.
     pub fn with_validation(validation: bool) -> Result<Context> {
         // SAFETY: loading the Vulkan loader library; we keep `entry` alive in the context for as
         // long as any object created from it.
@@ -387,7 +448,13 @@ impl Context {
         lock_allocator(&self.allocator)
     }
 
-    /// Records commands into a fresh primary command buffer, submits, and waits.
+    /// Records commands into a fresh primary command buffer, submits it to [`Context::queue`]
+    /// and waits for it to finish (a fence, not a device-wide idle), then frees the buffer.
+    ///
+    /// `record` receives the buffer in the recording state and must leave it recording (no
+    /// `vkEndCommandBuffer`); everything it references must stay alive until this returns.
+    /// Blocks the calling thread; uses [`Context::pool`] and the queue, so it must not run
+    /// concurrently with other users of either.
     pub fn one_shot(&self, record: impl FnOnce(vk::CommandBuffer)) -> Result<()> {
         let info = vk::CommandBufferAllocateInfo::default().command_pool(self.pool).command_buffer_count(1);
         // SAFETY: valid pool; the buffer is freed below after the fence wait.

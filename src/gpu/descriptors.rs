@@ -12,17 +12,28 @@ fn vkerr(call: &'static str) -> impl Fn(vk::Result) -> Error {
 /// What a binding holds, in binding order.
 #[derive(Clone, Copy)]
 pub enum Binding {
+    /// A `SAMPLED_IMAGE` (GLSL `texture2D`): the view must be in `SHADER_READ_ONLY_OPTIMAL`
+    /// whenever the set is used.
     Image(vk::ImageView),
+    /// A `SAMPLER` (GLSL `sampler`).
     Sampler(vk::Sampler),
 }
 
+/// A descriptor set layout with one set allocated from its own pool; binding `i` is the `i`-th
+/// [`Binding`] given to [`DescriptorSet::new`], one descriptor each, visible to the fragment stage.
+/// Not freed on drop: call [`DescriptorSet::destroy`].
 pub struct DescriptorSet {
+    /// The set's layout, for [`pipeline_layout`].
     pub layout: vk::DescriptorSetLayout,
+    /// The set, written once at creation.
     pub set: vk::DescriptorSet,
     pool: vk::DescriptorPool,
 }
 
 impl DescriptorSet {
+    /// Creates the layout, a pool sized for exactly this one set, allocates the set and writes
+    /// `bindings` into it. The views and samplers are not owned: they must outlive every use
+    /// of the set (and are not destroyed by [`DescriptorSet::destroy`]).
     pub fn new(ctx: &impl GpuDevice, bindings: &[Binding]) -> Result<DescriptorSet> {
         let ty = |b: &Binding| match b {
             Binding::Image(_) => vk::DescriptorType::SAMPLED_IMAGE,
@@ -86,6 +97,9 @@ impl DescriptorSet {
         }
     }
 
+    /// Destroys the pool (freeing the set) and the layout. `ctx` must be the device the set was
+    /// created on, and no pending GPU work may still use the set (e.g. after `vkDeviceWaitIdle`).
+    /// Call once: the handles are not reset.
     pub fn destroy(&mut self, ctx: &impl GpuDevice) {
         // SAFETY: the owner waited for the device to be idle; freeing the pool frees the set.
         unsafe {
@@ -95,7 +109,9 @@ impl DescriptorSet {
     }
 }
 
-/// A pipeline layout with the given set layouts and one push-constant range (0 bytes: none).
+/// A pipeline layout with the given set layouts (set `i` = `sets[i]`) and one push-constant
+/// range of `push_bytes` bytes at offset 0 visible to `stages` (0 bytes: no range; otherwise a
+/// multiple of 4 within `maxPushConstantsSize`). The caller owns and destroys the layout.
 pub fn pipeline_layout(
     ctx: &impl GpuDevice,
     sets: &[vk::DescriptorSetLayout],

@@ -1,5 +1,6 @@
 //! Thin wrappers over ash: context, memory, images, pipelines. Knows nothing about shadows.
 //! All of the crate's `unsafe` lives under this module and `render`.
+#![warn(missing_docs)]
 pub mod context;
 pub mod descriptors;
 pub mod pipeline;

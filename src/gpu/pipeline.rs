@@ -9,8 +9,10 @@ fn vkerr(call: &'static str) -> impl Fn(vk::Result) -> Error {
     Error::vk(call)
 }
 
+/// Colour blending, the same for every colour attachment of a pipeline.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Blend {
+    /// No blending: the fragment's colour replaces dst.
     None,
     /// dst += src (light accumulation).
     Additive,
@@ -23,34 +25,60 @@ pub enum Blend {
 }
 
 /// Everything that varies between the renderer's pipelines.
+///
+/// Fixed for all of them: triangle lists, fill mode, counter-clockwise front faces, one sample,
+/// line width 1, entry point `main`, and viewport and scissor as dynamic state (one each), so
+/// the caller sets both before drawing.
 #[derive(Clone)]
 pub struct PipelineDesc<'a> {
+    /// SPIR-V of the vertex shader (little-endian words, e.g. a [`super::shaders`] constant).
     pub vertex: &'a [u8],
+    /// SPIR-V of the fragment shader; `None` = no fragment stage (depth/stencil-only passes).
     pub fragment: Option<&'a [u8]>,
-    /// Vertex stride and (location, format, offset) attributes; stride 0 = no vertex input.
+    /// Byte stride of vertex binding 0 (per-vertex); 0 = no vertex input at all, in which case
+    /// the instance binding below is ignored too.
     pub vertex_stride: u32,
+    /// `(location, format, offset in bytes)` of each attribute read from binding 0.
     pub attributes: &'a [(u32, vk::Format, u32)],
-    /// A second, per-instance binding (1): stride and (location, format, offset) attributes;
-    /// stride 0 = none.
+    /// Byte stride of the per-instance binding 1; 0 = no such binding.
     pub instance_stride: u32,
+    /// `(location, format, offset in bytes)` of each attribute read from binding 1.
     pub instance_attributes: &'a [(u32, vk::Format, u32)],
+    /// Formats of the colour attachments, in attachment order (dynamic rendering); may be empty.
     pub color_formats: &'a [vk::Format],
+    /// Blending of every colour attachment.
     pub blend: Blend,
+    /// Whether RGBA is written to the colour attachments (false: write mask empty, e.g. stencil-only passes).
     pub color_write: bool,
+    /// Format of the depth attachment, `UNDEFINED` for none. A format with stencil is also
+    /// used as the stencil attachment format.
     pub depth_format: vk::Format,
+    /// Depth test enabled.
     pub depth_test: bool,
+    /// Depth writes enabled.
     pub depth_write: bool,
+    /// Depth comparison, when [`PipelineDesc::depth_test`] is on.
     pub depth_compare: vk::CompareOp,
+    /// Depth clamping instead of clipping at the near/far planes; needs [`super::Features::depth_clamp`].
     pub depth_clamp: bool,
+    /// Depth-bounds test; the bounds are then dynamic state (`vkCmdSetDepthBounds` before
+    /// drawing). Needs [`super::Features::depth_bounds`].
     pub depth_bounds: bool,
+    /// `(front, back)` stencil state; `Some` enables the stencil test, which needs a depth
+    /// format with stencil.
     pub stencil: Option<(vk::StencilOpState, vk::StencilOpState)>,
+    /// Faces culled (front faces are counter-clockwise).
     pub cull: vk::CullModeFlags,
-    /// Constant and slope-scaled depth bias (shadow-map pass).
+    /// Constant and slope-scaled depth bias (shadow-map pass), in Vulkan's depth-bias units.
     pub depth_bias: Option<(f32, f32)>,
+    /// The pipeline layout; must match the shaders' descriptor sets and push constants.
     pub layout: vk::PipelineLayout,
 }
 
 impl<'a> PipelineDesc<'a> {
+    /// A pipeline with a vertex shader only and everything off: no vertex input, no colour
+    /// attachments, no blending (colour writes on), no depth test or writes (compare `ALWAYS`),
+    /// no clamp, bounds, stencil, culling or bias. Set the fields that differ.
     pub fn new(vertex: &'a [u8], layout: vk::PipelineLayout, depth_format: vk::Format) -> Self {
         PipelineDesc {
             vertex,
@@ -76,13 +104,20 @@ impl<'a> PipelineDesc<'a> {
     }
 }
 
+/// Creates a shader module from SPIR-V bytes (little-endian words; a trailing partial word is
+/// ignored). `spirv` must be valid SPIR-V for the device, as the [`super::shaders`] constants
+/// (validated by naga at build time) are. The caller destroys the module.
 pub fn shader_module(ctx: &impl GpuDevice, spirv: &[u8]) -> Result<vk::ShaderModule> {
     let words: Vec<u32> = spirv.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
     let info = vk::ShaderModuleCreateInfo::default().code(&words);
-    // SAFETY: `words` is SPIR-V produced and validated by naga in build.rs.
+    // SAFETY: valid device; `info` points at `words`, alive for the call. `words` is SPIR-V
+    // produced and validated by naga in build.rs (the callers pass `shaders::` constants).
     unsafe { ctx.device().create_shader_module(&info, None) }.map_err(vkerr("vkCreateShaderModule"))
 }
 
+/// Creates the graphics pipeline `d` describes, for dynamic rendering (no render pass). The
+/// shader modules are created and destroyed here; the pipeline is the caller's to destroy,
+/// and `d.layout` must outlive every use of it.
 pub fn create(ctx: &impl GpuDevice, d: &PipelineDesc) -> Result<vk::Pipeline> {
     let vs = shader_module(ctx, d.vertex)?;
     let fs = match d.fragment {
@@ -219,7 +254,9 @@ pub fn create(ctx: &impl GpuDevice, d: &PipelineDesc) -> Result<vk::Pipeline> {
     result.map(|p| p[0]).map_err(|(_, e)| Error::Vulkan { call: "vkCreateGraphicsPipelines", result: e })
 }
 
-/// A stencil op state with wrap ops, for the shadow volume passes.
+/// A stencil op state for the shadow-volume passes: the test always passes, `pass` is applied
+/// where the depth test passes and `depth_fail` where it fails (e.g. `INCREMENT_AND_WRAP` /
+/// `DECREMENT_AND_WRAP`), all 8 bits compared and written, reference 0.
 pub fn stencil_ops(pass: vk::StencilOp, depth_fail: vk::StencilOp) -> vk::StencilOpState {
     vk::StencilOpState {
         fail_op: vk::StencilOp::KEEP,
@@ -232,7 +269,8 @@ pub fn stencil_ops(pass: vk::StencilOp, depth_fail: vk::StencilOp) -> vk::Stenci
     }
 }
 
-/// Stencil test `== reference`, no writes (illumination pass).
+/// Stencil test `stencil == reference` on all 8 bits, no writes (illumination pass: lit where
+/// the count is `reference`, usually 0).
 pub fn stencil_equal(reference: u32) -> vk::StencilOpState {
     vk::StencilOpState {
         fail_op: vk::StencilOp::KEEP,

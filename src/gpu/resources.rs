@@ -11,13 +11,21 @@ fn vkerr(call: &'static str) -> impl Fn(vk::Result) -> Error {
     Error::vk(call)
 }
 
+/// A `VkBuffer` bound to its own gpu-allocator allocation (exclusive sharing). Not freed on
+/// drop: call [`Buffer::destroy`].
 pub struct Buffer {
+    /// The buffer handle; null after [`Buffer::destroy`].
     pub raw: vk::Buffer,
+    /// The size asked for, in bytes. The `VkBuffer` itself is at least 4 bytes (Vulkan forbids
+    /// size 0), and [`Buffer::read`] returns exactly `size` bytes.
     pub size: u64,
     allocation: Option<Allocation>,
 }
 
 impl Buffer {
+    /// Creates a buffer of `size` bytes with `usage`, in memory at `location` (host-visible for
+    /// `CpuToGpu` / `GpuToCpu`, which [`Buffer::write`] and [`Buffer::read`] need). `name` labels
+    /// the allocation in gpu-allocator's reports and in the error.
     pub fn new(ctx: &impl GpuDevice, name: &str, size: u64, usage: vk::BufferUsageFlags, location: MemoryLocation) -> Result<Buffer> {
         let info = vk::BufferCreateInfo::default().size(size.max(4)).usage(usage).sharing_mode(vk::SharingMode::EXCLUSIVE);
         // SAFETY: valid device and create info.
@@ -45,6 +53,9 @@ impl Buffer {
         Ok(b)
     }
 
+    /// Copies `data` into the mapped memory at byte `offset`. Fails if the buffer is not host
+    /// visible or the write would end past the allocation. The caller must make sure the GPU is
+    /// not using that range meanwhile (memory is host-coherent: no flush needed).
     pub fn write(&mut self, offset: usize, data: &[u8]) -> Result<()> {
         let slice =
             self.allocation.as_mut().and_then(|a| a.mapped_slice_mut()).ok_or_else(|| Error::Other("buffer is not host visible".into()))?;
@@ -56,11 +67,17 @@ impl Buffer {
         Ok(())
     }
 
+    /// The first [`Buffer::size`] bytes of the mapped memory. Fails if the buffer is not host
+    /// visible. Meaningful only after the GPU writes have completed (fence wait) and been made
+    /// visible to the host (a barrier to `HOST_READ`).
     pub fn read(&self) -> Result<&[u8]> {
         let s = self.allocation.as_ref().and_then(|a| a.mapped_slice()).ok_or_else(|| Error::Other("buffer is not host visible".into()))?;
         Ok(&s[..self.size as usize])
     }
 
+    /// Frees the memory and destroys the buffer. `ctx` must be the device and allocator it was
+    /// created with, and the GPU must no longer use it (e.g. after `vkDeviceWaitIdle`). Calling
+    /// it again is harmless.
     pub fn destroy(&mut self, ctx: &impl GpuDevice) {
         if let Some(a) = self.allocation.take() {
             let _ = GpuDevice::allocator(ctx).free(a);
@@ -71,16 +88,27 @@ impl Buffer {
     }
 }
 
+/// A 2D image (one mip level, one layer, one sample, optimal tiling) in device-local memory,
+/// with a view of the whole image. Not freed on drop: call [`Image::destroy`].
 pub struct Image {
+    /// The image handle.
     pub raw: vk::Image,
+    /// A 2D view of the whole image with [`Image::aspect`].
     pub view: vk::ImageView,
+    /// The image's (and the view's) format.
     pub format: vk::Format,
+    /// Size in pixels.
     pub extent: vk::Extent2D,
+    /// The aspects the view and [`Image::range`] cover (`COLOR`, or `DEPTH | STENCIL` for the
+    /// depth-stencil buffer).
     pub aspect: vk::ImageAspectFlags,
     allocation: Option<Allocation>,
 }
 
 impl Image {
+    /// Creates the image in layout `UNDEFINED` (transition it before use, see [`transition`]),
+    /// allocates and binds `GpuOnly` memory, and creates its view over `aspect`, which must
+    /// match `format`. `name` labels the allocation.
     pub fn new_2d(
         ctx: &impl GpuDevice,
         name: &str,
@@ -123,10 +151,14 @@ impl Image {
         Ok(Image { raw, view, format, extent, aspect, allocation: Some(allocation) })
     }
 
+    /// The subresource range of the whole image (its single mip level and layer, [`Image::aspect`]).
     pub fn range(&self) -> vk::ImageSubresourceRange {
         vk::ImageSubresourceRange { aspect_mask: self.aspect, base_mip_level: 0, level_count: 1, base_array_layer: 0, layer_count: 1 }
     }
 
+    /// Destroys the view and the image and frees the memory. `ctx` must be the device and
+    /// allocator it was created with, and the GPU must no longer use it (e.g. after
+    /// `vkDeviceWaitIdle`). Call once: the handles are not reset.
     pub fn destroy(&mut self, ctx: &impl GpuDevice) {
         // SAFETY: the owner guarantees the GPU no longer uses the image (device idle).
         unsafe {
@@ -139,8 +171,10 @@ impl Image {
     }
 }
 
-/// A full-pipeline image layout transition (synchronization2). Conservative stage masks:
-/// the frame has a handful of these, never in an inner loop.
+/// Records a layout transition of the whole `image` from `from` to `to` into `cb` (which must
+/// be recording), as a synchronization2 barrier: all commands' memory writes before, all
+/// commands' reads and writes after. Conservative stage masks: the frame has a handful of
+/// these, never in an inner loop. `from` may be `UNDEFINED` (contents discarded).
 pub fn transition(ctx: &impl GpuDevice, cb: vk::CommandBuffer, image: &Image, from: vk::ImageLayout, to: vk::ImageLayout) {
     let barrier = vk::ImageMemoryBarrier2::default()
         .src_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
@@ -157,7 +191,8 @@ pub fn transition(ctx: &impl GpuDevice, cb: vk::CommandBuffer, image: &Image, fr
     unsafe { ctx.device().cmd_pipeline_barrier2(cb, &dep) };
 }
 
-/// A global memory barrier between two groups of stages.
+/// Records a global memory barrier into `cb` (which must be recording): `src` and `dst` are
+/// `(stages, accesses)` before and after the barrier.
 pub fn memory_barrier(
     ctx: &impl GpuDevice,
     cb: vk::CommandBuffer,
