@@ -11,8 +11,17 @@ deps:
 run: deps
 	$(CARGO) run -- render
 
+# Every test with validation on, the doc examples, and the library an engine embeds
+# (`default-features = false`) built and documented with warnings denied.
 test: deps
 	UMBRAGE_VALIDATION=1 $(CARGO) test --all-targets
+	$(CARGO) test --doc
+	$(CARGO) build --lib --no-default-features
+	$(MAKE) doc
+
+doc:
+	RUSTDOCFLAGS="-D warnings" $(CARGO) doc --no-deps
+	RUSTDOCFLAGS="-D warnings" $(CARGO) doc --no-deps --no-default-features
 
 bench: deps
 	$(CARGO) bench
