@@ -7,6 +7,7 @@
 //! is the number of caster triangles between it and the light (see `plan`).
 
 use crate::error::{Error, Result};
+use crate::geom::silhouette::FacePlanes;
 use crate::geom::topology::Topology;
 use crate::geom::{Aabb, Mesh};
 use crate::scene::SceneMesh;
@@ -82,6 +83,10 @@ pub struct Caster {
     /// winding: duplicates and back-to-back pairs), or `u32::MAX` when it has no twin.
     pub coincident: Vec<u32>,
     pub topology: Topology,
+    /// Object-space plane of every welded triangle, for the per-light facing bits
+    /// ([`FacePlanes::facing_packed`]); recompute with [`Caster::recompute_planes`] after
+    /// changing the welded positions.
+    pub planes: FacePlanes,
     pub chunks: Vec<Chunk>,
     /// For every welded triangle: (chunk, local triangle index).
     pub tri_chunk: Vec<(u32, u32)>,
@@ -147,6 +152,7 @@ impl Caster {
             kind,
             coincident,
             triangle_count: topology.mesh.triangles.len(),
+            planes: FacePlanes::new(&topology.mesh),
             topology,
             chunks,
             tri_chunk,
@@ -157,6 +163,12 @@ impl Caster {
             max_local_vertices,
             max_local_vertices_u8: max_local_vertices <= 128,
         })
+    }
+
+    /// Recomputes the triangle planes from the welded mesh's current positions (deforming
+    /// casters, after writing `topology.mesh.positions`).
+    pub fn recompute_planes(&mut self) {
+        self.planes.recompute(&self.topology.mesh);
     }
 
     pub fn is_manifold(&self) -> bool {

@@ -42,7 +42,7 @@
 use super::caster::{Caster, CasterKind};
 use crate::error::Error;
 use crate::geom::bounds::{box_distance, light_depth_bounds, light_scissor, shadow_volume_outside_frustum, Frustum, OcclusionPyramid};
-use crate::geom::silhouette::{facing_bits, possible_silhouette, SilhouetteEdge};
+use crate::geom::silhouette::{packed_bit, possible_silhouette_packed_into, SilhouetteEdge};
 use crate::geom::Aabb;
 use crate::scene::{Camera, Light, LightKind};
 use glam::{Mat4, Vec4};
@@ -274,8 +274,35 @@ pub struct Emit {
     pub light_cap: bool,
 }
 
+/// Per-triangle facing bits, as one `bool` per triangle or packed 64 to a word
+/// ([`crate::geom::silhouette::FacePlanes::facing_packed`]).
+trait FacingSet {
+    fn get(&self, t: u32) -> bool;
+}
+
+impl FacingSet for [bool] {
+    #[inline]
+    fn get(&self, t: u32) -> bool {
+        self.get(t as usize).copied().unwrap_or(false)
+    }
+}
+
+/// Packed facing bits (see [`FacingSet`]).
+struct Packed<'a>(&'a [u64]);
+
+impl FacingSet for Packed<'_> {
+    #[inline]
+    fn get(&self, t: u32) -> bool {
+        packed_bit(self.0, t)
+    }
+}
+
 /// Emits the index lists; returns (chunk draws, sides, dark cap, light cap) triangle counts.
 pub fn emit(caster: &Caster, facing: &[bool], sil: &[SilhouetteEdge], e: Emit) -> (Vec<ChunkDraw>, usize, usize, usize) {
+    emit_with(caster, facing, sil, e)
+}
+
+fn emit_with<F: FacingSet + ?Sized>(caster: &Caster, facing: &F, sil: &[SilhouetteEdge], e: Emit) -> (Vec<ChunkDraw>, usize, usize, usize) {
     let nch = caster.chunks.len();
     let mut vol: Vec<Vec<u16>> = vec![Vec::new(); nch];
     let mut cap: Vec<Vec<u16>> = vec![Vec::new(); nch];
@@ -325,7 +352,7 @@ pub fn emit(caster: &Caster, facing: &[bool], sil: &[SilhouetteEdge], e: Emit) -
                 for (ci, ch) in caster.chunks.iter().enumerate() {
                     let n = ch.n() as u16;
                     for (lt, &g) in ch.local_tris.iter().zip(&ch.tri_ids) {
-                        if facing[g as usize] == want {
+                        if facing.get(g) == want {
                             let t = if want { [lt[0] + n, lt[2] + n, lt[1] + n] } else { [lt[0] + n, lt[1] + n, lt[2] + n] };
                             vol[ci].extend_from_slice(&t);
                             dark += 1;
@@ -341,7 +368,7 @@ pub fn emit(caster: &Caster, facing: &[bool], sil: &[SilhouetteEdge], e: Emit) -
         let want = e.formulation == Formulation::Front;
         for (ci, ch) in caster.chunks.iter().enumerate() {
             for (lt, &g) in ch.local_tris.iter().zip(&ch.tri_ids) {
-                if facing[g as usize] == want {
+                if facing.get(g) == want {
                     let t = if want { *lt } else { [lt[0], lt[2], lt[1]] };
                     cap[ci].extend_from_slice(&t);
                     light += 1;
@@ -389,8 +416,18 @@ pub struct MultiplicityInput<'a> {
 
 /// Signed multiplicity of every undirected edge of the topology (`v[0] -> v[1]` positive).
 pub fn edge_multiplicities(caster: &Caster, facing: &[bool]) -> Vec<i32> {
+    edge_multiplicities_with(caster, facing)
+}
+
+fn edge_multiplicities_with<F: FacingSet + ?Sized>(caster: &Caster, facing: &F) -> Vec<i32> {
     let t = &caster.topology;
-    (0..t.edges.len()).map(|e| t.edge_uses(e).iter().map(|u| if u.forward == facing[u.tri as usize] { 1 } else { -1 }).sum()).collect()
+    t.edges
+        .iter()
+        .map(|e| {
+            let uses = t.uses.get(e.first_use as usize..(e.first_use + e.use_count) as usize).unwrap_or(&[]);
+            uses.iter().map(|u| if u.forward == facing.get(u.tri) { 1 } else { -1 }).sum()
+        })
+        .collect()
 }
 
 /// Emits a multiplicity caster's index lists; returns (draws, sides, dark cap, light cap,
@@ -398,6 +435,18 @@ pub fn edge_multiplicities(caster: &Caster, facing: &[bool]) -> Vec<i32> {
 pub fn emit_multiplicity(
     caster: &Caster,
     mi: &MultiplicityInput,
+    mult: &[i32],
+    case: Case,
+    directional: bool,
+    dark_cap: DarkCap,
+) -> (Vec<ChunkDraw>, usize, usize, usize, usize, u32) {
+    emit_multiplicity_with(caster, mi.facing, mi.shielded, mult, case, directional, dark_cap)
+}
+
+fn emit_multiplicity_with<F: FacingSet + ?Sized>(
+    caster: &Caster,
+    facing: &F,
+    shielded: &[bool],
     mult: &[i32],
     case: Case,
     directional: bool,
@@ -458,7 +507,7 @@ pub fn emit_multiplicity(
                 for (ci, ch) in caster.chunks.iter().enumerate() {
                     let n = ch.n() as u16;
                     for (lt, &g) in ch.local_tris.iter().zip(&ch.tri_ids) {
-                        let t = if mi.facing[g as usize] { [lt[0] + n, lt[2] + n, lt[1] + n] } else { [lt[0] + n, lt[1] + n, lt[2] + n] };
+                        let t = if facing.get(g) { [lt[0] + n, lt[2] + n, lt[1] + n] } else { [lt[0] + n, lt[1] + n, lt[2] + n] };
                         vol[ci].extend_from_slice(&t);
                         dark += 1;
                     }
@@ -471,8 +520,8 @@ pub fn emit_multiplicity(
     if case != Case::ZFail {
         for (ci, ch) in caster.chunks.iter().enumerate() {
             for (lt, &g) in ch.local_tris.iter().zip(&ch.tri_ids) {
-                let t = if mi.facing[g as usize] { *lt } else { [lt[0], lt[2], lt[1]] };
-                if !mi.shielded[g as usize] {
+                let t = if facing.get(g) { *lt } else { [lt[0], lt[2], lt[1]] };
+                if !shielded.get(g as usize).copied().unwrap_or(true) {
                     vol[ci].extend_from_slice(&t);
                     light += 1;
                 } else if case == Case::ZFailLightCap {
@@ -497,8 +546,10 @@ fn plan_multiplicity(
 ) -> (CasterPlan, f64) {
     let directional = l_obj.w == 0.0;
     let ts = Instant::now();
-    let facing = facing_bits(caster.mesh(), l_obj, caster.mirrored);
-    let mult = edge_multiplicities(caster, &facing);
+    let mut bits = Vec::new();
+    caster.planes.facing_packed(caster.mesh(), l_obj, caster.mirrored, &mut bits);
+    let facing = Packed(&bits);
+    let mult = edge_multiplicities_with(caster, &facing);
     let t = ts.elapsed().as_secs_f64() * 1e3;
     // The renderer draws opaque multiplicity casters two-sided in the G-buffer pass, so every
     // light cap (a caster triangle itself) lies at or behind the visible surface along any ray
@@ -514,8 +565,8 @@ fn plan_multiplicity(
     } else {
         DarkCap::AllFaces
     };
-    let mi = MultiplicityInput { facing: &facing, shielded: &shielded };
-    let (chunks, sides, dark_cap, light_cap, edges, mmax) = emit_multiplicity(caster, &mi, &mult, case, directional, dark_cap_kind);
+    let (chunks, sides, dark_cap, light_cap, edges, mmax) =
+        emit_multiplicity_with(caster, &facing, &shielded, &mult, case, directional, dark_cap_kind);
     let plan = CasterPlan {
         caster: ci,
         case,
@@ -590,8 +641,10 @@ pub fn plan_light_opts(input: &PlanInput, casters: &[Caster], edge_quads: bool) 
             continue;
         }
         let ts = Instant::now();
-        let facing = facing_bits(caster.mesh(), l_obj, caster.mirrored);
-        let sil = possible_silhouette(&caster.topology.manifold_edges, &facing);
+        let mut bits = Vec::new();
+        caster.planes.facing_packed(caster.mesh(), l_obj, caster.mirrored, &mut bits);
+        let mut sil = Vec::new();
+        possible_silhouette_packed_into(&caster.topology.manifold_edges, &bits, &mut sil);
         sil_time += ts.elapsed().as_secs_f64() * 1e3;
 
         let formulation =
@@ -607,7 +660,7 @@ pub fn plan_light_opts(input: &PlanInput, casters: &[Caster], edge_quads: bool) 
             DarkCap::FrontFaces
         };
         let e = Emit { formulation, directional, dark_cap: dark_cap_kind, light_cap: case == Case::ZFailLightCap };
-        let (chunks, sides, dark_cap, light_cap) = emit(caster, &facing, &sil, e);
+        let (chunks, sides, dark_cap, light_cap) = emit_with(caster, &Packed(&bits), &sil, e);
         plans.push(CasterPlan {
             caster: ci,
             case,

@@ -1,4 +1,5 @@
 use super::*;
+use crate::geom::silhouette::facing_bits;
 use crate::geom::Mesh;
 use crate::shadow::testmesh::{cube, signed_volume, torus, uv_sphere};
 use glam::{DVec3, Vec3};
