@@ -1,20 +1,21 @@
 //! Possible-silhouette extraction (facing bits + edge scan) on UV spheres of 10k, 100k and
 //! 1M triangles, as the planner does it per light: triangle planes precomputed once
-//! ([`FacePlanes::new`], outside the timed loops), facing as one f32 dot product per triangle
-//! with packed bits and the exact fallback near the planes, then the edge scan on the packed
-//! bits. `streaming_sum` is a plain streaming read of the same bytes the new path reads (the
+//! (`FacePlanes::new`, outside the timed loops), facing as one f32 dot product per triangle
+//! with packed bits and the exact fallback near the planes (threads from
+//! `PLANES_PARALLEL_THRESHOLD` triangles), then the edge scan on the packed bits.
+//! `edge_scan_serial` is `EdgeScan`'s scan, `edge_scan` the scan of the full edge records. `streaming_sum` is a plain streaming read of the same bytes the new path reads (the
 //! four plane arrays and the manifold edge records), in the same run, so the throughput of the
 //! other functions (the group's throughput is those bytes) can be compared to memory speed.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::Vec4;
 use std::hint::black_box;
-use umbrage::geom::silhouette::{possible_silhouette_packed_into, FacePlanes, SilhouetteEdge};
-use umbrage::geom::topology::{ManifoldEdge, Topology};
+use umbrage::geom::silhouette::{possible_silhouette_packed_into, EdgeScan, FacePlanes, SilhouetteEdge};
+use umbrage::geom::topology::Topology;
 use umbrage::shadow::testmesh::uv_sphere;
 
-fn bytes_of(planes: &FacePlanes, t: &Topology) -> u64 {
-    (planes.bytes() + t.manifold_edges.len() * std::mem::size_of::<ManifoldEdge>()) as u64
+fn bytes_of(planes: &FacePlanes, scan: &EdgeScan) -> u64 {
+    (planes.bytes() + scan.bytes()) as u64
 }
 
 /// The plane arrays as the facing pass sees them (same length and layout: 4 f32 arrays).
@@ -25,7 +26,7 @@ struct PlainArrays {
     d: Vec<f32>,
 }
 
-fn streaming_sum(p: &PlainArrays, edges: &[ManifoldEdge]) -> u64 {
+fn streaming_sum(p: &PlainArrays, pairs: &[[u32; 2]]) -> u64 {
     let mut s = [0u32; 8];
     for (((a, b), c), d) in p.a.chunks_exact(8).zip(p.b.chunks_exact(8)).zip(p.c.chunks_exact(8)).zip(p.d.chunks_exact(8)) {
         for k in 0..8 {
@@ -33,8 +34,8 @@ fn streaming_sum(p: &PlainArrays, edges: &[ManifoldEdge]) -> u64 {
         }
     }
     let mut t = 0u64;
-    for e in edges {
-        t = t.wrapping_add((e.a ^ e.b ^ e.t0 ^ e.t1) as u64);
+    for e in pairs {
+        t = t.wrapping_add((e[0] ^ e[1]) as u64);
     }
     s.iter().map(|&x| x as u64).sum::<u64>().wrapping_add(t)
 }
@@ -46,6 +47,8 @@ fn bench(c: &mut Criterion) {
         let topo = Topology::build(&uv_sphere(1.0, slices, stacks));
         assert!(topo.is_closed_manifold());
         let planes = FacePlanes::new(&topo.mesh);
+        let scan = EdgeScan::new(topo.manifold_edges.clone());
+        let pairs: Vec<[u32; 2]> = topo.manifold_edges.iter().map(|e| [e.t0 ^ 1, e.t1 ^ 3]).collect();
         let words = planes.bytes() / 16;
         let plain = PlainArrays {
             a: (0..words).map(|i| i as f32).collect(),
@@ -53,7 +56,7 @@ fn bench(c: &mut Criterion) {
             c: (0..words).map(|i| (i * 7) as f32).collect(),
             d: (0..words).map(|i| (i * 11) as f32).collect(),
         };
-        let bytes = bytes_of(&planes, &topo);
+        let bytes = bytes_of(&planes, &scan);
         let mut g = c.benchmark_group(format!("silhouette/{name}"));
         g.throughput(Throughput::Bytes(bytes));
         if slices >= 1000 {
@@ -63,13 +66,13 @@ fn bench(c: &mut Criterion) {
         let mut bits: Vec<u64> = Vec::new();
         let mut sil: Vec<SilhouetteEdge> = Vec::new();
         g.bench_function(BenchmarkId::new("streaming_sum", tris), |b| {
-            b.iter(|| black_box(streaming_sum(black_box(&plain), black_box(&topo.manifold_edges))))
+            b.iter(|| black_box(streaming_sum(black_box(&plain), black_box(&pairs))))
         });
         g.bench_function(BenchmarkId::new("facing+silhouette", tris), |b| {
             b.iter(|| {
-                planes.facing_packed(&topo.mesh, black_box(light), false, &mut bits);
+                planes.facing_packed_auto(&topo.mesh, black_box(light), false, &mut bits);
                 sil.clear();
-                possible_silhouette_packed_into(&topo.manifold_edges, &bits, &mut sil);
+                scan.scan_into(&bits, &mut sil);
                 black_box(sil.len())
             })
         });
@@ -89,12 +92,16 @@ fn bench(c: &mut Criterion) {
         g.bench_function(BenchmarkId::new("edge_scan_serial", tris), |b| {
             b.iter(|| {
                 sil.clear();
-                possible_silhouette_packed_into(&topo.manifold_edges, black_box(&bits), &mut sil);
+                scan.scan_into(black_box(&bits), &mut sil);
                 black_box(sil.len())
             })
         });
         g.bench_function(BenchmarkId::new("edge_scan", tris), |b| {
-            b.iter(|| black_box(umbrage::geom::silhouette::possible_silhouette_packed(&topo.manifold_edges, black_box(&bits)).len()))
+            b.iter(|| {
+                sil.clear();
+                possible_silhouette_packed_into(&topo.manifold_edges, black_box(&bits), &mut sil);
+                black_box(sil.len())
+            })
         });
         g.finish();
     }

@@ -9,6 +9,10 @@ use glam::{DVec3, Vec3, Vec4};
 /// Meshes with at least this many triangles get their facing bits on several threads
 /// (the f64 filtered orientation test is compute-bound).
 pub const PARALLEL_THRESHOLD: usize = 200_000;
+/// [`FacePlanes::facing_packed_auto`] splits over threads from this many triangles: on the
+/// 2-core machine 100k triangles took 134 µs on one thread and 102 µs on two, 1M 1.31 ms and
+/// 0.81 ms, while at 10k two threads cost more than they save (benches/silhouette.rs).
+pub const PLANES_PARALLEL_THRESHOLD: usize = 100_000;
 /// The edge scan is memory-bound: on a 2-core machine, 1.5M edges took 1.2 ms serial vs
 /// 2.4 ms on 2 threads (benches/silhouette.rs), so it only splits for very large meshes.
 pub const PARALLEL_EDGE_THRESHOLD: usize = 8_000_000;
@@ -296,6 +300,17 @@ impl FacePlanes {
         self.fill_words(mesh, l, flip, (lf, e), 0, out);
     }
 
+    /// [`facing_packed`](Self::facing_packed), on every available core (at most 8) for meshes
+    /// of at least [`PLANES_PARALLEL_THRESHOLD`] triangles, else on this thread.
+    pub fn facing_packed_auto(&self, mesh: &Mesh, l: Vec4, flip: bool, out: &mut Vec<u64>) {
+        let th = if self.len < PLANES_PARALLEL_THRESHOLD {
+            1
+        } else {
+            std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1).min(8)
+        };
+        self.facing_packed_threads(mesh, l, flip, th, out)
+    }
+
     /// [`facing_packed`](Self::facing_packed) split over `threads` threads (contiguous ranges of
     /// whole words); the same bits.
     pub fn facing_packed_threads(&self, mesh: &Mesh, l: Vec4, flip: bool, threads: usize, out: &mut Vec<u64>) {
@@ -384,6 +399,56 @@ pub fn possible_silhouette_packed(edges: &[ManifoldEdge], bits: &[u64]) -> Vec<S
     let mut out = Vec::new();
     possible_silhouette_packed_into(edges, bits, &mut out);
     out
+}
+
+/// Manifold edges prepared for the per-light scan: the full records, and their triangle pairs
+/// `(t0, t1)` packed 8 bytes an edge, which is all the scan reads except for the few edges on
+/// the possible silhouette.
+#[derive(Clone, Debug, Default)]
+pub struct EdgeScan {
+    edges: Vec<ManifoldEdge>,
+    pairs: Vec<[u32; 2]>,
+}
+
+impl EdgeScan {
+    /// The scan over `edges` (in this order).
+    pub fn new(edges: Vec<ManifoldEdge>) -> EdgeScan {
+        let pairs = edges.iter().map(|e| [e.t0, e.t1]).collect();
+        EdgeScan { edges, pairs }
+    }
+
+    /// The edges, in scan order.
+    pub fn edges(&self) -> &[ManifoldEdge] {
+        &self.edges
+    }
+
+    /// Bytes one scan reads (the triangle pairs).
+    pub fn bytes(&self) -> usize {
+        self.pairs.len() * 8
+    }
+
+    /// Appends the possible silhouette for the packed facing `bits` to `out`: the same edges in
+    /// the same order as [`possible_silhouette`] on the unpacked bits (a triangle past the bits
+    /// counts as not facing).
+    pub fn scan_into(&self, bits: &[u64], out: &mut Vec<SilhouetteEdge>) {
+        let bit = |t: u32| bits.get(t as usize / 64).map_or(0, |w| (w >> (t % 64)) & 1);
+        for (chunk, es) in self.pairs.chunks(64).zip(self.edges.chunks(64)) {
+            let mut m = 0u64;
+            for (k, p) in chunk.iter().enumerate() {
+                m |= (bit(p[0]) ^ bit(p[1])) << k;
+            }
+            while m != 0 {
+                let k = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let e = es[k];
+                out.push(if bit(e.t0) != 0 {
+                    SilhouetteEdge { a: e.a, b: e.b, lit: e.t0, lit_corner: e.c0, unlit: e.t1, unlit_corner: e.c1 }
+                } else {
+                    SilhouetteEdge { a: e.b, b: e.a, lit: e.t1, lit_corner: e.c1, unlit: e.t0, unlit_corner: e.c0 }
+                });
+            }
+        }
+    }
 }
 
 /// [`possible_silhouette_packed`] appending to `out` (reuse the allocation across frames).
@@ -488,6 +553,9 @@ mod tests {
                 let f = facing_bits(&t.mesh, l, flip);
                 assert_eq!(unpack_bits(&bits, f.len()), f);
                 assert_eq!(possible_silhouette_packed(&t.manifold_edges, &bits), possible_silhouette_serial(&t.manifold_edges, &f));
+                let mut sil = Vec::new();
+                EdgeScan::new(t.manifold_edges.clone()).scan_into(&bits, &mut sil);
+                assert_eq!(sil, possible_silhouette_serial(&t.manifold_edges, &f));
             }
             check_planes(&t.mesh, l);
         }

@@ -547,7 +547,7 @@ fn plan_multiplicity(
     let directional = l_obj.w == 0.0;
     let ts = Instant::now();
     let mut bits = Vec::new();
-    caster.planes.facing_packed(caster.mesh(), l_obj, caster.mirrored, &mut bits);
+    caster.planes.facing_packed_auto(caster.mesh(), l_obj, caster.mirrored, &mut bits);
     let facing = Packed(&bits);
     let mult = edge_multiplicities_with(caster, &facing);
     let t = ts.elapsed().as_secs_f64() * 1e3;
@@ -642,7 +642,7 @@ pub fn plan_light_opts(input: &PlanInput, casters: &[Caster], edge_quads: bool) 
         }
         let ts = Instant::now();
         let mut bits = Vec::new();
-        caster.planes.facing_packed(caster.mesh(), l_obj, caster.mirrored, &mut bits);
+        caster.planes.facing_packed_auto(caster.mesh(), l_obj, caster.mirrored, &mut bits);
         let mut sil = Vec::new();
         possible_silhouette_packed_into(&caster.topology.manifold_edges, &bits, &mut sil);
         sil_time += ts.elapsed().as_secs_f64() * 1e3;
