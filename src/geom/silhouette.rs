@@ -362,6 +362,7 @@ impl FacePlanes {
 /// Facing and "unsure" bits of 64 planes: bit k of the first word is set when plane k's value
 /// exceeds `e`, of the second when its magnitude does not (NaN included).
 #[inline]
+#[allow(clippy::needless_range_loop)] // indexed form: the compiler vectorises it
 fn block64(nx: &[f32], ny: &[f32], nz: &[f32], d: &[f32], l: Vec4, e: f32) -> (u64, u64) {
     let (nx, ny, nz, d) = (&nx[..64], &ny[..64], &nz[..64], &d[..64]);
     let (mut bits, mut unsure) = (0u64, 0u64);
@@ -408,13 +409,16 @@ pub fn possible_silhouette_packed(edges: &[ManifoldEdge], bits: &[u64]) -> Vec<S
 pub struct EdgeScan {
     edges: Vec<ManifoldEdge>,
     pairs: Vec<[u32; 2]>,
+    /// Largest triangle id of any edge.
+    max_tri: u32,
 }
 
 impl EdgeScan {
     /// The scan over `edges` (in this order).
     pub fn new(edges: Vec<ManifoldEdge>) -> EdgeScan {
         let pairs = edges.iter().map(|e| [e.t0, e.t1]).collect();
-        EdgeScan { edges, pairs }
+        let max_tri = edges.iter().map(|e| e.t0.max(e.t1)).max().unwrap_or(0);
+        EdgeScan { edges, pairs, max_tri }
     }
 
     /// The edges, in scan order.
@@ -432,15 +436,30 @@ impl EdgeScan {
     /// counts as not facing).
     pub fn scan_into(&self, bits: &[u64], out: &mut Vec<SilhouetteEdge>) {
         let bit = |t: u32| bits.get(t as usize / 64).map_or(0, |w| (w >> (t % 64)) & 1);
-        for (chunk, es) in self.pairs.chunks(64).zip(self.edges.chunks(64)) {
-            let mut m = 0u64;
-            for (k, p) in chunk.iter().enumerate() {
-                m |= (bit(p[0]) ^ bit(p[1])) << k;
+        // One byte a triangle (a short, vectorisable pass over the words): the scan's two
+        // lookups an edge are then plain byte loads. Triangle ids past the bits read 0.
+        let len = (self.max_tri as usize + 1).max(bits.len() * 64);
+        let mut bytes = vec![0u8; len];
+        for (dst, &w) in bytes.chunks_exact_mut(64).zip(bits) {
+            for (k, d) in dst.iter_mut().enumerate() {
+                *d = ((w >> k) & 1) as u8;
             }
-            while m != 0 {
-                let k = m.trailing_zeros() as usize;
-                m &= m - 1;
-                let e = es[k];
+        }
+        let fast = |t: u32| bytes.get(t as usize).copied().unwrap_or(0);
+        for (chunk, es) in self.pairs.chunks(64).zip(self.edges.chunks(64)) {
+            // most blocks hold no silhouette edge: one OR-reduction (no shifts into a mask), and
+            // only the rare blocks with one are walked again
+            let mut any = 0u8;
+            for p in chunk {
+                any |= fast(p[0]) ^ fast(p[1]);
+            }
+            if any == 0 {
+                continue;
+            }
+            for (p, &e) in chunk.iter().zip(es) {
+                if fast(p[0]) == fast(p[1]) {
+                    continue;
+                }
                 out.push(if bit(e.t0) != 0 {
                     SilhouetteEdge { a: e.a, b: e.b, lit: e.t0, lit_corner: e.c0, unlit: e.t1, unlit_corner: e.c1 }
                 } else {
