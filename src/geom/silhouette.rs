@@ -9,10 +9,12 @@ use glam::{DVec3, Vec3, Vec4};
 /// Meshes with at least this many triangles get their facing bits on several threads
 /// (the f64 filtered orientation test is compute-bound).
 pub const PARALLEL_THRESHOLD: usize = 200_000;
-/// [`FacePlanes::facing_packed_auto`] splits over threads from this many triangles: on the
-/// 2-core machine 100k triangles took 134 µs on one thread and 102 µs on two, 1M 1.31 ms and
-/// 0.81 ms, while at 10k two threads cost more than they save (benches/silhouette.rs).
-pub const PLANES_PARALLEL_THRESHOLD: usize = 100_000;
+/// [`FacePlanes::facing_packed_auto`] splits over threads from this many triangles. Measured on
+/// the shared 2-core machine (benches/silhouette.rs): 1M triangles took 1.97 ms on one thread and
+/// 1.41 ms on two in isolation, but followed by the edge scan (as the planner runs it) 9.4 ms
+/// threaded against 3.0 ms serial, and 100k 970 µs against 277 µs; at 10k two threads cost
+/// 5x more than they save. Threads do not pay on such a machine: only for very large meshes.
+pub const PLANES_PARALLEL_THRESHOLD: usize = 4_000_000;
 /// The edge scan is memory-bound: on a 2-core machine, 1.5M edges took 1.2 ms serial vs
 /// 2.4 ms on 2 threads (benches/silhouette.rs), so it only splits for very large meshes.
 pub const PARALLEL_EDGE_THRESHOLD: usize = 8_000_000;
