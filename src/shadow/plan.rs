@@ -408,6 +408,7 @@ fn emit_with<F: FacingSet + ?Sized>(
                 let want = e.dark_cap == DarkCap::FrontFaces;
                 for (ci, ch) in part_chunks() {
                     let n = ch.n() as u16;
+                    vol[ci].reserve(ch.local_tris.len() * 3);
                     for (lt, &g) in ch.local_tris.iter().zip(&ch.tri_ids) {
                         if facing.get(g) == want {
                             let t = if want { [lt[0] + n, lt[2] + n, lt[1] + n] } else { [lt[0] + n, lt[1] + n, lt[2] + n] };
@@ -424,6 +425,7 @@ fn emit_with<F: FacingSet + ?Sized>(
     if e.light_cap {
         let want = e.formulation == Formulation::Front;
         for (ci, ch) in part_chunks() {
+            cap[ci].reserve(ch.local_tris.len() * 3);
             for (lt, &g) in ch.local_tris.iter().zip(&ch.tri_ids) {
                 if facing.get(g) == want {
                     let t = if want { *lt } else { [lt[0], lt[2], lt[1]] };
