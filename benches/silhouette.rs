@@ -1,64 +1,107 @@
 //! Possible-silhouette extraction (facing bits + edge scan) on UV spheres of 10k, 100k and
-//! 1M triangles, next to a plain streaming read (sum) over the same bytes (positions +
-//! indices + edge records) in the same run, so throughput can be compared to memory speed.
+//! 1M triangles, as the planner does it per light: triangle planes precomputed once
+//! (`FacePlanes::new`, outside the timed loops), facing as one f32 dot product per triangle
+//! with packed bits and the exact fallback near the planes (threads from
+//! `PLANES_PARALLEL_THRESHOLD` triangles), then the edge scan on the packed bits.
+//! `edge_scan_serial` is `EdgeScan`'s scan, `edge_scan` the scan of the full edge records. `streaming_sum` is a plain streaming read of the same bytes the new path reads (the
+//! four plane arrays and the manifold edge records), in the same run, so the throughput of the
+//! other functions (the group's throughput is those bytes) can be compared to memory speed.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::Vec4;
 use std::hint::black_box;
-use umbrage::geom::silhouette::{facing_bits, facing_bits_threads, possible_silhouette, possible_silhouette_serial};
+use umbrage::geom::silhouette::{possible_silhouette_packed_into, EdgeScan, FacePlanes, SilhouetteEdge};
 use umbrage::geom::topology::Topology;
 use umbrage::shadow::testmesh::uv_sphere;
 
-fn bytes_of(t: &Topology) -> u64 {
-    (t.mesh.positions.len() * 12 + t.mesh.triangles.len() * 12 + t.manifold_edges.len() * std::mem::size_of_val(&t.manifold_edges[0]))
-        as u64
+fn bytes_of(planes: &FacePlanes, scan: &EdgeScan) -> u64 {
+    (planes.bytes() + scan.bytes()) as u64
 }
 
-fn streaming_sum(t: &Topology) -> u64 {
-    let mut s = 0u64;
-    for p in &t.mesh.positions {
-        s = s.wrapping_add((p.x.to_bits() ^ p.y.to_bits() ^ p.z.to_bits()) as u64);
+/// The plane arrays as the facing pass sees them (same length and layout: 4 f32 arrays).
+struct PlainArrays {
+    a: Vec<f32>,
+    b: Vec<f32>,
+    c: Vec<f32>,
+    d: Vec<f32>,
+}
+
+fn streaming_sum(p: &PlainArrays, pairs: &[[u32; 2]]) -> u64 {
+    let mut s = [0u32; 8];
+    for (((a, b), c), d) in p.a.chunks_exact(8).zip(p.b.chunks_exact(8)).zip(p.c.chunks_exact(8)).zip(p.d.chunks_exact(8)) {
+        for k in 0..8 {
+            s[k] = s[k].wrapping_add(a[k].to_bits() ^ b[k].to_bits() ^ c[k].to_bits() ^ d[k].to_bits());
+        }
     }
-    for tri in &t.mesh.triangles {
-        s = s.wrapping_add((tri[0] ^ tri[1] ^ tri[2]) as u64);
+    let mut t = 0u64;
+    for e in pairs {
+        t = t.wrapping_add((e[0] ^ e[1]) as u64);
     }
-    for e in &t.manifold_edges {
-        s = s.wrapping_add((e.a ^ e.b ^ e.t0 ^ e.t1) as u64);
-    }
-    s
+    s.iter().map(|&x| x as u64).sum::<u64>().wrapping_add(t)
 }
 
 fn bench(c: &mut Criterion) {
     let light = Vec4::new(3.0, 2.0, 1.0, 1.0);
+    let threads = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
     for (name, slices, stacks) in [("10k", 100u32, 51u32), ("100k", 317, 159), ("1M", 1000, 501)] {
         let topo = Topology::build(&uv_sphere(1.0, slices, stacks));
         assert!(topo.is_closed_manifold());
-        let bytes = bytes_of(&topo);
+        let planes = FacePlanes::new(&topo.mesh);
+        let scan = EdgeScan::new(topo.manifold_edges.clone());
+        let pairs: Vec<[u32; 2]> = topo.manifold_edges.iter().map(|e| [e.t0 ^ 1, e.t1 ^ 3]).collect();
+        let words = planes.bytes() / 16;
+        let plain = PlainArrays {
+            a: (0..words).map(|i| i as f32).collect(),
+            b: (0..words).map(|i| (i * 3) as f32).collect(),
+            c: (0..words).map(|i| (i * 7) as f32).collect(),
+            d: (0..words).map(|i| (i * 11) as f32).collect(),
+        };
+        let bytes = bytes_of(&planes, &scan);
         let mut g = c.benchmark_group(format!("silhouette/{name}"));
         g.throughput(Throughput::Bytes(bytes));
         if slices >= 1000 {
             g.sample_size(10);
         }
         let tris = topo.mesh.triangles.len();
-        g.bench_function(BenchmarkId::new("streaming_sum", tris), |b| b.iter(|| black_box(streaming_sum(black_box(&topo)))));
+        let mut bits: Vec<u64> = Vec::new();
+        let mut sil: Vec<SilhouetteEdge> = Vec::new();
+        g.bench_function(BenchmarkId::new("streaming_sum", tris), |b| {
+            b.iter(|| black_box(streaming_sum(black_box(&plain), black_box(&pairs))))
+        });
         g.bench_function(BenchmarkId::new("facing+silhouette", tris), |b| {
             b.iter(|| {
-                let f = facing_bits(&topo.mesh, black_box(light), false);
-                black_box(possible_silhouette(&topo.manifold_edges, &f).len())
+                planes.facing_packed_auto(&topo.mesh, black_box(light), false, &mut bits);
+                sil.clear();
+                scan.scan_into(&bits, &mut sil);
+                black_box(sil.len())
             })
         });
         g.bench_function(BenchmarkId::new("facing_serial", tris), |b| {
-            b.iter(|| black_box(facing_bits_threads(&topo.mesh, black_box(light), false, 1).len()))
+            b.iter(|| {
+                planes.facing_packed(&topo.mesh, black_box(light), false, &mut bits);
+                black_box(bits.len())
+            })
         });
         g.bench_function(BenchmarkId::new("facing", tris), |b| {
-            b.iter(|| black_box(facing_bits(&topo.mesh, black_box(light), false).len()))
+            b.iter(|| {
+                planes.facing_packed_threads(&topo.mesh, black_box(light), false, threads, &mut bits);
+                black_box(bits.len())
+            })
         });
-        let f = facing_bits(&topo.mesh, light, false);
+        planes.facing_packed(&topo.mesh, light, false, &mut bits);
         g.bench_function(BenchmarkId::new("edge_scan_serial", tris), |b| {
-            b.iter(|| black_box(possible_silhouette_serial(&topo.manifold_edges, black_box(&f)).len()))
+            b.iter(|| {
+                sil.clear();
+                scan.scan_into(black_box(&bits), &mut sil);
+                black_box(sil.len())
+            })
         });
         g.bench_function(BenchmarkId::new("edge_scan", tris), |b| {
-            b.iter(|| black_box(possible_silhouette(&topo.manifold_edges, black_box(&f)).len()))
+            b.iter(|| {
+                sil.clear();
+                possible_silhouette_packed_into(&topo.manifold_edges, black_box(&bits), &mut sil);
+                black_box(sil.len())
+            })
         });
         g.finish();
     }

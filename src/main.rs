@@ -315,6 +315,18 @@ fn info(json: bool, scene: Option<&str>) -> Result<ExitCode> {
                 c.chunks,
                 if c.reason.is_empty() { String::new() } else { format!("  ({})", c.reason) }
             );
+            if c.parts.len() > 1 {
+                let manifold = c.parts.iter().filter(|p| p.path == "manifold").count();
+                println!(
+                    "    {} parts: {} manifold, {} multiplicity (each planned on its own)",
+                    c.parts.len(),
+                    manifold,
+                    c.parts.len() - manifold
+                );
+                for (i, p) in c.parts.iter().enumerate().filter(|(_, p)| p.path != "manifold") {
+                    println!("      part {i}: {} triangles, multiplicity ({})", p.triangles, p.reason);
+                }
+            }
         }
     }
     Ok(ExitCode::SUCCESS)

@@ -167,6 +167,19 @@ pub struct CasterInfo {
     pub chunks: usize,
     /// Opacity below 1: the volumes go to the light-intensity map.
     pub transparent: bool,
+    /// The connected components, each planned on its own.
+    pub parts: Vec<PartInfo>,
+}
+
+/// One connected component of a caster.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct PartInfo {
+    /// "manifold" or "multiplicity".
+    pub path: String,
+    /// Why this part takes the multiplicity path (empty for manifold parts).
+    pub reason: String,
+    /// Its triangles.
+    pub triangles: usize,
 }
 
 /// Classifies every shadow-casting mesh of `scene` (no GPU needed).
@@ -187,6 +200,18 @@ pub fn caster_report(scene: &Scene) -> Result<Vec<CasterInfo>> {
                 triangles: c.triangle_count,
                 chunks: c.chunks.len(),
                 transparent: c.transmittance.is_some(),
+                parts: c
+                    .parts
+                    .iter()
+                    .map(|p| PartInfo {
+                        path: p.kind.path().to_string(),
+                        reason: match &p.kind {
+                            crate::shadow::CasterKind::Multiplicity { reason } => reason.clone(),
+                            _ => String::new(),
+                        },
+                        triangles: p.triangles.len(),
+                    })
+                    .collect(),
             })
         })
         .collect()

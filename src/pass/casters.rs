@@ -191,13 +191,6 @@ impl CasterTable {
                 *dst = p;
             }
         }
-        caster.object_bounds = caster.topology.mesh.bounds();
-        let apex = caster.object_bounds.center();
-        for ch in &mut caster.chunks {
-            for (v, &g) in ch.vertices.iter_mut().zip(&ch.global_ids) {
-                *v = if g == u32::MAX { apex } else { caster.topology.mesh.positions[g as usize] };
-            }
-        }
         caster.refresh_after_positions_changed();
         let chunks = self.upload_chunks(dev, &caster)?;
         let entry = &mut self.live[i];

@@ -3,10 +3,10 @@
 
 use super::casters::{CasterTable, Upload};
 use super::desc::{Counter, IndexFormat, PassSettings, Technique};
-use super::stats::{CasterStats, CpuMs, LightStats, Totals, Triangles};
+use super::stats::{CasterStats, CpuMs, LightStats, PartStats, Totals, Triangles};
 use crate::error::{Error, Result};
 use crate::geom::{Camera, Light, LightKind};
-use crate::shadow::{self, Case, CasterKind, LightPlan, PlanInput};
+use crate::shadow::{self, Case, CasterKind, LightPlan, PlanInput, PlanOptions};
 use ash::vk;
 use glam::{DMat4, DVec3, Mat4, Vec3, Vec4};
 use std::cell::Cell;
@@ -54,6 +54,8 @@ pub(crate) struct Draw {
     pub offset: u64,
     pub count: u32,
     pub format: IndexFormat,
+    /// The case of the caster part this chunk belongs to (its pipeline and sign follow it).
+    pub case: Case,
     /// A light cap (drawn with the depth-NEVER pipeline by the stencil counter).
     pub light_cap: bool,
 }
@@ -188,10 +190,11 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
     let mut cpu = CpuMs::default();
     let mut lights = Vec::with_capacity(input.lights.len());
     for (li, light) in input.lights.iter().enumerate() {
-        let plan = shadow::plan_light_opts(
+        // Each part (connected component) of a caster gets its own case; every draw carries it.
+        let plan = shadow::plan_light_with(
             &PlanInput { camera: &camera, width: view.width, height: view.height, view_proj, light, method },
             if input.casters { &table.cpu } else { &[] },
-            edge_quads,
+            &PlanOptions { edge_quads, case_per_part: true },
         );
         cpu.silhouettes += plan.silhouette_ms;
         cpu.plan += plan.plan_ms;
@@ -244,6 +247,7 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
                         offset,
                         count: indices.len() as u32,
                         format: fmt,
+                        case: cd.case,
                         light_cap: cap,
                     });
                 }
@@ -275,6 +279,17 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
                     _ => String::new(),
                 },
                 multiplicity_max: cp.multiplicity_max,
+                parts: cp
+                    .parts
+                    .iter()
+                    .map(|p| PartStats {
+                        part: p.part,
+                        case: case_name(p.case).to_string(),
+                        path: p.path.to_string(),
+                        silhouette_edges: p.silhouette_edges as u64,
+                        triangles: Triangles { sides: p.sides as u64, dark_cap: p.dark_cap as u64, light_cap: p.light_cap as u64 },
+                    })
+                    .collect(),
             });
             let edge_quad = match (&gpu.edge_quads, cp.path == "edgequad") {
                 (Some(eq), true) => Some(EdgeQuadDraw {

@@ -236,21 +236,23 @@ impl ShadowPass {
         let count = p.count.as_ref();
         let mut bound = vk::Pipeline::null();
         for c in lf.casters.iter().filter(|c| c.case != Case::Culled) {
-            let zpass = c.case == Case::ZPass;
-            let sign = if zpass { 1.0 } else { -1.0 };
-            let (color, wanted) = match kind {
-                VolumeKind::Transmit { .. } => match c.transmittance {
-                    Some(t) => ([sign, t.x, t.y, t.z], true),
-                    None => ([0.0; 4], false),
-                },
-                _ => ([sign, 0.0, 0.0, 0.0], c.transmittance.is_none()),
+            let wanted = match kind {
+                VolumeKind::Transmit { .. } => c.transmittance.is_some(),
+                _ => c.transmittance.is_none(),
             };
             if !wanted {
                 continue;
             }
-            // SAFETY: the caller's contract; push constants match the pipeline layout.
-            unsafe { self.push(cb, c, color) };
+            // Float counter: the sign a front face contributes (+1 z-pass, -1 z-fail);
+            // light-intensity map: and the caster's transmittance.
+            let color = |case: Case| {
+                let sign = if case == Case::ZPass { 1.0 } else { -1.0 };
+                let t = c.transmittance.unwrap_or_default();
+                [sign, t.x, t.y, t.z]
+            };
             if let Some(eq) = &c.edge_quad {
+                // SAFETY: the caller's contract; push constants match the pipeline layout.
+                unsafe { self.push(cb, c, color(c.case)) };
                 let (faces, sides) = match (kind, count) {
                     (VolumeKind::Stencil, _) => (p.stencil.eq_faces, p.stencil.eq_sides),
                     (VolumeKind::Float, Some(cp)) => (cp.eq_faces, cp.eq_sides),
@@ -271,8 +273,16 @@ impl ShadowPass {
                 bound = sides;
                 continue;
             }
+            let mut pushed = None;
             for dr in &c.draws {
-                let Some(pipe) = self.pipeline_for(kind, count, c.case, dr.light_cap) else { continue };
+                let Some(pipe) = self.pipeline_for(kind, count, dr.case, dr.light_cap) else { continue };
+                // Parts of one caster may take different cases: the sign follows the draw's.
+                let block = color(dr.case);
+                if pushed != Some(block) {
+                    // SAFETY: as above.
+                    unsafe { self.push(cb, c, block) };
+                    pushed = Some(block);
+                }
                 if pipe != bound {
                     // SAFETY: as above.
                     unsafe { self.dev.device.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipe) };
@@ -328,17 +338,17 @@ impl ShadowPass {
         // SAFETY: the caller's contract.
         unsafe { self.dev.device.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipe) };
         for lf in &frame.lights {
-            for c in &lf.casters {
-                let color = match c.case {
-                    Case::Culled => continue,
-                    Case::ZPass => [0.2f32, 0.4, 1.0, 0.12],
-                    Case::ZFail => [1.0, 0.3, 0.2, 0.12],
-                    Case::ZFailLightCap => [0.1, 1.0, 0.2, 0.12],
-                };
-                // SAFETY: as above.
-                unsafe {
-                    self.push(cb, c, color);
-                    for dr in c.draws.iter().filter(|dr| !dr.light_cap) {
+            for c in lf.casters.iter().filter(|c| c.case != Case::Culled) {
+                for dr in c.draws.iter().filter(|dr| !dr.light_cap) {
+                    let color = match dr.case {
+                        Case::Culled => continue,
+                        Case::ZPass => [0.2f32, 0.4, 1.0, 0.12],
+                        Case::ZFail => [1.0, 0.3, 0.2, 0.12],
+                        Case::ZFailLightCap => [0.1, 1.0, 0.2, 0.12],
+                    };
+                    // SAFETY: as above.
+                    unsafe {
+                        self.push(cb, c, color);
                         self.record_draw(cb, frame.stream, dr);
                     }
                 }

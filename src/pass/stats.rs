@@ -54,6 +54,25 @@ pub struct CasterStats {
     pub path_reason: String,
     /// Largest |edge multiplicity| drawn (1 for a manifold silhouette).
     pub multiplicity_max: u32,
+    /// Per part (connected component) that was planned: its own case, path and triangles
+    /// (empty when the caster was culled whole or drawn with edge quads).
+    pub parts: Vec<PartStats>,
+}
+
+/// One part (connected component) of a caster for one light.
+#[derive(Clone, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct PartStats {
+    /// Index of the part in the caster.
+    pub part: usize,
+    /// The part's case (`culled`, `zpass`, `zfail`, `zfail_light_cap`).
+    pub case: String,
+    /// `manifold` or `multiplicity`.
+    pub path: String,
+    /// Possible silhouette edges of the part.
+    pub silhouette_edges: u64,
+    /// Its shadow triangles.
+    pub triangles: Triangles,
 }
 
 #[derive(Clone, Debug)]

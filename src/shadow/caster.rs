@@ -7,6 +7,7 @@
 //! is the number of caster triangles between it and the light (see `plan`).
 
 use crate::error::{Error, Result};
+use crate::geom::silhouette::{EdgeScan, FacePlanes};
 use crate::geom::topology::Topology;
 use crate::geom::{Aabb, Mesh};
 #[cfg(feature = "cli")]
@@ -71,6 +72,27 @@ impl CasterKind {
     }
 }
 
+/// One connected component of a caster's welded mesh (triangles sharing a vertex belong to
+/// the same part), planned on its own: its own bounds, culling, case and path.
+#[derive(Clone, Debug)]
+pub struct Part {
+    /// [`CasterKind::Manifold`] when this component alone is a closed, consistently oriented
+    /// 2-manifold; transparent casters are one multiplicity part.
+    pub kind: CasterKind,
+    /// Welded triangle ids of the part, ascending.
+    pub triangles: Vec<u32>,
+    /// The part's chunks: `Caster::chunks[chunks]` (chunks never mix parts; their apex is the
+    /// centre of the part's bounds).
+    pub chunks: std::ops::Range<usize>,
+    /// Object-space bounds of the part's vertices.
+    pub object_bounds: Aabb,
+    /// Ids of the part's undirected edges in [`Topology::edges`], ascending.
+    pub edges: Vec<u32>,
+    /// The part's manifold edges (in [`Topology::manifold_edges`] order), ready for the
+    /// per-light possible-silhouette scan.
+    pub scan: EdgeScan,
+}
+
 /// A shadow caster: welded mesh, topology and chunks.
 #[derive(Clone, Debug)]
 pub struct Caster {
@@ -88,8 +110,16 @@ pub struct Caster {
     pub coincident: Vec<u32>,
     /// Welded mesh and its edge table (object space).
     pub topology: Topology,
-    /// The welded mesh split into pieces of at most [`MAX_CHUNK_VERTICES`] vertices.
+    /// Object-space plane of every welded triangle, for the per-light facing bits
+    /// ([`FacePlanes::facing_packed`]); recompute with [`Caster::recompute_planes`] after
+    /// changing the welded positions.
+    pub planes: FacePlanes,
+    /// The welded mesh split into pieces of at most [`MAX_CHUNK_VERTICES`] vertices (never
+    /// mixing parts).
     pub chunks: Vec<Chunk>,
+    /// The connected components, in order of their first triangle (one part for a connected
+    /// mesh, and for transparent casters).
+    pub parts: Vec<Part>,
     /// For every welded triangle: (chunk, local triangle index).
     pub tri_chunk: Vec<(u32, u32)>,
     /// Bounding box of the welded mesh, object space.
@@ -106,6 +136,8 @@ pub struct Caster {
     pub max_local_vertices: usize,
     /// True iff every chunk can use 8-bit indices.
     pub max_local_vertices_u8: bool,
+    /// The chunk vertex limit the caster was built with.
+    chunk_limit: usize,
 }
 
 impl Caster {
@@ -116,12 +148,11 @@ impl Caster {
     pub fn from_scene_mesh(m: &SceneMesh) -> Result<Caster> {
         let mut c = Caster::new(&m.name, &m.mesh, m.transform)?;
         if m.opacity < 1.0 {
-            if c.kind == CasterKind::Manifold {
-                c.kind = CasterKind::Multiplicity {
-                    reason: format!("transparent (opacity {}): every surface crossed attenuates the light", m.opacity),
-                };
-                c.coincident = coincident_groups(&c.topology.mesh);
-            }
+            let reason = match &c.kind {
+                CasterKind::Manifold => format!("transparent (opacity {}): every surface crossed attenuates the light", m.opacity),
+                CasterKind::Multiplicity { reason } => reason.clone(),
+            };
+            c.make_whole_multiplicity(reason);
             c.transmittance = Some(((1.0 - m.opacity) * m.color).max(glam::Vec3::splat(TRANSMITTANCE_FLOOR)));
         }
         Ok(c)
@@ -134,9 +165,10 @@ impl Caster {
         Caster::with_chunk_limit(name, mesh, transform, MAX_CHUNK_VERTICES)
     }
 
-    /// `limit`: most vertices per chunk including the apex (2..=32768; tests use small ones).
+    /// `limit`: most vertices per chunk including the apex (4..=32768, clamped; tests use
+    /// small ones).
     pub fn with_chunk_limit(name: &str, mesh: &Mesh, transform: Mat4, limit: usize) -> Result<Caster> {
-        assert!((4..=MAX_CHUNK_VERTICES).contains(&limit));
+        let limit = limit.clamp(4, MAX_CHUNK_VERTICES);
         mesh.validate(name)?;
         let topology = Topology::build(mesh);
         let kind = if topology.is_closed_manifold() {
@@ -149,8 +181,8 @@ impl Caster {
             return Err(Error::mesh(name, "transform is singular"));
         }
         let object_bounds = topology.mesh.bounds();
-        let apex = object_bounds.center();
-        let (chunks, tri_chunk) = build_chunks(&topology.mesh, apex, limit);
+        let (parts, chunks, tri_chunk) = build_parts(&topology, limit, false);
+        let kind = if parts.len() > 1 && parts.iter().all(|p| p.kind == CasterKind::Manifold) { CasterKind::Manifold } else { kind };
         let max_local_vertices = chunks.iter().map(|c| c.vertices.len()).max().unwrap_or(0);
         let coincident = match kind {
             CasterKind::Manifold => Vec::new(),
@@ -162,16 +194,41 @@ impl Caster {
             kind,
             coincident,
             triangle_count: topology.mesh.triangles.len(),
+            planes: FacePlanes::new(&topology.mesh),
             topology,
             chunks,
+            parts,
             tri_chunk,
             object_bounds,
+            chunk_limit: limit,
             transform,
             inverse: transform.inverse(),
             mirrored: det < 0.0,
             max_local_vertices,
             max_local_vertices_u8: max_local_vertices <= 128,
         })
+    }
+
+    /// Puts the whole caster on the multiplicity path as ONE part (transparent casters, whose
+    /// every surface attenuates the light; tests): rebuilds the parts and chunks (for a
+    /// connected mesh the chunks stay the same) and the coincident groups.
+    pub fn make_whole_multiplicity(&mut self, reason: String) {
+        self.kind = CasterKind::Multiplicity { reason };
+        let (parts, chunks, tri_chunk) = build_parts(&self.topology, self.chunk_limit, true);
+        self.parts = parts;
+        self.chunks = chunks;
+        self.tri_chunk = tri_chunk;
+        self.max_local_vertices = self.chunks.iter().map(|c| c.vertices.len()).max().unwrap_or(0);
+        self.max_local_vertices_u8 = self.max_local_vertices <= 128;
+        if self.coincident.len() != self.triangle_count {
+            self.coincident = coincident_groups(&self.topology.mesh);
+        }
+    }
+
+    /// Recomputes the triangle planes from the welded mesh's current positions (deforming
+    /// casters, after writing `topology.mesh.positions`).
+    pub fn recompute_planes(&mut self) {
+        self.planes.recompute(&self.topology.mesh);
     }
 
     /// True iff the caster takes the classic closed-manifold path.
@@ -222,14 +279,128 @@ fn coincident_groups(mesh: &Mesh) -> Vec<u32> {
     out
 }
 
-/// Greedy chunking in triangle order (mesh order usually has good locality).
-fn build_chunks(mesh: &Mesh, apex: Vec3, limit: usize) -> (Vec<Chunk>, Vec<(u32, u32)>) {
-    let max_local = limit - 1; // room for the apex
+/// Connected components of the welded mesh (triangles sharing a vertex), each with its kind,
+/// bounds, edges and chunks; `whole`: one multiplicity part with every triangle.
+fn build_parts(topo: &Topology, limit: usize, whole: bool) -> (Vec<Part>, Vec<Chunk>, Vec<(u32, u32)>) {
+    let mesh = &topo.mesh;
+    let nt = mesh.triangles.len();
+    // union-find over vertices
+    let mut parent: Vec<u32> = (0..mesh.positions.len() as u32).collect();
+    fn find(parent: &mut [u32], mut x: u32) -> u32 {
+        while parent[x as usize] != x {
+            let p = parent[parent[x as usize] as usize];
+            parent[x as usize] = p;
+            x = p;
+        }
+        x
+    }
+    let mut comp_of_tri = vec![0u32; nt];
+    let mut ncomp = 0usize;
+    if !whole {
+        for t in &mesh.triangles {
+            let r0 = find(&mut parent, t[0]);
+            for &v in &t[1..] {
+                let r = find(&mut parent, v);
+                if r != r0 {
+                    parent[r as usize] = r0;
+                }
+            }
+        }
+        // components numbered in order of their first triangle
+        let mut id = vec![u32::MAX; mesh.positions.len()];
+        for (ti, t) in mesh.triangles.iter().enumerate() {
+            let r = find(&mut parent, t[0]) as usize;
+            if id[r] == u32::MAX {
+                id[r] = ncomp as u32;
+                ncomp += 1;
+            }
+            comp_of_tri[ti] = id[r];
+        }
+    } else {
+        ncomp = usize::from(nt > 0);
+    }
+    let mut tris: Vec<Vec<u32>> = vec![Vec::new(); ncomp];
+    for (t, &c) in comp_of_tri.iter().enumerate() {
+        tris[c as usize].push(t as u32);
+    }
+    // per-part edge problems (an edge's uses all lie in one part)
+    let mut edges: Vec<Vec<u32>> = vec![Vec::new(); ncomp];
+    let mut problems = vec![[0usize; 3]; ncomp]; // boundary, non-manifold, inconsistent
+    for (ei, e) in topo.edges.iter().enumerate() {
+        let uses = topo.edge_uses(ei);
+        let Some(u0) = uses.first() else { continue };
+        let c = comp_of_tri[u0.tri as usize] as usize;
+        edges[c].push(ei as u32);
+        match e.use_count {
+            1 => problems[c][0] += 1,
+            2 if uses[0].forward == uses[1].forward => problems[c][2] += 1,
+            2 => {}
+            _ => problems[c][1] += 1,
+        }
+    }
+    let mut manifold: Vec<Vec<crate::geom::topology::ManifoldEdge>> = vec![Vec::new(); ncomp];
+    for e in &topo.manifold_edges {
+        manifold[comp_of_tri[e.t0 as usize] as usize].push(*e);
+    }
     let mut chunks = Vec::new();
-    let mut tri_chunk = vec![(0u32, 0u32); mesh.triangles.len()];
-    // vertex -> (chunk stamp, local index)
+    let mut tri_chunk = vec![(0u32, 0u32); nt];
     let mut stamp = vec![u32::MAX; mesh.positions.len()];
     let mut local = vec![0u16; mesh.positions.len()];
+    let mut parts = Vec::with_capacity(ncomp);
+    for (((ptris, pedges), [b, nm, inc]), pman) in tris.into_iter().zip(edges).zip(problems).zip(manifold) {
+        let bounds = if ncomp == 1 {
+            mesh.bounds()
+        } else {
+            Aabb::from_points(ptris.iter().flat_map(|&t| mesh.triangles[t as usize].iter().map(|&v| &mesh.positions[v as usize])))
+        };
+        let kind = if whole {
+            CasterKind::Multiplicity { reason: "whole caster".into() }
+        } else if !pedges.is_empty() && b == 0 && nm == 0 && inc == 0 {
+            CasterKind::Manifold
+        } else {
+            let mut why = Vec::new();
+            if pedges.is_empty() {
+                why.push("no edges".to_string());
+            }
+            if b > 0 {
+                why.push(format!("{b} boundary edges (open mesh)"));
+            }
+            if nm > 0 {
+                why.push(format!("{nm} edges shared by more than 2 triangles"));
+            }
+            if inc > 0 {
+                why.push(format!("{inc} edges with inconsistently oriented triangles"));
+            }
+            CasterKind::Multiplicity { reason: why.join(", ") }
+        };
+        let first = chunks.len();
+        build_chunks(mesh, &ptris, bounds.center(), limit, &mut chunks, &mut tri_chunk, &mut stamp, &mut local);
+        parts.push(Part {
+            kind,
+            triangles: ptris,
+            chunks: first..chunks.len(),
+            object_bounds: bounds,
+            edges: pedges,
+            scan: EdgeScan::new(pman),
+        });
+    }
+    (parts, chunks, tri_chunk)
+}
+
+/// Greedy chunking of the triangles `tris` in their order (mesh order usually has good
+/// locality), appended to `chunks`; `stamp`/`local`: per-vertex scratch shared across calls.
+#[allow(clippy::too_many_arguments)]
+fn build_chunks(
+    mesh: &Mesh,
+    tris: &[u32],
+    apex: Vec3,
+    limit: usize,
+    chunks: &mut Vec<Chunk>,
+    tri_chunk: &mut [(u32, u32)],
+    stamp: &mut [u32],
+    local: &mut [u16],
+) {
+    let max_local = limit - 1; // room for the apex
     let new_chunk = || Chunk { vertices: Vec::new(), local_tris: Vec::new(), tri_ids: Vec::new(), global_ids: Vec::new() };
     let mut cur = new_chunk();
     let finish = |mut c: Chunk, chunks: &mut Vec<Chunk>| {
@@ -237,7 +408,8 @@ fn build_chunks(mesh: &Mesh, apex: Vec3, limit: usize) -> (Vec<Chunk>, Vec<(u32,
         c.global_ids.push(u32::MAX);
         chunks.push(c);
     };
-    for (t, tri) in mesh.triangles.iter().enumerate() {
+    for &t in tris {
+        let tri = mesh.triangles[t as usize];
         let cid = chunks.len() as u32;
         let mut needed = 0;
         for (k, &v) in tri.iter().enumerate() {
@@ -246,7 +418,7 @@ fn build_chunks(mesh: &Mesh, apex: Vec3, limit: usize) -> (Vec<Chunk>, Vec<(u32,
             }
         }
         if cur.vertices.len() + needed > max_local {
-            finish(std::mem::replace(&mut cur, new_chunk()), &mut chunks);
+            finish(std::mem::replace(&mut cur, new_chunk()), chunks);
         }
         let cid = chunks.len() as u32;
         let mut lt = [0u16; 3];
@@ -259,21 +431,41 @@ fn build_chunks(mesh: &Mesh, apex: Vec3, limit: usize) -> (Vec<Chunk>, Vec<(u32,
             }
             lt[k] = local[v as usize];
         }
-        tri_chunk[t] = (cid, cur.local_tris.len() as u32);
+        tri_chunk[t as usize] = (cid, cur.local_tris.len() as u32);
         cur.local_tris.push(lt);
-        cur.tri_ids.push(t as u32);
+        cur.tri_ids.push(t);
     }
     if !cur.local_tris.is_empty() {
-        finish(cur, &mut chunks);
+        finish(cur, chunks);
     }
-    (chunks, tri_chunk)
 }
 
 impl Caster {
-    /// Re-derives what depends on vertex positions after they changed in place (same
-    /// topology): called by the shadow pass for deforming casters, after the welded positions,
-    /// the chunks' vertices and the bounds were updated.
-    pub fn refresh_after_positions_changed(&mut self) {}
+    /// Re-derives what depends on vertex positions after `topology.mesh.positions` changed in
+    /// place (same topology, deforming casters): the bounds of the caster and of each part,
+    /// every chunk's vertices (the apex at its part's new centre) and the triangle planes.
+    pub fn refresh_after_positions_changed(&mut self) {
+        self.object_bounds = self.topology.mesh.bounds();
+        let mesh = &self.topology.mesh;
+        let positions = &mesh.positions;
+        let single = self.parts.len() == 1;
+        for part in &mut self.parts {
+            // As `build_parts`: a connected mesh's part has the whole mesh's bounds.
+            let b = if single {
+                mesh.bounds()
+            } else {
+                Aabb::from_points(part.triangles.iter().flat_map(|&t| mesh.triangles[t as usize].iter().map(|&v| &positions[v as usize])))
+            };
+            part.object_bounds = b;
+            let apex = b.center();
+            for ch in &mut self.chunks[part.chunks.clone()] {
+                for (v, &g) in ch.vertices.iter_mut().zip(&ch.global_ids) {
+                    *v = if g == u32::MAX { apex } else { positions[g as usize] };
+                }
+            }
+        }
+        self.recompute_planes();
+    }
 
     /// Sets object -> world (finite and invertible; checked by the caller).
     pub fn set_transform(&mut self, transform: Mat4) {
@@ -288,10 +480,11 @@ impl Caster {
     /// through: it takes the multiplicity path whatever its topology, since its count must be
     /// the number of surfaces crossed (Kim et al. 2008).
     pub fn into_transparent(mut self, transmittance: glam::Vec3) -> Caster {
-        if self.kind == CasterKind::Manifold {
-            self.kind = CasterKind::Multiplicity { reason: "transparent: every surface crossed attenuates the light".into() };
-            self.coincident = coincident_groups(&self.topology.mesh);
-        }
+        let reason = match &self.kind {
+            CasterKind::Manifold => "transparent: every surface crossed attenuates the light".to_string(),
+            CasterKind::Multiplicity { reason } => reason.clone(),
+        };
+        self.make_whole_multiplicity(reason);
         self.transmittance = Some(transmittance.max(glam::Vec3::splat(TRANSMITTANCE_FLOOR)));
         self
     }

@@ -42,7 +42,7 @@
 use super::caster::{Caster, CasterKind};
 use crate::error::Error;
 use crate::geom::bounds::{box_distance, light_depth_bounds, light_scissor, shadow_volume_outside_frustum, Frustum, OcclusionPyramid};
-use crate::geom::silhouette::{facing_bits, possible_silhouette, SilhouetteEdge};
+use crate::geom::silhouette::{packed_bit, SilhouetteEdge};
 use crate::geom::Aabb;
 use crate::geom::{Camera, Light, LightKind};
 use glam::{Mat4, Vec4};
@@ -112,11 +112,12 @@ impl std::str::FromStr for Method {
 }
 
 /// How one caster's volume is drawn for one light.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub enum Case {
     /// Nothing drawn (outside the light's radius or cone, or the volume is off screen).
     #[cfg_attr(feature = "serde", serde(rename = "culled"))]
+    #[default]
     Culled,
     /// Case 1: z-pass, sides only.
     #[cfg_attr(feature = "serde", serde(rename = "zpass"))]
@@ -183,6 +184,9 @@ pub struct PlanInput<'a> {
 pub struct ChunkDraw {
     /// Index into the caster's [`Caster::chunks`].
     pub chunk: usize,
+    /// The case these lists were emitted for (the case of the caster's part the chunk belongs
+    /// to): the renderer's pipelines (z-pass or z-fail stencil operations) follow it.
+    pub case: Case,
     /// Sides then dark cap (then, for multiplicity casters, the light caps that may lie in
     /// front of the visible surface); drawn with depth test LESS.
     pub volume: Vec<u16>,
@@ -219,6 +223,50 @@ pub struct CasterPlan {
     /// Object-space homogeneous light the facing bits were decided for (the GPU must use the
     /// same value in EXTRUDE).
     pub light_object: [f32; 4],
+    /// One plan per part of the caster ([`Caster::parts`], same order). The caster's counts
+    /// are the sums of its parts', its draws the concatenation of theirs, its `case` the most
+    /// expensive of theirs, and its `dark_cap_kind` and `formulation` those of the first part
+    /// with that case.
+    pub parts: Vec<PartPlan>,
+}
+
+/// The plan of one part (connected component) of a caster.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct PartPlan {
+    /// Index into [`Caster::parts`].
+    pub part: usize,
+    /// The part's own case (McGuire's rule on the part's bounds).
+    pub case: Case,
+    /// `"manifold"` or `"multiplicity"`.
+    pub path: &'static str,
+    /// Possible silhouette edges of the part.
+    pub silhouette_edges: usize,
+    /// Largest |edge multiplicity| drawn (multiplicity parts).
+    pub multiplicity_max: u32,
+    /// Side triangles.
+    pub sides: usize,
+    /// Dark-cap triangles.
+    pub dark_cap: usize,
+    /// Light-cap triangles.
+    pub light_cap: usize,
+    /// Which dark cap was emitted.
+    pub dark_cap_kind: DarkCap,
+    /// Which closed volume the geometry describes.
+    pub formulation: Formulation,
+}
+
+/// Options of [`plan_light_with`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PlanOptions {
+    /// See [`plan_light_opts`].
+    pub edge_quads: bool,
+    /// Each part of a caster gets the case its own bounds call for, recorded per draw in
+    /// [`ChunkDraw::case`]: only for renderers that pick the pipeline per draw. Otherwise
+    /// (default) the parts of a caster that are not culled share one case (theirs when they
+    /// agree, else z-fail with light cap, always valid), so that `CasterPlan::case` holds for
+    /// every draw of the caster.
+    pub case_per_part: bool,
 }
 
 impl CasterPlan {
@@ -247,12 +295,12 @@ pub struct LightPlan {
 }
 
 /// Per-chunk index lists into draws, leaving out chunks with nothing to draw.
-fn chunk_draws(vol: Vec<Vec<u16>>, cap: Vec<Vec<u16>>) -> Vec<ChunkDraw> {
+fn chunk_draws(vol: Vec<Vec<u16>>, cap: Vec<Vec<u16>>, case: Case) -> Vec<ChunkDraw> {
     vol.into_iter()
         .zip(cap)
         .enumerate()
         .filter(|(_, (v, c))| !v.is_empty() || !c.is_empty())
-        .map(|(chunk, (volume, light_cap))| ChunkDraw { chunk, volume, light_cap })
+        .map(|(chunk, (volume, light_cap))| ChunkDraw { chunk, case, volume, light_cap })
         .collect()
 }
 
@@ -321,8 +369,53 @@ pub struct Emit {
     pub light_cap: bool,
 }
 
+/// Per-triangle facing bits, as one `bool` per triangle or packed 64 to a word
+/// ([`crate::geom::silhouette::FacePlanes::facing_packed`]).
+trait FacingSet {
+    fn get(&self, t: u32) -> bool;
+}
+
+impl FacingSet for [bool] {
+    #[inline]
+    fn get(&self, t: u32) -> bool {
+        self.get(t as usize).copied().unwrap_or(false)
+    }
+}
+
+/// Packed facing bits (see [`FacingSet`]).
+struct Packed<'a>(&'a [u64]);
+
+impl FacingSet for Packed<'_> {
+    #[inline]
+    fn get(&self, t: u32) -> bool {
+        packed_bit(self.0, t)
+    }
+}
+
 /// Emits the index lists; returns (chunk draws, sides, dark cap, light cap) triangle counts.
+/// Over every chunk of the caster; the draws' `case` is z-fail with light cap when `e.light_cap`,
+/// z-fail when there is a dark cap, else z-pass.
 pub fn emit(caster: &Caster, facing: &[bool], sil: &[SilhouetteEdge], e: Emit) -> (Vec<ChunkDraw>, usize, usize, usize) {
+    let case = if e.light_cap {
+        Case::ZFailLightCap
+    } else if e.dark_cap != DarkCap::None {
+        Case::ZFail
+    } else {
+        Case::ZPass
+    };
+    emit_with(caster, 0..caster.chunks.len(), facing, sil, e, case)
+}
+
+/// [`emit`] for the part whose chunks are `range` (`sil` from that part's edges).
+fn emit_with<F: FacingSet + ?Sized>(
+    caster: &Caster,
+    range: std::ops::Range<usize>,
+    facing: &F,
+    sil: &[SilhouetteEdge],
+    e: Emit,
+    case: Case,
+) -> (Vec<ChunkDraw>, usize, usize, usize) {
+    let part_chunks = || caster.chunks.iter().enumerate().skip(range.start).take(range.len());
     let nch = caster.chunks.len();
     let mut vol: Vec<Vec<u16>> = vec![Vec::new(); nch];
     let mut cap: Vec<Vec<u16>> = vec![Vec::new(); nch];
@@ -369,10 +462,11 @@ pub fn emit(caster: &Caster, facing: &[bool], sil: &[SilhouetteEdge], e: Emit) -
             }
             DarkCap::FrontFaces | DarkCap::BackFaces => {
                 let want = e.dark_cap == DarkCap::FrontFaces;
-                for (ci, ch) in caster.chunks.iter().enumerate() {
+                for (ci, ch) in part_chunks() {
                     let n = ch.n() as u16;
+                    vol[ci].reserve(ch.local_tris.len() * 3);
                     for (lt, &g) in ch.local_tris.iter().zip(&ch.tri_ids) {
-                        if facing[g as usize] == want {
+                        if facing.get(g) == want {
                             let t = if want { [lt[0] + n, lt[2] + n, lt[1] + n] } else { [lt[0] + n, lt[1] + n, lt[2] + n] };
                             vol[ci].extend_from_slice(&t);
                             dark += 1;
@@ -386,9 +480,10 @@ pub fn emit(caster: &Caster, facing: &[bool], sil: &[SilhouetteEdge], e: Emit) -
     }
     if e.light_cap {
         let want = e.formulation == Formulation::Front;
-        for (ci, ch) in caster.chunks.iter().enumerate() {
+        for (ci, ch) in part_chunks() {
+            cap[ci].reserve(ch.local_tris.len() * 3);
             for (lt, &g) in ch.local_tris.iter().zip(&ch.tri_ids) {
-                if facing[g as usize] == want {
+                if facing.get(g) == want {
                     let t = if want { *lt } else { [lt[0], lt[2], lt[1]] };
                     cap[ci].extend_from_slice(&t);
                     light += 1;
@@ -396,7 +491,7 @@ pub fn emit(caster: &Caster, facing: &[bool], sil: &[SilhouetteEdge], e: Emit) -
             }
         }
     }
-    let draws = chunk_draws(vol, cap);
+    let draws = chunk_draws(vol, cap, case);
     (draws, sides, dark, light)
 }
 
@@ -436,8 +531,20 @@ pub struct MultiplicityInput<'a> {
 
 /// Signed multiplicity of every undirected edge of the topology (`v[0] -> v[1]` positive).
 pub fn edge_multiplicities(caster: &Caster, facing: &[bool]) -> Vec<i32> {
+    let ids: Vec<u32> = (0..caster.topology.edges.len() as u32).collect();
+    edge_multiplicities_with(caster, &ids, facing)
+}
+
+fn edge_multiplicities_with<F: FacingSet + ?Sized>(caster: &Caster, edge_ids: &[u32], facing: &F) -> Vec<i32> {
     let t = &caster.topology;
-    (0..t.edges.len()).map(|e| t.edge_uses(e).iter().map(|u| if u.forward == facing[u.tri as usize] { 1 } else { -1 }).sum()).collect()
+    edge_ids
+        .iter()
+        .filter_map(|&e| t.edges.get(e as usize))
+        .map(|e| {
+            let uses = t.uses.get(e.first_use as usize..(e.first_use + e.use_count) as usize).unwrap_or(&[]);
+            uses.iter().map(|u| if u.forward == facing.get(u.tri) { 1 } else { -1 }).sum()
+        })
+        .collect()
 }
 
 /// Emits a multiplicity caster's index lists; returns (draws, sides, dark cap, light cap,
@@ -450,11 +557,31 @@ pub fn emit_multiplicity(
     directional: bool,
     dark_cap: DarkCap,
 ) -> (Vec<ChunkDraw>, usize, usize, usize, usize, u32) {
+    let edge_ids: Vec<u32> = (0..mult.len() as u32).collect();
+    let shielded = |g: u32| mi.shielded.get(g as usize).copied().unwrap_or(true);
+    emit_multiplicity_with(caster, 0..caster.chunks.len(), &edge_ids, mi.facing, shielded, mult, case, directional, dark_cap)
+}
+
+/// [`emit_multiplicity`] for the part whose chunks are `range` and whose edges are `edge_ids`
+/// (`mult[i]` the multiplicity of edge `edge_ids[i]`).
+#[allow(clippy::too_many_arguments)]
+fn emit_multiplicity_with<F: FacingSet + ?Sized, S: Fn(u32) -> bool>(
+    caster: &Caster,
+    range: std::ops::Range<usize>,
+    edge_ids: &[u32],
+    facing: &F,
+    shielded: S,
+    mult: &[i32],
+    case: Case,
+    directional: bool,
+    dark_cap: DarkCap,
+) -> (Vec<ChunkDraw>, usize, usize, usize, usize, u32) {
     let nch = caster.chunks.len();
     let mut vol: Vec<Vec<u16>> = vec![Vec::new(); nch];
     let mut cap: Vec<Vec<u16>> = vec![Vec::new(); nch];
     let (mut sides, mut dark, mut light, mut edges, mut mmax) = (0, 0, 0, 0, 0u32);
     let topo = &caster.topology;
+    let part_chunks = || caster.chunks.iter().enumerate().skip(range.start).take(range.len());
     // the oriented edge a->b (chunk-local, in the chunk of its first use) and |m|
     let oriented = |e: usize, m: i32| {
         let u = topo.edge_uses(e)[0];
@@ -469,7 +596,8 @@ pub fn emit_multiplicity(
         }
         (ci as usize, ch.n() as u16, a, b)
     };
-    for (e, &m) in mult.iter().enumerate() {
+    for (&e, &m) in edge_ids.iter().zip(mult) {
+        let e = e as usize;
         if m == 0 {
             continue;
         }
@@ -489,11 +617,11 @@ pub fn emit_multiplicity(
     if !directional {
         match dark_cap {
             DarkCap::Fan => {
-                for (e, &m) in mult.iter().enumerate() {
+                for (&e, &m) in edge_ids.iter().zip(mult) {
                     if m == 0 {
                         continue;
                     }
-                    let (ci, n, a, b) = oriented(e, m);
+                    let (ci, n, a, b) = oriented(e as usize, m);
                     let apex = caster.chunks[ci].apex();
                     for _ in 0..m.unsigned_abs() {
                         vol[ci].extend_from_slice(&[apex + n, b + n, a + n]);
@@ -502,10 +630,10 @@ pub fn emit_multiplicity(
                 }
             }
             DarkCap::AllFaces => {
-                for (ci, ch) in caster.chunks.iter().enumerate() {
+                for (ci, ch) in part_chunks() {
                     let n = ch.n() as u16;
                     for (lt, &g) in ch.local_tris.iter().zip(&ch.tri_ids) {
-                        let t = if mi.facing[g as usize] { [lt[0] + n, lt[2] + n, lt[1] + n] } else { [lt[0] + n, lt[1] + n, lt[2] + n] };
+                        let t = if facing.get(g) { [lt[0] + n, lt[2] + n, lt[1] + n] } else { [lt[0] + n, lt[1] + n, lt[2] + n] };
                         vol[ci].extend_from_slice(&t);
                         dark += 1;
                     }
@@ -516,10 +644,10 @@ pub fn emit_multiplicity(
         }
     }
     if case != Case::ZFail {
-        for (ci, ch) in caster.chunks.iter().enumerate() {
+        for (ci, ch) in part_chunks() {
             for (lt, &g) in ch.local_tris.iter().zip(&ch.tri_ids) {
-                let t = if mi.facing[g as usize] { *lt } else { [lt[0], lt[2], lt[1]] };
-                if !mi.shielded[g as usize] {
+                let t = if facing.get(g) { *lt } else { [lt[0], lt[2], lt[1]] };
+                if !shielded(g) {
                     vol[ci].extend_from_slice(&t);
                     light += 1;
                 } else if case == Case::ZFailLightCap {
@@ -529,55 +657,95 @@ pub fn emit_multiplicity(
             }
         }
     }
-    let draws = chunk_draws(vol, cap);
+    let draws = chunk_draws(vol, cap, case);
     (draws, sides, dark, light, edges, mmax)
 }
 
-fn plan_multiplicity(
+/// How expensive a case is to draw (the caster's case is its most expensive part's).
+fn case_rank(c: Case) -> u8 {
+    match c {
+        Case::Culled => 0,
+        Case::ZPass => 1,
+        Case::ZFail => 2,
+        Case::ZFailLightCap => 3,
+    }
+}
+
+/// Plans one part of a caster for which the facing `bits` are decided; returns the part plan
+/// and its draws.
+#[allow(clippy::too_many_arguments)]
+fn plan_part(
     input: &PlanInput,
     caster: &Caster,
-    ci: usize,
+    pi: usize,
+    multiplicity: bool,
+    case: Case,
     l_obj: Vec4,
-    wb: &Aabb,
-    frustum: &Frustum,
-    pyramid: &OcclusionPyramid,
-) -> (CasterPlan, f64) {
+    bits: &[u64],
+    sil: &mut Vec<SilhouetteEdge>,
+) -> (PartPlan, Vec<ChunkDraw>) {
+    let part = &caster.parts[pi];
     let directional = l_obj.w == 0.0;
-    let ts = Instant::now();
-    let facing = facing_bits(caster.mesh(), l_obj, caster.mirrored);
-    let mult = edge_multiplicities(caster, &facing);
-    let t = ts.elapsed().as_secs_f64() * 1e3;
-    // The renderer draws opaque multiplicity casters two-sided in the G-buffer pass, so every
-    // light cap (a caster triangle itself) lies at or behind the visible surface along any ray
-    // that crosses it: all caps are drawn with depth compare NEVER, never z-fighting the
-    // surface. Transparent casters are not in the depth buffer: their caps are real geometry
-    // in front of or behind the visible surface, depth-tested like the sides.
-    let shielded = vec![caster.transmittance.is_none(); caster.mesh().triangles.len()];
-    let case = select_case(input.method, pyramid, frustum, wb);
+    let facing = Packed(bits);
+    let inside = !directional && part.object_bounds.contains(l_obj.truncate());
+    if multiplicity {
+        let mult = edge_multiplicities_with(caster, &part.edges, &facing);
+        // The renderer draws opaque multiplicity casters two-sided in the G-buffer pass, so
+        // every light cap (a caster triangle itself) lies at or behind the visible surface along
+        // any ray that crosses it: all caps are drawn with depth compare NEVER, never z-fighting
+        // the surface. Transparent casters are not in the depth buffer: their caps are real
+        // geometry in front of or behind the visible surface, depth-tested like the sides.
+        let opaque = caster.transmittance.is_none();
+        let dark_cap_kind = if case == Case::ZPass || directional {
+            DarkCap::None
+        } else if input.method == Method::McGuire && !inside {
+            DarkCap::Fan
+        } else {
+            DarkCap::AllFaces
+        };
+        let (draws, sides, dark_cap, light_cap, edges, mmax) =
+            emit_multiplicity_with(caster, part.chunks.clone(), &part.edges, &facing, |_| opaque, &mult, case, directional, dark_cap_kind);
+        let pp = PartPlan {
+            part: pi,
+            case,
+            path: "multiplicity",
+            silhouette_edges: edges,
+            multiplicity_max: mmax,
+            sides,
+            dark_cap,
+            light_cap,
+            dark_cap_kind,
+            formulation: Formulation::TwoSided,
+        };
+        return (pp, draws);
+    }
+    sil.clear();
+    part.scan.scan_into(bits, sil);
+    let formulation = if inside { Formulation::Back } else { Formulation::Front };
     let dark_cap_kind = if case == Case::ZPass || directional {
         DarkCap::None
-    } else if input.method == Method::McGuire && !caster.object_bounds.contains(l_obj.truncate()) {
+    } else if formulation == Formulation::Back {
+        DarkCap::BackFaces
+    } else if input.method == Method::McGuire {
         DarkCap::Fan
     } else {
-        DarkCap::AllFaces
+        DarkCap::FrontFaces
     };
-    let mi = MultiplicityInput { facing: &facing, shielded: &shielded };
-    let (chunks, sides, dark_cap, light_cap, edges, mmax) = emit_multiplicity(caster, &mi, &mult, case, directional, dark_cap_kind);
-    let plan = CasterPlan {
-        caster: ci,
+    let e = Emit { formulation, directional, dark_cap: dark_cap_kind, light_cap: case == Case::ZFailLightCap };
+    let (draws, sides, dark_cap, light_cap) = emit_with(caster, part.chunks.clone(), &facing, sil, e, case);
+    let pp = PartPlan {
+        part: pi,
         case,
-        path: caster.kind.path(),
-        silhouette_edges: edges,
-        multiplicity_max: mmax,
+        path: "manifold",
+        silhouette_edges: sil.len(),
+        multiplicity_max: u32::from(!sil.is_empty()),
         sides,
         dark_cap,
         light_cap,
-        chunks,
         dark_cap_kind,
-        formulation: Formulation::TwoSided,
-        light_object: l_obj.to_array(),
+        formulation,
     };
-    (plan, t)
+    (pp, draws)
 }
 
 /// Plans every caster's shadow volume for one light.
@@ -590,6 +758,13 @@ pub fn plan_light(input: &PlanInput, casters: &[Caster]) -> LightPlan {
 /// z-fail with caps, no index lists, and the static counts the GPU draws (two triangles per
 /// edge as sides; every face as a cap, light or dark as the GPU decides).
 pub fn plan_light_opts(input: &PlanInput, casters: &[Caster], edge_quads: bool) -> LightPlan {
+    plan_light_with(input, casters, &PlanOptions { edge_quads, case_per_part: false })
+}
+
+/// [`plan_light`] with [`PlanOptions`]. Every part of a caster ([`Caster::parts`]) is culled
+/// and planned on its own: closed manifold parts on the silhouette path, the others on the
+/// multiplicity path.
+pub fn plan_light_with(input: &PlanInput, casters: &[Caster], opts: &PlanOptions) -> LightPlan {
     let t0 = Instant::now();
     let light = input.light;
     let light_h = light.homogeneous();
@@ -598,6 +773,8 @@ pub fn plan_light_opts(input: &PlanInput, casters: &[Caster], edge_quads: bool) 
     let pyramid = OcclusionPyramid::new(light_h, input.view_proj);
     let mut sil_time = 0.0f64;
     let mut plans = Vec::with_capacity(casters.len());
+    let mut bits = Vec::new();
+    let mut sil = Vec::new();
     for (ci, caster) in casters.iter().enumerate() {
         let wb = caster.world_bounds();
         let l_obj = avoid_vertex(caster, object_light(caster, light_h));
@@ -614,13 +791,17 @@ pub fn plan_light_opts(input: &PlanInput, casters: &[Caster], edge_quads: bool) 
             dark_cap_kind: DarkCap::None,
             formulation: Formulation::Front,
             light_object: l_obj.to_array(),
+            parts: Vec::new(),
         };
-        let out_of_radius = !directional && light.radius.is_some_and(|r| box_distance(&wb, light.position) > r);
-        if out_of_radius || spot_culls(light, &wb) || shadow_volume_outside_frustum(&wb, light_h, &frustum) {
+        let culls = |b: &Aabb| {
+            let out_of_radius = !directional && light.radius.is_some_and(|r| box_distance(b, light.position) > r);
+            out_of_radius || spot_culls(light, b) || shadow_volume_outside_frustum(b, light_h, &frustum)
+        };
+        if culls(&wb) {
             plans.push(culled_plan(Case::Culled));
             continue;
         }
-        if edge_quads && caster.kind == CasterKind::Manifold && caster.transmittance.is_none() {
+        if opts.edge_quads && caster.kind == CasterKind::Manifold && caster.transmittance.is_none() {
             plans.push(CasterPlan {
                 case: Case::ZFailLightCap,
                 path: "edgequad",
@@ -630,45 +811,73 @@ pub fn plan_light_opts(input: &PlanInput, casters: &[Caster], edge_quads: bool) 
             });
             continue;
         }
-        if let CasterKind::Multiplicity { .. } = caster.kind {
-            let (cp, t) = plan_multiplicity(input, caster, ci, l_obj, &wb, &frustum, &pyramid);
-            sil_time += t;
+        // A caster marked multiplicity as a whole (one part) keeps that path.
+        let whole_multiplicity = caster.kind != CasterKind::Manifold && caster.parts.len() == 1;
+        let single = caster.parts.len() == 1;
+        let mut cases: Vec<Case> = caster
+            .parts
+            .iter()
+            .map(|p| {
+                let pb = if single { wb } else { p.object_bounds.transformed(&caster.transform) };
+                if !single && culls(&pb) {
+                    Case::Culled
+                } else {
+                    select_case(input.method, &pyramid, &frustum, &pb)
+                }
+            })
+            .collect();
+        if !opts.case_per_part {
+            let mut live = cases.iter().copied().filter(|&c| c != Case::Culled);
+            if let Some(first) = live.next() {
+                let uniform = if live.all(|c| c == first) { first } else { Case::ZFailLightCap };
+                for c in cases.iter_mut().filter(|c| **c != Case::Culled) {
+                    *c = uniform;
+                }
+            }
+        }
+        let mut cp = culled_plan(Case::Culled);
+        if cases.iter().all(|&c| c == Case::Culled) {
             plans.push(cp);
             continue;
         }
         let ts = Instant::now();
-        let facing = facing_bits(caster.mesh(), l_obj, caster.mirrored);
-        let sil = possible_silhouette(&caster.topology.manifold_edges, &facing);
+        caster.planes.facing_packed_auto(caster.mesh(), l_obj, caster.mirrored, &mut bits);
         sil_time += ts.elapsed().as_secs_f64() * 1e3;
-
-        let formulation =
-            if !directional && caster.object_bounds.contains(l_obj.truncate()) { Formulation::Back } else { Formulation::Front };
-        let case = select_case(input.method, &pyramid, &frustum, &wb);
-        let dark_cap_kind = if case == Case::ZPass || directional {
-            DarkCap::None
-        } else if formulation == Formulation::Back {
-            DarkCap::BackFaces
-        } else if input.method == Method::McGuire {
-            DarkCap::Fan
-        } else {
-            DarkCap::FrontFaces
-        };
-        let e = Emit { formulation, directional, dark_cap: dark_cap_kind, light_cap: case == Case::ZFailLightCap };
-        let (chunks, sides, dark_cap, light_cap) = emit(caster, &facing, &sil, e);
-        plans.push(CasterPlan {
-            caster: ci,
-            case,
-            path: caster.kind.path(),
-            silhouette_edges: sil.len(),
-            multiplicity_max: u32::from(!sil.is_empty()),
-            sides,
-            dark_cap,
-            light_cap,
-            chunks,
-            dark_cap_kind,
-            formulation,
-            light_object: l_obj.to_array(),
-        });
+        let mut best = 0u8;
+        for (pi, &case) in cases.iter().enumerate() {
+            let part = &caster.parts[pi];
+            let multiplicity = whole_multiplicity || part.kind != CasterKind::Manifold;
+            if case == Case::Culled {
+                cp.parts.push(PartPlan {
+                    part: pi,
+                    case,
+                    path: if multiplicity { "multiplicity" } else { "manifold" },
+                    silhouette_edges: 0,
+                    multiplicity_max: 0,
+                    sides: 0,
+                    dark_cap: 0,
+                    light_cap: 0,
+                    dark_cap_kind: DarkCap::None,
+                    formulation: Formulation::Front,
+                });
+                continue;
+            }
+            let (pp, draws) = plan_part(input, caster, pi, multiplicity, case, l_obj, &bits, &mut sil);
+            cp.silhouette_edges += pp.silhouette_edges;
+            cp.multiplicity_max = cp.multiplicity_max.max(pp.multiplicity_max);
+            cp.sides += pp.sides;
+            cp.dark_cap += pp.dark_cap;
+            cp.light_cap += pp.light_cap;
+            if case_rank(case) > best {
+                best = case_rank(case);
+                cp.case = case;
+                cp.dark_cap_kind = pp.dark_cap_kind;
+                cp.formulation = pp.formulation;
+            }
+            cp.chunks.extend(draws);
+            cp.parts.push(pp);
+        }
+        plans.push(cp);
     }
     let (scissor, depth_bounds) = if directional {
         (None, None)

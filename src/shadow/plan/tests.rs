@@ -1,4 +1,5 @@
 use super::*;
+use crate::geom::silhouette::facing_bits;
 use crate::geom::Mesh;
 use crate::shadow::testmesh::{cube, signed_volume, torus, uv_sphere};
 use glam::{DVec3, Vec3};
@@ -548,8 +549,7 @@ fn multiplicity_caster(name: &str, m: &Mesh, transform: Mat4, limit: usize) -> C
     let mut c = Caster::with_chunk_limit(name, m, transform, limit).unwrap();
     if c.is_manifold() {
         // (only the inside-out box) exercise the multiplicity construction on it too
-        c.kind = crate::shadow::CasterKind::Multiplicity { reason: "forced by the test".into() };
-        c.coincident = vec![u32::MAX; c.triangle_count];
+        c.make_whole_multiplicity("forced by the test".into());
     }
     c
 }
@@ -842,4 +842,64 @@ fn multiplicity_rules() {
     // closed manifolds report the manifold path
     let p = &plan(&cam3(), &above, Method::McGuire, &box_caster()).casters[0];
     assert_eq!((p.path, p.multiplicity_max, p.formulation), ("manifold", 1, Formulation::Front));
+}
+
+/// A closed cube and an open quad apart in one mesh: two parts, the cube on the manifold
+/// path and the quad on the multiplicity path, each with its own counts.
+#[test]
+fn parts_planned_on_their_own() {
+    let mut m = cube(Vec3::ZERO, 0.5);
+    let b = m.positions.len() as u32;
+    for p in [Vec3::new(2.0, -0.5, -0.5), Vec3::new(3.0, -0.5, -0.5), Vec3::new(3.0, -0.5, 0.5), Vec3::new(2.0, -0.5, 0.5)] {
+        m.positions.push(p);
+    }
+    m.triangles.push([b, b + 1, b + 2]);
+    m.triangles.push([b, b + 2, b + 3]);
+    let c = Caster::new("two", &m, Mat4::IDENTITY).unwrap();
+    assert_eq!(c.parts.len(), 2);
+    assert_eq!(c.parts[0].kind, crate::shadow::CasterKind::Manifold);
+    assert!(matches!(&c.parts[1].kind, crate::shadow::CasterKind::Multiplicity { reason } if reason.contains("4 boundary edges")));
+    assert_eq!(c.parts[0].triangles.len(), 12);
+    assert_eq!(c.parts[1].triangles, vec![12, 13]);
+    assert!(!c.is_manifold());
+    // chunks never mix parts, and each part's apex is its own centre
+    for p in &c.parts {
+        for ch in &c.chunks[p.chunks.clone()] {
+            assert_eq!(*ch.vertices.last().unwrap(), p.object_bounds.center());
+            assert!(ch.tri_ids.iter().all(|t| p.triangles.contains(t)));
+        }
+    }
+    let cs = vec![c];
+    let cam = camera(Vec3::new(1.5, -6.0, 0.0), Vec3::new(1.5, 0.0, 0.0));
+    let l = point(Vec3::new(5.0, 5.0, 0.0));
+    let whole = plan(&cam, &l, Method::ZFail, &cs);
+    let cp = &whole.casters[0];
+    assert_eq!(cp.parts.len(), 2);
+    let (cube_p, quad_p) = (&cp.parts[0], &cp.parts[1]);
+    assert_eq!((cube_p.path, quad_p.path), ("manifold", "multiplicity"));
+    assert_eq!(cube_p.formulation, Formulation::Front);
+    assert_eq!(quad_p.formulation, Formulation::TwoSided);
+    // the cube: 6 faces, the light sees 2 of them (+x and +y): a silhouette of 6 edges
+    assert_eq!(cube_p.silhouette_edges, 6);
+    assert_eq!((cube_p.sides, cube_p.dark_cap, cube_p.light_cap), (12, 4, 4));
+    // the quad: 4 boundary edges of multiplicity 1, both triangles as caps
+    assert_eq!((quad_p.silhouette_edges, quad_p.multiplicity_max), (4, 1));
+    assert_eq!((quad_p.sides, quad_p.dark_cap, quad_p.light_cap), (8, 2, 2));
+    assert_eq!(cp.sides, cube_p.sides + quad_p.sides);
+    assert_eq!(cp.triangles(), 12 + 4 + 4 + 8 + 2 + 2);
+    let idx: usize = cp.chunks.iter().map(|d| d.volume.len() + d.light_cap.len()).sum();
+    assert_eq!(idx, 3 * cp.triangles());
+    assert!(cp.chunks.iter().all(|d| d.case == cp.case));
+    // the old single-caster path: the whole mesh on the multiplicity path costs more
+    let mut all = cs[0].clone();
+    all.make_whole_multiplicity("test".into());
+    let old = plan(&cam, &l, Method::ZFail, &[all]);
+    assert_eq!(old.casters[0].parts.len(), 1);
+    assert!(old.casters[0].triangles() > cp.triangles());
+    // a part outside the light's radius is culled on its own
+    let near = Light { radius: Some(2.0), ..point(Vec3::new(-1.0, 1.0, 0.0)) };
+    let p = plan(&cam, &near, Method::McGuire, &cs);
+    assert_eq!(p.casters[0].parts[1].case, Case::Culled);
+    assert_ne!(p.casters[0].parts[0].case, Case::Culled);
+    assert_eq!(p.casters[0].sides, p.casters[0].parts[0].sides);
 }
