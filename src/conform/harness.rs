@@ -174,10 +174,9 @@ pub fn render(
                 }
                 None => None,
             };
-            let mut push = [0f32; 24];
-            push[..16].copy_from_slice(&d.mvp.to_cols_array());
-            push[16..20].copy_from_slice(&[0.0, 0.0, 0.0, 1.0]);
-            recorded.push((p, vb_raw, ib, d.vertices.len() as u32, bytes(&push), d.spec.depth_bounds));
+            // shadow.vert's block; light (0, 0, 0, 1): w = 0 vertices extrude away from the origin.
+            let push = crate::pass::push::VolumePush::new(d.mvp, glam::Vec4::W, [0.0; 4]);
+            recorded.push((p, vb_raw, ib, d.vertices.len() as u32, bytemuck::bytes_of(&push).to_vec(), d.spec.depth_bounds));
         }
         let n = (width * height) as u64;
         buffers.push(Buffer::new(ctx, "conform-depth-readback", n * 4, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?);

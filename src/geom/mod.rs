@@ -5,6 +5,7 @@ pub use mesh::{Aabb, Mesh};
 pub mod bounds;
 pub mod light;
 pub use light::{Camera, Light, LightKind};
+pub mod planes;
 pub mod predicates;
 pub mod silhouette;
 pub mod topology;

@@ -39,9 +39,18 @@ pub struct ShadowMapper {
     lookup_pipeline: vk::Pipeline,
 }
 
-fn bytes_of<T: Copy>(v: &[T]) -> &[u8] {
-    // SAFETY: plain-old-data (f32 arrays) viewed as bytes for upload / push constants.
-    unsafe { std::slice::from_raw_parts(v.as_ptr() as *const u8, std::mem::size_of_val(v)) }
+/// `shadowmap_lookup.frag`: `{ mat4 light_view_proj; vec4 tile; vec4 light; vec4 params; }`.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct LookupPush {
+    /// Eye-relative world -> this face's clip space.
+    light_view_proj: [f32; 16],
+    /// Atlas tile: x0, y0, width, height (texels).
+    tile: [f32; 4],
+    /// Eye-relative light position (w = 1) or towards-light direction (w = 0).
+    light: [f32; 4],
+    /// x: face (0..5, -1 = single map), y: compare bias, z: normal offset.
+    params: [f32; 4],
 }
 
 /// One map to render and look up: the eye-relative light view-projection, its atlas tile,
@@ -86,7 +95,7 @@ impl ShadowMapper {
                 vk::BufferUsageFlags::VERTEX_BUFFER,
                 gpu_allocator::MemoryLocation::CpuToGpu,
             )?;
-            b.write(0, bytes_of(&pos))?;
+            b.write(0, bytemuck::cast_slice(&pos))?;
             Some(b)
         };
         let atlas = Image::new_2d(
@@ -219,7 +228,7 @@ impl ShadowMapper {
                         self.layouts[0],
                         vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
                         0,
-                        bytes_of(&f.view_proj.to_cols_array()),
+                        bytemuck::bytes_of(&f.view_proj.to_cols_array()),
                     );
                     d.cmd_draw(cb, self.caster_vertices, 1, 0, 0);
                 }
@@ -249,12 +258,13 @@ impl ShadowMapper {
             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.lookup_pipeline);
             d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, self.layouts[1], 0, &[self.set.set], &[]);
             for f in &faces {
-                let mut push = [0f32; 28];
-                push[..16].copy_from_slice(&f.view_proj.to_cols_array());
-                push[16..20].copy_from_slice(&[f.tile[0] as f32, f.tile[1] as f32, self.size as f32, self.size as f32]);
-                push[20..24].copy_from_slice(&light_h.to_array());
-                push[24..28].copy_from_slice(&[f.face, 2e-5, 1.5 * f.texel_world, 0.0]);
-                d.cmd_push_constants(cb, self.layouts[1], vk::ShaderStageFlags::FRAGMENT, 0, bytes_of(&push));
+                let push = LookupPush {
+                    light_view_proj: f.view_proj.to_cols_array(),
+                    tile: [f.tile[0] as f32, f.tile[1] as f32, self.size as f32, self.size as f32],
+                    light: light_h.to_array(),
+                    params: [f.face, 2e-5, 1.5 * f.texel_world, 0.0],
+                };
+                d.cmd_push_constants(cb, self.layouts[1], vk::ShaderStageFlags::FRAGMENT, 0, bytemuck::bytes_of(&push));
                 d.cmd_draw(cb, 3, 1, 0, 0);
             }
             d.cmd_end_rendering(cb);
