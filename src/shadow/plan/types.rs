@@ -117,7 +117,7 @@ pub enum Formulation {
     TwoSided,
 }
 
-/// What [`plan_light`] needs besides the casters: the view, the viewport and one light.
+/// What [`plan_light`](super::plan_light) needs besides the casters: the view, the viewport and one light.
 pub struct PlanInput<'a> {
     /// The camera `view_proj` was built from (the planner itself reads only `view_proj`).
     pub camera: &'a Camera,
@@ -138,7 +138,7 @@ pub struct PlanInput<'a> {
 #[derive(Clone, Debug, Default, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct ChunkDraw {
-    /// Index into the caster's [`Caster::chunks`].
+    /// Index into the caster's [`Caster::chunks`](crate::shadow::Caster::chunks).
     pub chunk: usize,
     /// The case these lists were emitted for (the case of the caster's part the chunk belongs
     /// to): the renderer's pipelines (z-pass or z-fail stencil operations) follow it.
@@ -154,11 +154,11 @@ pub struct ChunkDraw {
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct CasterPlan {
-    /// Index of the caster in the slice given to [`plan_light`].
+    /// Index of the caster in the slice given to [`plan_light`](super::plan_light).
     pub caster: usize,
     /// How the volume is drawn (culled, z-pass, z-fail with or without light cap).
     pub case: Case,
-    /// `"manifold"` or `"multiplicity"` ([`CasterKind::path`]).
+    /// `"manifold"` or `"multiplicity"` ([`CasterKind::path`](crate::shadow::CasterKind::path)).
     pub path: &'static str,
     /// Silhouette edges (manifold) / edges of non-zero multiplicity.
     pub silhouette_edges: usize,
@@ -179,7 +179,7 @@ pub struct CasterPlan {
     /// Object-space homogeneous light the facing bits were decided for (the GPU must use the
     /// same value in EXTRUDE).
     pub light_object: [f32; 4],
-    /// One plan per part of the caster ([`Caster::parts`], same order). The caster's counts
+    /// One plan per part of the caster ([`Caster::parts`](crate::shadow::Caster::parts), same order). The caster's counts
     /// are the sums of its parts', its draws the concatenation of theirs, its `case` the most
     /// expensive of theirs, and its `dark_cap_kind` and `formulation` those of the first part
     /// with that case.
@@ -190,7 +190,7 @@ pub struct CasterPlan {
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct PartPlan {
-    /// Index into [`Caster::parts`].
+    /// Index into [`Caster::parts`](crate::shadow::Caster::parts).
     pub part: usize,
     /// The part's own case (McGuire's rule on the part's bounds).
     pub case: Case,
@@ -212,10 +212,10 @@ pub struct PartPlan {
     pub formulation: Formulation,
 }
 
-/// Options of [`plan_light_with`].
+/// Options of [`plan_light_with`](super::plan_light_with).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct PlanOptions {
-    /// See [`plan_light_opts`].
+    /// See [`plan_light_opts`](super::plan_light_opts).
     pub edge_quads: bool,
     /// Each part of a caster gets the case its own bounds call for, recorded per draw in
     /// [`ChunkDraw::case`]: only for renderers that pick the pipeline per draw. Otherwise
@@ -237,10 +237,10 @@ impl CasterPlan {
 /// Every caster's plan for one light, with the light's scissor and depth bounds (Lengyel 2002).
 pub struct LightPlan {
     /// `[x, y, width, height]` in pixels (row 0 at the top) bounding the light's range on screen;
-    /// `None` = the whole viewport (see [`light_scissor`]).
+    /// `None` = the whole viewport (see [`light_scissor`](crate::geom::bounds::light_scissor)).
     pub scissor: Option<[u32; 4]>,
     /// `(min, max)` depth of the light's range for the depth-bounds test; `None` = unbounded
-    /// (see [`light_depth_bounds`]).
+    /// (see [`light_depth_bounds`](crate::geom::bounds::light_depth_bounds)).
     pub depth_bounds: Option<(f32, f32)>,
     /// One plan per caster, in the order of the casters given (culled ones included).
     pub casters: Vec<CasterPlan>,
