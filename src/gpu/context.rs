@@ -205,8 +205,15 @@ impl Context {
             extensions.push(ash::ext::debug_utils::NAME.as_ptr());
         }
         let app = vk::ApplicationInfo::default().application_name(c"umbrage").engine_name(c"umbrage").api_version(vk::API_VERSION_1_3);
-        let create =
+        // Synchronisation validation on whenever validation is (a missing barrier is invisible
+        // on lavapipe and flickers on a real GPU); `UMBRAGE_VALIDATION=nosync` leaves it off.
+        let sync = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+        let mut features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&sync);
+        let mut create =
             vk::InstanceCreateInfo::default().application_info(&app).enabled_layer_names(&layers).enabled_extension_names(&extensions);
+        if validation && std::env::var("UMBRAGE_VALIDATION").map(|v| v != "nosync").unwrap_or(true) {
+            create = create.push_next(&mut features);
+        }
         // SAFETY: all pointers in `create` refer to locals alive for this call.
         let instance = unsafe { entry.create_instance(&create, None) }
             .map_err(|e| Error::NoDevice(format!("vkCreateInstance failed ({e:?}): no Vulkan driver installed?")))?;

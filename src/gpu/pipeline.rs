@@ -135,7 +135,7 @@ pub fn create(ctx: &impl GpuDevice, d: &PipelineDesc) -> Result<vk::Pipeline> {
         .iter()
         .map(|&(location, format, offset)| vk::VertexInputAttributeDescription { location, binding: 0, format, offset })
         .collect();
-    if d.instance_stride > 0 {
+    if !d.instance_attributes.is_empty() {
         bindings.push(vk::VertexInputBindingDescription {
             binding: 1,
             stride: d.instance_stride,

@@ -15,7 +15,12 @@ use gpu_allocator::MemoryLocation;
 /// Vertex layout: position (anchor-relative), face normal, colour, opacity.
 pub(crate) const VERTEX_STRIDE: u32 = 40;
 /// Per-mesh instance data: 3 rows of the position map, 3 rows of the normal map.
-pub(crate) const INSTANCE_STRIDE: u32 = 96;
+pub(crate) const INSTANCE_BYTES: u64 = 96;
+/// The instance binding's stride: 0, every vertex of a draw reads the one record bound at
+/// the mesh's offset (no reliance on `firstInstance`; and synchronisation validation 1.3.239
+/// sizes instance-rate reads by the vertex count, which reported false hazards on the
+/// buffers next to the instance buffer).
+pub(crate) const INSTANCE_STRIDE: u32 = 0;
 /// The vertex attributes (binding 0) of every scene pipeline.
 pub(crate) const VERTEX_ATTRIBUTES: [(u32, vk::Format, u32); 4] = [
     (0, vk::Format::R32G32B32_SFLOAT, 0),
@@ -116,7 +121,7 @@ impl SceneGeometry {
         let baked = scene.meshes.iter().map(|m| m.transform.as_dmat4()).collect();
         let mut geo = SceneGeometry { vertices, ranges, anchor: eye, baked, instances: Vec::new() };
         for s in 0..slots {
-            let size = (scene.meshes.len().max(1) as u64) * INSTANCE_STRIDE as u64;
+            let size = (scene.meshes.len().max(1) as u64) * INSTANCE_BYTES;
             match Buffer::new(ctx, &format!("scene instances {s}"), size, vk::BufferUsageFlags::VERTEX_BUFFER, MemoryLocation::CpuToGpu) {
                 Ok(b) => geo.instances.push(b),
                 Err(e) => {
