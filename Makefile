@@ -14,6 +14,7 @@ run: deps
 # Every test with validation on, the doc examples, and the library an engine embeds
 # (`default-features = false`) built and documented with warnings denied.
 test: deps
+	./scripts/fetch-assets.sh || true
 	UMBRAGE_VALIDATION=1 $(CARGO) test --all-targets
 	$(CARGO) test --doc
 	$(CARGO) build --lib --no-default-features
