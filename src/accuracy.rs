@@ -85,7 +85,15 @@ pub fn evaluate(renderer: &mut Renderer, scene_name: &str, techniques: &[Techniq
             // these scenes but the 8-bit wrap).
             _ => Method::McGuire,
         };
-        let expected = expected_failure(scene_name, method, renderer.settings.counter);
+        // zpass-clear is right exactly where no volume crosses the near-plane rectangle (the
+        // notes' caveat), which the frame reports per light.
+        let split = frame.stats.lights.iter().any(|l| l.near_plane_split == Some(true));
+        let expected = match method {
+            Method::ZPassClear if split => Some("zpass-clear with a volume crossing the near plane (partly shadowed viewport)"),
+            // Otherwise it fails where any correct method does (the 8-bit wrap).
+            Method::ZPassClear => expected_failure(scene_name, Method::McGuire, renderer.settings.counter),
+            _ => expected_failure(scene_name, method, renderer.settings.counter),
+        };
         let ok = fraction <= THRESHOLD;
         rows.push(Row {
             scene: scene_name.to_string(),

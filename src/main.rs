@@ -22,7 +22,7 @@ struct FrameArgs {
     #[arg(long, default_value = "960x540", value_parser = parse_size)]
     size: (u32, u32),
     /// Shadow method: auto (= mcguire, with open / non-manifold casters on the multiplicity
-    /// path), mcguire, lengyel, everitt-kilgard, zfail, zpass; edgequad (GPU-only silhouettes,
+    /// path), mcguire, lengyel, everitt-kilgard, zfail, zpass, zpass-clear; edgequad (GPU-only silhouettes,
     /// the Cg article); or shadowmap (the PCF baseline).
     #[arg(long, value_enum, default_value = "auto")]
     method: MethodArg,
@@ -63,6 +63,10 @@ enum MethodArg {
     Zfail,
     /// z-pass everywhere (wrong with the eye in a volume).
     Zpass,
+    /// z-pass with the stencil cleared to the number of volumes containing the eye (the
+    /// lecture notes' eye-in-shadow fix; wrong where a volume crosses the near plane).
+    #[value(name = "zpass-clear")]
+    ZpassClear,
     /// The Cg article's GPU-only edge quads.
     Edgequad,
     /// The shadow-map baseline (PCF 3x3).
@@ -78,6 +82,7 @@ impl MethodArg {
             MethodArg::EverittKilgard => Technique::Volumes(M::EverittKilgard),
             MethodArg::Zfail => Technique::Volumes(M::ZFail),
             MethodArg::Zpass => Technique::Volumes(M::ZPass),
+            MethodArg::ZpassClear => Technique::Volumes(M::ZPassClear),
             MethodArg::Edgequad => Technique::EdgeQuads,
             MethodArg::Shadowmap => Technique::ShadowMap { size: shadow_map_size },
         }
@@ -345,6 +350,7 @@ fn bench_techniques(methods: &[MethodArg], shadow_map_size: u32) -> Vec<Techniqu
     let mut out: Vec<Technique> = Vec::new();
     if methods.is_empty() {
         out.extend(umbrage::shadow::Method::ALL.map(Technique::Volumes));
+        out.push(Technique::Volumes(umbrage::shadow::Method::ZPassClear));
         out.push(Technique::EdgeQuads);
         if shadow_map_size > 0 {
             out.push(Technique::ShadowMap { size });

@@ -93,6 +93,9 @@ pub struct LightFrame {
     pub stats: LightStats,
     /// The plan as the planner made it (cases, silhouettes, counts per caster).
     pub plan: LightPlan,
+    /// The value the determination clears the counter to inside the scissor: 0, or with
+    /// [`Method::ZPassClear`](crate::shadow::Method) the number of volumes containing the eye.
+    pub counter_clear: u32,
     pub(crate) casters: Vec<CasterDraw>,
 }
 
@@ -318,18 +321,39 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
             .filter(|r| r.extent.width > 0 && r.extent.height > 0)
             .unwrap_or(full);
         let depth_bounds = if input.depth_bounds { plan.depth_bounds } else { None };
+        let (eye_volumes, near_plane_split) = if method == shadow::Method::ZPassClear {
+            let transforms: Vec<DMat4> = table.live.iter().map(|g| g.transform).collect();
+            let at = |p: DVec3| super::eye::volumes_containing(p, light, &plan, &table.cpu, &transforms);
+            let n = at(view.eye);
+            let split = near_corners(view).into_iter().any(|c| at(c) != n);
+            (Some(n), Some(split))
+        } else {
+            (None, None)
+        };
         let stats = LightStats {
             index: li,
             kind: light_kind_name(light.kind).to_string(),
             scissor: plan.scissor,
             depth_bounds: depth_bounds.map(|(a, b)| [a, b]),
             casters: cstats,
+            eye_volumes,
+            near_plane_split,
         };
-        lights.push(LightFrame { scissor, depth_bounds, stats, plan, casters });
+        let counter_clear = eye_volumes.unwrap_or(0).max(0) as u32;
+        lights.push(LightFrame { scissor, depth_bounds, stats, plan, counter_clear, casters });
     }
     align(&mut stream, 16);
     totals.bytes_sent = totals.index_bytes + totals.vertex_bytes;
     Packed { stream, lights, totals, cpu }
+}
+
+/// The near-plane rectangle's corners in world space (Vulkan depth 0).
+fn near_corners(view: &ShadowView) -> [DVec3; 4] {
+    let inv = (view.proj.as_dmat4() * view.view.as_dmat4()).inverse();
+    [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(x, y)| {
+        let h = inv * glam::DVec4::new(x, y, 0.0, 1.0);
+        h.truncate() / h.w + view.eye
+    })
 }
 
 /// 8-bit stencil counts wrap at 256: a pixel inside a multiple of 256 volumes reads as lit.

@@ -47,6 +47,7 @@
 mod casters;
 mod desc;
 mod device;
+mod eye;
 mod frame;
 mod pipelines;
 pub mod push;

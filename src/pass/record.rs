@@ -43,13 +43,13 @@ pub fn lit_stencil_state() -> vk::StencilOpState {
     crate::gpu::pipeline::stencil_equal(0)
 }
 
-fn depth_attachment(target: &DepthStencilTarget, stencil: vk::AttachmentLoadOp) -> vk::RenderingAttachmentInfo<'static> {
+fn depth_attachment(target: &DepthStencilTarget, stencil: vk::AttachmentLoadOp, clear: u32) -> vk::RenderingAttachmentInfo<'static> {
     vk::RenderingAttachmentInfo::default()
         .image_view(target.view)
         .image_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
         .load_op(stencil)
         .store_op(vk::AttachmentStoreOp::STORE)
-        .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } })
+        .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: clear & 0xff } })
 }
 
 impl ShadowPass {
@@ -102,8 +102,9 @@ impl ShadowPass {
         let Some(lf) = frame.lights.get(light) else { return };
         // SAFETY: the caller's contract (outside a rendering instance).
         unsafe { self.cmd_upload(cb, frame) };
-        let depth = depth_attachment(target, vk::AttachmentLoadOp::LOAD);
-        let stencil = depth_attachment(target, vk::AttachmentLoadOp::CLEAR);
+        let depth = depth_attachment(target, vk::AttachmentLoadOp::LOAD, 0);
+        // Cleared to 0, or to the number of volumes containing the eye (zpass-clear).
+        let stencil = depth_attachment(target, vk::AttachmentLoadOp::CLEAR, lf.counter_clear);
         let info =
             vk::RenderingInfo::default().render_area(lf.scissor).layer_count(1).depth_attachment(&depth).stencil_attachment(&stencil);
         let d = &self.dev.device;
@@ -132,8 +133,9 @@ impl ShadowPass {
         target: &DepthStencilTarget,
         count: vk::ImageView,
     ) {
+        let start = frame.lights.get(light).map_or(0.0, |l| l.counter_clear as f32);
         // SAFETY: forwarded contract.
-        unsafe { self.cmd_counted_instance(cb, frame, light, target, count, [0.0; 4], VolumeKind::Float) }
+        unsafe { self.cmd_counted_instance(cb, frame, light, target, count, [start, 0.0, 0.0, 0.0], VolumeKind::Float) }
     }
 
     /// Records the transparent casters' light-intensity map of `light` (Kim et al. 2008) into
@@ -175,7 +177,7 @@ impl ShadowPass {
         let Some(lf) = frame.lights.get(light) else { return };
         // SAFETY: the caller's contract (outside a rendering instance).
         unsafe { self.cmd_upload(cb, frame) };
-        let ds = depth_attachment(target, vk::AttachmentLoadOp::LOAD);
+        let ds = depth_attachment(target, vk::AttachmentLoadOp::LOAD, 0);
         let att = [vk::RenderingAttachmentInfo::default()
             .image_view(color)
             .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)

@@ -89,6 +89,11 @@ pub struct LightStats {
     pub depth_bounds: Option<[f32; 2]>,
     /// One entry per caster.
     pub casters: Vec<CasterStats>,
+    /// `zpass-clear`: the number of drawn volumes containing the eye (the stencil starts there).
+    pub eye_volumes: Option<i32>,
+    /// `zpass-clear`: a volume crosses the near-plane rectangle (its corners are in a different
+    /// number of volumes than the eye), the notes' caveat: the clear is then wrong somewhere.
+    pub near_plane_split: Option<bool>,
 }
 
 #[derive(Clone, Debug, Default)]

@@ -255,7 +255,7 @@ fn emit_with<F: FacingSet + ?Sized>(
 /// The case a method picks for a caster whose world box is `wb` (same for both paths).
 fn select_case(method: Method, pyramid: &OcclusionPyramid, frustum: &Frustum, wb: &Aabb) -> Case {
     match method {
-        Method::ZPass => Case::ZPass,
+        Method::ZPass | Method::ZPassClear => Case::ZPass,
         Method::ZFail | Method::EverittKilgard => Case::ZFailLightCap,
         Method::Lengyel => {
             if pyramid.intersects_box(wb) {
