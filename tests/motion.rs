@@ -165,3 +165,21 @@ fn throughput_with_frames_in_flight() {
     }
     r.context().check_validation().unwrap();
 }
+
+/// Moving meshes and the camera: bad transforms and cameras are refused, nothing changes.
+#[test]
+fn bad_motion_is_refused() {
+    let Some(ctx) = common::context() else { return };
+    let mut r = Renderer::new(ctx, cube_grid(1), RenderOptions { width: 64, height: 48, ..Default::default() }).unwrap();
+    let before = r.scene().meshes[3].transform;
+    assert!(r.set_mesh_transform(3, Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0))).is_err(), "handedness change");
+    assert!(r.set_mesh_transform(3, Mat4::from_scale(Vec3::new(1.0, 0.0, 1.0))).is_err(), "singular");
+    assert!(r.set_mesh_transform(3, Mat4::from_translation(Vec3::new(f32::NAN, 0.0, 0.0))).is_err(), "NaN");
+    assert!(r.set_mesh_transform(99, Mat4::IDENTITY).is_err(), "no such mesh");
+    assert_eq!(r.scene().meshes[3].transform, before);
+    let mut cam = r.scene().camera.clone();
+    cam.target = cam.eye;
+    assert!(r.set_camera(cam).is_err(), "eye == target");
+    r.render().unwrap();
+    r.context().check_validation().unwrap();
+}
