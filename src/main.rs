@@ -69,6 +69,8 @@ enum MethodArg {
     ZpassClear,
     /// The Cg article's GPU-only edge quads.
     Edgequad,
+    /// Flat projected shadows onto y = 0 (the Cg article's baseline).
+    Planar,
     /// The shadow-map baseline (PCF 3x3).
     Shadowmap,
 }
@@ -84,6 +86,7 @@ impl MethodArg {
             MethodArg::Zpass => Technique::Volumes(M::ZPass),
             MethodArg::ZpassClear => Technique::Volumes(M::ZPassClear),
             MethodArg::Edgequad => Technique::EdgeQuads,
+            MethodArg::Planar => Technique::Planar,
             MethodArg::Shadowmap => Technique::ShadowMap { size: shadow_map_size },
         }
     }

@@ -55,6 +55,11 @@ pub enum Technique {
     /// The Cg article's GPU-only method: static per-face planes and zero-area edge quads,
     /// extruded in the vertex shader; no CPU work per frame but culling.
     EdgeQuads,
+    /// The Cg article's starting point: every opaque caster flattened onto one receiver plane
+    /// from the light ([`ShadowPass::set_planar_receiver`](super::ShadowPass::set_planar_receiver),
+    /// default y = 0) and drawn with the stencil set to 1 (so no pixel is darkened twice). Exact
+    /// on that plane, wrong everywhere else (no shadows on other surfaces).
+    Planar,
 }
 
 impl Technique {
@@ -63,6 +68,7 @@ impl Technique {
         match self {
             Technique::Volumes(m) => m.name(),
             Technique::EdgeQuads => "edgequad",
+            Technique::Planar => "planar",
         }
     }
     /// The case rule the planner uses (edge quads cull with McGuire's rule).
@@ -70,6 +76,8 @@ impl Technique {
         match self {
             Technique::Volumes(m) => m,
             Technique::EdgeQuads => Method::McGuire,
+            // Culling only: the casters' draws are replaced by their flattened triangles.
+            Technique::Planar => Method::ZPass,
         }
     }
 }

@@ -175,6 +175,8 @@ pub(crate) struct PackInput<'a> {
     pub depth_bounds: bool,
     /// Plan the casters (false: every caster culled, scissors only).
     pub casters: bool,
+    /// The receiver plane of [`Technique::Planar`](super::Technique::Planar) (world, `n·x + d = 0`).
+    pub planar_receiver: glam::DVec4,
 }
 
 /// Plans every light and packs the index streams (or naive vertices) into one byte stream.
@@ -199,6 +201,8 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
             if input.casters { &table.cpu } else { &[] },
             &PlanOptions { edge_quads, case_per_part: true },
         );
+        let mut plan = plan;
+        let planar_mvp = (input.settings.technique == Technique::Planar).then(|| flatten(&mut plan, table, light, input.planar_receiver));
         cpu.silhouettes += plan.silhouette_ms;
         cpu.plan += plan.plan_ms;
         let mut casters = Vec::with_capacity(plan.casters.len());
@@ -305,7 +309,11 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
             };
             casters.push(CasterDraw {
                 case: cp.case,
-                mvp: mvps[cp.caster],
+                mvp: match &planar_mvp {
+                    // Flattened: the caster's triangles projected from the light onto the plane.
+                    Some(m) => (vp_rel_d * DMat4::from_translation(-view.eye) * *m * table.live[cp.caster].transform).as_mat4(),
+                    None => mvps[cp.caster],
+                },
                 light_object: Vec4::from_array(cp.light_object),
                 transmittance: caster.transmittance,
                 draws,
@@ -345,6 +353,48 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
     align(&mut stream, 16);
     totals.bytes_sent = totals.index_bytes + totals.vertex_bytes;
     Packed { stream, lights, totals, cpu }
+}
+
+/// Planar projected shadows: every drawn opaque caster's plan becomes all its triangles (w = 1
+/// copies) in one z-pass list, and the matrix flattening world space onto the receiver plane
+/// `p` from the light `L` is returned: `M = (p·L) I - L pᵀ`. Transparent casters, and every
+/// caster when the light is not above the plane, are culled.
+fn flatten(plan: &mut LightPlan, table: &CasterTable, light: &Light, p: glam::DVec4) -> DMat4 {
+    let l = light.homogeneous().as_dvec4();
+    let pl = p.dot(l);
+    let m = DMat4::from_diagonal(glam::DVec4::splat(pl)) - DMat4::from_cols(l * p.x, l * p.y, l * p.z, l * p.w);
+    for cp in &mut plan.casters {
+        let caster = &table.cpu[cp.caster];
+        if cp.case == Case::Culled || caster.transmittance.is_some() || !(pl > 0.0) {
+            cp.case = Case::Culled;
+            cp.chunks.clear();
+            cp.parts.clear();
+            cp.sides = 0;
+            cp.dark_cap = 0;
+            cp.light_cap = 0;
+            continue;
+        }
+        cp.case = Case::ZPass;
+        cp.path = "planar";
+        cp.parts.clear();
+        cp.silhouette_edges = 0;
+        cp.dark_cap = 0;
+        cp.light_cap = 0;
+        cp.dark_cap_kind = shadow::DarkCap::None;
+        cp.chunks = caster
+            .chunks
+            .iter()
+            .enumerate()
+            .map(|(ci, ch)| shadow::ChunkDraw {
+                chunk: ci,
+                case: Case::ZPass,
+                volume: ch.local_tris.iter().flatten().copied().collect(),
+                light_cap: Vec::new(),
+            })
+            .collect();
+        cp.sides = caster.chunks.iter().map(|c| c.local_tris.len()).sum();
+    }
+    m
 }
 
 /// The near-plane rectangle's corners in world space (Vulkan depth 0).

@@ -95,6 +95,7 @@ pub struct ShadowPass {
     casters: CasterTable,
     slots: Vec<Slot>,
     serial: u64,
+    planar_receiver: glam::DVec4,
 }
 
 impl ShadowPass {
@@ -144,7 +145,27 @@ impl ShadowPass {
         let dev = PassDevice { device: device.clone(), allocator };
         let pipes = Pipelines::new(&dev, desc, caps.depth_clamp, caps.depth_bounds, caps.r32f_blend)?;
         let slots = (0..desc.frames_in_flight).map(|_| Slot { stream: None, staging: Vec::new() }).collect();
-        Ok(ShadowPass { dev, caps, desc: desc.clone(), settings: desc.settings, pipes, casters: CasterTable::new(), slots, serial: 0 })
+        Ok(ShadowPass {
+            dev,
+            caps,
+            desc: desc.clone(),
+            settings: desc.settings,
+            pipes,
+            casters: CasterTable::new(),
+            slots,
+            serial: 0,
+            planar_receiver: glam::DVec4::Y,
+        })
+    }
+
+    /// The receiver plane of [`Technique::Planar`] in world space, `n·x + d = 0` as
+    /// `(n, d)` with `n` pointing to the side the light is on (default: y = 0, up).
+    pub fn set_planar_receiver(&mut self, plane: glam::DVec4) -> Result<()> {
+        if !plane.is_finite() || plane.truncate().length_squared() == 0.0 {
+            return Err(Error::Other(format!("planar receiver {plane} is not a plane")));
+        }
+        self.planar_receiver = plane;
+        Ok(())
     }
 
     /// What the pass uses on this device.
@@ -296,6 +317,7 @@ impl ShadowPass {
                 u8_ok: self.caps.index_type_uint8,
                 depth_bounds: self.caps.depth_bounds,
                 casters,
+                planar_receiver: self.planar_receiver,
             },
         );
         let record_start = Instant::now();

@@ -47,6 +47,11 @@ pub(crate) struct Pipelines {
     pub transmit: Option<[[vk::Pipeline; 2]; 2]>,
     /// Debug overlay (alpha-blended volumes, depth LESS).
     pub overlay: Option<vk::Pipeline>,
+    /// Planar projected shadows: stencil REPLACE 1 where a flattened caster lands on the visible
+    /// receiver (depth LESS_OR_EQUAL, pulled towards the eye by a depth bias).
+    pub planar: vk::Pipeline,
+    /// The same into the float counter (+1, additive; any non-zero count is shadow).
+    pub planar_count: Option<vk::Pipeline>,
 }
 
 impl Pipelines {
@@ -171,7 +176,34 @@ impl Pipelines {
             }
             None => None,
         };
-        Ok(Pipelines { layout, stencil, count, transmit, overlay })
+        let mut pl = PipelineDesc::new(shaders::SHADOW_VERT, layout, df);
+        pl.vertex_stride = 16;
+        pl.attributes = &[(0, vk::Format::R32G32B32A32_SFLOAT, 0)];
+        pl.depth_test = true;
+        pl.depth_compare = vk::CompareOp::LESS_OR_EQUAL;
+        pl.depth_clamp = depth_clamp;
+        pl.depth_bias = Some((-4.0, -1.0));
+        let replace = vk::StencilOpState {
+            fail_op: S::KEEP,
+            pass_op: S::REPLACE,
+            depth_fail_op: S::KEEP,
+            compare_op: vk::CompareOp::ALWAYS,
+            compare_mask: 0xff,
+            write_mask: 0xff,
+            reference: 1,
+        };
+        pl.stencil = Some((replace, replace));
+        let planar = create(&pl)?;
+        let planar_count = if r32f_blend {
+            pl.stencil = None;
+            pl.fragment = Some(shaders::COUNT_FRAG);
+            pl.color_formats = &count_fmt;
+            pl.blend = Blend::Additive;
+            Some(create(&pl)?)
+        } else {
+            None
+        };
+        Ok(Pipelines { layout, stencil, count, transmit, overlay, planar, planar_count })
     }
 
     /// Every pipeline, once.
@@ -185,6 +217,8 @@ impl Pipelines {
             v.extend(t.iter().flatten());
         }
         v.extend(self.overlay);
+        v.push(self.planar);
+        v.extend(self.planar_count);
         v
     }
 

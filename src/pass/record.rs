@@ -277,7 +277,8 @@ impl ShadowPass {
             }
             let mut pushed = None;
             for dr in &c.draws {
-                let Some(pipe) = self.pipeline_for(kind, count, dr.case, dr.light_cap) else { continue };
+                let planar = frame.settings.technique == super::desc::Technique::Planar;
+                let Some(pipe) = self.pipeline_for(kind, count, dr.case, dr.light_cap, planar) else { continue };
                 // Parts of one caster may take different cases: the sign follows the draw's.
                 let block = color(dr.case);
                 if pushed != Some(block) {
@@ -297,8 +298,23 @@ impl ShadowPass {
     }
 
     /// Which pipeline counts a draw.
-    fn pipeline_for(&self, kind: VolumeKind, count: Option<&CountPipes>, case: Case, light_cap: bool) -> Option<vk::Pipeline> {
+    fn pipeline_for(
+        &self,
+        kind: VolumeKind,
+        count: Option<&CountPipes>,
+        case: Case,
+        light_cap: bool,
+        planar: bool,
+    ) -> Option<vk::Pipeline> {
         let s = &self.pipes.stencil;
+        if planar {
+            // Flattened casters: the sign pushed is +1 (z-pass), so the float count adds 1.
+            return match kind {
+                VolumeKind::Stencil => Some(self.pipes.planar),
+                VolumeKind::Float => self.pipes.planar_count,
+                _ => None,
+            };
+        }
         let zpass = case == Case::ZPass;
         Some(match kind {
             VolumeKind::Stencil => match (zpass, light_cap) {

@@ -76,6 +76,9 @@ pub enum Technique {
     Volumes(Method),
     /// The Cg article's GPU-only edge quads for closed opaque casters.
     EdgeQuads,
+    /// Flat projected shadows onto the plane y = 0 (the Cg article's first section): exact on
+    /// that plane, wrong everywhere else.
+    Planar,
     /// The shadow-map baseline (PCF 3x3) with maps of `size` texels a side.
     ShadowMap {
         /// Texels per side of one map (16..=8192).
@@ -89,6 +92,7 @@ impl Technique {
         match self {
             Technique::Volumes(m) => m.name(),
             Technique::EdgeQuads => "edgequad",
+            Technique::Planar => "planar",
             Technique::ShadowMap { .. } => "shadowmap",
         }
     }
@@ -101,6 +105,7 @@ impl Technique {
         match self {
             Technique::Volumes(m) => Some(crate::pass::Technique::Volumes(m)),
             Technique::EdgeQuads => Some(crate::pass::Technique::EdgeQuads),
+            Technique::Planar => Some(crate::pass::Technique::Planar),
             Technique::ShadowMap { .. } => None,
         }
     }
@@ -109,6 +114,7 @@ impl Technique {
     pub fn parse(s: &str, shadow_map_size: u32) -> Result<Technique> {
         match s {
             "edgequad" => Ok(Technique::EdgeQuads),
+            "planar" => Ok(Technique::Planar),
             "shadowmap" => Ok(Technique::ShadowMap { size: shadow_map_size }),
             _ => s.parse::<Method>().map(Technique::Volumes).map_err(|_| Error::UnknownName {
                 what: "method",
