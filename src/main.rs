@@ -355,6 +355,7 @@ fn bench_techniques(methods: &[MethodArg], shadow_map_size: u32) -> Vec<Techniqu
         out.extend(umbrage::shadow::Method::ALL.map(Technique::Volumes));
         out.push(Technique::Volumes(umbrage::shadow::Method::ZPassClear));
         out.push(Technique::EdgeQuads);
+        out.push(Technique::Planar);
         if shadow_map_size > 0 {
             out.push(Technique::ShadowMap { size });
         }
