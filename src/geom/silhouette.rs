@@ -177,39 +177,72 @@ impl EdgeScan {
     /// counts as not facing).
     pub fn scan_into(&self, bits: &[u64], out: &mut Vec<SilhouetteEdge>) {
         let bit = |t: u32| bits.get(t as usize / 64).map_or(0, |w| (w >> (t % 64)) & 1);
-        // One byte a triangle (a short, vectorisable pass over the words): the scan's two
-        // lookups an edge are then plain byte loads. Triangle ids past the bits read 0.
-        let len = (self.max_tri as usize + 1).max(bits.len() * 64);
-        let mut bytes = vec![0u8; len];
-        for (dst, &w) in bytes.chunks_exact_mut(64).zip(bits) {
-            for (k, d) in dst.iter_mut().enumerate() {
-                *d = ((w >> k) & 1) as u8;
+        // One byte a triangle (a short pass over the words, 8 bytes a table load): the scan's
+        // two lookups an edge are then plain byte loads. The table is this thread's, reused
+        // across calls (no allocation and no zeroing of fresh pages per light), sized to a
+        // power of two so that a masked index needs no bounds check; triangle ids past the bits
+        // read 0.
+        let need = (self.max_tri as usize + 1).max(bits.len() * 64);
+        let size = need.next_power_of_two();
+        let mask = size - 1;
+        SCAN_TABLE.with_borrow_mut(|table| {
+            if table.len() < size {
+                table.clear();
+                table.resize(size, 0);
             }
-        }
-        let fast = |t: u32| bytes.get(t as usize).copied().unwrap_or(0);
-        for (chunk, es) in self.pairs.chunks(64).zip(self.edges.chunks(64)) {
-            // most blocks hold no silhouette edge: one OR-reduction (no shifts into a mask), and
-            // only the rare blocks with one are walked again
-            let mut any = 0u8;
-            for p in chunk {
-                any |= fast(p[0]) ^ fast(p[1]);
+            let table = &mut table[..size];
+            for (dst, &w) in table.chunks_exact_mut(64).zip(bits) {
+                for (d8, byte) in dst.chunks_exact_mut(8).zip(w.to_le_bytes()) {
+                    d8.copy_from_slice(&SPREAD[byte as usize].to_le_bytes());
+                }
             }
-            if any == 0 {
-                continue;
-            }
-            for (p, &e) in chunk.iter().zip(es) {
-                if fast(p[0]) == fast(p[1]) {
+            table[(bits.len() * 64).min(size)..need].fill(0);
+            let tab: &[u8] = table;
+            let fast = |t: u32| tab[t as usize & mask];
+            for (chunk, es) in self.pairs.chunks(64).zip(self.edges.chunks(64)) {
+                // most blocks hold no silhouette edge: one OR-reduction (no shifts into a mask),
+                // and only the rare blocks with one are walked again
+                let mut any = 0u8;
+                for p in chunk {
+                    any |= fast(p[0]) ^ fast(p[1]);
+                }
+                if any == 0 {
                     continue;
                 }
-                out.push(if bit(e.t0) != 0 {
-                    SilhouetteEdge { a: e.a, b: e.b, lit: e.t0, lit_corner: e.c0, unlit: e.t1, unlit_corner: e.c1 }
-                } else {
-                    SilhouetteEdge { a: e.b, b: e.a, lit: e.t1, lit_corner: e.c1, unlit: e.t0, unlit_corner: e.c0 }
-                });
+                for (p, &e) in chunk.iter().zip(es) {
+                    if fast(p[0]) == fast(p[1]) {
+                        continue;
+                    }
+                    out.push(if bit(e.t0) != 0 {
+                        SilhouetteEdge { a: e.a, b: e.b, lit: e.t0, lit_corner: e.c0, unlit: e.t1, unlit_corner: e.c1 }
+                    } else {
+                        SilhouetteEdge { a: e.b, b: e.a, lit: e.t1, lit_corner: e.c1, unlit: e.t0, unlit_corner: e.c0 }
+                    });
+                }
             }
-        }
+        });
     }
 }
+
+thread_local! {
+    /// [`EdgeScan::scan_into`]'s byte-a-triangle table, kept per thread across calls.
+    static SCAN_TABLE: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// Byte `k` of `SPREAD[b]` is bit `k` of `b`.
+static SPREAD: [u64; 256] = {
+    let mut t = [0u64; 256];
+    let mut b = 0;
+    while b < 256 {
+        let mut k = 0;
+        while k < 8 {
+            t[b] |= (((b >> k) & 1) as u64) << (8 * k);
+            k += 1;
+        }
+        b += 1;
+    }
+    t
+};
 
 /// [`possible_silhouette_packed`] appending to `out` (reuse the allocation across frames).
 pub fn possible_silhouette_packed_into(edges: &[ManifoldEdge], bits: &[u64], out: &mut Vec<SilhouetteEdge>) {
@@ -320,6 +353,25 @@ mod tests {
                 assert_eq!(sil, possible_silhouette_serial(&t.manifold_edges, &f));
             }
             check_planes(&t.mesh, l);
+        }
+    }
+
+    #[test]
+    fn scan_table_reused_across_meshes() {
+        // the per-thread table is reused: larger and smaller meshes in turn, and bits shorter
+        // than the triangle ids (the missing triangles read as not facing, never stale bytes)
+        let big = Topology::build(&uv_sphere(1.0, 60, 31));
+        let small = Topology::build(&cube(Vec3::ZERO, 1.0));
+        let l = Vec4::new(3.0, 2.0, 1.0, 1.0);
+        for t in [&big, &small, &big, &small] {
+            let mut bits = Vec::new();
+            FacePlanes::new(&t.mesh).facing_packed(&t.mesh, l, false, &mut bits);
+            let scan = EdgeScan::new(t.manifold_edges.clone());
+            for b in [&bits[..], &bits[..bits.len() / 2], &[u64::MAX][..]] {
+                let mut sil = Vec::new();
+                scan.scan_into(b, &mut sil);
+                assert_eq!(sil, possible_silhouette_packed(&t.manifold_edges, b));
+            }
         }
     }
 
