@@ -3,7 +3,7 @@
 export PATH := $(HOME)/.cargo/bin:$(PATH)
 CARGO ?= cargo
 
-.PHONY: deps run test bench conform doc clean
+.PHONY: deps run test bench conform doc clean fuzz
 
 deps:
 	@./scripts/deps.sh
@@ -26,6 +26,12 @@ doc:
 
 bench: deps
 	$(CARGO) bench
+
+# The fuzz generators of tests/fuzz.rs in release, FUZZ_CASES cases each (4 generators plus
+# 1/20 as many raw-byte OBJ files: >= 1,000,000 cases in all), the counts printed per generator.
+FUZZ_CASES ?= 250000
+fuzz: deps
+	UMBRAGE_FUZZ_CASES=$(FUZZ_CASES) $(CARGO) test --release --test fuzz -- --nocapture
 
 conform: deps
 	UMBRAGE_VALIDATION=1 $(CARGO) run -- conform --out conform-report

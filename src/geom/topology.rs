@@ -112,7 +112,9 @@ pub fn weld(positions: &[Vec3], mode: Weld) -> (Vec<Vec3>, Vec<u32>) {
                 'search: for dx in -1..=1 {
                     for dy in -1..=1 {
                         for dz in -1..=1 {
-                            if let Some(list) = grid.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) {
+                            // wrapping: a tiny tolerance saturates the cell to i64::MAX (the exact distance
+                            // test below decides, so a wrapped neighbour only costs a lookup)
+                            if let Some(list) = grid.get(&[c[0].wrapping_add(dx), c[1].wrapping_add(dy), c[2].wrapping_add(dz)]) {
                                 for &id in list {
                                     if out[id as usize].distance(*p) <= tol {
                                         found = Some(id);

@@ -34,13 +34,45 @@ pub fn load_obj_str(text: &str, name: &str) -> Result<Mesh> {
 
 /// Rejects `v` lines whose coordinates parse to non-finite f32 values (`nan`, `inf`, 1e39),
 /// naming the vertex (1-based, as OBJ counts) and its line.
+///
+/// Also rejects face (and line) indices that cannot name an element, which tobj 4.0.5 turns
+/// into overflowing `usize` arithmetic (`vn * 3 + 2`, `vt * 2 + 1`: a panic in debug builds,
+/// an out-of-bounds index in release; found by tests/fuzz.rs): a positive index larger than the
+/// file's line count (every element takes a line of its own), and a negative (relative) index
+/// reaching before the first `v`/`vt`/`vn` defined so far.
 fn check_vertices(text: &str, name: &str) -> Result<()> {
     let mut count = 0usize;
+    let lines = text.lines().count() as u64;
+    // v, vt, vn lines so far (what relative indices count back from)
+    let mut defined = [0u64; 3];
     for (line_no, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
-        if words.next() != Some("v") {
+        let first = words.next();
+        match first {
+            Some("vt") => defined[1] += 1,
+            Some("vn") => defined[2] += 1,
+            Some("f") | Some("l") => {
+                for w in words {
+                    for (k, part) in w.split('/').enumerate().take(3) {
+                        let Ok(x) = part.parse::<i64>() else { continue };
+                        let bad = if x < 0 { x.unsigned_abs() > defined[k] } else { x.unsigned_abs() > lines };
+                        if bad {
+                            let what = ["vertex", "texture coordinate", "normal"][k];
+                            return Err(Error::input(
+                                format!("{name}:{}", line_no + 1),
+                                format!("face {what} index {x} out of range ({} defined so far, {lines} lines)", defined[k]),
+                            ));
+                        }
+                    }
+                }
+                continue;
+            }
+            _ => {}
+        }
+        if first != Some("v") {
             continue;
         }
+        defined[0] += 1;
         count += 1;
         for w in words.take(3) {
             if let Ok(x) = w.parse::<f32>() {
