@@ -249,8 +249,14 @@ impl Host {
             extensions.push(ash::ext::debug_utils::NAME.as_ptr());
         }
         let app = vk::ApplicationInfo::default().application_name(c"umbrage-embed").api_version(vk::API_VERSION_1_3);
-        let info =
+        // Synchronisation validation too: the host's barriers around the pass are checked.
+        let sync = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+        let mut features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&sync);
+        let mut info =
             vk::InstanceCreateInfo::default().application_info(&app).enabled_layer_names(&layers).enabled_extension_names(&extensions);
+        if !layers.is_empty() {
+            info = info.push_next(&mut features);
+        }
         // SAFETY: every pointer in `info` refers to locals alive for the call.
         let instance =
             unsafe { entry.create_instance(&info, None) }.map_err(|e| format!("vkCreateInstance failed ({e:?}): no Vulkan driver?"))?;
