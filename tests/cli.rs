@@ -148,3 +148,19 @@ fn bench_accepts_every_render_method() {
         assert!(out.status.success(), "{m}: {}", String::from_utf8_lossy(&out.stderr));
     }
 }
+
+/// `info --scene` lists each caster's parts (each planned on its own).
+#[test]
+fn info_lists_caster_parts() {
+    let out = umbrage(&["info", "--scene", "hard/open_casters", "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let casters = v["casters"].as_array().unwrap();
+    assert!(!casters.is_empty());
+    for c in casters {
+        let parts = c["parts"].as_array().unwrap();
+        assert!(!parts.is_empty(), "{c}");
+        let tris: u64 = parts.iter().map(|p| p["triangles"].as_u64().unwrap()).sum();
+        assert_eq!(tris, c["triangles"].as_u64().unwrap(), "parts cover the caster: {c}");
+    }
+}
