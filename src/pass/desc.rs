@@ -168,7 +168,7 @@ pub struct Capabilities {
     pub r32f_blend: bool,
 }
 
-/// Stencil bits of a depth-stencil format, `None` when it has no depth or no stencil.
+/// Refuses a depth-stencil format without a depth aspect or without 8 stencil bits.
 pub(crate) fn check_depth_stencil_format(format: vk::Format) -> Result<()> {
     match format {
         vk::Format::D16_UNORM_S8_UINT | vk::Format::D24_UNORM_S8_UINT | vk::Format::D32_SFLOAT_S8_UINT => Ok(()),

@@ -8,9 +8,10 @@
 //! Crossings are decided with exact `orient3d` signs on the f64 object-space coordinates; a
 //! segment through an edge or vertex exactly (a zero sign) is not a crossing.
 
+use super::casters::CasterTable;
 use crate::geom::{Light, LightKind};
-use crate::shadow::{Case, Caster, CasterKind, LightPlan};
-use glam::{DMat4, DVec3};
+use crate::shadow::{Case, CasterKind, LightPlan};
+use glam::DVec3;
 use robust::{orient3d, Coord3D};
 
 fn c(p: DVec3) -> Coord3D<f64> {
@@ -30,47 +31,44 @@ fn crosses(p: DVec3, q: DVec3, a: DVec3, b: DVec3, t: DVec3) -> bool {
     (e1 > 0.0 && e2 > 0.0 && e3 > 0.0) || (e1 < 0.0 && e2 < 0.0 && e3 < 0.0)
 }
 
-/// The number of the plan's drawn volumes that contain `point` (world space).
-pub(crate) fn volumes_containing(point: DVec3, light: &Light, plan: &LightPlan, casters: &[Caster], transforms: &[DMat4]) -> i32 {
-    let mut count = 0;
-    for cp in &plan.casters {
-        if cp.case == Case::Culled {
-            continue;
-        }
-        let caster = &casters[cp.caster];
-        let inv = transforms[cp.caster].inverse();
-        let p = inv.transform_point3(point);
-        let q = match light.kind {
-            // Towards a directional light: far beyond the caster along the light's direction.
-            LightKind::Directional => {
-                let d = inv.transform_vector3(-light.direction.as_dvec3()).normalize();
-                let b = caster.object_bounds;
-                let reach = (b.max.as_dvec3() - b.min.as_dvec3()).length() + (p - b.center().as_dvec3()).length();
-                p + d * (4.0 * reach + 1.0)
-            }
-            _ => inv.transform_point3(light.position.as_dvec3()),
-        };
+/// For each of `points` (world space), the number of the plan's drawn volumes that contain
+/// it. Each caster is brought to object space once for all points.
+pub(crate) fn volumes_containing(points: &[DVec3], light: &Light, plan: &LightPlan, table: &CasterTable) -> Vec<i32> {
+    let mut counts = vec![0; points.len()];
+    for cp in plan.casters.iter().filter(|cp| cp.case != Case::Culled) {
+        let caster = &table.cpu[cp.caster];
+        let inv = table.live[cp.caster].transform.inverse();
         let mesh = caster.mesh();
-        for pp in &cp.parts {
-            if pp.case == Case::Culled {
-                continue;
-            }
-            let part = &caster.parts[pp.part];
-            let hits = part
-                .triangles
-                .iter()
-                .filter(|&&t| {
-                    let [a, b, t3] = mesh.triangle(t as usize).map(|v| v.as_dvec3());
-                    crosses(p, q, a, b, t3)
-                })
-                .count() as i32;
-            count += match part.kind {
-                CasterKind::Manifold => (hits > 0) as i32,
-                CasterKind::Multiplicity { .. } => hits,
+        for (count, &point) in counts.iter_mut().zip(points) {
+            let p = inv.transform_point3(point);
+            let q = match light.kind {
+                // Towards a directional light: far beyond the caster along the light's direction.
+                LightKind::Directional => {
+                    let d = inv.transform_vector3(-light.direction.as_dvec3()).normalize();
+                    let b = caster.object_bounds;
+                    let reach = (b.max.as_dvec3() - b.min.as_dvec3()).length() + (p - b.center().as_dvec3()).length();
+                    p + d * (4.0 * reach + 1.0)
+                }
+                _ => inv.transform_point3(light.position.as_dvec3()),
             };
+            for pp in cp.parts.iter().filter(|pp| pp.case != Case::Culled) {
+                let part = &caster.parts[pp.part];
+                let hits = part
+                    .triangles
+                    .iter()
+                    .filter(|&&t| {
+                        let [a, b, t3] = mesh.triangle(t as usize).map(|v| v.as_dvec3());
+                        crosses(p, q, a, b, t3)
+                    })
+                    .count() as i32;
+                *count += match part.kind {
+                    CasterKind::Manifold => (hits > 0) as i32,
+                    CasterKind::Multiplicity { .. } => hits,
+                };
+            }
         }
     }
-    count
+    counts
 }
 
 #[cfg(test)]

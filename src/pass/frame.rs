@@ -330,11 +330,9 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
             .unwrap_or(full);
         let depth_bounds = if input.depth_bounds { plan.depth_bounds } else { None };
         let (eye_volumes, near_plane_split) = if method == shadow::Method::ZPassClear {
-            let transforms: Vec<DMat4> = table.live.iter().map(|g| g.transform).collect();
-            let at = |p: DVec3| super::eye::volumes_containing(p, light, &plan, &table.cpu, &transforms);
-            let n = at(view.eye);
-            let split = near_corners(view).into_iter().any(|c| at(c) != n);
-            (Some(n), Some(split))
+            let [c0, c1, c2, c3] = near_corners(view);
+            let counts = super::eye::volumes_containing(&[view.eye, c0, c1, c2, c3], light, &plan, table);
+            (Some(counts[0]), Some(counts[1..].iter().any(|&c| c != counts[0])))
         } else {
             (None, None)
         };

@@ -89,11 +89,9 @@ pub enum Technique {
 impl Technique {
     /// The name in `--stats` and the bench (`mcguire`, `edgequad`, `shadowmap`...).
     pub fn name(self) -> &'static str {
-        match self {
-            Technique::Volumes(m) => m.name(),
-            Technique::EdgeQuads => "edgequad",
-            Technique::Planar => "planar",
-            Technique::ShadowMap { .. } => "shadowmap",
+        match self.pass_technique() {
+            Some(t) => t.name(),
+            None => "shadowmap",
         }
     }
     /// The five volume methods (z-pass, z-fail, Everitt-Kilgard, Lengyel, McGuire).

@@ -165,6 +165,22 @@ impl SceneGeometry {
         Ok(buf.raw)
     }
 
+    /// Draws every mesh of `side`, each with its instance record of this slot's `instances`.
+    ///
+    /// # Safety
+    /// `cb` is recording inside a rendering instance with a scene pipeline bound (its push
+    /// constants set).
+    pub unsafe fn cmd_draw(&self, device: &ash::Device, cb: vk::CommandBuffer, instances: vk::Buffer, side: Sidedness) {
+        // SAFETY: the caller's contract; the buffers live until the slot retires.
+        unsafe {
+            device.cmd_bind_vertex_buffers(cb, 0, &[self.vertices.raw], &[0]);
+            for r in self.of(side) {
+                device.cmd_bind_vertex_buffers(cb, 1, &[instances], &[r.mesh as u64 * INSTANCE_BYTES]);
+                device.cmd_draw(cb, r.count, 1, r.first, 0);
+            }
+        }
+    }
+
     /// Ranges of one kind.
     pub fn of(&self, side: Sidedness) -> impl Iterator<Item = &MeshRange> {
         self.ranges.iter().filter(move |r| r.side == side)

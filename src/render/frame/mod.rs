@@ -367,7 +367,7 @@ impl Renderer {
                 let begin = stamp(all);
                 if let Some((sm, _)) = &self.shadow_mapper {
                     determine::begin_float(rec, t);
-                    sm.record(rec.ctx, rec.cb, t, light, rec_eye(&self.scene), frame.lights[li].scissor);
+                    sm.record(rec.ctx, rec.cb, t, light, self.scene.camera.eye.as_dvec3(), frame.lights[li].scissor);
                 }
                 determine::record(rec, pass, frame, li, t, into, layout.counts.get(li).copied());
                 spans.shadow.push(passes::timing_span(begin, stamp(all)));
@@ -495,11 +495,6 @@ impl Renderer {
         self.targets.destroy(ctx);
         self.geo.destroy(ctx);
     }
-}
-
-/// The eye of the scene's camera, f64.
-fn rec_eye(scene: &Scene) -> glam::DVec3 {
-    scene.camera.eye.as_dvec3()
 }
 
 impl Drop for Renderer {

@@ -6,7 +6,7 @@
 use super::{att, Rec, DS_CLEAR, ZERO};
 use crate::render::pipelines::FramePipelines;
 use crate::render::push::GBufferPush;
-use crate::render::scene_gpu::{SceneGeometry, Sidedness, INSTANCE_BYTES};
+use crate::render::scene_gpu::{SceneGeometry, Sidedness};
 use crate::render::targets::Targets;
 use ash::vk;
 use glam::{Mat4, Vec3};
@@ -42,16 +42,10 @@ pub(crate) unsafe fn record(
             0,
             bytemuck::bytes_of(&push),
         );
-        d.cmd_bind_vertex_buffers(cb, 0, &[geo.vertices.raw], &[0]);
         for (side, pipe) in [(Sidedness::OneSided, p.gbuffer), (Sidedness::TwoSided, p.gbuffer_two_sided)] {
-            let mut bound = false;
-            for r in geo.of(side) {
-                if !bound {
-                    d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipe);
-                    bound = true;
-                }
-                d.cmd_bind_vertex_buffers(cb, 1, &[instances], &[r.mesh as u64 * INSTANCE_BYTES]);
-                d.cmd_draw(cb, r.count, 1, r.first, 0);
+            if geo.of(side).next().is_some() {
+                d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipe);
+                geo.cmd_draw(d, cb, instances, side);
             }
         }
         d.cmd_end_rendering(cb);

@@ -5,7 +5,7 @@
 use super::{att, Rec, DS_CLEAR, ZERO};
 use crate::render::pipelines::FramePipelines;
 use crate::render::push::{ForwardPush, LightPush};
-use crate::render::scene_gpu::{SceneGeometry, Sidedness, INSTANCE_BYTES};
+use crate::render::scene_gpu::{SceneGeometry, Sidedness};
 use crate::render::targets::Targets;
 use ash::vk;
 use glam::{Mat4, Vec3};
@@ -20,11 +20,7 @@ pub(crate) unsafe fn draw_meshes(rec: &Rec, layout: vk::PipelineLayout, geo: &Sc
     // SAFETY: the caller's contract.
     unsafe {
         d.cmd_push_constants(rec.cb, layout, vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT, 0, bytemuck::bytes_of(push));
-        d.cmd_bind_vertex_buffers(rec.cb, 0, &[geo.vertices.raw], &[0]);
-        for r in geo.of(Sidedness::Transparent) {
-            d.cmd_bind_vertex_buffers(rec.cb, 1, &[instances], &[r.mesh as u64 * INSTANCE_BYTES]);
-            d.cmd_draw(rec.cb, r.count, 1, r.first, 0);
-        }
+        geo.cmd_draw(d, rec.cb, instances, Sidedness::Transparent);
     }
 }
 
