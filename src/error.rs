@@ -60,6 +60,19 @@ pub enum Error {
         #[source]
         source: gpu_allocator::AllocationError,
     },
+    /// An allocation would exceed the memory budget (`UMBRAGE_MEMORY_BUDGET`, see
+    /// [`crate::gpu::fault`]) or a scene's buffers would not fit the device's memory.
+    #[error("out of GPU memory for {name}: {size} bytes requested, {used} bytes in use, limit {budget} bytes")]
+    OutOfMemory {
+        /// What the memory was for.
+        name: String,
+        /// Requested size in bytes.
+        size: u64,
+        /// Bytes already allocated.
+        used: u64,
+        /// The budget or heap size in bytes.
+        budget: u64,
+    },
     /// A device feature a requested path needs is missing.
     #[error("unsupported on this device: {0}")]
     Unsupported(String),

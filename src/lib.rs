@@ -84,4 +84,6 @@ pub mod render;
 #[cfg(feature = "cli")]
 pub mod scene;
 pub mod shadow;
+#[cfg(feature = "cli")]
+pub mod soak;
 pub use error::{Error, Result};

@@ -171,6 +171,8 @@ enum Command {
         /// Write the report as a Markdown table.
         #[arg(long)]
         markdown: Option<PathBuf>,
+        #[command(flatten)]
+        soak: SoakArgs,
     },
     /// Compare a frame dump with the exact CPU reference.
     Check {
@@ -227,7 +229,12 @@ fn main() -> ExitCode {
         Command::Render { frame, out, stats, view, dump } => render(&frame, &out, stats.as_deref(), view, dump.as_deref()),
         Command::Info { json, scene } => info(json, scene.as_deref()),
         Command::Check { dir, band, threshold } => check(&dir, band, threshold),
-        Command::Bench { scenes, methods, frames, size, index_format, counters, frames_in_flight, shadow_map_size, json, markdown } => {
+        Command::Bench { scenes, methods, size, frames_in_flight, json, markdown, soak, .. } if soak.soak.is_some() => {
+            soak_cmd(&soak, scenes.first().map(String::as_str), &methods, size, frames_in_flight, json.as_deref(), markdown.as_deref())
+        }
+        Command::Bench {
+            scenes, methods, frames, size, index_format, counters, frames_in_flight, shadow_map_size, json, markdown, ..
+        } => {
             let techniques = bench_techniques(&methods, shadow_map_size);
             let opts = RenderOptions { width: size.0, height: size.1, index_format, frames_in_flight, ..Default::default() };
             bench(scenes, techniques, counters, frames, opts, json.as_deref(), markdown.as_deref())
@@ -348,6 +355,56 @@ fn check(dir: &Path, band: u32, threshold: f64) -> Result<ExitCode> {
 
 /// The bench's techniques: the given ones, or every volume method, edge quads and (size > 0)
 /// shadow maps.
+/// `umbrage bench --soak N`: memory and correctness held over many frames in one process.
+#[derive(clap::Args, Debug)]
+struct SoakArgs {
+    /// Soak instead of benchmarking: render N frames of one scene (the first --scene, default
+    /// `default`) with the lights orbiting and the casters spinning, and fail if host or GPU
+    /// memory drifts after warm-up, validation reports anything, or the last frame differs
+    /// from a fresh render of the same state. --json / --markdown write the samples.
+    #[arg(long, value_name = "N")]
+    soak: Option<usize>,
+    /// Frames per turn of the soak's motion (the first turn is the warm-up).
+    #[arg(long, default_value_t = 500)]
+    soak_period: usize,
+    /// Allowed spread of the memory samples after warm-up, percent.
+    #[arg(long, default_value_t = 1.0)]
+    soak_tolerance: f64,
+}
+
+fn soak_cmd(
+    args: &SoakArgs,
+    scene: Option<&str>,
+    methods: &[MethodArg],
+    size: (u32, u32),
+    frames_in_flight: usize,
+    json: Option<&Path>,
+    markdown: Option<&Path>,
+) -> Result<ExitCode> {
+    let frames = args.soak.unwrap_or(0);
+    let technique = methods.first().map(|m| m.technique(2048)).unwrap_or_default();
+    let options = RenderOptions { width: size.0, height: size.1, technique, frames_in_flight, ..Default::default() };
+    let cfg = umbrage::soak::SoakConfig {
+        scene: scene.unwrap_or("default").to_string(),
+        frames,
+        period: args.soak_period.min(frames.max(1)),
+        sample_every: (frames / 200).max(1),
+        tolerance: args.soak_tolerance / 100.0,
+        options,
+    };
+    let report = umbrage::soak::soak(&cfg)?;
+    let md = report.markdown();
+    println!("{md}");
+    if let Some(p) = json {
+        let text = serde_json::to_string_pretty(&report).map_err(|e| Error::Other(e.to_string()))?;
+        std::fs::write(p, text).map_err(|e| Error::io(p.display().to_string(), e))?;
+    }
+    if let Some(p) = markdown {
+        std::fs::write(p, &md).map_err(|e| Error::io(p.display().to_string(), e))?;
+    }
+    Ok(if report.passed { ExitCode::SUCCESS } else { ExitCode::FAILURE })
+}
+
 fn bench_techniques(methods: &[MethodArg], shadow_map_size: u32) -> Vec<Technique> {
     let size = if shadow_map_size > 0 { shadow_map_size } else { 2048 };
     let mut out: Vec<Technique> = Vec::new();

@@ -121,9 +121,57 @@ pub struct Context {
     pub validation: bool,
 }
 
-/// Whether validation is requested through `UMBRAGE_VALIDATION=1` (or `true`, any case).
+/// Whether validation is requested through `UMBRAGE_VALIDATION`: `1`, `true`, `sync`,
+/// `nosync`, `gpu` or `best` (any case; see [`ValidationMode`]).
 pub fn validation_requested() -> bool {
-    std::env::var("UMBRAGE_VALIDATION").map(|v| v == "1" || v.eq_ignore_ascii_case("true")).unwrap_or(false)
+    ValidationMode::from_env().is_some()
+}
+
+/// What `UMBRAGE_VALIDATION` asks the Khronos layer to check beyond API usage.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ValidationMode {
+    /// `1`, `true` or `sync`: API usage and synchronisation validation (the default of every
+    /// test and CI run).
+    Sync,
+    /// `nosync`: API usage only.
+    ApiOnly,
+    /// `gpu`: API usage and GPU-assisted validation (instrumented shaders: out-of-bounds
+    /// descriptor, buffer and indirect-argument accesses). Synchronisation validation cannot
+    /// run in the same instance, so it is off.
+    GpuAssisted,
+    /// `best`: API usage, synchronisation and best-practices warnings (logged with
+    /// `UMBRAGE_VERBOSE`, never fatal).
+    BestPractices,
+}
+
+impl ValidationMode {
+    /// Parses an `UMBRAGE_VALIDATION` value; `None` for off (`0`, empty, unknown).
+    pub fn parse(v: &str) -> Option<ValidationMode> {
+        match v.trim().to_ascii_lowercase().as_str() {
+            "1" | "true" | "sync" => Some(ValidationMode::Sync),
+            "nosync" => Some(ValidationMode::ApiOnly),
+            "gpu" => Some(ValidationMode::GpuAssisted),
+            "best" => Some(ValidationMode::BestPractices),
+            _ => None,
+        }
+    }
+    /// The mode `UMBRAGE_VALIDATION` asks for, if any.
+    pub fn from_env() -> Option<ValidationMode> {
+        std::env::var("UMBRAGE_VALIDATION").ok().and_then(|v| ValidationMode::parse(&v))
+    }
+    /// The layer features this mode enables.
+    pub fn features(self) -> &'static [vk::ValidationFeatureEnableEXT] {
+        match self {
+            ValidationMode::Sync => &[vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION],
+            ValidationMode::ApiOnly => &[],
+            ValidationMode::GpuAssisted => {
+                &[vk::ValidationFeatureEnableEXT::GPU_ASSISTED, vk::ValidationFeatureEnableEXT::GPU_ASSISTED_RESERVE_BINDING_SLOT]
+            }
+            ValidationMode::BestPractices => {
+                &[vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION, vk::ValidationFeatureEnableEXT::BEST_PRACTICES]
+            }
+        }
+    }
 }
 
 fn vkerr(call: &'static str) -> impl Fn(vk::Result) -> Error {
@@ -197,7 +245,7 @@ impl Context {
             let has = available.iter().any(|l| l.layer_name_as_c_str().map(|n| n == layer_name).unwrap_or(false));
             if !has {
                 return Err(Error::NoDevice(
-                    "UMBRAGE_VALIDATION=1 but VK_LAYER_KHRONOS_validation is not installed (apt-get install vulkan-validationlayers)"
+                    "UMBRAGE_VALIDATION is set but VK_LAYER_KHRONOS_validation is not installed (apt-get install vulkan-validationlayers)"
                         .into(),
                 ));
             }
@@ -206,12 +254,13 @@ impl Context {
         }
         let app = vk::ApplicationInfo::default().application_name(c"umbrage").engine_name(c"umbrage").api_version(vk::API_VERSION_1_3);
         // Synchronisation validation on whenever validation is (a missing barrier is invisible
-        // on lavapipe and flickers on a real GPU); `UMBRAGE_VALIDATION=nosync` leaves it off.
-        let sync = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
-        let mut features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&sync);
+        // on lavapipe and flickers on a real GPU) unless `UMBRAGE_VALIDATION` picks another
+        // mode (see `ValidationMode`).
+        let mode = ValidationMode::from_env().unwrap_or(ValidationMode::Sync);
+        let mut features = vk::ValidationFeaturesEXT::default().enabled_validation_features(mode.features());
         let mut create =
             vk::InstanceCreateInfo::default().application_info(&app).enabled_layer_names(&layers).enabled_extension_names(&extensions);
-        if validation && std::env::var("UMBRAGE_VALIDATION").map(|v| v != "nosync").unwrap_or(true) {
+        if validation && !mode.features().is_empty() {
             create = create.push_next(&mut features);
         }
         // SAFETY: all pointers in `create` refer to locals alive for this call.
@@ -476,9 +525,11 @@ impl Context {
             let fence = self.device.create_fence(&vk::FenceCreateInfo::default(), None).map_err(vkerr("vkCreateFence"))?;
             let cbs = [cb];
             let submit = vk::SubmitInfo::default().command_buffers(&cbs);
-            let r = self
-                .device
-                .queue_submit(self.queue, &[submit], fence)
+            let submitted = match super::fault::inject(super::fault::FaultPoint::Submit) {
+                Some(injected) => Err(injected),
+                None => self.device.queue_submit(self.queue, &[submit], fence),
+            };
+            let r = submitted
                 .map_err(vkerr("vkQueueSubmit"))
                 .and_then(|_| self.device.wait_for_fences(&[fence], true, u64::MAX).map_err(vkerr("vkWaitForFences")));
             self.device.destroy_fence(fence, None);

@@ -3,11 +3,12 @@
 #![warn(missing_docs)]
 pub mod context;
 pub mod descriptors;
+pub mod fault;
 pub mod pipeline;
 pub mod resources;
 pub mod shaders {
     //! The naga-compiled SPIR-V of every shader in `shaders/` (see build.rs).
     include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
 }
-pub use context::{Context, DeviceInfo, Features, GpuDevice};
+pub use context::{Context, DeviceInfo, Features, GpuDevice, ValidationMode};
 pub use resources::{Buffer, Image};

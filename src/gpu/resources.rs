@@ -2,6 +2,7 @@
 //! (`destroy`), in the owner's `Drop`, after the device is idle.
 
 use super::context::GpuDevice;
+use super::fault;
 use crate::error::{Error, Result};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme};
@@ -32,17 +33,35 @@ impl Buffer {
         let raw = unsafe { ctx.device().create_buffer(&info, None) }.map_err(vkerr("vkCreateBuffer"))?;
         // SAFETY: `raw` was just created on this device.
         let requirements = unsafe { ctx.device().get_buffer_memory_requirements(raw) };
-        let allocation = GpuDevice::allocator(ctx)
-            .allocate(&AllocationCreateDesc {
-                name,
-                requirements,
-                location,
-                linear: true,
-                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+        let allocation = {
+            let mut allocator = GpuDevice::allocator(ctx);
+            fault::check_budget(&allocator, name, requirements.size).and_then(|()| {
+                allocator
+                    .allocate(&AllocationCreateDesc {
+                        name,
+                        requirements,
+                        location,
+                        linear: true,
+                        allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+                    })
+                    .map_err(|source| Error::Allocation { name: name.to_string(), size, source })
             })
-            .map_err(|source| Error::Allocation { name: name.to_string(), size, source })?;
+        };
+        let allocation = match allocation {
+            Ok(a) => a,
+            Err(e) => {
+                // SAFETY: `raw` was created above, is bound to nothing and used by nothing.
+                unsafe { ctx.device().destroy_buffer(raw, None) };
+                return Err(e);
+            }
+        };
         // SAFETY: memory and offset come from an allocation made for these requirements.
-        unsafe { ctx.device().bind_buffer_memory(raw, allocation.memory(), allocation.offset()) }.map_err(vkerr("vkBindBufferMemory"))?;
+        if let Err(e) = unsafe { ctx.device().bind_buffer_memory(raw, allocation.memory(), allocation.offset()) } {
+            let _ = GpuDevice::allocator(ctx).free(allocation);
+            // SAFETY: `raw` is bound to nothing and used by nothing.
+            unsafe { ctx.device().destroy_buffer(raw, None) };
+            return Err(Error::Vulkan { call: "vkBindBufferMemory", result: e });
+        }
         Ok(Buffer { raw, size, allocation: Some(allocation) })
     }
 
@@ -88,6 +107,9 @@ impl Buffer {
     }
 }
 
+/// What [`Image::new_all`] creates: name, format, usage and aspect of one image.
+pub type ImageSpec<'a> = (&'a str, vk::Format, vk::ImageUsageFlags, vk::ImageAspectFlags);
+
 /// A 2D image (one mip level, one layer, one sample, optimal tiling) in device-local memory,
 /// with a view of the whole image. Not freed on drop: call [`Image::destroy`].
 pub struct Image {
@@ -131,24 +153,72 @@ impl Image {
         let raw = unsafe { ctx.device().create_image(&info, None) }.map_err(vkerr("vkCreateImage"))?;
         // SAFETY: `raw` is a new image of this device.
         let requirements = unsafe { ctx.device().get_image_memory_requirements(raw) };
-        let allocation = GpuDevice::allocator(ctx)
-            .allocate(&AllocationCreateDesc {
-                name,
-                requirements,
-                location: MemoryLocation::GpuOnly,
-                linear: false,
-                allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+        let allocation = {
+            let mut allocator = GpuDevice::allocator(ctx);
+            let label = format!("image {name}");
+            fault::check_budget(&allocator, &label, requirements.size).and_then(|()| {
+                allocator
+                    .allocate(&AllocationCreateDesc {
+                        name,
+                        requirements,
+                        location: MemoryLocation::GpuOnly,
+                        linear: false,
+                        allocation_scheme: AllocationScheme::GpuAllocatorManaged,
+                    })
+                    .map_err(|source| Error::Allocation { name: label, size: requirements.size, source })
             })
-            .map_err(|source| Error::Allocation { name: format!("image {name}"), size: requirements.size, source })?;
+        };
+        // On any failure below, what was created so far is released again.
+        let release = |allocation: Option<Allocation>| {
+            if let Some(a) = allocation {
+                let _ = GpuDevice::allocator(ctx).free(a);
+            }
+            // SAFETY: `raw` was created above and is used by nothing (no view, no command).
+            unsafe { ctx.device().destroy_image(raw, None) };
+        };
+        let allocation = match allocation {
+            Ok(a) => a,
+            Err(e) => {
+                release(None);
+                return Err(e);
+            }
+        };
         // SAFETY: the allocation satisfies the image's requirements.
-        unsafe { ctx.device().bind_image_memory(raw, allocation.memory(), allocation.offset()) }.map_err(vkerr("vkBindImageMemory"))?;
+        if let Err(e) = unsafe { ctx.device().bind_image_memory(raw, allocation.memory(), allocation.offset()) } {
+            release(Some(allocation));
+            return Err(Error::Vulkan { call: "vkBindImageMemory", result: e });
+        }
         let view_info =
             vk::ImageViewCreateInfo::default().image(raw).view_type(vk::ImageViewType::TYPE_2D).format(format).subresource_range(
                 vk::ImageSubresourceRange { aspect_mask: aspect, base_mip_level: 0, level_count: 1, base_array_layer: 0, layer_count: 1 },
             );
         // SAFETY: `raw` is bound to memory; the view covers its single subresource.
-        let view = unsafe { ctx.device().create_image_view(&view_info, None) }.map_err(vkerr("vkCreateImageView"))?;
+        let view = match unsafe { ctx.device().create_image_view(&view_info, None) } {
+            Ok(v) => v,
+            Err(e) => {
+                release(Some(allocation));
+                return Err(Error::Vulkan { call: "vkCreateImageView", result: e });
+            }
+        };
         Ok(Image { raw, view, format, extent, aspect, allocation: Some(allocation) })
+    }
+
+    /// Creates one image of `extent` per spec, all or nothing: when one fails, those already
+    /// made are destroyed again before the error is returned.
+    pub fn new_all<const N: usize>(ctx: &impl GpuDevice, extent: vk::Extent2D, specs: [ImageSpec<'_>; N]) -> Result<[Image; N]> {
+        let mut made: Vec<Image> = Vec::with_capacity(N);
+        for (name, format, usage, aspect) in specs {
+            match Image::new_2d(ctx, name, format, extent, usage, aspect) {
+                Ok(img) => made.push(img),
+                Err(e) => {
+                    for mut img in made {
+                        img.destroy(ctx);
+                    }
+                    return Err(e);
+                }
+            }
+        }
+        made.try_into().map_err(|_| Error::Other("image count mismatch".into()))
     }
 
     /// The subresource range of the whole image (its single mip level and layer, [`Image::aspect`]).

@@ -30,7 +30,7 @@ pub mod stats;
 pub mod targets;
 mod timing;
 
-pub use frame::{FrameTicket, Renderer, Throughput};
+pub use frame::{largest_device_heap, FrameTicket, MemoryEstimate, Renderer, Throughput};
 pub use frame_output::FrameOutput;
 pub use options::{Counter, DepthMode, FrameSettings, IndexFormat, RenderConfig, RenderOptions, Technique, TransmitMode, View};
 pub use passes::debug::stencil_heatmap;

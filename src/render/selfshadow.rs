@@ -58,16 +58,16 @@ impl SelfShadow {
     pub(crate) fn new(ctx: &Context, p: &FramePipelines, extent: vk::Extent2D, transmit_format: vk::Format) -> Result<SelfShadow> {
         let color = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED;
         let c = vk::ImageAspectFlags::COLOR;
-        let depth = Image::new_2d(
+        let ds = vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL;
+        let [depth, count, map] = Image::new_all(
             ctx,
-            "transparent depth",
-            ctx.depth_format,
             extent,
-            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
-            vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL,
+            [
+                ("transparent depth", ctx.depth_format, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT, ds),
+                ("self-shadow opaque count", COUNT_FORMAT, color, c),
+                ("self-shadow light-intensity map", transmit_format, color, c),
+            ],
         )?;
-        let count = Image::new_2d(ctx, "self-shadow opaque count", COUNT_FORMAT, extent, color, c)?;
-        let map = Image::new_2d(ctx, "self-shadow light-intensity map", transmit_format, extent, color, c)?;
         let set = DescriptorSet::new(ctx, &[Binding::Image(count.view), Binding::Image(map.view), Binding::Sampler(p.sampler)])?;
         let push = std::mem::size_of::<ForwardPush>() as u32;
         let layout = pipeline_layout(ctx, &[set.layout], push, vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)?;

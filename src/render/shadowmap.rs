@@ -95,7 +95,10 @@ impl ShadowMapper {
                 vk::BufferUsageFlags::VERTEX_BUFFER,
                 gpu_allocator::MemoryLocation::CpuToGpu,
             )?;
-            b.write(0, bytemuck::cast_slice(&pos))?;
+            if let Err(e) = b.write(0, bytemuck::cast_slice(&pos)) {
+                b.destroy(ctx);
+                return Err(e);
+            }
             Some(b)
         };
         let atlas = Image::new_2d(
@@ -105,7 +108,16 @@ impl ShadowMapper {
             vk::Extent2D { width: 3 * size, height: 2 * size },
             vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
             vk::ImageAspectFlags::DEPTH,
-        )?;
+        );
+        let atlas = match atlas {
+            Ok(a) => a,
+            Err(e) => {
+                if let Some(mut b) = casters {
+                    b.destroy(ctx);
+                }
+                return Err(e);
+            }
+        };
         let set = DescriptorSet::new(
             ctx,
             &[

@@ -45,31 +45,22 @@ impl Targets {
         let extent = vk::Extent2D { width, height };
         let color = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
         let c = vk::ImageAspectFlags::COLOR;
-        Ok(Targets {
+        let ds = vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL;
+        let [accum, albedo, normal, position, depth, count, transmit, output] = Image::new_all(
+            ctx,
             extent,
-            accum: Image::new_2d(ctx, "accum", ACCUM_FORMAT, extent, color, c)?,
-            albedo: Image::new_2d(ctx, "albedo", ALBEDO_FORMAT, extent, color, c)?,
-            normal: Image::new_2d(ctx, "normal", NORMAL_FORMAT, extent, color, c)?,
-            position: Image::new_2d(ctx, "position", POSITION_FORMAT, extent, color, c)?,
-            depth: Image::new_2d(
-                ctx,
-                "depth-stencil",
-                ctx.depth_format,
-                extent,
-                vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
-                vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL,
-            )?,
-            count: Image::new_2d(ctx, "count", COUNT_FORMAT, extent, color, c)?,
-            transmit: Image::new_2d(ctx, "light-intensity map", transmit_format, extent, color, c)?,
-            output: Image::new_2d(
-                ctx,
-                "output",
-                OUTPUT_FORMAT,
-                extent,
-                vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
-                c,
-            )?,
-        })
+            [
+                ("accum", ACCUM_FORMAT, color, c),
+                ("albedo", ALBEDO_FORMAT, color, c),
+                ("normal", NORMAL_FORMAT, color, c),
+                ("position", POSITION_FORMAT, color, c),
+                ("depth-stencil", ctx.depth_format, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC, ds),
+                ("count", COUNT_FORMAT, color, c),
+                ("light-intensity map", transmit_format, color, c),
+                ("output", OUTPUT_FORMAT, vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC, c),
+            ],
+        )?;
+        Ok(Targets { extent, accum, albedo, normal, position, depth, output, count, transmit })
     }
 
     /// The G-buffer pass's colour attachments, in attachment order.

@@ -14,7 +14,9 @@ use super::selfshadow::SelfShadow;
 use super::shadowmap::ShadowMapper;
 use super::targets::*;
 use super::timing::{Span, Timer};
+mod memory;
 mod motion;
+pub use memory::{largest_device_heap, MemoryEstimate};
 mod stats;
 
 use crate::error::{Error, Result};
@@ -115,6 +117,7 @@ impl Renderer {
             return Err(Error::Other(format!("frames in flight must be 1..=16, got {}", config.frames_in_flight)));
         }
         check_options(&ctx, &config, &settings)?;
+        memory::check_fits(&ctx, &scene, &config)?;
         let transmit_format = opts.transmit.format();
         let f = &ctx.features;
         let desc = ShadowPassDesc {
@@ -139,22 +142,74 @@ impl Renderer {
             });
         }
         let has_transparent = pass.casters().iter().any(|c| c.transmittance.is_some());
-        let geo = SceneGeometry::new(&ctx, &scene, config.frames_in_flight)?;
-        let targets = Targets::new(&ctx, config.width, config.height, transmit_format)?;
-        let pipes = FramePipelines::new(&ctx, &targets, pass.capabilities().depth_bounds)?;
+        // Each step that fails releases what the steps before it made (the pass drops itself).
+        let mut geo = SceneGeometry::new(&ctx, &scene, config.frames_in_flight)?;
+        let mut targets = match Targets::new(&ctx, config.width, config.height, transmit_format) {
+            Ok(t) => t,
+            Err(e) => {
+                geo.destroy(&ctx);
+                return Err(e);
+            }
+        };
+        let mut pipes = match FramePipelines::new(&ctx, &targets, pass.capabilities().depth_bounds) {
+            Ok(p) => p,
+            Err(e) => {
+                targets.destroy(&ctx);
+                geo.destroy(&ctx);
+                return Err(e);
+            }
+        };
         let self_shadow = match config.self_shadow && geo.of(Sidedness::Transparent).next().is_some() {
-            true => Some(SelfShadow::new(&ctx, &pipes, targets.extent, transmit_format)?),
+            true => match SelfShadow::new(&ctx, &pipes, targets.extent, transmit_format) {
+                Ok(s) => Some(s),
+                Err(e) => {
+                    // SAFETY: nothing was submitted with the pipelines yet.
+                    unsafe { pipes.destroy(&ctx) };
+                    targets.destroy(&ctx);
+                    geo.destroy(&ctx);
+                    return Err(e);
+                }
+            },
             false => None,
         };
         let mut slots = Vec::new();
         for _ in 0..config.frames_in_flight {
-            // SAFETY: object creation on a valid device; destroyed in Drop.
-            let (cmd, fence) = unsafe {
+            // SAFETY: object creation on a valid device; destroyed in Drop (the fence is only
+            // created once the command buffer exists, and the command buffers go with the pool).
+            let created = unsafe {
                 let info = vk::CommandBufferAllocateInfo::default().command_pool(ctx.pool).command_buffer_count(1);
-                let cmd = ctx.device.allocate_command_buffers(&info).map_err(Error::vk("vkAllocateCommandBuffers"))?[0];
-                (cmd, ctx.device.create_fence(&vk::FenceCreateInfo::default(), None).map_err(Error::vk("vkCreateFence"))?)
+                ctx.device.allocate_command_buffers(&info).map_err(Error::vk("vkAllocateCommandBuffers")).and_then(|cbs| {
+                    match ctx.device.create_fence(&vk::FenceCreateInfo::default(), None) {
+                        Ok(f) => Ok((cbs[0], f)),
+                        Err(e) => {
+                            ctx.device.free_command_buffers(ctx.pool, &cbs);
+                            Err(Error::Vulkan { call: "vkCreateFence", result: e })
+                        }
+                    }
+                })
             };
-            slots.push(FrameSlot { cmd, fence, timer: Timer::new(&ctx), readback: Readback { buffer: None }, in_flight: None });
+            match created {
+                Ok((cmd, fence)) => {
+                    slots.push(FrameSlot { cmd, fence, timer: Timer::new(&ctx), readback: Readback { buffer: None }, in_flight: None })
+                }
+                Err(e) => {
+                    // SAFETY: nothing was submitted from these slots or with the pipelines.
+                    unsafe {
+                        for s in &mut slots {
+                            s.timer.destroy(&ctx);
+                            ctx.device.destroy_fence(s.fence, None);
+                            ctx.device.free_command_buffers(ctx.pool, &[s.cmd]);
+                        }
+                        if let Some(mut ss) = self_shadow {
+                            ss.destroy(&ctx);
+                        }
+                        pipes.destroy(&ctx);
+                    }
+                    targets.destroy(&ctx);
+                    geo.destroy(&ctx);
+                    return Err(e);
+                }
+            }
         }
         Ok(Renderer {
             scene,
@@ -323,8 +378,11 @@ impl Renderer {
             let cbs = [cb];
             let fence = self.slots[slot].fence;
             d.reset_fences(&[fence]).map_err(Error::vk("vkResetFences"))?;
-            d.queue_submit(self.ctx.queue, &[vk::SubmitInfo::default().command_buffers(&cbs)], fence)
-                .map_err(Error::vk("vkQueueSubmit"))?;
+            match crate::gpu::fault::inject(crate::gpu::fault::FaultPoint::Submit) {
+                Some(injected) => Err(injected),
+                None => d.queue_submit(self.ctx.queue, &[vk::SubmitInfo::default().command_buffers(&cbs)], fence),
+            }
+            .map_err(Error::vk("vkQueueSubmit"))?;
         }
         let record_ms = record_start.elapsed().as_secs_f64() * 1e3;
         let serial = self.serial;
