@@ -242,15 +242,18 @@ impl Image {
 }
 
 /// Records a layout transition of the whole `image` from `from` to `to` into `cb` (which must
-/// be recording), as a synchronization2 barrier: all commands' memory writes before, all
-/// commands' reads and writes after. Conservative stage masks: the frame has a handful of
-/// these, never in an inner loop. `from` may be `UNDEFINED` (contents discarded).
+/// be recording), as a synchronization2 barrier scoped by the two layouts: the writes of the
+/// stages that use an image in `from` are made visible to the stages that use it in `to` (see
+/// `layout_scope`; layouts without a known use get the full scope). `from` may be `UNDEFINED`
+/// (contents discarded; earlier commands are still waited for).
 pub fn transition(ctx: &impl GpuDevice, cb: vk::CommandBuffer, image: &Image, from: vk::ImageLayout, to: vk::ImageLayout) {
+    let (src_stage, src_access) = layout_scope(from, true);
+    let (dst_stage, dst_access) = layout_scope(to, false);
     let barrier = vk::ImageMemoryBarrier2::default()
-        .src_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
-        .src_access_mask(vk::AccessFlags2::MEMORY_WRITE)
-        .dst_stage_mask(vk::PipelineStageFlags2::ALL_COMMANDS)
-        .dst_access_mask(vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE)
+        .src_stage_mask(src_stage)
+        .src_access_mask(src_access)
+        .dst_stage_mask(dst_stage)
+        .dst_access_mask(dst_access)
         .old_layout(from)
         .new_layout(to)
         .image(image.raw)
@@ -259,6 +262,33 @@ pub fn transition(ctx: &impl GpuDevice, cb: vk::CommandBuffer, image: &Image, fr
     let dep = vk::DependencyInfo::default().image_memory_barriers(&barriers);
     // SAFETY: `cb` is recording; the image belongs to this device.
     unsafe { ctx.device().cmd_pipeline_barrier2(cb, &dep) };
+}
+
+/// The stages and accesses an image in `layout` is used with: as the source of a transition
+/// (`src`: the writes to make available, and the stages to wait for) or as its destination.
+/// `UNDEFINED` as a source still waits for every earlier command (the previous frame may be
+/// reading the image: a write-after-read hazard needs the execution dependency); layouts not
+/// listed get the full `ALL_COMMANDS` / `MEMORY_*` scope.
+fn layout_scope(layout: vk::ImageLayout, src: bool) -> (vk::PipelineStageFlags2, vk::AccessFlags2) {
+    use vk::AccessFlags2 as A;
+    use vk::ImageLayout as L;
+    use vk::PipelineStageFlags2 as S;
+    let fragment_tests = S::EARLY_FRAGMENT_TESTS | S::LATE_FRAGMENT_TESTS;
+    match layout {
+        L::UNDEFINED => (if src { S::ALL_COMMANDS } else { S::NONE }, A::NONE),
+        L::COLOR_ATTACHMENT_OPTIMAL => {
+            (S::COLOR_ATTACHMENT_OUTPUT, if src { A::COLOR_ATTACHMENT_WRITE } else { A::COLOR_ATTACHMENT_READ | A::COLOR_ATTACHMENT_WRITE })
+        }
+        L::DEPTH_STENCIL_ATTACHMENT_OPTIMAL => (
+            fragment_tests,
+            if src { A::DEPTH_STENCIL_ATTACHMENT_WRITE } else { A::DEPTH_STENCIL_ATTACHMENT_READ | A::DEPTH_STENCIL_ATTACHMENT_WRITE },
+        ),
+        L::SHADER_READ_ONLY_OPTIMAL => (S::FRAGMENT_SHADER | S::COMPUTE_SHADER, if src { A::NONE } else { A::SHADER_READ }),
+        L::TRANSFER_SRC_OPTIMAL => (S::ALL_TRANSFER, if src { A::NONE } else { A::TRANSFER_READ }),
+        L::TRANSFER_DST_OPTIMAL => (S::ALL_TRANSFER, A::TRANSFER_WRITE),
+        L::PRESENT_SRC_KHR => (if src { S::ALL_COMMANDS } else { S::NONE }, A::NONE),
+        _ => (S::ALL_COMMANDS, if src { A::MEMORY_WRITE } else { A::MEMORY_READ | A::MEMORY_WRITE }),
+    }
 }
 
 /// Records a global memory barrier into `cb` (which must be recording): `src` and `dst` are
