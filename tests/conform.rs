@@ -59,6 +59,10 @@ fn filter_matching_nothing_exits_2_with_a_message() {
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("matches none"), "{err}");
+    // The test seam's variable, misspelt: a clear error, not a silently unbroken run.
+    let out = umbrage().args(["conform", "--filter", "zoo."]).env("UMBRAGE_CONFORM_BREAK", "frobnicate").output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("unknown stencil op"));
 }
 
 #[test]
