@@ -1,4 +1,4 @@
-//! The Markdown report (`conform.md`, also docs/conform/<device>.md) and writing every output.
+//! The Markdown report (`conform.md`, also `docs/conform/<device>.md`) and writing every output.
 
 use super::suite::Report;
 use super::{junit, Status};

@@ -9,7 +9,7 @@ use super::{images, CheckResult, Status};
 use crate::error::Result;
 use crate::gpu::{Context, DeviceInfo, Features};
 use ash::vk;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// Options of a suite run.
@@ -461,9 +461,4 @@ pub fn affected_by_break(brk: vk::StencilOp, filter: &[String], subpixel_bits: u
         .filter(|c| model::expect(c, subpixel_bits, None) != model::expect(c, subpixel_bits, Some(brk)))
         .map(|c| c.name)
         .collect()
-}
-
-/// Writes nothing; a helper for callers that want the image directory of a case.
-pub fn failure_dir(out: &Path, case: &str) -> PathBuf {
-    out.join("failures").join(case)
 }

@@ -220,7 +220,8 @@ fn bounds(config: Config) -> Vec<Case> {
 fn unrestricted(config: Config) -> Vec<Case> {
     let mut v = Vec::new();
     // (name, stored, quad ndc z, viewport, clamp, what)
-    let list: [(&str, f64, f32, (f32, f32), bool, &str); 4] = [
+    type Row = (&'static str, f64, f32, (f32, f32), bool, &'static str);
+    let list: [Row; 4] = [
         ("viewport_0_4", 3.0, 0.5, (0.0, 4.0), false, "viewport depth [0, 4]: ndc 0.5 -> 2.0 < stored 3.0, written unclamped"),
         ("stored_above_one", 2.5, 1.0, (0.0, 1.0), false, "stored 2.5 (outside [0, 1]) compared and overwritten with 1.0"),
         ("negative_viewport", 0.0, 0.5, (-2.0, 1.0), false, "viewport depth [-2, 1]: ndc 0.5 -> -0.5 < stored 0, written"),

@@ -31,10 +31,10 @@ fn state(op: [vk::StencilOp; 3], comp: vk::CompareOp, reference: u32, masks: (u3
 
 fn tile_case(config: Config, rest: String, what: String, front: vk::StencilOpState, back: vk::StencilOpState) -> Case {
     let mut c = Case::new(config, "stencil", &rest, (8, 8), 1.0, 0);
-    for y in 0..8usize {
+    for (y, &row) in ROW_STENCIL.iter().enumerate() {
         for x in 0..8usize {
             let i = y * 8 + x;
-            c.init_stencil[i] = ROW_STENCIL[y];
+            c.init_stencil[i] = row;
             c.init_depth[i] = if (x / 2) % 2 == 0 { 0.75 } else { 0.25 };
         }
     }
