@@ -230,8 +230,27 @@ fn compare(case: &Case, exp: &Expected, got: &TileResult) -> (u64, u64, u64, Vec
     let (mut sm, mut dm, mut judged) = (0u64, 0u64, 0u64);
     let mut first = Vec::new();
     let w = case.size.0 as usize;
+    let mut either = vec![None; exp.stencil.len()];
+    for &(i, allowed, _) in &case.either {
+        either[i] = Some(allowed);
+    }
     for (i, e) in exp.stencil.iter().enumerate() {
-        if let Some(e) = e {
+        if let Some(allowed) = either[i] {
+            judged += 1;
+            if !allowed.contains(&got.stencil[i]) {
+                sm += 1;
+                if first.len() < 3 {
+                    first.push(format!(
+                        "stencil at ({}, {}) on the shared edge: expected 0x{:02x} or 0x{:02x} (exactly one triangle), got 0x{:02x}",
+                        i % w,
+                        i / w,
+                        allowed[0],
+                        allowed[1],
+                        got.stencil[i]
+                    ));
+                }
+            }
+        } else if let Some(e) = e {
             judged += 1;
             if got.stencil[i] != *e {
                 sm += 1;
@@ -357,6 +376,13 @@ pub fn run_suite(ctx: &Context, new_context: &dyn Fn() -> Result<Context>, opts:
                 }
             } else {
                 o.message = format!("{judged} judged pixels exact");
+                if !c.either.is_empty() {
+                    let tl = c.either.iter().filter(|&&(i, _, p)| tile.stencil[i] == p).count();
+                    o.message.push_str(&format!(
+                        ", each of the {} centres on the shared edge covered once; the D3D top-left convention held at {tl} of them",
+                        c.either.len()
+                    ));
+                }
                 if !o.queries.is_empty() {
                     o.message.push_str(&format!(", {} query counts exact", o.queries.len()));
                 }

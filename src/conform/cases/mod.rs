@@ -268,6 +268,10 @@ pub struct Case {
     /// for properties the model cannot predict pixel by pixel but the spec guarantees
     /// (a watertight mesh counts every pixel exactly once).
     pub stencil_override: Option<Vec<Option<u8>>>,
+    /// Pixels whose stencil may be either of two values (a centre on a shared edge: which
+    /// triangle covers it is the implementation's choice), with the value the D3D top-left
+    /// convention predicts (reported, not required: Vulkan does not mandate it).
+    pub either: Vec<(usize, [u8; 2], u8)>,
     /// Whether depth is compared (false: only stencil and queries).
     pub check_depth: bool,
     /// The bug a zoo case would catch.
@@ -289,6 +293,7 @@ impl Case {
             init_stencil: vec![stencil; n],
             draws: Vec::new(),
             stencil_override: None,
+            either: Vec::new(),
             check_depth: true,
             bug: None,
         }

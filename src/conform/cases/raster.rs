@@ -93,15 +93,37 @@ fn shared_edges(config: Config) -> Vec<Case> {
     ];
     for (name, p, q) in lines {
         let mut c = Case::new(config, "raster", &format!("shared_edge.{name}"), size, 1.0, 0);
-        c.what = "two triangles sharing an edge through pixel centres: exactly one covers each centre on it".into();
+        c.what = "two triangles sharing an edge through pixel centres, drawn separately (INCR_WRAP; INVERT of bit 7): \
+                  every centre on the edge covered by exactly one (which one is the driver's choice; the D3D top-left \
+                  convention is reported)"
+            .into();
         let d = [q[0] - p[0], q[1] - p[1]];
         let (a, b) = ([p[0] - 10.0 * d[0], p[1] - 10.0 * d[1]], [p[0] + 10.0 * d[0], p[1] + 10.0 * d[1]]);
         let n = [-d[1] * 20.0, d[0] * 20.0];
         let m = [(a[0] + b[0]) * 0.5, (a[1] + b[1]) * 0.5];
         let v4 = |x: [f32; 2]| [x[0], x[1], 0.5, 1.0];
-        let verts = vec![v4(a), v4(b), v4([m[0] + n[0], m[1] + n[1]]), v4(b), v4(a), v4([m[0] - n[0], m[1] - n[1]])];
-        c.draws.push(Draw { state: counting_state(), mvp: super::pixel_ortho(size.0, size.1), vertices: verts, query: false });
-        all_ones(&mut c);
+        let tri_a = vec![v4(a), v4(b), v4([m[0] + n[0], m[1] + n[1]])];
+        let tri_b = vec![v4(b), v4(a), v4([m[0] - n[0], m[1] - n[1]])];
+        let ortho = super::pixel_ortho(size.0, size.1);
+        c.draws.push(Draw { state: counting_state(), mvp: ortho, vertices: tri_a, query: false });
+        let mut high = incr();
+        for s in [&mut high.0, &mut high.1] {
+            s.pass_op = vk::StencilOp::INVERT;
+            s.write_mask = 0x80;
+        }
+        c.draws.push(Draw { state: DsState { stencil: Some(high), ..Default::default() }, mvp: ortho, vertices: tri_b, query: false });
+        // The D3D rule gives the centre to the triangle whose left (or, for a horizontal
+        // edge, top) edge it is: A lies on the +n side of a -> b.
+        let a_owns = if d[1] != 0.0 { n[0] > 0.0 } else { n[1] > 0.0 };
+        for y in 0..size.1 {
+            for x in 0..size.0 {
+                let (cx, cy) = (x as f32 + 0.5 - p[0], y as f32 + 0.5 - p[1]);
+                if cx * d[1] - cy * d[0] == 0.0 {
+                    c.either.push(((y * size.0 + x) as usize, [0x01, 0x80], if a_owns { 0x01 } else { 0x80 }));
+                }
+            }
+        }
+        c.check_depth = false;
         v.push(c);
     }
     v
