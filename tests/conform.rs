@@ -197,5 +197,25 @@ fn broken_expectation_fails_exactly_the_affected_cases() {
     }
     assert!(report.cases.iter().filter(|c| !affected.contains(&c.name)).all(|c| c.status != Status::Fail));
     ctx.check_validation().unwrap();
+
+    // The same seam through the command line: exit 1, one JUnit <failure> per affected case.
+    let filter = "zoo.d24s8.dynamic_rendering.static_state";
+    let junit = dir.join("cli.xml");
+    let out = umbrage()
+        .args(["conform", "--filter", filter, "--out"])
+        .arg(dir.join("cli"))
+        .arg("--junit")
+        .arg(&junit)
+        .env("UMBRAGE_CONFORM_BREAK", "incr_wrap")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stdout));
+    let expected = suite::affected_by_break(op, &[filter.to_string()], ctx.limits.sub_pixel_precision_bits);
+    let xml = std::fs::read_to_string(&junit).unwrap();
+    assert_eq!(xml.matches("<failure ").count(), expected.len());
+    for name in &expected {
+        assert!(xml.contains(&format!("name=\"{name}\"")), "{name}");
+        assert!(dir.join("cli").join("failures").join(name).join("expected.png").is_file(), "{name}");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
