@@ -196,7 +196,7 @@ fn snap01(z: f64) -> f64 {
 /// it"), when that edge is shared with the adjacent triangle in the draw (a quad's diagonal),
 /// of the same facing and the same constant depth — so which of the two gets the fragment
 /// changes nothing. `None`: not determinable (a vertex, an unshared edge, different planes).
-fn shared_edge_owner(wt: &[WinTri], ti: usize, x: u32, y: u32) -> Option<bool> {
+fn shared_edge_owner(wt: &[WinTri], ti: usize, x: u32, y: u32, eps: f64) -> Option<bool> {
     let t = &wt[ti];
     let c = glam::DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
     let sign = if t.vk_area() < 0.0 { 1.0 } else { -1.0 };
@@ -205,7 +205,7 @@ fn shared_edge_owner(wt: &[WinTri], ti: usize, x: u32, y: u32) -> Option<bool> {
         let (a, b) = (t.p[i], t.p[(i + 1) % 3]);
         let e = b - a;
         let d = sign * (e.x * (c.y - a.y) - e.y * (c.x - a.x)) / e.length();
-        if d.abs() <= raster::EDGE_EPS {
+        if d.abs() <= eps {
             if on.is_some() {
                 return None;
             }
@@ -302,6 +302,25 @@ fn frag_depth(t: &WinTri, x: u32, y: u32, st: &DsState, kind: DepthKind, subpixe
     }
 }
 
+/// The band (pixels) around edges within which coverage is not judged for `draw`:
+/// [`raster::EDGE_EPS`] when every vertex lands exactly on the sub-pixel grid (the device's f32
+/// transform then snaps it where the model does), else 1.5 sub-pixel steps (a vertex may snap
+/// to a neighbouring grid point).
+fn edge_band(draw: &super::cases::Draw, w: u32, h: u32, subpixel_bits: u32) -> f64 {
+    let m = draw.mvp.as_dmat4();
+    let s = (1u64 << subpixel_bits) as f64;
+    let on_grid = draw.vertices.iter().all(|v| {
+        let c = m * glam::DVec4::new(v[0] as f64, v[1] as f64, v[2] as f64, v[3] as f64);
+        let (x, y) = ((c.x / c.w + 1.0) * 0.5 * w as f64, (c.y / c.w + 1.0) * 0.5 * h as f64);
+        (x * s).fract() == 0.0 && (y * s).fract() == 0.0
+    });
+    if on_grid {
+        raster::EDGE_EPS
+    } else {
+        1.5 / s
+    }
+}
+
 /// The expected result of `case` on a device with `subpixel_bits` of sub-pixel precision;
 /// `brk` substitutes [`broken`]`(op)` for one stencil op (the test seam).
 pub fn expect(case: &Case, subpixel_bits: u32, brk: Option<vk::StencilOp>) -> Expected {
@@ -316,6 +335,7 @@ pub fn expect(case: &Case, subpixel_bits: u32, brk: Option<vk::StencilOp>) -> Ex
         let st = &draw.state;
         let tris: Vec<[u32; 3]> = (0..draw.vertices.len() as u32 / 3).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
         let wt = raster::window_tris(draw.mvp, &draw.vertices, &tris, w, h, subpixel_bits);
+        let eps = edge_band(draw, w, h, subpixel_bits);
         let (mut qlo, mut qhi) = (0u64, 0u64);
         let depth_test = st.depth_test && kind != DepthKind::None;
         let depth_write = st.depth_write && kind != DepthKind::None;
@@ -339,9 +359,9 @@ pub fn expect(case: &Case, subpixel_bits: u32, brk: Option<vk::StencilOp>) -> Ex
                             d[i] = DepthExp::Any;
                         }
                     };
-                    match raster::cover(t, x, y) {
+                    match raster::cover_eps(t, x, y, eps) {
                         Cover::Out => continue,
-                        Cover::Edge => match shared_edge_owner(&wt, ti, x, y) {
+                        Cover::Edge => match shared_edge_owner(&wt, ti, x, y, eps) {
                             Some(true) => {}
                             Some(false) => continue,
                             None => {
@@ -468,8 +488,16 @@ mod tests {
         let mut n = 0;
         for c in all.iter().filter(|c| c.group == "stencil" || c.group == "zoo" || c.name.contains(".occlusion.")) {
             let e = expect(c, 8, None);
-            assert!(e.stencil.iter().all(|s| s.is_some()), "{}: unjudged pixels", c.name);
-            assert!(e.queries.iter().all(|q| q.0 == q.1), "{}: query range {:?}", c.name, e.queries);
+            let judged = e.stencil.iter().filter(|s| s.is_some()).count();
+            // Perspective draws (w = 0 dark caps) get a one-sub-pixel band around their edges.
+            let perspective = c.draws.iter().any(|d| d.vertices.iter().any(|v| v[3] == 0.0));
+            if perspective {
+                assert!(judged * 10 >= e.stencil.len() * 9, "{}: {judged} of {} judged", c.name, e.stencil.len());
+                assert!(e.queries.iter().all(|q| q.1 - q.0 <= 16), "{}: query range {:?}", c.name, e.queries);
+            } else {
+                assert_eq!(judged, e.stencil.len(), "{}: unjudged pixels", c.name);
+                assert!(e.queries.iter().all(|q| q.0 == q.1), "{}: query range {:?}", c.name, e.queries);
+            }
             n += 1;
         }
         assert!(n > 800);

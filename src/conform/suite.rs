@@ -384,7 +384,8 @@ pub fn run_suite(ctx: &Context, new_context: &dyn Fn() -> Result<Context>, opts:
                     ));
                 }
                 if !o.queries.is_empty() {
-                    o.message.push_str(&format!(", {} query counts exact", o.queries.len()));
+                    let exact = o.queries.iter().filter(|q| q.expected_min == q.expected_max).count();
+                    o.message.push_str(&format!(", {} query counts as modelled ({exact} of them exact)", o.queries.len()));
                 }
             }
         }
