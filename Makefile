@@ -3,7 +3,7 @@
 export PATH := $(HOME)/.cargo/bin:$(PATH)
 CARGO ?= cargo
 
-.PHONY: deps run test bench conform doc clean fuzz
+.PHONY: deps run test bench conform conform-docs doc clean fuzz
 
 deps:
 	@./scripts/deps.sh
@@ -34,7 +34,13 @@ fuzz: deps
 	UMBRAGE_FUZZ_CASES=$(FUZZ_CASES) $(CARGO) test --release --test fuzz -- --nocapture
 
 conform: deps
-	UMBRAGE_VALIDATION=1 $(CARGO) run -- conform --out conform-report
+	UMBRAGE_VALIDATION=1 $(CARGO) run -- conform --out conform-report --junit conform-report/junit.xml
+
+# Regenerates this device's report in docs/conform/ (DEVICE_DOC names it: lavapipe, or a GPU's name).
+DEVICE_DOC ?= lavapipe
+conform-docs: deps
+	UMBRAGE_VALIDATION=1 $(CARGO) run -- conform --out target/conform-docs --junit target/conform-docs/junit.xml
+	cp target/conform-docs/conform.md docs/conform/$(DEVICE_DOC).md
 
 clean:
 	$(CARGO) clean

@@ -186,8 +186,21 @@ enum Command {
     },
     /// The driver conformance suite for what shadow volumes rely on (reports into --out).
     Conform {
+        /// Report directory (conform.json, conform.md, failures/<case>/*.png); default conform-report.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Run only cases matching these comma-separated patterns (substring, or glob with '*').
+        #[arg(long)]
+        filter: Option<String>,
+        /// List the selected case names and exit.
+        #[arg(long)]
+        list: bool,
+        /// Also write JUnit XML to this file.
+        #[arg(long)]
+        junit: Option<PathBuf>,
+        /// Run on the device whose name contains NAME (case-insensitive).
+        #[arg(long, value_name = "NAME")]
+        device: Option<String>,
     },
 }
 
@@ -239,7 +252,9 @@ fn main() -> ExitCode {
             let opts = RenderOptions { width: size.0, height: size.1, index_format, frames_in_flight, ..Default::default() };
             bench(scenes, techniques, counters, frames, opts, json.as_deref(), markdown.as_deref())
         }
-        Command::Conform { out } => umbrage::conform::run(out),
+        Command::Conform { out, filter, list, junit, device } => {
+            umbrage::conform::run(umbrage::conform::RunArgs { filter, list, junit, out, device })
+        }
     };
     match result {
         Ok(code) => code,

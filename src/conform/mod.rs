@@ -1,9 +1,23 @@
 //! `umbrage conform`: the driver conformance suite for what shadow volumes rely on.
 //!
-//! Each check is a small offscreen render, read back and compared with an exact expectation
-//! computed on the CPU (coverage by the pixel-centre rule on the device's sub-pixel grid,
-//! stencil counts modulo 256, depth 1.0 at infinity), except the last, which runs the whole
-//! shadow pipeline on every `hard/*` scene and method against the CPU reference.
+//! Two layers:
+//!
+//! - **The parametrised suite** ([`cases`], [`model`], [`batch`], [`suite`]): 4,816
+//!   CTS-style cases (those of formats and features a device lacks are skipped, with the
+//!   reason) — the stencil-op table, depth and infinity, depth clamp and bias, depth bounds, unrestricted depth, rasterisation and occlusion queries, and a
+//!   known-bug zoo — in every configuration the device supports: each depth-stencil format
+//!   (D16S8, D24S8, D32S8, S8 as `vkGetPhysicalDeviceFormatProperties` reports them) x
+//!   dynamic rendering / a classic render pass x static pipeline state / Vulkan 1.3 dynamic
+//!   state. Every case draws into its own tile of one image per configuration (one
+//!   submission), and each tile is compared exactly with a CPU model of the spec.
+//! - **The single-configuration checks** ([`checks`], named `legacy.*` and
+//!   `pipeline.hard_cases.*`): the original eight checks, the last of which runs the whole
+//!   shadow pipeline on every `hard/*` scene and method against the CPU reference.
+//!
+//! Outputs: `conform.json`, `conform.md`, JUnit XML (`--junit`), and for every failure the
+//! expected, actual and difference images. See docs/conform/cts-mapping.md.
+//!
+//! The legacy checks:
 //!
 //! | check | what |
 //! |---|---|
@@ -20,14 +34,23 @@
 
 #![warn(missing_docs)]
 
+pub mod batch;
+pub mod cases;
 pub mod checks;
+pub mod devices;
 pub mod harness;
+pub mod images;
+pub mod junit;
+pub mod model;
 pub mod raster;
+pub mod report;
+pub mod suite;
+
+pub use suite::{run_suite, Report, SuiteOptions};
 
 use crate::error::{Error, Result};
-use crate::gpu::{Context, DeviceInfo, Features};
-use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use crate::gpu::Context;
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
@@ -104,7 +127,7 @@ impl CheckResult {
     pub fn skipped(name: &str, why: &str) -> CheckResult {
         CheckResult { name: name.into(), status: Status::Skipped, summary: why.into(), numbers: Default::default(), cases: Vec::new() }
     }
-    fn error(name: &str, e: &Error) -> CheckResult {
+    pub(crate) fn error(name: &str, e: &Error) -> CheckResult {
         CheckResult {
             name: name.into(),
             status: Status::Fail,
@@ -115,73 +138,7 @@ impl CheckResult {
     }
 }
 
-/// The whole suite's result on one device (`conform.json`).
-#[derive(Clone, Debug, serde::Serialize)]
-pub struct Report {
-    /// The physical device and driver the suite ran on.
-    pub device: DeviceInfo,
-    /// The optional features found (which decide the skipped checks).
-    pub features: Features,
-    /// Whether the validation layers were on (their errors fail the check they occur in).
-    pub validation: bool,
-    /// `VkPhysicalDeviceLimits::subPixelPrecisionBits`, the grid the CPU coverage predictions snap to.
-    pub subpixel_bits: u32,
-    /// One result per check, in the order of the module table.
-    pub checks: Vec<CheckResult>,
-}
-
-impl Report {
-    /// The checks that failed.
-    pub fn failed(&self) -> Vec<&CheckResult> {
-        self.checks.iter().filter(|c| c.status == Status::Fail).collect()
-    }
-}
-
-/// Options of the suite.
-pub struct Options {
-    /// Size of the `shadow_pipeline_hard_cases` renders.
-    pub pipeline_size: (u32, u32),
-}
-
-impl Default for Options {
-    fn default() -> Self {
-        Options { pipeline_size: (160, 120) }
-    }
-}
-
-/// Runs every check on `ctx`; `new_context` makes the fresh contexts the renderer needs for the
-/// pipeline check (a [`crate::render::Renderer`] owns its context).
-pub fn run_suite(ctx: &Context, new_context: &dyn Fn() -> Result<Context>, opts: &Options) -> Report {
-    type Check = fn(&Context) -> Result<CheckResult>;
-    let unit: [(&str, Check); 7] = [
-        ("w0_vertices_and_infinity", checks::w0_vertices_and_infinity),
-        ("depth_clamp", checks::depth_clamp),
-        ("watertight_fan", checks::watertight_fan),
-        ("two_sided_stencil_wrap", checks::two_sided_stencil_wrap),
-        ("stencil_formats", checks::stencil_formats),
-        ("depth_bounds", checks::depth_bounds),
-        ("index_types", checks::index_types),
-    ];
-    let mut results = Vec::new();
-    let _ = ctx.take_validation_errors();
-    for (name, f) in unit {
-        let mut r = f(ctx).unwrap_or_else(|e| CheckResult::error(name, &e));
-        with_validation(&mut r, ctx.take_validation_errors());
-        results.push(r);
-    }
-    let (w, h) = opts.pipeline_size;
-    let r = checks::shadow_pipeline_hard_cases(new_context, w, h).unwrap_or_else(|e| CheckResult::error("shadow_pipeline_hard_cases", &e));
-    results.push(r);
-    Report {
-        device: ctx.info.clone(),
-        features: ctx.features.clone(),
-        validation: ctx.validation,
-        subpixel_bits: ctx.limits.sub_pixel_precision_bits,
-        checks: results,
-    }
-}
-
-fn with_validation(r: &mut CheckResult, errors: Vec<String>) {
+pub(crate) fn with_validation(r: &mut CheckResult, errors: Vec<String>) {
     r.numbers.insert("validation_errors".into(), serde_json::json!(errors.len()));
     if let Some(first) = errors.first() {
         r.status = Status::Fail;
@@ -189,83 +146,75 @@ fn with_validation(r: &mut CheckResult, errors: Vec<String>) {
     }
 }
 
-/// The summary table (Markdown, also printed).
-pub fn summary_table(report: &Report) -> String {
-    let mut s = String::from("| check | result | details |\n|---|---|---|\n");
-    for c in &report.checks {
-        let _ = writeln!(s, "| `{}` | **{}** | {} |", c.name, c.status.name(), c.summary.replace('|', "\\|"));
+/// The command line's options (`umbrage conform`).
+#[derive(Clone, Debug, Default)]
+pub struct RunArgs {
+    /// Comma-separated case-name patterns (glob with `*`, else substring).
+    pub filter: Option<String>,
+    /// Print the selected case names and exit.
+    pub list: bool,
+    /// Write JUnit XML here.
+    pub junit: Option<PathBuf>,
+    /// Report directory (default `conform-report`).
+    pub out: Option<PathBuf>,
+    /// Run on the device whose name contains this.
+    pub device: Option<String>,
+}
+
+/// Exit status when `--filter` selects nothing.
+pub const EXIT_NOTHING_SELECTED: u8 = 2;
+
+/// `umbrage conform`: lists or runs the selected cases (validation as `UMBRAGE_VALIDATION`
+/// says), writes the reports, prints the verdict and the failures. Exit 0 only when nothing
+/// failed; [`EXIT_NOTHING_SELECTED`] when the filter matches no case. `--device` sets
+/// `UMBRAGE_DEVICE` for the context after checking that such a device exists (else the
+/// error lists the devices). `UMBRAGE_CONFORM_BREAK=<op>` is the test seam of
+/// [`SuiteOptions::break_op`].
+pub fn run(a: RunArgs) -> Result<ExitCode> {
+    let filter: Vec<String> =
+        a.filter.as_deref().unwrap_or("").split(',').map(|p| p.trim().to_string()).filter(|p| !p.is_empty()).collect();
+    let names: Vec<String> =
+        suite::all_names().into_iter().filter(|n| filter.is_empty() || filter.iter().any(|p| suite::matches(p, n))).collect();
+    if names.is_empty() {
+        eprintln!(
+            "error: --filter '{}' matches none of the {} cases (patterns are substrings, or globs with '*'; --list shows every name)",
+            filter.join(","),
+            suite::all_names().len()
+        );
+        return Ok(ExitCode::from(EXIT_NOTHING_SELECTED));
     }
-    s
-}
-
-/// The full Markdown report (`conform.md`): device, features, the summary table, then each
-/// check's numbers and cases.
-pub fn markdown(report: &Report) -> String {
-    let d = &report.device;
-    let mut s = String::new();
-    let _ = writeln!(s, "# umbrage conform: {}\n", d.name);
-    let _ = writeln!(s, "- device: {} ({}), vendor 0x{:04x}, device 0x{:04x}", d.name, d.kind, d.vendor_id, d.device_id);
-    let _ = writeln!(s, "- driver: {} {}", d.driver, d.driver_info);
-    let _ = writeln!(s, "- Vulkan API: {}", d.api_version);
-    let _ = writeln!(s, "- validation layers: {}", if report.validation { "on" } else { "off" });
-    let _ = writeln!(s, "- sub-pixel precision bits: {}", report.subpixel_bits);
-    let f = &report.features;
-    let _ = writeln!(
-        s,
-        "- features: depthClamp {}, depthBounds {}, depth_range_unrestricted {}, indexTypeUint8 {}, depth-stencil format {}\n",
-        f.depth_clamp, f.depth_bounds, f.depth_range_unrestricted, f.index_type_uint8, f.depth_stencil_format
-    );
-    let failed = report.failed().len();
-    let _ = writeln!(s, "**{}** ({} failed)\n", if failed == 0 { "PASS" } else { "FAIL" }, failed);
-    s.push_str(&summary_table(report));
-    for c in &report.checks {
-        let _ = writeln!(s, "\n## `{}`: {}\n\n{}\n", c.name, c.status.name(), c.summary);
-        if !c.numbers.is_empty() {
-            let _ = writeln!(s, "```json\n{}\n```", serde_json::to_string_pretty(&c.numbers).unwrap_or_default());
+    if a.list {
+        for n in &names {
+            println!("{n}");
         }
-        if !c.cases.is_empty() {
-            s.push_str("\n| scene | method | status | compared | outside band | worst fraction | ambiguous | band |\n|---|---|---|---|---|---|---|---|\n");
-            for k in &c.cases {
-                let _ = writeln!(
-                    s,
-                    "| {} | {} | {} | {} | {} | {:.4}% | {} | {} |",
-                    k.scene,
-                    k.method,
-                    k.status,
-                    k.compared,
-                    k.mismatches_outside_band,
-                    k.worst_fraction_outside_band * 100.0,
-                    k.ambiguous,
-                    k.band_pixels
-                );
-            }
-        }
+        return Ok(ExitCode::SUCCESS);
     }
-    s
-}
-
-/// Writes `conform.json` and `conform.md` into `dir`.
-pub fn write_report(dir: &Path, report: &Report) -> Result<()> {
-    std::fs::create_dir_all(dir).map_err(|e| Error::io(dir.display().to_string(), e))?;
-    let json = serde_json::to_string_pretty(report).map_err(|e| Error::Other(e.to_string()))?;
-    let p = dir.join("conform.json");
-    std::fs::write(&p, json + "\n").map_err(|e| Error::io(p.display().to_string(), e))?;
-    let p = dir.join("conform.md");
-    std::fs::write(&p, markdown(report)).map_err(|e| Error::io(p.display().to_string(), e))?;
-    Ok(())
-}
-
-/// `umbrage conform [--out DIR]`: runs the suite (validation as `UMBRAGE_VALIDATION` says),
-/// writes the reports, prints the summary; failure exit status when any check failed.
-pub fn run(out: Option<PathBuf>) -> Result<ExitCode> {
-    let out = out.unwrap_or_else(|| PathBuf::from("conform-report"));
+    if let Some(d) = &a.device {
+        let hits = devices::find(d)?;
+        eprintln!("device: {}", hits[0]);
+        std::env::set_var("UMBRAGE_DEVICE", d);
+    }
+    let break_op = match std::env::var("UMBRAGE_CONFORM_BREAK") {
+        Ok(v) if !v.is_empty() => {
+            Some(cases::parse_op(&v).ok_or_else(|| Error::Other(format!("UMBRAGE_CONFORM_BREAK: unknown stencil op '{v}'")))?)
+        }
+        _ => None,
+    };
+    let out = a.out.unwrap_or_else(|| PathBuf::from("conform-report"));
     let ctx = Context::new()?;
     let validation = ctx.validation;
-    let report = run_suite(&ctx, &|| Context::with_validation(validation), &Options::default());
-    write_report(&out, &report)?;
-    println!("{} | {} | Vulkan {}", report.device.name, report.device.driver_info, report.device.api_version);
-    print!("{}", summary_table(&report));
+    let opts = SuiteOptions { filter, image_dir: Some(out.clone()), break_op, ..Default::default() };
+    let r = run_suite(&ctx, &|| Context::with_validation(validation), &opts);
+    report::write_all(&out, a.junit.as_deref(), &r)?;
+    println!("{} | {} | Vulkan {}", r.device.name, r.device.driver_info, r.device.api_version);
+    for c in r.failed() {
+        println!("FAIL {}: {}", c.name, c.message);
+    }
+    println!("{}", report::verdict(&r));
     println!("reports: {}/conform.json, {}/conform.md", out.display(), out.display());
+    if let Some(j) = &a.junit {
+        println!("junit: {}", j.display());
+    }
     ctx.check_validation()?;
-    Ok(if report.failed().is_empty() { ExitCode::SUCCESS } else { ExitCode::FAILURE })
+    Ok(if r.failed().is_empty() { ExitCode::SUCCESS } else { ExitCode::FAILURE })
 }

@@ -68,6 +68,12 @@ pub fn window_tris(mvp: Mat4, verts: &[[f32; 4]], tris: &[[u32; 3]], width: u32,
 /// Whether triangle `t` covers the centre of pixel (x, y) by the pixel-centre rule, with
 /// centres within [`EDGE_EPS`] of an edge reported as [`Cover::Edge`].
 pub fn cover(t: &WinTri, x: u32, y: u32) -> Cover {
+    cover_eps(t, x, y, EDGE_EPS)
+}
+
+/// [`cover`] with centres within `eps` pixels of an edge reported as [`Cover::Edge`] (a wider
+/// band where the device's f32 vertex transform may snap a vertex to a neighbouring sub-pixel).
+pub fn cover_eps(t: &WinTri, x: u32, y: u32, eps: f64) -> Cover {
     let c = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
     let area = t.vk_area();
     if area == 0.0 {
@@ -80,10 +86,10 @@ pub fn cover(t: &WinTri, x: u32, y: u32) -> Cover {
         let e = b - a;
         let len = e.length();
         let d = sign * (e.x * (c.y - a.y) - e.y * (c.x - a.x)) / len;
-        if d < -EDGE_EPS {
+        if d < -eps {
             return Cover::Out;
         }
-        if d <= EDGE_EPS {
+        if d <= eps {
             ambiguous = true;
         }
     }

@@ -45,6 +45,9 @@ pub struct Features {
     pub r32f_blend: bool,
     /// R32G32B32A32_SFLOAT can be blended (optional): the fp32 light-intensity map needs it.
     pub rgba32f_blend: bool,
+    /// `occlusionQueryPrecise` is supported (and enabled): occlusion queries with
+    /// `VK_QUERY_CONTROL_PRECISE_BIT` return exact sample counts (the conformance suite checks them).
+    pub occlusion_query_precise: bool,
 }
 
 /// Identification of the chosen physical device, for `umbrage info`, logs and the stats JSON.
@@ -433,12 +436,14 @@ impl Context {
             geometry_shader: base.geometry_shader == vk::TRUE,
             r32f_blend: blendable(vk::Format::R32_SFLOAT),
             rgba32f_blend: blendable(vk::Format::R32G32B32A32_SFLOAT),
+            occlusion_query_precise: base.occlusion_query_precise == vk::TRUE,
         };
 
         let enabled = vk::PhysicalDeviceFeatures::default()
             .depth_clamp(features.depth_clamp)
             .depth_bounds(features.depth_bounds)
-            .pipeline_statistics_query(features.pipeline_statistics_query);
+            .pipeline_statistics_query(features.pipeline_statistics_query)
+            .occlusion_query_precise(features.occlusion_query_precise);
         let mut e13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true);
         let mut e_u8 = vk::PhysicalDeviceIndexTypeUint8FeaturesEXT::default().index_type_uint8(true);
         let mut dev_exts = Vec::new();

@@ -1,0 +1,491 @@
+//! Runs the parametrised suite: selects the cases (filter, device support), batches each
+//! configuration into one submission, compares every tile with the CPU model, and adds the
+//! single-configuration end-to-end checks (`legacy.*`, `pipeline.hard_cases.*`).
+
+use super::batch::{self, TileResult};
+use super::cases::{self, Bug, Case, Config, Req, FORMATS};
+use super::model::{self, DepthExp, Expected};
+use super::{images, CheckResult, Status};
+use crate::error::Result;
+use crate::gpu::{Context, DeviceInfo, Features};
+use ash::vk;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// Options of a suite run.
+#[derive(Clone, Debug)]
+pub struct SuiteOptions {
+    /// Case-name patterns; a case runs when any matches (empty: every case). A pattern with
+    /// `*` is a glob over the whole name, otherwise a substring.
+    pub filter: Vec<String>,
+    /// Size of the `pipeline.hard_cases.*` renders.
+    pub pipeline_size: (u32, u32),
+    /// Where failure images go (`<dir>/failures/<case>/`); `None`: not written.
+    pub image_dir: Option<PathBuf>,
+    /// Test seam: the expectation applies [`model::broken`]`(op)` wherever it should apply `op`
+    /// (`UMBRAGE_CONFORM_BREAK=<op>` on the command line), so the cases that exercise `op`
+    /// must fail — and only those.
+    #[doc(hidden)]
+    pub break_op: Option<vk::StencilOp>,
+}
+
+impl Default for SuiteOptions {
+    fn default() -> Self {
+        SuiteOptions { filter: Vec::new(), pipeline_size: (160, 120), image_dir: None, break_op: None }
+    }
+}
+
+/// Whether `name` matches `pattern` (glob with `*` and `?` when it has either, else substring).
+pub fn matches(pattern: &str, name: &str) -> bool {
+    if !pattern.contains(['*', '?']) {
+        return name.contains(pattern);
+    }
+    fn glob(p: &[u8], s: &[u8]) -> bool {
+        match (p.first(), s.first()) {
+            (None, None) => true,
+            (Some(b'*'), _) => glob(&p[1..], s) || (!s.is_empty() && glob(p, &s[1..])),
+            (Some(b'?'), Some(_)) => glob(&p[1..], &s[1..]),
+            (Some(a), Some(b)) if a == b => glob(&p[1..], &s[1..]),
+            _ => false,
+        }
+    }
+    glob(pattern.as_bytes(), name.as_bytes())
+}
+
+fn selected(filter: &[String], name: &str) -> bool {
+    filter.is_empty() || filter.iter().any(|p| matches(p, name))
+}
+
+/// One query draw's count.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct QueryOutcome {
+    /// Smallest count the model allows.
+    pub expected_min: u64,
+    /// Largest count the model allows.
+    pub expected_max: u64,
+    /// What the device counted.
+    pub actual: u64,
+}
+
+/// The result of one case.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct CaseOutcome {
+    /// The full dotted name.
+    pub name: String,
+    /// `stencil`, `depth`, `raster`, `zoo`, `legacy` or `pipeline`.
+    pub group: String,
+    /// The configuration (`d24s8.dynamic_rendering.static_state`); `None` for the legacy and
+    /// pipeline checks (the renderer's format, dynamic rendering, static state).
+    pub config: Option<String>,
+    /// Pass, fail or skipped.
+    pub status: Status,
+    /// Pass: what held; fail: what differed; skipped: the missing feature.
+    pub message: String,
+    /// What the case checks.
+    pub what: String,
+    /// The bug a zoo case reproduces.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bug: Option<Bug>,
+    /// Seconds: the configuration's submission time shared equally among its cases.
+    pub seconds: f64,
+    /// Pixels whose stencil was judged.
+    pub judged_pixels: u64,
+    /// Judged pixels whose stencil differed.
+    pub stencil_mismatches: u64,
+    /// Judged pixels whose depth differed.
+    pub depth_mismatches: u64,
+    /// Occlusion-query counts.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub queries: Vec<QueryOutcome>,
+    /// Failure images written (expected, actual, diff).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub images: Vec<String>,
+}
+
+impl CaseOutcome {
+    fn new(name: String, group: &str, config: Option<String>, what: String) -> CaseOutcome {
+        CaseOutcome {
+            name,
+            group: group.into(),
+            config,
+            status: Status::Pass,
+            message: String::new(),
+            what,
+            bug: None,
+            seconds: 0.0,
+            judged_pixels: 0,
+            stencil_mismatches: 0,
+            depth_mismatches: 0,
+            queries: Vec::new(),
+            images: Vec::new(),
+        }
+    }
+}
+
+/// Whether a depth-stencil format was usable.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct FormatSupport {
+    /// Short name (`d24s8`).
+    pub name: String,
+    /// Vulkan name.
+    pub format: String,
+    /// Depth-stencil attachment, transfer source and destination with optimal tiling.
+    pub usable: bool,
+}
+
+/// One configuration's submission.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ConfigRun {
+    /// `d24s8.dynamic_rendering.static_state`.
+    pub name: String,
+    /// Cases drawn in the submission.
+    pub cases: usize,
+    /// Wall time: pipelines, recording, submission, read-back and comparison.
+    pub seconds: f64,
+    /// Validation errors reported during it (each fails every case of the configuration).
+    pub validation_errors: usize,
+}
+
+/// The whole run on one device (`conform.json`).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Report {
+    /// The physical device and driver.
+    pub device: DeviceInfo,
+    /// The optional features found.
+    pub features: Features,
+    /// Whether the validation layers were on.
+    pub validation: bool,
+    /// `subPixelPrecisionBits`, the grid the CPU model snaps vertices to.
+    pub subpixel_bits: u32,
+    /// The filter patterns (empty: all).
+    pub filter: Vec<String>,
+    /// The formats tried.
+    pub formats: Vec<FormatSupport>,
+    /// The configurations run.
+    pub configs: Vec<ConfigRun>,
+    /// Every selected case, in name order of generation.
+    pub cases: Vec<CaseOutcome>,
+    /// The legacy single-configuration checks' full results (numbers), when selected.
+    pub legacy: Vec<CheckResult>,
+    /// Wall time of the whole run.
+    pub seconds: f64,
+}
+
+impl Report {
+    /// (passed, failed, skipped).
+    pub fn counts(&self) -> (usize, usize, usize) {
+        let n = |s: Status| self.cases.iter().filter(|c| c.status == s).count();
+        (n(Status::Pass), n(Status::Fail), n(Status::Skipped))
+    }
+    /// The failed cases.
+    pub fn failed(&self) -> Vec<&CaseOutcome> {
+        self.cases.iter().filter(|c| c.status == Status::Fail).collect()
+    }
+}
+
+const LEGACY: [&str; 7] = [
+    "w0_vertices_and_infinity",
+    "depth_clamp",
+    "watertight_fan",
+    "two_sided_stencil_wrap",
+    "stencil_formats",
+    "depth_bounds",
+    "index_types",
+];
+
+fn pipeline_names() -> Vec<String> {
+    let mut v = Vec::new();
+    for scene in crate::scene::builtin_names().into_iter().filter(|n| n.starts_with("hard/")) {
+        for m in crate::shadow::Method::ALL {
+            v.push(format!("pipeline.hard_cases.{}.{}", scene.trim_start_matches("hard/"), m.name()));
+        }
+    }
+    v
+}
+
+/// Every case name, with or without a device (`--list`), in run order.
+pub fn all_names() -> Vec<String> {
+    let mut v: Vec<String> = cases::all(&Config::all(&FORMATS)).into_iter().map(|c| c.name).collect();
+    v.extend(LEGACY.iter().map(|n| format!("legacy.{n}")));
+    v.extend(pipeline_names());
+    v
+}
+
+/// Whether `ctx` has what `r` names, for `format`.
+fn have(ctx: &Context, r: Req, format: vk::Format) -> bool {
+    let f = &ctx.features;
+    match r {
+        Req::DepthAspect => cases::depth_kind(format) != cases::DepthKind::None,
+        Req::DepthClamp => f.depth_clamp,
+        Req::DepthBounds => f.depth_bounds,
+        Req::DepthRangeUnrestricted => f.depth_range_unrestricted,
+        Req::FloatDepth => cases::depth_kind(format) == cases::DepthKind::Float32,
+        Req::OcclusionQueryPrecise => f.occlusion_query_precise,
+    }
+}
+
+/// Compares one tile with its expectation: (stencil mismatches, depth mismatches, judged, query outcomes, message).
+fn compare(case: &Case, exp: &Expected, got: &TileResult) -> (u64, u64, u64, Vec<QueryOutcome>, Vec<String>) {
+    let kind = case.config.depth_kind();
+    let (mut sm, mut dm, mut judged) = (0u64, 0u64, 0u64);
+    let mut first = Vec::new();
+    let w = case.size.0 as usize;
+    let mut either = vec![None; exp.stencil.len()];
+    for &(i, allowed, _) in &case.either {
+        either[i] = Some(allowed);
+    }
+    for (i, e) in exp.stencil.iter().enumerate() {
+        if let Some(allowed) = either[i] {
+            judged += 1;
+            if !allowed.contains(&got.stencil[i]) {
+                sm += 1;
+                if first.len() < 3 {
+                    first.push(format!(
+                        "stencil at ({}, {}) on the shared edge: expected 0x{:02x} or 0x{:02x} (exactly one triangle), got 0x{:02x}",
+                        i % w,
+                        i / w,
+                        allowed[0],
+                        allowed[1],
+                        got.stencil[i]
+                    ));
+                }
+            }
+        } else if let Some(e) = e {
+            judged += 1;
+            if got.stencil[i] != *e {
+                sm += 1;
+                if first.len() < 3 {
+                    first.push(format!(
+                        "stencil at ({}, {}): expected {e} (0x{e:02x}), got {} (0x{:02x})",
+                        i % w,
+                        i / w,
+                        got.stencil[i],
+                        got.stencil[i]
+                    ));
+                }
+            }
+        }
+    }
+    for (i, e) in exp.depth.iter().enumerate() {
+        if *e == DepthExp::Any || got.depth.is_empty() {
+            continue;
+        }
+        let v = model::from_raw(kind, got.depth[i]);
+        if !e.accepts(v) {
+            dm += 1;
+            if first.len() < 6 {
+                first.push(format!("depth at ({}, {}): expected {e:?}, got {v}", i % w, i / w));
+            }
+        }
+    }
+    let mut q = Vec::new();
+    for (k, &(lo, hi)) in exp.queries.iter().enumerate() {
+        let actual = got.queries.get(k).copied().unwrap_or(u64::MAX);
+        if actual < lo || actual > hi {
+            first.push(format!("occlusion query {k}: expected {lo}..={hi} samples, got {actual}"));
+        }
+        q.push(QueryOutcome { expected_min: lo, expected_max: hi, actual });
+    }
+    (sm, dm, judged, q, first)
+}
+
+/// Runs the selected cases on `ctx`. `new_context` makes the fresh contexts the pipeline
+/// checks' renderers need.
+pub fn run_suite(ctx: &Context, new_context: &dyn Fn() -> Result<Context>, opts: &SuiteOptions) -> Report {
+    let start = Instant::now();
+    let bits = ctx.limits.sub_pixel_precision_bits;
+    let mut formats = Vec::new();
+    let mut usable = Vec::new();
+    for f in FORMATS {
+        let ok = batch::format_usable(ctx, f);
+        formats.push(FormatSupport { name: cases::format_name(f).into(), format: format!("{f:?}"), usable: ok });
+        usable.push((f, ok));
+    }
+    let mut outcomes = Vec::new();
+    let mut configs = Vec::new();
+    let _ = ctx.take_validation_errors();
+    for cfg in Config::all(&FORMATS) {
+        let all: Vec<Case> = cases::all(&[cfg]).into_iter().filter(|c| selected(&opts.filter, &c.name)).collect();
+        if all.is_empty() {
+            continue;
+        }
+        let format_ok = usable.iter().any(|&(f, ok)| f == cfg.format && ok);
+        let mut run: Vec<&Case> = Vec::new();
+        let mut first_of_cfg = outcomes.len();
+        for c in &all {
+            let mut o = CaseOutcome::new(c.name.clone(), c.group, Some(cfg.name()), c.what.clone());
+            o.bug = c.bug.clone();
+            if !format_ok {
+                o.status = Status::Skipped;
+                o.message = format!(
+                    "{:?} not supported as a depth-stencil attachment with transfers (vkGetPhysicalDeviceFormatProperties)",
+                    cfg.format
+                );
+            } else if let Some(r) = c.missing(&|r| have(ctx, r, cfg.format)) {
+                o.status = Status::Skipped;
+                o.message = r.reason().into();
+            } else {
+                run.push(c);
+            }
+            outcomes.push(o);
+        }
+        if run.is_empty() {
+            continue;
+        }
+        let t0 = Instant::now();
+        let result = batch::run(ctx, cfg, &run);
+        let errors = ctx.take_validation_errors();
+        let seconds = t0.elapsed().as_secs_f64();
+        let per_case = seconds / run.len() as f64;
+        configs.push(ConfigRun { name: cfg.name(), cases: run.len(), seconds, validation_errors: errors.len() });
+        let mut tiles = result.map_err(|e| e.to_string()).map(|t| t.into_iter());
+        for c in run {
+            while outcomes[first_of_cfg].name != c.name {
+                first_of_cfg += 1;
+            }
+            let o = &mut outcomes[first_of_cfg];
+            o.seconds = per_case;
+            let tile = match &mut tiles {
+                Ok(it) => it.next(),
+                Err(_) => None,
+            };
+            let Some(tile) = tile else {
+                o.status = Status::Fail;
+                o.message = format!("error: {}", tiles.as_ref().err().cloned().unwrap_or_else(|| "no result".into()));
+                continue;
+            };
+            let exp = model::expect(c, bits, opts.break_op);
+            let (sm, dm, judged, q, detail) = compare(c, &exp, &tile);
+            (o.stencil_mismatches, o.depth_mismatches, o.judged_pixels, o.queries) = (sm, dm, judged, q);
+            if !detail.is_empty() || !errors.is_empty() {
+                o.status = Status::Fail;
+                let mut parts = Vec::new();
+                if !errors.is_empty() {
+                    parts.push(format!("{} validation errors in the configuration (first: {})", errors.len(), errors[0]));
+                }
+                if sm + dm > 0 {
+                    parts.push(format!("{sm} stencil and {dm} depth mismatches of {judged} judged pixels"));
+                }
+                parts.extend(detail);
+                o.message = parts.join("; ");
+                if let Some(dir) = &opts.image_dir {
+                    match images::write_failure(&dir.join("failures").join(&c.name), c, &exp, &tile) {
+                        Ok(paths) => o.images = paths,
+                        Err(e) => o.message.push_str(&format!("; images not written: {e}")),
+                    }
+                }
+            } else {
+                o.message = format!("{judged} judged pixels exact");
+                if !c.either.is_empty() {
+                    let tl = c.either.iter().filter(|&&(i, _, p)| tile.stencil[i] == p).count();
+                    o.message.push_str(&format!(
+                        ", each of the {} centres on the shared edge covered once; the D3D top-left convention held at {tl} of them",
+                        c.either.len()
+                    ));
+                }
+                if !o.queries.is_empty() {
+                    let exact = o.queries.iter().filter(|q| q.expected_min == q.expected_max).count();
+                    o.message.push_str(&format!(", {} query counts as modelled ({exact} of them exact)", o.queries.len()));
+                }
+            }
+        }
+    }
+    let legacy = run_legacy(ctx, new_context, opts, &mut outcomes);
+    Report {
+        device: ctx.info.clone(),
+        features: ctx.features.clone(),
+        validation: ctx.validation,
+        subpixel_bits: bits,
+        filter: opts.filter.clone(),
+        formats,
+        configs,
+        cases: outcomes,
+        legacy,
+        seconds: start.elapsed().as_secs_f64(),
+    }
+}
+
+fn run_legacy(
+    ctx: &Context,
+    new_context: &dyn Fn() -> Result<Context>,
+    opts: &SuiteOptions,
+    out: &mut Vec<CaseOutcome>,
+) -> Vec<CheckResult> {
+    type Check = fn(&Context) -> Result<CheckResult>;
+    let unit: [(&str, Check); 7] = [
+        (LEGACY[0], super::checks::w0_vertices_and_infinity),
+        (LEGACY[1], super::checks::depth_clamp),
+        (LEGACY[2], super::checks::watertight_fan),
+        (LEGACY[3], super::checks::two_sided_stencil_wrap),
+        (LEGACY[4], super::checks::stencil_formats),
+        (LEGACY[5], super::checks::depth_bounds),
+        (LEGACY[6], super::checks::index_types),
+    ];
+    let mut results = Vec::new();
+    for (name, f) in unit {
+        let full = format!("legacy.{name}");
+        if !selected(&opts.filter, &full) {
+            continue;
+        }
+        let t0 = Instant::now();
+        let mut r = f(ctx).unwrap_or_else(|e| CheckResult::error(name, &e));
+        super::with_validation(&mut r, ctx.take_validation_errors());
+        let mut o = CaseOutcome::new(full, "legacy", None, format!("single-configuration check `{name}` (the renderer's depth format)"));
+        o.status = r.status;
+        o.message = r.summary.clone();
+        o.seconds = t0.elapsed().as_secs_f64();
+        out.push(o);
+        results.push(r);
+    }
+    let names: Vec<String> = pipeline_names().into_iter().filter(|n| selected(&opts.filter, n)).collect();
+    if !names.is_empty() {
+        let t0 = Instant::now();
+        let (w, h) = opts.pipeline_size;
+        match super::checks::shadow_pipeline_hard_cases(new_context, w, h) {
+            Ok(r) => {
+                let per = t0.elapsed().as_secs_f64() / r.cases.len().max(1) as f64;
+                for k in &r.cases {
+                    let full = format!("pipeline.hard_cases.{}.{}", k.scene.trim_start_matches("hard/"), k.method);
+                    if !names.contains(&full) {
+                        continue;
+                    }
+                    let mut o =
+                        CaseOutcome::new(full, "pipeline", None, "the whole shadow pipeline against the exact CPU reference".into());
+                    o.seconds = per;
+                    o.status = if k.status == "fail" { Status::Fail } else { Status::Pass };
+                    o.message = format!(
+                        "{}: {} of {} compared pixels mismatched outside the 1-pixel band ({:.4}%)",
+                        k.status,
+                        k.mismatches_outside_band,
+                        k.compared,
+                        k.worst_fraction_outside_band * 100.0
+                    );
+                    if k.expected_failure {
+                        o.message.push_str(" — a known limitation of this method (accuracy::expected_failure), reproduced");
+                    }
+                    out.push(o);
+                }
+                results.push(r);
+            }
+            Err(e) => {
+                for n in names {
+                    let mut o = CaseOutcome::new(n, "pipeline", None, "the whole shadow pipeline against the exact CPU reference".into());
+                    o.status = Status::Fail;
+                    o.message = format!("error: {e}");
+                    out.push(o);
+                }
+            }
+        }
+    }
+    results
+}
+
+/// The cases whose expectation `brk` changes (the seam test's prediction), among `filter`.
+pub fn affected_by_break(brk: vk::StencilOp, filter: &[String], subpixel_bits: u32) -> Vec<String> {
+    cases::all(&Config::all(&FORMATS))
+        .into_iter()
+        .filter(|c| selected(filter, &c.name))
+        .filter(|c| model::expect(c, subpixel_bits, None) != model::expect(c, subpixel_bits, Some(brk)))
+        .map(|c| c.name)
+        .collect()
+}
