@@ -71,6 +71,8 @@ enum MethodArg {
     Edgequad,
     /// Flat projected shadows onto y = 0 (the Cg article's baseline).
     Planar,
+    /// McGuire's cases with GPU possible silhouettes (compute pass, indirect draws).
+    Compute,
     /// The shadow-map baseline (PCF 3x3).
     Shadowmap,
 }
@@ -87,6 +89,7 @@ impl MethodArg {
             MethodArg::ZpassClear => Technique::Volumes(M::ZPassClear),
             MethodArg::Edgequad => Technique::EdgeQuads,
             MethodArg::Planar => Technique::Planar,
+            MethodArg::Compute => Technique::Compute,
             MethodArg::Shadowmap => Technique::ShadowMap { size: shadow_map_size },
         }
     }
@@ -356,6 +359,7 @@ fn bench_techniques(methods: &[MethodArg], shadow_map_size: u32) -> Vec<Techniqu
         out.push(Technique::Volumes(umbrage::shadow::Method::ZPassClear));
         out.push(Technique::EdgeQuads);
         out.push(Technique::Planar);
+        out.push(Technique::Compute);
         if shadow_map_size > 0 {
             out.push(Technique::ShadowMap { size });
         }

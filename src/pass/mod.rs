@@ -45,6 +45,7 @@
 #![warn(missing_docs)]
 
 mod casters;
+mod compute;
 mod desc;
 mod device;
 mod eye;
@@ -82,6 +83,10 @@ use std::time::Instant;
 struct Slot {
     stream: Option<Buffer>,
     staging: Vec<Buffer>,
+    /// The compute pass's records, output and facing buffers and descriptor sets.
+    compute: compute::SlotCompute,
+    /// Serial of the frame last prepared in this slot.
+    serial: Option<u64>,
 }
 
 /// The shadow determination as an embeddable component (see the [module docs](self) for the
@@ -96,6 +101,7 @@ pub struct ShadowPass {
     slots: Vec<Slot>,
     serial: u64,
     planar_receiver: glam::DVec4,
+    compute_pipes: Option<compute::ComputePipes>,
 }
 
 impl ShadowPass {
@@ -143,8 +149,18 @@ impl ShadowPass {
         }
         desc.settings.check(&caps)?;
         let dev = PassDevice { device: device.clone(), allocator };
-        let pipes = Pipelines::new(&dev, desc, caps.depth_clamp, caps.depth_bounds, caps.r32f_blend)?;
-        let slots = (0..desc.frames_in_flight).map(|_| Slot { stream: None, staging: Vec::new() }).collect();
+        let mut pipes = Pipelines::new(&dev, desc, caps.depth_clamp, caps.depth_bounds, caps.r32f_blend)?;
+        let compute_pipes = match compute::ComputePipes::new(&dev) {
+            Ok(c) => c,
+            Err(e) => {
+                // SAFETY: the pipelines were just created and never used.
+                unsafe { pipes.destroy(&dev.device) };
+                return Err(e);
+            }
+        };
+        let slots = (0..desc.frames_in_flight)
+            .map(|_| Slot { stream: None, staging: Vec::new(), compute: Default::default(), serial: None })
+            .collect();
         Ok(ShadowPass {
             dev,
             caps,
@@ -155,6 +171,7 @@ impl ShadowPass {
             slots,
             serial: 0,
             planar_receiver: glam::DVec4::Y,
+            compute_pipes: Some(compute_pipes),
         })
     }
 
@@ -300,6 +317,9 @@ impl ShadowPass {
         if self.settings.technique == Technique::EdgeQuads {
             self.casters.ensure_edge_quads(&self.dev)?;
         }
+        if self.settings.technique == Technique::Compute {
+            self.casters.ensure_compute(&self.dev)?;
+        }
         let mut uploads = Vec::new();
         let mut upload_bytes = 0;
         for (b, up) in self.casters.pending.drain(..) {
@@ -326,9 +346,14 @@ impl ShadowPass {
         cpu.record = record_start.elapsed().as_secs_f64() * 1e3;
         let mut totals = packed.totals;
         totals.bytes_sent += upload_bytes;
+        let compute = match packed.compute {
+            Some(cf) => Some(self.prepare_compute(slot, cf)?),
+            None => None,
+        };
         let warnings = overflow_warnings(&self.casters, &packed.lights, self.settings.counter);
         let serial = self.serial;
         self.serial += 1;
+        self.slots[slot].serial = Some(serial);
         Ok(PreparedFrame {
             slot,
             serial,
@@ -341,6 +366,7 @@ impl ShadowPass {
             settings: self.settings,
             warnings,
             extent: vk::Extent2D { width: view.width, height: view.height },
+            compute,
         })
     }
 
@@ -390,6 +416,10 @@ impl Drop for ShadowPass {
         // SAFETY: the embedding contract (module docs): the host drops the pass only after
         // every command buffer that used it has completed, while the device is alive.
         unsafe { self.pipes.destroy(&self.dev.device) };
+        if let Some(mut c) = self.compute_pipes.take() {
+            // SAFETY: as above.
+            unsafe { c.destroy(&self.dev.device) };
+        }
         self.casters.destroy(&self.dev);
         for s in &mut self.slots {
             if let Some(mut b) = s.stream.take() {
@@ -398,6 +428,7 @@ impl Drop for ShadowPass {
             for mut b in s.staging.drain(..) {
                 b.destroy(&self.dev);
             }
+            s.compute.destroy(&self.dev);
         }
     }
 }
