@@ -21,10 +21,15 @@
 //! 3. the host records its depth pre-pass / G-buffer into its depth-stencil image;
 //! 4. [`ShadowPass::cmd_upload`] (new or deformed casters' vertex copies; also recorded by the
 //!    first `cmd_determine` of the frame when the host did not call it);
+//! 4b. [`ShadowPass::cmd_compute_silhouettes`] ([`Technique::Compute`] only: the GPU possible
+//!    silhouettes of every light, dispatched outside rendering; also recorded by the first
+//!    `cmd_determine` of the frame when the host did not call it);
 //! 5. per light: [`ShadowPass::cmd_determine`] leaves the count in the stencil (cleared inside
 //!    the light's scissor), then the host's lighting pass tests `stencil == 0`
 //!    ([`lit_stencil_state`]), with the light's [`LightFrame::scissor`] and depth bounds;
-//! 6. the host submits; a later `prepare(s, ..)` may only come after that submission retired.
+//! 6. the host submits; a later `prepare(s, ..)` may only come after that submission retired
+//!    (with [`Technique::Compute`], [`ShadowPass::read_back_counts`] after the fence puts the
+//!    GPU's triangle counts into the frame's stats).
 //!
 //! **Frames in flight:** the ring has [`ShadowPassDesc::frames_in_flight`] slots; the host
 //! passes the slot of the frame it records. Removing a caster or changing its positions
@@ -35,8 +40,9 @@
 //! of the host's image between `vkCmdBeginRendering` and `vkCmdEndRendering`. The host makes
 //! its depth writes visible before (a barrier from late fragment tests to early fragment
 //! tests, depth-stencil read), and makes the stencil writes visible to its lighting pass after.
-//! `cmd_upload` records transfer writes followed by a barrier to vertex-attribute and
-//! index reads.
+//! `cmd_upload` records transfer writes followed by a barrier to vertex-attribute, index and
+//! compute reads; `cmd_compute_silhouettes` records compute writes followed by a barrier to
+//! indirect-command and index reads.
 //!
 //! **Drop order:** drop the pass while its device and allocator are alive, after every command
 //! buffer that uses it has completed (it does not wait for the device: the host owns the
@@ -342,14 +348,15 @@ impl ShadowPass {
         );
         let record_start = Instant::now();
         let stream = self.write_stream(slot, &packed.stream)?;
-        let mut cpu = packed.cpu;
-        cpu.record = record_start.elapsed().as_secs_f64() * 1e3;
-        let mut totals = packed.totals;
-        totals.bytes_sent += upload_bytes;
+        // The compute pass's records and descriptor sets count as recording work too.
         let compute = match packed.compute {
             Some(cf) => Some(self.prepare_compute(slot, cf)?),
             None => None,
         };
+        let mut cpu = packed.cpu;
+        cpu.record = record_start.elapsed().as_secs_f64() * 1e3;
+        let mut totals = packed.totals;
+        totals.bytes_sent += upload_bytes;
         let warnings = overflow_warnings(&self.casters, &packed.lights, self.settings.counter);
         let serial = self.serial;
         self.serial += 1;
