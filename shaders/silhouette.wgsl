@@ -1,6 +1,7 @@
 // GPU possible silhouettes (`--method compute`): per caster and light, two passes.
 //
-// `facing` (one invocation a triangle): the facing bit from the caster's static object-space
+// `facing` (one invocation a triangle), then `exact` (the few triangles `facing` could not
+// decide): the facing bit from the caster's static object-space
 // plane, exactly as the CPU's `FacePlanes::facing_packed` decides it: the f32 plane value is
 // trusted only beyond the CPU's proven error bound (`bound`, computed on the CPU per caster
 // and light), and every other triangle, degenerate ones included (their planes are zero), is
@@ -8,10 +9,11 @@
 // 48 (point light) or 24 (directional) products of three f32 values in a fixed-point
 // accumulator of 12-bit limbs (no rounding at all). The bits are therefore the CPU's, bit for
 // bit, and every edge is derived from one bit per triangle: the volume is closed by
-// construction. The same pass writes the triangle's face caps (dark cap of front or back
-// faces, light cap) for the chunks whose case needs them.
+// construction. (The exact test is its own entry point: in the filter's entry its code made
+// lavapipe ten times slower on every triangle.)
 //
-// `edges` (one invocation a manifold edge): an edge whose two triangles' bits differ is a
+// `edges` (one invocation a triangle and a manifold edge): the triangle's face caps (dark cap
+// of front or back faces, light cap) for the chunks whose case needs them, and an edge whose two triangles' bits differ is a
 // possible silhouette edge; its side quad (and, for McGuire's fan dark cap, one fan triangle)
 // go to the chunk of the light-facing triangle (front formulation) or of the other one (back
 // formulation, the light inside the part's bounds), with the same winding as the CPU's
@@ -38,10 +40,14 @@ struct Push {
     edges: u32,
     // Word offset of this caster's chunk records for this light.
     rec_base: u32,
-    // Offset (in triangles) of this caster and light's facing words.
+    // Offset of this caster and light's facing words (2 per triangle: the bits, then the list
+    // of triangles the filter left to the exact test).
     fac_base: u32,
-    pad0: u32,
-    pad1: u32,
+    // Word offset of this caster and light's job header in the records (word 0: the length
+    // of the exact list).
+    job_base: u32,
+    // 1: some chunk of this job has face caps (dark cap of front or back faces, light cap).
+    caps: u32,
 }
 
 struct Tri {
@@ -233,15 +239,16 @@ fn facing_exact(t: u32) -> bool {
     return acc_sign() > 0;
 }
 
-fn facing_of(t: u32) -> bool {
+// The filter's verdict: 1 light-facing, 0 not, 2 undecided (the exact test decides).
+fn filtered(t: u32) -> u32 {
     let pl = planes[t];
     let f = pc.filt;
     // the CPU's order: ((nx lx + ny ly) + nz lz) + d lw
     let v = ((pl.x * f.x + pl.y * f.y) + pl.z * f.z) + pl.w * f.w;
     if (abs(v) > pc.bound) {
-        return v > pc.bound;
+        return select(0u, 1u, v > pc.bound);
     }
-    return facing_exact(t);
+    return 2u;
 }
 
 // ---- output ----
@@ -298,39 +305,61 @@ fn total_threads(nwg: vec3<u32>) -> u32 {
     return nwg.x * 64u;
 }
 
+// Pass 1: the filter. Undecided triangles are listed for pass 2 (rare: grazing light,
+// degenerate triangles; all of them for meshes beyond the filter's range).
 @compute @workgroup_size(64)
 fn facing(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let stride = total_threads(nwg);
     for (var t = gid.x; t < pc.tris; t = t + stride) {
-        let f = facing_of(t);
-        facing_bits[pc.fac_base + t] = select(0u, 1u, f);
-        let tri = tris[t];
-        let r = pc.rec_base + tri.l.w * RECORD_WORDS;
-        let flags = atomicLoad(&records[r + R_FLAGS]);
-        if ((flags & F_ENABLED) == 0u) {
-            continue;
+        let v = filtered(t);
+        facing_bits[pc.fac_base + t] = v & 1u;
+        if (v == 2u) {
+            let k = atomicAdd(&records[pc.job_base], 1u);
+            facing_bits[pc.fac_base + pc.tris + k] = t;
         }
-        let n = atomicLoad(&records[r + R_N]);
-        let dc = (flags >> 3u) & 3u;
-        if ((dc == DC_FRONT && f) || (dc == DC_BACK && !f)) {
-            var idx = array<u32, 9>(tri.l.x + n, tri.l.y + n, tri.l.z + n, 0u, 0u, 0u, 0u, 0u, 0u);
-            if (dc == DC_FRONT) {
-                idx[1] = tri.l.z + n;
-                idx[2] = tri.l.y + n;
-            }
-            emit(r, false, idx, 3u);
-            atomicAdd(&records[r + R_DARK], 1u);
+    }
+}
+
+// Pass 2: the exact test for the listed triangles (a few workgroups striding over the list,
+// so that the common case, an empty list, costs nothing).
+@compute @workgroup_size(64)
+fn exact(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let stride = total_threads(nwg);
+    let count = atomicLoad(&records[pc.job_base]);
+    for (var k = gid.x; k < count; k = k + stride) {
+        let t = facing_bits[pc.fac_base + pc.tris + k];
+        facing_bits[pc.fac_base + t] = select(0u, 1u, facing_exact(t));
+    }
+}
+
+fn face_caps(t: u32) {
+    let f = facing_bits[pc.fac_base + t] != 0u;
+    let tri = tris[t];
+    let r = pc.rec_base + tri.l.w * RECORD_WORDS;
+    let flags = atomicLoad(&records[r + R_FLAGS]);
+    if ((flags & F_ENABLED) == 0u) {
+        return;
+    }
+    let n = atomicLoad(&records[r + R_N]);
+    let dc = (flags >> 3u) & 3u;
+    if ((dc == DC_FRONT && f) || (dc == DC_BACK && !f)) {
+        var idx = array<u32, 9>(tri.l.x + n, tri.l.y + n, tri.l.z + n, 0u, 0u, 0u, 0u, 0u, 0u);
+        if (dc == DC_FRONT) {
+            idx[1] = tri.l.z + n;
+            idx[2] = tri.l.y + n;
         }
-        if ((flags & F_LIGHT_CAP) != 0u) {
-            let want = (flags & F_BACK) == 0u;
-            if (f == want) {
-                var idx = array<u32, 9>(tri.l.x, tri.l.y, tri.l.z, 0u, 0u, 0u, 0u, 0u, 0u);
-                if (!want) {
-                    idx[1] = tri.l.z;
-                    idx[2] = tri.l.y;
-                }
-                emit(r, true, idx, 3u);
+        emit(r, false, idx, 3u);
+        atomicAdd(&records[r + R_DARK], 1u);
+    }
+    if ((flags & F_LIGHT_CAP) != 0u) {
+        let want = (flags & F_BACK) == 0u;
+        if (f == want) {
+            var idx = array<u32, 9>(tri.l.x, tri.l.y, tri.l.z, 0u, 0u, 0u, 0u, 0u, 0u);
+            if (!want) {
+                idx[1] = tri.l.z;
+                idx[2] = tri.l.y;
             }
+            emit(r, true, idx, 3u);
         }
     }
 }
@@ -345,10 +374,21 @@ fn corner(l: vec4<u32>, k: u32) -> u32 {
     return l.z;
 }
 
+// Pass 3: triangle i's face caps (when its chunk's case needs them) and edge i's side.
 @compute @workgroup_size(64)
 fn edges(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let stride = total_threads(nwg);
-    for (var i = gid.x; i < pc.edges; i = i + stride) {
+    var n = pc.edges;
+    if (pc.caps != 0u) {
+        n = max(pc.tris, pc.edges);
+    }
+    for (var i = gid.x; i < n; i = i + stride) {
+        if (pc.caps != 0u && i < pc.tris) {
+            face_caps(i);
+        }
+        if (i >= pc.edges) {
+            continue;
+        }
         let e = edge_table[i];
         let f0 = facing_bits[pc.fac_base + e.x];
         let f1 = facing_bits[pc.fac_base + e.y];

@@ -82,9 +82,12 @@ impl ComputeFrame {
         while self.jobs.len() <= li {
             self.jobs.push(Vec::new());
         }
-        let rec_base = self.records.len();
+        // a header of 4 words (word 0: the length of the exact test's list), then the chunks
+        let job_base = self.records.len();
+        let rec_base = job_base + 4;
         self.records.resize(rec_base + RECORD_WORDS * caster.chunks.len(), 0);
         let l_obj = glam::Vec4::from_array(cp.light_object);
+        let mut caps = false;
         let directional = l_obj.w == 0.0;
         for (pp_index, pp) in cp.parts.iter().enumerate() {
             if pp.path != "compute" || pp.case == Case::Culled {
@@ -114,6 +117,7 @@ impl ComputeFrame {
             if light_cap {
                 flags |= rec::F_LIGHT_CAP;
             }
+            caps |= light_cap || faces > 0;
             for chunk in part.chunks.clone() {
                 let t = st.chunk_tris[chunk] as u64;
                 let vol = per_edge * st.chunk_edges[chunk] as u64 + faces * t;
@@ -161,9 +165,10 @@ impl ComputeFrame {
             edges: st.edge_count,
             rec_base: rec_base as u32,
             fac_base: self.facing_words as u32,
-            pad: [0; 2],
+            job_base: job_base as u32,
+            caps: caps as u32,
         };
-        self.facing_words += st.triangles as u64;
+        self.facing_words += 2 * st.triangles as u64;
         self.jobs[li].push(Job { caster: ci, push });
     }
 

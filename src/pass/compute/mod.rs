@@ -72,7 +72,9 @@ pub(crate) struct SilhouettePush {
     pub edges: u32,
     pub rec_base: u32,
     pub fac_base: u32,
-    pub pad: [u32; 2],
+    pub job_base: u32,
+    /// 1 when some chunk of the job writes face caps.
+    pub caps: u32,
 }
 
 impl SilhouettePush {
@@ -155,11 +157,12 @@ pub(crate) fn padded_bytes<T: Pod>(v: &[T], min: usize) -> Vec<u8> {
     b
 }
 
-/// The compute pipelines (facing, then edges) and their layout.
+/// The compute pipelines (facing filter, exact facing, then caps and edges) and their layout.
 pub(crate) struct ComputePipes {
     pub set_layout: vk::DescriptorSetLayout,
     pub layout: vk::PipelineLayout,
     pub facing: vk::Pipeline,
+    pub exact: vk::Pipeline,
     pub edges: vk::Pipeline,
 }
 
@@ -182,7 +185,7 @@ impl ComputePipes {
         // SAFETY: creation on a valid device from locals; destroyed in `destroy` (or below on error).
         let set_layout = unsafe { d.create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None) }
             .map_err(Error::vk("vkCreateDescriptorSetLayout"))?;
-        let mut me = ComputePipes { set_layout, layout: vk::PipelineLayout::null(), facing: vk::Pipeline::null(), edges: vk::Pipeline::null() };
+        let mut me = ComputePipes { set_layout, layout: vk::PipelineLayout::null(), facing: vk::Pipeline::null(), exact: vk::Pipeline::null(), edges: vk::Pipeline::null() };
         match me.create(dev) {
             Ok(()) => Ok(me),
             Err(e) => {
@@ -207,6 +210,10 @@ impl ComputePipes {
         };
         let r = make(c"facing").and_then(|f| {
             self.facing = f;
+            make(c"exact")
+        });
+        let r = r.and_then(|x| {
+            self.exact = x;
             make(c"edges").map(|e| self.edges = e)
         });
         // SAFETY: the pipelines keep what they need of the module.
@@ -220,6 +227,7 @@ impl ComputePipes {
         // SAFETY: the caller's contract; null handles are ignored.
         unsafe {
             d.destroy_pipeline(self.facing, None);
+            d.destroy_pipeline(self.exact, None);
             d.destroy_pipeline(self.edges, None);
             d.destroy_pipeline_layout(self.layout, None);
             d.destroy_descriptor_set_layout(self.set_layout, None);
@@ -234,7 +242,7 @@ pub(crate) struct SlotCompute {
     pub records: Option<Buffer>,
     /// Output indices (u16, two a word), every light's regions.
     pub out: Option<Buffer>,
-    /// One facing word per triangle, per caster and light.
+    /// Two facing words per triangle, per caster and light (the bits, the exact test's list).
     pub facing: Option<Buffer>,
     pub pool: vk::DescriptorPool,
     pub pool_sets: u32,

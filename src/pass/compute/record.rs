@@ -5,7 +5,8 @@
 //! Barriers (global memory barriers, synchronization2):
 //! 1. earlier indirect, index and compute accesses (a previous frame on the queue) and the
 //!    caster uploads -> compute reads and writes;
-//! 2. the facing pass's writes -> the edge pass's reads and atomics;
+//! 2. the facing filter's writes -> the exact facing pass; its writes -> the caps-and-edges
+//!    pass's reads and atomics;
 //! 3. the compute writes -> indirect-command reads, index reads, and host reads (the counts
 //!    `--stats` reads back after the fence).
 
@@ -17,6 +18,9 @@ use ash::vk;
 
 /// Most workgroups of one dispatch (the shader strides over the rest).
 const MAX_GROUPS: u32 = 65535;
+/// Workgroups of the exact facing pass (it strides over the filter's list of undecided
+/// triangles, usually empty).
+const EXACT_GROUPS: u32 = 16;
 
 fn groups(n: u32) -> u32 {
     n.div_ceil(64).min(MAX_GROUPS)
@@ -31,7 +35,7 @@ fn barrier(d: &ash::Device, cb: vk::CommandBuffer, src: (vk::PipelineStageFlags2
 impl ShadowPass {
     /// Records the GPU possible silhouettes of every light of `frame`
     /// ([`Technique::Compute`](crate::pass::Technique::Compute)): per caster and light a facing
-    /// pass and an edge pass writing 16-bit indices and the indirect draw counts, then a barrier
+    /// filter, the exact test of what it left undecided, and a caps-and-edges pass writing 16-bit indices and the indirect draw counts, then a barrier
     /// to the indirect draws and index reads. Nothing for other techniques. Idempotent per
     /// frame; also recorded by the first `cmd_determine` / `cmd_count_float` /
     /// `cmd_light_intensity` of the frame when the host did not call it (hosts drawing with
@@ -67,8 +71,15 @@ impl ShadowPass {
         barrier(d, cb, (S::COMPUTE_SHADER, A::SHADER_STORAGE_WRITE), (S::COMPUTE_SHADER, rw));
         // SAFETY: as above.
         unsafe {
+            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, cp.exact);
+            // a few workgroups striding over the (usually empty) list
+            self.dispatch_all(cb, cf, cp.layout, |p| groups(p.tris).min(EXACT_GROUPS));
+        }
+        barrier(d, cb, (S::COMPUTE_SHADER, A::SHADER_STORAGE_WRITE), (S::COMPUTE_SHADER, rw));
+        // SAFETY: as above.
+        unsafe {
             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, cp.edges);
-            self.dispatch_all(cb, cf, cp.layout, |p| groups(p.edges));
+            self.dispatch_all(cb, cf, cp.layout, |p| groups(if p.caps != 0 { p.edges.max(p.tris) } else { p.edges }));
         }
         barrier(
             d,
