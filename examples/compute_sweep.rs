@@ -47,7 +47,9 @@ fn main() -> umbrage::Result<()> {
     let frames: usize = std::env::args().nth(1).and_then(|a| a.parse().ok()).unwrap_or(7);
     let mut ctx = umbrage::gpu::Context::new()?;
     println!("device: {}, 320x240, medians of {frames} frames\n", ctx.info.name);
-    println!("| view | triangles | method | CPU ms (plan + record) | of which silhouettes | shadow triangles | GPU shadow ms | bytes sent |");
+    println!(
+        "| view | triangles | method | CPU ms (plan + record) | of which silhouettes | shadow triangles | GPU shadow ms | bytes sent |"
+    );
     println!("|---|---:|---|---:|---:|---:|---:|---:|");
     let quick = std::env::var_os("SWEEP_QUICK").is_some();
     let views = [("outside (z-pass)", [0.0f32, 4.0, 9.0]), ("in the shadow (z-fail, fan cap)", [0.2, 0.3, 0.4])];

@@ -148,6 +148,7 @@ fn compute_multiplicity_parts_fall_back_to_the_cpu() {
     let Some(ctx) = common::context() else { return };
     let mut r = renderer(ctx, umbrage::scene::load("hard/open_casters").unwrap());
     let g = compare(&mut r, "hard/open_casters");
-    let parts: Vec<&str> = g.stats.lights.iter().flat_map(|l| l.casters.iter().flat_map(|c| c.parts.iter().map(|p| p.path.as_str()))).collect();
+    let parts: Vec<&str> =
+        g.stats.lights.iter().flat_map(|l| l.casters.iter().flat_map(|c| c.parts.iter().map(|p| p.path.as_str()))).collect();
     assert!(parts.contains(&"multiplicity"), "{parts:?}");
 }

@@ -20,8 +20,8 @@
 //!    streams written into slot `s`);
 //! 3. the host records its depth pre-pass / G-buffer into its depth-stencil image;
 //! 4. [`ShadowPass::cmd_upload`] (new or deformed casters' vertex copies; also recorded by the
-//!    first `cmd_determine` of the frame when the host did not call it);
-//! 4b. [`ShadowPass::cmd_compute_silhouettes`] ([`Technique::Compute`] only: the GPU possible
+//!    first `cmd_determine` of the frame when the host did not call it), then
+//!    [`ShadowPass::cmd_compute_silhouettes`] ([`Technique::Compute`] only: the GPU possible
 //!    silhouettes of every light, dispatched outside rendering; also recorded by the first
 //!    `cmd_determine` of the frame when the host did not call it);
 //! 5. per light: [`ShadowPass::cmd_determine`] leaves the count in the stencil (cleared inside

@@ -13,7 +13,7 @@ use crate::error::{Error, Result};
 use crate::pass::frame::{Draw, LightFrame};
 use crate::pass::stats::{CasterStats, Totals};
 use crate::pass::IndexFormat;
-use crate::shadow::plan::{CasterPlan, Case, DarkCap, Formulation};
+use crate::shadow::plan::{Case, CasterPlan, DarkCap, Formulation};
 use crate::shadow::Caster;
 use ash::vk;
 use std::cell::Cell;

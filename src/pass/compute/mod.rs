@@ -185,7 +185,13 @@ impl ComputePipes {
         // SAFETY: creation on a valid device from locals; destroyed in `destroy` (or below on error).
         let set_layout = unsafe { d.create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None) }
             .map_err(Error::vk("vkCreateDescriptorSetLayout"))?;
-        let mut me = ComputePipes { set_layout, layout: vk::PipelineLayout::null(), facing: vk::Pipeline::null(), exact: vk::Pipeline::null(), edges: vk::Pipeline::null() };
+        let mut me = ComputePipes {
+            set_layout,
+            layout: vk::PipelineLayout::null(),
+            facing: vk::Pipeline::null(),
+            exact: vk::Pipeline::null(),
+            edges: vk::Pipeline::null(),
+        };
         match me.create(dev) {
             Ok(()) => Ok(me),
             Err(e) => {
@@ -251,7 +257,14 @@ pub(crate) struct SlotCompute {
 impl SlotCompute {
     /// Makes `b` at least `size` bytes (the next power of two, at least 64 KiB); its old
     /// contents are dropped (the slot's previous frame has retired).
-    pub fn ensure(dev: &PassDevice, b: &mut Option<Buffer>, name: &str, size: u64, usage: vk::BufferUsageFlags, loc: MemoryLocation) -> Result<()> {
+    pub fn ensure(
+        dev: &PassDevice,
+        b: &mut Option<Buffer>,
+        name: &str,
+        size: u64,
+        usage: vk::BufferUsageFlags,
+        loc: MemoryLocation,
+    ) -> Result<()> {
         if b.as_ref().is_some_and(|b| b.size >= size) {
             return Ok(());
         }
@@ -281,7 +294,8 @@ impl SlotCompute {
             self.pool_sets = n;
         } else {
             // SAFETY: as above.
-            unsafe { d.reset_descriptor_pool(self.pool, vk::DescriptorPoolResetFlags::empty()) }.map_err(Error::vk("vkResetDescriptorPool"))?;
+            unsafe { d.reset_descriptor_pool(self.pool, vk::DescriptorPoolResetFlags::empty()) }
+                .map_err(Error::vk("vkResetDescriptorPool"))?;
         }
         Ok(())
     }

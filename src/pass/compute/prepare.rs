@@ -58,8 +58,10 @@ impl ShadowPass {
             let d = &dev.device;
             // SAFETY: the pool was reset or created for at least this many sets; the slot's
             // previous frame (the only user of its sets) has retired.
-            let sets = unsafe { d.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(sc.pool).set_layouts(&layouts)) }
-                .map_err(Error::vk("vkAllocateDescriptorSets"))?;
+            let sets = unsafe {
+                d.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(sc.pool).set_layouts(&layouts))
+            }
+            .map_err(Error::vk("vkAllocateDescriptorSets"))?;
             let mut infos: Vec<[vk::DescriptorBufferInfo; 1]> = Vec::with_capacity(casters.len() * 7);
             for &ci in &casters {
                 let st = self.casters.live[ci].compute.as_ref().ok_or_else(|| Error::Other("compute tables missing".into()))?;
@@ -103,14 +105,18 @@ impl ShadowPass {
         let Some(cf) = frame.compute.as_ref() else { return Ok(()) };
         let slot = &self.slots[frame.slot];
         if slot.serial != Some(frame.serial) {
-            return Err(Error::Other(format!("read_back_counts: ring slot {} was prepared again since frame {}", frame.slot, frame.serial)));
+            return Err(Error::Other(format!(
+                "read_back_counts: ring slot {} was prepared again since frame {}",
+                frame.slot, frame.serial
+            )));
         }
         if cf.metas.is_empty() {
             return Ok(());
         }
         let Some(records) = slot.compute.records.as_ref() else { return Ok(()) };
         let bytes = records.read()?;
-        let words: &[u32] = bytemuck::try_cast_slice(&bytes[..cf.records.len() * 4]).map_err(|e| Error::Other(format!("compute records: {e}")))?;
+        let words: &[u32] =
+            bytemuck::try_cast_slice(&bytes[..cf.records.len() * 4]).map_err(|e| Error::Other(format!("compute records: {e}")))?;
         cf.read_back(words, &mut frame.lights, &mut frame.totals)
     }
 }

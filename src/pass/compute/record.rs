@@ -26,7 +26,12 @@ fn groups(n: u32) -> u32 {
     n.div_ceil(64).min(MAX_GROUPS)
 }
 
-fn barrier(d: &ash::Device, cb: vk::CommandBuffer, src: (vk::PipelineStageFlags2, vk::AccessFlags2), dst: (vk::PipelineStageFlags2, vk::AccessFlags2)) {
+fn barrier(
+    d: &ash::Device,
+    cb: vk::CommandBuffer,
+    src: (vk::PipelineStageFlags2, vk::AccessFlags2),
+    dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
+) {
     let b = [vk::MemoryBarrier2::default().src_stage_mask(src.0).src_access_mask(src.1).dst_stage_mask(dst.0).dst_access_mask(dst.1)];
     // SAFETY: the callers record outside a rendering instance on a recording command buffer.
     unsafe { d.cmd_pipeline_barrier2(cb, &vk::DependencyInfo::default().memory_barriers(&b)) };
@@ -59,7 +64,10 @@ impl ShadowPass {
         barrier(
             d,
             cb,
-            (S::DRAW_INDIRECT | S::VERTEX_INPUT | S::COMPUTE_SHADER | S::COPY, A::INDIRECT_COMMAND_READ | A::INDEX_READ | rw | A::TRANSFER_WRITE),
+            (
+                S::DRAW_INDIRECT | S::VERTEX_INPUT | S::COMPUTE_SHADER | S::COPY,
+                A::INDIRECT_COMMAND_READ | A::INDEX_READ | rw | A::TRANSFER_WRITE,
+            ),
             (S::COMPUTE_SHADER, rw),
         );
         // SAFETY: the caller's contract; the pipelines, sets and buffers live until the slot
@@ -91,7 +99,13 @@ impl ShadowPass {
 
     /// # Safety
     /// `cb` is recording outside a rendering instance with a compute pipeline of `layout` bound.
-    unsafe fn dispatch_all(&self, cb: vk::CommandBuffer, cf: &ComputeFrame, layout: vk::PipelineLayout, count: impl Fn(&SilhouettePush) -> u32) {
+    unsafe fn dispatch_all(
+        &self,
+        cb: vk::CommandBuffer,
+        cf: &ComputeFrame,
+        layout: vk::PipelineLayout,
+        count: impl Fn(&SilhouettePush) -> u32,
+    ) {
         let d = &self.dev.device;
         let mut bound = None;
         for job in cf.jobs.iter().flatten() {
