@@ -23,7 +23,7 @@ struct FrameArgs {
     size: (u32, u32),
     /// Shadow method: auto (= mcguire, with open / non-manifold casters on the multiplicity
     /// path), mcguire, lengyel, everitt-kilgard, zfail, zpass, zpass-clear; edgequad (GPU-only silhouettes,
-    /// the Cg article); or shadowmap (the PCF baseline).
+    /// the Cg article); planar; compute (GPU possible silhouettes); or shadowmap (the PCF baseline).
     #[arg(long, value_enum, default_value = "auto")]
     method: MethodArg,
     /// infinite (far plane at infinity) or clamp (finite far plane + depthClamp).
@@ -71,6 +71,8 @@ enum MethodArg {
     Edgequad,
     /// Flat projected shadows onto y = 0 (the Cg article's baseline).
     Planar,
+    /// McGuire's cases with GPU possible silhouettes (compute pass, indirect draws).
+    Compute,
     /// The shadow-map baseline (PCF 3x3).
     Shadowmap,
 }
@@ -87,6 +89,7 @@ impl MethodArg {
             MethodArg::ZpassClear => Technique::Volumes(M::ZPassClear),
             MethodArg::Edgequad => Technique::EdgeQuads,
             MethodArg::Planar => Technique::Planar,
+            MethodArg::Compute => Technique::Compute,
             MethodArg::Shadowmap => Technique::ShadowMap { size: shadow_map_size },
         }
     }
@@ -428,6 +431,7 @@ fn bench_techniques(methods: &[MethodArg], shadow_map_size: u32) -> Vec<Techniqu
         out.push(Technique::Volumes(umbrage::shadow::Method::ZPassClear));
         out.push(Technique::EdgeQuads);
         out.push(Technique::Planar);
+        out.push(Technique::Compute);
         if shadow_map_size > 0 {
             out.push(Technique::ShadowMap { size });
         }

@@ -30,12 +30,15 @@ fn every_method_on_every_hard_case_matches_the_reference() {
             rows.extend(evaluate(&mut r, name, &Technique::all_volumes(), 1).unwrap());
             // The GPU-only edge-quad method (closed opaque casters; the others keep their path).
             rows.extend(evaluate(&mut r, name, &[Technique::EdgeQuads, Technique::Volumes(Method::ZPassClear)], 1).unwrap());
+            // GPU possible silhouettes (tests/compute.rs checks its counts equal mcguire's).
+            rows.extend(evaluate(&mut r, name, &[Technique::Compute], 1).unwrap());
             r.context().check_validation().unwrap();
             ctx = r.into_context();
         }
         let mut columns: Vec<&str> = Method::ALL.iter().map(|m| m.name()).collect();
         columns.push("edgequad");
         columns.push("zpass-clear");
+        columns.push("compute");
         let table = markdown_table(&rows, &columns);
         doc += &format!("\n## Counter: {}\n\n{}\n", counter.name(), table);
         println!("{table}");

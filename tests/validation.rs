@@ -18,7 +18,7 @@ fn run(mode: &str, method: &str) -> (bool, String) {
 
 #[test]
 fn gpu_assisted_validation_is_clean_for_every_technique() {
-    let methods = ["auto", "zpass", "everitt-kilgard", "edgequad", "planar", "shadowmap"];
+    let methods = ["auto", "zpass", "everitt-kilgard", "compute", "edgequad", "planar", "shadowmap"];
     for m in methods {
         let (ok, err) = run("gpu", m);
         assert!(ok, "{m}: {err}");

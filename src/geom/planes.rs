@@ -150,6 +150,14 @@ impl FacePlanes {
         }
     }
 
+    /// The f32 plane `(nx, ny, nz, d)` of every triangle, in triangle order (zero for the
+    /// triangles always decided exactly; all zero when the mesh is out of the filter's range):
+    /// what the GPU facing pass (`--method compute`) filters with, together with
+    /// [`error_bound`](Self::error_bound).
+    pub fn planes_xyzd(&self) -> Vec<[f32; 4]> {
+        (0..self.len).map(|t| if self.all_exact { [0.0; 4] } else { [self.nx[t], self.ny[t], self.nz[t], self.d[t]] }).collect()
+    }
+
     /// Bytes the facing pass reads per light (the four plane arrays).
     pub fn bytes(&self) -> usize {
         self.nx.len() * 16

@@ -2,6 +2,7 @@
 //! dual-length vertex buffers, uploads recorded into the host's command buffer, and deferred
 //! release once every frame in flight that could use a buffer has retired.
 
+use super::compute::{padded_bytes, ComputeMesh, ComputeStatic};
 use super::device::PassDevice;
 use crate::error::{Error, Result};
 use crate::geom::Mesh;
@@ -46,6 +47,9 @@ pub(crate) struct GpuCaster {
     pub chunks: Vec<Buffer>,
     /// Edge quads, built the first time a frame asks for them (closed opaque casters only).
     pub edge_quads: Option<EdgeQuadGpu>,
+    /// The compute pass's static tables, built the first time a frame asks for them
+    /// (opaque casters with a closed manifold part).
+    pub compute: Option<ComputeStatic>,
 }
 
 /// Buffers waiting for the frames in flight that may use them to retire: bit `s` of `mask`
@@ -129,7 +133,7 @@ impl CasterTable {
         self.slots.push((0, Some(self.live.len())));
         let shells = shell_count(caster.mesh());
         self.cpu.push(caster);
-        self.live.push(GpuCaster { id, transform, shells, chunks, edge_quads: None });
+        self.live.push(GpuCaster { id, transform, shells, chunks, edge_quads: None, compute: None });
         Ok(id)
     }
 
@@ -150,6 +154,9 @@ impl CasterTable {
         if let Some(eq) = c.edge_quads.take() {
             buffers.push(eq.vertices);
             buffers.push(eq.indices);
+        }
+        if let Some(cs) = c.compute.take() {
+            buffers.extend(cs.buffers());
         }
         self.graves.push(Grave { buffers, mask: all_slots });
         Ok(())
@@ -199,6 +206,10 @@ impl CasterTable {
             old.push(eq.vertices);
             old.push(eq.indices);
         }
+        // New positions: new planes and positions for the compute pass (rebuilt on demand).
+        if let Some(cs) = entry.compute.take() {
+            old.extend(cs.buffers());
+        }
         self.cpu[i] = caster;
         self.graves.push(Grave { buffers: old, mask: all_slots });
         Ok(())
@@ -219,6 +230,53 @@ impl CasterTable {
             let indices = self.staged(dev, "edge-quad indices", bytemuck::cast_slice(&idx), vk::BufferUsageFlags::INDEX_BUFFER)?;
             self.live[i].edge_quads =
                 Some(EdgeQuadGpu { vertices, indices, face_indices: m.faces.len() as u32, quad_indices: m.quads.len() as u32 });
+        }
+        Ok(())
+    }
+
+    /// Builds the compute pass's static tables of every opaque caster with a closed manifold
+    /// part that lacks them (staged copies, recorded by the frame's `cmd_upload`).
+    pub fn ensure_compute(&mut self, dev: &PassDevice) -> Result<()> {
+        for i in 0..self.live.len() {
+            let c = &self.cpu[i];
+            if self.live[i].compute.is_some() || c.transmittance.is_some() || !c.parts.iter().any(|p| p.kind == CasterKind::Manifold) {
+                continue;
+            }
+            let m = ComputeMesh::new(c);
+            let chunk_tris = c.chunks.iter().map(|ch| ch.local_tris.len() as u32).collect();
+            let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
+            let mut made: Vec<Buffer> = Vec::new();
+            let parts: [(&str, Vec<u8>); 4] = [
+                ("compute planes", padded_bytes(&m.planes, 16)),
+                ("compute triangles", padded_bytes(&m.tris, 32)),
+                ("compute positions", padded_bytes(&m.positions, 16)),
+                ("compute edges", padded_bytes(&m.edges, 16)),
+            ];
+            for (name, bytes) in parts {
+                match self.staged(dev, name, &bytes, usage) {
+                    Ok(b) => made.push(b),
+                    Err(e) => {
+                        // the staged copies already queued still refer to `made`: leave them
+                        // to the graves of the next frames (freed once no frame can use them)
+                        self.graves.push(Grave { buffers: made, mask: u64::MAX });
+                        return Err(e);
+                    }
+                }
+            }
+            let mut it = made.into_iter();
+            let (Some(planes), Some(tris), Some(positions), Some(edges)) = (it.next(), it.next(), it.next(), it.next()) else {
+                return Err(Error::Other("compute tables".into()));
+            };
+            self.live[i].compute = Some(ComputeStatic {
+                planes,
+                tris,
+                positions,
+                edges,
+                triangles: m.tris.len() as u32,
+                edge_count: m.edges.len() as u32,
+                chunk_edges: m.chunk_edges,
+                chunk_tris,
+            });
         }
         Ok(())
     }
@@ -248,6 +306,11 @@ impl CasterTable {
             if let Some(mut eq) = c.edge_quads.take() {
                 eq.vertices.destroy(dev);
                 eq.indices.destroy(dev);
+            }
+            if let Some(cs) = c.compute.take() {
+                for mut b in cs.buffers() {
+                    b.destroy(dev);
+                }
             }
         }
         self.live.clear();

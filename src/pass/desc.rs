@@ -60,22 +60,30 @@ pub enum Technique {
     /// default y = 0) and drawn with the stencil set to 1 (so no pixel is darkened twice). Exact
     /// on that plane, wrong everywhere else (no shadows on other surfaces).
     Planar,
+    /// GPU possible silhouettes: McGuire's three cases chosen on the CPU from bounds, then per
+    /// caster and light a compute pass finds facing (from static object-space planes, exact as
+    /// the CPU's), silhouette edges (from a static edge table) and writes the sides and caps as
+    /// 16-bit indices, drawn with `vkCmdDrawIndexedIndirect`: no CPU work per triangle and no
+    /// geometry sent per frame. Parts on the multiplicity path (open, non-manifold) and
+    /// transparent casters keep the CPU path.
+    Compute,
 }
 
 impl Technique {
-    /// The name on the command line and in `--stats` (`mcguire`, ..., `edgequad`).
+    /// The name on the command line and in `--stats` (`mcguire`, ..., `edgequad`, `compute`).
     pub fn name(self) -> &'static str {
         match self {
             Technique::Volumes(m) => m.name(),
             Technique::EdgeQuads => "edgequad",
             Technique::Planar => "planar",
+            Technique::Compute => "compute",
         }
     }
     /// The case rule the planner uses (edge quads cull with McGuire's rule).
     pub fn method(self) -> Method {
         match self {
             Technique::Volumes(m) => m,
-            Technique::EdgeQuads => Method::McGuire,
+            Technique::EdgeQuads | Technique::Compute => Method::McGuire,
             // Culling only: the casters' draws are replaced by their flattened triangles.
             Technique::Planar => Method::ZPass,
         }

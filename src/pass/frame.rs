@@ -2,6 +2,7 @@
 //! lists), packed into the ring slot's stream, and the statistics `--stats` reports.
 
 use super::casters::{CasterTable, Upload};
+use super::compute::frame::ComputeFrame;
 use super::desc::{Counter, IndexFormat, PassSettings, Technique};
 use super::stats::{CasterStats, CpuMs, LightStats, PartStats, Totals, Triangles};
 use crate::error::{Error, Result};
@@ -58,6 +59,10 @@ pub(crate) struct Draw {
     pub case: Case,
     /// A light cap (drawn with the depth-NEVER pipeline by the stencil counter).
     pub light_cap: bool,
+    /// GPU silhouettes: `offset` is the byte offset of the draw's
+    /// `VkDrawIndexedIndirectCommand` in the frame's compute records, the indices (u16) are in
+    /// its compute output buffer, and `count` is unknown (0) until read back.
+    pub indirect: bool,
 }
 
 /// Edge-quad geometry of a caster (static buffers).
@@ -132,6 +137,9 @@ pub struct PreparedFrame {
     /// Things the host should tell its user (e.g. a possible 8-bit stencil overflow).
     pub warnings: Vec<String>,
     pub(crate) extent: vk::Extent2D,
+    /// The GPU silhouettes of [`Technique::Compute`] (counts read back by
+    /// [`ShadowPass::read_back_counts`](super::ShadowPass::read_back_counts)).
+    pub(crate) compute: Option<ComputeFrame>,
 }
 
 impl PreparedFrame {
@@ -161,6 +169,8 @@ impl PreparedFrame {
 /// The plans, packed: what `prepare` builds before writing the slot's stream.
 pub(crate) struct Packed {
     pub stream: Vec<u8>,
+    /// The compute pass's layout ([`Technique::Compute`]).
+    pub compute: Option<ComputeFrame>,
     pub lights: Vec<LightFrame>,
     pub totals: Totals,
     pub cpu: CpuMs,
@@ -186,6 +196,8 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
     let vp_rel_d = view.proj.as_dmat4() * view.view.as_dmat4();
     let camera = Camera { eye: view.eye.as_vec3(), ..Camera::default() };
     let edge_quads = input.settings.technique == Technique::EdgeQuads;
+    let gpu_silhouettes = input.settings.technique == Technique::Compute;
+    let mut compute = gpu_silhouettes.then(ComputeFrame::default);
     let method = input.settings.technique.method();
     let mvps: Vec<Mat4> = table.live.iter().map(|g| (vp_rel_d * DMat4::from_translation(-view.eye) * g.transform).as_mat4()).collect();
     let full = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: vk::Extent2D { width: view.width, height: view.height } };
@@ -199,7 +211,7 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
         let plan = shadow::plan_light_with(
             &PlanInput { camera: &camera, width: view.width, height: view.height, view_proj, light, method },
             if input.casters { &table.cpu } else { &[] },
-            &PlanOptions { edge_quads, case_per_part: true },
+            &PlanOptions { edge_quads, case_per_part: true, gpu_silhouettes },
         );
         let mut plan = plan;
         let planar_mvp = (input.settings.technique == Technique::Planar).then(|| flatten(&mut plan, table, light, input.planar_receiver));
@@ -256,7 +268,15 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
                         format: fmt,
                         case: cd.case,
                         light_cap: cap,
+                        indirect: false,
                     });
+                }
+            }
+            if let (Some(cf), Some(st)) = (compute.as_mut(), gpu.compute.as_ref()) {
+                if cp.parts.iter().any(|p| p.path == "compute" && p.case != Case::Culled) {
+                    let buffers: Vec<vk::Buffer> = gpu.chunks.iter().map(|b| b.raw).collect();
+                    cf.add_caster(li, cstats.len(), cp.caster, caster, st, cp, &buffers, &mut draws);
+                    fmt_used = IndexFormat::U16.name();
                 }
             }
             let tris = Triangles { sides: cp.sides as u64, dark_cap: cp.dark_cap as u64, light_cap: cp.light_cap as u64 };
@@ -350,7 +370,7 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
     }
     align(&mut stream, 16);
     totals.bytes_sent = totals.index_bytes + totals.vertex_bytes;
-    Packed { stream, lights, totals, cpu }
+    Packed { stream, lights, totals, cpu, compute }
 }
 
 /// Planar projected shadows: every drawn opaque caster's plan becomes all its triangles (w = 1

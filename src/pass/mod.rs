@@ -20,11 +20,16 @@
 //!    streams written into slot `s`);
 //! 3. the host records its depth pre-pass / G-buffer into its depth-stencil image;
 //! 4. [`ShadowPass::cmd_upload`] (new or deformed casters' vertex copies; also recorded by the
-//!    first `cmd_determine` of the frame when the host did not call it);
+//!    first `cmd_determine` of the frame when the host did not call it), then
+//!    [`ShadowPass::cmd_compute_silhouettes`] ([`Technique::Compute`] only: the GPU possible
+//!    silhouettes of every light, dispatched outside rendering; also recorded by the first
+//!    `cmd_determine` of the frame when the host did not call it);
 //! 5. per light: [`ShadowPass::cmd_determine`] leaves the count in the stencil (cleared inside
 //!    the light's scissor), then the host's lighting pass tests `stencil == 0`
 //!    ([`lit_stencil_state`]), with the light's [`LightFrame::scissor`] and depth bounds;
-//! 6. the host submits; a later `prepare(s, ..)` may only come after that submission retired.
+//! 6. the host submits; a later `prepare(s, ..)` may only come after that submission retired
+//!    (with [`Technique::Compute`], [`ShadowPass::read_back_counts`] after the fence puts the
+//!    GPU's triangle counts into the frame's stats).
 //!
 //! **Frames in flight:** the ring has [`ShadowPassDesc::frames_in_flight`] slots; the host
 //! passes the slot of the frame it records. Removing a caster or changing its positions
@@ -35,8 +40,9 @@
 //! of the host's image between `vkCmdBeginRendering` and `vkCmdEndRendering`. The host makes
 //! its depth writes visible before (a barrier from late fragment tests to early fragment
 //! tests, depth-stencil read), and makes the stencil writes visible to its lighting pass after.
-//! `cmd_upload` records transfer writes followed by a barrier to vertex-attribute and
-//! index reads.
+//! `cmd_upload` records transfer writes followed by a barrier to vertex-attribute, index and
+//! compute reads; `cmd_compute_silhouettes` records compute writes followed by a barrier to
+//! indirect-command and index reads.
 //!
 //! **Drop order:** drop the pass while its device and allocator are alive, after every command
 //! buffer that uses it has completed (it does not wait for the device: the host owns the
@@ -45,6 +51,7 @@
 #![warn(missing_docs)]
 
 mod casters;
+mod compute;
 mod desc;
 mod device;
 mod eye;
@@ -82,6 +89,10 @@ use std::time::Instant;
 struct Slot {
     stream: Option<Buffer>,
     staging: Vec<Buffer>,
+    /// The compute pass's records, output and facing buffers and descriptor sets.
+    compute: compute::SlotCompute,
+    /// Serial of the frame last prepared in this slot.
+    serial: Option<u64>,
 }
 
 /// The shadow determination as an embeddable component (see the [module docs](self) for the
@@ -96,6 +107,7 @@ pub struct ShadowPass {
     slots: Vec<Slot>,
     serial: u64,
     planar_receiver: glam::DVec4,
+    compute_pipes: Option<compute::ComputePipes>,
 }
 
 impl ShadowPass {
@@ -143,8 +155,18 @@ impl ShadowPass {
         }
         desc.settings.check(&caps)?;
         let dev = PassDevice { device: device.clone(), allocator };
-        let pipes = Pipelines::new(&dev, desc, caps.depth_clamp, caps.depth_bounds, caps.r32f_blend)?;
-        let slots = (0..desc.frames_in_flight).map(|_| Slot { stream: None, staging: Vec::new() }).collect();
+        let mut pipes = Pipelines::new(&dev, desc, caps.depth_clamp, caps.depth_bounds, caps.r32f_blend)?;
+        let compute_pipes = match compute::ComputePipes::new(&dev) {
+            Ok(c) => c,
+            Err(e) => {
+                // SAFETY: the pipelines were just created and never used.
+                unsafe { pipes.destroy(&dev.device) };
+                return Err(e);
+            }
+        };
+        let slots = (0..desc.frames_in_flight)
+            .map(|_| Slot { stream: None, staging: Vec::new(), compute: Default::default(), serial: None })
+            .collect();
         Ok(ShadowPass {
             dev,
             caps,
@@ -155,6 +177,7 @@ impl ShadowPass {
             slots,
             serial: 0,
             planar_receiver: glam::DVec4::Y,
+            compute_pipes: Some(compute_pipes),
         })
     }
 
@@ -300,6 +323,9 @@ impl ShadowPass {
         if self.settings.technique == Technique::EdgeQuads {
             self.casters.ensure_edge_quads(&self.dev)?;
         }
+        if self.settings.technique == Technique::Compute {
+            self.casters.ensure_compute(&self.dev)?;
+        }
         let mut uploads = Vec::new();
         let mut upload_bytes = 0;
         for (b, up) in self.casters.pending.drain(..) {
@@ -322,6 +348,11 @@ impl ShadowPass {
         );
         let record_start = Instant::now();
         let stream = self.write_stream(slot, &packed.stream)?;
+        // The compute pass's records and descriptor sets count as recording work too.
+        let compute = match packed.compute {
+            Some(cf) => Some(self.prepare_compute(slot, cf)?),
+            None => None,
+        };
         let mut cpu = packed.cpu;
         cpu.record = record_start.elapsed().as_secs_f64() * 1e3;
         let mut totals = packed.totals;
@@ -329,6 +360,7 @@ impl ShadowPass {
         let warnings = overflow_warnings(&self.casters, &packed.lights, self.settings.counter);
         let serial = self.serial;
         self.serial += 1;
+        self.slots[slot].serial = Some(serial);
         Ok(PreparedFrame {
             slot,
             serial,
@@ -341,6 +373,7 @@ impl ShadowPass {
             settings: self.settings,
             warnings,
             extent: vk::Extent2D { width: view.width, height: view.height },
+            compute,
         })
     }
 
@@ -390,6 +423,10 @@ impl Drop for ShadowPass {
         // SAFETY: the embedding contract (module docs): the host drops the pass only after
         // every command buffer that used it has completed, while the device is alive.
         unsafe { self.pipes.destroy(&self.dev.device) };
+        if let Some(mut c) = self.compute_pipes.take() {
+            // SAFETY: as above.
+            unsafe { c.destroy(&self.dev.device) };
+        }
         self.casters.destroy(&self.dev);
         for s in &mut self.slots {
             if let Some(mut b) = s.stream.take() {
@@ -398,6 +435,7 @@ impl Drop for ShadowPass {
             for mut b in s.staging.drain(..) {
                 b.destroy(&self.dev);
             }
+            s.compute.destroy(&self.dev);
         }
     }
 }

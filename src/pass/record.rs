@@ -76,8 +76,10 @@ impl ShadowPass {
             let b = [vk::MemoryBarrier2::default()
                 .src_stage_mask(vk::PipelineStageFlags2::COPY)
                 .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-                .dst_stage_mask(vk::PipelineStageFlags2::VERTEX_INPUT)
-                .dst_access_mask(vk::AccessFlags2::VERTEX_ATTRIBUTE_READ | vk::AccessFlags2::INDEX_READ)];
+                .dst_stage_mask(vk::PipelineStageFlags2::VERTEX_INPUT | vk::PipelineStageFlags2::COMPUTE_SHADER)
+                .dst_access_mask(
+                    vk::AccessFlags2::VERTEX_ATTRIBUTE_READ | vk::AccessFlags2::INDEX_READ | vk::AccessFlags2::SHADER_STORAGE_READ,
+                )];
             d.cmd_pipeline_barrier2(cb, &vk::DependencyInfo::default().memory_barriers(&b));
         }
     }
@@ -101,7 +103,10 @@ impl ShadowPass {
     pub unsafe fn cmd_determine(&self, cb: vk::CommandBuffer, frame: &PreparedFrame, light: usize, target: &DepthStencilTarget) {
         let Some(lf) = frame.lights.get(light) else { return };
         // SAFETY: the caller's contract (outside a rendering instance).
-        unsafe { self.cmd_upload(cb, frame) };
+        unsafe {
+            self.cmd_upload(cb, frame);
+            self.cmd_compute_silhouettes(cb, frame);
+        }
         let depth = depth_attachment(target, vk::AttachmentLoadOp::LOAD, 0);
         // Cleared to 0, or to the number of volumes containing the eye (zpass-clear).
         let stencil = depth_attachment(target, vk::AttachmentLoadOp::CLEAR, lf.counter_clear);
@@ -176,7 +181,10 @@ impl ShadowPass {
     ) {
         let Some(lf) = frame.lights.get(light) else { return };
         // SAFETY: the caller's contract (outside a rendering instance).
-        unsafe { self.cmd_upload(cb, frame) };
+        unsafe {
+            self.cmd_upload(cb, frame);
+            self.cmd_compute_silhouettes(cb, frame);
+        }
         let ds = depth_attachment(target, vk::AttachmentLoadOp::LOAD, 0);
         let att = [vk::RenderingAttachmentInfo::default()
             .image_view(color)
@@ -229,7 +237,7 @@ impl ShadowPass {
     /// scissor set (e.g. by [`cmd_light_state`](Self::cmd_light_state)).
     ///
     /// # Safety
-    /// `cb` is recording inside such a rendering instance; the frame's uploads were recorded
+    /// `cb` is recording inside such a rendering instance; the frame's uploads and GPU silhouettes were recorded
     /// earlier ([`cmd_upload`](Self::cmd_upload)); `frame` is live as for `cmd_determine`;
     /// for the float kinds the device blends R32F, for `Transmit` the pass has a transmit format.
     pub unsafe fn cmd_draw_volumes(&self, cb: vk::CommandBuffer, frame: &PreparedFrame, light: usize, kind: VolumeKind) {
@@ -292,7 +300,7 @@ impl ShadowPass {
                     bound = pipe;
                 }
                 // SAFETY: as above.
-                unsafe { self.record_draw(cb, frame.stream, dr) };
+                unsafe { self.record_draw(cb, frame, dr) };
             }
         }
     }
@@ -350,7 +358,7 @@ impl ShadowPass {
     /// `cb` is recording inside a rendering instance with one colour attachment of
     /// [`ShadowPassDesc::debug_color_format`](super::ShadowPassDesc) (the pass must have been
     /// created with it) and the depth-stencil image loaded, viewport and scissor set; the
-    /// frame's uploads were recorded; `frame` is live.
+    /// frame's uploads and GPU silhouettes were recorded; `frame` is live.
     pub unsafe fn cmd_draw_volume_overlay(&self, cb: vk::CommandBuffer, frame: &PreparedFrame) {
         let Some(pipe) = self.pipes.overlay else { return };
         // SAFETY: the caller's contract.
@@ -367,7 +375,7 @@ impl ShadowPass {
                     // SAFETY: as above.
                     unsafe {
                         self.push(cb, c, color);
-                        self.record_draw(cb, frame.stream, dr);
+                        self.record_draw(cb, frame, dr);
                     }
                 }
             }
@@ -393,12 +401,21 @@ impl ShadowPass {
     /// Binds the chunk's vertices (or the streamed naive vertices) and draws.
     ///
     /// # Safety
-    /// `cb` is recording inside a rendering instance with a volume pipeline bound; `stream`
-    /// is the frame's stream.
-    unsafe fn record_draw(&self, cb: vk::CommandBuffer, stream: vk::Buffer, dr: &Draw) {
+    /// `cb` is recording inside a rendering instance with a volume pipeline bound; `frame` is
+    /// the frame the draw belongs to (its stream, or its compute records and indices, whose
+    /// writes [`cmd_compute_silhouettes`](Self::cmd_compute_silhouettes) made visible).
+    unsafe fn record_draw(&self, cb: vk::CommandBuffer, frame: &PreparedFrame, dr: &Draw) {
         let d = &self.dev.device;
+        let stream = frame.stream;
         // SAFETY: the caller's contract; offsets were computed from the stream just written.
         unsafe {
+            if dr.indirect {
+                let Some(cf) = frame.compute.as_ref() else { return };
+                d.cmd_bind_vertex_buffers(cb, 0, &[dr.vertices], &[0]);
+                d.cmd_bind_index_buffer(cb, cf.out_buffer, 0, vk::IndexType::UINT16);
+                d.cmd_draw_indexed_indirect(cb, cf.records_buffer, dr.offset, 1, 20);
+                return;
+            }
             match dr.format {
                 IndexFormat::Naive => {
                     d.cmd_bind_vertex_buffers(cb, 0, &[stream], &[dr.offset]);

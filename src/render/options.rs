@@ -79,6 +79,9 @@ pub enum Technique {
     /// Flat projected shadows onto the plane y = 0 (the Cg article's first section): exact on
     /// that plane, wrong everywhere else.
     Planar,
+    /// Stencil shadow volumes from GPU possible silhouettes (compute pass, indirect draws):
+    /// McGuire's cases from CPU bounds, no CPU work per triangle.
+    Compute,
     /// The shadow-map baseline (PCF 3x3) with maps of `size` texels a side.
     ShadowMap {
         /// Texels per side of one map (16..=8192).
@@ -104,6 +107,7 @@ impl Technique {
             Technique::Volumes(m) => Some(crate::pass::Technique::Volumes(m)),
             Technique::EdgeQuads => Some(crate::pass::Technique::EdgeQuads),
             Technique::Planar => Some(crate::pass::Technique::Planar),
+            Technique::Compute => Some(crate::pass::Technique::Compute),
             Technique::ShadowMap { .. } => None,
         }
     }
@@ -113,11 +117,12 @@ impl Technique {
         match s {
             "edgequad" => Ok(Technique::EdgeQuads),
             "planar" => Ok(Technique::Planar),
+            "compute" => Ok(Technique::Compute),
             "shadowmap" => Ok(Technique::ShadowMap { size: shadow_map_size }),
             _ => s.parse::<Method>().map(Technique::Volumes).map_err(|_| Error::UnknownName {
                 what: "method",
                 name: s.into(),
-                expected: format!("auto, {}, edgequad, shadowmap", Method::ALL.map(|m| m.name()).join(", ")),
+                expected: format!("auto, {}, edgequad, planar, compute, shadowmap", Method::ALL.map(|m| m.name()).join(", ")),
             }),
         }
     }

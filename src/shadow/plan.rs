@@ -290,6 +290,27 @@ fn case_rank(c: Case) -> u8 {
     }
 }
 
+/// What a closed manifold part not culled emits for the object-space light `l_obj` in `case`:
+/// the back formulation (and the dark cap of its back faces) when a point light is inside the
+/// part's bounds, else the front one with McGuire's fan dark cap (`Method::McGuire`) or the
+/// front faces' w=0 copies; no dark cap for z-pass or a directional light; the light cap in
+/// case 3. The CPU path and the GPU silhouettes (`--method compute`) both follow it.
+pub fn manifold_emit(method: Method, part: &super::caster::Part, case: Case, l_obj: Vec4) -> Emit {
+    let directional = l_obj.w == 0.0;
+    let inside = !directional && part.object_bounds.contains(l_obj.truncate());
+    let formulation = if inside { Formulation::Back } else { Formulation::Front };
+    let dark_cap = if case == Case::ZPass || directional {
+        DarkCap::None
+    } else if formulation == Formulation::Back {
+        DarkCap::BackFaces
+    } else if method == Method::McGuire {
+        DarkCap::Fan
+    } else {
+        DarkCap::FrontFaces
+    };
+    Emit { formulation, directional, dark_cap, light_cap: case == Case::ZFailLightCap }
+}
+
 /// Plans one part of a caster for which the facing `bits` are decided; returns the part plan
 /// and its draws.
 #[allow(clippy::too_many_arguments)]
@@ -340,17 +361,8 @@ fn plan_part(
     }
     sil.clear();
     part.scan.scan_into(bits, sil);
-    let formulation = if inside { Formulation::Back } else { Formulation::Front };
-    let dark_cap_kind = if case == Case::ZPass || directional {
-        DarkCap::None
-    } else if formulation == Formulation::Back {
-        DarkCap::BackFaces
-    } else if input.method == Method::McGuire {
-        DarkCap::Fan
-    } else {
-        DarkCap::FrontFaces
-    };
-    let e = Emit { formulation, directional, dark_cap: dark_cap_kind, light_cap: case == Case::ZFailLightCap };
+    let e = manifold_emit(input.method, part, case, l_obj);
+    let (formulation, dark_cap_kind) = (e.formulation, e.dark_cap);
     let (draws, sides, dark_cap, light_cap) = emit_with(caster, part.chunks.clone(), &facing, sil, e, case);
     let pp = PartPlan {
         part: pi,
@@ -377,7 +389,7 @@ pub fn plan_light(input: &PlanInput, casters: &[Caster]) -> LightPlan {
 /// z-fail with caps, no index lists, and the static counts the GPU draws (two triangles per
 /// edge as sides; every face as a cap, light or dark as the GPU decides).
 pub fn plan_light_opts(input: &PlanInput, casters: &[Caster], edge_quads: bool) -> LightPlan {
-    plan_light_with(input, casters, &PlanOptions { edge_quads, case_per_part: false })
+    plan_light_with(input, casters, &PlanOptions { edge_quads, ..PlanOptions::default() })
 }
 
 /// [`plan_light`] with [`PlanOptions`]. Every part of a caster ([`Caster::parts`]) is culled
@@ -459,13 +471,44 @@ pub fn plan_light_with(input: &PlanInput, casters: &[Caster], opts: &PlanOptions
             plans.push(cp);
             continue;
         }
-        let ts = Instant::now();
-        caster.planes.facing_packed_auto(caster.mesh(), l_obj, caster.mirrored, &mut bits);
-        sil_time += ts.elapsed().as_secs_f64() * 1e3;
+        // GPU silhouettes: closed manifold parts of opaque casters are left to the compute
+        // pass; the CPU computes facing bits only when a part on the multiplicity path is drawn.
+        let gpu = opts.gpu_silhouettes && caster.transmittance.is_none() && !whole_multiplicity;
+        let on_gpu = |pi: usize| gpu && caster.parts[pi].kind == CasterKind::Manifold;
+        if !cases.iter().enumerate().all(|(pi, &c)| c == Case::Culled || on_gpu(pi)) {
+            let ts = Instant::now();
+            caster.planes.facing_packed_auto(caster.mesh(), l_obj, caster.mirrored, &mut bits);
+            sil_time += ts.elapsed().as_secs_f64() * 1e3;
+        }
+        if gpu && caster.kind == CasterKind::Manifold {
+            cp.path = "compute";
+        }
         let mut best = 0u8;
         for (pi, &case) in cases.iter().enumerate() {
             let part = &caster.parts[pi];
             let multiplicity = whole_multiplicity || part.kind != CasterKind::Manifold;
+            if case != Case::Culled && on_gpu(pi) {
+                let e = manifold_emit(input.method, part, case, l_obj);
+                cp.parts.push(PartPlan {
+                    part: pi,
+                    case,
+                    path: "compute",
+                    silhouette_edges: 0,
+                    multiplicity_max: 0,
+                    sides: 0,
+                    dark_cap: 0,
+                    light_cap: 0,
+                    dark_cap_kind: e.dark_cap,
+                    formulation: e.formulation,
+                });
+                if case_rank(case) > best {
+                    best = case_rank(case);
+                    cp.case = case;
+                    cp.dark_cap_kind = e.dark_cap;
+                    cp.formulation = e.formulation;
+                }
+                continue;
+            }
             if case == Case::Culled {
                 cp.parts.push(PartPlan {
                     part: pi,

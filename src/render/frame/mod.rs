@@ -460,7 +460,9 @@ impl Renderer {
 
     /// Waits for a submitted frame and reads it back.
     pub fn finish(&mut self, ticket: FrameTicket) -> Result<FrameOutput> {
-        let f = self.wait(&ticket)?;
+        let mut f = self.wait(&ticket)?;
+        // GPU silhouettes: the triangle counts are in the indirect arguments.
+        self.pass.read_back_counts(&mut f.frame)?;
         let s = &self.slots[ticket.slot];
         let transmit = self.has_transparent.then_some(TransmitMode { fp32: self.config.transmit_fp32, log: f.settings.transmit_log });
         let c = parse(&s.readback, &f.layout, f.float_counts, transmit, f.eye)?;

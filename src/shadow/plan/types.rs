@@ -166,7 +166,7 @@ pub struct CasterPlan {
     pub caster: usize,
     /// How the volume is drawn (culled, z-pass, z-fail with or without light cap).
     pub case: Case,
-    /// `"manifold"` or `"multiplicity"` ([`CasterKind::path`](crate::shadow::CasterKind::path)).
+    /// `"manifold"` or `"multiplicity"` ([`CasterKind::path`](crate::shadow::CasterKind::path)), `"edgequad"`, `"planar"` or `"compute"`.
     pub path: &'static str,
     /// Silhouette edges (manifold) / edges of non-zero multiplicity.
     pub silhouette_edges: usize,
@@ -202,7 +202,7 @@ pub struct PartPlan {
     pub part: usize,
     /// The part's own case (McGuire's rule on the part's bounds).
     pub case: Case,
-    /// `"manifold"` or `"multiplicity"`.
+    /// `"manifold"`, `"multiplicity"` or `"compute"` (left to the GPU silhouettes).
     pub path: &'static str,
     /// Possible silhouette edges of the part.
     pub silhouette_edges: usize,
@@ -231,6 +231,11 @@ pub struct PlanOptions {
     /// agree, else z-fail with light cap, always valid), so that `CasterPlan::case` holds for
     /// every draw of the caster.
     pub case_per_part: bool,
+    /// Closed manifold parts of opaque casters that are not culled get their case,
+    /// formulation and dark-cap kind ([`manifold_emit`](super::manifold_emit)) but no facing
+    /// bits, silhouette or index lists: path `"compute"`, zero counts (the GPU's compute pass
+    /// finds them, `--method compute`). Other parts are planned as usual.
+    pub gpu_silhouettes: bool,
 }
 
 impl CasterPlan {

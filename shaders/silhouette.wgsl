@@ -1,0 +1,448 @@
+// GPU possible silhouettes (`--method compute`): per caster and light, two passes.
+//
+// `facing` (one invocation a triangle), then `exact` (the few triangles `facing` could not
+// decide): the facing bit from the caster's static object-space
+// plane, exactly as the CPU's `FacePlanes::facing_packed` decides it: the f32 plane value is
+// trusted only beyond the CPU's proven error bound (`bound`, computed on the CPU per caster
+// and light), and every other triangle, degenerate ones included (their planes are zero), is
+// decided by the EXACT sign of orient3d of its f32 vertices, evaluated here as a sum of
+// 48 (point light) or 24 (directional) products of three f32 values in a fixed-point
+// accumulator of 12-bit limbs (no rounding at all). The bits are therefore the CPU's, bit for
+// bit, and every edge is derived from one bit per triangle: the volume is closed by
+// construction. (The exact test is its own entry point: in the filter's entry its code made
+// lavapipe ten times slower on every triangle.)
+//
+// `edges` (one invocation a triangle and a manifold edge): the triangle's face caps (dark cap
+// of front or back faces, light cap) for the chunks whose case needs them, and an edge whose two triangles' bits differ is a
+// possible silhouette edge; its side quad (and, for McGuire's fan dark cap, one fan triangle)
+// go to the chunk of the light-facing triangle (front formulation) or of the other one (back
+// formulation, the light inside the part's bounds), with the same winding as the CPU's
+// `shadow::plan::emit`.
+//
+// Output: 16-bit indices into the chunk's dual-length vertex buffer (index i < n: (p, 1),
+// i + n: (p, 0)), packed two to a u32 word. A chunk's region is allocated with an atomic add
+// on its VkDrawIndexedIndirectCommand::indexCount; a word shared by two allocations is written
+// with atomicAnd/atomicOr on disjoint halves (order independent), a word owned whole with
+// atomicStore. Regions are sized on the CPU for the worst case of the chunk's case; a write
+// past the region is not made and flags the record's overflow word instead (never silent).
+
+struct Push {
+    // The light in the caster's object space (w = 1 point, w = 0 directional), f32 as the
+    // CPU planner has it.
+    light: vec4<f32>,
+    // The plane filter's light (negated for mirroring transforms), and its error bound
+    // (+inf: every triangle exact).
+    filt: vec4<f32>,
+    bound: f32,
+    // 1: mirroring transform (triangle corners 1 and 2 swapped for the exact test).
+    flip: u32,
+    tris: u32,
+    edges: u32,
+    // Word offset of this caster's chunk records for this light.
+    rec_base: u32,
+    // Offset of this caster and light's facing words (2 per triangle: the bits, then the list
+    // of triangles the filter left to the exact test).
+    fac_base: u32,
+    // Word offset of this caster and light's job header in the records (word 0: the length
+    // of the exact list).
+    job_base: u32,
+    // 1: some chunk of this job has face caps (dark cap of front or back faces, light cap).
+    caps: u32,
+}
+
+struct Tri {
+    // welded vertex ids (positions)
+    g: vec4<u32>,
+    // chunk-local corner indices, chunk in w
+    l: vec4<u32>,
+}
+
+@group(0) @binding(0) var<storage, read> planes: array<vec4<f32>>;
+@group(0) @binding(1) var<storage, read> tris: array<Tri>;
+@group(0) @binding(2) var<storage, read> positions: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read> edge_table: array<vec4<u32>>;
+@group(0) @binding(4) var<storage, read_write> facing_bits: array<u32>;
+@group(0) @binding(5) var<storage, read_write> records: array<atomic<u32>>;
+@group(0) @binding(6) var<storage, read_write> out_words: array<atomic<u32>>;
+
+var<immediate> pc: Push;
+
+// Chunk record layout (u32 words, RECORD_WORDS a chunk): the volume's indirect command
+// (0..5), the light cap's (5..10), then counters and parameters.
+const RECORD_WORDS: u32 = 20u;
+const R_VOL_COUNT: u32 = 0u;
+const R_VOL_FIRST: u32 = 2u;
+const R_CAP_COUNT: u32 = 5u;
+const R_CAP_FIRST: u32 = 7u;
+const R_SIDES: u32 = 10u;
+const R_DARK: u32 = 11u;
+const R_EDGES: u32 = 12u;
+const R_FLAGS: u32 = 13u;
+const R_N: u32 = 14u;
+const R_VOL_CAP: u32 = 15u;
+const R_CAP_CAP: u32 = 16u;
+const R_OVERFLOW: u32 = 17u;
+
+const F_ENABLED: u32 = 1u;
+const F_BACK: u32 = 2u;
+const F_DIRECTIONAL: u32 = 4u;
+const F_LIGHT_CAP: u32 = 32u;
+// dark cap in bits 3..5: 0 none, 1 fan, 2 front faces, 3 back faces
+const DC_FAN: u32 = 1u;
+const DC_FRONT: u32 = 2u;
+const DC_BACK: u32 = 3u;
+
+// ---- exact orient3d: fixed-point sum of products of three f32 values ----
+
+const LIMBS: u32 = 72u;
+// 3 x (smallest f32 exponent, -149) = -447: bit 0 of the accumulator is 2^-447.
+const BIAS: i32 = 447;
+var<private> acc: array<i32, 72>;
+
+fn acc_clear() {
+    for (var i = 0u; i < LIMBS; i = i + 1u) {
+        acc[i] = 0;
+    }
+}
+
+// Adds s * x * y * z exactly (s = +1 or -1).
+fn add3(x: f32, y: f32, z: f32, s: i32) {
+    let bx = bitcast<u32>(x);
+    let by = bitcast<u32>(y);
+    let bz = bitcast<u32>(z);
+    if ((bx & 0x7fffffffu) == 0u || (by & 0x7fffffffu) == 0u || (bz & 0x7fffffffu) == 0u) {
+        return;
+    }
+    var sign = s;
+    if (((bx ^ by ^ bz) >> 31u) != 0u) {
+        sign = -s;
+    }
+    var e = 0i;
+    var m = array<u32, 3>(0u, 0u, 0u);
+    let bs = array<u32, 3>(bx, by, bz);
+    for (var k = 0u; k < 3u; k = k + 1u) {
+        let b = bs[k];
+        let ef = (b >> 23u) & 0xffu;
+        let f = b & 0x7fffffu;
+        if (ef == 0u) {
+            m[k] = f;
+            e = e - 149;
+        } else {
+            m[k] = f | 0x800000u;
+            e = e + i32(ef) - 150;
+        }
+    }
+    // m0 * m1 in 12-bit limbs
+    let a0 = m[0] & 0xfffu;
+    let a1 = m[0] >> 12u;
+    let b0 = m[1] & 0xfffu;
+    let b1 = m[1] >> 12u;
+    var r = array<u32, 4>(a0 * b0, a0 * b1 + a1 * b0, a1 * b1, 0u);
+    for (var i = 0u; i < 3u; i = i + 1u) {
+        r[i + 1u] = r[i + 1u] + (r[i] >> 12u);
+        r[i] = r[i] & 0xfffu;
+    }
+    // times m2
+    let c0 = m[2] & 0xfffu;
+    let c1 = m[2] >> 12u;
+    var t = array<u32, 6>(r[0] * c0, r[0] * c1 + r[1] * c0, r[1] * c1 + r[2] * c0, r[2] * c1 + r[3] * c0, r[3] * c1, 0u);
+    for (var i = 0u; i < 5u; i = i + 1u) {
+        t[i + 1u] = t[i + 1u] + (t[i] >> 12u);
+        t[i] = t[i] & 0xfffu;
+    }
+    let p = u32(e + BIAS);
+    let q = p / 12u;
+    let sh = p % 12u;
+    for (var i = 0u; i < 6u; i = i + 1u) {
+        let v = t[i] << sh;
+        acc[q + i] = acc[q + i] + sign * i32(v & 0xfffu);
+        acc[q + i + 1u] = acc[q + i + 1u] + sign * i32(v >> 12u);
+    }
+}
+
+// Sign of the accumulated sum: -1, 0 or 1.
+fn acc_sign() -> i32 {
+    var carry = 0i;
+    var nonzero = false;
+    for (var i = 0u; i < LIMBS; i = i + 1u) {
+        let v = acc[i] + carry;
+        carry = v >> 12u;
+        let limb = v - carry * 4096;
+        if (limb != 0) {
+            nonzero = true;
+        }
+    }
+    if (carry < 0) {
+        return -1;
+    }
+    if (carry > 0 || nonzero) {
+        return 1;
+    }
+    return 0;
+}
+
+// Adds s * (x0 - x1) * (y0 - y1) * (z0 - z1) (each factor a difference of two f32 values,
+// expanded: no rounding).
+fn add_diff3(x0: f32, x1: f32, y0: f32, y1: f32, z0: f32, z1: f32, s: i32) {
+    add3(x0, y0, z0, s);
+    add3(x0, y0, z1, -s);
+    add3(x0, y1, z0, -s);
+    add3(x0, y1, z1, s);
+    add3(x1, y0, z0, -s);
+    add3(x1, y0, z1, s);
+    add3(x1, y1, z0, s);
+    add3(x1, y1, z1, -s);
+}
+
+// Exact facing: point light: det[p0 - L, p1 - L, p2 - L] < 0; directional:
+// det[p1 - p0, p2 - p0, d] > 0 (`geom::predicates::facing_exact`).
+fn facing_exact(t: u32) -> bool {
+    let tri = tris[t];
+    var i1 = tri.g.y;
+    var i2 = tri.g.z;
+    if (pc.flip != 0u) {
+        i1 = tri.g.z;
+        i2 = tri.g.y;
+    }
+    let p0 = positions[tri.g.x].xyz;
+    let p1 = positions[i1].xyz;
+    let p2 = positions[i2].xyz;
+    let l = pc.light.xyz;
+    acc_clear();
+    if (pc.light.w != 0.0) {
+        // rows a = p0 - L, b = p1 - L, c = p2 - L; det = sum over permutations
+        add_diff3(p0.x, l.x, p1.y, l.y, p2.z, l.z, 1);
+        add_diff3(p0.x, l.x, p1.z, l.z, p2.y, l.y, -1);
+        add_diff3(p0.y, l.y, p1.z, l.z, p2.x, l.x, 1);
+        add_diff3(p0.y, l.y, p1.x, l.x, p2.z, l.z, -1);
+        add_diff3(p0.z, l.z, p1.x, l.x, p2.y, l.y, 1);
+        add_diff3(p0.z, l.z, p1.y, l.y, p2.x, l.x, -1);
+        return acc_sign() < 0;
+    }
+    // rows u = p1 - p0, v = p2 - p0, d: det = sum over permutations u_i v_j d_k
+    let d = l;
+    let perms = array<vec4<i32>, 6>(
+        vec4<i32>(0, 1, 2, 1), vec4<i32>(0, 2, 1, -1), vec4<i32>(1, 2, 0, 1),
+        vec4<i32>(1, 0, 2, -1), vec4<i32>(2, 0, 1, 1), vec4<i32>(2, 1, 0, -1));
+    for (var k = 0u; k < 6u; k = k + 1u) {
+        let pm = perms[k];
+        let ui = p1[pm.x];
+        let uo = p0[pm.x];
+        let vi = p2[pm.y];
+        let vo = p0[pm.y];
+        let dk = d[pm.z];
+        add3(ui, vi, dk, pm.w);
+        add3(ui, vo, dk, -pm.w);
+        add3(uo, vi, dk, -pm.w);
+        add3(uo, vo, dk, pm.w);
+    }
+    return acc_sign() > 0;
+}
+
+// The filter's verdict: 1 light-facing, 0 not, 2 undecided (the exact test decides).
+fn filtered(t: u32) -> u32 {
+    let pl = planes[t];
+    let f = pc.filt;
+    // the CPU's order: ((nx lx + ny ly) + nz lz) + d lw
+    let v = ((pl.x * f.x + pl.y * f.y) + pl.z * f.z) + pl.w * f.w;
+    if (abs(v) > pc.bound) {
+        return select(0u, 1u, v > pc.bound);
+    }
+    return 2u;
+}
+
+// ---- output ----
+
+fn put_half(pos: u32, value: u32) {
+    let w = pos >> 1u;
+    if ((pos & 1u) == 0u) {
+        atomicAnd(&out_words[w], 0xffff0000u);
+        atomicOr(&out_words[w], value);
+    } else {
+        atomicAnd(&out_words[w], 0x0000ffffu);
+        atomicOr(&out_words[w], value << 16u);
+    }
+}
+
+// Writes `count` (3, 6 or 9) indices at index position `pos`.
+fn put(pos: u32, idx: array<u32, 9>, count: u32) {
+    var i = 0u;
+    if ((pos & 1u) == 1u) {
+        put_half(pos, idx[0]);
+        i = 1u;
+    }
+    loop {
+        if (i + 1u >= count) {
+            break;
+        }
+        atomicStore(&out_words[(pos + i) >> 1u], idx[i] | (idx[i + 1u] << 16u));
+        i = i + 2u;
+    }
+    if (i < count) {
+        put_half(pos + i, idx[i]);
+    }
+}
+
+// Allocates `count` indices in the volume (cap = false) or light-cap region of record `r`.
+fn emit(r: u32, cap: bool, idx: array<u32, 9>, count: u32) {
+    var c = R_VOL_COUNT;
+    var first = R_VOL_FIRST;
+    var capacity = R_VOL_CAP;
+    if (cap) {
+        c = R_CAP_COUNT;
+        first = R_CAP_FIRST;
+        capacity = R_CAP_CAP;
+    }
+    let at = atomicAdd(&records[r + c], count);
+    if (at + count > atomicLoad(&records[r + capacity])) {
+        atomicStore(&records[r + R_OVERFLOW], 1u);
+        return;
+    }
+    put(atomicLoad(&records[r + first]) + at, idx, count);
+}
+
+fn total_threads(nwg: vec3<u32>) -> u32 {
+    return nwg.x * 64u;
+}
+
+// Pass 1: the filter. Undecided triangles are listed for pass 2 (rare: grazing light,
+// degenerate triangles; all of them for meshes beyond the filter's range).
+@compute @workgroup_size(64)
+fn facing(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let stride = total_threads(nwg);
+    for (var t = gid.x; t < pc.tris; t = t + stride) {
+        let v = filtered(t);
+        facing_bits[pc.fac_base + t] = v & 1u;
+        if (v == 2u) {
+            let k = atomicAdd(&records[pc.job_base], 1u);
+            facing_bits[pc.fac_base + pc.tris + k] = t;
+        }
+    }
+}
+
+// Pass 2: the exact test for the listed triangles (a few workgroups striding over the list,
+// so that the common case, an empty list, costs nothing).
+@compute @workgroup_size(64)
+fn exact(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let stride = total_threads(nwg);
+    let count = atomicLoad(&records[pc.job_base]);
+    for (var k = gid.x; k < count; k = k + stride) {
+        let t = facing_bits[pc.fac_base + pc.tris + k];
+        facing_bits[pc.fac_base + t] = select(0u, 1u, facing_exact(t));
+    }
+}
+
+fn face_caps(t: u32) {
+    let f = facing_bits[pc.fac_base + t] != 0u;
+    let tri = tris[t];
+    let r = pc.rec_base + tri.l.w * RECORD_WORDS;
+    let flags = atomicLoad(&records[r + R_FLAGS]);
+    if ((flags & F_ENABLED) == 0u) {
+        return;
+    }
+    let n = atomicLoad(&records[r + R_N]);
+    let dc = (flags >> 3u) & 3u;
+    if ((dc == DC_FRONT && f) || (dc == DC_BACK && !f)) {
+        var idx = array<u32, 9>(tri.l.x + n, tri.l.y + n, tri.l.z + n, 0u, 0u, 0u, 0u, 0u, 0u);
+        if (dc == DC_FRONT) {
+            idx[1] = tri.l.z + n;
+            idx[2] = tri.l.y + n;
+        }
+        emit(r, false, idx, 3u);
+        atomicAdd(&records[r + R_DARK], 1u);
+    }
+    if ((flags & F_LIGHT_CAP) != 0u) {
+        let want = (flags & F_BACK) == 0u;
+        if (f == want) {
+            var idx = array<u32, 9>(tri.l.x, tri.l.y, tri.l.z, 0u, 0u, 0u, 0u, 0u, 0u);
+            if (!want) {
+                idx[1] = tri.l.z;
+                idx[2] = tri.l.y;
+            }
+            emit(r, true, idx, 3u);
+        }
+    }
+}
+
+fn corner(l: vec4<u32>, k: u32) -> u32 {
+    if (k == 0u) {
+        return l.x;
+    }
+    if (k == 1u) {
+        return l.y;
+    }
+    return l.z;
+}
+
+// Pass 3: triangle i's face caps (when its chunk's case needs them) and edge i's side.
+@compute @workgroup_size(64)
+fn edges(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let stride = total_threads(nwg);
+    var n = pc.edges;
+    if (pc.caps != 0u) {
+        n = max(pc.tris, pc.edges);
+    }
+    for (var i = gid.x; i < n; i = i + stride) {
+        if (pc.caps != 0u && i < pc.tris) {
+            face_caps(i);
+        }
+        if (i >= pc.edges) {
+            continue;
+        }
+        let e = edge_table[i];
+        let f0 = facing_bits[pc.fac_base + e.x];
+        let f1 = facing_bits[pc.fac_base + e.y];
+        if (f0 == f1) {
+            continue;
+        }
+        // lit: the light-facing triangle and the corner where a -> b starts in it
+        var lit = e.x;
+        var lit_c = e.z & 0xffu;
+        var unlit = e.y;
+        var unlit_c = (e.z >> 8u) & 0xffu;
+        if (f0 == 0u) {
+            lit = e.y;
+            lit_c = (e.z >> 8u) & 0xffu;
+            unlit = e.x;
+            unlit_c = e.z & 0xffu;
+        }
+        // which chunk's record decides: the lit triangle's (front) or the unlit one's (back)
+        let lit_tri = tris[lit];
+        let r_lit = pc.rec_base + lit_tri.l.w * RECORD_WORDS;
+        let back = (atomicLoad(&records[r_lit + R_FLAGS]) & F_BACK) != 0u;
+        var tri = lit_tri;
+        var k = lit_c;
+        if (back) {
+            tri = tris[unlit];
+            k = unlit_c;
+        }
+        let r = pc.rec_base + tri.l.w * RECORD_WORDS;
+        let flags = atomicLoad(&records[r + R_FLAGS]);
+        if ((flags & F_ENABLED) == 0u) {
+            continue;
+        }
+        let n = atomicLoad(&records[r + R_N]);
+        var a = corner(tri.l, k);
+        var b = corner(tri.l, (k + 1u) % 3u);
+        if (back) {
+            let s = a;
+            a = b;
+            b = s;
+        }
+        atomicAdd(&records[r + R_EDGES], 1u);
+        if ((flags & F_DIRECTIONAL) != 0u) {
+            emit(r, false, array<u32, 9>(b, a, a + n, 0u, 0u, 0u, 0u, 0u, 0u), 3u);
+            atomicAdd(&records[r + R_SIDES], 1u);
+            continue;
+        }
+        let dc = (flags >> 3u) & 3u;
+        if (dc == DC_FAN) {
+            let apex = n - 1u;
+            emit(r, false, array<u32, 9>(b, a, a + n, b, a + n, b + n, apex + n, b + n, a + n), 9u);
+            atomicAdd(&records[r + R_DARK], 1u);
+        } else {
+            emit(r, false, array<u32, 9>(b, a, a + n, b, a + n, b + n, 0u, 0u, 0u), 6u);
+        }
+        atomicAdd(&records[r + R_SIDES], 2u);
+    }
+}

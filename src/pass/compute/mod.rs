@@ -1,0 +1,360 @@
+//! GPU possible silhouettes ([`Technique::Compute`](super::Technique::Compute)): the static
+//! per-caster tables the compute pass reads, its pipelines, and the per-slot buffers it writes.
+//!
+//! Per caster, uploaded once (and again only when a deforming caster moves its vertices):
+//! * the object-space f32 plane of every triangle ([`FacePlanes::planes_xyzd`]), the filter of
+//!   the CPU's facing test;
+//! * per triangle its three welded vertex ids, chunk-local corners and chunk, and the welded
+//!   positions: the exact fallback of the facing test and the indices the caps are made of;
+//! * the edge table: every edge of the closed manifold parts, `(t0, t1, c0 | c1 << 8)`.
+//!
+//! Per frame and light the CPU writes only one small record per chunk (`RECORD_WORDS` words:
+//! the chunk's two `VkDrawIndexedIndirectCommand`s, with zero counts and the first index of the
+//! chunk's region, its case parameters and its capacities); the shader
+//! (`shaders/silhouette.wgsl`) does the rest. See [`frame`] for the layout and [`record`] for
+//! the commands and barriers.
+//!
+//! Facing is bit for bit the CPU's ([`FacePlanes::facing_packed`]): the same f32 plane filter
+//! with the CPU's error bound (Vulkan's f32 add and multiply are correctly rounded, and the
+//! bound covers flushed denormals), and where it cannot decide, the exact sign of orient3d of
+//! the f32 vertices, summed without rounding in a fixed-point accumulator. So the GPU's
+//! triangle counts equal the CPU planner's for the same light and caster.
+
+pub(crate) mod frame;
+mod prepare;
+pub(crate) mod record;
+
+use super::device::PassDevice;
+use crate::error::{Error, Result};
+use crate::gpu::descriptors::pipeline_layout;
+use crate::gpu::{pipeline, shaders, Buffer, GpuDevice};
+use crate::shadow::{Caster, CasterKind};
+use ash::vk;
+use bytemuck::{Pod, Zeroable};
+use gpu_allocator::MemoryLocation;
+
+/// Words of one chunk record (see `shaders/silhouette.wgsl`).
+pub(crate) const RECORD_WORDS: usize = 20;
+/// Record word offsets.
+pub(crate) mod rec {
+    pub const VOL_COUNT: usize = 0;
+    pub const VOL_INSTANCES: usize = 1;
+    pub const VOL_FIRST: usize = 2;
+    pub const CAP_COUNT: usize = 5;
+    pub const CAP_INSTANCES: usize = 6;
+    pub const CAP_FIRST: usize = 7;
+    pub const SIDES: usize = 10;
+    pub const DARK: usize = 11;
+    pub const EDGES: usize = 12;
+    pub const FLAGS: usize = 13;
+    pub const N: usize = 14;
+    pub const VOL_CAP: usize = 15;
+    pub const CAP_CAP: usize = 16;
+    pub const OVERFLOW: usize = 17;
+    pub const F_ENABLED: u32 = 1;
+    pub const F_BACK: u32 = 2;
+    pub const F_DIRECTIONAL: u32 = 4;
+    pub const F_LIGHT_CAP: u32 = 32;
+    pub const DC_FAN: u32 = 1;
+    pub const DC_FRONT: u32 = 2;
+    pub const DC_BACK: u32 = 3;
+}
+
+/// The push-constant block of `shaders/silhouette.wgsl` (`struct Push`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub(crate) struct SilhouettePush {
+    pub light: [f32; 4],
+    pub filt: [f32; 4],
+    pub bound: f32,
+    pub flip: u32,
+    pub tris: u32,
+    pub edges: u32,
+    pub rec_base: u32,
+    pub fac_base: u32,
+    pub job_base: u32,
+    /// 1 when some chunk of the job writes face caps.
+    pub caps: u32,
+}
+
+impl SilhouettePush {
+    pub const SIZE: u32 = std::mem::size_of::<SilhouettePush>() as u32;
+}
+
+/// A caster's static tables for the compute pass, on the CPU.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct ComputeMesh {
+    /// Per triangle, `(nx, ny, nz, d)`.
+    pub planes: Vec<[f32; 4]>,
+    /// Per triangle: welded ids `g0 g1 g2 _`, local corners `l0 l1 l2 chunk`.
+    pub tris: Vec<[u32; 8]>,
+    /// Welded positions (w unused).
+    pub positions: Vec<[f32; 4]>,
+    /// Edges of the closed manifold parts: `(t0, t1, c0 | c1 << 8, 0)`.
+    pub edges: Vec<[u32; 4]>,
+    /// Per chunk: edges of the table with a triangle in the chunk (the side capacity).
+    pub chunk_edges: Vec<u32>,
+}
+
+impl ComputeMesh {
+    /// The tables of `caster` (every triangle; the edges of its closed manifold parts only:
+    /// the others keep the CPU's multiplicity path).
+    pub fn new(caster: &Caster) -> ComputeMesh {
+        let mesh = caster.mesh();
+        let planes = caster.planes.planes_xyzd();
+        let tris = mesh
+            .triangles
+            .iter()
+            .zip(&caster.tri_chunk)
+            .map(|(t, &(ci, li))| {
+                let l = caster.chunks[ci as usize].local_tris[li as usize];
+                [t[0], t[1], t[2], 0, l[0] as u32, l[1] as u32, l[2] as u32, ci]
+            })
+            .collect();
+        let positions = mesh.positions.iter().map(|p| [p.x, p.y, p.z, 1.0]).collect();
+        let mut edges = Vec::new();
+        let mut chunk_edges = vec![0u32; caster.chunks.len()];
+        let whole_multiplicity = caster.kind != CasterKind::Manifold && caster.parts.len() == 1;
+        for part in caster.parts.iter().filter(|p| p.kind == CasterKind::Manifold && !whole_multiplicity) {
+            for e in part.scan.edges() {
+                edges.push([e.t0, e.t1, e.c0 as u32 | (e.c1 as u32) << 8, 0]);
+                let (c0, c1) = (caster.tri_chunk[e.t0 as usize].0, caster.tri_chunk[e.t1 as usize].0);
+                chunk_edges[c0 as usize] += 1;
+                if c1 != c0 {
+                    chunk_edges[c1 as usize] += 1;
+                }
+            }
+        }
+        ComputeMesh { planes, tris, positions, edges, chunk_edges }
+    }
+}
+
+/// A caster's static tables on the GPU (device local, uploaded through staging copies).
+pub(crate) struct ComputeStatic {
+    pub planes: Buffer,
+    pub tris: Buffer,
+    pub positions: Buffer,
+    pub edges: Buffer,
+    pub triangles: u32,
+    pub edge_count: u32,
+    pub chunk_edges: Vec<u32>,
+    /// Triangles per chunk.
+    pub chunk_tris: Vec<u32>,
+}
+
+impl ComputeStatic {
+    pub fn buffers(self) -> [Buffer; 4] {
+        [self.planes, self.tris, self.positions, self.edges]
+    }
+}
+
+/// Bytes of `v`, at least `min` long (zero padded: a copy of zero bytes is invalid).
+pub(crate) fn padded_bytes<T: Pod>(v: &[T], min: usize) -> Vec<u8> {
+    let mut b = bytemuck::cast_slice(v).to_vec();
+    if b.len() < min {
+        b.resize(min, 0);
+    }
+    b
+}
+
+/// The compute pipelines (facing filter, exact facing, then caps and edges) and their layout.
+pub(crate) struct ComputePipes {
+    pub set_layout: vk::DescriptorSetLayout,
+    pub layout: vk::PipelineLayout,
+    pub facing: vk::Pipeline,
+    pub exact: vk::Pipeline,
+    pub edges: vk::Pipeline,
+}
+
+/// Storage-buffer bindings of the set: 0..4 the caster's tables, 4 facing words, 5 the
+/// chunk records, 6 the output indices.
+pub(crate) const BINDINGS: u32 = 7;
+
+impl ComputePipes {
+    pub fn new(dev: &PassDevice) -> Result<ComputePipes> {
+        let d = dev.device();
+        let bindings: Vec<_> = (0..BINDINGS)
+            .map(|i| {
+                vk::DescriptorSetLayoutBinding::default()
+                    .binding(i)
+                    .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                    .descriptor_count(1)
+                    .stage_flags(vk::ShaderStageFlags::COMPUTE)
+            })
+            .collect();
+        // SAFETY: creation on a valid device from locals; destroyed in `destroy` (or below on error).
+        let set_layout = unsafe { d.create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None) }
+            .map_err(Error::vk("vkCreateDescriptorSetLayout"))?;
+        let mut me = ComputePipes {
+            set_layout,
+            layout: vk::PipelineLayout::null(),
+            facing: vk::Pipeline::null(),
+            exact: vk::Pipeline::null(),
+            edges: vk::Pipeline::null(),
+        };
+        match me.create(dev) {
+            Ok(()) => Ok(me),
+            Err(e) => {
+                // SAFETY: nothing created here was used yet.
+                unsafe { me.destroy(d) };
+                Err(e)
+            }
+        }
+    }
+
+    fn create(&mut self, dev: &PassDevice) -> Result<()> {
+        self.layout = pipeline_layout(dev, &[self.set_layout], SilhouettePush::SIZE, vk::ShaderStageFlags::COMPUTE)?;
+        let module = pipeline::shader_module(dev, shaders::SILHOUETTE_WGSL)?;
+        let d = dev.device();
+        let make = |entry: &std::ffi::CStr| -> Result<vk::Pipeline> {
+            let stage = vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::COMPUTE).module(module).name(entry);
+            let info = [vk::ComputePipelineCreateInfo::default().stage(stage).layout(self.layout)];
+            // SAFETY: valid device, module and layout; the create info points at locals.
+            unsafe { d.create_compute_pipelines(vk::PipelineCache::null(), &info, None) }
+                .map(|p| p[0])
+                .map_err(|(_, e)| Error::vk("vkCreateComputePipelines")(e))
+        };
+        let r = make(c"facing").and_then(|f| {
+            self.facing = f;
+            make(c"exact")
+        });
+        let r = r.and_then(|x| {
+            self.exact = x;
+            make(c"edges").map(|e| self.edges = e)
+        });
+        // SAFETY: the pipelines keep what they need of the module.
+        unsafe { d.destroy_shader_module(module, None) };
+        r
+    }
+
+    /// # Safety
+    /// No pending command buffer uses the pipelines.
+    pub unsafe fn destroy(&mut self, d: &ash::Device) {
+        // SAFETY: the caller's contract; null handles are ignored.
+        unsafe {
+            d.destroy_pipeline(self.facing, None);
+            d.destroy_pipeline(self.exact, None);
+            d.destroy_pipeline(self.edges, None);
+            d.destroy_pipeline_layout(self.layout, None);
+            d.destroy_descriptor_set_layout(self.set_layout, None);
+        }
+    }
+}
+
+/// One ring slot's buffers and descriptor sets for the compute pass.
+#[derive(Default)]
+pub(crate) struct SlotCompute {
+    /// Chunk records of every light (host visible: written at prepare, read back for stats).
+    pub records: Option<Buffer>,
+    /// Output indices (u16, two a word), every light's regions.
+    pub out: Option<Buffer>,
+    /// Two facing words per triangle, per caster and light (the bits, the exact test's list).
+    pub facing: Option<Buffer>,
+    pub pool: vk::DescriptorPool,
+    pub pool_sets: u32,
+}
+
+impl SlotCompute {
+    /// Makes `b` at least `size` bytes (the next power of two, at least 64 KiB); its old
+    /// contents are dropped (the slot's previous frame has retired).
+    pub fn ensure(
+        dev: &PassDevice,
+        b: &mut Option<Buffer>,
+        name: &str,
+        size: u64,
+        usage: vk::BufferUsageFlags,
+        loc: MemoryLocation,
+    ) -> Result<()> {
+        if b.as_ref().is_some_and(|b| b.size >= size) {
+            return Ok(());
+        }
+        if let Some(mut old) = b.take() {
+            old.destroy(dev);
+        }
+        *b = Some(Buffer::new(dev, name, size.max(1 << 16).next_power_of_two(), usage, loc)?);
+        Ok(())
+    }
+
+    /// A reset pool with room for `sets` sets (grown when short).
+    pub fn reset_pool(&mut self, dev: &PassDevice, sets: u32) -> Result<()> {
+        let d = dev.device();
+        if self.pool_sets < sets || self.pool == vk::DescriptorPool::null() {
+            let n = sets.max(8).next_power_of_two();
+            // SAFETY: the slot's previous frame retired: its sets are no longer in use.
+            unsafe {
+                if self.pool != vk::DescriptorPool::null() {
+                    d.destroy_descriptor_pool(self.pool, None);
+                    self.pool = vk::DescriptorPool::null();
+                }
+                let sizes = [vk::DescriptorPoolSize { ty: vk::DescriptorType::STORAGE_BUFFER, descriptor_count: n * BINDINGS }];
+                self.pool = d
+                    .create_descriptor_pool(&vk::DescriptorPoolCreateInfo::default().max_sets(n).pool_sizes(&sizes), None)
+                    .map_err(Error::vk("vkCreateDescriptorPool"))?;
+            }
+            self.pool_sets = n;
+        } else {
+            // SAFETY: as above.
+            unsafe { d.reset_descriptor_pool(self.pool, vk::DescriptorPoolResetFlags::empty()) }
+                .map_err(Error::vk("vkResetDescriptorPool"))?;
+        }
+        Ok(())
+    }
+
+    pub fn destroy(&mut self, dev: &PassDevice) {
+        for b in [&mut self.records, &mut self.out, &mut self.facing] {
+            if let Some(mut b) = b.take() {
+                b.destroy(dev);
+            }
+        }
+        if self.pool != vk::DescriptorPool::null() {
+            // SAFETY: the pass is dropped after its command buffers completed.
+            unsafe { dev.device().destroy_descriptor_pool(self.pool, None) };
+            self.pool = vk::DescriptorPool::null();
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shadow::testmesh::{cube, uv_sphere};
+    use glam::{Mat4, Vec3};
+
+    #[test]
+    fn tables_cover_every_edge_and_triangle() {
+        let c = Caster::with_chunk_limit("s", &uv_sphere(1.0, 24, 12), Mat4::IDENTITY, 60).unwrap();
+        let m = ComputeMesh::new(&c);
+        assert_eq!(m.tris.len(), c.triangle_count);
+        assert_eq!(m.planes.len(), c.triangle_count);
+        assert_eq!(m.edges.len(), c.topology.manifold_edges.len());
+        assert!(c.chunks.len() > 2);
+        // every edge counted once per chunk it touches
+        let touching: u32 = m.chunk_edges.iter().sum();
+        assert!(touching as usize >= m.edges.len() && (touching as usize) < 2 * m.edges.len());
+        for (t, row) in m.tris.iter().enumerate() {
+            let (ci, li) = c.tri_chunk[t];
+            assert_eq!(row[7], ci);
+            let lt = c.chunks[ci as usize].local_tris[li as usize];
+            assert_eq!([row[4], row[5], row[6]], lt.map(|x| x as u32));
+        }
+        // corners: the edge a -> b starts at corner c0 of t0
+        for e in &m.edges {
+            let (t0, c0) = (e[0] as usize, (e[2] & 0xff) as usize);
+            let (t1, c1) = (e[1] as usize, (e[2] >> 8) as usize);
+            let (a, b) = (c.mesh().triangles[t0][c0], c.mesh().triangles[t0][(c0 + 1) % 3]);
+            assert_eq!((c.mesh().triangles[t1][c1], c.mesh().triangles[t1][(c1 + 1) % 3]), (b, a));
+        }
+        // an open mesh has no compute edges
+        let mut open = cube(Vec3::ZERO, 1.0);
+        open.triangles.pop();
+        let oc = Caster::new("open", &open, Mat4::IDENTITY).unwrap();
+        assert!(ComputeMesh::new(&oc).edges.is_empty());
+    }
+
+    #[test]
+    fn push_matches_the_wgsl_block() {
+        assert_eq!(SilhouettePush::SIZE, 64);
+        assert_eq!(std::mem::offset_of!(SilhouettePush, bound), 32);
+        assert_eq!(std::mem::offset_of!(SilhouettePush, rec_base), 48);
+    }
+}
