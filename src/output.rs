@@ -60,6 +60,7 @@ pub fn write_frame_dump(dir: &Path, scene: &Scene, frame: &FrameOutput) -> Resul
         positions: frame.positions.iter().flatten().copied().collect(),
         normals: frame.normals.iter().flatten().copied().collect(),
         shadow: frame.shadow_masks(scene),
+        spheres: scene.spheres.iter().filter(|s| s.casts_shadow).map(|s| s.sphere).collect(),
         camera: Some(scene.camera.clone()),
         extra: Default::default(),
     };

@@ -241,7 +241,8 @@ fn worst_ratio(sphere: &Sphere, t: &Tangency, light: DVec4, view: &ViewScale) ->
             let c = sphere.center;
             let s_eye = (view.eye - c).dot(away);
             let scale = sphere.radius.max(1e-30);
-            let samples = std::iter::once(0.0).chain((0..=240).map(|i| scale * 10f64.powf(i as f64 / 40.0))).chain((s_eye > 0.0).then_some(s_eye));
+            let samples =
+                std::iter::once(0.0).chain((0..=240).map(|i| scale * 10f64.powf(i as f64 / 40.0))).chain((s_eye > 0.0).then_some(s_eye));
             for s in samples {
                 at(c + away * s, sphere.radius, sphere.radius);
             }

@@ -5,7 +5,7 @@ use crate::scene::{builtin_names, load, load_str, shapes, LightKind};
 use glam::{Mat4, Vec3};
 use std::path::Path;
 
-const CAM: &str = "[camera]\neye = [0, 2, 5]\ntarget = [0, 0, 0]\n";
+pub(super) const CAM: &str = "[camera]\neye = [0, 2, 5]\ntarget = [0, 0, 0]\n";
 
 fn err(toml: &str) -> String {
     let r = std::panic::catch_unwind(|| load_str(toml, "bad.toml", Path::new(".")));
@@ -16,7 +16,7 @@ fn err(toml: &str) -> String {
     }
 }
 
-fn check(toml: &str, wants: &[&str]) {
+pub(super) fn check(toml: &str, wants: &[&str]) {
     let e = err(toml);
     assert!(e.contains("bad.toml"), "error does not name the file: {e}");
     for w in wants {
