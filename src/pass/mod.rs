@@ -56,11 +56,11 @@ mod spheres;
 pub mod stats;
 
 pub use casters::CasterId;
-pub use spheres::SphereId;
 pub use desc::{Capabilities, Counter, DepthMode, EnabledFeatures, IndexFormat, PassSettings, ShadowPassDesc, Technique};
 pub use frame::{case_name, LightFrame, PreparedFrame, ShadowView};
 pub use pipelines::COUNT_FORMAT;
 pub use record::{lit_stencil_state, DepthStencilTarget, VolumeKind};
+pub use spheres::SphereId;
 
 use crate::error::{Error, Result};
 use crate::geom::Light;

@@ -139,10 +139,8 @@ pub(crate) fn pack_light(
             tris.sides = if directional { n as u64 } else { 2 * n as u64 };
             tris.dark_cap = (volume.len() as u64).saturating_sub(tris.sides);
             tris.light_cap = cap.len() as u64;
-            let draws = vec![
-                stream_tris(stream, &volume, Case::ZFailLightCap, false),
-                stream_tris(stream, &cap, Case::ZFailLightCap, true),
-            ];
+            let draws =
+                vec![stream_tris(stream, &volume, Case::ZFailLightCap, false), stream_tris(stream, &cap, Case::ZFailLightCap, true)];
             (Case::ZFailLightCap, draws, vp_rel * DMat4::from_translation(c))
         };
         let vertex_bytes: u64 = draws.iter().map(|d| d.count as u64 * 16).sum();

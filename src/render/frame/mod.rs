@@ -12,6 +12,7 @@ use super::readback::{Layout, Readback};
 use super::scene_gpu::{SceneGeometry, Sidedness};
 use super::selfshadow::SelfShadow;
 use super::shadowmap::ShadowMapper;
+use super::sphere_gpu::SphereGeometry;
 use super::targets::*;
 use super::timing::{Span, Timer};
 mod motion;
@@ -89,6 +90,7 @@ pub struct Renderer {
     caster_ids: Vec<Option<CasterId>>,
     has_transparent: bool,
     geo: SceneGeometry,
+    spheres: SphereGeometry,
     targets: Targets,
     pipes: FramePipelines,
     self_shadow: Option<SelfShadow>,
@@ -138,8 +140,12 @@ impl Renderer {
                 false => None,
             });
         }
+        for s in scene.spheres.iter().filter(|s| s.casts_shadow) {
+            pass.add_sphere_caster(&s.name, s.sphere, s.segments)?;
+        }
         let has_transparent = pass.casters().iter().any(|c| c.transmittance.is_some());
         let geo = SceneGeometry::new(&ctx, &scene, config.frames_in_flight)?;
+        let spheres = SphereGeometry::new(&ctx, &scene, config.frames_in_flight)?;
         let targets = Targets::new(&ctx, config.width, config.height, transmit_format)?;
         let pipes = FramePipelines::new(&ctx, &targets, pass.capabilities().depth_bounds)?;
         let self_shadow = match config.self_shadow && geo.of(Sidedness::Transparent).next().is_some() {
@@ -164,6 +170,7 @@ impl Renderer {
             caster_ids,
             has_transparent,
             geo,
+            spheres,
             targets,
             pipes,
             self_shadow,
@@ -189,6 +196,7 @@ impl Renderer {
             std::ptr::drop_in_place(&mut me.slots);
             std::ptr::drop_in_place(&mut me.self_shadow);
             std::ptr::drop_in_place(&mut me.shadow_mapper);
+            std::ptr::drop_in_place(&mut me.spheres);
             std::ptr::read(&me.ctx)
         }
     }
@@ -269,6 +277,7 @@ impl Renderer {
         self.next_slot = (slot + 1) % self.slots.len();
         self.retire(slot)?;
         check_options(&self.ctx, &self.config, &self.settings)?;
+        check_spheres(&self.scene, &self.settings)?;
         let wall = Instant::now();
         let settings = self.settings;
         let (w, h) = (self.config.width, self.config.height);
@@ -292,6 +301,7 @@ impl Renderer {
         };
         let record_start = Instant::now();
         let instances = self.geo.write_instances(slot, &self.scene)?;
+        let spheres = self.spheres.write(slot, &self.scene)?;
         let capture = settings.capture || settings.view == View::Stencil;
         let float_counts = settings.counter == Counter::Float || self.shadow_mapper.is_some();
         let nlights = self.scene.lights.len();
@@ -316,7 +326,7 @@ impl Renderer {
         let full = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: self.targets.extent };
         let viewport = vk::Viewport { x: 0.0, y: 0.0, width: w as f32, height: h as f32, min_depth: 0.0, max_depth: 1.0 };
         let rec = Rec { ctx: &self.ctx, cb, full, viewport, timer: &s.timer, readback };
-        let spans = self.record_frame(&rec, &frame, &layout, instances, vp_rel, &lights, float_counts);
+        let spans = self.record_frame(&rec, &frame, &layout, (instances, spheres), vp_rel, &lights, float_counts);
         // SAFETY: recording finished; the submission signals the slot's fence.
         unsafe {
             d.end_command_buffer(cb).map_err(Error::vk("vkEndCommandBuffer"))?;
@@ -340,7 +350,7 @@ impl Renderer {
         rec: &Rec,
         frame: &PreparedFrame,
         layout: &Layout,
-        instances: vk::Buffer,
+        (instances, spheres): (vk::Buffer, Option<(vk::Buffer, u32)>),
         vp_rel: Mat4,
         lights: &[LightPush],
         float_counts: bool,
@@ -356,7 +366,7 @@ impl Renderer {
         // layouts each pass expects are those the previous pass leaves.
         unsafe {
             pass.cmd_upload(rec.cb, frame);
-            gbuffer::record(rec, t, p, &self.geo, instances, vp_rel, self.scene.ambient);
+            gbuffer::record(rec, t, p, &self.geo, instances, vp_rel, self.scene.ambient, spheres);
             spans.depth.end = stamp(all);
             let into = match (&self.shadow_mapper, self.settings.counter) {
                 (Some(_), _) => determine::CountInto::External,
@@ -494,6 +504,7 @@ impl Renderer {
         }
         self.targets.destroy(ctx);
         self.geo.destroy(ctx);
+        self.spheres.destroy(ctx);
     }
 }
 
@@ -501,6 +512,22 @@ impl Drop for Renderer {
     fn drop(&mut self) {
         self.destroy_resources();
     }
+}
+
+/// Spheres the frame cannot draw: the eye inside or on one (it may have moved there), or
+/// casting spheres with the shadow-map baseline (its depth pass draws meshes only).
+fn check_spheres(scene: &Scene, s: &FrameSettings) -> Result<()> {
+    for sp in &scene.spheres {
+        if let Some(problem) = crate::scene::sphere_placement_problem(sp, &scene.camera, &scene.lights) {
+            return Err(Error::Other(problem));
+        }
+    }
+    if matches!(s.technique, Technique::ShadowMap { .. }) && scene.spheres.iter().any(|s| s.casts_shadow) {
+        return Err(Error::Unsupported(
+            "--method shadowmap does not draw analytic sphere casters into its maps; use a shadow-volume method".into(),
+        ));
+    }
+    Ok(())
 }
 
 /// The pass's share of the frame settings.
