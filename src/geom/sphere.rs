@@ -217,6 +217,17 @@ pub struct ViewScale {
     pub near: f64,
 }
 
+impl ViewScale {
+    /// The scale of `camera` rendering a `width` x `height` image (the renderer's projection:
+    /// vertical field of view `fov_y_deg`, square pixels).
+    pub fn from_camera(camera: &crate::geom::Camera, width: u32, height: u32) -> ViewScale {
+        let ty = ((camera.fov_y_deg as f64).to_radians() * 0.5).tan();
+        let tx = ty * width.max(1) as f64 / height.max(1) as f64;
+        let cos2 = 1.0 / (1.0 + tx * tx + ty * ty);
+        ViewScale { eye: camera.eye.as_dvec3(), pixel_angle: 2.0 * ty / height.max(1) as f64 * cos2, near: camera.near as f64 }
+    }
+}
+
 /// The worst ratio (world width of the polygon's excess / distance from the eye), per unit of
 /// `sec(π/n) - 1`, along the shadow's axis.
 fn worst_ratio(sphere: &Sphere, t: &Tangency, light: DVec4, view: &ViewScale) -> f64 {
