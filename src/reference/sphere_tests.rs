@@ -113,5 +113,11 @@ fn dumps_carry_the_spheres_and_check_against_them() {
     no_sphere.spheres.clear();
     write_dump(&dir, &no_sphere).unwrap();
     assert!(!check_dump(&dir, 1).unwrap().passed(0.0));
+    // A dumped sphere with a bad radius: an error naming frame.json and the sphere.
+    write_dump(&dir, &dump).unwrap();
+    let json = std::fs::read_to_string(dir.join("frame.json")).unwrap().replace("\"radius\": 1.0", "\"radius\": -1.0");
+    std::fs::write(dir.join("frame.json"), json).unwrap();
+    let e = read_dump(&dir).unwrap_err().to_string();
+    assert!(e.contains("frame.json") && e.contains("sphere 0") && e.contains("radius"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
