@@ -250,3 +250,28 @@ fn write_docs_spheres_md() {
     }
     std::fs::write(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/spheres-table.md"), doc).unwrap();
 }
+
+/// `--method planar`: a sphere's tangency polygon flattened onto the floor from the light is
+/// its exact shadow there (to the half-pixel rule); the sphere itself receives no shadow.
+#[test]
+fn planar_flattens_the_tangency_polygon_onto_the_floor() {
+    let Some(ctx) = common::context() else { return };
+    let body = "[[sphere]]\ncenter = [0.0, CY, 0.0]\nradius = RADIUS\n[[sphere]]\ncenter = [0.6, 3.4, 0.4]\nradius = 0.4\n";
+    let scene = umbrage::scene::load_str(&one_sphere(1.0, 6.0, body), "planar", std::path::Path::new(".")).unwrap();
+    let (w, h) = (320, 240);
+    let opts = RenderOptions { width: w, height: h, technique: Technique::Planar, capture: true, ..Default::default() };
+    let mut r = Renderer::new(ctx, scene, opts).unwrap();
+    let out = r.render().unwrap();
+    let reference = umbrage::reference::Reference::from_scene(r.scene()).render(&r.scene().camera, &r.scene().lights, w, h);
+    let truth = reference.mask(0);
+    let masks = out.shadow_masks(r.scene());
+    // Off the floor, the reference's own answer: only floor pixels can mismatch.
+    let floor: Vec<u8> = masks[0].iter().enumerate().map(|(i, &v)| if out.positions[i][1].abs() < 1e-4 { v } else { truth[i] }).collect();
+    let m = umbrage::reference::metrics::compare_all(&[floor], &reference, 1).unwrap();
+    eprintln!("planar spheres on the floor: {} / {}", m[0].mismatches_outside_band, m[0].compared);
+    assert!(m[0].fraction_outside_band <= THRESHOLD, "{:?}", m[0]);
+    // The small sphere shadows the big one's top in the reference; planar misses that.
+    let all = umbrage::reference::metrics::compare_all(&masks, &reference, 1).unwrap();
+    assert!(all[0].mismatches_outside_band > 0, "planar should miss the sphere-on-sphere shadow");
+    r.context().check_validation().unwrap();
+}
