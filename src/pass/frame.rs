@@ -331,7 +331,10 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
                 technique: input.settings.technique,
                 planar_receiver: input.planar_receiver,
             };
+            let start = std::time::Instant::now();
             super::spheres::pack_light(input.spheres, &sin, &mut stream, &mut totals, &mut casters, &mut cstats);
+            // The spheres' planning (tangency circles, n, volumes) counts as planning.
+            cpu.plan += start.elapsed().as_secs_f64() * 1e3;
         }
         let scissor = plan
             .scissor
