@@ -275,3 +275,15 @@ fn planar_flattens_the_tangency_polygon_onto_the_floor() {
     assert!(all[0].mismatches_outside_band > 0, "planar should miss the sphere-on-sphere shadow");
     r.context().check_validation().unwrap();
 }
+
+/// A finite far plane with depth clamp (`--depth-mode clamp`) reaches past the spheres too.
+#[test]
+fn clamp_depth_mode_keeps_the_spheres() {
+    let Some(ctx) = common::context() else { return };
+    let scene = umbrage::scene::load("analytic/sphere_only").unwrap();
+    let opts = RenderOptions { width: 200, height: 150, depth_mode: umbrage::render::DepthMode::Clamp, ..Default::default() };
+    let mut r = Renderer::new(ctx, scene, opts).unwrap();
+    let row = &evaluate(&mut r, "sphere_only clamp", &[Technique::Volumes(Method::McGuire)], 1).unwrap()[0];
+    assert!(row.compared > 10_000 && row.fraction <= THRESHOLD, "{row:?}");
+    r.context().check_validation().unwrap();
+}

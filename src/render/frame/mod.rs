@@ -230,8 +230,16 @@ impl Renderer {
             DepthMode::Clamp => {
                 // Far plane just beyond the scene: everything further is clamped to depth 1.
                 let eye = self.scene.camera.eye;
-                let far =
-                    self.scene.meshes.iter().flat_map(|m| m.world_bounds().corners()).map(|c| c.distance(eye)).fold(1.0f32, f32::max) * 1.5;
+                let spheres = self.scene.spheres.iter().map(|s| (s.sphere.center.distance(eye.as_dvec3()) + s.sphere.radius) as f32);
+                let far = self
+                    .scene
+                    .meshes
+                    .iter()
+                    .flat_map(|m| m.world_bounds().corners())
+                    .map(|c| c.distance(eye))
+                    .chain(spheres)
+                    .fold(1.0f32, f32::max)
+                    * 1.5;
                 self.scene.camera.proj_finite(aspect, far.max(self.scene.camera.near * 2.0))
             }
         }
