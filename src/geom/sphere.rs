@@ -35,13 +35,13 @@
 //! # Choosing n
 //!
 //! At a distance `s` from a point light along the shadow's axis the polygon's cone is wider
-//! than the true one by `s tan α (sec(π/n) - 1)` (a directional light's cylinder: `r (sec(π/n)
-//! - 1)`). Seen from the eye at distance `D`, that is `width / D` radians, and one pixel is
+//! than the true one by `s tan α (sec(π/n) - 1)` (a directional light's cylinder:
+//! `r (sec(π/n) - 1)`). Seen from the eye at distance `D`, that is `width / D` radians, and one pixel is
 //! `pixel_angle` radians (the smallest pixel of the view, at its corners). [`auto_segments`]
 //! takes the worst ratio along the axis (sampled geometrically from the sphere to 10^6 times
 //! its distance, plus the axis point closest to the eye; `D` is the distance from the eye to
 //! the cone's cross-section there, at least the near distance) and the smallest `n` whose
-//! error there is at most half a pixel, clamped to [`MIN_SEGMENTS`, `MAX_SEGMENTS`]. The rule
+//! error there is at most half a pixel, clamped to [`MIN_SEGMENTS`] ..= [`MAX_SEGMENTS`]. The rule
 //! bounds the error perpendicular to the light's rays; on a receiver at a grazing angle to
 //! the light the shadow's edge is stretched by `1 / cos` (that is where the comparison's band
 //! and the reference's ambiguity take over).
@@ -268,7 +268,7 @@ pub fn shadow_error_px(sphere: &Sphere, t: &Tangency, light: DVec4, view: &ViewS
     (sec - 1.0) * worst_ratio(sphere, t, light, view) / view.pixel_angle
 }
 
-/// The smallest `n` in [`MIN_SEGMENTS`, `MAX_SEGMENTS`] whose [`shadow_error_px`] is at most
+/// The smallest `n` in [`MIN_SEGMENTS`] ..= [`MAX_SEGMENTS`] whose [`shadow_error_px`] is at most
 /// half a pixel (`MAX_SEGMENTS` when none is).
 pub fn auto_segments(sphere: &Sphere, t: &Tangency, light: DVec4, view: &ViewScale) -> u32 {
     let k = worst_ratio(sphere, t, light, view) / view.pixel_angle;

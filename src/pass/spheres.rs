@@ -17,7 +17,7 @@ use crate::geom::sphere::{auto_segments, shadow_error_px, volume_triangles, View
 use crate::geom::{Light, LightKind, Sphere};
 use crate::shadow::Case;
 use ash::vk;
-use glam::{DMat4, DVec4, Vec4};
+use glam::{DMat4, DVec4};
 
 /// A sphere caster added to a [`ShadowPass`](super::ShadowPass) (ids are never reused).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
@@ -172,7 +172,7 @@ pub(crate) fn pack_light(
         casters.push(CasterDraw {
             case,
             mvp: mvp.as_mat4(),
-            light_object: Vec4::from(light_object.as_vec4()),
+            light_object: light_object.as_vec4(),
             transmittance: None,
             draws,
             edge_quad: None,
