@@ -60,6 +60,7 @@ pub fn write_frame_dump(dir: &Path, scene: &Scene, frame: &FrameOutput) -> Resul
         positions: frame.positions.iter().flatten().copied().collect(),
         normals: frame.normals.iter().flatten().copied().collect(),
         shadow: frame.shadow_masks(scene),
+        spheres: scene.spheres.iter().filter(|s| s.casts_shadow).map(|s| s.sphere).collect(),
         camera: Some(scene.camera.clone()),
         extra: Default::default(),
     };
@@ -169,6 +170,25 @@ pub struct CasterInfo {
     pub transparent: bool,
     /// The connected components, each planned on its own.
     pub parts: Vec<PartInfo>,
+    /// For an analytic sphere caster (`path` = `sphere`; `triangles` = 0, no parts).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sphere: Option<SphereInfo>,
+}
+
+/// An analytic sphere caster in `info --scene`.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct SphereInfo {
+    /// Centre, world space.
+    pub center: [f64; 3],
+    /// Radius.
+    pub radius: f64,
+    /// The scene's fixed `segments`, if any.
+    pub segments: Option<u32>,
+    /// Per light, the polygon's segments from the scene's camera at 960x540 (the half-pixel
+    /// rule, or the fixed value).
+    pub segments_per_light: Vec<u32>,
+    /// Per light, the rule's bound on the shadow's error with those segments, pixels.
+    pub error_px_per_light: Vec<f64>,
 }
 
 /// One connected component of a caster.
@@ -184,6 +204,44 @@ pub struct PartInfo {
 
 /// Classifies every shadow-casting mesh of `scene` (no GPU needed).
 pub fn caster_report(scene: &Scene) -> Result<Vec<CasterInfo>> {
+    let mut out = mesh_caster_report(scene)?;
+    let view = crate::geom::sphere::ViewScale::from_camera(&scene.camera, 960, 540);
+    for sp in scene.spheres.iter().filter(|s| s.casts_shadow) {
+        let (mut segs, mut errs) = (Vec::new(), Vec::new());
+        for l in &scene.lights {
+            let h = match l.kind {
+                crate::scene::LightKind::Directional => (-l.direction.as_dvec3().normalize()).extend(0.0),
+                _ => l.position.as_dvec3().extend(1.0),
+            };
+            let Some(t) = sp.sphere.tangency(h) else { continue };
+            let n = sp.segments.unwrap_or_else(|| crate::geom::sphere::auto_segments(&sp.sphere, &t, h, &view));
+            segs.push(n);
+            errs.push(crate::geom::sphere::shadow_error_px(&sp.sphere, &t, h, &view, n));
+        }
+        out.push(CasterInfo {
+            name: sp.name.clone(),
+            path: "sphere".into(),
+            reason: match sp.segments {
+                Some(n) => format!("analytic sphere, {n} segments"),
+                None => format!("analytic sphere, segments per light at 960x540: {segs:?}"),
+            },
+            triangles: 0,
+            chunks: 0,
+            transparent: false,
+            parts: Vec::new(),
+            sphere: Some(SphereInfo {
+                center: sp.sphere.center.to_array(),
+                radius: sp.sphere.radius,
+                segments: sp.segments,
+                segments_per_light: segs,
+                error_px_per_light: errs,
+            }),
+        });
+    }
+    Ok(out)
+}
+
+fn mesh_caster_report(scene: &Scene) -> Result<Vec<CasterInfo>> {
     scene
         .meshes
         .iter()
@@ -212,6 +270,7 @@ pub fn caster_report(scene: &Scene) -> Result<Vec<CasterInfo>> {
                         triangles: p.triangles.len(),
                     })
                     .collect(),
+                sphere: None,
             })
         })
         .collect()

@@ -164,3 +164,26 @@ fn info_lists_caster_parts() {
         assert_eq!(tris, c["triangles"].as_u64().unwrap(), "parts cover the caster: {c}");
     }
 }
+
+/// `info --scene` lists analytic sphere casters with the segments the half-pixel rule picks.
+#[test]
+fn info_lists_sphere_casters() {
+    let out = umbrage(&["info", "--scene", "analytic/sphere_and_meshes", "--json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let spheres: Vec<_> = v["casters"].as_array().unwrap().iter().filter(|c| c["path"] == "sphere").collect();
+    assert_eq!(spheres.len(), 3);
+    for c in spheres {
+        let n = c["sphere"]["segments_per_light"].as_array().unwrap();
+        assert_eq!(n.len(), 3, "{c}");
+        assert!(n.iter().all(|n| n.as_u64().unwrap() >= 8), "{c}");
+        assert!(c["sphere"]["error_px_per_light"].as_array().unwrap().iter().all(|e| e.as_f64().unwrap() <= 0.5), "{c}");
+    }
+    let text = umbrage(&["info", "--scene", "analytic/sphere_only"]);
+    assert!(String::from_utf8_lossy(&text.stdout).contains("sphere"));
+    // A bad sphere in a scene file: a clear error naming the file and key, no panic.
+    let d = tmp("badsphere");
+    let f = d.join("s.toml");
+    std::fs::write(&f, "[camera]\neye = [0, 2, 5]\ntarget = [0, 0, 0]\n[[sphere]]\ncenter = [0, 1, 0]\nradius = -1\n").unwrap();
+    fails_with(&umbrage(&["render", "--scene", f.to_str().unwrap(), "--out", d.join("a.png").to_str().unwrap()]), "radius");
+}

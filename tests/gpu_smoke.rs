@@ -33,6 +33,7 @@ fn ambient_and_light_without_casters() {
             casts_shadow: false,
         }],
         ambient: Vec3::splat(0.05),
+        spheres: Vec::new(),
     };
     let mut r = Renderer::new(ctx, scene, RenderOptions { width: 64, height: 48, capture: true, ..Default::default() }).unwrap();
     let out = r.render().unwrap();

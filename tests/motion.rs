@@ -45,6 +45,7 @@ fn cube_grid(n: usize) -> Scene {
         lights,
         meshes,
         ambient: Vec3::splat(0.05),
+        spheres: Vec::new(),
     }
 }
 

@@ -107,6 +107,7 @@ fn scene(c: &Case) -> Scene {
         lights: vec![light],
         meshes,
         ambient: Vec3::splat(0.05),
+        spheres: Vec::new(),
     }
 }
 

@@ -124,6 +124,7 @@ pub fn scene(frame: usize) -> Scene {
             mesh("box", shapes::cuboid(Vec3::ONE), box_transform(frame), true),
         ],
         ambient: Vec3::splat(0.06),
+        spheres: Vec::new(),
     }
 }
 

@@ -8,4 +8,6 @@ pub use light::{Camera, Light, LightKind};
 pub mod planes;
 pub mod predicates;
 pub mod silhouette;
+pub mod sphere;
+pub use sphere::Sphere;
 pub mod topology;

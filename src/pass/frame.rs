@@ -187,6 +187,8 @@ pub(crate) struct PackInput<'a> {
     pub casters: bool,
     /// The receiver plane of [`Technique::Planar`](super::Technique::Planar) (world, `n·x + d = 0`).
     pub planar_receiver: glam::DVec4,
+    /// The analytic sphere casters (planned after the mesh casters, per light).
+    pub spheres: &'a [super::spheres::SphereCaster],
 }
 
 /// Plans every light and packs the index streams (or naive vertices) into one byte stream.
@@ -317,6 +319,7 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
                         triangles: Triangles { sides: p.sides as u64, dark_cap: p.dark_cap as u64, light_cap: p.light_cap as u64 },
                     })
                     .collect(),
+                sphere: None,
             });
             let edge_quad = match (&gpu.edge_quads, cp.path == "edgequad") {
                 (Some(eq), true) => Some(EdgeQuadDraw {
@@ -339,6 +342,19 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
                 draws,
                 edge_quad,
             });
+        }
+        if input.casters {
+            let sin = super::spheres::SphereInput {
+                view,
+                scale: super::spheres::view_scale(view),
+                light,
+                technique: input.settings.technique,
+                planar_receiver: input.planar_receiver,
+            };
+            let start = std::time::Instant::now();
+            super::spheres::pack_light(input.spheres, &sin, &mut stream, &mut totals, &mut casters, &mut cstats);
+            // The spheres' planning (tangency circles, n, volumes) counts as planning.
+            cpu.plan += start.elapsed().as_secs_f64() * 1e3;
         }
         let scissor = plan
             .scissor

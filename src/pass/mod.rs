@@ -59,6 +59,7 @@ mod frame;
 mod pipelines;
 pub mod push;
 mod record;
+mod spheres;
 pub mod stats;
 
 pub use casters::CasterId;
@@ -66,6 +67,7 @@ pub use desc::{Capabilities, Counter, DepthMode, EnabledFeatures, IndexFormat, P
 pub use frame::{case_name, LightFrame, PreparedFrame, ShadowView};
 pub use pipelines::COUNT_FORMAT;
 pub use record::{lit_stencil_state, DepthStencilTarget, VolumeKind};
+pub use spheres::SphereId;
 
 use crate::error::{Error, Result};
 use crate::geom::Light;
@@ -108,6 +110,9 @@ pub struct ShadowPass {
     serial: u64,
     planar_receiver: glam::DVec4,
     compute_pipes: Option<compute::ComputePipes>,
+    /// Analytic sphere casters, in draw order (after the mesh casters).
+    spheres: Vec<spheres::SphereCaster>,
+    next_sphere: u64,
 }
 
 impl ShadowPass {
@@ -178,6 +183,8 @@ impl ShadowPass {
             serial: 0,
             planar_receiver: glam::DVec4::Y,
             compute_pipes: Some(compute_pipes),
+            spheres: Vec::new(),
+            next_sphere: 0,
         })
     }
 
@@ -273,6 +280,40 @@ impl ShadowPass {
         self.casters.remove(id, all)
     }
 
+    /// Adds an analytic sphere caster (lecture notes §2.1): its volume is built every frame
+    /// and light from the tangency circle as an n-gon circumscribed about it, `segments`
+    /// fixing n (3..=4096) or `None` choosing it so the shadow's error stays under half a
+    /// pixel. Opaque; drawn z-fail with its light cap, whatever the method (the polygon is
+    /// flattened onto the receiver with [`Technique::Planar`]). A frame whose positional
+    /// light is inside or on a sphere caster is refused by `prepare`.
+    pub fn add_sphere_caster(&mut self, name: &str, sphere: crate::geom::Sphere, segments: Option<u32>) -> Result<SphereId> {
+        spheres::check_sphere(name, &sphere, segments)?;
+        let id = SphereId(self.next_sphere);
+        self.next_sphere += 1;
+        self.spheres.push(spheres::SphereCaster { id, name: name.to_string(), sphere, segments });
+        Ok(id)
+    }
+
+    /// Moves or resizes a sphere caster (from the next `prepare`).
+    pub fn set_sphere(&mut self, id: SphereId, sphere: crate::geom::Sphere) -> Result<()> {
+        let i = spheres::find(&self.spheres, id)?;
+        spheres::check_sphere(&self.spheres[i].name, &sphere, self.spheres[i].segments)?;
+        self.spheres[i].sphere = sphere;
+        Ok(())
+    }
+
+    /// Removes a sphere caster (its volumes live in the per-frame stream: nothing to release).
+    pub fn remove_sphere(&mut self, id: SphereId) -> Result<()> {
+        let i = spheres::find(&self.spheres, id)?;
+        self.spheres.remove(i);
+        Ok(())
+    }
+
+    /// The sphere casters, in draw order: (id, name, sphere, fixed segments).
+    pub fn spheres(&self) -> impl Iterator<Item = (SphereId, &str, crate::geom::Sphere, Option<u32>)> + '_ {
+        self.spheres.iter().map(|s| (s.id, s.name.as_str(), s.sphere, s.segments))
+    }
+
     /// The prepared casters, in draw order (the planner's view).
     pub fn casters(&self) -> &[Caster] {
         &self.casters.cpu
@@ -311,6 +352,9 @@ impl ShadowPass {
         }
         view.check()?;
         check_lights(lights)?;
+        if casters {
+            spheres::check(&self.spheres, lights)?;
+        }
         self.settings.check(&self.caps)?;
         if self.casters.cpu.iter().any(|c| c.transmittance.is_some()) && self.pipes.transmit.is_none() {
             return Err(Error::Other("transparent casters need ShadowPassDesc::transmit_format".into()));
@@ -344,6 +388,7 @@ impl ShadowPass {
                 depth_bounds: self.caps.depth_bounds,
                 casters,
                 planar_receiver: self.planar_receiver,
+                spheres: &self.spheres,
             },
         );
         let record_start = Instant::now();

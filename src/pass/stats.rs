@@ -57,6 +57,21 @@ pub struct CasterStats {
     /// Per part (connected component) that was planned: its own case, path and triangles
     /// (empty when the caster was culled whole or drawn with edge quads).
     pub parts: Vec<PartStats>,
+    /// For an analytic sphere caster (`path` = `sphere`): its polygon for this light.
+    #[cfg_attr(feature = "serde", serde(skip_serializing_if = "Option::is_none"))]
+    pub sphere: Option<SphereStats>,
+}
+
+/// An analytic sphere caster's shadow-volume polygon for one light.
+#[derive(Clone, Copy, Debug)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
+pub struct SphereStats {
+    /// Segments of the polygon circumscribed about the tangency circle.
+    pub segments: u32,
+    /// Chosen by the half-pixel rule (false: fixed by the scene's `segments`).
+    pub auto: bool,
+    /// The rule's bound on the shadow's error with these segments, pixels.
+    pub error_px: f64,
 }
 
 /// One part (connected component) of a caster for one light.

@@ -93,7 +93,10 @@ pub fn check_dump(dir: impl AsRef<std::path::Path>, band: u32) -> Result<CheckRe
     let dir = dir.as_ref();
     let dump = read_dump(dir)?;
     let lights: Vec<Light> = dump.lights.iter().map(|l| l.to_light()).collect::<Result<_>>()?;
-    let reference = Reference::from_triangles(dump.triangles.iter().map(|t| [t[0].as_dvec3(), t[1].as_dvec3(), t[2].as_dvec3()]).collect());
+    let spheres: Vec<super::RefSphere> =
+        dump.spheres.iter().enumerate().map(|(i, &sphere)| super::RefSphere { sphere, occluder: true, mesh: i as u32 }).collect();
+    let reference = Reference::from_triangles(dump.triangles.iter().map(|t| [t[0].as_dvec3(), t[1].as_dvec3(), t[2].as_dvec3()]).collect())
+        .with_spheres(&spheres);
     let (w, h) = (dump.width as usize, dump.height as usize);
     let pos = |i: usize| DVec3::new(dump.positions[3 * i] as f64, dump.positions[3 * i + 1] as f64, dump.positions[3 * i + 2] as f64);
     let nrm = |i: usize| DVec3::new(dump.normals[3 * i] as f64, dump.normals[3 * i + 1] as f64, dump.normals[3 * i + 2] as f64);

@@ -8,6 +8,9 @@
 //!   direction the light travels), `"cone_deg"`, `"radius"`; top level `"camera"`
 //!   `{"eye","target","up","fov_y_deg","near"}`. Any other top-level key is kept in
 //!   [`Dump::extra`]. Readers accept dumps with only the required keys.
+//!   `"spheres": [{"center": [x,y,z], "radius": r}, ...]` (f64, world space) lists the
+//!   shadow-casting analytic spheres, written when there are any; their pixels in
+//!   `positions.f32`/`normals.f32` are the exact sphere surface (ray-cast, not tessellated).
 //! * `world.obj`: every shadow-casting triangle in world space (`v x y z`, `f a b c`,
 //!   1-based; the reader also accepts `a/b/c` tokens, negative indices and polygons, which
 //!   it fans).
@@ -115,6 +118,8 @@ pub struct Dump {
     pub normals: Vec<f32>,
     /// One W*H mask per light (255 lit, 0 not lit, 128 background).
     pub shadow: Vec<Vec<u8>>,
+    /// Shadow-casting analytic spheres (`"spheres"`), world space.
+    pub spheres: Vec<crate::geom::Sphere>,
     /// Optional full camera (written as "camera").
     pub camera: Option<Camera>,
     /// Other top-level keys of frame.json, kept as they are.
@@ -129,6 +134,8 @@ struct FrameJson {
     lights: Vec<LightJson>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     camera: Option<CameraJson>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    spheres: Vec<SphereJson>,
     #[serde(flatten)]
     extra: BTreeMap<String, serde_json::Value>,
 }
@@ -144,6 +151,13 @@ struct LightJson {
     cone_deg: Option<f32>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     radius: Option<f32>,
+}
+
+#[derive(serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SphereJson {
+    center: [f64; 3],
+    radius: f64,
 }
 
 #[derive(serde::Serialize, serde::Deserialize)]
@@ -230,6 +244,7 @@ pub fn write_dump(dir: impl AsRef<Path>, dump: &Dump) -> Result<()> {
             fov_y_deg: c.fov_y_deg,
             near: c.near,
         }),
+        spheres: dump.spheres.iter().map(|s| SphereJson { center: s.center.to_array(), radius: s.radius }).collect(),
         extra: dump.extra.clone(),
     };
     let p = dir.join("frame.json");
@@ -378,6 +393,15 @@ pub fn read_dump(dir: impl AsRef<Path>) -> Result<Dump> {
         near: c.near,
     });
 
+    let mut spheres = Vec::new();
+    for (k, s) in frame.spheres.iter().enumerate() {
+        let sphere = crate::geom::Sphere { center: glam::DVec3::from_array(s.center), radius: s.radius };
+        if let Some(problem) = sphere.problem() {
+            return Err(Error::input(&loc, format!("sphere {k}: {problem}")));
+        }
+        spheres.push(sphere);
+    }
+
     let p = dir.join("world.obj");
     let text = std::fs::read_to_string(&p).map_err(|e| Error::input(p.display().to_string(), format!("cannot read world.obj: {e}")))?;
     let triangles = parse_obj(&text, &p.display().to_string())?;
@@ -417,6 +441,7 @@ pub fn read_dump(dir: impl AsRef<Path>) -> Result<Dump> {
         positions,
         normals,
         shadow,
+        spheres,
         camera,
         extra: frame.extra,
     })

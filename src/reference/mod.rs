@@ -191,8 +191,21 @@ pub struct Reference {
     /// (0 for opaque casters); see [`transmit`].
     filters: Vec<[f64; 3]>,
     scale: f64,
+    /// Exact spheres, seen and (when they cast shadows) occluding: intersected analytically.
+    spheres: Vec<RefSphere>,
     /// How close to a shadow boundary a point may be before it is called ambiguous.
     pub tolerance: Tolerance,
+}
+
+/// An exact sphere of a [`Reference`] ([`Reference::with_spheres`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RefSphere {
+    /// Centre and radius, world space.
+    pub sphere: crate::geom::Sphere,
+    /// Casts shadows.
+    pub occluder: bool,
+    /// The id reported in [`RefPixel::mesh`] (after the scene's meshes: `meshes.len() + i`).
+    pub mesh: u32,
 }
 
 /// Per-triangle flags for [`Reference::new`].
@@ -256,8 +269,35 @@ impl Reference {
             mesh_of,
             filters: kept_filters,
             scale,
+            spheres: Vec::new(),
             tolerance: Tolerance::default(),
         }
+    }
+
+    /// The same reference with exact spheres added (seen by camera rays, occluding when
+    /// `occluder`); the scene size then covers them too. Spheres that are not finite or have
+    /// no positive radius are dropped.
+    pub fn with_spheres(mut self, spheres: &[RefSphere]) -> Reference {
+        self.spheres.extend(spheres.iter().copied().filter(|s| s.sphere.problem().is_none()));
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for p in self.tris.iter().flatten() {
+            lo = lo.min(*p);
+            hi = hi.max(*p);
+        }
+        for s in &self.spheres {
+            lo = lo.min(s.sphere.center - s.sphere.radius);
+            hi = hi.max(s.sphere.center + s.sphere.radius);
+        }
+        if lo.is_finite() && hi.is_finite() {
+            self.scale = (hi - lo).length().max(1e-30);
+        }
+        self
+    }
+
+    /// The exact spheres of this reference.
+    pub fn spheres(&self) -> &[RefSphere] {
+        &self.spheres
     }
 
     /// All triangles visible, all occluding, mesh 0.
@@ -289,7 +329,14 @@ impl Reference {
                 filters.push(filter);
             }
         }
-        Reference::with_filters(tris, &flags, &filters)
+        let base = scene.meshes.len() as u32;
+        let spheres: Vec<RefSphere> = scene
+            .spheres
+            .iter()
+            .enumerate()
+            .map(|(i, s)| RefSphere { sphere: s.sphere, occluder: s.casts_shadow, mesh: base + i as u32 })
+            .collect();
+        Reference::with_filters(tris, &flags, &filters).with_spheres(&spheres)
     }
 
     /// The same reference with another [`Tolerance`].
@@ -314,5 +361,7 @@ impl Reference {
     }
 }
 
+#[cfg(test)]
+mod sphere_tests;
 #[cfg(test)]
 mod tests;

@@ -102,8 +102,9 @@ impl Reference {
     /// light. Transparent casters (non-zero filter) do not occlude: they attenuate, and are
     /// judged by [`Reference::transmittance_at`].
     fn occluded(&self, p: DVec3, n: DVec3, light: &Light) -> bool {
-        self.shadow_segment(p, n, light)
-            .is_some_and(|(o, d, t_max)| self.occluders.any_hit(o, d, 0.0, t_max, |t| self.filter(t) != [0.0; 3]))
+        self.shadow_segment(p, n, light).is_some_and(|(o, d, t_max)| {
+            self.occluders.any_hit(o, d, 0.0, t_max, |t| self.filter(t) != [0.0; 3]) || self.sphere_blocks(o, d, t_max)
+        })
     }
 
     /// The shadow ray of surface point `p` (offset along `n`): origin, unit direction towards
@@ -171,26 +172,49 @@ impl Reference {
         // Angular size of one pixel (vertical), for the footprint.
         let pix_angle = 2.0 * ((camera.fov_y_deg as f64).to_radians() * 0.5).tan() / height.max(1) as f64;
         let (o, d) = camera.pixel_ray(x, y, width, height);
-        let hit = self.visible.closest_hit(o, d, 0.0, f64::INFINITY)?;
-        let t = &self.tris[hit.tri as usize];
-        let p = t[0] * (1.0 - hit.u - hit.v) + t[1] * hit.u + t[2] * hit.v;
-        // The visible side of the surface: its geometric normal turned towards the eye (a
-        // closed, outward mesh is only ever seen from the front, so this changes nothing
-        // there; open and two-sided surfaces are lit on the side the eye sees when that side
-        // faces the light).
-        let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
-        let n = if n.dot(d) > 0.0 { -n } else { n };
+        let hit = self.visible.closest_hit(o, d, 0.0, f64::INFINITY);
+        // An exact sphere in front of the nearest triangle is what the pixel sees.
+        let t_tri = hit.as_ref().map_or(f64::INFINITY, |h| h.t);
+        let (p, n, mesh, tri) = match self.sphere_hit(o, d, t_tri) {
+            Some((t_s, s)) => {
+                let p = o + d * t_s;
+                ((p), (p - s.sphere.center) / s.sphere.radius, s.mesh, u32::MAX)
+            }
+            None => {
+                let hit = hit?;
+                let t = &self.tris[hit.tri as usize];
+                let p = t[0] * (1.0 - hit.u - hit.v) + t[1] * hit.u + t[2] * hit.v;
+                // The visible side of the surface: its geometric normal turned towards the eye (a
+                // closed, outward mesh is only ever seen from the front, so this changes nothing
+                // there; open and two-sided surfaces are lit on the side the eye sees when that side
+                // faces the light).
+                let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
+                (p, if n.dot(d) > 0.0 { -n } else { n }, self.mesh_of[hit.tri as usize], hit.tri)
+            }
+        };
         let depth = (p - eye).length();
         let r = self.tolerance.footprint_fraction * depth * pix_angle;
-        let pixel = RefPixel {
-            hit: true,
-            position: p.as_vec3(),
-            normal: n.as_vec3(),
-            depth: depth as f32,
-            mesh: self.mesh_of[hit.tri as usize],
-            tri: hit.tri,
-        };
+        let pixel = RefPixel { hit: true, position: p.as_vec3(), normal: n.as_vec3(), depth: depth as f32, mesh, tri };
         Some((pixel, p, n, r))
+    }
+}
+
+impl Reference {
+    /// The nearest sphere the ray `o + t d` enters before `t_max` (the eye is outside every
+    /// sphere: scenes refuse it), with its `t`.
+    fn sphere_hit(&self, o: DVec3, d: DVec3, t_max: f64) -> Option<(f64, &super::RefSphere)> {
+        let mut best: Option<(f64, &super::RefSphere)> = None;
+        for s in &self.spheres {
+            if let Some(t) = s.sphere.ray_hit(o, d, 0.0, best.map_or(t_max, |b| b.0)) {
+                best = Some((t, s));
+            }
+        }
+        best
+    }
+
+    /// Whether a shadow-casting sphere meets the segment `o + t d`, `0 < t < t_max`.
+    pub(crate) fn sphere_blocks(&self, o: DVec3, d: DVec3, t_max: f64) -> bool {
+        self.spheres.iter().any(|s| s.occluder && s.sphere.ray_hit(o, d, 0.0, t_max).is_some())
     }
 }
 

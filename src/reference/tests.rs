@@ -131,6 +131,7 @@ fn scene(meshes: Vec<(Mesh, bool)>, lights: Vec<Light>, camera: Camera) -> Scene
             })
             .collect(),
         ambient: Vec3::splat(0.08),
+        spheres: Vec::new(),
     }
 }
 
@@ -298,6 +299,7 @@ fn dump_from(img: &RefImage, s: &Scene) -> Dump {
         positions: img.positions_f32(),
         normals: img.normals_f32(),
         shadow: (0..img.light_count).map(|k| img.mask(k)).collect(),
+        spheres: s.spheres.iter().filter(|s| s.casts_shadow).map(|s| s.sphere).collect(),
         camera: Some(s.camera.clone()),
         extra: Default::default(),
     }

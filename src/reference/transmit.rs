@@ -382,6 +382,7 @@ mod tests {
             lights: vec![point_light(Vec3::new(0.0, 6.0, 0.0))],
             meshes,
             ambient: Vec3::splat(0.08),
+            spheres: Vec::new(),
         }
     }
 

@@ -26,6 +26,7 @@ mod readback;
 mod scene_gpu;
 mod selfshadow;
 pub mod shadowmap;
+mod sphere_gpu;
 pub mod stats;
 pub mod targets;
 mod timing;

@@ -32,6 +32,8 @@ pub(crate) struct FramePipelines {
     pub sampler: vk::Sampler,
     pub gbuffer: vk::Pipeline,
     pub gbuffer_two_sided: vk::Pipeline,
+    /// Analytic spheres: their bounding cubes' back faces, ray-cast, depth written.
+    pub gbuffer_sphere: vk::Pipeline,
     /// `[stencil, float count][without, with the light-intensity map]`.
     pub illuminate: [[vk::Pipeline; 2]; 2],
     pub transparent_over: vk::Pipeline,
@@ -101,6 +103,17 @@ impl FramePipelines {
         let gbuffer = create(&g)?;
         g.cull = vk::CullModeFlags::NONE;
         let gbuffer_two_sided = create(&g)?;
+        let mut gs = PipelineDesc::new(shaders::SPHERE_VERT, layouts.gbuffer, df);
+        gs.fragment = Some(shaders::SPHERE_FRAG);
+        gs.vertex_stride = VERTEX_STRIDE;
+        gs.attributes = &VERTEX_ATTRIBUTES;
+        gs.color_formats = &gbuffer_formats;
+        gs.depth_test = true;
+        gs.depth_write = true;
+        gs.depth_compare = vk::CompareOp::LESS;
+        // Back faces: they cover the sphere's projection wherever the eye is outside it.
+        gs.cull = vk::CullModeFlags::FRONT;
+        let gbuffer_sphere = create(&gs)?;
 
         let accum = [ACCUM_FORMAT];
         let mut i = PipelineDesc::new(shaders::FULLSCREEN_VERT, layouts.illuminate, df);
@@ -144,6 +157,7 @@ impl FramePipelines {
             sampler,
             gbuffer,
             gbuffer_two_sided,
+            gbuffer_sphere,
             illuminate,
             transparent_over,
             transparent_light,

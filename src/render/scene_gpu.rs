@@ -115,7 +115,11 @@ impl SceneGeometry {
             }
         }
         if all.is_empty() {
-            return Err(Error::Other(format!("scene '{}' has no triangle to draw", scene.name)));
+            if scene.spheres.is_empty() {
+                return Err(Error::Other(format!("scene '{}' has no triangle or sphere to draw", scene.name)));
+            }
+            // Spheres only: a buffer to bind (never drawn from; no mesh ranges).
+            all.push([0.0; 10]);
         }
         let vertices = upload(ctx, "scene", bytemuck::cast_slice(&all), vk::BufferUsageFlags::VERTEX_BUFFER)?;
         let baked = scene.meshes.iter().map(|m| m.transform.as_dmat4()).collect();

@@ -29,6 +29,8 @@ pub const SCENES: &[(&str, &str)] = &[
     ("hard/staircase_300", include_str!("../../scenes/hard/staircase_300.toml")),
     ("hard/background", include_str!("../../scenes/hard/background.toml")),
     ("hard/look_at_light", include_str!("../../scenes/hard/look_at_light.toml")),
+    ("analytic/sphere_only", include_str!("../../scenes/analytic/sphere_only.toml")),
+    ("analytic/sphere_and_meshes", include_str!("../../scenes/analytic/sphere_and_meshes.toml")),
     ("transparent/balls_and_cubes", include_str!("../../scenes/transparent/balls_and_cubes.toml")),
     ("transparent/inner_structure", include_str!("../../scenes/transparent/inner_structure.toml")),
     ("transparent/depth_1", include_str!("../../scenes/transparent/depth_1.toml")),

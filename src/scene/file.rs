@@ -6,6 +6,7 @@
 mod keys;
 mod lights;
 mod meshes;
+mod spheres;
 
 use super::Scene;
 use crate::error::{Error, Result};
@@ -47,11 +48,20 @@ pub(crate) fn parse(src: &str, origin: &str, objs: ObjSource<'_>) -> Result<Scen
         meshes.push(meshes::mesh(&cx, i, &sm.span(), sm.get_ref(), &objs)?);
     }
 
+    let mut spheres = Vec::new();
+    for (i, ss) in file.sphere.iter().enumerate() {
+        let sp = spheres::sphere(&cx, i, &ss.span(), ss.get_ref())?;
+        spheres::check_placement(&cx, &ss.span(), &sp, &camera, &lights)?;
+        spheres.push(sp);
+    }
+
     let name = file
         .name
         .unwrap_or_else(|| Path::new(origin).file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| origin.to_string()));
-    Ok(Scene { name, camera, lights, meshes, ambient })
+    Ok(Scene { name, camera, lights, meshes, ambient, spheres })
 }
 
+#[cfg(test)]
+mod sphere_tests;
 #[cfg(test)]
 mod tests;

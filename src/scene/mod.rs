@@ -37,6 +37,44 @@ impl SceneMesh {
     }
 }
 
+/// An analytic sphere of a scene (`[[sphere]]`): drawn exactly (ray-cast), casting a shadow
+/// volume from its tangency circle as an n-gon ([`geom::sphere`](crate::geom::sphere)).
+#[derive(Clone, Debug)]
+pub struct SceneSphere {
+    /// The table's `name`, else `sphere<i>`.
+    pub name: String,
+    /// Centre and radius, world space (f64).
+    pub sphere: crate::geom::Sphere,
+    /// Linear RGB albedo.
+    pub color: Vec3,
+    /// 1 (transparent spheres are refused at load).
+    pub opacity: f32,
+    /// Whether the sphere casts shadows (every sphere receives them).
+    pub casts_shadow: bool,
+    /// Fixed number of segments of the shadow volume's polygon (`None`: chosen per frame and
+    /// light so the shadow's error stays under half a pixel).
+    pub segments: Option<u32>,
+}
+
+/// Why a sphere cannot be rendered with this camera and these lights: the eye inside or on
+/// it, or a positional light inside or on it while it casts shadows.
+pub fn sphere_placement_problem(sp: &SceneSphere, camera: &Camera, lights: &[Light]) -> Option<String> {
+    if sp.sphere.contains(camera.eye.as_dvec3()) {
+        return Some(format!("{}: the camera eye {} is inside or on the sphere (not supported: move the eye out)", sp.name, camera.eye));
+    }
+    if sp.casts_shadow {
+        for (li, l) in lights.iter().enumerate() {
+            if l.kind != LightKind::Directional && sp.sphere.tangency(l.position.as_dvec3().extend(1.0)).is_none() {
+                return Some(format!(
+                    "{}: light {li} at {} is inside or on the shadow-casting sphere (it would light nothing: no tangent cone exists)",
+                    sp.name, l.position
+                ));
+            }
+        }
+    }
+    None
+}
+
 /// A whole scene: one camera, any number of lights and meshes.
 #[derive(Clone, Debug)]
 pub struct Scene {
@@ -50,6 +88,8 @@ pub struct Scene {
     pub meshes: Vec<SceneMesh>,
     /// Ambient light colour (default 0.08 grey).
     pub ambient: Vec3,
+    /// Analytic spheres (`[[sphere]]`).
+    pub spheres: Vec<SceneSphere>,
 }
 
 pub mod builtin;

@@ -12,6 +12,7 @@ use super::readback::{Layout, Readback};
 use super::scene_gpu::{SceneGeometry, Sidedness};
 use super::selfshadow::SelfShadow;
 use super::shadowmap::ShadowMapper;
+use super::sphere_gpu::SphereGeometry;
 use super::targets::*;
 use super::timing::{Span, Timer};
 mod memory;
@@ -91,6 +92,7 @@ pub struct Renderer {
     caster_ids: Vec<Option<CasterId>>,
     has_transparent: bool,
     geo: SceneGeometry,
+    spheres: SphereGeometry,
     targets: Targets,
     pipes: FramePipelines,
     self_shadow: Option<SelfShadow>,
@@ -141,12 +143,23 @@ impl Renderer {
                 false => None,
             });
         }
+        for s in scene.spheres.iter().filter(|s| s.casts_shadow) {
+            pass.add_sphere_caster(&s.name, s.sphere, s.segments)?;
+        }
         let has_transparent = pass.casters().iter().any(|c| c.transmittance.is_some());
         // Each step that fails releases what the steps before it made (the pass drops itself).
         let mut geo = SceneGeometry::new(&ctx, &scene, config.frames_in_flight)?;
+        let mut spheres = match SphereGeometry::new(&ctx, &scene, config.frames_in_flight) {
+            Ok(s) => s,
+            Err(e) => {
+                geo.destroy(&ctx);
+                return Err(e);
+            }
+        };
         let mut targets = match Targets::new(&ctx, config.width, config.height, transmit_format) {
             Ok(t) => t,
             Err(e) => {
+                spheres.destroy(&ctx);
                 geo.destroy(&ctx);
                 return Err(e);
             }
@@ -155,6 +168,7 @@ impl Renderer {
             Ok(p) => p,
             Err(e) => {
                 targets.destroy(&ctx);
+                spheres.destroy(&ctx);
                 geo.destroy(&ctx);
                 return Err(e);
             }
@@ -166,6 +180,7 @@ impl Renderer {
                     // SAFETY: nothing was submitted with the pipelines yet.
                     unsafe { pipes.destroy(&ctx) };
                     targets.destroy(&ctx);
+                    spheres.destroy(&ctx);
                     geo.destroy(&ctx);
                     return Err(e);
                 }
@@ -206,6 +221,7 @@ impl Renderer {
                         pipes.destroy(&ctx);
                     }
                     targets.destroy(&ctx);
+                    spheres.destroy(&ctx);
                     geo.destroy(&ctx);
                     return Err(e);
                 }
@@ -219,6 +235,7 @@ impl Renderer {
             caster_ids,
             has_transparent,
             geo,
+            spheres,
             targets,
             pipes,
             self_shadow,
@@ -244,6 +261,7 @@ impl Renderer {
             std::ptr::drop_in_place(&mut me.slots);
             std::ptr::drop_in_place(&mut me.self_shadow);
             std::ptr::drop_in_place(&mut me.shadow_mapper);
+            std::ptr::drop_in_place(&mut me.spheres);
             std::ptr::read(&me.ctx)
         }
     }
@@ -277,8 +295,16 @@ impl Renderer {
             DepthMode::Clamp => {
                 // Far plane just beyond the scene: everything further is clamped to depth 1.
                 let eye = self.scene.camera.eye;
-                let far =
-                    self.scene.meshes.iter().flat_map(|m| m.world_bounds().corners()).map(|c| c.distance(eye)).fold(1.0f32, f32::max) * 1.5;
+                let spheres = self.scene.spheres.iter().map(|s| (s.sphere.center.distance(eye.as_dvec3()) + s.sphere.radius) as f32);
+                let far = self
+                    .scene
+                    .meshes
+                    .iter()
+                    .flat_map(|m| m.world_bounds().corners())
+                    .map(|c| c.distance(eye))
+                    .chain(spheres)
+                    .fold(1.0f32, f32::max)
+                    * 1.5;
                 self.scene.camera.proj_finite(aspect, far.max(self.scene.camera.near * 2.0))
             }
         }
@@ -324,6 +350,7 @@ impl Renderer {
         self.next_slot = (slot + 1) % self.slots.len();
         self.retire(slot)?;
         check_options(&self.ctx, &self.config, &self.settings)?;
+        check_spheres(&self.scene, &self.settings)?;
         let wall = Instant::now();
         let settings = self.settings;
         let (w, h) = (self.config.width, self.config.height);
@@ -347,6 +374,7 @@ impl Renderer {
         };
         let record_start = Instant::now();
         let instances = self.geo.write_instances(slot, &self.scene)?;
+        let spheres = self.spheres.write(slot, &self.scene)?;
         let capture = settings.capture || settings.view == View::Stencil;
         let float_counts = settings.counter == Counter::Float || self.shadow_mapper.is_some();
         let nlights = self.scene.lights.len();
@@ -371,7 +399,7 @@ impl Renderer {
         let full = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: self.targets.extent };
         let viewport = vk::Viewport { x: 0.0, y: 0.0, width: w as f32, height: h as f32, min_depth: 0.0, max_depth: 1.0 };
         let rec = Rec { ctx: &self.ctx, cb, full, viewport, timer: &s.timer, readback };
-        let spans = self.record_frame(&rec, &frame, &layout, instances, vp_rel, &lights, float_counts);
+        let spans = self.record_frame(&rec, &frame, &layout, (instances, spheres), vp_rel, &lights, float_counts);
         // SAFETY: recording finished; the submission signals the slot's fence.
         unsafe {
             d.end_command_buffer(cb).map_err(Error::vk("vkEndCommandBuffer"))?;
@@ -398,7 +426,7 @@ impl Renderer {
         rec: &Rec,
         frame: &PreparedFrame,
         layout: &Layout,
-        instances: vk::Buffer,
+        (instances, spheres): (vk::Buffer, Option<(vk::Buffer, u32)>),
         vp_rel: Mat4,
         lights: &[LightPush],
         float_counts: bool,
@@ -414,7 +442,7 @@ impl Renderer {
         // layouts each pass expects are those the previous pass leaves.
         unsafe {
             pass.cmd_upload(rec.cb, frame);
-            gbuffer::record(rec, t, p, &self.geo, instances, vp_rel, self.scene.ambient);
+            gbuffer::record(rec, t, p, &self.geo, instances, vp_rel, self.scene.ambient, spheres);
             spans.depth.end = stamp(all);
             let into = match (&self.shadow_mapper, self.settings.counter) {
                 (Some(_), _) => determine::CountInto::External,
@@ -554,6 +582,7 @@ impl Renderer {
         }
         self.targets.destroy(ctx);
         self.geo.destroy(ctx);
+        self.spheres.destroy(ctx);
     }
 }
 
@@ -561,6 +590,22 @@ impl Drop for Renderer {
     fn drop(&mut self) {
         self.destroy_resources();
     }
+}
+
+/// Spheres the frame cannot draw: the eye inside or on one (it may have moved there), or
+/// casting spheres with the shadow-map baseline (its depth pass draws meshes only).
+fn check_spheres(scene: &Scene, s: &FrameSettings) -> Result<()> {
+    for sp in &scene.spheres {
+        if let Some(problem) = crate::scene::sphere_placement_problem(sp, &scene.camera, &scene.lights) {
+            return Err(Error::Other(problem));
+        }
+    }
+    if matches!(s.technique, Technique::ShadowMap { .. }) && scene.spheres.iter().any(|s| s.casts_shadow) {
+        return Err(Error::Unsupported(
+            "--method shadowmap does not draw analytic sphere casters into its maps; use a shadow-volume method".into(),
+        ));
+    }
+    Ok(())
 }
 
 /// The pass's share of the frame settings.

@@ -1,7 +1,8 @@
 //! 1. The ambient / G-buffer pass: every opaque mesh, depth LESS, writing the ambient term
 //!    into the float accumulation target and albedo, face normal and eye-relative position
 //!    into the G-buffer. Closed outward meshes are drawn with back faces culled, every other
-//!    opaque mesh two-sided.
+//!    opaque mesh two-sided. Analytic spheres are ray-cast in their bounding cubes (exact
+//!    depth, normal and position).
 
 use super::{att, Rec, DS_CLEAR, ZERO};
 use crate::render::pipelines::FramePipelines;
@@ -13,7 +14,8 @@ use glam::{Mat4, Vec3};
 
 /// # Safety
 /// `rec.cb` is recording outside a rendering instance; `instances` is this slot's instance
-/// buffer, written for this frame.
+/// buffer and `spheres` this slot's sphere cubes (buffer, vertex count), written for this frame.
+#[allow(clippy::too_many_arguments)]
 pub(crate) unsafe fn record(
     rec: &Rec,
     t: &Targets,
@@ -22,6 +24,7 @@ pub(crate) unsafe fn record(
     instances: vk::Buffer,
     vp_rel: Mat4,
     ambient: Vec3,
+    spheres: Option<(vk::Buffer, u32)>,
 ) {
     for img in t.gbuffer() {
         rec.transition(img, vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
@@ -47,6 +50,11 @@ pub(crate) unsafe fn record(
                 d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipe);
                 geo.cmd_draw(d, cb, instances, side);
             }
+        }
+        if let Some((buffer, count)) = spheres {
+            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, p.gbuffer_sphere);
+            d.cmd_bind_vertex_buffers(cb, 0, &[buffer], &[0]);
+            d.cmd_draw(cb, count, 1, 0, 0);
         }
         d.cmd_end_rendering(cb);
     }

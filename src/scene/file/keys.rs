@@ -17,6 +17,20 @@ pub(super) struct FileScene {
     pub(super) light: Vec<Spanned<FileLight>>,
     #[serde(default)]
     pub(super) mesh: Vec<Spanned<FileMesh>>,
+    #[serde(default)]
+    pub(super) sphere: Vec<Spanned<FileSphere>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct FileSphere {
+    pub(super) center: [f64; 3],
+    pub(super) radius: f64,
+    pub(super) name: Option<String>,
+    pub(super) color: Option<[f64; 3]>,
+    pub(super) opacity: Option<f64>,
+    pub(super) casts_shadow: Option<bool>,
+    pub(super) segments: Option<i64>,
 }
 
 #[derive(Deserialize)]
