@@ -14,6 +14,7 @@ use super::selfshadow::SelfShadow;
 use super::shadowmap::ShadowMapper;
 use super::targets::*;
 use super::timing::{Span, Timer};
+mod area;
 mod motion;
 mod stats;
 
@@ -79,7 +80,14 @@ struct FrameSlot {
 
 /// umbrage's renderer (see the module docs).
 pub struct Renderer {
+    /// The scene as rendered: its `lights` are the point lights of this frame, every area
+    /// light split into its samples ([`crate::geom::area`]).
     scene: Scene,
+    /// The scene's lights as given (area lights whole).
+    source_lights: Vec<crate::scene::Light>,
+    /// The frame the area-light samples in `scene.lights` were drawn for (`None`: the fixed
+    /// pattern).
+    samples_for: Option<u64>,
     config: RenderConfig,
     /// What the next frame does (technique, counter, index format, view, capture); checked
     /// against the device before every frame.
@@ -106,8 +114,10 @@ pub struct Renderer {
 impl Renderer {
     /// A renderer for `scene`: its casters prepared and uploaded, targets of the options'
     /// size, pipelines for its fixed settings.
-    pub fn new(ctx: Context, scene: Scene, opts: RenderOptions) -> Result<Renderer> {
+    pub fn new(ctx: Context, mut scene: Scene, opts: RenderOptions) -> Result<Renderer> {
         let (config, settings) = (opts.config(), opts.settings());
+        let source_lights = area::checked_lights(&scene.lights)?;
+        scene.lights = crate::geom::area::expand_lights(&source_lights, None);
         if config.width == 0 || config.height == 0 || config.width > 16384 || config.height > 16384 {
             return Err(Error::Other(format!("invalid image size {}x{} (1..=16384 each)", config.width, config.height)));
         }
@@ -158,6 +168,8 @@ impl Renderer {
         }
         Ok(Renderer {
             scene,
+            source_lights,
+            samples_for: None,
             config,
             settings,
             pass,
@@ -269,6 +281,7 @@ impl Renderer {
         self.next_slot = (slot + 1) % self.slots.len();
         self.retire(slot)?;
         check_options(&self.ctx, &self.config, &self.settings)?;
+        self.update_area_samples();
         let wall = Instant::now();
         let settings = self.settings;
         let (w, h) = (self.config.width, self.config.height);
