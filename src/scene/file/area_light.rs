@@ -36,9 +36,6 @@ pub(super) fn area(cx: &Ctx, s: &Range<usize>, l: &FileLight, position: Vec3, ey
         }
         return Ok(None);
     }
-    if l.direction.is_some() {
-        return Err(cx.key_err(s, "direction", "an area light faces its `normal` (it has no direction)"));
-    }
     if l.cone_deg.is_some() {
         return Err(cx.key_err(s, "cone_deg", "an area light has no cone"));
     }

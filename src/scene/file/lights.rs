@@ -49,6 +49,9 @@ pub(super) fn light(cx: &Ctx, s: &Range<usize>, l: &FileLight, eye: Vec3) -> Res
             })
         }
     };
+    if l.kind == "area" && l.direction.is_some() {
+        return Err(cx.key_err(s, "direction", "an area light faces its `normal` (it has no direction)"));
+    }
     let positional = kind != LightKind::Directional;
     let position = match (positional, l.position) {
         (true, Some(p)) => cx.v3(s, "position", p)?,

@@ -1,0 +1,217 @@
+//! Area lights as jittered point lights (McGuire et al. 2003, §8): the soft shadow's error
+//! against the CPU reference's visible fraction falls with the samples; every sample's hard
+//! shadow is exact; a tiny one-sample disc is the point light; the pattern is fixed unless
+//! jittered; 64+ samples and several area lights render; bad input is refused.
+mod common;
+use std::path::Path;
+use umbrage::reference::{area_error, sample_fraction, AreaMetrics, Reference};
+use umbrage::render::{Counter, RenderOptions, Renderer, Technique};
+use umbrage::scene::{Light, Scene};
+use umbrage::shadow::Method;
+
+fn with_samples(lights: &[Light], n: u32) -> Vec<Light> {
+    lights.iter().map(|l| Light { area: l.area.map(|a| umbrage::geom::AreaLight { samples: n, ..a }), ..l.clone() }).collect()
+}
+
+/// The soft-shadow error of source light `k` in the renderer's last frame.
+fn soft_error(r: &mut Renderer, reference: &umbrage::reference::AreaImage, k: usize) -> AreaMetrics {
+    let frame = r.render().unwrap();
+    let masks = frame.shadow_masks(r.scene());
+    let range = r.light_samples()[k].clone();
+    let gpu = sample_fraction(&masks[range]);
+    area_error(&gpu, reference, 1, 0.1).unwrap()
+}
+
+#[test]
+fn soft_shadow_error_falls_with_samples_and_every_sample_is_exact() {
+    let Some(ctx) = common::context() else { return };
+    let scene = umbrage::scene::load("area/disc").unwrap();
+    let (w, h) = (128, 96);
+    let reference = Reference::from_scene(&scene);
+    let truth = reference.render_area(&scene.camera, &scene.lights[0], w, h, 256);
+    let opts = RenderOptions { width: w, height: h, capture: true, counter: Counter::Float, ..Default::default() };
+    let mut r = Renderer::new(ctx, scene.clone(), opts).unwrap();
+    let mut errors = Vec::new();
+    for n in [1, 4, 16, 64] {
+        r.set_lights(with_samples(&scene.lights, n)).unwrap();
+        let m = soft_error(&mut r, &truth, 0);
+        assert_eq!(r.scene().lights.len(), n as usize);
+        println!(
+            "samples {n:>2}: mean |err| {:.4}, penumbra {:.4} ({} px), rms {:.4}, > 0.1: {:.2}%",
+            m.mean_abs_error,
+            m.penumbra_mean_abs_error,
+            m.penumbra,
+            m.rms_error,
+            m.over_threshold * 100.0
+        );
+        assert!(m.compared > (w * h / 2) as u64, "{m:?}");
+        assert!(m.penumbra > 200, "the scene has wide penumbrae: {m:?}");
+        errors.push(m);
+    }
+    for p in errors.windows(2) {
+        assert!(p[1].mean_abs_error < p[0].mean_abs_error, "error must fall with samples: {errors:#?}");
+        assert!(p[1].penumbra_mean_abs_error < p[0].penumbra_mean_abs_error, "{errors:#?}");
+    }
+    assert!(errors[3].penumbra_mean_abs_error < 0.05, "64 samples: {:?}", errors[3]);
+    assert!(errors[3].over_threshold < 0.01, "64 samples: {:?}", errors[3]);
+    // Each of the 64 samples is a point light whose hard shadow is exact.
+    let rows = umbrage::accuracy::evaluate(&mut r, "area/disc", &[Technique::Volumes(Method::McGuire)], 1).unwrap();
+    assert_eq!(rows[0].per_light.len(), 64);
+    assert!(rows[0].passed, "{:?}", rows[0]);
+    r.context().check_validation().unwrap();
+}
+
+const TINY: &str = r#"
+[camera]
+eye = [0, 5, 7]
+target = [0, 0.5, 0]
+[[light]]
+KIND
+position = [0.5, 4, 0.3]
+radius = 9
+[[mesh]]
+shape = "plane"
+size = [10, 10]
+casts_shadow = false
+[[mesh]]
+shape = "box"
+translate = [0, 0.6, 0]
+rotate_deg = [0, 30, 0]
+"#;
+
+fn tiny(kind: &str) -> Scene {
+    umbrage::scene::load_str(&TINY.replace("KIND", kind), "tiny", Path::new(".")).unwrap()
+}
+
+#[test]
+fn a_one_sample_tiny_disc_is_the_point_light_and_samples_are_planned_each() {
+    let Some(ctx) = common::context() else { return };
+    let opts = RenderOptions { width: 96, height: 72, capture: true, ..Default::default() };
+    let mut r = Renderer::new(ctx, tiny("kind = \"point\""), opts.clone()).unwrap();
+    let point = r.render().unwrap();
+    let point_mask = point.shadow_masks(r.scene());
+    let ctx = r.into_context();
+    let disc = tiny("kind = \"area\"\nsize = 1e-6\nsamples = 1");
+    let mut r = Renderer::new(ctx, disc, opts).unwrap();
+    let area = r.render().unwrap();
+    let area_mask = area.shadow_masks(r.scene());
+    let diff = point_mask[0].iter().zip(&area_mask[0]).filter(|(a, b)| a != b).count();
+    assert!(diff <= 2, "{diff} shadow pixels differ");
+    let max = point.color.iter().zip(&area.color).map(|(a, b)| a.abs_diff(*b)).max().unwrap();
+    assert!(max <= 1 || diff > 0, "colours differ by {max} with identical shadows");
+    let differing = point.color.chunks(4).zip(area.color.chunks(4)).filter(|(a, b)| a != b).count();
+    assert!(differing <= 2 + diff, "{differing} pixels differ");
+
+    // A 1-unit disc, 16 samples, a light range: every sample is planned as its own light (its
+    // own scissor from its own range sphere), and the samples' intensities sum to the light's.
+    let mut lights = tiny("kind = \"area\"\nsize = 1.0\nsamples = 16").lights;
+    lights[0].radius = Some(2.0);
+    lights[0].position = glam::Vec3::new(0.5, 1.8, 0.3);
+    r.set_lights(lights).unwrap();
+    let out = r.render().unwrap();
+    assert_eq!(out.stats.lights.len(), 16);
+    let scissors: std::collections::HashSet<_> = out.stats.lights.iter().map(|l| l.scissor).collect();
+    assert!(scissors.len() > 8, "samples share scissors: {scissors:?}");
+    let sum: f32 = r.scene().lights.iter().map(|l| l.intensity).sum();
+    assert!((sum - 1.0).abs() < 1e-5);
+    r.context().check_validation().unwrap();
+}
+
+#[test]
+fn the_pattern_is_fixed_unless_jittered() {
+    let Some(ctx) = common::context() else { return };
+    let scene = umbrage::scene::load("area/rect").unwrap();
+    let opts = RenderOptions { width: 64, height: 48, ..Default::default() };
+    let mut r = Renderer::new(ctx, scene, opts).unwrap();
+    let a = r.render().unwrap();
+    let la = r.scene().lights.clone();
+    let b = r.render().unwrap();
+    assert_eq!(la, r.scene().lights);
+    assert_eq!(a.color, b.color, "same pattern, same image");
+    r.settings.jitter = true;
+    let c = r.render().unwrap();
+    let lc = r.scene().lights.clone();
+    let d = r.render().unwrap();
+    assert_eq!(lc.len(), 20);
+    assert_ne!(lc, la);
+    assert_ne!(lc, r.scene().lights, "a new pattern every frame");
+    assert_ne!(c.color, d.color);
+    // Back to the fixed pattern.
+    r.settings.jitter = false;
+    let e = r.render().unwrap();
+    assert_eq!(la, r.scene().lights);
+    assert_eq!(a.color, e.color);
+    r.context().check_validation().unwrap();
+}
+
+#[test]
+fn many_samples_and_several_area_lights_render() {
+    let Some(ctx) = common::context() else { return };
+    let mut scene = umbrage::scene::load("area/rect").unwrap();
+    let disc = scene.lights[1].clone();
+    scene.lights = with_samples(&scene.lights, 64);
+    scene.lights.push(Light { position: glam::Vec3::new(2.0, 3.5, 1.0), ..with_samples(&[disc], 256)[0].clone() });
+    let opts = RenderOptions { width: 48, height: 32, capture: true, counter: Counter::Float, ..Default::default() };
+    let mut r = Renderer::new(ctx, scene, opts).unwrap();
+    let out = r.render().unwrap();
+    assert_eq!(out.stats.lights.len(), 64 + 64 + 256);
+    assert_eq!(out.counts.len(), 384);
+    assert_eq!(r.light_samples(), vec![0..64, 64..128, 128..384]);
+    r.context().check_validation().unwrap();
+}
+
+#[test]
+fn bad_area_lights_are_refused() {
+    let base = |light: &str| format!("[camera]\neye = [0, 2, 6]\ntarget = [0, 0, 0]\n[[light]]\n{light}\n[[mesh]]\nshape = \"box\"\n");
+    let cases = [
+        ("kind = \"area\"\nposition = [0, 4, 0]\nsize = 0", "size: area light radius must be finite and > 0"),
+        ("kind = \"area\"\nposition = [0, 4, 0]\nsize = -1", "must be finite and > 0"),
+        ("kind = \"area\"\nposition = [0, 4, 0]\nsize = nan", "non-finite"),
+        ("kind = \"area\"\nposition = [0, 4, 0]\nsize = 1e40", "non-finite"),
+        ("kind = \"area\"\nposition = [0, 4, 0]\nsize = 1e7", "too large"),
+        ("kind = \"area\"\nposition = [0, 4, 0]\nshape = \"rect\"\nsize = [1, 0]", "height must be finite and > 0"),
+        ("kind = \"area\"\nposition = [0, 4, 0]\nsize = 1\nsamples = 0", "samples: must be an integer in [1, 1024]"),
+        ("kind = \"area\"\nposition = [0, 4, 0]\nsize = 1\nsamples = 5000", "samples: must be an integer in [1, 1024]"),
+        ("kind = \"area\"\nposition = [0, 4, 0]", "needs a `size`"),
+        ("kind = \"area\"\nposition = [0, 4, 0]\nshape = \"star\"\nsize = 1", "unknown area-light shape `star`"),
+        ("kind = \"area\"\nposition = [0, 4, 0]\nshape = \"rect\"\nsize = 1", "[width, height]"),
+        ("kind = \"area\"\nposition = [0, 4, 0]\nsize = [1, 2]", "one number"),
+        ("kind = \"area\"\nposition = [0, 4, 0]\nsize = 1\nnormal = [0, 0, 0]", "normal: must be a nonzero vector"),
+        ("kind = \"area\"\nposition = [0, 4, 0]\nsize = 1\ntangent = [1, 0, 0]", "only a rectangle has a tangent"),
+        ("kind = \"area\"\nposition = [0, 4, 0]\nshape = \"rect\"\nsize = [1, 1]\ntangent = [0, 2, 0]", "not parallel to the normal"),
+        ("kind = \"area\"\nposition = [0, 4, 0]\nsize = 1\ndirection = [0, -1, 0]", "faces its `normal`"),
+        ("kind = \"area\"\nsize = 1", "needs a position"),
+        ("kind = \"area\"\nposition = [0.3, 2, 6]\nsize = 1\nnormal = [0, 0, 1]", "the camera eye lies on the area light"),
+        ("kind = \"point\"\nposition = [0, 4, 0]\nsamples = 4", "only area lights"),
+        ("kind = \"spot\"\nposition = [0, 4, 0]\ndirection = [0, -1, 0]\nsize = 1", "only area lights"),
+    ];
+    for (light, want) in cases {
+        let err = umbrage::scene::load_str(&base(light), "bad.toml", Path::new(".")).err();
+        let msg = err.map(|e| e.to_string()).unwrap_or_default();
+        assert!(msg.contains(want), "{light:?}: expected {want:?}, got {msg:?}");
+        assert!(msg.contains("bad.toml:"), "{msg}");
+    }
+}
+
+#[test]
+fn bad_area_lights_given_to_a_renderer_are_refused() {
+    let Some(ctx) = common::context() else { return };
+    let scene = umbrage::scene::load("area/disc").unwrap();
+    let good = scene.lights.clone();
+    let mut r = Renderer::new(ctx, scene, RenderOptions { width: 32, height: 24, ..Default::default() }).unwrap();
+    let mut bad = good.clone();
+    bad[0].area.as_mut().unwrap().samples = 0;
+    assert!(r.set_lights(bad).unwrap_err().to_string().contains("samples"));
+    let mut bad = good.clone();
+    bad[0].area.as_mut().unwrap().shape = umbrage::geom::AreaShape::Disc { radius: f32::NAN };
+    assert!(r.set_lights(bad).is_err());
+    let mut bad = good.clone();
+    bad[0].kind = umbrage::scene::LightKind::Directional;
+    assert!(r.set_lights(bad).is_err());
+    let too_many = with_samples(&good, 1024).into_iter().cycle().take(5).collect();
+    assert!(r.set_lights(too_many).unwrap_err().to_string().contains("at most 4096"));
+    // Nothing changed: the next frame still renders the scene's light.
+    assert_eq!(r.source_lights(), &good[..]);
+    r.render().unwrap();
+    r.context().check_validation().unwrap();
+}
