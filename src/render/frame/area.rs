@@ -10,6 +10,17 @@ use crate::scene::{Light, LightKind};
 /// The most point lights (area-light samples included) a frame may have.
 pub const MAX_FRAME_LIGHTS: usize = 4096;
 
+/// The accumulation format for a scene with `lights`: RGBA32F when one is an area light and
+/// the device can blend it (many small additions lose too much in fp16), else RGBA16F (every
+/// scene without area lights renders exactly as before).
+pub(super) fn accum_format(lights: &[Light], rgba32f_blend: bool) -> ash::vk::Format {
+    use crate::render::targets::{ACCUM_FORMAT, ACCUM_FORMAT_FP32};
+    match rgba32f_blend && lights.iter().any(|l| l.area.is_some()) {
+        true => ACCUM_FORMAT_FP32,
+        false => ACCUM_FORMAT,
+    }
+}
+
 /// `lights`, checked: every area light valid and of kind point, and no more than
 /// [`MAX_FRAME_LIGHTS`] point lights once they are split into samples.
 pub(super) fn checked_lights(lights: &[Light]) -> Result<Vec<Light>> {

@@ -127,6 +127,7 @@ impl Renderer {
         check_options(&ctx, &config, &settings)?;
         let transmit_format = opts.transmit.format();
         let f = &ctx.features;
+        let accum_format = area::accum_format(&source_lights, f.rgba32f_blend);
         let desc = ShadowPassDesc {
             depth_stencil_format: ctx.depth_format,
             frames_in_flight: config.frames_in_flight,
@@ -138,7 +139,7 @@ impl Renderer {
             },
             settings: pass_settings(&settings),
             transmit_format: Some(transmit_format),
-            debug_color_format: Some(ACCUM_FORMAT),
+            debug_color_format: Some(accum_format),
         };
         let mut pass = ShadowPass::new(&ctx.instance, ctx.physical, &ctx.device, (*ctx.allocator).clone(), &desc)?;
         let mut caster_ids = Vec::with_capacity(scene.meshes.len());
@@ -150,7 +151,7 @@ impl Renderer {
         }
         let has_transparent = pass.casters().iter().any(|c| c.transmittance.is_some());
         let geo = SceneGeometry::new(&ctx, &scene, config.frames_in_flight)?;
-        let targets = Targets::new(&ctx, config.width, config.height, transmit_format)?;
+        let targets = Targets::with_accum(&ctx, config.width, config.height, transmit_format, accum_format)?;
         let pipes = FramePipelines::new(&ctx, &targets, pass.capabilities().depth_bounds)?;
         let self_shadow = match config.self_shadow && geo.of(Sidedness::Transparent).next().is_some() {
             true => Some(SelfShadow::new(&ctx, &pipes, targets.extent, transmit_format)?),
@@ -205,7 +206,9 @@ impl Renderer {
         }
     }
 
-    /// The scene as it stands (camera, lights and transforms included).
+    /// The scene as it stands (camera, lights and transforms included). Its `lights` are the
+    /// point lights the frames render: every area light split into its samples (those of the
+    /// last submitted frame under `jitter`); [`Renderer::source_lights`] has them whole.
     pub fn scene(&self) -> &Scene {
         &self.scene
     }
