@@ -48,6 +48,7 @@
 //!     intensity: 1.0,
 //!     radius: None,
 //!     cone_deg: 45.0,
+//!     area: None,
 //! };
 //! let (width, height) = (640, 480);
 //! let view_proj = camera.proj_infinite(width as f32 / height as f32) * camera.view();

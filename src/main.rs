@@ -45,6 +45,10 @@ struct FrameArgs {
     /// passes read a light-intensity map built on the nearest transparent surface.
     #[arg(long)]
     self_shadow: bool,
+    /// Re-draw the area lights' jittered sample pattern every frame (default: the same
+    /// pattern every frame).
+    #[arg(long)]
+    jitter: bool,
 }
 
 /// `--method`: every technique `render` and `bench` accept.
@@ -219,6 +223,7 @@ impl Default for FrameArgs {
             transmit: TransmitArg::Log16,
             shadow_map_size: 2048,
             self_shadow: false,
+            jitter: false,
         }
     }
 }
@@ -279,6 +284,7 @@ impl FrameArgs {
             counter: self.counter,
             transmit: self.transmit.mode(),
             self_shadow: self.self_shadow,
+            jitter: self.jitter,
             ..Default::default()
         })
     }
@@ -325,10 +331,12 @@ fn render(frame: &FrameArgs, out: &Path, stats: Option<&Path>, view: View, dump:
 }
 
 fn info(json: bool, scene: Option<&str>) -> Result<ExitCode> {
-    let casters = match scene {
-        Some(s) => Some(umbrage::output::caster_report(&umbrage::scene::load(s)?)?),
+    let loaded = scene.map(umbrage::scene::load).transpose()?;
+    let casters = match &loaded {
+        Some(s) => Some(umbrage::output::caster_report(s)?),
         None => None,
     };
+    let lights = loaded.as_ref().map(umbrage::output::light_report);
     let ctx = umbrage::gpu::Context::new()?;
     let report = umbrage::output::info_report(&ctx);
     if json {
@@ -336,9 +344,19 @@ fn info(json: bool, scene: Option<&str>) -> Result<ExitCode> {
         if let (Some(obj), Some(c)) = (value.as_object_mut(), casters) {
             obj.insert("casters".into(), serde_json::to_value(c).map_err(|e| Error::Other(e.to_string()))?);
         }
+        if let (Some(obj), Some(l)) = (value.as_object_mut(), &lights) {
+            obj.insert("lights".into(), serde_json::to_value(l).map_err(|e| Error::Other(e.to_string()))?);
+        }
         println!("{}", serde_json::to_string_pretty(&value).map_err(|e| Error::Other(e.to_string()))?);
     } else {
         println!("{}", umbrage::output::info_text(&report));
+        for (i, l) in lights.iter().flatten().enumerate() {
+            let what = match (&l.shape, &l.size) {
+                (Some(s), Some(v)) => format!("area {s} {v:?}, {} jittered point lights", l.point_lights),
+                _ => l.kind.clone(),
+            };
+            println!("  light {i:<3} {what}");
+        }
         for c in casters.iter().flatten() {
             println!(
                 "  caster {:<24} {:<12} {:>8} triangles {:>3} chunk(s){}",

@@ -275,3 +275,50 @@ fn mesh_caster_report(scene: &Scene) -> Result<Vec<CasterInfo>> {
         })
         .collect()
 }
+
+/// One light of `umbrage info --scene`: what it is and how many point lights render it.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct LightInfo {
+    /// `point`, `spot`, `directional` or `area`.
+    pub kind: String,
+    /// An area light's shape: `disc` or `rect`.
+    pub shape: Option<String>,
+    /// An area light's size: `[radius]` for a disc, `[width, height]` for a rectangle.
+    pub size: Option<Vec<f32>>,
+    /// The point lights it is rendered as (an area light's `samples`; 1 otherwise), each with
+    /// its own determination (its own scissor and depth bounds) and illumination pass.
+    pub point_lights: u32,
+    /// Position (the centre of an area light), world space; absent for a directional light.
+    pub position: Option<[f32; 3]>,
+}
+
+/// Describes every light of `scene` (no GPU needed).
+pub fn light_report(scene: &Scene) -> Vec<LightInfo> {
+    use crate::geom::AreaShape;
+    use crate::scene::LightKind;
+    scene
+        .lights
+        .iter()
+        .map(|l| {
+            let (kind, shape, size, n) = match (&l.area, l.kind) {
+                (Some(a), _) => {
+                    let (s, v) = match a.shape {
+                        AreaShape::Disc { radius } => ("disc", vec![radius]),
+                        AreaShape::Rect { width, height } => ("rect", vec![width, height]),
+                    };
+                    ("area", Some(s.to_string()), Some(v), a.samples)
+                }
+                (None, LightKind::Point) => ("point", None, None, 1),
+                (None, LightKind::Spot) => ("spot", None, None, 1),
+                (None, LightKind::Directional) => ("directional", None, None, 1),
+            };
+            LightInfo {
+                kind: kind.into(),
+                shape,
+                size,
+                point_lights: n,
+                position: (l.kind != LightKind::Directional).then(|| l.position.to_array()),
+            }
+        })
+        .collect()
+}

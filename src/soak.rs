@@ -165,15 +165,17 @@ fn drift(v: &[u64]) -> f64 {
 }
 
 fn apply(r: &mut Renderer, state: &Scene) -> Result<()> {
-    r.set_lights(state.lights.clone());
+    r.set_lights(state.lights.clone())?;
     for (k, m) in state.meshes.iter().enumerate().filter(|(_, m)| m.casts_shadow) {
         r.set_mesh_transform(k, m.transform)?;
     }
     Ok(())
 }
 
-fn mismatches(a: &FrameOutput, b: &FrameOutput, scene: &Scene) -> usize {
-    let (ma, mb) = (a.shadow_masks(scene), b.shadow_masks(scene));
+/// Differing mask pixels of two frames, each read with the scene its renderer drew (area
+/// lights as their point-light samples).
+fn mismatches(a: &FrameOutput, sa: &Scene, b: &FrameOutput, sb: &Scene) -> usize {
+    let (ma, mb) = (a.shadow_masks(sa), b.shadow_masks(sb));
     ma.iter().zip(&mb).map(|(x, y)| x.iter().zip(y).filter(|(p, q)| p != q).count()).sum::<usize>()
         + ma.len().abs_diff(mb.len()) * (a.width * a.height) as usize
 }
@@ -218,6 +220,7 @@ pub fn soak(cfg: &SoakConfig) -> Result<SoakReport> {
     let state = state_at(&base, cfg.frames - 1, cfg.period);
     let (width, height, frames_in_flight) = (r.config().width, r.config().height, r.config().frames_in_flight);
     let seconds = start.elapsed().as_secs_f64();
+    let drawn = r.scene().clone();
     let ctx = r.into_context();
     validation_errors += ctx.take_validation_errors().len();
 
@@ -227,7 +230,7 @@ pub fn soak(cfg: &SoakConfig) -> Result<SoakReport> {
     let mut fresh = Renderer::new(ctx, state.clone(), opts)?;
     let reference = fresh.render()?;
     validation_errors += fresh.context().take_validation_errors().len();
-    let final_mask_mismatches = mismatches(&last, &reference, &state);
+    let final_mask_mismatches = mismatches(&last, &drawn, &reference, fresh.scene());
 
     let warmup_frames = cfg.period.min(cfg.frames);
     let steady: Vec<&SoakSample> = samples.iter().filter(|s| s.frame > warmup_frames).collect();

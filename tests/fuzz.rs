@@ -1004,6 +1004,7 @@ fn plan_case(rng: &mut Rng) -> PlanCase {
         intensity: 1.0,
         radius: if rng.chance(0.2) { Some(rng.range(0.01, 10.0)) } else { None },
         cone_deg: *rng.pick(&[10.0, 45.0, 90.0, 179.0, 180.0, 270.0, 0.0]),
+        area: None,
     };
     let eye = match rng.below(5) {
         0 => special_point(rng, &meshes),
@@ -1235,6 +1236,7 @@ fn checks_catch_broken_volumes() {
         intensity: 1.0,
         radius: None,
         cone_deg: 45.0,
+        area: None,
     };
     let open_box = {
         let mut m = shapes::cuboid(Vec3::ONE);

@@ -23,6 +23,7 @@ fn ambient_and_light_without_casters() {
             intensity: 1.0,
             radius: None,
             cone_deg: 45.0,
+            area: None,
         }],
         meshes: vec![SceneMesh {
             name: "floor".into(),

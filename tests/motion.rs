@@ -36,6 +36,7 @@ fn cube_grid(n: usize) -> Scene {
                 intensity: 4.0 / n as f32,
                 radius: Some(3.5),
                 cone_deg: 45.0,
+                area: None,
             }
         })
         .collect();
@@ -105,7 +106,7 @@ fn moving_lights_casters_and_camera_match_a_fresh_render() {
     let mut moved = Vec::new();
     let mut tickets = vec![first];
     for s in &states {
-        r.set_lights(s.lights.clone());
+        r.set_lights(s.lights.clone()).unwrap();
         for (i, m) in s.meshes.iter().enumerate() {
             if m.transform != r.scene().meshes[i].transform {
                 r.set_mesh_transform(i, m.transform).unwrap();

@@ -88,6 +88,7 @@ fn scene(c: &Case) -> Scene {
             intensity: 1.0,
             radius: None,
             cone_deg: 45.0,
+            area: None,
         }
     } else {
         Light {
@@ -98,6 +99,7 @@ fn scene(c: &Case) -> Scene {
             intensity: 1.0,
             radius: None,
             cone_deg: 45.0,
+            area: None,
         }
     };
     let eye = Vec3::new(c.cam_angle.cos() * c.cam_dist, c.cam_height, c.cam_angle.sin() * c.cam_dist);

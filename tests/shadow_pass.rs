@@ -37,6 +37,7 @@ fn light() -> Light {
         intensity: 1.0,
         radius: None,
         cone_deg: 45.0,
+        area: None,
     }
 }
 

@@ -113,6 +113,7 @@ pub fn scene(frame: usize) -> Scene {
         intensity: 1.0,
         radius: None,
         cone_deg: 45.0,
+        area: None,
     };
     Scene {
         name: "embedded".into(),

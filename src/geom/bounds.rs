@@ -338,7 +338,16 @@ mod tests {
     }
 
     fn point_light(pos: Vec3, r: Option<f32>) -> Light {
-        Light { kind: LightKind::Point, position: pos, direction: Vec3::NEG_Y, color: Vec3::ONE, intensity: 1.0, radius: r, cone_deg: 45.0 }
+        Light {
+            kind: LightKind::Point,
+            position: pos,
+            direction: Vec3::NEG_Y,
+            color: Vec3::ONE,
+            intensity: 1.0,
+            radius: r,
+            cone_deg: 45.0,
+            area: None,
+        }
     }
 
     #[test]

@@ -106,6 +106,9 @@ pub struct Light {
     pub radius: Option<f32>,
     /// Full cone angle of a spot light, degrees.
     pub cone_deg: f32,
+    /// `Some` for an area light ([`crate::geom::area`]): `kind` is then [`LightKind::Point`]
+    /// and `position` the centre; the renderer splits it into point-light samples.
+    pub area: Option<super::area::AreaLight>,
 }
 
 impl Light {

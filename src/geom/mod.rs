@@ -2,6 +2,8 @@
 #![warn(missing_docs)]
 pub mod mesh;
 pub use mesh::{Aabb, Mesh};
+pub mod area;
+pub use area::{AreaLight, AreaShape};
 pub mod bounds;
 pub mod light;
 pub use light::{Camera, Light, LightKind};

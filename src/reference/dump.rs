@@ -71,6 +71,7 @@ impl DumpLight {
             intensity: 1.0,
             radius: self.radius,
             cone_deg: self.cone_deg.unwrap_or(180.0),
+            area: None,
         };
         match kind {
             LightKind::Directional => {

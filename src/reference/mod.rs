@@ -35,6 +35,7 @@
 //! A non-finite or zero normal is also Ambiguous.
 
 #![warn(missing_docs)]
+pub mod area;
 pub mod bvh;
 mod check;
 pub mod dump;
@@ -46,6 +47,7 @@ use crate::scene::Scene;
 use bvh::Bvh;
 use glam::{DVec3, Vec3};
 
+pub use area::{area_error, sample_fraction, AreaImage, AreaMetrics};
 pub use check::{check_dump, CheckReport, LightCheck};
 pub use dump::{read_dump, write_dump, Dump, DumpLight};
 pub use metrics::Metrics;

@@ -22,6 +22,7 @@ fn floor_and_ball() -> Scene {
             intensity: 1.0,
             radius: None,
             cone_deg: 45.0,
+            area: None,
         }],
         meshes: vec![SceneMesh {
             name: "floor".into(),

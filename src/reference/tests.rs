@@ -106,7 +106,16 @@ fn icosphere(centre: Vec3, r: f32, subdiv: u32) -> Mesh {
 }
 
 fn point_light(p: Vec3) -> Light {
-    Light { kind: LightKind::Point, position: p, direction: Vec3::NEG_Y, color: Vec3::ONE, intensity: 1.0, radius: None, cone_deg: 45.0 }
+    Light {
+        kind: LightKind::Point,
+        position: p,
+        direction: Vec3::NEG_Y,
+        color: Vec3::ONE,
+        intensity: 1.0,
+        radius: None,
+        cone_deg: 45.0,
+        area: None,
+    }
 }
 
 fn dir_light(d: Vec3) -> Light {

@@ -364,6 +364,7 @@ mod tests {
             intensity: 1.0,
             radius: None,
             cone_deg: 45.0,
+            area: None,
         }
     }
 

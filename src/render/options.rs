@@ -167,6 +167,9 @@ pub struct FrameSettings {
     pub transmit_log: bool,
     /// Read back per-light counts, positions and normals (dumps, tests).
     pub capture: bool,
+    /// Re-draw the area lights' sample pattern every frame (`--jitter`; see
+    /// [`crate::geom::area`]); off: the same pattern every frame.
+    pub jitter: bool,
 }
 
 /// Everything a renderer is created with: its [`RenderConfig`] and first [`FrameSettings`].
@@ -195,6 +198,8 @@ pub struct RenderOptions {
     pub self_shadow: bool,
     /// Frames in flight (at least 1).
     pub frames_in_flight: usize,
+    /// Animate the area lights' sample pattern ([`FrameSettings::jitter`]).
+    pub jitter: bool,
 }
 
 impl RenderOptions {
@@ -218,6 +223,7 @@ impl RenderOptions {
             view: self.view,
             transmit_log: self.transmit.log,
             capture: self.capture,
+            jitter: self.jitter,
         }
     }
 }
@@ -236,6 +242,7 @@ impl Default for RenderOptions {
             capture: false,
             self_shadow: false,
             frames_in_flight: 2,
+            jitter: false,
         }
     }
 }

@@ -39,6 +39,8 @@ pub(crate) struct FramePipelines {
     pub transparent_over: vk::Pipeline,
     pub transparent_light: vk::Pipeline,
     pub tonemap: vk::Pipeline,
+    /// The accumulation target's format the pipelines draw into.
+    pub accum_format: vk::Format,
     made: Vec<vk::Pipeline>,
 }
 
@@ -91,7 +93,7 @@ impl FramePipelines {
             Ok(p)
         };
         let df = ctx.depth_format;
-        let gbuffer_formats = [ACCUM_FORMAT, ALBEDO_FORMAT, NORMAL_FORMAT, POSITION_FORMAT];
+        let gbuffer_formats = [t.accum_format, ALBEDO_FORMAT, NORMAL_FORMAT, POSITION_FORMAT];
         let mut g = scene_pipeline(shaders::GBUFFER_VERT, layouts.gbuffer, df);
         g.fragment = Some(shaders::GBUFFER_FRAG);
         g.attributes = &VERTEX_ATTRIBUTES[..3];
@@ -115,7 +117,7 @@ impl FramePipelines {
         gs.cull = vk::CullModeFlags::FRONT;
         let gbuffer_sphere = create(&gs)?;
 
-        let accum = [ACCUM_FORMAT];
+        let accum = [t.accum_format];
         let mut i = PipelineDesc::new(shaders::FULLSCREEN_VERT, layouts.illuminate, df);
         i.color_formats = &accum;
         i.blend = Blend::Additive;
@@ -162,6 +164,7 @@ impl FramePipelines {
             transparent_over,
             transparent_light,
             tonemap,
+            accum_format: t.accum_format,
             made,
         })
     }

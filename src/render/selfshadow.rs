@@ -77,7 +77,7 @@ impl SelfShadow {
         d.depth_write = true;
         d.depth_compare = vk::CompareOp::LESS;
         let depth_pipe = pipeline::create(ctx, &d)?;
-        let accum = [ACCUM_FORMAT];
+        let accum = [p.accum_format];
         let mut l = scene_pipeline(shaders::TRANSPARENT_VERT, layout, ctx.depth_format);
         l.fragment = Some(shaders::TRANSPARENT_SS_FRAG);
         l.color_formats = &accum;

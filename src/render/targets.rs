@@ -6,6 +6,11 @@ use ash::vk;
 
 /// The float accumulation target (ambient + every light).
 pub const ACCUM_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+/// The accumulation target of scenes with area lights (where the device can blend it): many
+/// samples of `intensity / samples` each lose too much in fp16 (an 11-bit mantissa: 1024
+/// samples of a lit floor summed to 20 levels in 255 off the point light's image, 256 to 6,
+/// 64 to 2), in f32 nothing visible.
+pub const ACCUM_FORMAT_FP32: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 /// Albedo in the G-buffer.
 pub const ALBEDO_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
 /// Normals and positions in full f32: the dump's positions/normals come straight from here.
@@ -21,8 +26,10 @@ pub use crate::pass::COUNT_FORMAT;
 pub struct Targets {
     /// Their size.
     pub extent: vk::Extent2D,
-    /// Float accumulation (RGBA16F).
+    /// Float accumulation (RGBA16F, or RGBA32F for area lights: [`Targets::with_accum`]).
     pub accum: Image,
+    /// The format of `accum`.
+    pub accum_format: vk::Format,
     /// G-buffer albedo.
     pub albedo: Image,
     /// G-buffer face normal (f32).
@@ -42,6 +49,11 @@ pub struct Targets {
 impl Targets {
     /// All targets; `transmit_format`: the transparent casters' light-intensity map (RGBA16F or RGBA32F).
     pub fn new(ctx: &Context, width: u32, height: u32, transmit_format: vk::Format) -> Result<Targets> {
+        Targets::with_accum(ctx, width, height, transmit_format, ACCUM_FORMAT)
+    }
+    /// [`Targets::new`] with the accumulation target in `accum_format` ([`ACCUM_FORMAT`] or
+    /// [`ACCUM_FORMAT_FP32`]).
+    pub fn with_accum(ctx: &Context, width: u32, height: u32, transmit_format: vk::Format, accum_format: vk::Format) -> Result<Targets> {
         let extent = vk::Extent2D { width, height };
         let color = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
         let c = vk::ImageAspectFlags::COLOR;
@@ -50,7 +62,7 @@ impl Targets {
             ctx,
             extent,
             [
-                ("accum", ACCUM_FORMAT, color, c),
+                ("accum", accum_format, color, c),
                 ("albedo", ALBEDO_FORMAT, color, c),
                 ("normal", NORMAL_FORMAT, color, c),
                 ("position", POSITION_FORMAT, color, c),
@@ -60,7 +72,7 @@ impl Targets {
                 ("output", OUTPUT_FORMAT, vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC, c),
             ],
         )?;
-        Ok(Targets { extent, accum, albedo, normal, position, depth, output, count, transmit })
+        Ok(Targets { extent, accum, accum_format, albedo, normal, position, depth, output, count, transmit })
     }
 
     /// The G-buffer pass's colour attachments, in attachment order.

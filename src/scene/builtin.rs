@@ -37,6 +37,8 @@ pub const SCENES: &[(&str, &str)] = &[
     ("transparent/depth_4", include_str!("../../scenes/transparent/depth_4.toml")),
     ("transparent/depth_16", include_str!("../../scenes/transparent/depth_16.toml")),
     ("transparent/depth_64", include_str!("../../scenes/transparent/depth_64.toml")),
+    ("area/disc", include_str!("../../scenes/area/disc.toml")),
+    ("area/rect", include_str!("../../scenes/area/rect.toml")),
 ];
 
 /// Embedded data files the built-in scenes reference, by repository-relative path.

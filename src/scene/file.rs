@@ -3,6 +3,7 @@
 //! Rotation convention: `rotate_deg = [x, y, z]` is R = Rz * Ry * Rx (X applied first), the same
 //! as glam's `Mat4::from_euler(EulerRot::ZYX, z, y, x)`. A mesh's transform is T * R * S.
 
+mod area_light;
 mod keys;
 mod lights;
 mod meshes;

@@ -16,6 +16,7 @@ use super::sphere_gpu::SphereGeometry;
 use super::targets::*;
 use super::timing::{Span, Timer};
 mod memory;
+mod area;
 mod motion;
 pub use memory::{largest_device_heap, MemoryEstimate};
 mod stats;
@@ -82,7 +83,14 @@ struct FrameSlot {
 
 /// umbrage's renderer (see the module docs).
 pub struct Renderer {
+    /// The scene as rendered: its `lights` are the point lights of this frame, every area
+    /// light split into its samples ([`crate::geom::area`]).
     scene: Scene,
+    /// The scene's lights as given (area lights whole).
+    source_lights: Vec<crate::scene::Light>,
+    /// The frame the area-light samples in `scene.lights` were drawn for (`None`: the fixed
+    /// pattern).
+    samples_for: Option<u64>,
     config: RenderConfig,
     /// What the next frame does (technique, counter, index format, view, capture); checked
     /// against the device before every frame.
@@ -110,8 +118,10 @@ pub struct Renderer {
 impl Renderer {
     /// A renderer for `scene`: its casters prepared and uploaded, targets of the options'
     /// size, pipelines for its fixed settings.
-    pub fn new(ctx: Context, scene: Scene, opts: RenderOptions) -> Result<Renderer> {
+    pub fn new(ctx: Context, mut scene: Scene, opts: RenderOptions) -> Result<Renderer> {
         let (config, settings) = (opts.config(), opts.settings());
+        let source_lights = area::checked_lights(&scene.lights)?;
+        scene.lights = crate::geom::area::expand_lights(&source_lights, None);
         if config.width == 0 || config.height == 0 || config.width > 16384 || config.height > 16384 {
             return Err(Error::Other(format!("invalid image size {}x{} (1..=16384 each)", config.width, config.height)));
         }
@@ -122,6 +132,7 @@ impl Renderer {
         memory::check_fits(&ctx, &scene, &config)?;
         let transmit_format = opts.transmit.format();
         let f = &ctx.features;
+        let accum_format = area::accum_format(&source_lights, f.rgba32f_blend);
         let desc = ShadowPassDesc {
             depth_stencil_format: ctx.depth_format,
             frames_in_flight: config.frames_in_flight,
@@ -133,7 +144,7 @@ impl Renderer {
             },
             settings: pass_settings(&settings),
             transmit_format: Some(transmit_format),
-            debug_color_format: Some(ACCUM_FORMAT),
+            debug_color_format: Some(accum_format),
         };
         let mut pass = ShadowPass::new(&ctx.instance, ctx.physical, &ctx.device, (*ctx.allocator).clone(), &desc)?;
         let mut caster_ids = Vec::with_capacity(scene.meshes.len());
@@ -156,7 +167,7 @@ impl Renderer {
                 return Err(e);
             }
         };
-        let mut targets = match Targets::new(&ctx, config.width, config.height, transmit_format) {
+        let mut targets = match Targets::with_accum(&ctx, config.width, config.height, transmit_format, accum_format) {
             Ok(t) => t,
             Err(e) => {
                 spheres.destroy(&ctx);
@@ -229,6 +240,8 @@ impl Renderer {
         }
         Ok(Renderer {
             scene,
+            source_lights,
+            samples_for: None,
             config,
             settings,
             pass,
@@ -266,7 +279,9 @@ impl Renderer {
         }
     }
 
-    /// The scene as it stands (camera, lights and transforms included).
+    /// The scene as it stands (camera, lights and transforms included). Its `lights` are the
+    /// point lights the frames render: every area light split into its samples (those of the
+    /// last submitted frame under `jitter`); [`Renderer::source_lights`] has them whole.
     pub fn scene(&self) -> &Scene {
         &self.scene
     }
@@ -351,6 +366,7 @@ impl Renderer {
         self.retire(slot)?;
         check_options(&self.ctx, &self.config, &self.settings)?;
         check_spheres(&self.scene, &self.settings)?;
+        self.update_area_samples();
         let wall = Instant::now();
         let settings = self.settings;
         let (w, h) = (self.config.width, self.config.height);

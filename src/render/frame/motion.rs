@@ -16,9 +16,16 @@ impl Renderer {
         self.scene_version += 1;
         Ok(())
     }
-    /// Replaces the lights (any number; from the next frame).
-    pub fn set_lights(&mut self, lights: Vec<Light>) {
-        self.scene.lights = lights;
+    /// Replaces the lights (any number; from the next frame). Area lights are split into
+    /// their samples ([`crate::geom::area`]); an invalid area light is an error and changes
+    /// nothing. The accumulation target's format was chosen at creation (RGBA32F if the scene
+    /// had area lights then): area lights added to a scene created without any sum in RGBA16F.
+    pub fn set_lights(&mut self, lights: Vec<Light>) -> Result<()> {
+        let lights = super::area::checked_lights(&lights)?;
+        self.scene.lights = crate::geom::area::expand_lights(&lights, self.samples_for);
+        self.source_lights = lights;
+        self.scene_version += 1;
+        Ok(())
     }
     /// Moves mesh `index` (object -> world; from the next frame). A transform must keep the
     /// mesh's handedness (its winding was fixed at load).

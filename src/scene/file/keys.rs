@@ -53,6 +53,12 @@ pub(super) struct FileLight {
     pub(super) intensity: Option<f64>,
     pub(super) radius: Option<f64>,
     pub(super) cone_deg: Option<f64>,
+    // area lights (`kind = "area"`)
+    pub(super) shape: Option<String>,
+    pub(super) size: Option<NumOrVec>,
+    pub(super) normal: Option<[f64; 3]>,
+    pub(super) tangent: Option<[f64; 3]>,
+    pub(super) samples: Option<i64>,
 }
 
 #[derive(Deserialize, Clone)]

@@ -38,17 +38,20 @@ pub(super) fn camera(cx: &Ctx, cs: &Range<usize>, c: FileCamera) -> Result<Camer
 /// positional light must not coincide with.
 pub(super) fn light(cx: &Ctx, s: &Range<usize>, l: &FileLight, eye: Vec3) -> Result<Light> {
     let kind = match l.kind.as_str() {
-        "point" => LightKind::Point,
+        "point" | "area" => LightKind::Point,
         "spot" => LightKind::Spot,
         "directional" => LightKind::Directional,
         other => {
             return Err(Error::UnknownName {
                 what: "light kind",
                 name: other.to_string(),
-                expected: format!("point, spot, directional; at {}:{}", cx.origin, cx.key_line(s, "kind")),
+                expected: format!("point, spot, directional, area; at {}:{}", cx.origin, cx.key_line(s, "kind")),
             })
         }
     };
+    if l.kind == "area" && l.direction.is_some() {
+        return Err(cx.key_err(s, "direction", "an area light faces its `normal` (it has no direction)"));
+    }
     let positional = kind != LightKind::Directional;
     let position = match (positional, l.position) {
         (true, Some(p)) => cx.v3(s, "position", p)?,
@@ -96,5 +99,6 @@ pub(super) fn light(cx: &Ctx, s: &Range<usize>, l: &FileLight, eye: Vec3) -> Res
     if positional && position == eye {
         return Err(cx.key_err(s, "position", "a light must not coincide with the camera eye"));
     }
-    Ok(Light { kind, position, direction, color: cx.color(s, "color", l.color, Vec3::ONE)?, intensity, radius, cone_deg })
+    let area = super::area_light::area(cx, s, l, position, eye)?;
+    Ok(Light { kind, position, direction, color: cx.color(s, "color", l.color, Vec3::ONE)?, intensity, radius, cone_deg, area })
 }

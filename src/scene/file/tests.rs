@@ -216,7 +216,7 @@ fn unknown_names() {
     assert!(matches!(e, Error::UnknownName { what: "shape", .. }));
     let e = e.to_string();
     assert!(e.contains("hexagon") && e.contains("torus") && e.contains("bad.toml:5"), "{e}");
-    let e = load_str(&format!("{CAM}[[light]]\nkind = \"area\"\nposition = [0, 1, 0]\n"), "bad.toml", Path::new(".")).unwrap_err();
+    let e = load_str(&format!("{CAM}[[light]]\nkind = \"laser\"\nposition = [0, 1, 0]\n"), "bad.toml", Path::new(".")).unwrap_err();
     assert!(matches!(e, Error::UnknownName { what: "light kind", .. }));
     assert!(e.to_string().contains("bad.toml:5"));
     let e = load("no_such_scene").unwrap_err();

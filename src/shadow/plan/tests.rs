@@ -8,7 +8,16 @@ use glam::{DVec3, Vec3};
 use std::collections::HashMap;
 
 fn point(pos: Vec3) -> Light {
-    Light { kind: LightKind::Point, position: pos, direction: Vec3::NEG_Y, color: Vec3::ONE, intensity: 1.0, radius: None, cone_deg: 45.0 }
+    Light {
+        kind: LightKind::Point,
+        position: pos,
+        direction: Vec3::NEG_Y,
+        color: Vec3::ONE,
+        intensity: 1.0,
+        radius: None,
+        cone_deg: 45.0,
+        area: None,
+    }
 }
 fn dir(d: Vec3) -> Light {
     Light { kind: LightKind::Directional, direction: d, ..point(Vec3::ZERO) }
