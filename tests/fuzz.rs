@@ -1023,7 +1023,7 @@ fn plan_case(rng: &mut Rng) -> PlanCase {
         light,
         camera,
         method: *rng.pick(&Method::ALL),
-        opts: PlanOptions { edge_quads: rng.chance(0.05), case_per_part: rng.chance(0.5) },
+        opts: PlanOptions { edge_quads: rng.chance(0.05), case_per_part: rng.chance(0.5), ..PlanOptions::default() },
         aspect: *rng.pick(&[1.0, 1.5, 0.5]),
     }
 }
@@ -1159,7 +1159,11 @@ fn check_planner(c: &PlanCase) {
     // z-fail with light caps everywhere: every part that is not culled must be closed
     if c.method != Method::ZFail {
         let input = PlanInput { method: Method::ZFail, ..input };
-        let plan = plan_light_with(&input, &casters, &PlanOptions { edge_quads: false, case_per_part: c.opts.case_per_part });
+        let plan = plan_light_with(
+            &input,
+            &casters,
+            &PlanOptions { edge_quads: false, case_per_part: c.opts.case_per_part, ..PlanOptions::default() },
+        );
         check_plan(&casters, &plan.casters, c.light.kind == LightKind::Directional);
     }
 }

@@ -30,7 +30,7 @@ fn triangles(scene: &Scene, li: usize, w: u32, h: u32) -> (usize, usize) {
             c
         })
         .collect();
-    let per_part = plan_light_with(&input, &parts, &PlanOptions { edge_quads: false, case_per_part: true });
+    let per_part = plan_light_with(&input, &parts, &PlanOptions { edge_quads: false, case_per_part: true, ..PlanOptions::default() });
     let before = plan_light_opts(&input, &whole, false);
     (per_part.casters.iter().map(|c| c.triangles()).sum(), before.casters.iter().map(|c| c.triangles()).sum())
 }

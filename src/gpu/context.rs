@@ -30,6 +30,9 @@ pub struct Features {
     pub index_type_uint8: bool,
     /// `pipelineStatisticsQuery` is supported (and enabled).
     pub pipeline_statistics_query: bool,
+    /// `occlusionQueryPrecise` is supported (and enabled): occlusion queries count samples
+    /// exactly (the bench's rasterised-fragment counter).
+    pub occlusion_query_precise: bool,
     /// The graphics queue writes timestamps (`timestampValidBits > 0`) and the device reports a
     /// non-zero `timestampPeriod`.
     pub timestamps: bool,
@@ -378,6 +381,7 @@ impl Context {
             depth_range_unrestricted: has_dru,
             index_type_uint8: u8_supported,
             pipeline_statistics_query: base.pipeline_statistics_query == vk::TRUE,
+            occlusion_query_precise: base.occlusion_query_precise == vk::TRUE,
             timestamps,
             timestamp_period_ns: props.limits.timestamp_period,
             depth_stencil_format: format!("{depth_format:?}"),
@@ -389,7 +393,8 @@ impl Context {
         let enabled = vk::PhysicalDeviceFeatures::default()
             .depth_clamp(features.depth_clamp)
             .depth_bounds(features.depth_bounds)
-            .pipeline_statistics_query(features.pipeline_statistics_query);
+            .pipeline_statistics_query(features.pipeline_statistics_query)
+            .occlusion_query_precise(features.occlusion_query_precise);
         let mut e13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true);
         let mut e_u8 = vk::PhysicalDeviceIndexTypeUint8FeaturesEXT::default().index_type_uint8(true);
         let mut dev_exts = Vec::new();

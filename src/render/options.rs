@@ -2,7 +2,7 @@
 
 use crate::error::{Error, Result};
 use crate::named_enum::named_enum;
-pub use crate::pass::{Counter, DepthMode, IndexFormat};
+pub use crate::pass::{Counter, DepthMode, IndexFormat, PassToggles};
 use crate::shadow::Method;
 use ash::vk;
 
@@ -162,6 +162,13 @@ pub struct FrameSettings {
     pub transmit_log: bool,
     /// Read back per-light counts, positions and normals (dumps, tests).
     pub capture: bool,
+    /// Scissor, depth bounds and culling on or off (ablations; all on by default).
+    pub toggles: PassToggles,
+    /// Measure the shadow pass's counters ([`crate::render::Stats::counters`]): per light an
+    /// occlusion query around the counting variant of the determination (the exact number of
+    /// fragments its volumes rasterise) and pipeline statistics around the determination.
+    /// Adds a pass per light: do not time such frames.
+    pub counters: bool,
 }
 
 /// Everything a renderer is created with: its [`RenderConfig`] and first [`FrameSettings`].
@@ -213,6 +220,8 @@ impl RenderOptions {
             view: self.view,
             transmit_log: self.transmit.log,
             capture: self.capture,
+            toggles: PassToggles::default(),
+            counters: false,
         }
     }
 }

@@ -377,7 +377,7 @@ pub fn plan_light(input: &PlanInput, casters: &[Caster]) -> LightPlan {
 /// z-fail with caps, no index lists, and the static counts the GPU draws (two triangles per
 /// edge as sides; every face as a cap, light or dark as the GPU decides).
 pub fn plan_light_opts(input: &PlanInput, casters: &[Caster], edge_quads: bool) -> LightPlan {
-    plan_light_with(input, casters, &PlanOptions { edge_quads, case_per_part: false })
+    plan_light_with(input, casters, &PlanOptions { edge_quads, ..PlanOptions::default() })
 }
 
 /// [`plan_light`] with [`PlanOptions`]. Every part of a caster ([`Caster::parts`]) is culled
@@ -414,7 +414,7 @@ pub fn plan_light_with(input: &PlanInput, casters: &[Caster], opts: &PlanOptions
         };
         let culls = |b: &Aabb| {
             let out_of_radius = !directional && light.radius.is_some_and(|r| box_distance(b, light.position) > r);
-            out_of_radius || spot_culls(light, b) || shadow_volume_outside_frustum(b, light_h, &frustum)
+            !opts.no_culling && (out_of_radius || spot_culls(light, b) || shadow_volume_outside_frustum(b, light_h, &frustum))
         };
         if culls(&wb) {
             plans.push(culled_plan(Case::Culled));

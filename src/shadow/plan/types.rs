@@ -231,6 +231,9 @@ pub struct PlanOptions {
     /// agree, else z-fail with light cap, always valid), so that `CasterPlan::case` holds for
     /// every draw of the caster.
     pub case_per_part: bool,
+    /// Ablation: never cull (out of the light's range or cone, or a volume missing the
+    /// frustum); every caster gets a case and its volume. The result stays exact, only slower.
+    pub no_culling: bool,
 }
 
 impl CasterPlan {
