@@ -379,12 +379,12 @@ impl Renderer {
             };
             for (li, light) in self.scene.lights.iter().enumerate() {
                 let begin = stamp(all);
+                if let Some(c) = counters {
+                    c.statistics(rec.ctx, rec.cb, li as u32, true);
+                }
                 if let Some((sm, _)) = &self.shadow_mapper {
                     determine::begin_float(rec, t);
                     sm.record(rec.ctx, rec.cb, t, light, self.scene.camera.eye.as_dvec3(), frame.lights[li].scissor);
-                }
-                if let Some(c) = counters {
-                    c.statistics(rec.ctx, rec.cb, li as u32, true);
                 }
                 determine::record(rec, pass, frame, li, t, into, layout.counts.get(li).copied());
                 if let Some(c) = counters {
