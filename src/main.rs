@@ -189,7 +189,8 @@ struct BenchArgs {
     /// Write the report as JSON.
     #[arg(long)]
     json: Option<PathBuf>,
-    /// Write the report as a Markdown table.
+    /// Write the report as a Markdown table (with --suite: the suite's report, plots linked
+    /// relative to it).
     #[arg(long)]
     markdown: Option<PathBuf>,
     /// Run a benchmark suite instead of the fixed scenes: `fill-vertex` (limits, counters,
@@ -405,6 +406,13 @@ fn suite(a: &BenchArgs) -> Result<ExitCode> {
     let p = a.out.join("bench.md");
     std::fs::write(&p, &md).map_err(|e| Error::io(p.display().to_string(), e))?;
     println!("{md}");
+    // --markdown: the same report elsewhere (docs/bench-lavapipe.md), plots linked relative to it.
+    if let Some(m) = &a.markdown {
+        let base = m.parent().unwrap_or(Path::new(""));
+        let rel = a.out.strip_prefix(base).map(Path::to_path_buf).unwrap_or_else(|_| a.out.clone());
+        let text = report.markdown(&rel.display().to_string());
+        std::fs::write(m, text).map_err(|e| Error::io(m.display().to_string(), e))?;
+    }
     Ok(ExitCode::SUCCESS)
 }
 

@@ -154,6 +154,11 @@ pub struct SuiteReport {
     pub scale: String,
     /// Wall-clock seconds the run took (limits included).
     pub seconds: f64,
+    /// CPU seconds the process used (all threads; on lavapipe the rendering itself), where the
+    /// OS reports it: with other work on the machine, wall time grows but this much less.
+    pub cpu_seconds: Option<f64>,
+    /// The 1-minute load average when the run ended (Linux), the conditions of the timings.
+    pub load_average: Option<f64>,
     /// CPU threads available to the run.
     pub cpu_threads: usize,
     /// The device's limits, measured in this run.
@@ -285,7 +290,7 @@ impl SuiteReport {
         let mut s = String::new();
         let _ = writeln!(
             s,
-            "Device: {} ({}); suite `{}`{}; {} CPU threads; {:.0} s.\n",
+            "Device: {} ({}); suite `{}`{}; {} CPU threads; {:.0} s wall, {} s CPU, load average {} at the end.\n",
             self.device,
             self.driver,
             self.suite,
@@ -295,7 +300,9 @@ impl SuiteReport {
                 _ => "",
             },
             self.cpu_threads,
-            self.seconds
+            self.seconds,
+            self.cpu_seconds.map(|c| format!("{c:.0}")).unwrap_or_else(|| "?".into()),
+            self.load_average.map(|c| format!("{c:.1}")).unwrap_or_else(|| "?".into()),
         );
         let _ = writeln!(s, "## Limits (measured in the same run, {}x{} target)\n", l.target[0], l.target[1]);
         let _ = writeln!(s, "| limit | value |\n|---|---|");

@@ -54,11 +54,14 @@ impl Variant {
 
 struct Runner {
     ctx: Option<Context>,
+    /// Print a line per point (progress requested but stderr is not a terminal).
+    log: bool,
     limits: RowLimits,
     frames: usize,
     frames_in_flight: usize,
     bar: indicatif::ProgressBar,
     skipped: Vec<String>,
+    start: Instant,
 }
 
 fn scene_of(p: &PointScene) -> Result<(Scene, String)> {
@@ -82,6 +85,9 @@ impl Runner {
         errors: bool,
     ) -> Result<Vec<SuiteRow>> {
         let ctx = self.ctx.take().ok_or_else(|| Error::Other("context lost".into()))?;
+        if self.log {
+            eprintln!("[{:>6.1} s] {sweep} {name} {}x{} ({} variants)", self.start.elapsed().as_secs_f64(), size.0, size.1, variants.len());
+        }
         let opts = RenderOptions { width: size.0, height: size.1, frames_in_flight: self.frames_in_flight, ..Default::default() };
         let casters = scene.meshes.iter().filter(|m| m.casts_shadow).count() as u64;
         let triangles: u64 = scene.meshes.iter().filter(|m| m.casts_shadow).map(|m| m.mesh.triangles.len() as u64).sum();
@@ -226,6 +232,7 @@ fn evaluate_fractions(r: &mut Renderer, name: &str, techniques: &[Technique]) ->
 /// Runs the suite on `ctx` and writes its outputs into `cfg.out`.
 pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
     let start = Instant::now();
+    let cpu0 = process_cpu_seconds();
     let scale = cfg.scale;
     let frames = cfg.frames.unwrap_or_else(|| scale.frames()).max(1);
     let base = scale.base_size();
@@ -263,7 +270,9 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
     } else {
         indicatif::ProgressBar::hidden()
     };
-    let mut run = Runner { ctx: Some(ctx), limits: row_limits, frames, frames_in_flight: cfg.frames_in_flight, bar, skipped: Vec::new() };
+    let log = cfg.progress && bar.is_hidden();
+    let mut run =
+        Runner { ctx: Some(ctx), log, limits: row_limits, frames, frames_in_flight: cfg.frames_in_flight, bar, skipped: Vec::new(), start };
     let mut rows = Vec::new();
     let all: Vec<Variant> = techniques.iter().map(|&t| Variant::of(t)).collect();
     // The named scenes, with their error (the Pareto chart).
@@ -319,11 +328,14 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
         crossovers,
         ablations,
         plots: Vec::new(),
+        cpu_seconds: None,
+        load_average: load_average(),
         skipped: run.skipped,
     };
     std::fs::create_dir_all(&cfg.out).map_err(|e| Error::io(cfg.out.display().to_string(), e))?;
     report.plots = super::plots::write_all(&report, &cfg.out)?;
     report.seconds = start.elapsed().as_secs_f64();
+    report.cpu_seconds = process_cpu_seconds().map(|c| c - cpu0.unwrap_or(0.0));
     report.write(&cfg.out)?;
     Ok(report)
 }
@@ -387,4 +399,21 @@ fn ablations(rows: &[SuiteRow]) -> Vec<Ablation> {
         }
     }
     out
+}
+
+/// This process's CPU time (user + system, all threads: lavapipe's rasteriser threads too),
+/// seconds; Linux only (`/proc/self/stat`, 100 ticks a second).
+fn process_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name (which may hold spaces) in parentheses.
+    let rest = &stat[stat.rfind(')')? + 2..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let (utime, stime): (f64, f64) = (f.get(11)?.parse().ok()?, f.get(12)?.parse().ok()?);
+    Some((utime + stime) / 100.0)
+}
+
+/// The machine's 1-minute load average at the end of the run (other work competing for the
+/// CPU slows lavapipe); Linux only.
+fn load_average() -> Option<f64> {
+    std::fs::read_to_string("/proc/loadavg").ok()?.split_whitespace().next()?.parse().ok()
 }

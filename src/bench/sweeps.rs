@@ -266,12 +266,12 @@ mod tests {
     fn crossovers_are_found_between_the_points() {
         // Fill constant, triangles growing: fill-bound, then vertex-bound between x=10 and 100.
         let rows = vec![
-            row("tess", "a", 1.0, 1_000_000, 1_000, 2.0),
-            row("tess", "a", 10.0, 1_000_000, 100_000, 2.0),
+            row("tess", "a", 1.0, 1_000_000, 100, 2.0),
+            row("tess", "a", 10.0, 1_000_000, 500, 2.0),
             row("tess", "a", 100.0, 1_000_000, 10_000_000, 20.0),
             row("tess", "b", 1.0, 1_000_000, 1_000, 1.0),
             row("tess", "b", 10.0, 1_000_000, 1_000, 3.0),
-            row("tess", "b", 100.0, 1_000_000, 1_000, 3.0),
+            row("tess", "b", 100.0, 1_000_000, 1_000, 30.0),
         ];
         let c = crossovers(&rows);
         let bound: Vec<_> = c.iter().filter(|c| c.kind == "bound").collect();
