@@ -7,6 +7,7 @@
 //! | colour fill | full-screen quads into RGBA16F, additive blending, depth test LEQUAL on (the illumination pass's state) | fragments / s |
 //! | small triangles | a grid of 2-pixel triangles over the whole target (stencil-only, as the shadow pass) | triangles / s |
 //! | big triangles | screen-covering triangles (stencil-only) | triangles / s |
+//! | slivers | 1-pixel-wide triangles from the centre past the edges (shadow-volume sides) | triangles / s |
 //! | index fetch | one 256-vertex patch drawn through u8, u16 and u32 indices and as streamed 4 x f32 vertices | triangles / s |
 //! | draw calls | one tiny triangle per `vkCmdDraw`, each with its push constants and vertex binding (as the shadow pass) | draws / s |
 //! | CPU stream | a sum over a buffer far larger than the caches | GiB / s |
@@ -38,6 +39,10 @@ pub struct Limits {
     pub small_tri_mtri_s: f64,
     /// Screen-covering triangles, stencil-only: Mtriangles / s.
     pub big_tri_mtri_s: f64,
+    /// Slivers: triangles from the centre to past the target's edge, a pixel wide there (the
+    /// shape of shadow-volume sides extruded to infinity: few fragments, a screen-sized
+    /// bounding box), stencil-only: Mtriangles / s.
+    pub sliver_tri_mtri_s: f64,
     /// Draw calls of one tiny triangle each: draws / s.
     pub draws_per_s: f64,
     /// The CPU's memory-stream read bandwidth (one thread): GiB / s.
@@ -244,6 +249,20 @@ fn measure_with(
     let big_vb = upload("limits-big", bytes(&big), vk::BufferUsageFlags::VERTEX_BUFFER)?;
     let big_ms = time(ctx, t, &mk(stencil_pipe, false, big_vb, None, (3 * big_n, 1)), reps)?;
 
+    // Slivers: a fan of 1-pixel-wide triangles from the centre out past the edges.
+    let slivers = scaled(20_000.0);
+    let mut sliver: Vec<[f32; 4]> = Vec::new();
+    for i in 0..slivers {
+        let a = std::f32::consts::TAU * i as f32 / slivers as f32;
+        let (s, c) = a.sin_cos();
+        let (ex, ey) = (1.5 * c, 1.5 * s);
+        // One pixel across at the far end, perpendicular to the sliver.
+        let (px, py) = (-s * 2.0 / w as f32, c * 2.0 / h as f32);
+        sliver.extend([[0.0, 0.0, 0.5, 1.0], [ex, ey, 0.5, 1.0], [ex + px, ey + py, 0.5, 1.0]]);
+    }
+    let sliver_vb = upload("limits-sliver", bytes(&sliver), vk::BufferUsageFlags::VERTEX_BUFFER)?;
+    let sliver_ms = time(ctx, t, &mk(stencil_pipe, false, sliver_vb, None, (3 * slivers, 1)), reps)?;
+
     // Index fetch: a 16x16-vertex patch (256 vertices: u8 can address it) of 2-pixel cells,
     // its 450 triangles repeated.
     let mut patch: Vec<[f32; 4]> = Vec::new();
@@ -294,6 +313,7 @@ fn measure_with(
         ("color_fill_gfrag_s", "Gfragments/s"),
         ("small_tri_mtri_s", "Mtriangles/s"),
         ("big_tri_mtri_s", "Mtriangles/s"),
+        ("sliver_tri_mtri_s", "Mtriangles/s"),
         ("draws_per_s", "draws/s"),
         ("cpu_stream_gib_s", "GiB/s"),
         ("index_u8_mtri_s", "Mtriangles/s"),
@@ -309,6 +329,7 @@ fn measure_with(
         color_fill_gfrag_s: rate(fill_frags, color_ms, 1e9),
         small_tri_mtri_s: rate(small_tris, small_ms, 1e6),
         big_tri_mtri_s: rate(big_n as f64, big_ms, 1e6),
+        sliver_tri_mtri_s: rate(slivers as f64, sliver_ms, 1e6),
         draws_per_s: rate(draws as f64, draw_ms, 1.0),
         cpu_stream_gib_s: cpu_stream_gib_s(cfg.scale, reps),
         index_u8_mtri_s: u8_ms.map(|ms| rate(idx_tris, ms, 1e6)),

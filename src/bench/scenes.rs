@@ -19,11 +19,14 @@ pub struct SweepScene {
     pub lights: u32,
     /// The lights' height above the spheres' centres, in sphere spacings.
     pub light_height: f32,
+    /// The lights' range in sphere spacings (`None`: unbounded, so their scissor is the whole
+    /// target and no caster is out of range).
+    pub light_range: Option<f32>,
 }
 
 impl Default for SweepScene {
     fn default() -> Self {
-        SweepScene { casters: 4, triangles: 16_000, lights: 1, light_height: 1.5 }
+        SweepScene { casters: 4, triangles: 16_000, lights: 1, light_height: 1.5, light_range: None }
     }
 }
 
@@ -34,9 +37,16 @@ fn sphere_segments(tris: u64) -> u32 {
 }
 
 impl SweepScene {
+    /// The ablations' scene: 64 spheres under 8 lights of limited range (scissors smaller
+    /// than the target, casters out of some lights' range).
+    pub fn ranged() -> SweepScene {
+        SweepScene { casters: 64, triangles: 64 * 2000, lights: 8, light_height: 1.0, light_range: Some(3.0) }
+    }
+
     /// The scene's name in reports (`sweep/c4-t16000-l1-h1.5`).
     pub fn name(&self) -> String {
-        format!("sweep/c{}-t{}-l{}-h{}", self.casters, self.triangles, self.lights, self.light_height)
+        let range = self.light_range.map(|r| format!("-r{r}")).unwrap_or_default();
+        format!("sweep/c{}-t{}-l{}-h{}{range}", self.casters, self.triangles, self.lights, self.light_height)
     }
 
     /// Builds the scene.
@@ -91,7 +101,7 @@ impl SweepScene {
                     direction: Vec3::NEG_Y,
                     color: Vec3::ONE,
                     intensity: 1.0 / self.lights.max(1) as f32,
-                    radius: None,
+                    radius: self.light_range.map(|r| r * spacing),
                     cone_deg: 45.0,
                 }
             })
