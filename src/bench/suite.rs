@@ -74,6 +74,7 @@ fn scene_of(p: &PointScene) -> Result<(Scene, String)> {
 impl Runner {
     /// Measures every variant on one scene and size. `errors`: render the reference too and
     /// fill in each technique's error.
+    #[allow(clippy::too_many_arguments)]
     fn point(
         &mut self,
         sweep: &str,
