@@ -1,6 +1,8 @@
 //! The whole per-light planner on `bench/vertex` (36 casters, ~435k triangles): culling, case
 //! selection, facing bits, possible silhouettes and index emission, for every method, as
-//! `umbrage bench` runs it once per frame and light.
+//! `umbrage bench` runs it once per frame and light; `streaming_sum` beside them reads the
+//! bytes the planner must at least touch (every caster's positions and triangles) as a plain
+//! streaming sum, so its time can be held against memory speed in the same run.
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::hint::black_box;
@@ -18,6 +20,17 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("plan/bench-vertex");
     g.throughput(Throughput::Elements(tris as u64));
     g.sample_size(20);
+    // The same bytes, read plainly: positions (3 x f32) and triangles (3 x u32) of every caster.
+    let plain: Vec<u32> = scene
+        .meshes
+        .iter()
+        .filter(|m| m.casts_shadow)
+        .flat_map(|m| {
+            let p = m.mesh.positions.iter().flat_map(|v| [v.x.to_bits(), v.y.to_bits(), v.z.to_bits()]);
+            p.chain(m.mesh.triangles.iter().flat_map(|t| t.iter().copied()).collect::<Vec<_>>())
+        })
+        .collect();
+    g.bench_function("streaming_sum", |b| b.iter(|| black_box(black_box(&plain).iter().fold(0u64, |a, &x| a.wrapping_add(x as u64)))));
     for method in [Method::McGuire, Method::ZFail, Method::ZPass] {
         let input = PlanInput { camera: cam, width: w, height: h, view_proj: vp, light, method };
         g.bench_function(method.name(), |b| b.iter(|| black_box(plan_light(black_box(&input), &casters).casters.len())));

@@ -147,40 +147,9 @@ enum Command {
         #[arg(long)]
         scene: Option<String>,
     },
-    /// Speed against error: every method on each scene, side by side on this device.
-    Bench {
-        /// Scenes (repeatable); default: the fill-rate and vertex-rate bench scenes plus default.
-        #[arg(long = "scene")]
-        scenes: Vec<String>,
-        /// Comma-separated techniques, every one `render --method` accepts (default: the five
-        /// volume methods, edgequad and shadowmap).
-        #[arg(long, value_enum, value_delimiter = ',')]
-        methods: Vec<MethodArg>,
-        #[arg(long, default_value_t = 10)]
-        frames: usize,
-        #[arg(long, default_value = "960x540", value_parser = parse_size)]
-        size: (u32, u32),
-        #[arg(long, value_enum, default_value = "auto")]
-        index_format: IndexFormat,
-        /// Comma-separated counters to compare (stencil, float).
-        #[arg(long, value_enum, value_delimiter = ',', default_value = "stencil")]
-        counters: Vec<Counter>,
-        /// Frames in flight for the throughput measurement.
-        #[arg(long, default_value_t = 2)]
-        frames_in_flight: usize,
-        /// Shadow-map size when the shadowmap technique runs (0: leave shadowmap out of the
-        /// default technique list).
-        #[arg(long, default_value_t = 2048)]
-        shadow_map_size: u32,
-        /// Write the report as JSON.
-        #[arg(long)]
-        json: Option<PathBuf>,
-        /// Write the report as a Markdown table.
-        #[arg(long)]
-        markdown: Option<PathBuf>,
-        #[command(flatten)]
-        soak: SoakArgs,
-    },
+    /// Speed against error: every method on each scene, side by side on this device; with
+    /// `--suite fill-vertex`, the fill-rate vs vertex-rate suite against the device's limits.
+    Bench(BenchArgs),
     /// Compare a frame dump with the exact CPU reference.
     Check {
         dir: PathBuf,
@@ -209,6 +178,64 @@ enum Command {
         #[arg(long, value_name = "NAME")]
         device: Option<String>,
     },
+}
+
+/// `umbrage bench` (one struct so that new modes add fields here, not to the dispatch).
+#[derive(clap::Args)]
+struct BenchArgs {
+    /// Scenes (repeatable); default: the fill-rate and vertex-rate bench scenes plus default.
+    #[arg(long = "scene")]
+    scenes: Vec<String>,
+    /// Comma-separated techniques, every one `render --method` accepts (default: the five
+    /// volume methods, edgequad and shadowmap).
+    #[arg(long, value_enum, value_delimiter = ',')]
+    methods: Vec<MethodArg>,
+    #[arg(long, default_value_t = 10)]
+    frames: usize,
+    #[arg(long, default_value = "960x540", value_parser = parse_size)]
+    size: (u32, u32),
+    #[arg(long, value_enum, default_value = "auto")]
+    index_format: IndexFormat,
+    /// Comma-separated counters to compare (stencil, float).
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "stencil")]
+    counters: Vec<Counter>,
+    /// Frames in flight for the throughput measurement.
+    #[arg(long, default_value_t = 2)]
+    frames_in_flight: usize,
+    /// Shadow-map size when the shadowmap technique runs (0: leave shadowmap out of the
+    /// default technique list).
+    #[arg(long, default_value_t = 2048)]
+    shadow_map_size: u32,
+    /// Write the report as JSON.
+    #[arg(long)]
+    json: Option<PathBuf>,
+    /// Write the report as a Markdown table (with --suite: the suite's report, plots linked
+    /// relative to it).
+    #[arg(long)]
+    markdown: Option<PathBuf>,
+    /// Run a benchmark suite instead of the fixed scenes: `fill-vertex` (limits, counters,
+    /// sweeps, bounds, crossovers, ablations, plots); writes into --out.
+    #[arg(long, value_enum)]
+    suite: Option<SuiteArg>,
+    /// With --suite: fewer points and frames (about 3 minutes on lavapipe on 2 cores).
+    #[arg(long)]
+    quick: bool,
+    /// With --suite: output directory for bench.json, bench.csv, the plots and bench.md.
+    #[arg(long, default_value = "bench-out")]
+    out: PathBuf,
+    /// With --suite: two points a sweep at 160x90 (tests; also UMBRAGE_BENCH_TINY=1).
+    #[arg(long, hide = true)]
+    tiny: bool,
+    #[command(flatten)]
+    soak: SoakArgs,
+}
+
+/// `bench --suite`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum SuiteArg {
+    /// Fill-rate vs vertex-rate: the limits, sweeps that cross over, the bound at each point.
+    #[value(name = "fill-vertex")]
+    FillVertex,
 }
 
 impl Default for FrameArgs {
@@ -250,16 +277,7 @@ fn main() -> ExitCode {
         Command::Render { frame, out, stats, view, dump } => render(&frame, &out, stats.as_deref(), view, dump.as_deref()),
         Command::Info { json, scene } => info(json, scene.as_deref()),
         Command::Check { dir, band, threshold } => check(&dir, band, threshold),
-        Command::Bench { scenes, methods, size, frames_in_flight, json, markdown, soak, .. } if soak.soak.is_some() => {
-            soak_cmd(&soak, scenes.first().map(String::as_str), &methods, size, frames_in_flight, json.as_deref(), markdown.as_deref())
-        }
-        Command::Bench {
-            scenes, methods, frames, size, index_format, counters, frames_in_flight, shadow_map_size, json, markdown, ..
-        } => {
-            let techniques = bench_techniques(&methods, shadow_map_size);
-            let opts = RenderOptions { width: size.0, height: size.1, index_format, frames_in_flight, ..Default::default() };
-            bench(scenes, techniques, counters, frames, opts, json.as_deref(), markdown.as_deref())
-        }
+        Command::Bench(args) => bench_command(args),
         Command::Conform { out, filter, list, junit, device } => {
             umbrage::conform::run(umbrage::conform::RunArgs { filter, list, junit, out, device })
         }
@@ -389,6 +407,64 @@ fn check(dir: &Path, band: u32, threshold: f64) -> Result<ExitCode> {
     Ok(if report.passed(threshold) { ExitCode::SUCCESS } else { ExitCode::FAILURE })
 }
 
+fn bench_command(a: BenchArgs) -> Result<ExitCode> {
+    if a.soak.soak.is_some() {
+        return soak_cmd(
+            &a.soak,
+            a.scenes.first().map(String::as_str),
+            &a.methods,
+            a.size,
+            a.frames_in_flight,
+            a.json.as_deref(),
+            a.markdown.as_deref(),
+        );
+    }
+    if a.suite.is_some() {
+        return suite(&a);
+    }
+    let techniques = bench_techniques(&a.methods, a.shadow_map_size);
+    let opts = RenderOptions {
+        width: a.size.0,
+        height: a.size.1,
+        index_format: a.index_format,
+        frames_in_flight: a.frames_in_flight,
+        ..Default::default()
+    };
+    bench(a.scenes, techniques, a.counters, a.frames, opts, a.json.as_deref(), a.markdown.as_deref())
+}
+
+/// `bench --suite fill-vertex`: runs the suite, writes its outputs, prints the Markdown.
+fn suite(a: &BenchArgs) -> Result<ExitCode> {
+    use umbrage::bench::sweeps::Scale;
+    let tiny = a.tiny || std::env::var("UMBRAGE_BENCH_TINY").is_ok_and(|v| v == "1");
+    let scale = match (tiny, a.quick) {
+        (true, _) => Scale::Tiny,
+        (false, true) => Scale::Quick,
+        (false, false) => Scale::Full,
+    };
+    let cfg = umbrage::bench::suite::SuiteConfig {
+        scale,
+        frames: None,
+        frames_in_flight: a.frames_in_flight,
+        out: a.out.clone(),
+        progress: !tiny,
+    };
+    let ctx = umbrage::gpu::Context::new()?;
+    let report = umbrage::bench::suite::run(ctx, &cfg)?;
+    let md = report.markdown(".");
+    let p = a.out.join("bench.md");
+    std::fs::write(&p, &md).map_err(|e| Error::io(p.display().to_string(), e))?;
+    println!("{md}");
+    // --markdown: the same report elsewhere (docs/bench-lavapipe.md), plots linked relative to it.
+    if let Some(m) = &a.markdown {
+        let base = m.parent().unwrap_or(Path::new(""));
+        let rel = a.out.strip_prefix(base).map(Path::to_path_buf).unwrap_or_else(|_| a.out.clone());
+        let text = report.markdown(&rel.display().to_string());
+        std::fs::write(m, text).map_err(|e| Error::io(m.display().to_string(), e))?;
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
 /// The bench's techniques: the given ones, or every volume method, edge quads and (size > 0)
 /// shadow maps.
 /// `umbrage bench --soak N`: memory and correctness held over many frames in one process.
@@ -445,14 +521,8 @@ fn bench_techniques(methods: &[MethodArg], shadow_map_size: u32) -> Vec<Techniqu
     let size = if shadow_map_size > 0 { shadow_map_size } else { 2048 };
     let mut out: Vec<Technique> = Vec::new();
     if methods.is_empty() {
-        out.extend(umbrage::shadow::Method::ALL.map(Technique::Volumes));
-        out.push(Technique::Volumes(umbrage::shadow::Method::ZPassClear));
-        out.push(Technique::EdgeQuads);
-        out.push(Technique::Planar);
-        out.push(Technique::Compute);
-        if shadow_map_size > 0 {
-            out.push(Technique::ShadowMap { size });
-        }
+        let sizes: &[u32] = if shadow_map_size > 0 { &[size] } else { &[] };
+        out = umbrage::bench::methods::all_techniques(sizes);
     } else {
         for m in methods {
             let t = m.technique(size);

@@ -122,6 +122,7 @@ pub fn info_report(ctx: &Context) -> InfoReport {
             ),
         ),
         ("pipelineStatisticsQuery".into(), yes_no(f.pipeline_statistics_query, "present", "missing")),
+        ("occlusionQueryPrecise".into(), yes_no(f.occlusion_query_precise, "present", "missing")),
         ("timestamps".into(), yes_no(f.timestamps, "used: gpu_ms in --stats", "missing: gpu_ms omitted")),
         (
             "R32_SFLOAT blending".into(),

@@ -30,6 +30,10 @@ pub struct Features {
     pub index_type_uint8: bool,
     /// `pipelineStatisticsQuery` is supported (and enabled).
     pub pipeline_statistics_query: bool,
+    /// `occlusionQueryPrecise` is supported (and enabled): occlusion queries with
+    /// `VK_QUERY_CONTROL_PRECISE_BIT` count samples exactly (the bench's rasterised-fragment
+    /// counter; the conformance suite checks them).
+    pub occlusion_query_precise: bool,
     /// The graphics queue writes timestamps (`timestampValidBits > 0`) and the device reports a
     /// non-zero `timestampPeriod`.
     pub timestamps: bool,
@@ -45,9 +49,6 @@ pub struct Features {
     pub r32f_blend: bool,
     /// R32G32B32A32_SFLOAT can be blended (optional): the fp32 light-intensity map needs it.
     pub rgba32f_blend: bool,
-    /// `occlusionQueryPrecise` is supported (and enabled): occlusion queries with
-    /// `VK_QUERY_CONTROL_PRECISE_BIT` return exact sample counts (the conformance suite checks them).
-    pub occlusion_query_precise: bool,
 }
 
 /// Identification of the chosen physical device, for `umbrage info`, logs and the stats JSON.
@@ -430,13 +431,13 @@ impl Context {
             depth_range_unrestricted: has_dru,
             index_type_uint8: u8_supported,
             pipeline_statistics_query: base.pipeline_statistics_query == vk::TRUE,
+            occlusion_query_precise: base.occlusion_query_precise == vk::TRUE,
             timestamps,
             timestamp_period_ns: props.limits.timestamp_period,
             depth_stencil_format: format!("{depth_format:?}"),
             geometry_shader: base.geometry_shader == vk::TRUE,
             r32f_blend: blendable(vk::Format::R32_SFLOAT),
             rgba32f_blend: blendable(vk::Format::R32G32B32A32_SFLOAT),
-            occlusion_query_precise: base.occlusion_query_precise == vk::TRUE,
         };
 
         let enabled = vk::PhysicalDeviceFeatures::default()

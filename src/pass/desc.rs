@@ -160,6 +160,30 @@ pub struct PassSettings {
     pub counter: Counter,
     /// Index format of the per-frame streams.
     pub index_format: IndexFormat,
+    /// The paper's constant-factor optimisations, each of which can be switched off to
+    /// measure what it saves (all on by default).
+    pub toggles: PassToggles,
+}
+
+/// The per-light optimisations McGuire et al. claim constant factors for; switching one off
+/// keeps the shadows exact (they only bound where the volumes are drawn) and costs what it
+/// saves. `umbrage bench --suite fill-vertex` measures each as an ablation.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PassToggles {
+    /// Limit each light's determination (and lighting) to its screen-space scissor rectangle
+    /// (off: the whole target).
+    pub scissor: bool,
+    /// The depth-bounds test to the light's range, when the device has it (off: no bounds).
+    pub depth_bounds: bool,
+    /// Cull casters whose shadow volume cannot reach the view frustum, or that lie beyond the
+    /// light's range or cone (off: every caster's volume is drawn, its case still chosen).
+    pub culling: bool,
+}
+
+impl Default for PassToggles {
+    fn default() -> Self {
+        PassToggles { scissor: true, depth_bounds: true, culling: true }
+    }
 }
 
 /// What the pass can use: the host's enabled features intersected with what the physical

@@ -213,7 +213,7 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
         let plan = shadow::plan_light_with(
             &PlanInput { camera: &camera, width: view.width, height: view.height, view_proj, light, method },
             if input.casters { &table.cpu } else { &[] },
-            &PlanOptions { edge_quads, case_per_part: true, gpu_silhouettes },
+            &PlanOptions { edge_quads, case_per_part: true, gpu_silhouettes, no_culling: !input.settings.toggles.culling },
         );
         let mut plan = plan;
         let planar_mvp = (input.settings.technique == Technique::Planar).then(|| flatten(&mut plan, table, light, input.planar_receiver));
@@ -286,6 +286,7 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
             totals.triangles.add(&tris);
             totals.index_bytes += index_bytes;
             totals.vertex_bytes += vertex_bytes;
+            totals.draws += draws.len() as u64 + if cp.path == "edgequad" { 2 } else { 0 };
             match cp.case {
                 Case::Culled => totals.cases.culled += 1,
                 Case::ZPass => totals.cases.zpass += 1,
@@ -362,7 +363,7 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
                 offset: vk::Offset2D { x: x as i32, y: y as i32 },
                 extent: vk::Extent2D { width: sw, height: sh },
             })
-            .filter(|r| r.extent.width > 0 && r.extent.height > 0)
+            .filter(|r| r.extent.width > 0 && r.extent.height > 0 && input.settings.toggles.scissor)
             .unwrap_or(full);
         let depth_bounds = if input.depth_bounds { plan.depth_bounds } else { None };
         let (eye_volumes, near_plane_split) = if method == shadow::Method::ZPassClear {
@@ -375,7 +376,7 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
         let stats = LightStats {
             index: li,
             kind: light_kind_name(light.kind).to_string(),
-            scissor: plan.scissor,
+            scissor: plan.scissor.filter(|_| input.settings.toggles.scissor),
             depth_bounds: depth_bounds.map(|(a, b)| [a, b]),
             casters: cstats,
             eye_volumes,

@@ -63,7 +63,7 @@ mod spheres;
 pub mod stats;
 
 pub use casters::CasterId;
-pub use desc::{Capabilities, Counter, DepthMode, EnabledFeatures, IndexFormat, PassSettings, ShadowPassDesc, Technique};
+pub use desc::{Capabilities, Counter, DepthMode, EnabledFeatures, IndexFormat, PassSettings, PassToggles, ShadowPassDesc, Technique};
 pub use frame::{case_name, LightFrame, PreparedFrame, ShadowView};
 pub use pipelines::COUNT_FORMAT;
 pub use record::{lit_stencil_state, DepthStencilTarget, VolumeKind};
@@ -385,7 +385,7 @@ impl ShadowPass {
                 lights,
                 settings: self.settings,
                 u8_ok: self.caps.index_type_uint8,
-                depth_bounds: self.caps.depth_bounds,
+                depth_bounds: self.caps.depth_bounds && self.settings.toggles.depth_bounds,
                 casters,
                 planar_receiver: self.planar_receiver,
                 spheres: &self.spheres,

@@ -38,9 +38,20 @@ pub(crate) struct CountPipes {
     pub eq_sides: vk::Pipeline,
 }
 
+/// The counting variant ([`VolumeKind::Rasterised`](super::VolumeKind::Rasterised)): depth
+/// and stencil tests always pass and nothing is written, so an occlusion query around the
+/// draws counts every fragment the volumes rasterise (the stencil fill the pass costs).
+pub(crate) struct RasterPipes {
+    /// Shadow-volume geometry (shadow.vert).
+    pub volume: vk::Pipeline,
+    /// Edge quads (edgequad.vert).
+    pub edge_quads: vk::Pipeline,
+}
+
 pub(crate) struct Pipelines {
     pub layout: vk::PipelineLayout,
     pub stencil: StencilPipes,
+    pub raster: RasterPipes,
     /// `None` when R32_SFLOAT does not blend on this device.
     pub count: Option<CountPipes>,
     /// Light-intensity map, `[multiplicative, log][z-pass, z-fail]`.
@@ -112,6 +123,16 @@ impl Pipelines {
         e.depth_compare = vk::CompareOp::LESS;
         let eq_sides = create(&e)?;
         let stencil = StencilPipes { zpass, zfail, zfail_cap, eq_faces, eq_sides };
+        // The counting variant: ALWAYS, write masks 0 (depth bounds kept: they cull fill).
+        let keep = vk::StencilOpState { write_mask: 0, ..pipeline::stencil_ops(S::KEEP, S::KEEP) };
+        let mut r = s.clone();
+        r.depth_compare = vk::CompareOp::ALWAYS;
+        r.stencil = Some((keep, keep));
+        let raster_volume = create(&r)?;
+        let mut re = e.clone();
+        re.depth_compare = vk::CompareOp::ALWAYS;
+        re.stencil = Some((keep, keep));
+        let raster = RasterPipes { volume: raster_volume, edge_quads: create(&re)? };
 
         let count_fmt = [COUNT_FORMAT];
         let mut c = s.clone();
@@ -203,13 +224,13 @@ impl Pipelines {
         } else {
             None
         };
-        Ok(Pipelines { layout, stencil, count, transmit, overlay, planar, planar_count })
+        Ok(Pipelines { layout, stencil, raster, count, transmit, overlay, planar, planar_count })
     }
 
     /// Every pipeline, once.
     fn all(&self) -> Vec<vk::Pipeline> {
         let s = &self.stencil;
-        let mut v = vec![s.zpass, s.zfail, s.zfail_cap, s.eq_faces, s.eq_sides];
+        let mut v = vec![s.zpass, s.zfail, s.zfail_cap, s.eq_faces, s.eq_sides, self.raster.volume, self.raster.edge_quads];
         if let Some(c) = &self.count {
             v.extend([c.zpass, c.zfail, c.cap, c.eq_faces, c.eq_sides]);
         }

@@ -35,6 +35,10 @@ pub enum VolumeKind {
         /// Log-space map (additive) rather than multiplicative.
         log: bool,
     },
+    /// Opaque casters with depth and stencil tests always passing and nothing written: under
+    /// an occlusion query, the exact number of fragments the volumes rasterise
+    /// ([`ShadowPass::cmd_count_rasterised`](super::ShadowPass::cmd_count_rasterised)).
+    Rasterised,
 }
 
 /// The stencil state of a lighting pass that lights where the count is zero: compare EQUAL
@@ -118,6 +122,32 @@ impl ShadowPass {
             d.cmd_begin_rendering(cb, &info);
             self.cmd_light_state(cb, frame, light, target.extent);
             self.cmd_draw_volumes(cb, frame, light, VolumeKind::Stencil);
+            d.cmd_end_rendering(cb);
+        }
+    }
+
+    /// The counting variant of [`cmd_determine`](Self::cmd_determine): the same volumes of
+    /// light `light` over the same scissor (and depth bounds), with depth and stencil tests
+    /// always passing and nothing written. Wrapped by the host in an occlusion query
+    /// (`VK_QUERY_CONTROL_PRECISE_BIT` with `occlusionQueryPrecise`), the query counts every
+    /// fragment the determination rasterises: the stencil fill it costs. The image's contents
+    /// are left as they are.
+    ///
+    /// # Safety
+    /// As [`cmd_determine`](Self::cmd_determine) (the stencil aspect is loaded, not cleared);
+    /// the frame's uploads were recorded earlier in `cb` or a command buffer submitted before it.
+    pub unsafe fn cmd_count_rasterised(&self, cb: vk::CommandBuffer, frame: &PreparedFrame, light: usize, target: &DepthStencilTarget) {
+        let Some(lf) = frame.lights.get(light) else { return };
+        // SAFETY: the caller's contract (outside a rendering instance).
+        unsafe { self.cmd_upload(cb, frame) };
+        let att = depth_attachment(target, vk::AttachmentLoadOp::LOAD, 0);
+        let info = vk::RenderingInfo::default().render_area(lf.scissor).layer_count(1).depth_attachment(&att).stencil_attachment(&att);
+        let d = &self.dev.device;
+        // SAFETY: the caller's contract; the attachments are the caller's image.
+        unsafe {
+            d.cmd_begin_rendering(cb, &info);
+            self.cmd_light_state(cb, frame, light, target.extent);
+            self.cmd_draw_volumes(cb, frame, light, VolumeKind::Rasterised);
             d.cmd_end_rendering(cb);
         }
     }
@@ -265,6 +295,7 @@ impl ShadowPass {
                 unsafe { self.push(cb, c, color(c.case)) };
                 let (faces, sides) = match (kind, count) {
                     (VolumeKind::Stencil, _) => (p.stencil.eq_faces, p.stencil.eq_sides),
+                    (VolumeKind::Rasterised, _) => (p.raster.edge_quads, p.raster.edge_quads),
                     (VolumeKind::Float, Some(cp)) => (cp.eq_faces, cp.eq_sides),
                     // Self-shadowing leaves edge-quad casters out (their faces are not a
                     // depth-tested volume); transparent casters never take edge quads.
@@ -315,6 +346,9 @@ impl ShadowPass {
         planar: bool,
     ) -> Option<vk::Pipeline> {
         let s = &self.pipes.stencil;
+        if kind == VolumeKind::Rasterised {
+            return Some(self.pipes.raster.volume);
+        }
         if planar {
             // Flattened casters: the sign pushed is +1 (z-pass), so the float count adds 1.
             return match kind {
@@ -348,6 +382,7 @@ impl ShadowPass {
             }
             // Transparent casters' caps are all in the volume list (not NEVER).
             VolumeKind::Transmit { log } => self.pipes.transmit?[log as usize][(!zpass) as usize],
+            VolumeKind::Rasterised => self.pipes.raster.volume,
         })
     }
 

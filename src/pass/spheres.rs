@@ -81,7 +81,15 @@ fn stream_tris(stream: &mut Vec<u8>, tris: &[[DVec4; 3]], case: Case, light_cap:
             stream.extend(f.to_le_bytes());
         }
     }
-    Draw { vertices: vk::Buffer::null(), offset, count: 3 * tris.len() as u32, format: IndexFormat::Naive, case, light_cap, indirect: false }
+    Draw {
+        vertices: vk::Buffer::null(),
+        offset,
+        count: 3 * tris.len() as u32,
+        format: IndexFormat::Naive,
+        case,
+        light_cap,
+        indirect: false,
+    }
 }
 
 /// What [`pack_light`] needs besides the spheres.

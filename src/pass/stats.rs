@@ -140,6 +140,8 @@ pub struct Totals {
     pub bytes_sent: u64,
     /// Caster-light pairs per case.
     pub cases: Cases,
+    /// Volume draw calls the determination records (all lights; an edge-quad caster's two).
+    pub draws: u64,
 }
 
 #[derive(Clone, Debug, Default)]

@@ -16,6 +16,7 @@
 
 #![warn(missing_docs)]
 
+pub mod counters;
 pub mod frame;
 mod frame_output;
 pub mod options;
@@ -31,9 +32,12 @@ pub mod stats;
 pub mod targets;
 mod timing;
 
+pub use counters::PassCounters;
 pub use frame::{largest_device_heap, FrameTicket, MemoryEstimate, Renderer, Throughput};
 pub use frame_output::FrameOutput;
-pub use options::{Counter, DepthMode, FrameSettings, IndexFormat, RenderConfig, RenderOptions, Technique, TransmitMode, View};
+pub use options::{
+    Counter, DepthMode, FrameSettings, IndexFormat, PassToggles, RenderConfig, RenderOptions, Technique, TransmitMode, View,
+};
 pub use passes::debug::stencil_heatmap;
 pub use stats::Stats;
 

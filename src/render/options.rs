@@ -2,7 +2,7 @@
 
 use crate::error::{Error, Result};
 use crate::named_enum::named_enum;
-pub use crate::pass::{Counter, DepthMode, IndexFormat};
+pub use crate::pass::{Counter, DepthMode, IndexFormat, PassToggles};
 use crate::shadow::Method;
 use ash::vk;
 
@@ -170,6 +170,13 @@ pub struct FrameSettings {
     /// Re-draw the area lights' sample pattern every frame (`--jitter`; see
     /// [`crate::geom::area`]); off: the same pattern every frame.
     pub jitter: bool,
+    /// Scissor, depth bounds and culling on or off (ablations; all on by default).
+    pub toggles: PassToggles,
+    /// Measure the shadow pass's counters ([`crate::render::Stats::counters`]): per light an
+    /// occlusion query around the counting variant of the determination (the exact number of
+    /// fragments its volumes rasterise) and pipeline statistics around the determination.
+    /// Adds a pass per light: do not time such frames.
+    pub counters: bool,
 }
 
 /// Everything a renderer is created with: its [`RenderConfig`] and first [`FrameSettings`].
@@ -224,6 +231,8 @@ impl RenderOptions {
             transmit_log: self.transmit.log,
             capture: self.capture,
             jitter: self.jitter,
+            toggles: PassToggles::default(),
+            counters: false,
         }
     }
 }

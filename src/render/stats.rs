@@ -65,6 +65,8 @@ pub struct Stats {
     pub features_used: Vec<String>,
     /// Optional features the device lacks (their paths were skipped).
     pub features_missing: Vec<String>,
+    /// The shadow pass's counters, when the frame measured them (`FrameSettings::counters`).
+    pub counters: Option<super::PassCounters>,
     /// Things the user should know about this frame (e.g. possible 8-bit stencil overflow).
     pub warnings: Vec<String>,
 }

@@ -426,7 +426,7 @@ pub fn plan_light_with(input: &PlanInput, casters: &[Caster], opts: &PlanOptions
         };
         let culls = |b: &Aabb| {
             let out_of_radius = !directional && light.radius.is_some_and(|r| box_distance(b, light.position) > r);
-            out_of_radius || spot_culls(light, b) || shadow_volume_outside_frustum(b, light_h, &frustum)
+            !opts.no_culling && (out_of_radius || spot_culls(light, b) || shadow_volume_outside_frustum(b, light_h, &frustum))
         };
         if culls(&wb) {
             plans.push(culled_plan(Case::Culled));

@@ -3,6 +3,7 @@
 //! (G-buffer -> per light determination + illumination -> final pass) into one command buffer
 //! per ring slot, with frames in flight.
 
+use super::counters::CounterPools;
 use super::frame_output::{parse, FrameOutput};
 use super::options::*;
 use super::passes::{self, debug, determine, gbuffer, illuminate, intensity, tonemap, transparent, Rec};
@@ -15,8 +16,8 @@ use super::shadowmap::ShadowMapper;
 use super::sphere_gpu::SphereGeometry;
 use super::targets::*;
 use super::timing::{Span, Timer};
-mod memory;
 mod area;
+mod memory;
 mod motion;
 pub use memory::{largest_device_heap, MemoryEstimate};
 mod stats;
@@ -77,6 +78,7 @@ struct FrameSlot {
     cmd: vk::CommandBuffer,
     fence: vk::Fence,
     timer: Timer,
+    counters: CounterPools,
     readback: Readback,
     in_flight: Option<InFlight>,
 }
@@ -215,14 +217,20 @@ impl Renderer {
                 })
             };
             match created {
-                Ok((cmd, fence)) => {
-                    slots.push(FrameSlot { cmd, fence, timer: Timer::new(&ctx), readback: Readback { buffer: None }, in_flight: None })
-                }
+                Ok((cmd, fence)) => slots.push(FrameSlot {
+                    cmd,
+                    fence,
+                    timer: Timer::new(&ctx),
+                    counters: CounterPools::new(&ctx),
+                    readback: Readback { buffer: None },
+                    in_flight: None,
+                }),
                 Err(e) => {
                     // SAFETY: nothing was submitted from these slots or with the pipelines.
                     unsafe {
                         for s in &mut slots {
                             s.timer.destroy(&ctx);
+                            s.counters.destroy(&ctx);
                             ctx.device.destroy_fence(s.fence, None);
                             ctx.device.free_command_buffers(ctx.pool, &[s.cmd]);
                         }
@@ -383,7 +391,7 @@ impl Renderer {
         // 1. The CPU work: plans and streams (the shadow-map baseline plans scissors only).
         let frame = match settings.technique.pass_technique() {
             Some(t) => {
-                self.pass.set_settings(PassSettings { technique: t, counter: settings.counter, index_format: settings.index_format })?;
+                self.pass.set_settings(PassSettings { technique: t, ..pass_settings(&settings) })?;
                 self.pass.prepare(slot, &view, &self.scene.lights)?
             }
             None => self.pass.prepare_culled(slot, &view, &self.scene.lights)?,
@@ -411,11 +419,15 @@ impl Renderer {
             d.begin_command_buffer(cb, &begin).map_err(Error::vk("vkBeginCommandBuffer"))?;
         }
         s.timer.begin(&self.ctx, cb, 4 + 4 * nlights as u32)?;
+        if settings.counters {
+            s.counters.begin(&self.ctx, cb, nlights as u32)?;
+        }
         let s = &self.slots[slot];
+        let counters = settings.counters.then_some(&s.counters);
         let full = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: self.targets.extent };
         let viewport = vk::Viewport { x: 0.0, y: 0.0, width: w as f32, height: h as f32, min_depth: 0.0, max_depth: 1.0 };
         let rec = Rec { ctx: &self.ctx, cb, full, viewport, timer: &s.timer, readback };
-        let spans = self.record_frame(&rec, &frame, &layout, (instances, spheres), vp_rel, &lights, float_counts);
+        let spans = self.record_frame(&rec, &frame, &layout, (instances, spheres), vp_rel, &lights, float_counts, counters);
         // SAFETY: recording finished; the submission signals the slot's fence.
         unsafe {
             d.end_command_buffer(cb).map_err(Error::vk("vkEndCommandBuffer"))?;
@@ -446,6 +458,7 @@ impl Renderer {
         vp_rel: Mat4,
         lights: &[LightPush],
         float_counts: bool,
+        counters: Option<&CounterPools>,
     ) -> FrameSpans {
         let (t, p, pass) = (&self.targets, &self.pipes, &self.pass);
         let stamp = |stage| rec.timer.stamp(rec.ctx, rec.cb, stage);
@@ -467,12 +480,21 @@ impl Renderer {
             };
             for (li, light) in self.scene.lights.iter().enumerate() {
                 let begin = stamp(all);
+                if let Some(c) = counters {
+                    c.statistics(rec.ctx, rec.cb, li as u32, true);
+                }
                 if let Some((sm, _)) = &self.shadow_mapper {
                     determine::begin_float(rec, t);
                     sm.record(rec.ctx, rec.cb, t, light, self.scene.camera.eye.as_dvec3(), frame.lights[li].scissor);
                 }
                 determine::record(rec, pass, frame, li, t, into, layout.counts.get(li).copied());
+                if let Some(c) = counters {
+                    c.statistics(rec.ctx, rec.cb, li as u32, false);
+                }
                 spans.shadow.push(passes::timing_span(begin, stamp(all)));
+                if let Some(c) = counters {
+                    determine::record_count(rec, pass, frame, li, t, c);
+                }
                 if self.has_transparent {
                     intensity::record(rec, pass, frame, li, t, self.settings.transmit_log, layout.transmit.get(li).copied());
                 }
@@ -585,6 +607,7 @@ impl Renderer {
                 ctx.device.destroy_fence(s.fence, None);
                 ctx.device.free_command_buffers(ctx.pool, &[s.cmd]);
                 s.timer.destroy(ctx);
+                s.counters.destroy(ctx);
                 s.readback.destroy(ctx);
                 s.in_flight = None;
             }
@@ -626,7 +649,12 @@ fn check_spheres(scene: &Scene, s: &FrameSettings) -> Result<()> {
 
 /// The pass's share of the frame settings.
 fn pass_settings(s: &FrameSettings) -> PassSettings {
-    PassSettings { technique: s.technique.pass_technique().unwrap_or_default(), counter: s.counter, index_format: s.index_format }
+    PassSettings {
+        technique: s.technique.pass_technique().unwrap_or_default(),
+        counter: s.counter,
+        index_format: s.index_format,
+        toggles: s.toggles,
+    }
 }
 
 /// The options this device can honour (checked at creation and before every frame, since

@@ -68,6 +68,10 @@ impl Renderer {
             wall_ms: f.wall.elapsed().as_secs_f64() * 1e3,
             features_used,
             features_missing,
+            counters: match f.settings.counters {
+                true => Some(self.slots[ticket.slot].counters.read(ctx)?),
+                false => None,
+            },
             warnings: f.frame.warnings.clone(),
         })
     }

@@ -4,6 +4,7 @@
 
 use super::{Rec, DS_RW, FRAG_TESTS};
 use crate::pass::{DepthStencilTarget, PreparedFrame, ShadowPass};
+use crate::render::counters::CounterPools;
 use crate::render::readback::Range;
 use crate::render::targets::Targets;
 use ash::vk;
@@ -63,4 +64,18 @@ pub(crate) unsafe fn record(
     if float {
         rec.transition(&t.count, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
     }
+}
+
+/// The counting variant of light `light`'s determination inside its occlusion query (outside
+/// the light's timed span): the exact number of fragments its volumes rasterise.
+///
+/// # Safety
+/// As [`record`], after it (the depth-stencil target in attachment layout).
+pub(crate) unsafe fn record_count(rec: &Rec, pass: &ShadowPass, frame: &PreparedFrame, light: usize, t: &Targets, c: &CounterPools) {
+    let target = DepthStencilTarget { view: t.depth.view, extent: t.extent };
+    c.occlusion(rec.ctx, rec.cb, light as u32, true);
+    // SAFETY: the caller's contract, which is `ShadowPass`'s.
+    unsafe { pass.cmd_count_rasterised(rec.cb, frame, light, &target) };
+    c.occlusion(rec.ctx, rec.cb, light as u32, false);
+    rec.barrier((FRAG_TESTS, DS_RW), (FRAG_TESTS, DS_RW));
 }

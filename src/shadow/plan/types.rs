@@ -236,6 +236,9 @@ pub struct PlanOptions {
     /// bits, silhouette or index lists: path `"compute"`, zero counts (the GPU's compute pass
     /// finds them, `--method compute`). Other parts are planned as usual.
     pub gpu_silhouettes: bool,
+    /// Ablation: never cull (out of the light's range or cone, or a volume missing the
+    /// frustum); every caster gets a case and its volume. The result stays exact, only slower.
+    pub no_culling: bool,
 }
 
 impl CasterPlan {

@@ -1,7 +1,7 @@
-//! `umbrage bench`: every method's speed *against its error*, measured side by side in one run
-//! on one device: per scene and method, the median of N frames (GPU timestamps and wall
-//! clock), the shadow geometry sent, and the mismatch fraction against the CPU reference.
-#![warn(missing_docs)]
+//! `umbrage bench` without `--suite`: every method's speed *against its error*, measured side
+//! by side in one run on one device: per scene and method, the median of N frames (GPU
+//! timestamps and wall clock), the shadow geometry sent, and the mismatch fraction against
+//! the CPU reference.
 
 use crate::accuracy::evaluate;
 use crate::error::{Error, Result};
@@ -62,7 +62,7 @@ pub struct BenchReport {
     pub rows: Vec<BenchRow>,
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
+pub(crate) fn median(mut v: Vec<f64>) -> f64 {
     if v.is_empty() {
         return f64::NAN;
     }
@@ -86,7 +86,7 @@ pub struct BenchConfig {
 }
 
 /// The name of a bench row's technique.
-fn technique_label(t: Technique) -> String {
+pub fn technique_label(t: Technique) -> String {
     match t {
         Technique::ShadowMap { size } => format!("shadowmap-{size}"),
         t => t.name().to_string(),

@@ -1,0 +1,58 @@
+//! The one list of every technique the benchmarks run: each volume method, edge quads,
+//! planar projection and the shadow-map baseline at each size. A technique added to
+//! [`Technique`] or a method added to [`Method`] fails to compile here until it is listed,
+//! so new techniques join every bench (the default `umbrage bench` list and every point of the
+//! suite) from this one place.
+
+use crate::render::Technique;
+use crate::shadow::Method;
+
+/// Every volume method (the papers' case rules and the lecture notes' z-pass with clear).
+pub fn volume_methods() -> Vec<Method> {
+    // Exhaustive on purpose: a new Method variant is a compile error until listed below.
+    let listed = |m: Method| match m {
+        Method::ZPass | Method::ZFail | Method::EverittKilgard | Method::Lengyel | Method::McGuire | Method::ZPassClear => (),
+    };
+    let all = [Method::ZPass, Method::ZFail, Method::EverittKilgard, Method::Lengyel, Method::McGuire, Method::ZPassClear];
+    all.iter().for_each(|&m| listed(m));
+    all.to_vec()
+}
+
+/// Every technique, shadow maps once per size in `shadow_map_sizes` (none when empty).
+pub fn all_techniques(shadow_map_sizes: &[u32]) -> Vec<Technique> {
+    let mut out: Vec<Technique> = volume_methods().into_iter().map(Technique::Volumes).collect();
+    // Exhaustive on purpose: a new Technique variant is a compile error until listed below.
+    let listed = |t: Technique| match t {
+        Technique::Volumes(_) | Technique::EdgeQuads | Technique::Compute | Technique::Planar | Technique::ShadowMap { .. } => (),
+    };
+    for t in [Technique::EdgeQuads, Technique::Compute, Technique::Planar] {
+        listed(t);
+        out.push(t);
+    }
+    out.extend(shadow_map_sizes.iter().map(|&size| Technique::ShadowMap { size }));
+    out
+}
+
+/// Whether a technique gives exact shadows by construction (the volume methods but z-pass,
+/// z-pass with clear and planar are exact; shadow maps are approximations).
+pub fn is_exact(t: Technique) -> bool {
+    match t {
+        Technique::Volumes(m) => !matches!(m, Method::ZPass | Method::ZPassClear),
+        Technique::EdgeQuads | Technique::Compute => true,
+        Technique::Planar | Technique::ShadowMap { .. } => false,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    #[test]
+    fn every_method_once() {
+        let all = all_techniques(&[512, 4096]);
+        assert_eq!(all.len(), volume_methods().len() + 5);
+        for (i, a) in all.iter().enumerate() {
+            assert!(!all[i + 1..].contains(a), "{a:?} listed twice");
+        }
+        assert!(volume_methods().iter().all(|m| Method::ALL.contains(m) || *m == Method::ZPassClear));
+    }
+}

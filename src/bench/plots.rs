@@ -1,0 +1,271 @@
+//! The suite's plots, each as SVG and PNG (plotters; PNG text from an embedded DejaVu Sans
+//! Mono, so no system fonts are needed):
+//!
+//! - `time_vs_triangles`: GPU shadow ms against caster triangles (tessellation sweep), per
+//!   method, with the limit lines (every caster triangle at the small-triangle rate; the
+//!   McGuire volumes' fragments at the stencil fill rate);
+//! - `time_vs_resolution`: against pixels (bench/fill), with the fill limit line;
+//! - `roofline`: every row's fill fraction against its vertex fraction: the diagonal splits
+//!   fill-bound from vertex-bound, 100% on an axis is the device's limit;
+//! - `pareto`: speed against error on the named scenes, shadow maps at each size included.
+
+use super::report::{SuiteReport, SuiteRow};
+use crate::error::{Error, Result};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::path::Path;
+
+static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSansMono.ttf");
+const W: u32 = 960;
+const H: u32 = 600;
+
+fn register_font() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
+    });
+}
+
+fn err<E: std::fmt::Debug>(what: &str) -> impl Fn(E) -> Error + '_ {
+    move |e| Error::Other(format!("plot {what}: {e:?}"))
+}
+
+/// Writes every plot into `dir` and returns the file names.
+pub fn write_all(report: &SuiteReport, dir: &Path) -> Result<Vec<String>> {
+    register_font();
+    let mut out = Vec::new();
+    macro_rules! emit {
+        ($name:expr, $f:ident) => {{
+            let p = dir.join(format!("{}.svg", $name));
+            {
+                let root = SVGBackend::new(&p, (W, H)).into_drawing_area();
+                $f(report, root)?;
+            }
+            out.push(format!("{}.svg", $name));
+            let mut buf = vec![0u8; (W * H * 3) as usize];
+            {
+                let root = BitMapBackend::with_buffer(&mut buf, (W, H)).into_drawing_area();
+                $f(report, root)?;
+            }
+            let rgba: Vec<u8> = buf.chunks_exact(3).flat_map(|c| [c[0], c[1], c[2], 255]).collect();
+            crate::output::write_png(&dir.join(format!("{}.png", $name)), W, H, &rgba)?;
+            out.push(format!("{}.png", $name));
+        }};
+    }
+    emit!("time_vs_triangles", time_vs_triangles);
+    emit!("time_vs_resolution", time_vs_resolution);
+    emit!("roofline", roofline);
+    emit!("pareto", pareto);
+    Ok(out)
+}
+
+/// Methods in first-seen order.
+fn methods<'a>(rows: impl Iterator<Item = &'a SuiteRow>) -> Vec<String> {
+    let mut m: Vec<String> = Vec::new();
+    for r in rows {
+        if !m.contains(&r.method) {
+            m.push(r.method.clone());
+        }
+    }
+    m
+}
+
+fn range(v: impl Iterator<Item = f64>) -> (f64, f64) {
+    let (lo, hi) = v.filter(|x| x.is_finite() && *x > 0.0).fold((f64::MAX, f64::MIN), |(a, b), x| (a.min(x), b.max(x)));
+    if lo > hi {
+        (0.1, 10.0)
+    } else {
+        (lo / 1.5, hi * 1.5)
+    }
+}
+
+/// A log-log chart of GPU shadow ms against `x`, one line per method, plus `limits` lines.
+fn sweep_chart<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    title: &str,
+    x_label: &str,
+    rows: &[&SuiteRow],
+    limits: &[(String, Vec<(f64, f64)>)],
+) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(err(title))?;
+    let (x0, x1) = range(rows.iter().map(|r| r.x));
+    let (y0, y1) = range(rows.iter().filter_map(|r| r.gpu_shadow_ms).chain(limits.iter().flat_map(|l| l.1.iter().map(|p| p.1))));
+    let mut chart = ChartBuilder::on(&root)
+        .caption(title, ("sans-serif", 20))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+        .map_err(err(title))?;
+    chart.configure_mesh().x_desc(x_label).y_desc("GPU shadow ms").draw().map_err(err(title))?;
+    for (i, m) in methods(rows.iter().copied()).iter().enumerate() {
+        let color = Palette99::pick(i).to_rgba();
+        let mut pts: Vec<(f64, f64)> = rows.iter().filter(|r| &r.method == m).filter_map(|r| Some((r.x, r.gpu_shadow_ms?))).collect();
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        chart
+            .draw_series(LineSeries::new(pts.clone(), color.stroke_width(2)))
+            .map_err(err(title))?
+            .label(m.as_str())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(2)));
+        chart.draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled()))).map_err(err(title))?;
+    }
+    for (i, (name, pts)) in limits.iter().enumerate() {
+        let color = if i == 0 { BLACK.mix(0.8) } else { RED.mix(0.8) };
+        chart
+            .draw_series(LineSeries::new(pts.clone(), color.stroke_width(3)))
+            .map_err(err(title))?
+            .label(name.as_str())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], color.stroke_width(3)));
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperLeft)
+        .label_font(("sans-serif", 12))
+        .draw()
+        .map_err(err(title))?;
+    root.present().map_err(err(title))?;
+    Ok(())
+}
+
+fn time_vs_triangles<DB: DrawingBackend>(r: &SuiteReport, root: DrawingArea<DB, Shift>) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let rows: Vec<&SuiteRow> = r.rows.iter().filter(|x| x.sweep == "tessellation").collect();
+    let tri = r.limits.small_tri_mtri_s * 1e6;
+    let fill = r.limits.stencil_fill_gfrag_s * 1e9;
+    let mut xs: Vec<f64> = rows.iter().map(|x| x.x).collect();
+    xs.sort_by(f64::total_cmp);
+    xs.dedup();
+    let vertex_line: Vec<(f64, f64)> = xs.iter().map(|&x| (x, x / tri * 1e3)).collect();
+    let fill_line: Vec<(f64, f64)> = rows
+        .iter()
+        .filter(|x| x.method == "mcguire")
+        .filter_map(|x| Some((x.x, x.stencil_fragments? as f64 / fill * 1e3)))
+        .filter(|p| p.1 > 0.0)
+        .collect();
+    let title = format!("Shadow time vs caster triangles ({})", r.device);
+    let limits = vec![
+        (format!("every caster triangle at {:.1} Mtri/s", r.limits.small_tri_mtri_s), vertex_line),
+        (format!("mcguire fragments at {:.2} Gfrag/s", r.limits.stencil_fill_gfrag_s), fill_line),
+    ];
+    sweep_chart(root, &title, "caster triangles", &rows, &limits)
+}
+
+fn time_vs_resolution<DB: DrawingBackend>(r: &SuiteReport, root: DrawingArea<DB, Shift>) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let rows: Vec<&SuiteRow> = r.rows.iter().filter(|x| x.sweep == "resolution").collect();
+    let fill = r.limits.stencil_fill_gfrag_s * 1e9;
+    let mut fill_line: Vec<(f64, f64)> = rows
+        .iter()
+        .filter(|x| x.method == "mcguire")
+        .filter_map(|x| Some((x.x, x.stencil_fragments? as f64 / fill * 1e3)))
+        .filter(|p| p.1 > 0.0)
+        .collect();
+    fill_line.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let title = format!("Shadow time vs resolution, bench/fill ({})", r.device);
+    let limits = vec![(format!("mcguire fragments at {:.2} Gfrag/s", r.limits.stencil_fill_gfrag_s), fill_line)];
+    sweep_chart(root, &title, "pixels", &rows, &limits)
+}
+
+fn roofline<DB: DrawingBackend>(r: &SuiteReport, root: DrawingArea<DB, Shift>) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let title = format!("Each pass against the limits: fill vs vertex fraction ({})", r.device);
+    root.fill(&WHITE).map_err(err(&title))?;
+    let rows: Vec<&SuiteRow> =
+        r.rows.iter().filter(|x| x.fill_fraction.is_some_and(|f| f > 0.0) && x.vertex_fraction.is_some_and(|f| f > 0.0)).collect();
+    let (a0, a1) = range(rows.iter().flat_map(|x| [x.fill_fraction.unwrap_or(1.0), x.vertex_fraction.unwrap_or(1.0)]).chain([1.0]));
+    let mut chart = ChartBuilder::on(&root)
+        .caption(&title, ("sans-serif", 18))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d((a0..a1).log_scale(), (a0..a1).log_scale())
+        .map_err(err(&title))?;
+    chart.configure_mesh().x_desc("fill fraction (fragments / fill limit / time)").y_desc("vertex fraction").draw().map_err(err(&title))?;
+    chart.draw_series(LineSeries::new(vec![(a0, a0), (a1, a1)], BLACK.stroke_width(1))).map_err(err(&title))?.label("fill = vertex");
+    chart
+        .draw_series(LineSeries::new(vec![(1.0, a0), (1.0, a1)], RED.mix(0.6).stroke_width(2)))
+        .map_err(err(&title))?
+        .label("limit (100%)");
+    chart.draw_series(LineSeries::new(vec![(a0, 1.0), (a1, 1.0)], RED.mix(0.6).stroke_width(2))).map_err(err(&title))?;
+    for (i, sweep) in ["scenes", "resolution", "tessellation", "lights", "light_distance", "casters", "ablation"].iter().enumerate() {
+        let color = Palette99::pick(i).to_rgba();
+        let pts: Vec<(f64, f64)> =
+            rows.iter().filter(|x| x.sweep == *sweep).filter_map(|x| Some((x.fill_fraction?, x.vertex_fraction?))).collect();
+        if pts.is_empty() {
+            continue;
+        }
+        chart
+            .draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))
+            .map_err(err(&title))?
+            .label(*sweep)
+            .legend(move |(x, y)| Circle::new((x + 8, y), 4, color.filled()));
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::LowerRight)
+        .label_font(("sans-serif", 12))
+        .draw()
+        .map_err(err(&title))?;
+    root.present().map_err(err(&title))?;
+    Ok(())
+}
+
+fn pareto<DB: DrawingBackend>(r: &SuiteReport, root: DrawingArea<DB, Shift>) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let title = format!("Speed against error, named scenes ({})", r.device);
+    root.fill(&WHITE).map_err(err(&title))?;
+    let rows: Vec<&SuiteRow> =
+        r.rows.iter().filter(|x| x.sweep == "scenes" && x.error_fraction.is_some() && x.gpu_shadow_ms.is_some()).collect();
+    let e_max = rows.iter().filter_map(|x| x.error_fraction).fold(0.0f64, f64::max) * 100.0;
+    let (y0, y1) = range(rows.iter().filter_map(|x| x.gpu_shadow_ms));
+    let mut scenes: Vec<&str> = Vec::new();
+    for x in &rows {
+        if !scenes.contains(&x.scene.as_str()) {
+            scenes.push(&x.scene);
+        }
+    }
+    let areas = root.split_evenly((1, scenes.len().max(1)));
+    for (area, scene) in areas.iter().zip(scenes) {
+        let mut chart = ChartBuilder::on(area)
+            .caption(scene, ("sans-serif", 16))
+            .margin(10)
+            .x_label_area_size(40)
+            .y_label_area_size(55)
+            .build_cartesian_2d(-0.05 * e_max.max(0.01)..e_max.max(0.01) * 1.15, (y0..y1).log_scale())
+            .map_err(err(&title))?;
+        chart.configure_mesh().x_desc("error, % of pixels").y_desc("GPU shadow ms").draw().map_err(err(&title))?;
+        for (i, m) in methods(rows.iter().copied()).iter().enumerate() {
+            let color = Palette99::pick(i).to_rgba();
+            let pts: Vec<(f64, f64)> = rows
+                .iter()
+                .filter(|x| x.scene == scene && &x.method == m)
+                .filter_map(|x| Some((x.error_fraction? * 100.0, x.gpu_shadow_ms?)))
+                .collect();
+            let label = m.clone();
+            chart
+                .draw_series(pts.iter().map(|&p| {
+                    EmptyElement::at(p)
+                        + Circle::new((0, 0), 4, color.filled())
+                        + Text::new(label.clone(), (6, -6), ("sans-serif", 11).into_font())
+                }))
+                .map_err(err(&title))?;
+        }
+    }
+    root.present().map_err(err(&title))?;
+    Ok(())
+}

@@ -1,0 +1,428 @@
+//! `umbrage bench --suite fill-vertex`: the limits, then every sweep point with every
+//! technique ([`super::methods::all_techniques`]), the named scenes with their error against the
+//! reference, the ablations; fractions, bounds and crossovers; JSON, CSV and plots.
+//!
+//! Each point: one renderer for the scene and size; per variant one *counting* frame
+//! (`FrameSettings::counters`: exact rasterised fragments and pipeline statistics; not timed),
+//! then a warm-up frame and `frames` timed frames round-robin over the variants (drift hits
+//! every variant alike), medians of the GPU timestamps.
+
+use super::classic::{median, technique_label};
+use super::limits::{self, Limits, LimitsConfig};
+use super::methods::all_techniques;
+use super::report::{Ablation, RowLimits, SuiteReport, SuiteRow};
+use super::sweeps::{self, PointScene, Scale, SweepPoint};
+use crate::accuracy::evaluate;
+use crate::error::{Error, Result};
+use crate::gpu::Context;
+use crate::render::{IndexFormat, PassToggles, RenderOptions, Renderer, Technique};
+use crate::scene::Scene;
+use crate::shadow::Method;
+use std::collections::HashMap;
+use std::path::PathBuf;
+use std::time::Instant;
+
+/// What to run (the CLI's `bench --suite` arguments).
+#[derive(Clone, Debug)]
+pub struct SuiteConfig {
+    /// Points and frames ([`Scale::Quick`] for `--quick`).
+    pub scale: Scale,
+    /// Timed frames per variant (default: the scale's).
+    pub frames: Option<usize>,
+    /// Frames in flight of the renderers (the counting and timed frames run one at a time).
+    pub frames_in_flight: usize,
+    /// Output directory (bench.json, bench.csv, plots).
+    pub out: PathBuf,
+    /// Show a progress bar (it also hides itself when stderr is not a terminal).
+    pub progress: bool,
+}
+
+/// One way to render a point: the technique plus the pass settings an ablation changes.
+#[derive(Clone, Debug)]
+struct Variant {
+    technique: Technique,
+    toggles: PassToggles,
+    index_format: IndexFormat,
+    label: String,
+}
+
+impl Variant {
+    fn of(t: Technique) -> Variant {
+        Variant { technique: t, toggles: PassToggles::default(), index_format: IndexFormat::Auto, label: String::new() }
+    }
+}
+
+struct Runner {
+    ctx: Option<Context>,
+    /// Print a line per point (progress requested but stderr is not a terminal).
+    log: bool,
+    limits: RowLimits,
+    frames: usize,
+    frames_in_flight: usize,
+    bar: indicatif::ProgressBar,
+    skipped: Vec<String>,
+    start: Instant,
+}
+
+fn scene_of(p: &PointScene) -> Result<(Scene, String)> {
+    match p {
+        PointScene::Named(n) => Ok((crate::scene::load(n)?, n.clone())),
+        PointScene::Param(s) => Ok((s.build(), s.name())),
+    }
+}
+
+impl Runner {
+    /// Measures every variant on one scene and size. `errors`: render the reference too and
+    /// fill in each technique's error.
+    #[allow(clippy::too_many_arguments)]
+    fn point(
+        &mut self,
+        sweep: &str,
+        x: f64,
+        scene: Scene,
+        name: &str,
+        size: (u32, u32),
+        variants: &[Variant],
+        errors: bool,
+    ) -> Result<Vec<SuiteRow>> {
+        let ctx = self.ctx.take().ok_or_else(|| Error::Other("context lost".into()))?;
+        if self.log {
+            eprintln!("[{:>6.1} s] {sweep} {name} {}x{} ({} variants)", self.start.elapsed().as_secs_f64(), size.0, size.1, variants.len());
+        }
+        let opts = RenderOptions { width: size.0, height: size.1, frames_in_flight: self.frames_in_flight, ..Default::default() };
+        let casters = scene.meshes.iter().filter(|m| m.casts_shadow).count() as u64;
+        let triangles: u64 = scene.meshes.iter().filter(|m| m.casts_shadow).map(|m| m.mesh.triangles.len() as u64).sum();
+        let nlights = scene.lights.len();
+        let mut r = Renderer::new(ctx, scene, opts)?;
+        let result = self.measure(&mut r, sweep, x, name, variants, errors, casters, triangles, nlights);
+        self.ctx = Some(r.into_context());
+        result
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn measure(
+        &mut self,
+        r: &mut Renderer,
+        sweep: &str,
+        x: f64,
+        name: &str,
+        variants: &[Variant],
+        errors: bool,
+        casters: u64,
+        triangles: u64,
+        nlights: usize,
+    ) -> Result<Vec<SuiteRow>> {
+        let mut kept: Vec<&Variant> = Vec::with_capacity(variants.len());
+        for v in variants {
+            match v.technique {
+                Technique::ShadowMap { size } if !sweeps::shadow_map_fits(size, nlights) => {
+                    self.skipped.push(format!("{sweep} {name}: shadowmap-{size} with {nlights} lights (over 2^26 map texels a frame)"));
+                    self.bar.inc(1);
+                }
+                _ if v.index_format == IndexFormat::U8 && !r.context().features.index_type_uint8 => {
+                    self.skipped.push(format!("{sweep} {name}: index-u8 (VK_EXT_index_type_uint8 missing)"));
+                    self.bar.inc(1);
+                }
+                _ => kept.push(v),
+            }
+        }
+        let variants = kept;
+        let mut error: HashMap<Technique, f64> = HashMap::new();
+        if errors {
+            let techniques: Vec<Technique> = variants.iter().map(|v| v.technique).collect();
+            let rows = evaluate_fractions(r, name, &techniques)?;
+            for (t, f) in techniques.iter().zip(rows) {
+                error.insert(*t, f);
+            }
+        }
+        // One frame first: the casters' uploads land in it, not in a variant's counts.
+        r.render()?;
+        let base = r.settings;
+        let apply = |r: &mut Renderer, v: &Variant| {
+            r.settings = base;
+            r.settings.technique = v.technique;
+            r.settings.toggles = v.toggles;
+            r.settings.index_format = v.index_format;
+        };
+        // Counting frames (not timed).
+        let mut counted = Vec::with_capacity(variants.len());
+        for v in &variants {
+            apply(r, v);
+            r.settings.counters = true;
+            counted.push(r.render()?.stats);
+            r.settings.counters = false;
+        }
+        // Timed frames, round-robin.
+        #[derive(Default)]
+        struct Acc {
+            shadow: Vec<f64>,
+            frame: Vec<f64>,
+            depth: Vec<f64>,
+            illum: Vec<f64>,
+            plan: Vec<f64>,
+        }
+        let mut acc: Vec<Acc> = variants.iter().map(|_| Acc::default()).collect();
+        for frame in 0..=self.frames {
+            for (k, v) in variants.iter().enumerate() {
+                apply(r, v);
+                let f = r.render()?;
+                if frame == 0 {
+                    continue;
+                }
+                let a = &mut acc[k];
+                if let Some(g) = &f.stats.gpu_ms {
+                    a.shadow.push(g.shadow);
+                    a.frame.push(g.frame);
+                    a.depth.push(g.depth);
+                    a.illum.push(g.illuminate);
+                }
+                a.plan.push(f.stats.cpu_ms.plan + f.stats.cpu_ms.silhouettes);
+            }
+        }
+        r.settings = base;
+        let (w, h) = (r.config().width, r.config().height);
+        let mut rows = Vec::new();
+        for ((v, s), a) in variants.iter().zip(counted).zip(acc) {
+            let c = s.counters.clone().unwrap_or_default();
+            let shadow_map = matches!(v.technique, Technique::ShadowMap { .. });
+            let med = |x: Vec<f64>| (!x.is_empty()).then(|| median(x));
+            let mut row = SuiteRow {
+                suite: "fill-vertex".into(),
+                sweep: sweep.into(),
+                x,
+                variant: v.label.clone(),
+                scene: name.into(),
+                method: technique_label(v.technique),
+                counter: if shadow_map { "float".into() } else { s.counter.clone() },
+                index_format: v.index_format.name().into(),
+                width: w,
+                height: h,
+                triangles,
+                casters,
+                lights: nlights as u64,
+                frames: self.frames,
+                gpu_shadow_ms: med(a.shadow),
+                gpu_frame_ms: med(a.frame),
+                gpu_depth_ms: med(a.depth),
+                gpu_illuminate_ms: med(a.illum),
+                stencil_fragments: c.stencil_fragments,
+                shadow_triangles: s.totals.triangles.total(),
+                shadow_sides: s.totals.triangles.sides,
+                primitives: c.primitives,
+                clipped_primitives: c.clipped_primitives,
+                draws: s.totals.draws,
+                cpu_plan_ms: median(a.plan),
+                bytes: s.totals.bytes_sent,
+                error_fraction: error.get(&v.technique).copied(),
+                ..Default::default()
+            };
+            sweeps::classify(&mut row, self.limits);
+            self.bar.inc(1);
+            rows.push(row);
+        }
+        Ok(rows)
+    }
+}
+
+/// Each technique's worst-light error fraction, in the order given.
+fn evaluate_fractions(r: &mut Renderer, name: &str, techniques: &[Technique]) -> Result<Vec<f64>> {
+    let rows = evaluate(r, name, techniques, 1)?;
+    if rows.len() != techniques.len() {
+        return Err(Error::Other(format!("accuracy rows: {} for {} techniques", rows.len(), techniques.len())));
+    }
+    Ok(rows.iter().map(|row| row.fraction).collect())
+}
+
+/// Runs the suite on `ctx` and writes its outputs into `cfg.out`.
+pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
+    let start = Instant::now();
+    let cpu0 = process_cpu_seconds();
+    let scale = cfg.scale;
+    let frames = cfg.frames.unwrap_or_else(|| scale.frames()).max(1);
+    let base = scale.base_size();
+    let device = ctx.info.name.clone();
+    let driver = format!("{} {}", ctx.info.driver, ctx.info.driver_info);
+    let lscale = match scale {
+        Scale::Full => 1.0,
+        Scale::Quick => 0.5,
+        Scale::Tiny => 0.02,
+    };
+    let limits: Limits = limits::measure(
+        &ctx,
+        &LimitsConfig { width: base.0, height: base.1, reps: if scale == Scale::Full { 5 } else { 3 }, scale: lscale },
+    )?;
+    let row_limits = RowLimits {
+        stencil_fill_gfrag_s: limits.stencil_fill_gfrag_s,
+        small_tri_mtri_s: limits.small_tri_mtri_s,
+        sliver_tri_mtri_s: limits.sliver_tri_mtri_s,
+        draws_per_s: limits.draws_per_s,
+    };
+    let techniques = all_techniques(&scale.shadow_map_sizes());
+    let points = sweeps::points(scale);
+    // The tiny suite (tests) leaves the 435k-triangle vertex scene out.
+    let named: &[&str] = if scale == Scale::Tiny { &["bench/fill", "default"] } else { &["bench/fill", "bench/vertex"] };
+    let ablation_scenes: &[&str] = if scale == Scale::Tiny { &["default"] } else { &["bench/fill", "bench/vertex", "default"] };
+    let index_scene = if scale == Scale::Tiny { "default" } else { "bench/vertex" };
+    let toggle_variants = toggle_variants(&ctx);
+    let index_variants = index_variants();
+    let units =
+        (named.len() + points.len()) * techniques.len() + (ablation_scenes.len() + 1) * toggle_variants.len() + index_variants.len();
+    let bar = if cfg.progress {
+        let b = indicatif::ProgressBar::new(units as u64);
+        if let Ok(style) = indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} {msg}") {
+            b.set_style(style);
+        }
+        b
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    let log = cfg.progress && bar.is_hidden();
+    let mut run =
+        Runner { ctx: Some(ctx), log, limits: row_limits, frames, frames_in_flight: cfg.frames_in_flight, bar, skipped: Vec::new(), start };
+    let mut rows = Vec::new();
+    let all: Vec<Variant> = techniques.iter().map(|&t| Variant::of(t)).collect();
+    // The named scenes, with their error (the Pareto chart).
+    for &n in named {
+        run.bar.set_message(format!("scenes {n}"));
+        let scene = crate::scene::load(n)?;
+        rows.extend(run.point("scenes", 0.0, scene, n, base, &all, true)?);
+    }
+    for p in &points {
+        let SweepPoint { sweep, x, scene, size } = p;
+        let (scene, name) = scene_of(scene)?;
+        run.bar.set_message(format!("{sweep} {name} {}x{}", size.0, size.1));
+        rows.extend(run.point(sweep, *x, scene, &name, *size, &all, false)?);
+    }
+    // Ablations: McGuire with each optimisation off; index formats on the vertex scene.
+    for &n in ablation_scenes {
+        run.bar.set_message(format!("ablation {n}"));
+        let scene = crate::scene::load(n)?;
+        rows.extend(run.point("ablation", 0.0, scene, n, base, &toggle_variants, false)?);
+    }
+    // Lights with a range, casters beyond some of them: what scissor and culling are for.
+    let ranged = super::scenes::SweepScene::ranged();
+    rows.extend(run.point("ablation", 0.0, ranged.build(), &ranged.name(), base, &toggle_variants, false)?);
+    run.bar.set_message("ablation index formats");
+    rows.extend(run.point("ablation", 0.0, crate::scene::load(index_scene)?, index_scene, base, &index_variants, false)?);
+    run.bar.finish_and_clear();
+    let ctx = run.ctx.take().ok_or_else(|| Error::Other("context lost".into()))?;
+    ctx.check_validation()?;
+    let crossovers = sweeps::crossovers(&rows);
+    let mut ablations = ablations(&rows);
+    if !ctx.features.depth_bounds {
+        for &n in ablation_scenes {
+            ablations.push(Ablation {
+                what: "depth-bounds".into(),
+                scene: n.into(),
+                variant: "depth-bounds-off".into(),
+                baseline: "all-on".into(),
+                time_ratio: None,
+                fragment_ratio: None,
+                triangle_ratio: None,
+                byte_ratio: None,
+                skipped: "the device has no depthBounds feature (the pass never uses it here)".into(),
+            });
+        }
+    }
+    let mut report = SuiteReport {
+        device,
+        driver,
+        suite: "fill-vertex".into(),
+        quick: scale != Scale::Full,
+        scale: format!("{scale:?}").to_lowercase(),
+        seconds: 0.0,
+        cpu_threads: std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
+        limits,
+        rows,
+        crossovers,
+        ablations,
+        plots: Vec::new(),
+        cpu_seconds: None,
+        load_average: load_average(),
+        skipped: run.skipped,
+    };
+    std::fs::create_dir_all(&cfg.out).map_err(|e| Error::io(cfg.out.display().to_string(), e))?;
+    report.plots = super::plots::write_all(&report, &cfg.out)?;
+    report.seconds = start.elapsed().as_secs_f64();
+    report.cpu_seconds = process_cpu_seconds().map(|c| c - cpu0.unwrap_or(0.0));
+    report.write(&cfg.out)?;
+    Ok(report)
+}
+
+fn toggle_variants(ctx: &Context) -> Vec<Variant> {
+    let m = Technique::Volumes(Method::McGuire);
+    let on = PassToggles::default();
+    let mut v = vec![
+        Variant { label: "all-on".into(), ..Variant::of(m) },
+        Variant { label: "scissor-off".into(), toggles: PassToggles { scissor: false, ..on }, ..Variant::of(m) },
+        Variant { label: "culling-off".into(), toggles: PassToggles { culling: false, ..on }, ..Variant::of(m) },
+    ];
+    if ctx.features.depth_bounds {
+        v.push(Variant { label: "depth-bounds-off".into(), toggles: PassToggles { depth_bounds: false, ..on }, ..Variant::of(m) });
+    }
+    v
+}
+
+fn index_variants() -> Vec<Variant> {
+    let m = Technique::Volumes(Method::McGuire);
+    [IndexFormat::U8, IndexFormat::U16, IndexFormat::U32, IndexFormat::Naive]
+        .into_iter()
+        .map(|f| Variant { label: format!("index-{}", f.name()), index_format: f, ..Variant::of(m) })
+        .collect()
+}
+
+/// The constant factors as ratios: toggles against `all-on`, the other methods' triangles and
+/// time against McGuire's on the named scenes, index formats against u16.
+fn ablations(rows: &[SuiteRow]) -> Vec<Ablation> {
+    let ratio = |a: Option<f64>, b: Option<f64>| match (a, b) {
+        (Some(a), Some(b)) if b > 0.0 => Some(a / b),
+        _ => None,
+    };
+    let make = |what: &str, v: &SuiteRow, b: &SuiteRow, vl: &str, bl: &str| Ablation {
+        what: what.into(),
+        scene: v.scene.clone(),
+        variant: vl.into(),
+        baseline: bl.into(),
+        time_ratio: ratio(v.gpu_shadow_ms, b.gpu_shadow_ms),
+        fragment_ratio: ratio(v.stencil_fragments.map(|x| x as f64), b.stencil_fragments.map(|x| x as f64)),
+        triangle_ratio: ratio(Some(v.shadow_triangles as f64), Some(b.shadow_triangles as f64)),
+        byte_ratio: ratio(Some(v.bytes as f64), Some(b.bytes as f64)),
+        skipped: String::new(),
+    };
+    let mut out = Vec::new();
+    let abl: Vec<&SuiteRow> = rows.iter().filter(|r| r.sweep == "ablation").collect();
+    for b in abl.iter().filter(|r| r.variant == "all-on") {
+        for v in abl.iter().filter(|r| r.scene == b.scene && r.variant.ends_with("-off")) {
+            out.push(make(v.variant.trim_end_matches("-off"), v, b, &v.variant, "all-on"));
+        }
+    }
+    for b in abl.iter().filter(|r| r.variant == "index-u16") {
+        for v in abl.iter().filter(|r| r.scene == b.scene && r.variant.starts_with("index-") && r.variant != "index-u16") {
+            out.push(make("index-format", v, b, &v.variant, "index-u16"));
+        }
+    }
+    let scenes: Vec<&SuiteRow> = rows.iter().filter(|r| r.sweep == "scenes").collect();
+    for b in scenes.iter().filter(|r| r.method == "mcguire") {
+        for v in scenes.iter().filter(|r| r.scene == b.scene && matches!(r.method.as_str(), "lengyel" | "everitt-kilgard" | "zfail")) {
+            out.push(make("method", v, b, &v.method, "mcguire"));
+        }
+    }
+    out
+}
+
+/// This process's CPU time (user + system, all threads: lavapipe's rasteriser threads too),
+/// seconds; Linux only (`/proc/self/stat`, 100 ticks a second).
+fn process_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name (which may hold spaces) in parentheses.
+    let rest = &stat[stat.rfind(')')? + 2..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let (utime, stime): (f64, f64) = (f.get(11)?.parse().ok()?, f.get(12)?.parse().ok()?);
+    Some((utime + stime) / 100.0)
+}
+
+/// The machine's 1-minute load average at the end of the run (other work competing for the
+/// CPU slows lavapipe); Linux only.
+fn load_average() -> Option<f64> {
+    std::fs::read_to_string("/proc/loadavg").ok()?.split_whitespace().next()?.parse().ok()
+}

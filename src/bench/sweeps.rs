@@ -1,0 +1,309 @@
+//! The suite's points (which scene, at which size, along which sweep), each row's fractions
+//! of the limits and its bound, and the crossovers found along the sweeps.
+
+use super::report::{Crossover, RowLimits, SuiteRow};
+use super::scenes::SweepScene;
+
+/// How many points: the full suite, `--quick` (about 3 minutes on lavapipe on 2 cores), or
+/// the tiny one the tests run (two points a sweep, small targets).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Scale {
+    /// Every point.
+    Full,
+    /// Fewer points and frames.
+    Quick,
+    /// Two points a sweep at a small size (tests).
+    Tiny,
+}
+
+/// Where a point's scene comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PointScene {
+    /// A built-in scene or a scene file ([`crate::scene::load`]).
+    Named(String),
+    /// The parametric sphere grid.
+    Param(SweepScene),
+}
+
+/// One point of a sweep.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SweepPoint {
+    /// The sweep's name (`resolution`, `tessellation`, `lights`, `light_distance`, `casters`).
+    pub sweep: &'static str,
+    /// The sweep variable's value.
+    pub x: f64,
+    /// The scene.
+    pub scene: PointScene,
+    /// Frame size.
+    pub size: (u32, u32),
+}
+
+impl Scale {
+    /// The base frame size (named scenes, ablations and the parametric sweeps).
+    pub fn base_size(self) -> (u32, u32) {
+        match self {
+            Scale::Tiny => (160, 90),
+            _ => (960, 540),
+        }
+    }
+    /// Timed frames per variant (after a warm-up frame).
+    pub fn frames(self) -> usize {
+        match self {
+            Scale::Full => 7,
+            Scale::Quick => 3,
+            Scale::Tiny => 1,
+        }
+    }
+    /// Shadow-map sizes every point runs.
+    pub fn shadow_map_sizes(self) -> Vec<u32> {
+        match self {
+            Scale::Full => vec![512, 1024, 2048, 4096],
+            Scale::Quick => vec![512, 2048],
+            Scale::Tiny => vec![512],
+        }
+    }
+}
+
+/// Every sweep's points at `scale`.
+pub fn points(scale: Scale) -> Vec<SweepPoint> {
+    let pick = |full: &[f64], quick: &[f64], tiny: &[f64]| -> Vec<f64> {
+        match scale {
+            Scale::Full => full.to_vec(),
+            Scale::Quick => quick.to_vec(),
+            Scale::Tiny => tiny.to_vec(),
+        }
+    };
+    let base = scale.base_size();
+    let mut out = Vec::new();
+    let sizes: Vec<(u32, u32)> = match scale {
+        Scale::Full => vec![(320, 180), (640, 360), (960, 540), (1280, 720), (1920, 1080)],
+        Scale::Quick => vec![(320, 180), (960, 540), (1920, 1080)],
+        Scale::Tiny => vec![(80, 45), (160, 90)],
+    };
+    for s in sizes {
+        out.push(SweepPoint { sweep: "resolution", x: (s.0 * s.1) as f64, scene: PointScene::Named("bench/fill".into()), size: s });
+    }
+    let d = SweepScene::default();
+    let param = |sweep: &'static str, x: f64, p: SweepScene| SweepPoint { sweep, x, scene: PointScene::Param(p), size: base };
+    for t in pick(&[1e3, 4e3, 16e3, 64e3, 256e3, 1e6, 2e6], &[1e3, 16e3, 256e3], &[1e3, 4e3]) {
+        let p = SweepScene { triangles: t as u64, ..d };
+        out.push(param("tessellation", p.built_triangles() as f64, p));
+    }
+    for l in pick(&[1.0, 4.0, 16.0, 64.0, 256.0], &[1.0, 8.0, 32.0], &[1.0, 4.0]) {
+        out.push(param("lights", l, SweepScene { lights: l as u32, ..d }));
+    }
+    for h in pick(&[0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0], &[0.25, 2.0, 16.0], &[0.25, 4.0]) {
+        out.push(param("light_distance", h, SweepScene { light_height: h as f32, ..d }));
+    }
+    for c in pick(&[1.0, 4.0, 16.0, 64.0, 256.0], &[1.0, 16.0, 256.0], &[1.0, 4.0]) {
+        out.push(param("casters", c, SweepScene { casters: c as u32, triangles: c as u64 * 512, ..d }));
+    }
+    out
+}
+
+/// Whether shadow maps of `size` run with `lights` lights: a point light renders six faces a
+/// frame, so big maps with many lights are left out (lights x size^2 <= 2^26 texels).
+pub fn shadow_map_fits(size: u32, lights: usize) -> bool {
+    lights as u64 * (size as u64).pow(2) <= 1 << 26
+}
+
+/// Fills in a row's fractions of `limits` and its bound.
+pub fn classify(row: &mut SuiteRow, limits: RowLimits) {
+    row.limits = limits;
+    let Some(t) = row.gpu_shadow_ms.filter(|t| *t > 0.0) else {
+        row.bound = "none".into();
+        return;
+    };
+    let secs = t * 1e-3;
+    let shadow_map = row.method.starts_with("shadowmap");
+    // Shadow maps draw no volumes: their fill (the maps' depth fragments) is not counted.
+    row.fill_fraction = match shadow_map {
+        true => None,
+        false => row.stencil_fragments.map(|f| f as f64 / (limits.stencil_fill_gfrag_s * 1e9) / secs),
+    };
+    // Volume sides reach the screen's edge (slivers); caps are small on screen.
+    let vertex_secs = match shadow_map {
+        true => row.primitives.unwrap_or(0) as f64 / (limits.small_tri_mtri_s * 1e6),
+        false => {
+            let sides = row.shadow_sides.min(row.shadow_triangles) as f64;
+            let caps = (row.shadow_triangles as f64 - sides).max(0.0);
+            let sliver = if limits.sliver_tri_mtri_s > 0.0 { limits.sliver_tri_mtri_s } else { limits.small_tri_mtri_s };
+            sides / (sliver * 1e6) + caps / (limits.small_tri_mtri_s * 1e6)
+        }
+    };
+    row.vertex_fraction = Some(vertex_secs / secs);
+    row.draw_fraction = (!shadow_map).then(|| row.draws as f64 / limits.draws_per_s / secs);
+    row.cpu_fraction = Some(row.cpu_plan_ms / t);
+    let candidates = [("fill", row.fill_fraction), ("vertex", row.vertex_fraction), ("draw", row.draw_fraction), ("cpu", row.cpu_fraction)];
+    row.bound = candidates
+        .iter()
+        .filter_map(|(n, f)| f.filter(|f| f.is_finite()).map(|f| (*n, f)))
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(n, _)| n.to_string())
+        .unwrap_or_else(|| "none".into());
+}
+
+/// `x` where `a(x) - b(x)` crosses zero between two points, on a log scale of x (linear
+/// when a point is at or below 0).
+fn interpolate(x0: f64, x1: f64, d0: f64, d1: f64) -> f64 {
+    let t = if (d0 - d1).abs() > 0.0 { d0 / (d0 - d1) } else { 0.5 };
+    let t = t.clamp(0.0, 1.0);
+    if x0 > 0.0 && x1 > 0.0 {
+        (x0.ln() + t * (x1.ln() - x0.ln())).exp()
+    } else {
+        x0 + t * (x1 - x0)
+    }
+}
+
+fn fraction(r: &SuiteRow, bound: &str) -> f64 {
+    match bound {
+        "fill" => r.fill_fraction,
+        "vertex" => r.vertex_fraction,
+        "draw" => r.draw_fraction,
+        "cpu" => r.cpu_fraction,
+        _ => None,
+    }
+    .unwrap_or(0.0)
+}
+
+/// Along each sweep: per method, where its bound changes; per pair of methods, where the
+/// faster one changes (GPU shadow time).
+pub fn crossovers(rows: &[SuiteRow]) -> Vec<Crossover> {
+    let mut out = Vec::new();
+    let mut sweeps: Vec<&str> = Vec::new();
+    for r in rows {
+        if !sweeps.contains(&r.sweep.as_str()) && !matches!(r.sweep.as_str(), "scenes" | "ablation") {
+            sweeps.push(&r.sweep);
+        }
+    }
+    for sweep in sweeps {
+        let mut methods: Vec<&str> = Vec::new();
+        for r in rows.iter().filter(|r| r.sweep == sweep) {
+            if !methods.contains(&r.method.as_str()) {
+                methods.push(&r.method);
+            }
+        }
+        let series = |m: &str| -> Vec<&SuiteRow> {
+            let mut v: Vec<&SuiteRow> = rows.iter().filter(|r| r.sweep == sweep && r.method == m).collect();
+            v.sort_by(|a, b| a.x.total_cmp(&b.x));
+            v
+        };
+        for &m in &methods {
+            let s = series(m);
+            for w in s.windows(2) {
+                let (a, b) = (w[0], w[1]);
+                if a.bound != b.bound && a.bound != "none" && b.bound != "none" {
+                    let d0 = fraction(a, &a.bound) - fraction(a, &b.bound);
+                    let d1 = fraction(b, &a.bound) - fraction(b, &b.bound);
+                    out.push(Crossover {
+                        kind: "bound".into(),
+                        sweep: sweep.into(),
+                        method: m.into(),
+                        from: a.bound.clone(),
+                        to: b.bound.clone(),
+                        between: [a.x, b.x],
+                        at: interpolate(a.x, b.x, d0, d1),
+                    });
+                }
+            }
+        }
+        for (i, &ma) in methods.iter().enumerate() {
+            for &mb in &methods[i + 1..] {
+                let (sa, sb) = (series(ma), series(mb));
+                let pairs: Vec<(f64, f64, f64)> = sa
+                    .iter()
+                    .filter_map(|a| {
+                        let b = sb.iter().find(|b| b.x == a.x)?;
+                        Some((a.x, a.gpu_shadow_ms?, b.gpu_shadow_ms?))
+                    })
+                    .collect();
+                for w in pairs.windows(2) {
+                    let (d0, d1) = (w[0].1 - w[0].2, w[1].1 - w[1].2);
+                    if d0 * d1 < 0.0 {
+                        let (before, after) = if d0 < 0.0 { (ma, mb) } else { (mb, ma) };
+                        out.push(Crossover {
+                            kind: "overtake".into(),
+                            sweep: sweep.into(),
+                            method: after.into(),
+                            from: before.into(),
+                            to: after.into(),
+                            between: [w[0].0, w[1].0],
+                            at: interpolate(w[0].0, w[1].0, d0, d1),
+                        });
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(sweep: &str, method: &str, x: f64, frags: u64, tris: u64, ms: f64) -> SuiteRow {
+        let mut r = SuiteRow {
+            sweep: sweep.into(),
+            method: method.into(),
+            x,
+            stencil_fragments: Some(frags),
+            shadow_triangles: tris,
+            gpu_shadow_ms: Some(ms),
+            draws: 1,
+            ..Default::default()
+        };
+        classify(&mut r, RowLimits { stencil_fill_gfrag_s: 1.0, small_tri_mtri_s: 1.0, sliver_tri_mtri_s: 1.0, draws_per_s: 1e6 });
+        r
+    }
+
+    #[test]
+    fn fractions_and_bound() {
+        // 1e6 fragments at 1 Gfrag/s = 1 ms of a 2 ms pass; 100 triangles at 1 Mtri/s = 0.1 ms.
+        let r = row("t", "m", 1.0, 1_000_000, 100, 2.0);
+        assert!((r.fill_fraction.unwrap() - 0.5).abs() < 1e-9);
+        assert!((r.vertex_fraction.unwrap() - 0.05).abs() < 1e-9);
+        assert_eq!(r.bound, "fill");
+        let r = row("t", "m", 1.0, 1000, 1_000_000, 2.0);
+        assert_eq!(r.bound, "vertex");
+        let mut none = SuiteRow::default();
+        classify(&mut none, RowLimits::default());
+        assert_eq!(none.bound, "none");
+    }
+
+    #[test]
+    fn crossovers_are_found_between_the_points() {
+        // Fill constant, triangles growing: fill-bound, then vertex-bound between x=10 and 100.
+        let rows = vec![
+            row("tess", "a", 1.0, 1_000_000, 100, 2.0),
+            row("tess", "a", 10.0, 1_000_000, 500, 2.0),
+            row("tess", "a", 100.0, 1_000_000, 10_000_000, 20.0),
+            row("tess", "b", 1.0, 1_000_000, 1_000, 1.0),
+            row("tess", "b", 10.0, 1_000_000, 1_000, 3.0),
+            row("tess", "b", 100.0, 1_000_000, 1_000, 30.0),
+        ];
+        let c = crossovers(&rows);
+        let bound: Vec<_> = c.iter().filter(|c| c.kind == "bound").collect();
+        assert_eq!(bound.len(), 1);
+        assert_eq!((bound[0].from.as_str(), bound[0].to.as_str()), ("fill", "vertex"));
+        assert_eq!(bound[0].between, [10.0, 100.0]);
+        assert!(bound[0].at > 10.0 && bound[0].at < 100.0);
+        let over: Vec<_> = c.iter().filter(|c| c.kind == "overtake").collect();
+        assert_eq!(over.len(), 1);
+        assert_eq!((over[0].method.as_str(), over[0].from.as_str()), ("a", "b"));
+        assert_eq!(over[0].between, [1.0, 10.0]);
+    }
+
+    #[test]
+    fn points_per_scale() {
+        let quick = points(Scale::Quick);
+        let full = points(Scale::Full);
+        assert!(quick.len() < full.len());
+        for s in ["resolution", "tessellation", "lights", "light_distance", "casters"] {
+            assert!(points(Scale::Tiny).iter().filter(|p| p.sweep == s).count() == 2, "{s}");
+        }
+        let tess: Vec<f64> = full.iter().filter(|p| p.sweep == "tessellation").map(|p| p.x).collect();
+        assert!(tess[0] < 1.5e3 && *tess.last().unwrap() > 1.5e6, "{tess:?}");
+        assert!(shadow_map_fits(4096, 1) && !shadow_map_fits(4096, 256) && shadow_map_fits(512, 256));
+    }
+}

@@ -1,0 +1,113 @@
+//! `umbrage bench --suite fill-vertex` end to end at the tiny test size (two points a sweep,
+//! 160x90; the hidden `--tiny`): the bench.json contract (issue #10's keys), the CSV, the
+//! Markdown and the SVG + PNG plots, under validation.
+
+use std::process::Command;
+
+fn keys(v: &serde_json::Value, want: &[&str], what: &str) {
+    let o = v.as_object().unwrap_or_else(|| panic!("{what} is not an object"));
+    for k in want {
+        assert!(o.contains_key(*k), "{what} lacks '{k}'");
+    }
+}
+
+#[test]
+fn tiny_suite_writes_the_contract_and_the_plots() {
+    let dir = std::env::temp_dir().join(format!("umbrage-suite-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = Command::new(env!("CARGO_BIN_EXE_umbrage"))
+        .args(["bench", "--suite", "fill-vertex", "--quick", "--tiny", "--out", dir.to_str().unwrap()])
+        .env("UMBRAGE_VALIDATION", "1")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    if !out.status.success() && std::env::var_os("CI").is_none() && err.contains("Vulkan") {
+        eprintln!("SKIPPED (no Vulkan device, CI not set): {err}");
+        return;
+    }
+    assert!(out.status.success(), "suite failed: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    let text = std::fs::read_to_string(dir.join("bench.json")).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    keys(&v, &["device", "driver", "limits", "rows", "crossovers", "ablations", "plots"], "bench.json");
+    let limits = &v["limits"];
+    keys(
+        limits,
+        &["stencil_fill_gfrag_s", "color_fill_gfrag_s", "small_tri_mtri_s", "big_tri_mtri_s", "draws_per_s", "cpu_stream_gib_s", "units"],
+        "limits",
+    );
+    for k in ["stencil_fill_gfrag_s", "color_fill_gfrag_s", "small_tri_mtri_s", "big_tri_mtri_s", "draws_per_s", "cpu_stream_gib_s"] {
+        let x = limits[k].as_f64().unwrap_or(0.0);
+        assert!(x.is_finite() && x > 0.0, "limit {k} = {x}");
+    }
+    let rows = v["rows"].as_array().unwrap();
+    let contract = [
+        "suite",
+        "scene",
+        "method",
+        "counter",
+        "width",
+        "height",
+        "triangles",
+        "lights",
+        "gpu_shadow_ms",
+        "gpu_frame_ms",
+        "stencil_fragments",
+        "shadow_triangles",
+        "cpu_plan_ms",
+        "bytes",
+        "error_fraction",
+        "fill_fraction",
+        "vertex_fraction",
+        "bound",
+    ];
+    assert!(!rows.is_empty());
+    for r in rows {
+        keys(r, &contract, "row");
+        keys(&r["limits"], &["stencil_fill_gfrag_s", "small_tri_mtri_s", "draws_per_s"], "row limits");
+        let bound = r["bound"].as_str().unwrap();
+        assert!(["fill", "vertex", "draw", "cpu"].contains(&bound), "bound {bound}");
+    }
+    // Every sweep and every technique is there.
+    for s in ["scenes", "resolution", "tessellation", "lights", "light_distance", "casters", "ablation"] {
+        assert!(rows.iter().any(|r| r["sweep"] == s), "no {s} rows");
+    }
+    let methods: Vec<&str> = rows.iter().filter(|r| r["sweep"] == "tessellation").filter_map(|r| r["method"].as_str()).collect();
+    for m in ["zpass", "zfail", "everitt-kilgard", "lengyel", "mcguire", "zpass-clear", "edgequad", "planar", "shadowmap-512"] {
+        assert!(methods.contains(&m), "tessellation sweep lacks {m}");
+    }
+    // The named scenes carry their error; volumes rasterise counted fragments.
+    assert!(rows.iter().filter(|r| r["sweep"] == "scenes").all(|r| r["error_fraction"].is_number()));
+    assert!(rows.iter().any(|r| r["method"] == "mcguire" && r["stencil_fragments"].as_u64().unwrap_or(0) > 0));
+    // Ablations: scissor and culling measured as ratios.
+    let abl = v["ablations"].as_array().unwrap();
+    for what in ["scissor", "culling", "index-format"] {
+        assert!(abl.iter().any(|a| a["what"] == what && a["time_ratio"].is_number()), "ablation {what}");
+    }
+    // Outputs.
+    let csv = std::fs::read_to_string(dir.join("bench.csv")).unwrap();
+    assert_eq!(csv.lines().count(), rows.len() + 1);
+    assert!(csv.lines().next().unwrap().starts_with("suite,sweep,x,"));
+    for p in ["time_vs_triangles", "time_vs_resolution", "roofline", "pareto"] {
+        for ext in ["svg", "png"] {
+            let f = dir.join(format!("{p}.{ext}"));
+            let len = std::fs::metadata(&f).map(|m| m.len()).unwrap_or(0);
+            assert!(len > 1000, "{} missing or empty", f.display());
+        }
+    }
+    let svg = std::fs::read_to_string(dir.join("time_vs_triangles.svg")).unwrap();
+    assert!(svg.contains("<svg") && svg.contains("mcguire"), "the SVG has a legend");
+    let png = std::fs::read(dir.join("roofline.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+    let md = std::fs::read_to_string(dir.join("bench.md")).unwrap();
+    assert!(md.contains("## Limits") && md.contains("## Crossovers") && md.contains("## Ablations"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn suite_refuses_bad_arguments() {
+    let out = Command::new(env!("CARGO_BIN_EXE_umbrage")).args(["bench", "--suite", "no-such-suite"]).output().unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("no-such-suite") && !err.contains("panicked"), "{err}");
+}
