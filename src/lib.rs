@@ -84,4 +84,6 @@ pub mod render;
 #[cfg(feature = "cli")]
 pub mod scene;
 pub mod shadow;
+#[cfg(feature = "view")]
+pub mod view;
 pub use error::{Error, Result};

@@ -15,6 +15,7 @@ use super::shadowmap::ShadowMapper;
 use super::targets::*;
 use super::timing::{Span, Timer};
 mod motion;
+mod present;
 mod stats;
 
 use crate::error::{Error, Result};
