@@ -323,8 +323,19 @@ impl Live {
     /// One window event; `Ok(true)`: exit.
     fn event(&mut self, ev: &WindowEvent) -> Result<bool> {
         let egui_live = self.overlay_visible || self.menu_at.is_some();
-        let consumed = egui_live && self.egui.state.on_window_event(&self.window, ev).consumed;
-        let over_ui = egui_live && (self.egui.ctx.is_pointer_over_egui() || self.egui.ctx.egui_wants_pointer_input());
+        if egui_live {
+            let _ = self.egui.state.on_window_event(&self.window, ev);
+        }
+        // Over the overlay at the cursor's position now (egui's own hover state is a frame
+        // old, and a press can arrive in the same batch as the move that led to it).
+        let ppp = self.window.scale_factor() as f32;
+        let over_ui = egui_live
+            && (self.egui.ctx.egui_is_using_pointer()
+                || self
+                    .egui
+                    .ctx
+                    .layer_id_at(egui::pos2(self.cursor.x / ppp, self.cursor.y / ppp))
+                    .is_some_and(|l| l.order != egui::Order::Background));
         match ev {
             WindowEvent::CloseRequested | WindowEvent::Destroyed => return Ok(true),
             WindowEvent::Resized(s) => {
@@ -351,17 +362,16 @@ impl Live {
                 self.cursor = p;
             }
             WindowEvent::MouseInput { state, button, .. } => match (button, state) {
-                (MouseButton::Left, ElementState::Pressed) if !consumed && !over_ui => {
+                (MouseButton::Left, ElementState::Pressed) if !over_ui => {
                     self.drag = Some((DragKind::from_modifiers(self.ctrl, self.shift), self.cursor));
                 }
                 (MouseButton::Left, ElementState::Released) => self.drag = None,
                 (MouseButton::Right, ElementState::Pressed) if !over_ui => {
-                    let ppp = self.window.scale_factor() as f32;
                     self.menu_at = Some(egui::pos2(self.cursor.x / ppp, self.cursor.y / ppp));
                 }
                 _ => {}
             },
-            WindowEvent::MouseWheel { delta, .. } if !consumed && !over_ui => {
+            WindowEvent::MouseWheel { delta, .. } if !over_ui => {
                 let steps = match delta {
                     MouseScrollDelta::LineDelta(_, y) => *y,
                     MouseScrollDelta::PixelDelta(p) => p.y as f32 / 40.0,

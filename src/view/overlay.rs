@@ -81,9 +81,8 @@ pub fn ui(ctx: &egui::Context, s: &Shown, menu_at: &mut Option<egui::Pos2>) -> C
                         "GPU ms: depth {:.2}  shadow {:.2}  illuminate {:.2}  frame {:.2}",
                         g.depth, g.shadow, g.illuminate, g.frame
                     ));
-                    for (i, l) in g.per_light.iter().enumerate() {
-                        ui.label(format!("  light {i}: shadow {:.2}  illuminate {:.2}", l.shadow, l.illuminate));
-                    }
+                    let per: Vec<String> = g.per_light.iter().map(|l| format!("{:.2}+{:.2}", l.shadow, l.illuminate)).collect();
+                    ui.label(format!("  per light (shadow+illuminate): {}", per.join("  ")));
                 }
                 None => {
                     ui.label("GPU ms: no timestamps on this device");
@@ -96,11 +95,26 @@ pub fn ui(ctx: &egui::Context, s: &Shown, menu_at: &mut Option<egui::Pos2>) -> C
                 ui.colored_label(egui::Color32::YELLOW, w);
             }
         }
-        ui.label(format!("present: {}", s.present));
+        ui.label(format!(
+            "{} / {} / {}  mode {}  present {}",
+            s.techniques.get(s.technique).map(|t| t.name()).unwrap_or("?"),
+            s.counter.name(),
+            s.view.name(),
+            s.mode.name(),
+            s.present
+        ));
         for n in s.notes {
             ui.colored_label(egui::Color32::YELLOW, n);
         }
-        ui.separator();
+        egui::CollapsingHeader::new("controls").default_open(false).show(ui, |ui| controls(ui, s, &mut ch));
+    });
+    menu(ctx, menu_at, &mut ch);
+    ch
+}
+
+/// The settings and the selected light as widgets.
+fn controls(ui: &mut egui::Ui, s: &Shown, ch: &mut Changes) {
+    {
         let name = |t: &Technique| t.name().to_string();
         let mut t = s.technique;
         egui::ComboBox::from_label("method (M)").selected_text(s.techniques.get(t).map(name).unwrap_or_default()).show_ui(ui, |ui| {
@@ -150,10 +164,9 @@ pub fn ui(ctx: &egui::Context, s: &Shown, menu_at: &mut Option<egui::Pos2>) -> C
                 ch.light_position = Some(q);
             }
         }
-        ui.label("drag: turn  Ctrl: move X/Y  Shift: move Z  wheel: zoom  Space: pause  P/F12: screenshot  H: hide  Esc: quit");
-    });
-    menu(ctx, menu_at, &mut ch);
-    ch
+        ui.label("drag: turn, Ctrl: move X/Y, Shift: move Z, wheel: zoom");
+        ui.label("Space: pause, P/F12: screenshot, H: hide, Esc: quit");
+    }
 }
 
 /// Only the right-click menu (the overlay is hidden).
