@@ -348,10 +348,10 @@ impl Live {
                 self.ctrl = m.state().control_key();
                 self.shift = m.state().shift_key();
             }
-            WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed && !event.repeat => {
-                if !(egui_live && self.egui.ctx.egui_wants_keyboard_input()) {
-                    return Ok(self.key(&event.logical_key));
-                }
+            WindowEvent::KeyboardInput { event, .. }
+                if event.state == ElementState::Pressed && !event.repeat && !(egui_live && self.egui.ctx.egui_wants_keyboard_input()) =>
+            {
+                return Ok(self.key(&event.logical_key));
             }
             WindowEvent::CursorMoved { position, .. } => {
                 let p = Vec2::new(position.x as f32, position.y as f32);
