@@ -3,13 +3,17 @@
 export PATH := $(HOME)/.cargo/bin:$(PATH)
 CARGO ?= cargo
 
-.PHONY: deps run test bench conform conform-docs doc clean fuzz
+.PHONY: deps run view test bench conform conform-docs doc clean fuzz
 
 deps:
 	@./scripts/deps.sh
 
 run: deps
 	$(CARGO) run -- render
+
+# The interactive window (needs a display; docs/view.md): the animated stress scene.
+view: deps
+	$(CARGO) run --release -- view --scene stress
 
 # Every test with validation on, the doc examples, and the library an engine embeds
 # (`default-features = false`) built and documented with warnings denied.

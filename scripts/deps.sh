@@ -1,13 +1,16 @@
 #!/usr/bin/env bash
 # Installs what umbrage needs to build and run on a fresh Debian/Ubuntu machine, and nothing
 # that is already there: the Vulkan loader, Mesa's lavapipe (a CPU Vulkan driver), the
-# Khronos validation layers and spirv-tools (spirv-val, used by the tests). Rust via rustup
-# only when cargo is missing.
+# Khronos validation layers and spirv-tools (spirv-val, used by the tests), and for the
+# `umbrage view` tests a virtual X server (xvfb, xauth for xvfb-run) and xdotool (synthetic
+# input), and the X11 libraries winit loads at run time. Rust via rustup only when cargo is
+# missing.
 set -euo pipefail
 
 need=()
 have_pkg() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed"; }
-for p in libvulkan1 mesa-vulkan-drivers vulkan-validationlayers spirv-tools; do
+for p in libvulkan1 mesa-vulkan-drivers vulkan-validationlayers spirv-tools \
+  xvfb xauth xdotool libxkbcommon-x11-0 libxcursor1 libxrandr2 libxi6; do
   have_pkg "$p" || need+=("$p")
 done
 if ! command -v cc >/dev/null 2>&1; then need+=(build-essential); fi

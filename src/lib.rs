@@ -87,4 +87,6 @@ pub mod scene;
 pub mod shadow;
 #[cfg(feature = "cli")]
 pub mod soak;
+#[cfg(feature = "view")]
+pub mod view;
 pub use error::{Error, Result};

@@ -1,4 +1,4 @@
-//! The `umbrage` command line: render | info | check | conform | bench.
+//! The `umbrage` command line: render | view | info | check | conform | bench.
 
 use clap::{Parser, Subcommand, ValueEnum};
 use std::path::{Path, PathBuf};
@@ -137,6 +137,19 @@ enum Command {
         /// Write a frame dump (frame.json, world.obj, positions/normals, masks) into DIR.
         #[arg(long)]
         dump: Option<PathBuf>,
+        /// Render an animated scene at T seconds (spins and light paths; `umbrage view`
+        /// reports each frame's time).
+        #[arg(long, default_value_t = 0.0)]
+        time: f64,
+    },
+    /// An interactive window (winit + ash-window) on the same frame as `render`, with an
+    /// egui overlay; needs a display (X11; Xvfb works).
+    #[cfg(feature = "view")]
+    View {
+        #[command(flatten)]
+        frame: FrameArgs,
+        #[command(flatten)]
+        view: umbrage::view::ViewArgs,
     },
     /// Device, driver, optional features and the code paths they select.
     Info {
@@ -273,8 +286,11 @@ fn main() -> ExitCode {
         stats: None,
         view: View::Shaded,
         dump: None,
+        time: 0.0,
     }) {
-        Command::Render { frame, out, stats, view, dump } => render(&frame, &out, stats.as_deref(), view, dump.as_deref()),
+        Command::Render { frame, out, stats, view, dump, time } => render(&frame, &out, stats.as_deref(), view, dump.as_deref(), time),
+        #[cfg(feature = "view")]
+        Command::View { frame, view } => frame.options().and_then(|o| umbrage::view::run(&frame.scene, o, &view)),
         Command::Info { json, scene } => info(json, scene.as_deref()),
         Command::Check { dir, band, threshold } => check(&dir, band, threshold),
         Command::Bench(args) => bench_command(args),
@@ -308,11 +324,15 @@ impl FrameArgs {
     }
 }
 
-fn render(frame: &FrameArgs, out: &Path, stats: Option<&Path>, view: View, dump: Option<&Path>) -> Result<ExitCode> {
+fn render(frame: &FrameArgs, out: &Path, stats: Option<&Path>, view: View, dump: Option<&Path>, time: f64) -> Result<ExitCode> {
     let mut opts = frame.options()?;
     opts.view = view;
     opts.capture = dump.is_some();
-    let scene = umbrage::scene::load(&frame.scene)?;
+    if !time.is_finite() {
+        return Err(Error::Other(format!("--time must be a finite number of seconds, got {time}")));
+    }
+    let (scene, motion) = umbrage::scene::load_animated(&frame.scene)?;
+    let scene = motion.scene_at(&scene, time);
     let ctx = umbrage::gpu::Context::new()?;
     let mut renderer = Renderer::new(ctx, scene, opts)?;
     let frame_out = renderer.render()?;

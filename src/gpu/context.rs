@@ -235,6 +235,17 @@ impl Context {
     /// [`Error::Unsupported`] when the device lacks `dynamicRendering`, `synchronization2` or a
     /// depth-stencil format with 8 stencil bits.
     pub fn with_validation(validation: bool) -> Result<Context> {
+        Self::with_extensions(validation, &[], &[])
+    }
+
+    /// [`with_validation`](Self::with_validation), with extra instance and device extensions
+    /// (a windowed host's surface and swapchain extensions). A device extension the chosen
+    /// device lacks is [`Error::Unsupported`]; the pointers must be NUL-terminated names.
+    pub fn with_extensions(
+        validation: bool,
+        instance_extensions: &[*const std::ffi::c_char],
+        device_extensions: &[&CStr],
+    ) -> Result<Context> {
         // SAFETY: loading the Vulkan loader library; we keep `entry` alive in the context for as
         // long as any object created from it.
         let entry =
@@ -256,6 +267,7 @@ impl Context {
             layers.push(layer_name.as_ptr());
             extensions.push(ash::ext::debug_utils::NAME.as_ptr());
         }
+        extensions.extend_from_slice(instance_extensions);
         let app = vk::ApplicationInfo::default().application_name(c"umbrage").engine_name(c"umbrage").api_version(vk::API_VERSION_1_3);
         // Synchronisation validation on whenever validation is (a missing barrier is invisible
         // on lavapipe and flickers on a real GPU) unless `UMBRAGE_VALIDATION` picks another
@@ -290,7 +302,7 @@ impl Context {
             None
         };
 
-        match Self::open_device(&instance) {
+        match Self::open_device(&instance, device_extensions) {
             Ok((physical, device, queue_family, features, info, depth_format, limits)) => {
                 // SAFETY: the queue family/index were requested at device creation.
                 let queue = unsafe { device.get_device_queue(queue_family, 0) };
@@ -342,6 +354,7 @@ impl Context {
     #[allow(clippy::type_complexity)]
     fn open_device(
         instance: &ash::Instance,
+        extra_extensions: &[&CStr],
     ) -> Result<(vk::PhysicalDevice, ash::Device, u32, Features, DeviceInfo, vk::Format, vk::PhysicalDeviceLimits)> {
         // SAFETY: enumeration on a valid instance.
         let physicals = unsafe { instance.enumerate_physical_devices() }.map_err(vkerr("vkEnumeratePhysicalDevices"))?;
@@ -453,6 +466,12 @@ impl Context {
         }
         if has_dru {
             dev_exts.push(ash::ext::depth_range_unrestricted::NAME.as_ptr());
+        }
+        for &e in extra_extensions {
+            if !has_ext(e) {
+                return Err(Error::Unsupported(format!("{name}: the device lacks {}", e.to_string_lossy())));
+            }
+            dev_exts.push(e.as_ptr());
         }
         let prio = [1.0f32];
         let qinfo = [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&prio)];

@@ -6,6 +6,7 @@ pub const SCENES: &[(&str, &str)] = &[
     ("stairs", include_str!("../../scenes/stairs.toml")),
     ("cubes", include_str!("../../scenes/cubes.toml")),
     ("spheres", include_str!("../../scenes/spheres.toml")),
+    ("stress", include_str!("../../scenes/stress.toml")),
     ("bench/fill", include_str!("../../scenes/bench/fill.toml")),
     ("bench/vertex", include_str!("../../scenes/bench/vertex.toml")),
     ("hard/big_caster", include_str!("../../scenes/hard/big_caster.toml")),

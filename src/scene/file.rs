@@ -7,8 +7,10 @@ mod area_light;
 mod keys;
 mod lights;
 mod meshes;
+mod motion;
 mod spheres;
 
+use super::motion::Motion;
 use super::Scene;
 use crate::error::{Error, Result};
 use glam::Vec3;
@@ -28,6 +30,11 @@ pub(crate) enum ObjSource<'a> {
 
 /// Parses and validates a scene from TOML text. `origin` names the file in every error.
 pub(crate) fn parse(src: &str, origin: &str, objs: ObjSource<'_>) -> Result<Scene> {
+    parse_animated(src, origin, objs).map(|(scene, _)| scene)
+}
+
+/// [`parse`], with the scene's motion (spins and light paths).
+pub(crate) fn parse_animated(src: &str, origin: &str, objs: ObjSource<'_>) -> Result<(Scene, Motion)> {
     let cx = Ctx { origin, src };
     let file: FileScene = toml::from_str(src).map_err(|e| match e.span() {
         Some(s) => cx.at(line_of(src, s.start), e.message().trim().to_string()),
@@ -56,10 +63,11 @@ pub(crate) fn parse(src: &str, origin: &str, objs: ObjSource<'_>) -> Result<Scen
         spheres.push(sp);
     }
 
+    let motion = motion::motion(&cx, &file.mesh, &file.light, &lights)?;
     let name = file
         .name
         .unwrap_or_else(|| Path::new(origin).file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| origin.to_string()));
-    Ok(Scene { name, camera, lights, meshes, ambient, spheres })
+    Ok((Scene { name, camera, lights, meshes, ambient, spheres }, motion))
 }
 
 #[cfg(test)]

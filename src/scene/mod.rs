@@ -94,6 +94,7 @@ pub struct Scene {
 
 pub mod builtin;
 pub mod file;
+pub mod motion;
 pub mod obj;
 pub mod shapes;
 
@@ -112,19 +113,24 @@ pub fn builtin_names() -> Vec<&'static str> {
 /// TOML scene file. A name that is neither a built-in nor an existing file (and does not end
 /// in `.toml`) is [`Error::UnknownName`].
 pub fn load(spec: &str) -> Result<Scene> {
+    load_animated(spec).map(|(scene, _)| scene)
+}
+
+/// [`load`], with the scene's motion (spins and light paths; empty for a static scene).
+pub fn load_animated(spec: &str) -> Result<(Scene, motion::Motion)> {
     if let Some(text) = builtin::scene(spec) {
         let origin = format!("scenes/{spec}.toml");
         let dir = match origin.rfind('/') {
             Some(i) => origin[..i].to_string(),
             None => String::new(),
         };
-        return file::parse(text, &origin, file::ObjSource::Builtin(&dir));
+        return file::parse_animated(text, &origin, file::ObjSource::Builtin(&dir));
     }
     let path = Path::new(spec);
     if path.is_file() || spec.ends_with(".toml") {
         let text = std::fs::read_to_string(path).map_err(|e| Error::input(spec, format!("cannot read scene file: {e}")))?;
         let dir = path.parent().unwrap_or(Path::new(""));
-        return load_str(&text, spec, dir);
+        return file::parse_animated(&text, spec, file::ObjSource::Dir(dir));
     }
     Err(Error::UnknownName { what: "scene", name: spec.to_string(), expected: builtin_names().join(", ") })
 }

@@ -20,6 +20,7 @@ mod area;
 mod memory;
 mod motion;
 pub use memory::{largest_device_heap, MemoryEstimate};
+mod present;
 mod stats;
 
 use crate::error::{Error, Result};

@@ -59,6 +59,26 @@ pub(super) struct FileLight {
     pub(super) normal: Option<[f64; 3]>,
     pub(super) tangent: Option<[f64; 3]>,
     pub(super) samples: Option<i64>,
+    // motion (src/scene/file/motion.rs)
+    pub(super) orbit: Option<FileOrbit>,
+    pub(super) keyframes: Option<Vec<FileKeyframe>>,
+}
+
+/// `orbit = { center, radius, period_s }` of a light.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct FileOrbit {
+    pub(super) center: [f64; 3],
+    pub(super) radius: f64,
+    pub(super) period_s: f64,
+}
+
+/// One of a light's `keyframes = [{ t, position }, ...]`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct FileKeyframe {
+    pub(super) t: f64,
+    pub(super) position: [f64; 3],
 }
 
 #[derive(Deserialize, Clone)]
@@ -97,6 +117,8 @@ pub(super) struct FileMesh {
     pub(super) color: Option<[f64; 3]>,
     pub(super) opacity: Option<f64>,
     pub(super) casts_shadow: Option<bool>,
+    // motion (src/scene/file/motion.rs)
+    pub(super) spin_deg_per_s: Option<[f64; 3]>,
 }
 
 /// Shape names and the parameter keys each accepts.
