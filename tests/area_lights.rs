@@ -248,7 +248,7 @@ fn bad_area_lights_given_to_a_renderer_are_refused() {
 /// (1024 rays a pixel) and the GPU time, against the samples. Slow (tens of seconds of CPU
 /// reference): `cargo test --test area_lights -- --ignored`.
 #[test]
-#[ignore]
+#[ignore = "slow CPU reference (1024 rays a pixel), writes docs/area-lights.md: run with -- --ignored"]
 fn write_area_light_docs() {
     let Some(mut ctx) = common::context() else { return };
     let (w, h, rays) = (320u32, 240u32, 1024u32);

@@ -177,7 +177,7 @@ fn timed(r: &mut Renderer, frames: usize) -> (f64, f64, f64, u64) {
 /// meshes (triangles, time). Timing makes it slow and machine-dependent, so it is run on
 /// purpose: `cargo test --release --test spheres -- --ignored`.
 #[test]
-#[ignore]
+#[ignore = "timing, writes docs/spheres.md: run with cargo test --release --test spheres -- --ignored"]
 fn write_docs_spheres_md() {
     let Some(mut ctx) = common::context() else { return };
     let (w, h) = (640u32, 480u32);

@@ -6,6 +6,7 @@ pub mod descriptors;
 pub mod fault;
 pub mod pipeline;
 pub mod resources;
+pub mod validation;
 pub mod shaders {
     //! The naga-compiled SPIR-V of every shader in `shaders/` (see build.rs).
     include!(concat!(env!("OUT_DIR"), "/shaders.rs"));

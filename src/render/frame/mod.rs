@@ -9,14 +9,18 @@ use super::options::*;
 use super::passes::{self, debug, determine, gbuffer, illuminate, intensity, tonemap, transparent, Rec};
 use super::pipelines::FramePipelines;
 use super::push::LightPush;
-use super::readback::{Layout, Readback};
+use super::readback::Layout;
 use super::scene_gpu::{SceneGeometry, Sidedness};
 use super::selfshadow::SelfShadow;
 use super::shadowmap::ShadowMapper;
 use super::sphere_gpu::SphereGeometry;
 use super::targets::*;
-use super::timing::{Span, Timer};
+use super::timing::Span;
 mod area;
+mod checks;
+mod slots;
+use checks::{check_options, check_spheres, pass_settings};
+use slots::FrameSlot;
 mod memory;
 mod motion;
 pub use memory::{largest_device_heap, MemoryEstimate};
@@ -72,16 +76,6 @@ struct FrameSpans {
     frame: Span,
     shadow: Vec<Span>,
     illuminate: Vec<Span>,
-}
-
-/// One ring slot: its command buffer, fence, timestamps and readback.
-struct FrameSlot {
-    cmd: vk::CommandBuffer,
-    fence: vk::Fence,
-    timer: Timer,
-    counters: CounterPools,
-    readback: Readback,
-    in_flight: Option<InFlight>,
 }
 
 /// umbrage's renderer (see the module docs).
@@ -201,52 +195,22 @@ impl Renderer {
             },
             false => None,
         };
-        let mut slots = Vec::new();
-        for _ in 0..config.frames_in_flight {
-            // SAFETY: object creation on a valid device; destroyed in Drop (the fence is only
-            // created once the command buffer exists, and the command buffers go with the pool).
-            let created = unsafe {
-                let info = vk::CommandBufferAllocateInfo::default().command_pool(ctx.pool).command_buffer_count(1);
-                ctx.device.allocate_command_buffers(&info).map_err(Error::vk("vkAllocateCommandBuffers")).and_then(|cbs| {
-                    match ctx.device.create_fence(&vk::FenceCreateInfo::default(), None) {
-                        Ok(f) => Ok((cbs[0], f)),
-                        Err(e) => {
-                            ctx.device.free_command_buffers(ctx.pool, &cbs);
-                            Err(Error::Vulkan { call: "vkCreateFence", result: e })
-                        }
+        let slots = match FrameSlot::ring(&ctx, config.frames_in_flight) {
+            Ok(s) => s,
+            Err(e) => {
+                // SAFETY: nothing was submitted with the pipelines.
+                unsafe {
+                    if let Some(mut ss) = self_shadow {
+                        ss.destroy(&ctx);
                     }
-                })
-            };
-            match created {
-                Ok((cmd, fence)) => slots.push(FrameSlot {
-                    cmd,
-                    fence,
-                    timer: Timer::new(&ctx),
-                    counters: CounterPools::new(&ctx),
-                    readback: Readback { buffer: None },
-                    in_flight: None,
-                }),
-                Err(e) => {
-                    // SAFETY: nothing was submitted from these slots or with the pipelines.
-                    unsafe {
-                        for s in &mut slots {
-                            s.timer.destroy(&ctx);
-                            s.counters.destroy(&ctx);
-                            ctx.device.destroy_fence(s.fence, None);
-                            ctx.device.free_command_buffers(ctx.pool, &[s.cmd]);
-                        }
-                        if let Some(mut ss) = self_shadow {
-                            ss.destroy(&ctx);
-                        }
-                        pipes.destroy(&ctx);
-                    }
-                    targets.destroy(&ctx);
-                    spheres.destroy(&ctx);
-                    geo.destroy(&ctx);
-                    return Err(e);
+                    pipes.destroy(&ctx);
                 }
+                targets.destroy(&ctx);
+                spheres.destroy(&ctx);
+                geo.destroy(&ctx);
+                return Err(e);
             }
-        }
+        };
         Ok(Renderer {
             scene,
             source_lights,
@@ -605,12 +569,7 @@ impl Renderer {
         unsafe {
             let _ = ctx.device.device_wait_idle();
             for s in &mut self.slots {
-                ctx.device.destroy_fence(s.fence, None);
-                ctx.device.free_command_buffers(ctx.pool, &[s.cmd]);
-                s.timer.destroy(ctx);
-                s.counters.destroy(ctx);
-                s.readback.destroy(ctx);
-                s.in_flight = None;
+                s.destroy(ctx);
             }
             self.pipes.destroy(ctx);
         }
@@ -630,54 +589,4 @@ impl Drop for Renderer {
     fn drop(&mut self) {
         self.destroy_resources();
     }
-}
-
-/// Spheres the frame cannot draw: the eye inside or on one (it may have moved there), or
-/// casting spheres with the shadow-map baseline (its depth pass draws meshes only).
-fn check_spheres(scene: &Scene, s: &FrameSettings) -> Result<()> {
-    for sp in &scene.spheres {
-        if let Some(problem) = crate::scene::sphere_placement_problem(sp, &scene.camera, &scene.lights) {
-            return Err(Error::Other(problem));
-        }
-    }
-    if matches!(s.technique, Technique::ShadowMap { .. }) && scene.spheres.iter().any(|s| s.casts_shadow) {
-        return Err(Error::Unsupported(
-            "--method shadowmap does not draw analytic sphere casters into its maps; use a shadow-volume method".into(),
-        ));
-    }
-    Ok(())
-}
-
-/// The pass's share of the frame settings.
-fn pass_settings(s: &FrameSettings) -> PassSettings {
-    PassSettings {
-        technique: s.technique.pass_technique().unwrap_or_default(),
-        counter: s.counter,
-        index_format: s.index_format,
-        toggles: s.toggles,
-    }
-}
-
-/// The options this device can honour (checked at creation and before every frame, since
-/// benchmarks switch methods and counters between frames).
-fn check_options(ctx: &Context, config: &RenderConfig, s: &FrameSettings) -> Result<()> {
-    let f = &ctx.features;
-    if config.depth_mode == DepthMode::Clamp && !f.depth_clamp {
-        return Err(Error::Unsupported("--depth-mode clamp needs the depthClamp feature; use --depth-mode infinite".into()));
-    }
-    if s.index_format == IndexFormat::U8 && !f.index_type_uint8 {
-        return Err(Error::Unsupported("--index-format u8 needs VK_EXT_index_type_uint8; use auto or u16".into()));
-    }
-    let shadow_map = matches!(s.technique, Technique::ShadowMap { .. });
-    if (s.counter == Counter::Float || shadow_map || config.self_shadow) && !f.r32f_blend {
-        return Err(Error::Unsupported(
-            "--counter float, --method shadowmap and --self-shadow need R32_SFLOAT colour blending, which this device lacks; use --counter stencil".into(),
-        ));
-    }
-    if config.transmit_fp32 && !f.rgba32f_blend {
-        return Err(Error::Unsupported(
-            "--transmit log32/mul32 need R32G32B32A32_SFLOAT blending, which this device lacks; use log16".into(),
-        ));
-    }
-    Ok(())
 }

@@ -1,0 +1,58 @@
+//! What a frame checks before it is planned: the options the device can honour, the spheres
+//! it can draw, and the pass's share of the frame settings.
+
+use crate::error::{Error, Result};
+use crate::gpu::Context;
+use crate::pass::PassSettings;
+use crate::render::options::*;
+use crate::scene::Scene;
+
+/// Spheres the frame cannot draw: the eye inside or on one (it may have moved there), or
+/// casting spheres with the shadow-map baseline (its depth pass draws meshes only).
+pub(super) fn check_spheres(scene: &Scene, s: &FrameSettings) -> Result<()> {
+    for sp in &scene.spheres {
+        if let Some(problem) = crate::scene::sphere_placement_problem(sp, &scene.camera, &scene.lights) {
+            return Err(Error::Other(problem));
+        }
+    }
+    if matches!(s.technique, Technique::ShadowMap { .. }) && scene.spheres.iter().any(|s| s.casts_shadow) {
+        return Err(Error::Unsupported(
+            "--method shadowmap does not draw analytic sphere casters into its maps; use a shadow-volume method".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// The pass's share of the frame settings.
+pub(super) fn pass_settings(s: &FrameSettings) -> PassSettings {
+    PassSettings {
+        technique: s.technique.pass_technique().unwrap_or_default(),
+        counter: s.counter,
+        index_format: s.index_format,
+        toggles: s.toggles,
+    }
+}
+
+/// The options this device can honour (checked at creation and before every frame, since
+/// benchmarks switch methods and counters between frames).
+pub(super) fn check_options(ctx: &Context, config: &RenderConfig, s: &FrameSettings) -> Result<()> {
+    let f = &ctx.features;
+    if config.depth_mode == DepthMode::Clamp && !f.depth_clamp {
+        return Err(Error::Unsupported("--depth-mode clamp needs the depthClamp feature; use --depth-mode infinite".into()));
+    }
+    if s.index_format == IndexFormat::U8 && !f.index_type_uint8 {
+        return Err(Error::Unsupported("--index-format u8 needs VK_EXT_index_type_uint8; use auto or u16".into()));
+    }
+    let shadow_map = matches!(s.technique, Technique::ShadowMap { .. });
+    if (s.counter == Counter::Float || shadow_map || config.self_shadow) && !f.r32f_blend {
+        return Err(Error::Unsupported(
+            "--counter float, --method shadowmap and --self-shadow need R32_SFLOAT colour blending, which this device lacks; use --counter stencil".into(),
+        ));
+    }
+    if config.transmit_fp32 && !f.rgba32f_blend {
+        return Err(Error::Unsupported(
+            "--transmit log32/mul32 need R32G32B32A32_SFLOAT blending, which this device lacks; use log16".into(),
+        ));
+    }
+    Ok(())
+}
