@@ -3,9 +3,14 @@
 //! (`FacePlanes::new`, outside the timed loops), facing as one f32 dot product per triangle
 //! with packed bits and the exact fallback near the planes (threads from
 //! `PLANES_PARALLEL_THRESHOLD` triangles), then the edge scan on the packed bits.
-//! `edge_scan_serial` is `EdgeScan`'s scan, `edge_scan` the scan of the full edge records. `streaming_sum` is a plain streaming read of the same bytes the new path reads (the
-//! four plane arrays and the manifold edge records), in the same run, so the throughput of the
+//! `edge_scan_serial` is `EdgeScan`'s scan (distance classes a facing word at a time, the
+//! other edges by lookups), `edge_scan` the per-edge scan of the full edge records.
+//! `streaming_sum` is a plain streaming read of the same bytes the new path reads (the four
+//! plane arrays and `EdgeScan::bytes`), in the same run, so the throughput of the
 //! other functions (the group's throughput is those bytes) can be compared to memory speed.
+//! `facing+silhouette_shuffled` is the same work on the same sphere with its triangles in
+//! random order: no distance classes and no decidable blocks, the worst case (compare its time:
+//! it reads more bytes than the group's throughput counts).
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glam::Vec4;
@@ -48,7 +53,8 @@ fn bench(c: &mut Criterion) {
         assert!(topo.is_closed_manifold());
         let planes = FacePlanes::new(&topo.mesh);
         let scan = EdgeScan::new(topo.manifold_edges.clone());
-        let pairs: Vec<[u32; 2]> = topo.manifold_edges.iter().map(|e| [e.t0 ^ 1, e.t1 ^ 3]).collect();
+        // as many 8-byte records as the scan reads (class masks and residual pairs)
+        let pairs: Vec<[u32; 2]> = (0..scan.bytes() / 8).map(|i| [i as u32 ^ 1, i as u32 ^ 3]).collect();
         let words = planes.bytes() / 16;
         let plain = PlainArrays {
             a: (0..words).map(|i| i as f32).collect(),
@@ -103,8 +109,33 @@ fn bench(c: &mut Criterion) {
                 black_box(sil.len())
             })
         });
+        // The worst case for the edge scan's distance classes and the facing's block bounds:
+        // the same sphere with its triangles in a fixed pseudo-random order.
+        let shuffled = Topology::build(&shuffle(&uv_sphere(1.0, slices, stacks)));
+        let (splanes, sscan) = (FacePlanes::new(&shuffled.mesh), EdgeScan::new(shuffled.manifold_edges.clone()));
+        g.bench_function(BenchmarkId::new("facing+silhouette_shuffled", tris), |b| {
+            b.iter(|| {
+                splanes.facing_packed_auto(&shuffled.mesh, black_box(light), false, &mut bits);
+                sil.clear();
+                sscan.scan_into(&bits, &mut sil);
+                black_box(sil.len())
+            })
+        });
         g.finish();
     }
+}
+
+/// `m` with its triangles in a fixed pseudo-random order (xorshift Fisher-Yates).
+fn shuffle(m: &umbrage::geom::Mesh) -> umbrage::geom::Mesh {
+    let mut order: Vec<usize> = (0..m.triangles.len()).collect();
+    let mut x = 0x9e37_79b9_7f4a_7c15u64;
+    for i in (1..order.len()).rev() {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        order.swap(i, (x % (i as u64 + 1)) as usize);
+    }
+    umbrage::geom::Mesh::new(m.positions.clone(), order.iter().map(|&i| m.triangles[i]).collect())
 }
 
 criterion_group!(benches, bench);

@@ -5,6 +5,7 @@ pub use mesh::{Aabb, Mesh};
 pub mod area;
 pub use area::{AreaLight, AreaShape};
 pub mod bounds;
+pub mod edgescan;
 pub mod light;
 pub use light::{Camera, Light, LightKind};
 pub mod planes;

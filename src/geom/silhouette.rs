@@ -143,106 +143,7 @@ pub fn possible_silhouette_packed(edges: &[ManifoldEdge], bits: &[u64]) -> Vec<S
     out
 }
 
-/// Manifold edges prepared for the per-light scan: the full records, and their triangle pairs
-/// `(t0, t1)` packed 8 bytes an edge, which is all the scan reads except for the few edges on
-/// the possible silhouette.
-#[derive(Clone, Debug, Default)]
-pub struct EdgeScan {
-    edges: Vec<ManifoldEdge>,
-    pairs: Vec<[u32; 2]>,
-    /// Largest triangle id of any edge.
-    max_tri: u32,
-}
-
-impl EdgeScan {
-    /// The scan over `edges` (in this order).
-    pub fn new(edges: Vec<ManifoldEdge>) -> EdgeScan {
-        let pairs = edges.iter().map(|e| [e.t0, e.t1]).collect();
-        let max_tri = edges.iter().map(|e| e.t0.max(e.t1)).max().unwrap_or(0);
-        EdgeScan { edges, pairs, max_tri }
-    }
-
-    /// The edges, in scan order.
-    pub fn edges(&self) -> &[ManifoldEdge] {
-        &self.edges
-    }
-
-    /// Bytes one scan reads (the triangle pairs).
-    pub fn bytes(&self) -> usize {
-        self.pairs.len() * 8
-    }
-
-    /// Appends the possible silhouette for the packed facing `bits` to `out`: the same edges in
-    /// the same order as [`possible_silhouette`] on the unpacked bits (a triangle past the bits
-    /// counts as not facing).
-    pub fn scan_into(&self, bits: &[u64], out: &mut Vec<SilhouetteEdge>) {
-        let bit = |t: u32| bits.get(t as usize / 64).map_or(0, |w| (w >> (t % 64)) & 1);
-        // One byte a triangle (a short pass over the words, 8 bytes a table load): the scan's
-        // two lookups an edge are then plain byte loads. The table is this thread's, reused
-        // across calls (no allocation and no zeroing of fresh pages per light), sized to a
-        // power of two so that a masked index needs no bounds check; triangle ids past the bits
-        // read 0.
-        let need = (self.max_tri as usize + 1).max(bits.len() * 64);
-        let size = need.next_power_of_two();
-        let mask = size - 1;
-        SCAN_TABLE.with_borrow_mut(|table| {
-            if table.len() < size {
-                table.clear();
-                table.resize(size, 0);
-            }
-            let table = &mut table[..size];
-            for (dst, &w) in table.chunks_exact_mut(64).zip(bits) {
-                for (d8, byte) in dst.chunks_exact_mut(8).zip(w.to_le_bytes()) {
-                    d8.copy_from_slice(&SPREAD[byte as usize].to_le_bytes());
-                }
-            }
-            table[(bits.len() * 64).min(size)..need].fill(0);
-            let tab: &[u8] = table;
-            let fast = |t: u32| tab[t as usize & mask];
-            for (chunk, es) in self.pairs.chunks(64).zip(self.edges.chunks(64)) {
-                // most blocks hold no silhouette edge: one OR-reduction (no shifts into a mask),
-                // and only the rare blocks with one are walked again
-                let mut any = 0u8;
-                for p in chunk {
-                    any |= fast(p[0]) ^ fast(p[1]);
-                }
-                if any == 0 {
-                    continue;
-                }
-                for (p, &e) in chunk.iter().zip(es) {
-                    if fast(p[0]) == fast(p[1]) {
-                        continue;
-                    }
-                    out.push(if bit(e.t0) != 0 {
-                        SilhouetteEdge { a: e.a, b: e.b, lit: e.t0, lit_corner: e.c0, unlit: e.t1, unlit_corner: e.c1 }
-                    } else {
-                        SilhouetteEdge { a: e.b, b: e.a, lit: e.t1, lit_corner: e.c1, unlit: e.t0, unlit_corner: e.c0 }
-                    });
-                }
-            }
-        });
-    }
-}
-
-thread_local! {
-    /// [`EdgeScan::scan_into`]'s byte-a-triangle table, kept per thread across calls.
-    static SCAN_TABLE: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
-}
-
-/// Byte `k` of `SPREAD[b]` is bit `k` of `b`.
-static SPREAD: [u64; 256] = {
-    let mut t = [0u64; 256];
-    let mut b = 0;
-    while b < 256 {
-        let mut k = 0;
-        while k < 8 {
-            t[b] |= (((b >> k) & 1) as u64) << (8 * k);
-            k += 1;
-        }
-        b += 1;
-    }
-    t
-};
+pub use super::edgescan::EdgeScan;
 
 /// [`possible_silhouette_packed`] appending to `out` (reuse the allocation across frames).
 pub fn possible_silhouette_packed_into(edges: &[ManifoldEdge], bits: &[u64], out: &mut Vec<SilhouetteEdge>) {
@@ -349,8 +250,9 @@ mod tests {
                 assert_eq!(unpack_bits(&bits, f.len()), f);
                 assert_eq!(possible_silhouette_packed(&t.manifold_edges, &bits), possible_silhouette_serial(&t.manifold_edges, &f));
                 let mut sil = Vec::new();
-                EdgeScan::new(t.manifold_edges.clone()).scan_into(&bits, &mut sil);
-                assert_eq!(sil, possible_silhouette_serial(&t.manifold_edges, &f));
+                let scan = EdgeScan::new(t.manifold_edges.clone());
+                scan.scan_into(&bits, &mut sil);
+                assert_eq!(sil, possible_silhouette_serial(scan.edges(), &f));
             }
             check_planes(&t.mesh, l);
         }
@@ -370,7 +272,7 @@ mod tests {
             for b in [&bits[..], &bits[..bits.len() / 2], &[u64::MAX][..]] {
                 let mut sil = Vec::new();
                 scan.scan_into(b, &mut sil);
-                assert_eq!(sil, possible_silhouette_packed(&t.manifold_edges, b));
+                assert_eq!(sil, possible_silhouette_packed(scan.edges(), b));
             }
         }
     }

@@ -218,7 +218,8 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
         let mut plan = plan;
         let planar_mvp = (input.settings.technique == Technique::Planar).then(|| flatten(&mut plan, table, light, input.planar_receiver));
         cpu.silhouettes += plan.silhouette_ms;
-        cpu.plan += plan.plan_ms;
+        // plan_ms covers the whole planner, facing and silhouettes included
+        cpu.plan += (plan.plan_ms - plan.silhouette_ms).max(0.0);
         let mut casters = Vec::with_capacity(plan.casters.len());
         let mut cstats = Vec::with_capacity(plan.casters.len());
         for cp in &plan.casters {
