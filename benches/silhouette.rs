@@ -17,7 +17,7 @@ use glam::Vec4;
 use std::hint::black_box;
 use umbrage::geom::silhouette::{possible_silhouette_packed_into, EdgeScan, FacePlanes, SilhouetteEdge};
 use umbrage::geom::topology::Topology;
-use umbrage::shadow::testmesh::uv_sphere;
+use umbrage::shadow::testmesh::{shuffled, uv_sphere};
 
 fn bytes_of(planes: &FacePlanes, scan: &EdgeScan) -> u64 {
     (planes.bytes() + scan.bytes()) as u64
@@ -111,7 +111,7 @@ fn bench(c: &mut Criterion) {
         });
         // The worst case for the edge scan's distance classes and the facing's block bounds:
         // the same sphere with its triangles in a fixed pseudo-random order.
-        let shuffled = Topology::build(&shuffle(&uv_sphere(1.0, slices, stacks)));
+        let shuffled = Topology::build(&shuffled(&uv_sphere(1.0, slices, stacks)));
         let (splanes, sscan) = (FacePlanes::new(&shuffled.mesh), EdgeScan::new(shuffled.manifold_edges.clone()));
         g.bench_function(BenchmarkId::new("facing+silhouette_shuffled", tris), |b| {
             b.iter(|| {
@@ -123,19 +123,6 @@ fn bench(c: &mut Criterion) {
         });
         g.finish();
     }
-}
-
-/// `m` with its triangles in a fixed pseudo-random order (xorshift Fisher-Yates).
-fn shuffle(m: &umbrage::geom::Mesh) -> umbrage::geom::Mesh {
-    let mut order: Vec<usize> = (0..m.triangles.len()).collect();
-    let mut x = 0x9e37_79b9_7f4a_7c15u64;
-    for i in (1..order.len()).rev() {
-        x ^= x << 13;
-        x ^= x >> 7;
-        x ^= x << 17;
-        order.swap(i, (x % (i as u64 + 1)) as usize);
-    }
-    umbrage::geom::Mesh::new(m.positions.clone(), order.iter().map(|&i| m.triangles[i]).collect())
 }
 
 criterion_group!(benches, bench);

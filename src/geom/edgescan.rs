@@ -309,8 +309,7 @@ mod tests {
     use super::*;
     use crate::geom::silhouette::{possible_silhouette_packed, FacePlanes};
     use crate::geom::topology::Topology;
-    use crate::geom::Mesh;
-    use crate::shadow::testmesh::{cube, uv_sphere};
+    use crate::shadow::testmesh::{cube, shuffled, uv_sphere};
     use glam::{Vec3, Vec4};
     use proptest::prelude::*;
 
@@ -354,17 +353,7 @@ mod tests {
     #[test]
     fn shuffled_triangles_take_the_residual_path() {
         // a fixed pseudo-random triangle order: no distance class, every edge looked up
-        let m = uv_sphere(1.0, 200, 101);
-        let mut order: Vec<usize> = (0..m.triangles.len()).collect();
-        let mut x = 0x9e37_79b9_7f4a_7c15u64;
-        for i in (1..order.len()).rev() {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            order.swap(i, (x % (i as u64 + 1)) as usize);
-        }
-        let shuffled = Mesh::new(m.positions.clone(), order.iter().map(|&i| m.triangles[i]).collect());
-        let t = Topology::build(&shuffled);
+        let t = Topology::build(&shuffled(&uv_sphere(1.0, 200, 101)));
         let mut bits = Vec::new();
         FacePlanes::new(&t.mesh).facing_packed(&t.mesh, Vec4::new(3.0, 2.0, 1.0, 1.0), false, &mut bits);
         let scan = check(t.manifold_edges.clone(), &bits);

@@ -212,12 +212,12 @@ impl FacePlanes {
                 *ci += pi as f64 / k;
             }
         }
+        let cinf = c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
         let offset = |t: usize| {
             let (n, d) = plane(t);
             let v = d + n[0] * c[0] + n[1] * c[1] + n[2] * c[2];
             // four roundings of terms at most |d| + |n|_1 |c|_inf
-            let err =
-                4.0 * (d.abs() + (n[0].abs() + n[1].abs() + n[2].abs()) * c.iter().fold(0.0f64, |a, x| a.max(x.abs()))) * 2f64.powi(-53);
+            let err = 4.0 * (d.abs() + (n[0].abs() + n[1].abs() + n[2].abs()) * cinf) * 2f64.powi(-53);
             (v, err)
         };
         let (mut nm, mut dm) = ([0.0f64; 3], 0.0f64);
@@ -242,7 +242,7 @@ impl FacePlanes {
         let spread = spread.map(|x| x * up);
         let spread_d = spread_d * up;
         let l1 = |v: [f64; 3]| v[0].abs() + v[1].abs() + v[2].abs();
-        let scale = [l1(nm) + l1(spread), c.iter().fold(0.0f64, |a, x| a.max(x.abs())), dm.abs() + spread_d];
+        let scale = [l1(nm) + l1(spread), cinf, dm.abs() + spread_d];
         let finite = scale.iter().all(|x| x.is_finite());
         BlockBound { c, n: nm, d: dm, spread, spread_d, scale, decidable: finite }
     }

@@ -59,6 +59,20 @@ pub fn uv_sphere(r: f32, slices: u32, stacks: u32) -> Mesh {
     Mesh::new(pos, tris)
 }
 
+/// `m` with its triangles in a fixed pseudo-random order (xorshift Fisher-Yates): the worst
+/// triangle order for order-exploiting scans.
+pub fn shuffled(m: &Mesh) -> Mesh {
+    let mut order: Vec<usize> = (0..m.triangles.len()).collect();
+    let mut x = 0x9e37_79b9_7f4a_7c15u64;
+    for i in (1..order.len()).rev() {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        order.swap(i, (x % (i as u64 + 1)) as usize);
+    }
+    Mesh::new(m.positions.clone(), order.iter().map(|&i| m.triangles[i]).collect())
+}
+
 /// Torus around the y axis: `2 * u * v` triangles.
 pub fn torus(big_r: f32, small_r: f32, u: u32, v: u32) -> Mesh {
     let mut pos = Vec::new();
