@@ -3,10 +3,15 @@
 export PATH := $(HOME)/.cargo/bin:$(PATH)
 CARGO ?= cargo
 
-.PHONY: deps run view test bench conform conform-docs doc clean fuzz
+.PHONY: deps drivers run view test bench conform conform-docs doc clean fuzz
 
 deps:
 	@./scripts/deps.sh
+
+# Three Mesa lavapipe versions (Vulkan 1.0, 1.3, 1.4) in .drivers/, beside the system's; select
+# one with eval "$$(scripts/drivers.sh env 25.0.7)" (scripts/drivers.sh --help).
+drivers:
+	./scripts/drivers.sh install 20.3.5 22.3.6 25.0.7
 
 run: deps
 	$(CARGO) run -- render
