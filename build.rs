@@ -96,6 +96,9 @@ fn compile(path: &Path, define: Option<&str>) -> Result<Vec<u32>, String> {
     let mut spv = naga::back::spv::Options::default();
     // GLSL here is written for Vulkan's clip space: do not let naga flip gl_Position.y.
     spv.flags.remove(naga::back::spv::WriterFlags::ADJUST_COORDINATE_SPACE);
-    spv.lang_version = (1, 3);
+    // SPIR-V 1.0 for the GLSL graphics shaders, the version a Vulkan 1.0 device accepts (the
+    // conformance suite runs there); the WGSL compute modules use storage buffers as SPIR-V 1.3
+    // has them (the compute path needs a Vulkan 1.3 device anyway).
+    spv.lang_version = if path.extension().and_then(|e| e.to_str()) == Some("wgsl") { (1, 3) } else { (1, 0) };
     naga::back::spv::write_vec(&module, &info, &spv, None).map_err(|e| format!("{file}: SPIR-V output: {e}"))
 }

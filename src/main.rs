@@ -190,6 +190,23 @@ enum Command {
         /// Run on the device whose name contains NAME (case-insensitive).
         #[arg(long, value_name = "NAME")]
         device: Option<String>,
+        /// Run every unit (a configuration's submission, the legacy checks, the pipeline
+        /// checks) in this process instead of a child process each: faster to debug, but a
+        /// driver crash ends the run.
+        #[arg(long)]
+        no_isolate: bool,
+        /// Seconds a child may run before it is killed and its cases reported as hung.
+        #[arg(long, default_value_t = 300.0, value_name = "SECONDS")]
+        timeout: f64,
+        /// Child processes at once.
+        #[arg(long, default_value_t = 1, value_name = "N")]
+        jobs: usize,
+        /// Internal: run one unit and write its result to --child-result (crash isolation).
+        #[arg(long, hide = true, value_name = "UNIT")]
+        child: Option<String>,
+        /// Internal: where a child writes its result.
+        #[arg(long, hide = true, value_name = "FILE")]
+        child_result: Option<PathBuf>,
     },
 }
 
@@ -294,8 +311,19 @@ fn main() -> ExitCode {
         Command::Info { json, scene } => info(json, scene.as_deref()),
         Command::Check { dir, band, threshold } => check(&dir, band, threshold),
         Command::Bench(args) => bench_command(args),
-        Command::Conform { out, filter, list, junit, device } => {
-            umbrage::conform::run(umbrage::conform::RunArgs { filter, list, junit, out, device })
+        Command::Conform { out, filter, list, junit, device, no_isolate, timeout, jobs, child, child_result } => {
+            umbrage::conform::run(umbrage::conform::RunArgs {
+                filter,
+                list,
+                junit,
+                out,
+                device,
+                isolate: !no_isolate,
+                timeout_s: timeout,
+                jobs,
+                child,
+                child_result,
+            })
         }
     };
     match result {
@@ -375,7 +403,7 @@ fn info(json: bool, scene: Option<&str>) -> Result<ExitCode> {
         None => None,
     };
     let lights = loaded.as_ref().map(umbrage::output::light_report);
-    let ctx = umbrage::gpu::Context::new()?;
+    let ctx = umbrage::gpu::Context::any_version(umbrage::gpu::context::validation_requested())?;
     let report = umbrage::output::info_report(&ctx);
     if json {
         let mut value = serde_json::to_value(&report).map_err(|e| Error::Other(e.to_string()))?;

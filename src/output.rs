@@ -94,6 +94,14 @@ pub fn info_report(ctx: &Context) -> InfoReport {
     let yes_no = |b: bool, y: &str, n: &str| if b { y.to_string() } else { n.to_string() };
     let paths = vec![
         (
+            "dynamicRendering, synchronization2".into(),
+            yes_no(
+                f.dynamic_rendering && f.synchronization2,
+                "present: render, bench, view and every conform configuration work",
+                "missing: render, bench and view need it; conform runs its render-pass, static-state configurations",
+            ),
+        ),
+        (
             "depthClamp".into(),
             yes_no(f.depth_clamp, "available: --depth-mode clamp (finite far plane, clamped) works", "missing: only --depth-mode infinite"),
         ),

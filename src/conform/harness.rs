@@ -5,7 +5,7 @@
 
 use crate::error::{Error, Result};
 use crate::gpu::pipeline::{self, PipelineDesc};
-use crate::gpu::resources::transition;
+use crate::gpu::resources::{memory_barrier, transition};
 use crate::gpu::{shaders, Buffer, Context, Image};
 use ash::vk;
 use glam::Mat4;
@@ -244,14 +244,12 @@ pub fn render(
                     &[region(vk::ImageAspectFlags::STENCIL)],
                 );
             }
-            let b = [vk::MemoryBarrier2::default()
-                .src_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
-                .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-                .dst_stage_mask(vk::PipelineStageFlags2::HOST)
-                .dst_access_mask(vk::AccessFlags2::HOST_READ)];
-            let dep = vk::DependencyInfo::default().memory_barriers(&b);
-            // SAFETY: recording.
-            unsafe { ctx.device.cmd_pipeline_barrier2(cb, &dep) };
+            memory_barrier(
+                ctx,
+                cb,
+                (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE),
+                (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
+            );
         })?;
         let depth_bytes = buffers[buffers.len() - 2].read()?;
         let depth = depth_bytes.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();

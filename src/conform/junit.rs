@@ -45,10 +45,11 @@ pub fn junit(report: &Report) -> String {
         }
     }
     let (_, failed, skipped) = report.counts();
+    let errors = report.crashed().len();
     let mut x = String::from("<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
     let _ = writeln!(
         x,
-        "<testsuites name=\"umbrage conform\" tests=\"{}\" failures=\"{failed}\" errors=\"0\" skipped=\"{skipped}\" time=\"{:.3}\">",
+        "<testsuites name=\"umbrage conform\" tests=\"{}\" failures=\"{failed}\" errors=\"{errors}\" skipped=\"{skipped}\" time=\"{:.3}\">",
         report.cases.len(),
         report.seconds
     );
@@ -56,10 +57,11 @@ pub fn junit(report: &Report) -> String {
     for (name, cases) in &suites {
         let f = cases.iter().filter(|c| c.status == Status::Fail).count();
         let s = cases.iter().filter(|c| c.status == Status::Skipped).count();
+        let e = cases.iter().filter(|c| c.status == Status::Crash).count();
         let t: f64 = cases.iter().map(|c| c.seconds).sum();
         let _ = writeln!(
             x,
-            "  <testsuite name=\"{}\" tests=\"{}\" failures=\"{f}\" errors=\"0\" skipped=\"{s}\" time=\"{t:.3}\">",
+            "  <testsuite name=\"{}\" tests=\"{}\" failures=\"{f}\" errors=\"{e}\" skipped=\"{s}\" time=\"{t:.3}\">",
             escape(name),
             cases.len()
         );
@@ -86,6 +88,14 @@ pub fn junit(report: &Report) -> String {
                 Status::Pass => x.push_str("/>\n"),
                 Status::Skipped => {
                     let _ = writeln!(x, ">\n      <skipped message=\"{}\"/>\n    </testcase>", escape(&c.message));
+                }
+                Status::Crash => {
+                    let _ = writeln!(
+                        x,
+                        ">\n      <error message=\"{}\" type=\"crash\">{}</error>\n    </testcase>",
+                        escape(&c.message),
+                        escape(&c.message)
+                    );
                 }
                 Status::Fail => {
                     let mut body = c.message.clone();

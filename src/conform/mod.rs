@@ -40,6 +40,7 @@ pub mod checks;
 pub mod devices;
 pub mod harness;
 pub mod images;
+pub mod isolate;
 pub mod junit;
 pub mod model;
 pub mod raster;
@@ -53,7 +54,7 @@ use crate::gpu::Context;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 /// The outcome of one check.
 #[serde(rename_all = "lowercase")]
 pub enum Status {
@@ -63,6 +64,10 @@ pub enum Status {
     Fail,
     /// The device lacks the feature the check exercises (e.g. `depthClamp`, `depthBounds`).
     Skipped,
+    /// The driver crashed (the child process running the case's configuration died of a
+    /// signal or exited without a result) or hung (no result within the timeout): JUnit's
+    /// `<error>`, as deqp-runner reports a crashing CTS case.
+    Crash,
 }
 
 impl Status {
@@ -72,12 +77,13 @@ impl Status {
             Status::Pass => "pass",
             Status::Fail => "fail",
             Status::Skipped => "skipped",
+            Status::Crash => "crash",
         }
     }
 }
 
 /// One (scene, method) case of `shadow_pipeline_hard_cases`.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct CaseResult {
     /// The built-in scene name (`hard/...`).
     pub scene: String,
@@ -102,7 +108,7 @@ pub struct CaseResult {
 }
 
 /// The result of one check.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct CheckResult {
     /// The check's name, as in the module table (e.g. `watertight_fan`).
     pub name: String,
@@ -113,7 +119,7 @@ pub struct CheckResult {
     /// The measured numbers (pixel counts, depths, probes), written to `conform.json`.
     pub numbers: serde_json::Map<String, serde_json::Value>,
     /// Per-case results (only `shadow_pipeline_hard_cases` has any).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(skip_serializing_if = "Vec::is_empty", default)]
     pub cases: Vec<CaseResult>,
 }
 
@@ -159,6 +165,28 @@ pub struct RunArgs {
     pub out: Option<PathBuf>,
     /// Run on the device whose name contains this.
     pub device: Option<String>,
+    /// Run each unit in a child process ([`isolate`]).
+    pub isolate: bool,
+    /// Seconds before a child is killed as hung.
+    pub timeout_s: f64,
+    /// Children at once.
+    pub jobs: usize,
+    /// Child mode: the unit to run ([`isolate::Unit::name`]).
+    pub child: Option<String>,
+    /// Child mode: where to write the [`isolate::ChildResult`].
+    pub child_result: Option<PathBuf>,
+}
+
+/// Child mode: runs one unit and writes its result as JSON (see [`isolate`]).
+fn run_child(ctx: &Context, unit: &str, result: Option<&std::path::Path>, opts: &SuiteOptions) -> Result<ExitCode> {
+    let unit = isolate::Unit::parse(unit).ok_or_else(|| Error::Other(format!("--child: unknown unit '{unit}'")))?;
+    let result = result.ok_or_else(|| Error::Other("--child needs --child-result FILE".into()))?;
+    isolate::injected_crash(unit);
+    let validation = ctx.validation;
+    let r = isolate::run_unit(ctx, unit, &|| Context::with_validation(validation), opts);
+    let json = serde_json::to_string(&r).map_err(|e| Error::Other(e.to_string()))?;
+    std::fs::write(result, json).map_err(|e| Error::io(result.display().to_string(), e))?;
+    Ok(ExitCode::SUCCESS)
 }
 
 /// Exit status when `--filter` selects nothing.
@@ -200,11 +228,32 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         }
         _ => None,
     };
-    let out = a.out.unwrap_or_else(|| PathBuf::from("conform-report"));
-    let ctx = Context::new()?;
+    let out = a.out.clone().unwrap_or_else(|| PathBuf::from("conform-report"));
+    let ctx = Context::any_version(crate::gpu::context::validation_requested())?;
     let validation = ctx.validation;
-    let opts = SuiteOptions { filter, image_dir: Some(out.clone()), break_op, ..Default::default() };
-    let r = run_suite(&ctx, &|| Context::with_validation(validation), &opts);
+    let opts = SuiteOptions { filter: filter.clone(), image_dir: Some(out.clone()), break_op, ..Default::default() };
+    if let Some(unit) = &a.child {
+        return run_child(&ctx, unit, a.child_result.as_deref(), &opts);
+    }
+    if !(a.timeout_s > 0.0 && a.timeout_s.is_finite()) {
+        return Err(Error::Other(format!("--timeout must be a positive number of seconds, got {}", a.timeout_s)));
+    }
+    let r = if a.isolate {
+        let exe = std::env::current_exe().map_err(|e| Error::io("the umbrage executable", e))?;
+        let iso = isolate::Isolation {
+            exe,
+            timeout: std::time::Duration::from_secs_f64(a.timeout_s),
+            jobs: a.jobs.max(1),
+            scratch: out.join("children"),
+        };
+        let mut args = vec!["--out".to_string(), out.display().to_string()];
+        if !filter.is_empty() {
+            args.extend(["--filter".to_string(), filter.join(",")]);
+        }
+        isolate::run_suite_isolated(&ctx, &opts, &iso, &args)?
+    } else {
+        run_suite(&ctx, &|| Context::with_validation(validation), &opts)
+    };
     report::write_all(&out, a.junit.as_deref(), &r)?;
     println!("{} | {} | Vulkan {}", r.device.name, r.device.driver_info, r.device.api_version);
     for c in r.failed() {

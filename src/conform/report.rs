@@ -6,10 +6,16 @@ use crate::error::{Error, Result};
 use std::fmt::Write as _;
 use std::path::Path;
 
-/// The one-line verdict: `PASS: 2456 cases, 2100 passed, 0 failed, 356 skipped (41.2 s)`.
+/// The one-line verdict: `PASS: 2456 cases, 2100 passed, 0 failed, 356 skipped, 0 crashed (41.2 s)`.
 pub fn verdict(r: &Report) -> String {
     let (p, f, s) = r.counts();
-    format!("{}: {} cases, {p} passed, {f} failed, {s} skipped ({:.1} s)", if f == 0 { "PASS" } else { "FAIL" }, r.cases.len(), r.seconds)
+    let c = r.crashed().len();
+    format!(
+        "{}: {} cases, {p} passed, {f} failed, {s} skipped, {c} crashed ({:.1} s)",
+        if f + c == 0 { "PASS" } else { "FAIL" },
+        r.cases.len(),
+        r.seconds
+    )
 }
 
 /// The full Markdown report.
@@ -44,26 +50,29 @@ pub fn markdown(r: &Report) -> String {
         let _ = writeln!(s, "| `{}` | {} | {:.2} | {} |", c.name, c.cases, c.seconds, c.validation_errors);
     }
 
-    s.push_str("\n## Results by group and configuration\n\n| group | configuration | pass | fail | skipped |\n|---|---|---|---|---|\n");
-    let mut rows: Vec<(String, String, [usize; 3])> = Vec::new();
+    s.push_str(
+        "\n## Results by group and configuration\n\n| group | configuration | pass | fail | skipped | crashed |\n|---|---|---|---|---|---|\n",
+    );
+    let mut rows: Vec<(String, String, [usize; 4])> = Vec::new();
     for c in &r.cases {
         let cfg = c.config.clone().unwrap_or_else(|| "(renderer's format, dynamic rendering, static state)".into());
         let k = match c.status {
             Status::Pass => 0,
             Status::Fail => 1,
             Status::Skipped => 2,
+            Status::Crash => 3,
         };
         match rows.iter_mut().find(|(g, cf, _)| *g == c.group && *cf == cfg) {
             Some((_, _, n)) => n[k] += 1,
             None => {
-                let mut n = [0; 3];
+                let mut n = [0; 4];
                 n[k] = 1;
                 rows.push((c.group.clone(), cfg, n));
             }
         }
     }
     for (g, cfg, n) in &rows {
-        let _ = writeln!(s, "| {g} | `{cfg}` | {} | {} | {} |", n[0], n[1], n[2]);
+        let _ = writeln!(s, "| {g} | `{cfg}` | {} | {} | {} | {} |", n[0], n[1], n[2], n[3]);
     }
 
     s.push_str("\n## Skipped cases, by reason\n\n| reason | cases | example |\n|---|---|---|\n");
@@ -78,6 +87,13 @@ pub fn markdown(r: &Report) -> String {
         let _ = writeln!(s, "| {m} | {n} | `{e}` |");
     }
 
+    let crashed = r.crashed();
+    if !crashed.is_empty() {
+        let _ = writeln!(s, "\n## Crashes and hangs ({})\n", crashed.len());
+        for c in &crashed {
+            let _ = writeln!(s, "- `{}`: {}", c.name, c.message.replace('|', "\\|"));
+        }
+    }
     let failed = r.failed();
     let _ = writeln!(s, "\n## Failures ({})\n", failed.len());
     for c in &failed {

@@ -3,7 +3,7 @@
 //! single-configuration end-to-end checks (`legacy.*`, `pipeline.hard_cases.*`).
 
 use super::batch::{self, TileResult};
-use super::cases::{self, Bug, Case, Config, Req, FORMATS};
+use super::cases::{self, Bug, Case, Config, RenderModel, Req, StateModel, FORMATS};
 use super::model::{self, DepthExp, Expected};
 use super::{images, CheckResult, Status};
 use crate::error::Result;
@@ -57,7 +57,7 @@ fn selected(filter: &[String], name: &str) -> bool {
 }
 
 /// One query draw's count.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct QueryOutcome {
     /// Smallest count the model allows.
     pub expected_min: u64,
@@ -68,7 +68,7 @@ pub struct QueryOutcome {
 }
 
 /// The result of one case.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct CaseOutcome {
     /// The full dotted name.
     pub name: String,
@@ -83,8 +83,8 @@ pub struct CaseOutcome {
     pub message: String,
     /// What the case checks.
     pub what: String,
-    /// The bug a zoo case reproduces.
-    #[serde(skip_serializing_if = "Option::is_none")]
+    /// The bug a zoo case reproduces (not sent back by an isolated child: the parent has it).
+    #[serde(skip_serializing_if = "Option::is_none", skip_deserializing)]
     pub bug: Option<Bug>,
     /// Seconds: the configuration's submission time shared equally among its cases.
     pub seconds: f64,
@@ -95,15 +95,15 @@ pub struct CaseOutcome {
     /// Judged pixels whose depth differed.
     pub depth_mismatches: u64,
     /// Occlusion-query counts.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(skip_serializing_if = "Vec::is_empty", default)]
     pub queries: Vec<QueryOutcome>,
     /// Failure images written (expected, actual, diff).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
+    #[serde(skip_serializing_if = "Vec::is_empty", default)]
     pub images: Vec<String>,
 }
 
 impl CaseOutcome {
-    fn new(name: String, group: &str, config: Option<String>, what: String) -> CaseOutcome {
+    pub(crate) fn new(name: String, group: &str, config: Option<String>, what: String) -> CaseOutcome {
         CaseOutcome {
             name,
             group: group.into(),
@@ -134,7 +134,7 @@ pub struct FormatSupport {
 }
 
 /// One configuration's submission.
-#[derive(Clone, Debug, serde::Serialize)]
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct ConfigRun {
     /// `d24s8.dynamic_rendering.static_state`.
     pub name: String,
@@ -181,6 +181,10 @@ impl Report {
     pub fn failed(&self) -> Vec<&CaseOutcome> {
         self.cases.iter().filter(|c| c.status == Status::Fail).collect()
     }
+    /// The cases whose driver crashed or hung (isolated runs only).
+    pub fn crashed(&self) -> Vec<&CaseOutcome> {
+        self.cases.iter().filter(|c| c.status == Status::Crash).collect()
+    }
 }
 
 const LEGACY: [&str; 7] = [
@@ -193,14 +197,28 @@ const LEGACY: [&str; 7] = [
     "index_types",
 ];
 
+fn pipeline_name(scene: &str, m: crate::shadow::Method) -> String {
+    format!("pipeline.hard_cases.{}.{}", scene.trim_start_matches("hard/"), m.name())
+}
+
 fn pipeline_names() -> Vec<String> {
     let mut v = Vec::new();
     for scene in crate::scene::builtin_names().into_iter().filter(|n| n.starts_with("hard/")) {
         for m in crate::shadow::Method::ALL {
-            v.push(format!("pipeline.hard_cases.{}.{}", scene.trim_start_matches("hard/"), m.name()));
+            v.push(pipeline_name(scene, m));
         }
     }
     v
+}
+
+/// The selected case names of the legacy or pipeline unit (empty for a configuration unit).
+pub fn unit_case_names(unit: super::isolate::Unit, filter: &[String]) -> Vec<String> {
+    let all = match unit {
+        super::isolate::Unit::Legacy => LEGACY.iter().map(|n| format!("legacy.{n}")).collect(),
+        super::isolate::Unit::Pipeline => pipeline_names(),
+        super::isolate::Unit::Config(_) => Vec::new(),
+    };
+    all.into_iter().filter(|n| selected(filter, n)).collect()
 }
 
 /// Every case name, with or without a device (`--list`), in run order.
@@ -222,6 +240,22 @@ fn have(ctx: &Context, r: Req, format: vk::Format) -> bool {
         Req::FloatDepth => cases::depth_kind(format) == cases::DepthKind::Float32,
         Req::OcclusionQueryPrecise => f.occlusion_query_precise,
     }
+}
+
+/// Why `ctx` cannot run configuration `cfg` at all (its render or state model needs a newer
+/// Vulkan than the device has), or `None`.
+pub fn config_unsupported(ctx: &Context, cfg: Config) -> Option<String> {
+    let f = &ctx.features;
+    let v = &ctx.info.api_version;
+    if cfg.render == RenderModel::DynamicRendering && !f.dynamic_rendering {
+        return Some(format!("dynamic rendering needs Vulkan 1.3 (dynamicRendering); the device has Vulkan {v}"));
+    }
+    if cfg.state == StateModel::Dynamic && !f.extended_dynamic_state {
+        return Some(format!(
+            "dynamic depth/stencil state (vkCmdSetStencilOp, vkCmdSetDepthCompareOp, ...) needs Vulkan 1.3; the device has Vulkan {v}"
+        ));
+    }
+    None
 }
 
 /// Compares one tile with its expectation: (stencil mismatches, depth mismatches, judged, query outcomes, message).
@@ -289,115 +323,144 @@ fn compare(case: &Case, exp: &Expected, got: &TileResult) -> (u64, u64, u64, Vec
     (sm, dm, judged, q, first)
 }
 
-/// Runs the selected cases on `ctx`. `new_context` makes the fresh contexts the pipeline
-/// checks' renderers need.
+/// The formats tried and whether each is usable on `ctx`.
+pub fn format_support(ctx: &Context) -> Vec<(vk::Format, FormatSupport)> {
+    FORMATS
+        .iter()
+        .map(|&f| {
+            let usable = batch::format_usable(ctx, f);
+            (f, FormatSupport { name: cases::format_name(f).into(), format: format!("{f:?}"), usable })
+        })
+        .collect()
+}
+
+/// One configuration's selected cases: every outcome (skipped ones decided, the others
+/// pending as passes) and the cases to draw.
+pub fn plan_config(ctx: &Context, cfg: Config, format_ok: bool, opts: &SuiteOptions) -> (Vec<CaseOutcome>, Vec<Case>) {
+    let mut outcomes = Vec::new();
+    let mut run = Vec::new();
+    for c in cases::all(&[cfg]).into_iter().filter(|c| selected(&opts.filter, &c.name)) {
+        let mut o = CaseOutcome::new(c.name.clone(), c.group, Some(cfg.name()), c.what.clone());
+        o.bug = c.bug.clone();
+        if let Some(why) = config_unsupported(ctx, cfg) {
+            o.status = Status::Skipped;
+            o.message = why;
+        } else if !format_ok {
+            o.status = Status::Skipped;
+            o.message = format!(
+                "{:?} not supported as a depth-stencil attachment with transfers (vkGetPhysicalDeviceFormatProperties)",
+                cfg.format
+            );
+        } else if let Some(r) = c.missing(&|r| have(ctx, r, cfg.format)) {
+            o.status = Status::Skipped;
+            o.message = r.reason().into();
+        } else {
+            run.push(c);
+        }
+        outcomes.push(o);
+    }
+    (outcomes, run)
+}
+
+/// Runs one configuration's selected cases in one submission: their outcomes (skipped ones
+/// included, in generation order) and the submission's record (`None` when nothing ran).
+pub fn run_config(ctx: &Context, cfg: Config, format_ok: bool, opts: &SuiteOptions) -> (Vec<CaseOutcome>, Option<ConfigRun>) {
+    let bits = ctx.limits.sub_pixel_precision_bits;
+    let (mut outcomes, run) = plan_config(ctx, cfg, format_ok, opts);
+    if run.is_empty() {
+        return (outcomes, None);
+    }
+    let _ = ctx.take_validation_errors();
+    let t0 = Instant::now();
+    let refs: Vec<&Case> = run.iter().collect();
+    let result = batch::run(ctx, cfg, &refs);
+    let errors = ctx.take_validation_errors();
+    let seconds = t0.elapsed().as_secs_f64();
+    let per_case = seconds / run.len() as f64;
+    let config_run = ConfigRun { name: cfg.name(), cases: run.len(), seconds, validation_errors: errors.len() };
+    let mut tiles = result.map_err(|e| e.to_string()).map(|t| t.into_iter());
+    let mut k = 0;
+    for c in &run {
+        while outcomes[k].name != c.name {
+            k += 1;
+        }
+        let o = &mut outcomes[k];
+        o.seconds = per_case;
+        let tile = match &mut tiles {
+            Ok(it) => it.next(),
+            Err(_) => None,
+        };
+        let Some(tile) = tile else {
+            o.status = Status::Fail;
+            o.message = format!("error: {}", tiles.as_ref().err().cloned().unwrap_or_else(|| "no result".into()));
+            continue;
+        };
+        judge(c, &tile, bits, &errors, opts, o);
+    }
+    (outcomes, Some(config_run))
+}
+
+/// Judges one drawn case's tile against the model into `o`.
+fn judge(c: &Case, tile: &TileResult, bits: u32, errors: &[String], opts: &SuiteOptions, o: &mut CaseOutcome) {
+    let exp = model::expect(c, bits, opts.break_op);
+    let (sm, dm, judged, q, detail) = compare(c, &exp, tile);
+    (o.stencil_mismatches, o.depth_mismatches, o.judged_pixels, o.queries) = (sm, dm, judged, q);
+    if !detail.is_empty() || !errors.is_empty() {
+        o.status = Status::Fail;
+        let mut parts = Vec::new();
+        if !errors.is_empty() {
+            parts.push(format!("{} validation errors in the configuration (first: {})", errors.len(), errors[0]));
+        }
+        if sm + dm > 0 {
+            parts.push(format!("{sm} stencil and {dm} depth mismatches of {judged} judged pixels"));
+        }
+        parts.extend(detail);
+        o.message = parts.join("; ");
+        if let Some(dir) = &opts.image_dir {
+            match images::write_failure(&dir.join("failures").join(&c.name), c, &exp, tile) {
+                Ok(paths) => o.images = paths,
+                Err(e) => o.message.push_str(&format!("; images not written: {e}")),
+            }
+        }
+    } else {
+        o.message = format!("{judged} judged pixels exact");
+        if !c.either.is_empty() {
+            let tl = c.either.iter().filter(|&&(i, _, p)| tile.stencil[i] == p).count();
+            o.message.push_str(&format!(
+                ", each of the {} centres on the shared edge covered once; the D3D top-left convention held at {tl} of them",
+                c.either.len()
+            ));
+        }
+        if !o.queries.is_empty() {
+            let exact = o.queries.iter().filter(|q| q.expected_min == q.expected_max).count();
+            o.message.push_str(&format!(", {} query counts as modelled ({exact} of them exact)", o.queries.len()));
+        }
+    }
+}
+
+/// Runs the selected cases on `ctx`, in this process. `new_context` makes the fresh contexts
+/// the pipeline checks' renderers need. [`super::isolate::run_suite_isolated`] runs the same
+/// units in child processes instead.
 pub fn run_suite(ctx: &Context, new_context: &dyn Fn() -> Result<Context>, opts: &SuiteOptions) -> Report {
     let start = Instant::now();
-    let bits = ctx.limits.sub_pixel_precision_bits;
-    let mut formats = Vec::new();
-    let mut usable = Vec::new();
-    for f in FORMATS {
-        let ok = batch::format_usable(ctx, f);
-        formats.push(FormatSupport { name: cases::format_name(f).into(), format: format!("{f:?}"), usable: ok });
-        usable.push((f, ok));
-    }
+    let support = format_support(ctx);
     let mut outcomes = Vec::new();
     let mut configs = Vec::new();
-    let _ = ctx.take_validation_errors();
     for cfg in Config::all(&FORMATS) {
-        let all: Vec<Case> = cases::all(&[cfg]).into_iter().filter(|c| selected(&opts.filter, &c.name)).collect();
-        if all.is_empty() {
-            continue;
-        }
-        let format_ok = usable.iter().any(|&(f, ok)| f == cfg.format && ok);
-        let mut run: Vec<&Case> = Vec::new();
-        let mut first_of_cfg = outcomes.len();
-        for c in &all {
-            let mut o = CaseOutcome::new(c.name.clone(), c.group, Some(cfg.name()), c.what.clone());
-            o.bug = c.bug.clone();
-            if !format_ok {
-                o.status = Status::Skipped;
-                o.message = format!(
-                    "{:?} not supported as a depth-stencil attachment with transfers (vkGetPhysicalDeviceFormatProperties)",
-                    cfg.format
-                );
-            } else if let Some(r) = c.missing(&|r| have(ctx, r, cfg.format)) {
-                o.status = Status::Skipped;
-                o.message = r.reason().into();
-            } else {
-                run.push(c);
-            }
-            outcomes.push(o);
-        }
-        if run.is_empty() {
-            continue;
-        }
-        let t0 = Instant::now();
-        let result = batch::run(ctx, cfg, &run);
-        let errors = ctx.take_validation_errors();
-        let seconds = t0.elapsed().as_secs_f64();
-        let per_case = seconds / run.len() as f64;
-        configs.push(ConfigRun { name: cfg.name(), cases: run.len(), seconds, validation_errors: errors.len() });
-        let mut tiles = result.map_err(|e| e.to_string()).map(|t| t.into_iter());
-        for c in run {
-            while outcomes[first_of_cfg].name != c.name {
-                first_of_cfg += 1;
-            }
-            let o = &mut outcomes[first_of_cfg];
-            o.seconds = per_case;
-            let tile = match &mut tiles {
-                Ok(it) => it.next(),
-                Err(_) => None,
-            };
-            let Some(tile) = tile else {
-                o.status = Status::Fail;
-                o.message = format!("error: {}", tiles.as_ref().err().cloned().unwrap_or_else(|| "no result".into()));
-                continue;
-            };
-            let exp = model::expect(c, bits, opts.break_op);
-            let (sm, dm, judged, q, detail) = compare(c, &exp, &tile);
-            (o.stencil_mismatches, o.depth_mismatches, o.judged_pixels, o.queries) = (sm, dm, judged, q);
-            if !detail.is_empty() || !errors.is_empty() {
-                o.status = Status::Fail;
-                let mut parts = Vec::new();
-                if !errors.is_empty() {
-                    parts.push(format!("{} validation errors in the configuration (first: {})", errors.len(), errors[0]));
-                }
-                if sm + dm > 0 {
-                    parts.push(format!("{sm} stencil and {dm} depth mismatches of {judged} judged pixels"));
-                }
-                parts.extend(detail);
-                o.message = parts.join("; ");
-                if let Some(dir) = &opts.image_dir {
-                    match images::write_failure(&dir.join("failures").join(&c.name), c, &exp, &tile) {
-                        Ok(paths) => o.images = paths,
-                        Err(e) => o.message.push_str(&format!("; images not written: {e}")),
-                    }
-                }
-            } else {
-                o.message = format!("{judged} judged pixels exact");
-                if !c.either.is_empty() {
-                    let tl = c.either.iter().filter(|&&(i, _, p)| tile.stencil[i] == p).count();
-                    o.message.push_str(&format!(
-                        ", each of the {} centres on the shared edge covered once; the D3D top-left convention held at {tl} of them",
-                        c.either.len()
-                    ));
-                }
-                if !o.queries.is_empty() {
-                    let exact = o.queries.iter().filter(|q| q.expected_min == q.expected_max).count();
-                    o.message.push_str(&format!(", {} query counts as modelled ({exact} of them exact)", o.queries.len()));
-                }
-            }
-        }
+        let format_ok = support.iter().any(|(f, s)| *f == cfg.format && s.usable);
+        let (o, run) = run_config(ctx, cfg, format_ok, opts);
+        outcomes.extend(o);
+        configs.extend(run);
     }
-    let legacy = run_legacy(ctx, new_context, opts, &mut outcomes);
+    let mut legacy = run_legacy(ctx, opts, &mut outcomes);
+    legacy.extend(run_pipeline(ctx, new_context, opts, &mut outcomes));
     Report {
         device: ctx.info.clone(),
         features: ctx.features.clone(),
         validation: ctx.validation,
-        subpixel_bits: bits,
+        subpixel_bits: ctx.limits.sub_pixel_precision_bits,
         filter: opts.filter.clone(),
-        formats,
+        formats: support.into_iter().map(|(_, s)| s).collect(),
         configs,
         cases: outcomes,
         legacy,
@@ -405,12 +468,8 @@ pub fn run_suite(ctx: &Context, new_context: &dyn Fn() -> Result<Context>, opts:
     }
 }
 
-fn run_legacy(
-    ctx: &Context,
-    new_context: &dyn Fn() -> Result<Context>,
-    opts: &SuiteOptions,
-    out: &mut Vec<CaseOutcome>,
-) -> Vec<CheckResult> {
+/// The selected `legacy.*` checks (outcomes into `out`, full results returned).
+pub fn run_legacy(ctx: &Context, opts: &SuiteOptions, out: &mut Vec<CaseOutcome>) -> Vec<CheckResult> {
     type Check = fn(&Context) -> Result<CheckResult>;
     let unit: [(&str, Check); 7] = [
         (LEGACY[0], super::checks::w0_vertices_and_infinity),
@@ -427,6 +486,17 @@ fn run_legacy(
         if !selected(&opts.filter, &full) {
             continue;
         }
+        if !ctx.features.dynamic_rendering {
+            let mut o =
+                CaseOutcome::new(full, "legacy", None, format!("single-configuration check `{name}` (the renderer's depth format)"));
+            o.status = Status::Skipped;
+            o.message = format!(
+                "the single-configuration checks draw with dynamic rendering (Vulkan 1.3); the device has Vulkan {}",
+                ctx.info.api_version
+            );
+            out.push(o);
+            continue;
+        }
         let t0 = Instant::now();
         let mut r = f(ctx).unwrap_or_else(|e| CheckResult::error(name, &e));
         super::with_validation(&mut r, ctx.take_validation_errors());
@@ -437,11 +507,34 @@ fn run_legacy(
         out.push(o);
         results.push(r);
     }
+    results
+}
+
+/// The selected `pipeline.hard_cases.*` cases (outcomes into `out`, the check's full result
+/// returned).
+pub fn run_pipeline(
+    ctx: &Context,
+    new_context: &dyn Fn() -> Result<Context>,
+    opts: &SuiteOptions,
+    out: &mut Vec<CaseOutcome>,
+) -> Vec<CheckResult> {
+    let mut results = Vec::new();
     let names: Vec<String> = pipeline_names().into_iter().filter(|n| selected(&opts.filter, n)).collect();
-    if !names.is_empty() {
+    if !names.is_empty() && !ctx.features.dynamic_rendering {
+        for n in names {
+            let mut o = CaseOutcome::new(n, "pipeline", None, "the whole shadow pipeline against the exact CPU reference".into());
+            o.status = Status::Skipped;
+            o.message = format!(
+                "the renderer needs Vulkan 1.3 (dynamicRendering, synchronization2); the device has Vulkan {}",
+                ctx.info.api_version
+            );
+            out.push(o);
+        }
+    } else if !names.is_empty() {
         let t0 = Instant::now();
         let (w, h) = opts.pipeline_size;
-        match super::checks::shadow_pipeline_hard_cases(new_context, w, h) {
+        let chosen = |scene: &str, m: crate::shadow::Method| names.contains(&pipeline_name(scene, m));
+        match super::checks::shadow_pipeline_hard_cases(new_context, w, h, &chosen) {
             Ok(r) => {
                 let per = t0.elapsed().as_secs_f64() / r.cases.len().max(1) as f64;
                 for k in &r.cases {

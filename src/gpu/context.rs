@@ -19,6 +19,20 @@ use std::sync::{Arc, Mutex};
 #[derive(Clone, Debug, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Features {
+    /// The device's Vulkan version as `VK_MAKE_API_VERSION` packs it (`DeviceInfo::api_version`
+    /// spells it out). Below 1.3 only what Vulkan 1.0 core offers is used, and the context is
+    /// made only through [`Context::any_version`].
+    #[cfg_attr(feature = "serde", serde(skip))]
+    pub api_version: u32,
+    /// `dynamicRendering` (Vulkan 1.3 core) is enabled: `vkCmdBeginRendering` may be used.
+    pub dynamic_rendering: bool,
+    /// `synchronization2` (Vulkan 1.3 core) is enabled: barriers are recorded with
+    /// `vkCmdPipelineBarrier2`; without it [`super::resources::transition`] and
+    /// [`super::resources::memory_barrier`] record Vulkan 1.0 barriers.
+    pub synchronization2: bool,
+    /// The Vulkan 1.3 core dynamic depth/stencil state (`vkCmdSetStencilOp`,
+    /// `vkCmdSetDepthCompareOp`, ..., formerly `VK_EXT_extended_dynamic_state`) can be used.
+    pub extended_dynamic_state: bool,
     /// `depthClamp` is supported (and enabled on the device): `--depth-mode clamp` (finite far
     /// plane, geometry beyond it clamped to depth 1.0 instead of clipped).
     pub depth_clamp: bool,
@@ -64,7 +78,8 @@ pub struct DeviceInfo {
     pub driver: String,
     /// `driverInfo` from `VkPhysicalDeviceDriverProperties`, typically the driver's version string.
     pub driver_info: String,
-    /// The device's Vulkan version, `major.minor.patch` (at least 1.3.0).
+    /// The device's Vulkan version, `major.minor.patch` (at least 1.3.0, except for a context
+    /// made with [`Context::any_version`]).
     pub api_version: String,
     /// PCI vendor id (`vendorID`).
     pub vendor_id: u32,
@@ -124,6 +139,20 @@ pub struct Context {
     pub limits: vk::PhysicalDeviceLimits,
     /// Whether the validation layer and debug messenger are active.
     pub validation: bool,
+}
+
+/// The oldest device a context accepts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Minimum {
+    /// Vulkan 1.3 with `dynamicRendering` and `synchronization2`: the renderer and the viewer.
+    Vulkan13,
+    /// Any Vulkan device: the conformance suite and `umbrage info`.
+    Vulkan10,
+}
+
+/// `major.minor.patch` of a packed Vulkan version.
+pub fn version_string(v: u32) -> String {
+    format!("{}.{}.{}", vk::api_version_major(v), vk::api_version_minor(v), vk::api_version_patch(v))
 }
 
 /// Whether validation is requested through `UMBRAGE_VALIDATION`: `1`, `true`, `sync`,
@@ -200,6 +229,24 @@ impl Context {
         instance_extensions: &[*const std::ffi::c_char],
         device_extensions: &[&CStr],
     ) -> Result<Context> {
+        Self::open(validation, instance_extensions, device_extensions, Minimum::Vulkan13)
+    }
+
+    /// A context on any Vulkan 1.0+ device (the best-ranked one with a graphics queue, or the
+    /// one `UMBRAGE_DEVICE` names), for what needs nothing newer: the conformance suite's
+    /// classic render pass with static state, and `umbrage info`. [`Features`] says what the
+    /// device has beyond 1.0 (`dynamic_rendering`, `synchronization2`,
+    /// `extended_dynamic_state` need Vulkan 1.3); callers must check them before using it.
+    pub fn any_version(validation: bool) -> Result<Context> {
+        Self::open(validation, &[], &[], Minimum::Vulkan10)
+    }
+
+    fn open(
+        validation: bool,
+        instance_extensions: &[*const std::ffi::c_char],
+        device_extensions: &[&CStr],
+        minimum: Minimum,
+    ) -> Result<Context> {
         // SAFETY: loading the Vulkan loader library; we keep `entry` alive in the context for as
         // long as any object created from it.
         let entry =
@@ -222,6 +269,16 @@ impl Context {
             extensions.push(ash::ext::debug_utils::NAME.as_ptr());
         }
         extensions.extend_from_slice(instance_extensions);
+        // Vulkan 1.0 devices answer the `*2` property and feature queries only through
+        // VK_KHR_get_physical_device_properties2 (every loader since 2017 offers it).
+        // SAFETY: plain enumeration call on a loaded entry.
+        let instance_exts =
+            unsafe { entry.enumerate_instance_extension_properties(None) }.map_err(vkerr("vkEnumerateInstanceExtensionProperties"))?;
+        let gpdp2 = ash::khr::get_physical_device_properties2::NAME;
+        let has_gpdp2 = instance_exts.iter().any(|e| e.extension_name_as_c_str().map(|n| n == gpdp2).unwrap_or(false));
+        if has_gpdp2 && minimum == Minimum::Vulkan10 {
+            extensions.push(gpdp2.as_ptr());
+        }
         let app = vk::ApplicationInfo::default().application_name(c"umbrage").engine_name(c"umbrage").api_version(vk::API_VERSION_1_3);
         // Synchronisation validation on whenever validation is (a missing barrier is invisible
         // on lavapipe and flickers on a real GPU) unless `UMBRAGE_VALIDATION` picks another
@@ -256,7 +313,9 @@ impl Context {
             None
         };
 
-        match Self::open_device(&instance, device_extensions) {
+        let gpdp2 = (has_gpdp2 && minimum == Minimum::Vulkan10)
+            .then(|| ash::khr::get_physical_device_properties2::Instance::new(&entry, &instance));
+        match Self::open_device(&instance, gpdp2.as_ref(), device_extensions, minimum) {
             Ok((physical, device, queue_family, features, info, depth_format, limits)) => {
                 // SAFETY: the queue family/index were requested at device creation.
                 let queue = unsafe { device.get_device_queue(queue_family, 0) };
@@ -308,8 +367,18 @@ impl Context {
     #[allow(clippy::type_complexity)]
     fn open_device(
         instance: &ash::Instance,
+        gpdp2: Option<&ash::khr::get_physical_device_properties2::Instance>,
         extra_extensions: &[&CStr],
+        minimum: Minimum,
     ) -> Result<(vk::PhysicalDevice, ash::Device, u32, Features, DeviceInfo, vk::Format, vk::PhysicalDeviceLimits)> {
+        let min_version = match minimum {
+            Minimum::Vulkan13 => vk::API_VERSION_1_3,
+            Minimum::Vulkan10 => vk::API_VERSION_1_0,
+        };
+        let min_name = match minimum {
+            Minimum::Vulkan13 => "Vulkan 1.3",
+            Minimum::Vulkan10 => "Vulkan",
+        };
         // SAFETY: enumeration on a valid instance.
         let physicals = unsafe { instance.enumerate_physical_devices() }.map_err(vkerr("vkEnumeratePhysicalDevices"))?;
         if physicals.is_empty() {
@@ -317,11 +386,18 @@ impl Context {
         }
         let wanted = std::env::var("UMBRAGE_DEVICE").ok().map(|s| s.to_lowercase());
         let mut candidates = Vec::new();
+        let mut too_old = Vec::new();
         for &pd in &physicals {
             // SAFETY: `pd` comes from the enumeration above.
             let props = unsafe { instance.get_physical_device_properties(pd) };
             let name = props.device_name_as_c_str().map(|c| c.to_string_lossy().into_owned()).unwrap_or_default();
-            if props.api_version < vk::API_VERSION_1_3 {
+            if let Some(w) = &wanted {
+                if !name.to_lowercase().contains(w) {
+                    continue;
+                }
+            }
+            if props.api_version < min_version {
+                too_old.push(format!("{name} (Vulkan {})", version_string(props.api_version)));
                 continue;
             }
             // SAFETY: as above.
@@ -329,11 +405,6 @@ impl Context {
             let Some(qf) = families.iter().position(|f| f.queue_flags.contains(vk::QueueFlags::GRAPHICS)) else {
                 continue;
             };
-            if let Some(w) = &wanted {
-                if !name.to_lowercase().contains(w) {
-                    continue;
-                }
-            }
             let rank = match props.device_type {
                 vk::PhysicalDeviceType::DISCRETE_GPU => 0,
                 vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
@@ -345,31 +416,56 @@ impl Context {
         }
         candidates.sort_by_key(|c| c.0);
         let Some((_, physical, queue_family, props, name)) = candidates.into_iter().next() else {
+            if !too_old.is_empty() {
+                // A device is there, only too old: not a missing driver.
+                return Err(Error::Unsupported(format!(
+                    "{} has no dynamicRendering and synchronization2 (Vulkan 1.3), which this needs; \
+                     `umbrage conform` and `umbrage info` run on any Vulkan 1.0 device, and \
+                     `scripts/drivers.sh install 25.0.7` gives a Vulkan 1.4 lavapipe",
+                    too_old.join(", ")
+                )));
+            }
             return Err(Error::NoDevice(match wanted {
-                Some(w) => format!("no Vulkan 1.3 device with graphics whose name contains '{w}' (UMBRAGE_DEVICE)"),
-                None => "no Vulkan 1.3 device with a graphics queue".into(),
+                Some(w) => format!("no {min_name} device with graphics whose name contains '{w}' (UMBRAGE_DEVICE)"),
+                None => format!("no {min_name} device with a graphics queue"),
             }));
         };
+        let api = props.api_version;
+        let v11 = api >= vk::API_VERSION_1_1;
+        let v13 = api >= vk::API_VERSION_1_3;
 
-        // Probe optional features.
-        let mut f_u8 = vk::PhysicalDeviceIndexTypeUint8FeaturesEXT::default();
-        let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
-        let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13);
+        // Probe optional features: through the Vulkan 1.1 core query, or on a Vulkan 1.0 device
+        // through VK_KHR_get_physical_device_properties2 (when the loader has it; otherwise
+        // only the 1.0 features are known).
         // SAFETY: enumeration of extensions on a valid physical device.
         let exts =
             unsafe { instance.enumerate_device_extension_properties(physical) }.map_err(vkerr("vkEnumerateDeviceExtensionProperties"))?;
         let has_ext = |n: &CStr| exts.iter().any(|e| e.extension_name_as_c_str().map(|x| x == n).unwrap_or(false));
-        let has_u8_ext = has_ext(ash::ext::index_type_uint8::NAME);
+        let can_query2 = v11 || gpdp2.is_some();
+        let has_u8_ext = has_ext(ash::ext::index_type_uint8::NAME) && can_query2;
         let has_dru = has_ext(ash::ext::depth_range_unrestricted::NAME);
+        let mut f_u8 = vk::PhysicalDeviceIndexTypeUint8FeaturesEXT::default();
+        let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
+        let mut f2 = vk::PhysicalDeviceFeatures2::default();
+        if v13 {
+            f2 = f2.push_next(&mut f13);
+        }
         if has_u8_ext {
             f2 = f2.push_next(&mut f_u8);
         }
-        // SAFETY: the chain points at locals alive for this call.
-        unsafe { instance.get_physical_device_features2(physical, &mut f2) };
+        // SAFETY: the chain points at locals alive for this call; a struct is chained only when
+        // the device's version or extensions define it.
+        unsafe {
+            match (v11, gpdp2) {
+                (true, _) => instance.get_physical_device_features2(physical, &mut f2),
+                (false, Some(g)) => g.get_physical_device_features2(physical, &mut f2),
+                (false, None) => f2.features = instance.get_physical_device_features(physical),
+            }
+        }
         let base = f2.features;
         let (dyn_rendering, sync2) = (f13.dynamic_rendering == vk::TRUE, f13.synchronization2 == vk::TRUE);
         let u8_supported = has_u8_ext && f_u8.index_type_uint8 == vk::TRUE;
-        if !dyn_rendering || !sync2 {
+        if minimum == Minimum::Vulkan13 && (!dyn_rendering || !sync2) {
             return Err(Error::Unsupported(format!("{name}: umbrage needs dynamicRendering and synchronization2 (Vulkan 1.3)")));
         }
         // SAFETY: as above.
@@ -383,7 +479,9 @@ impl Context {
             .find(|&f| {
                 // SAFETY: format query on a valid physical device.
                 let p = unsafe { instance.get_physical_device_format_properties(physical, f) };
-                p.optimal_tiling_features.contains(needed)
+                // Vulkan 1.0 has no TRANSFER_SRC format feature (VK_KHR_maintenance1): every
+                // attachment format may be copied there.
+                p.optimal_tiling_features.contains(if v11 { needed } else { vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT })
             })
             .ok_or_else(|| Error::Unsupported(format!("{name}: no depth-stencil format with 8 stencil bits (D32S8 or D24S8)")))?;
 
@@ -393,6 +491,10 @@ impl Context {
             p.optimal_tiling_features.contains(vk::FormatFeatureFlags::COLOR_ATTACHMENT_BLEND)
         };
         let features = Features {
+            api_version: api,
+            dynamic_rendering: v13 && dyn_rendering,
+            synchronization2: v13 && sync2,
+            extended_dynamic_state: v13,
             depth_clamp: base.depth_clamp == vk::TRUE,
             depth_bounds: base.depth_bounds == vk::TRUE,
             depth_range_unrestricted: has_dru,
@@ -412,7 +514,9 @@ impl Context {
             .depth_bounds(features.depth_bounds)
             .pipeline_statistics_query(features.pipeline_statistics_query)
             .occlusion_query_precise(features.occlusion_query_precise);
-        let mut e13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true);
+        let mut e13 = vk::PhysicalDeviceVulkan13Features::default()
+            .dynamic_rendering(features.dynamic_rendering)
+            .synchronization2(features.synchronization2);
         let mut e_u8 = vk::PhysicalDeviceIndexTypeUint8FeaturesEXT::default().index_type_uint8(true);
         let mut dev_exts = Vec::new();
         if u8_supported {
@@ -429,28 +533,36 @@ impl Context {
         }
         let prio = [1.0f32];
         let qinfo = [vk::DeviceQueueCreateInfo::default().queue_family_index(queue_family).queue_priorities(&prio)];
-        let mut dinfo = vk::DeviceCreateInfo::default()
-            .queue_create_infos(&qinfo)
-            .enabled_features(&enabled)
-            .enabled_extension_names(&dev_exts)
-            .push_next(&mut e13);
+        let mut dinfo =
+            vk::DeviceCreateInfo::default().queue_create_infos(&qinfo).enabled_features(&enabled).enabled_extension_names(&dev_exts);
+        if v13 {
+            dinfo = dinfo.push_next(&mut e13);
+        }
         if u8_supported {
             dinfo = dinfo.push_next(&mut e_u8);
         }
         // SAFETY: all pointers refer to locals alive for the call.
         let device = unsafe { instance.create_device(physical, &dinfo, None) }.map_err(vkerr("vkCreateDevice"))?;
 
+        // The driver's name and version string: core in 1.2, else VK_KHR_driver_properties.
         let mut driver = vk::PhysicalDeviceDriverProperties::default();
-        let mut p2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
-        // SAFETY: chain of locals.
-        unsafe { instance.get_physical_device_properties2(physical, &mut p2) };
-        let v = props.api_version;
+        let has_driver_props = api >= vk::API_VERSION_1_2 || (has_ext(ash::khr::driver_properties::NAME) && can_query2);
+        if has_driver_props {
+            let mut p2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
+            // SAFETY: chain of locals; the driver-properties struct is defined for this device.
+            unsafe {
+                match (v11, gpdp2) {
+                    (false, Some(g)) => g.get_physical_device_properties2(physical, &mut p2),
+                    _ => instance.get_physical_device_properties2(physical, &mut p2),
+                }
+            }
+        }
         let info = DeviceInfo {
             name,
             kind: format!("{:?}", props.device_type),
             driver: driver.driver_name_as_c_str().map(|c| c.to_string_lossy().into_owned()).unwrap_or_default(),
             driver_info: driver.driver_info_as_c_str().map(|c| c.to_string_lossy().into_owned()).unwrap_or_default(),
-            api_version: format!("{}.{}.{}", vk::api_version_major(v), vk::api_version_minor(v), vk::api_version_patch(v)),
+            api_version: version_string(api),
             vendor_id: props.vendor_id,
             device_id: props.device_id,
         };
@@ -535,6 +647,11 @@ pub trait GpuDevice {
     fn device(&self) -> &ash::Device;
     /// The memory allocator, locked.
     fn allocator(&self) -> std::sync::MutexGuard<'_, gpu_allocator::vulkan::Allocator>;
+    /// Whether `synchronization2` is enabled on the device: the barrier helpers record
+    /// `vkCmdPipelineBarrier2` when it is and Vulkan 1.0 `vkCmdPipelineBarrier` otherwise.
+    fn synchronization2(&self) -> bool {
+        true
+    }
 }
 
 impl GpuDevice for Context {
@@ -543,6 +660,9 @@ impl GpuDevice for Context {
     }
     fn allocator(&self) -> std::sync::MutexGuard<'_, gpu_allocator::vulkan::Allocator> {
         lock_allocator(&self.allocator)
+    }
+    fn synchronization2(&self) -> bool {
+        self.features.synchronization2
     }
 }
 

@@ -258,10 +258,58 @@ pub fn transition(ctx: &impl GpuDevice, cb: vk::CommandBuffer, image: &Image, fr
         .new_layout(to)
         .image(image.raw)
         .subresource_range(image.range());
+    if !ctx.synchronization2() {
+        let b = [vk::ImageMemoryBarrier::default()
+            .src_access_mask(access_v1(src_access))
+            .dst_access_mask(access_v1(dst_access))
+            .old_layout(from)
+            .new_layout(to)
+            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .image(image.raw)
+            .subresource_range(image.range())];
+        // SAFETY: `cb` is recording; the image belongs to this device.
+        unsafe {
+            ctx.device().cmd_pipeline_barrier(
+                cb,
+                stage_v1(src_stage, true),
+                stage_v1(dst_stage, false),
+                vk::DependencyFlags::empty(),
+                &[],
+                &[],
+                &b,
+            )
+        };
+        return;
+    }
     let barriers = [barrier];
     let dep = vk::DependencyInfo::default().image_memory_barriers(&barriers);
     // SAFETY: `cb` is recording; the image belongs to this device.
     unsafe { ctx.device().cmd_pipeline_barrier2(cb, &dep) };
+}
+
+/// A synchronization2 stage mask as Vulkan 1.0 stage flags: the bits below 2^32 are the same
+/// (`ALL_TRANSFER` is `TRANSFER`); `NONE` becomes `TOP_OF_PIPE` as a source and
+/// `BOTTOM_OF_PIPE` as a destination; the finer 2-only stages widen to `ALL_COMMANDS`.
+fn stage_v1(s: vk::PipelineStageFlags2, src: bool) -> vk::PipelineStageFlags {
+    if s == vk::PipelineStageFlags2::NONE {
+        return if src { vk::PipelineStageFlags::TOP_OF_PIPE } else { vk::PipelineStageFlags::BOTTOM_OF_PIPE };
+    }
+    if s.as_raw() >> 32 != 0 {
+        return vk::PipelineStageFlags::ALL_COMMANDS;
+    }
+    vk::PipelineStageFlags::from_raw(s.as_raw() as u32)
+}
+
+/// A synchronization2 access mask as Vulkan 1.0 access flags (the finer 2-only accesses widen to
+/// `MEMORY_READ | MEMORY_WRITE`).
+fn access_v1(a: vk::AccessFlags2) -> vk::AccessFlags {
+    let low = vk::AccessFlags::from_raw(a.as_raw() as u32);
+    if a.as_raw() >> 32 != 0 {
+        low | vk::AccessFlags::MEMORY_READ | vk::AccessFlags::MEMORY_WRITE
+    } else {
+        low
+    }
 }
 
 /// The stages and accesses an image in `layout` is used with: as the source of a transition
@@ -299,6 +347,14 @@ pub fn memory_barrier(
     src: (vk::PipelineStageFlags2, vk::AccessFlags2),
     dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
 ) {
+    if !ctx.synchronization2() {
+        let b = [vk::MemoryBarrier::default().src_access_mask(access_v1(src.1)).dst_access_mask(access_v1(dst.1))];
+        // SAFETY: `cb` is recording.
+        unsafe {
+            ctx.device().cmd_pipeline_barrier(cb, stage_v1(src.0, true), stage_v1(dst.0, false), vk::DependencyFlags::empty(), &b, &[], &[])
+        };
+        return;
+    }
     let b = [vk::MemoryBarrier2::default().src_stage_mask(src.0).src_access_mask(src.1).dst_stage_mask(dst.0).dst_access_mask(dst.1)];
     let dep = vk::DependencyInfo::default().memory_barriers(&b);
     // SAFETY: `cb` is recording.

@@ -12,7 +12,7 @@ mod pipe;
 use super::cases::{Case, Config, DepthKind, RenderModel, StateModel};
 use super::model::to_raw;
 use crate::error::{Error, Result};
-use crate::gpu::resources::transition;
+use crate::gpu::resources::{memory_barrier, transition};
 use crate::gpu::{Buffer, Context, Image};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -62,8 +62,14 @@ fn depth_bpp(kind: DepthKind) -> u32 {
 /// Whether `format` can be used by the runner: depth-stencil attachment, transfer source and
 /// destination (optimal tiling).
 pub fn format_usable(ctx: &Context, format: vk::Format) -> bool {
-    let needed =
-        vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT | vk::FormatFeatureFlags::TRANSFER_SRC | vk::FormatFeatureFlags::TRANSFER_DST;
+    // Vulkan 1.0 without VK_KHR_maintenance1 has no transfer format features: there every
+    // format may be copied.
+    let transfer = if ctx.features.api_version >= vk::API_VERSION_1_1 {
+        vk::FormatFeatureFlags::TRANSFER_SRC | vk::FormatFeatureFlags::TRANSFER_DST
+    } else {
+        vk::FormatFeatureFlags::empty()
+    };
+    let needed = vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT | transfer;
     // SAFETY: a format query on the context's valid physical device.
     let p = unsafe { ctx.instance.get_physical_device_format_properties(ctx.physical, format) };
     p.optimal_tiling_features.contains(needed)
@@ -341,12 +347,12 @@ fn run_inner(ctx: &Context, cfg: Config, cases: &[&Case], origins: &[(u32, u32)]
             }
             transition(ctx, cb, img, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
             d.cmd_copy_image_to_buffer(cb, img.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, read_buf, &regions);
-            let b = [vk::MemoryBarrier2::default()
-                .src_stage_mask(vk::PipelineStageFlags2::ALL_TRANSFER)
-                .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-                .dst_stage_mask(vk::PipelineStageFlags2::HOST)
-                .dst_access_mask(vk::AccessFlags2::HOST_READ)];
-            d.cmd_pipeline_barrier2(cb, &vk::DependencyInfo::default().memory_barriers(&b));
+            memory_barrier(
+                ctx,
+                cb,
+                (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE),
+                (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
+            );
         }
     })?;
     let mut counts = vec![0u64; queries as usize];

@@ -3,37 +3,53 @@
 use crate::conform::{CaseResult, CheckResult, Status};
 use crate::error::Result;
 use crate::gpu::Context;
+use crate::shadow::Method;
 use serde_json::json;
 
 /// Threshold on the fraction of compared pixels outside the 1-pixel band (the accuracy suite's).
 pub const PIPELINE_THRESHOLD: f64 = crate::accuracy::THRESHOLD;
 
-/// Check 8: The whole shadow pipeline on every `hard/*` scene and every method, against the CPU
+/// Check 8: The whole shadow pipeline on every `hard/*` scene and every method (those
+/// `selected(scene, method)` accepts), against the CPU
 /// reference (through the same dump check as `umbrage check`).
 ///
-/// Each case renders `width` x `height` with a fresh context from `new_context`, dumps the frame
+/// Each case renders `width` x `height` (one context from `new_context` for the whole check, one
+/// renderer per scene with the method switched between frames), dumps the frame
 /// and compares each light's mask outside a 1-pixel band; it passes at most
 /// [`PIPELINE_THRESHOLD`] of the compared pixels mismatched. Cases [`crate::accuracy::expected_failure`] lists as
 /// expected failures are reported, not failed (an unexpected pass is flagged); validation errors
 /// during a render fail the case.
-pub fn shadow_pipeline_hard_cases(new_context: &dyn Fn() -> Result<Context>, width: u32, height: u32) -> Result<CheckResult> {
+pub fn shadow_pipeline_hard_cases(
+    new_context: &dyn Fn() -> Result<Context>,
+    width: u32,
+    height: u32,
+    selected: &dyn Fn(&str, Method) -> bool,
+) -> Result<CheckResult> {
     use crate::render::{RenderOptions, Renderer, Technique};
-    use crate::shadow::Method;
     let tmp = std::env::temp_dir().join(format!("umbrage-conform-{}", std::process::id()));
     let mut cases = Vec::new();
     let mut fails = Vec::new();
     let mut flagged = Vec::new();
+    // One context for the whole check and one renderer per scene, its method switched between
+    // frames as the viewer does: building a renderer (pipelines) is what costs, not a frame.
+    let mut spare: Option<Context> = None;
     for name in crate::scene::builtin_names().into_iter().filter(|n| n.starts_with("hard/")) {
-        for method in Method::ALL {
-            let scene = crate::scene::load(name)?;
-            let ctx = new_context()?;
-            let opts = RenderOptions { width, height, technique: Technique::Volumes(method), capture: true, ..Default::default() };
-            let mut renderer = Renderer::new(ctx, scene, opts)?;
+        let methods: Vec<Method> = Method::ALL.into_iter().filter(|&m| selected(name, m)).collect();
+        let Some(&first) = methods.first() else { continue };
+        let scene = crate::scene::load(name)?;
+        let ctx = match spare.take() {
+            Some(c) => c,
+            None => new_context()?,
+        };
+        let opts = RenderOptions { width, height, technique: Technique::Volumes(first), capture: true, ..Default::default() };
+        let mut renderer = Renderer::new(ctx, scene, opts)?;
+        let _ = renderer.context().take_validation_errors();
+        for method in methods {
+            renderer.settings.technique = Technique::Volumes(method);
             let frame = renderer.render()?;
             let validation = renderer.context().take_validation_errors();
             let dir = tmp.join(format!("{}-{}", name.replace('/', "_"), method.name()));
             crate::output::write_frame_dump(&dir, renderer.scene(), &frame)?;
-            drop(renderer);
             let report = crate::reference::check_dump(&dir, 1)?;
             let _ = std::fs::remove_dir_all(&dir);
             let expected_failure = crate::accuracy::expected_failure(name, method, crate::render::Counter::Stencil).is_some();
@@ -68,6 +84,14 @@ pub fn shadow_pipeline_hard_cases(new_context: &dyn Fn() -> Result<Context>, wid
                 status: status.to_string(),
             });
         }
+        let ctx = renderer.into_context();
+        // Teardown complaints (leaked objects) belong to the last case of the scene.
+        let teardown = ctx.take_validation_errors();
+        if let (Some(first), Some(last)) = (teardown.first(), cases.last_mut()) {
+            fails.push(format!("{name}: {} validation errors at teardown: {first}", teardown.len()));
+            last.status = "fail".into();
+        }
+        spare = Some(ctx);
     }
     let _ = std::fs::remove_dir_all(&tmp);
     let mut numbers = serde_json::Map::new();
