@@ -3,7 +3,7 @@
 export PATH := $(HOME)/.cargo/bin:$(PATH)
 CARGO ?= cargo
 
-.PHONY: deps drivers run view test bench conform conform-docs doc clean fuzz
+.PHONY: deps drivers run view test bench conform conform-docs conform-matrix doc clean fuzz
 
 deps:
 	@./scripts/deps.sh
@@ -20,11 +20,13 @@ run: deps
 view: deps
 	$(CARGO) run --release -- view --scene stress
 
-# Every test with validation on, the doc examples, and the library an engine embeds
+# Every test with validation on, the quick conformance matrix on three Mesa lavapipes
+# (scripts/drivers.sh installs them into .drivers/), the doc examples, and the library an engine embeds
 # (`default-features = false`) built and documented with warnings denied.
 test: deps
 	./scripts/fetch-assets.sh || true
 	UMBRAGE_VALIDATION=1 $(CARGO) test --all-targets
+	./scripts/conform-matrix.sh --quick
 	$(CARGO) test --doc
 	$(CARGO) build --lib --no-default-features
 	$(MAKE) doc
@@ -50,6 +52,11 @@ DEVICE_DOC ?= lavapipe
 conform-docs: deps
 	UMBRAGE_VALIDATION=1 $(CARGO) run -- conform --out target/conform-docs --junit target/conform-docs/junit.xml
 	cp target/conform-docs/conform.md docs/conform/$(DEVICE_DOC).md
+
+# The driver matrix: the full suite on lavapipe 20.3.5 / 22.3.6 / 25.0.7 and llvmpipe's
+# switches, side by side in docs/conform/drivers.md (explanations: docs/conform/drivers-notes.md).
+conform-matrix: deps
+	./scripts/conform-matrix.sh
 
 clean:
 	$(CARGO) clean

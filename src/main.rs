@@ -201,12 +201,30 @@ enum Command {
         /// Child processes at once.
         #[arg(long, default_value_t = 1, value_name = "N")]
         jobs: usize,
+        /// The driver's expected failures (`case,Fail` / `case,Crash` lines, as Mesa's CI
+        /// keeps them): exit 0 only when the run matches the list, no new failure and no
+        /// unexpected pass.
+        #[arg(long, value_name = "FILE")]
+        expect: Option<PathBuf>,
         /// Internal: run one unit and write its result to --child-result (crash isolation).
         #[arg(long, hide = true, value_name = "UNIT")]
         child: Option<String>,
         /// Internal: where a child writes its result.
         #[arg(long, hide = true, value_name = "FILE")]
         child_result: Option<PathBuf>,
+    },
+    /// The driver matrix: several `conform --out DIR` runs side by side (family x column, every
+    /// difference by pattern), as Markdown (`make conform-matrix` writes docs/conform/drivers.md).
+    ConformMatrix {
+        /// A column: its name and the directory holding that run's conform.json (repeat).
+        #[arg(long = "column", value_name = "NAME=DIR", required = true)]
+        columns: Vec<String>,
+        /// Hand-written explanations appended to the matrix.
+        #[arg(long, value_name = "FILE")]
+        notes: Option<PathBuf>,
+        /// The Markdown file to write.
+        #[arg(long, value_name = "FILE")]
+        out: PathBuf,
     },
 }
 
@@ -311,7 +329,7 @@ fn main() -> ExitCode {
         Command::Info { json, scene } => info(json, scene.as_deref()),
         Command::Check { dir, band, threshold } => check(&dir, band, threshold),
         Command::Bench(args) => bench_command(args),
-        Command::Conform { out, filter, list, junit, device, no_isolate, timeout, jobs, child, child_result } => {
+        Command::Conform { out, filter, list, junit, device, no_isolate, timeout, jobs, expect, child, child_result } => {
             umbrage::conform::run(umbrage::conform::RunArgs {
                 filter,
                 list,
@@ -323,7 +341,11 @@ fn main() -> ExitCode {
                 jobs,
                 child,
                 child_result,
+                expect,
             })
+        }
+        Command::ConformMatrix { columns, notes, out } => {
+            umbrage::conform::matrix::run(&columns, notes.as_deref(), &out).map(|_| ExitCode::SUCCESS)
         }
     };
     match result {

@@ -1,6 +1,7 @@
 //! The conformance suite on lavapipe (or whatever device is present): the CLI's list, filter,
 //! bad-input and JUnit contracts, the full suite once (0 failures, every skip explained), and
-//! the test seam that breaks one stencil op in the expectation.
+//! the test seam that breaks one stencil op in the expectation, crash isolation (an aborting
+//! and a hanging child) and the expected-failure lists.
 
 mod common;
 
@@ -217,5 +218,112 @@ fn broken_expectation_fails_exactly_the_affected_cases() {
         assert!(xml.contains(&format!("name=\"{name}\"")), "{name}");
         assert!(dir.join("cli").join("failures").join(name).join("expected.png").is_file(), "{name}");
     }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Crash isolation: a unit whose child aborts (as a driver assertion would) costs exactly its
+/// configuration's cases, each a JUnit `<error>` naming the signal; the run goes on, the other
+/// configurations pass, and the exit status is 1.
+#[test]
+fn a_crashing_driver_costs_only_its_configuration() {
+    let Some(_ctx) = common::context() else { return };
+    let dir = tmp("crash");
+    let junit = dir.join("junit.xml");
+    let crashed_cfg = "d24s8.render_pass.static_state";
+    let out = umbrage()
+        .args(["conform", "--filter", "zoo.", "--out"])
+        .arg(&dir)
+        .arg("--junit")
+        .arg(&junit)
+        .env("UMBRAGE_CONFORM_CRASH", format!("{crashed_cfg}:abort"))
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{stdout}");
+    let j = json(&dir);
+    let cases = j["cases"].as_array().unwrap();
+    let (mut crashed, mut others) = (0, 0);
+    for c in cases {
+        let in_cfg = c["config"].as_str() == Some(crashed_cfg);
+        if in_cfg && c["status"] != "skipped" {
+            assert_eq!(c["status"], "crash", "{}", c["name"]);
+            let m = c["message"].as_str().unwrap();
+            assert!(m.contains("signal 6 (SIGABRT)") && m.contains(crashed_cfg), "{m}");
+            crashed += 1;
+        } else {
+            assert!(c["status"] == "pass" || c["status"] == "skipped", "{}: {}", c["name"], c["status"]);
+            others += (c["status"] == "pass") as usize;
+        }
+    }
+    assert!(crashed > 0 && others > crashed, "{crashed} crashed, {others} passed");
+    let xml = std::fs::read_to_string(&junit).unwrap();
+    assert_eq!(xml.matches("<error ").count(), crashed);
+    assert!(xml.contains(&format!("errors=\"{crashed}\"")));
+    assert!(stdout.contains(&format!("{crashed} crashed")), "{stdout}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A hung driver: the child is killed at `--timeout` and its cases say so; the rest passes.
+#[test]
+fn a_hanging_driver_is_killed_at_the_timeout() {
+    let Some(_ctx) = common::context() else { return };
+    let dir = tmp("hang");
+    let t0 = std::time::Instant::now();
+    let out = umbrage()
+        .args(["conform", "--filter", "zoo.", "--timeout", "5", "--out"])
+        .arg(&dir)
+        .env("UMBRAGE_CONFORM_CRASH", "s8.render_pass.static_state:hang")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    assert!(t0.elapsed().as_secs() < 240, "the hung child was not killed in time");
+    let j = json(&dir);
+    let cases = j["cases"].as_array().unwrap();
+    let hung: Vec<_> = cases.iter().filter(|c| c["status"] == "crash").collect();
+    assert!(!hung.is_empty());
+    for c in &hung {
+        assert_eq!(c["config"], "s8.render_pass.static_state");
+        assert!(c["message"].as_str().unwrap().contains("no result within 5 s"), "{}", c["message"]);
+    }
+    assert!(cases.iter().filter(|c| c["config"] != "s8.render_pass.static_state").all(|c| c["status"] != "crash"));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `--expect`: a run is judged against the driver's list of expected failures, Mesa CI style:
+/// listed crashes that happen are fine, a listed case that passes (and any unlisted failure)
+/// is not.
+#[test]
+fn expectations_fail_on_any_change() {
+    let Some(_ctx) = common::context() else { return };
+    let dir = tmp("expect");
+    std::fs::create_dir_all(&dir).unwrap();
+    let filter = "zoo.*.render_pass.static_state.*";
+    let names: Vec<String> = suite::all_names().into_iter().filter(|n| suite::matches(filter, n)).collect();
+    let d24: Vec<&String> = names.iter().filter(|n| n.contains(".d24s8.")).collect();
+    assert!(!d24.is_empty());
+    let list = dir.join("fails.txt");
+    let run = |list_text: String, crash: Option<&str>| {
+        std::fs::write(&list, list_text).unwrap();
+        let mut c = umbrage();
+        c.args(["conform", "--filter", filter, "--out"]).arg(dir.join("out")).arg("--expect").arg(&list);
+        if let Some(cr) = crash {
+            c.env("UMBRAGE_CONFORM_CRASH", cr);
+        }
+        let out = c.output().unwrap();
+        (out.status.code(), String::from_utf8_lossy(&out.stdout).to_string())
+    };
+    // Every d24s8 case crashes, and the list says so: a match.
+    let crash_list: String = d24.iter().map(|n| format!("{n},Crash\n")).collect();
+    let (code, stdout) = run(crash_list.clone(), Some("d24s8.render_pass.static_state:abort"));
+    assert_eq!(code, Some(0), "{stdout}");
+    assert!(stdout.contains(&format!("{} expected failures, 0 new failures, 0 unexpected passes", d24.len())), "{stdout}");
+    // The same list without the crash: every listed case is an unexpected pass.
+    let (code, stdout) = run(crash_list, None);
+    assert_eq!(code, Some(1));
+    assert_eq!(stdout.matches("UNEXPECTED PASS").count(), d24.len(), "{stdout}");
+    // An empty list with the crash: new failures.
+    let (code, stdout) = run(String::new(), Some("d24s8.render_pass.static_state:abort"));
+    assert_eq!(code, Some(1));
+    assert_eq!(stdout.matches("NEW FAILURE").count(), d24.len(), "{stdout}");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -38,10 +38,12 @@ pub mod batch;
 pub mod cases;
 pub mod checks;
 pub mod devices;
+pub mod expect;
 pub mod harness;
 pub mod images;
 pub mod isolate;
 pub mod junit;
+pub mod matrix;
 pub mod model;
 pub mod raster;
 pub mod report;
@@ -175,6 +177,9 @@ pub struct RunArgs {
     pub child: Option<String>,
     /// Child mode: where to write the [`isolate::ChildResult`].
     pub child_result: Option<PathBuf>,
+    /// The driver's expected failures ([`expect`]): the exit status then says whether the
+    /// run matched them (no new failure, no unexpected pass) instead of whether it passed.
+    pub expect: Option<PathBuf>,
 }
 
 /// Child mode: runs one unit and writes its result as JSON (see [`isolate`]).
@@ -235,6 +240,7 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     if let Some(unit) = &a.child {
         return run_child(&ctx, unit, a.child_result.as_deref(), &opts);
     }
+    let expectations = a.expect.as_deref().map(expect::Expectations::load).transpose()?;
     if !(a.timeout_s > 0.0 && a.timeout_s.is_finite()) {
         return Err(Error::Other(format!("--timeout must be a positive number of seconds, got {}", a.timeout_s)));
     }
@@ -265,5 +271,24 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         println!("junit: {}", j.display());
     }
     ctx.check_validation()?;
-    Ok(if r.failed().is_empty() { ExitCode::SUCCESS } else { ExitCode::FAILURE })
+    if let Some(e) = &expectations {
+        let v = e.judge(&r);
+        for n in &v.new_failures {
+            println!("NEW FAILURE (not in the expectations): {n}");
+        }
+        for n in &v.unexpected_passes {
+            println!("UNEXPECTED PASS (listed as failing; remove it from the list): {n}");
+        }
+        println!(
+            "expectations: {} expected failures, {} new failures, {} unexpected passes",
+            v.expected_failures,
+            v.new_failures.len(),
+            v.unexpected_passes.len()
+        );
+        let p = out.join("expectations.json");
+        let json = serde_json::to_string_pretty(&v).map_err(|e| Error::Other(e.to_string()))?;
+        std::fs::write(&p, json + "\n").map_err(|e| Error::io(p.display().to_string(), e))?;
+        return Ok(if v.ok() { ExitCode::SUCCESS } else { ExitCode::FAILURE });
+    }
+    Ok(if r.failed().is_empty() && r.crashed().is_empty() { ExitCode::SUCCESS } else { ExitCode::FAILURE })
 }
