@@ -3,10 +3,14 @@
 export PATH := $(HOME)/.cargo/bin:$(PATH)
 CARGO ?= cargo
 
-.PHONY: deps drivers run view test bench conform conform-docs conform-matrix doc clean fuzz
+.PHONY: deps deps-tests drivers run view test bench conform conform-docs conform-matrix doc clean fuzz
 
 deps:
 	@./scripts/deps.sh
+
+# What the tests and the conformance runs need as well (off Debian: the validation layer too).
+deps-tests:
+	@./scripts/deps.sh --tests
 
 # Three Mesa lavapipe versions (Vulkan 1.0, 1.3, 1.4) in .drivers/, beside the system's; select
 # one with eval "$$(scripts/drivers.sh env 25.0.7)" (scripts/drivers.sh --help).
@@ -23,7 +27,7 @@ view: deps
 # Every test with validation on, the quick conformance matrix on three Mesa lavapipes
 # (scripts/drivers.sh installs them into .drivers/), the doc examples, and the library an engine embeds
 # (`default-features = false`) built and documented with warnings denied.
-test: deps
+test: deps-tests
 	./scripts/fetch-assets.sh || true
 	UMBRAGE_VALIDATION=1 $(CARGO) test --all-targets
 	./scripts/conform-matrix.sh --quick
@@ -44,18 +48,18 @@ FUZZ_CASES ?= 250000
 fuzz: deps
 	UMBRAGE_FUZZ_CASES=$(FUZZ_CASES) $(CARGO) test --release --test fuzz -- --nocapture
 
-conform: deps
+conform: deps-tests
 	UMBRAGE_VALIDATION=1 $(CARGO) run -- conform --out conform-report --junit conform-report/junit.xml
 
 # Regenerates this device's report in docs/conform/ (DEVICE_DOC names it: lavapipe, or a GPU's name).
 DEVICE_DOC ?= lavapipe
-conform-docs: deps
+conform-docs: deps-tests
 	UMBRAGE_VALIDATION=1 $(CARGO) run -- conform --out target/conform-docs --junit target/conform-docs/junit.xml
 	cp target/conform-docs/conform.md docs/conform/$(DEVICE_DOC).md
 
 # The driver matrix: the full suite on lavapipe 20.3.5 / 22.3.6 / 25.0.7 and llvmpipe's
 # switches, side by side in docs/conform/drivers.md (explanations: docs/conform/drivers-notes.md).
-conform-matrix: deps
+conform-matrix: deps-tests
 	./scripts/conform-matrix.sh
 
 clean:

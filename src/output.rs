@@ -21,7 +21,7 @@ pub fn write_grey_png(path: &Path, width: u32, height: u32, grey: &[u8]) -> Resu
 }
 
 /// The dump of a captured frame: frame.json, world.obj, positions.f32, normals.f32,
-/// shadow_K.png, stencil_K.png and color.png (format in the README).
+/// shadow_K.png, stencil_K.png and color.png (format in docs/formats.md).
 pub fn write_frame_dump(dir: &Path, scene: &Scene, frame: &FrameOutput) -> Result<()> {
     if frame.positions.is_empty() {
         return Err(Error::Other("frame was rendered without capture; cannot dump".into()));
