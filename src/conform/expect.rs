@@ -109,4 +109,55 @@ mod tests {
         assert!(Expectations::parse("raster.a,Flake").is_err());
         assert!(Expectations::parse("a,Fail\na,Fail").is_err());
     }
+
+    fn report(statuses: &[(&str, Status)]) -> Report {
+        let device = crate::gpu::DeviceInfo {
+            name: "d".into(),
+            kind: "CPU".into(),
+            driver: String::new(),
+            driver_info: String::new(),
+            api_version: "1.0.2".into(),
+            vendor_id: 0,
+            device_id: 0,
+        };
+        let cases = statuses
+            .iter()
+            .map(|&(n, st)| {
+                let mut o = crate::conform::suite::CaseOutcome::new(n.into(), "raster", None, String::new());
+                o.status = st;
+                o
+            })
+            .collect();
+        Report {
+            device,
+            features: Default::default(),
+            validation: true,
+            subpixel_bits: 8,
+            filter: Vec::new(),
+            formats: Vec::new(),
+            configs: Vec::new(),
+            cases,
+            legacy: Vec::new(),
+            seconds: 0.0,
+        }
+    }
+
+    #[test]
+    fn judges_changes_only() {
+        let e = Expectations::parse("a,Fail\nb,Crash\nc,Fail\nnot_run,Fail\n").unwrap();
+        // a and b fail as listed, c passes (unexpected), d fails (new), b2 crashes (new).
+        let r = report(&[("a", Status::Fail), ("b", Status::Crash), ("c", Status::Pass), ("d", Status::Fail), ("e", Status::Skipped)]);
+        let v = e.judge(&r);
+        assert_eq!(v.expected_failures, 2);
+        assert_eq!(v.unexpected_passes, vec!["c".to_string()]);
+        assert_eq!(v.new_failures, vec!["d".to_string()]);
+        assert!(!v.ok());
+        // A listed Fail that crashes is a change too.
+        let v = e.judge(&report(&[("a", Status::Crash)]));
+        assert_eq!(v.new_failures, vec!["a".to_string()]);
+        // The list a run needs reproduces it exactly.
+        let r = report(&[("a", Status::Fail), ("x", Status::Crash), ("y", Status::Pass)]);
+        let again = Expectations::parse(&Expectations::from_report(&r)).unwrap();
+        assert!(again.judge(&r).ok());
+    }
 }
