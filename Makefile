@@ -3,7 +3,7 @@
 export PATH := $(HOME)/.cargo/bin:$(PATH)
 CARGO ?= cargo
 
-.PHONY: deps deps-tests drivers run view test bench conform conform-docs conform-matrix doc clean fuzz
+.PHONY: deps deps-tests drivers lint run view test bench conform conform-docs conform-matrix doc clean fuzz
 
 deps:
 	@./scripts/deps.sh
@@ -27,13 +27,19 @@ view: deps
 # Every test with validation on, the quick conformance matrix on three Mesa lavapipes
 # (scripts/drivers.sh installs them into .drivers/), the doc examples, and the library an engine embeds
 # (`default-features = false`) built and documented with warnings denied.
-test: deps-tests
+test: deps-tests lint
 	./scripts/fetch-assets.sh || true
 	UMBRAGE_VALIDATION=1 $(CARGO) test --all-targets
 	./scripts/conform-matrix.sh --quick
 	$(CARGO) test --doc
 	$(CARGO) build --lib --no-default-features
 	$(MAKE) doc
+
+# Formatting and lints (Cargo.toml's [lints]: every unsafe block and unsafe fn documented),
+# warnings denied.
+lint:
+	$(CARGO) fmt --check
+	$(CARGO) clippy --all-targets -- -D warnings
 
 doc:
 	RUSTDOCFLAGS="-D warnings" $(CARGO) doc --no-deps

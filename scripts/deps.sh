@@ -141,3 +141,15 @@ if ! command -v cargo >/dev/null 2>&1; then
     curl --proto '=https' --tlsv1.2 -sSf https://sh.rustup.rs | sh -s -- -y --profile minimal
   fi
 fi
+
+# `make test` runs rustfmt and clippy (make lint): add them where rustup installed a minimal
+# toolchain without them.
+if command -v rustup >/dev/null 2>&1 || [ -x "${HOME:-}/.cargo/bin/rustup" ]; then
+  rustup_bin=$(command -v rustup || echo "$HOME/.cargo/bin/rustup")
+  for c in clippy rustfmt; do
+    if ! "$rustup_bin" component list --installed 2>/dev/null | grep -q "^$c"; then
+      echo "deps: adding the $c component"
+      "$rustup_bin" component add "$c" >/dev/null
+    fi
+  done
+fi

@@ -98,7 +98,7 @@ impl Host {
         };
         let target = DepthStencilTarget { view: depth.view, extent: self.extent };
 
-        // SAFETY (the whole recording): the slot's previous submission retired (`retire`
+        // SAFETY: (the whole recording) the slot's previous submission retired (`retire`
         // waited its fence), so its command buffer may be reset and re-recorded; every object
         // recorded belongs to this device and lives until the device is idle at teardown; the
         // layouts named are those the preceding barriers leave; `frame` was prepared for this

@@ -62,11 +62,11 @@ pub fn present(
 ) -> Result<Presented> {
     let f = &sc.frames[slot];
     let d = &ctx.device;
-    // SAFETY: the swapchain is valid and the semaphore unsignalled (its last wait was by the
-    // submission this slot's fence covers).
     // An injected fault (`UMBRAGE_FAULT=present=...`) replaces the call: nothing is acquired.
     let acquired = match crate::gpu::fault::inject(crate::gpu::fault::FaultPoint::Present) {
         Some(injected) => Err(injected),
+        // SAFETY: the swapchain is valid and the semaphore unsignalled (its last wait was by the
+        // submission this slot's fence covers).
         None => unsafe { sc.swapchain_fn.acquire_next_image(sc.swapchain, u64::MAX, f.acquired, vk::Fence::null()) },
     };
     let index = match acquired {
