@@ -183,7 +183,7 @@ impl Report {
     }
 }
 
-const LEGACY: [&str; 7] = [
+const LEGACY: [&str; 8] = [
     "w0_vertices_and_infinity",
     "depth_clamp",
     "watertight_fan",
@@ -191,6 +191,7 @@ const LEGACY: [&str; 7] = [
     "stencil_formats",
     "depth_bounds",
     "index_types",
+    "deep_wrap_float_count",
 ];
 
 fn pipeline_names() -> Vec<String> {
@@ -412,7 +413,7 @@ fn run_legacy(
     out: &mut Vec<CaseOutcome>,
 ) -> Vec<CheckResult> {
     type Check = fn(&Context) -> Result<CheckResult>;
-    let unit: [(&str, Check); 7] = [
+    let unit: [(&str, Check); 8] = [
         (LEGACY[0], super::checks::w0_vertices_and_infinity),
         (LEGACY[1], super::checks::depth_clamp),
         (LEGACY[2], super::checks::watertight_fan),
@@ -420,6 +421,7 @@ fn run_legacy(
         (LEGACY[4], super::checks::stencil_formats),
         (LEGACY[5], super::checks::depth_bounds),
         (LEGACY[6], super::checks::index_types),
+        (LEGACY[7], super::checks::deep_wrap_float_count),
     ];
     let mut results = Vec::new();
     for (name, f) in unit {
