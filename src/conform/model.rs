@@ -243,7 +243,7 @@ fn shared_edge_owner(wt: &[WinTri], polys: &[Option<ClippedPoly>], ti: usize, x:
 /// so even a constant depth is only known within the interpolation tolerance.
 fn frag_depth(t: &WinTri, x: u32, y: u32, st: &DsState, kind: DepthKind, subpixel_bits: u32, clipped: bool) -> Frag {
     let c = glam::DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
-    let z: Vec<f64> = t.z.iter().map(|&z| snap01(z)).collect();
+    let z = t.z.map(snap01);
     let constant = !clipped && z[0] == z[1] && z[1] == z[2];
     let (mut lo, mut hi) = if constant {
         (z[0], z[0])

@@ -342,8 +342,22 @@ fn grid_case(config: Config, seed: u64) -> Case {
     c
 }
 
-/// The watertightness cases of `config`.
+/// The watertightness cases of `config`. The geometry and its expectation do not depend on the
+/// configuration, so they are built once (the first call) and stamped with each configuration.
 pub fn cases(config: Config) -> Vec<Case> {
+    static TEMPLATES: std::sync::OnceLock<(Config, Vec<Case>)> = std::sync::OnceLock::new();
+    let (first, templates) = TEMPLATES.get_or_init(|| (config, build(config)));
+    let prefix = format!("watertight.{}.", first.name());
+    templates
+        .iter()
+        .map(|t| {
+            let rest = t.name.strip_prefix(&prefix).expect("a template's name starts with its configuration");
+            Case { name: format!("watertight.{}.{rest}", config.name()), config, ..t.clone() }
+        })
+        .collect()
+}
+
+fn build(config: Config) -> Vec<Case> {
     let mut v = Vec::new();
     let ortho = |rng: &mut Rng, r: (f32, f32)| {
         pixel_ortho(SIZE.0, SIZE.1)
