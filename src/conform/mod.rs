@@ -2,16 +2,17 @@
 //!
 //! Two layers:
 //!
-//! - **The parametrised suite** ([`cases`], [`model`], [`batch`], [`suite`]): 4,816
+//! - **The parametrised suite** ([`cases`], [`model`], [`batch`], [`suite`]): 5,904
 //!   CTS-style cases (those of formats and features a device lacks are skipped, with the
-//!   reason) — the stencil-op table, depth and infinity, depth clamp and bias, depth bounds, unrestricted depth, rasterisation and occlusion queries, and a
-//!   known-bug zoo — in every configuration the device supports: each depth-stencil format
+//!   reason) — the stencil-op table, depth and infinity, depth clamp and bias, depth bounds, unrestricted depth, rasterisation and occlusion queries, a
+//!   known-bug zoo, and four families beyond the CTS (deep wrap, homogeneous clipping,
+//!   watertightness across draws, exact occlusion counts) — in every configuration the device supports: each depth-stencil format
 //!   (D16S8, D24S8, D32S8, S8 as `vkGetPhysicalDeviceFormatProperties` reports them) x
 //!   dynamic rendering / a classic render pass x static pipeline state / Vulkan 1.3 dynamic
 //!   state. Every case draws into its own tile of one image per configuration (one
 //!   submission), and each tile is compared exactly with a CPU model of the spec.
 //! - **The single-configuration checks** ([`checks`], named `legacy.*` and
-//!   `pipeline.hard_cases.*`): the original eight checks, the last of which runs the whole
+//!   `pipeline.hard_cases.*`): the original nine checks, the last of which runs the whole
 //!   shadow pipeline on every `hard/*` scene and method against the CPU reference.
 //!
 //! Outputs: `conform.json`, `conform.md`, JUnit XML (`--junit`), and for every failure the
@@ -28,9 +29,16 @@
 //! | `stencil_formats` | D24S8 / D32S8: stencil clear, write, read back |
 //! | `depth_bounds` | stored depth outside the bounds rejected (when depthBounds) |
 //! | `index_types` | u32 / u16 / u8 / non-indexed give identical stencil images |
+//! | `deep_wrap_float_count` | 1000 front / 700 back faces: exactly 300.0 in an R32F count, 44 in the wrapping stencil (a render pass: runs on Vulkan 1.0) |
 //! | `shadow_pipeline_hard_cases` | every hard scene x method vs the reference (z-pass expected failures recorded) |
 //!
 //! A check also fails when the validation layers reported an error during it.
+//!
+//! The command line runs every unit (a configuration's submission, the legacy checks, the
+//! pipeline checks) in a child process ([`isolate`]), judges a run against a driver's
+//! expected failures ([`expect`]), and puts several runs side by side ([`matrix`]). Any
+//! Vulkan 1.0 device runs the classic render pass with static state; what needs 1.3 is skipped
+//! with the reason.
 
 #![warn(missing_docs)]
 

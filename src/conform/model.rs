@@ -9,7 +9,7 @@
 //! stencil bit for bit, depth as the format's representable value.
 
 use super::cases::{Case, DepthKind, DsState};
-use super::raster::{self, Cover, WinTri};
+use super::raster::{self, ClippedPoly, Cover, WinTri};
 use ash::vk;
 
 /// What a pixel's depth must be.
@@ -196,7 +196,7 @@ fn snap01(z: f64) -> f64 {
 /// it"), when that edge is shared with the adjacent triangle in the draw (a quad's diagonal),
 /// of the same facing and the same constant depth — so which of the two gets the fragment
 /// changes nothing. `None`: not determinable (a vertex, an unshared edge, different planes).
-fn shared_edge_owner(wt: &[WinTri], ti: usize, x: u32, y: u32, eps: f64) -> Option<bool> {
+fn shared_edge_owner(wt: &[WinTri], polys: &[Option<ClippedPoly>], ti: usize, x: u32, y: u32, eps: f64) -> Option<bool> {
     let t = &wt[ti];
     let c = glam::DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
     let sign = if t.vk_area() < 0.0 { 1.0 } else { -1.0 };
@@ -219,6 +219,9 @@ fn shared_edge_owner(wt: &[WinTri], ti: usize, x: u32, y: u32, eps: f64) -> Opti
     // Triangles pair up as (2k, 2k + 1), the way quads are emitted; the partner must share
     // the edge and lie on its other side.
     let u = ti ^ 1;
+    if polys.get(u).is_some_and(|p| p.is_some()) {
+        return None; // the partner is clipped: its window triangle is not `wt[u]`
+    }
     let n = wt.get(u)?;
     let shares = (0..3).any(|i| {
         let (p, q) = (n.p[i], n.p[(i + 1) % 3]);
@@ -235,11 +238,13 @@ fn shared_edge_owner(wt: &[WinTri], ti: usize, x: u32, y: u32, eps: f64) -> Opti
     None
 }
 
-/// The fragment depth of triangle `t` at the centre of pixel (x, y) under `st`.
-fn frag_depth(t: &WinTri, x: u32, y: u32, st: &DsState, kind: DepthKind, subpixel_bits: u32) -> Frag {
+/// The fragment depth of triangle `t` at the centre of pixel (x, y) under `st`. `clipped`: `t`
+/// is part of a clipped polygon, whose new vertices the device computes with its own rounding,
+/// so even a constant depth is only known within the interpolation tolerance.
+fn frag_depth(t: &WinTri, x: u32, y: u32, st: &DsState, kind: DepthKind, subpixel_bits: u32, clipped: bool) -> Frag {
     let c = glam::DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
-    let z: Vec<f64> = t.z.iter().map(|&z| snap01(z)).collect();
-    let constant = z[0] == z[1] && z[1] == z[2];
+    let z = t.z.map(snap01);
+    let constant = !clipped && z[0] == z[1] && z[1] == z[2];
     let (mut lo, mut hi) = if constant {
         (z[0], z[0])
     } else {
@@ -321,6 +326,43 @@ fn edge_band(draw: &super::cases::Draw, w: u32, h: u32, subpixel_bits: u32) -> f
     }
 }
 
+/// For each triangle of `draw`: its clipped window polygon when a vertex has clip-space
+/// `w <= 0` (computed in f64 from the f32 matrix and vertices, as [`raster::window_tris`]
+/// does), `None` when every vertex is in front of the eye.
+fn clipped_polys(draw: &super::cases::Draw, tris: &[[u32; 3]], w: u32, h: u32, subpixel_bits: u32) -> Vec<Option<ClippedPoly>> {
+    let m = draw.mvp.as_dmat4();
+    let clip: Vec<glam::DVec4> =
+        draw.vertices.iter().map(|v| m * glam::DVec4::new(v[0] as f64, v[1] as f64, v[2] as f64, v[3] as f64)).collect();
+    tris.iter()
+        .map(|t| {
+            let c = t.map(|i| clip[i as usize]);
+            c.iter().any(|v| v.w <= 0.0).then(|| ClippedPoly::new(c, draw.state.depth_clamp, w, h, subpixel_bits))
+        })
+        .collect()
+}
+
+/// The fan triangle that contains the centre of pixel (x, y) deepest (largest smallest
+/// distance to its edges).
+fn fan_tri_at(fan: &[WinTri], x: u32, y: u32) -> &WinTri {
+    let c = glam::DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
+    let depth_in = |t: &WinTri| {
+        let sign = if t.vk_area() < 0.0 { 1.0 } else { -1.0 };
+        (0..3)
+            .map(|i| {
+                let (a, b) = (t.p[i], t.p[(i + 1) % 3]);
+                let e = b - a;
+                let len = e.length();
+                if len == 0.0 {
+                    f64::NEG_INFINITY
+                } else {
+                    sign * (e.x * (c.y - a.y) - e.y * (c.x - a.x)) / len
+                }
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    fan.iter().max_by(|a, b| depth_in(a).total_cmp(&depth_in(b))).expect("a polygon of at least three vertices")
+}
+
 /// The expected result of `case` on a device with `subpixel_bits` of sub-pixel precision;
 /// `brk` substitutes [`broken`]`(op)` for one stencil op (the test seam).
 pub fn expect(case: &Case, subpixel_bits: u32, brk: Option<vk::StencilOp>) -> Expected {
@@ -336,18 +378,42 @@ pub fn expect(case: &Case, subpixel_bits: u32, brk: Option<vk::StencilOp>) -> Ex
         let tris: Vec<[u32; 3]> = (0..draw.vertices.len() as u32 / 3).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
         let wt = raster::window_tris(draw.mvp, &draw.vertices, &tris, w, h, subpixel_bits);
         let eps = edge_band(draw, w, h, subpixel_bits);
+        // Triangles with a vertex at w <= 0 are clipped in homogeneous clip space first; the
+        // others go straight to the viewport (for w > 0 the per-fragment depth check below is
+        // the z clipping, and the viewport the x/y clipping).
+        let polys = clipped_polys(draw, &tris, w, h, subpixel_bits);
+        let clip_eps = eps.max(1.5 / (1u64 << subpixel_bits) as f64);
         let (mut qlo, mut qhi) = (0u64, 0u64);
         let depth_test = st.depth_test && kind != DepthKind::None;
         let depth_write = st.depth_write && kind != DepthKind::None;
         for (ti, t) in wt.iter().enumerate() {
-            if t.vk_area() == 0.0 || t.p.iter().any(|p| !p.x.is_finite() || !p.y.is_finite()) {
-                continue;
-            }
-            let face = if t.front_facing() { st.stencil.map(|s| s.0) } else { st.stencil.map(|s| s.1) };
-            let xs = t.p.iter().map(|p| p.x).fold(f64::INFINITY, f64::min).floor().clamp(0.0, w as f64) as u32;
-            let xe = t.p.iter().map(|p| p.x).fold(f64::NEG_INFINITY, f64::max).ceil().clamp(0.0, w as f64) as u32;
-            let ys = t.p.iter().map(|p| p.y).fold(f64::INFINITY, f64::min).floor().clamp(0.0, h as f64) as u32;
-            let ye = t.p.iter().map(|p| p.y).fold(f64::NEG_INFINITY, f64::max).ceil().clamp(0.0, h as f64) as u32;
+            let poly = polys[ti].as_ref();
+            let fan = poly.map(|p| p.fan()).unwrap_or_default();
+            let pts: &[glam::DVec2] = match poly {
+                Some(p) if p.singular => {
+                    // The polygon reaches the clip volume's apex: nothing about it is known.
+                    for i in 0..(w * h) as usize {
+                        if st.stencil.is_some() {
+                            s[i] = None;
+                        }
+                        if depth_write {
+                            d[i] = DepthExp::Any;
+                        }
+                    }
+                    qhi += u64::from(w * h);
+                    continue;
+                }
+                Some(p) if p.vk_area() == 0.0 => continue,
+                Some(p) => &p.p,
+                None if t.vk_area() == 0.0 || t.p.iter().any(|p| !p.x.is_finite() || !p.y.is_finite()) => continue,
+                None => &t.p,
+            };
+            let front = poly.map_or_else(|| t.front_facing(), |p| p.front_facing());
+            let face = if front { st.stencil.map(|s| s.0) } else { st.stencil.map(|s| s.1) };
+            let xs = pts.iter().map(|p| p.x).fold(f64::INFINITY, f64::min).floor().clamp(0.0, w as f64) as u32;
+            let xe = pts.iter().map(|p| p.x).fold(f64::NEG_INFINITY, f64::max).ceil().clamp(0.0, w as f64) as u32;
+            let ys = pts.iter().map(|p| p.y).fold(f64::INFINITY, f64::min).floor().clamp(0.0, h as f64) as u32;
+            let ye = pts.iter().map(|p| p.y).fold(f64::NEG_INFINITY, f64::max).ceil().clamp(0.0, h as f64) as u32;
             for y in ys..ye {
                 for x in xs..xe {
                     let i = (y * w + x) as usize;
@@ -359,9 +425,23 @@ pub fn expect(case: &Case, subpixel_bits: u32, brk: Option<vk::StencilOp>) -> Ex
                             d[i] = DepthExp::Any;
                         }
                     };
-                    match raster::cover_eps(t, x, y, eps) {
+                    // The triangle whose plane gives the depth: the fan triangle of a clipped
+                    // polygon that contains the centre best (all lie in one plane).
+                    let t = match poly {
+                        None => t,
+                        Some(p) => match p.cover_eps(x, y, clip_eps) {
+                            Cover::Out => continue,
+                            Cover::Edge => {
+                                unknown(&mut s, &mut d);
+                                qhi += 1;
+                                continue;
+                            }
+                            Cover::In => fan_tri_at(&fan, x, y),
+                        },
+                    };
+                    match if poly.is_some() { Cover::In } else { raster::cover_eps(t, x, y, eps) } {
                         Cover::Out => continue,
-                        Cover::Edge => match shared_edge_owner(&wt, ti, x, y, eps) {
+                        Cover::Edge => match shared_edge_owner(&wt, &polys, ti, x, y, eps) {
                             Some(true) => {}
                             Some(false) => continue,
                             None => {
@@ -372,7 +452,7 @@ pub fn expect(case: &Case, subpixel_bits: u32, brk: Option<vk::StencilOp>) -> Ex
                         },
                         Cover::In => {}
                     }
-                    let zf = match frag_depth(t, x, y, st, kind, subpixel_bits) {
+                    let zf = match frag_depth(t, x, y, st, kind, subpixel_bits, poly.is_some()) {
                         Frag::Clipped => continue,
                         Frag::Maybe => {
                             unknown(&mut s, &mut d);

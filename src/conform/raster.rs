@@ -65,6 +65,123 @@ pub fn window_tris(mvp: Mat4, verts: &[[f32; 4]], tris: &[[u32; 3]], width: u32,
     tris.iter().map(|t| WinTri { p: t.map(|i| w[i as usize].0), z: t.map(|i| w[i as usize].1) }).collect()
 }
 
+/// The clip volume's planes as `dot(plane, clip) >= 0`: `-w <= x <= w`, `-w <= y <= w`, then
+/// `0 <= z <= w` (the last two dropped under depth clamp, which disables z clipping). Any
+/// point inside satisfies `w >= 0`, so clipping against them removes whatever lies behind the eye.
+const PLANES: [[f64; 4]; 6] =
+    [[1.0, 0.0, 0.0, 1.0], [-1.0, 0.0, 0.0, 1.0], [0.0, 1.0, 0.0, 1.0], [0.0, -1.0, 0.0, 1.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, -1.0, 1.0]];
+
+/// Sutherland-Hodgman clipping of a clip-space triangle (f64) against the view volume
+/// ([`PLANES`]; the z planes only without `depth_clamp`). The polygon keeps the triangle's
+/// vertex order, so its window-space winding is the clipped primitive's facing. Empty when
+/// nothing of the triangle is inside.
+pub fn clip_polygon(tri: [DVec4; 3], depth_clamp: bool) -> Vec<DVec4> {
+    let mut poly = tri.to_vec();
+    let planes = if depth_clamp { &PLANES[..4] } else { &PLANES[..] };
+    for pl in planes {
+        let pl = DVec4::from_array(*pl);
+        let mut out = Vec::with_capacity(poly.len() + 1);
+        for i in 0..poly.len() {
+            let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+            let (da, db) = (pl.dot(a), pl.dot(b));
+            if da >= 0.0 {
+                out.push(a);
+            }
+            if (da > 0.0 && db < 0.0) || (da < 0.0 && db > 0.0) {
+                out.push(a + (b - a) * (da / (da - db)));
+            }
+        }
+        poly = out;
+        if poly.is_empty() {
+            break;
+        }
+    }
+    poly
+}
+
+/// A triangle with a vertex at `w <= 0`, clipped in homogeneous clip space ([`clip_polygon`])
+/// and mapped to window coordinates: the convex polygon the rasteriser must fill. Dividing such
+/// a triangle's vertices by `w` directly (what [`to_window`] alone does) gives the "external"
+/// triangle, which is wrong.
+#[derive(Clone, Debug)]
+pub struct ClippedPoly {
+    /// Window positions (snapped to the sub-pixel grid), in the original triangle's order.
+    pub p: Vec<DVec2>,
+    /// Window depths (NDC z) of the vertices.
+    pub z: Vec<f64>,
+    /// Some clipped vertex lies at `w <= 0` (only the clip volume's apex, x = y = z = w = 0):
+    /// its projection is undefined.
+    pub singular: bool,
+}
+
+impl ClippedPoly {
+    /// Clips the clip-space triangle `tri` ([`clip_polygon`]) and maps the result to a `width`
+    /// x `height` viewport, snapping to `subpixel_bits`.
+    pub fn new(tri: [DVec4; 3], depth_clamp: bool, width: u32, height: u32, subpixel_bits: u32) -> ClippedPoly {
+        let poly = clip_polygon(tri, depth_clamp);
+        let singular = poly.iter().any(|c| c.w <= 0.0);
+        let (p, z) =
+            if singular { (Vec::new(), Vec::new()) } else { poly.iter().map(|&c| to_window(c, width, height, subpixel_bits)).unzip() };
+        ClippedPoly { p, z, singular }
+    }
+    /// Vulkan's signed area of the polygon in framebuffer coordinates (see [`WinTri::vk_area`]);
+    /// its sign is the primitive's facing. For a triangle crossing `w = 0` it is the sign of
+    /// `det[x y w]` of the original clip-space vertices, not that of the naively divided
+    /// triangle (the two differ when one or three vertices have `w < 0`).
+    pub fn vk_area(&self) -> f64 {
+        let n = self.p.len();
+        let mut s = 0.0;
+        for i in 0..n {
+            let (a, b) = (self.p[i], self.p[(i + 1) % n]);
+            s += a.x * b.y - b.x * a.y;
+        }
+        -0.5 * s
+    }
+    /// Front facing under `VK_FRONT_FACE_COUNTER_CLOCKWISE`.
+    pub fn front_facing(&self) -> bool {
+        self.vk_area() > 0.0
+    }
+    /// The fan triangles `(0, i, i + 1)` (for depth interpolation).
+    pub fn fan(&self) -> Vec<WinTri> {
+        (1..self.p.len().saturating_sub(1))
+            .map(|i| WinTri { p: [self.p[0], self.p[i], self.p[i + 1]], z: [self.z[0], self.z[i], self.z[i + 1]] })
+            .collect()
+    }
+    /// Coverage of the centre of pixel (x, y) by the (convex) polygon, with centres within
+    /// `eps` pixels of any of its edges reported as [`Cover::Edge`]; the fan's inner diagonals
+    /// are not edges (exactly one fan triangle covers a centre on one).
+    pub fn cover_eps(&self, x: u32, y: u32, eps: f64) -> Cover {
+        let c = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
+        let area = self.vk_area();
+        if area == 0.0 || self.p.len() < 3 {
+            return Cover::Out;
+        }
+        let sign = if (-area) > 0.0 { 1.0 } else { -1.0 };
+        let mut ambiguous = false;
+        let n = self.p.len();
+        for i in 0..n {
+            let (a, b) = (self.p[i], self.p[(i + 1) % n]);
+            let e = b - a;
+            let len = e.length();
+            if len == 0.0 {
+                continue;
+            }
+            let d = sign * (e.x * (c.y - a.y) - e.y * (c.x - a.x)) / len;
+            if d < -eps {
+                return Cover::Out;
+            }
+            if d <= eps {
+                ambiguous = true;
+            }
+        }
+        if ambiguous {
+            Cover::Edge
+        } else {
+            Cover::In
+        }
+    }
+}
+
 /// Whether triangle `t` covers the centre of pixel (x, y) by the pixel-centre rule, with
 /// centres within [`EDGE_EPS`] of an edge reported as [`Cover::Edge`].
 pub fn cover(t: &WinTri, x: u32, y: u32) -> Cover {

@@ -187,7 +187,7 @@ impl Report {
     }
 }
 
-const LEGACY: [&str; 7] = [
+const LEGACY: [&str; 8] = [
     "w0_vertices_and_infinity",
     "depth_clamp",
     "watertight_fan",
@@ -195,6 +195,7 @@ const LEGACY: [&str; 7] = [
     "stencil_formats",
     "depth_bounds",
     "index_types",
+    "deep_wrap_float_count",
 ];
 
 fn pipeline_name(scene: &str, m: crate::shadow::Method) -> String {
@@ -471,7 +472,7 @@ pub fn run_suite(ctx: &Context, new_context: &dyn Fn() -> Result<Context>, opts:
 /// The selected `legacy.*` checks (outcomes into `out`, full results returned).
 pub fn run_legacy(ctx: &Context, opts: &SuiteOptions, out: &mut Vec<CaseOutcome>) -> Vec<CheckResult> {
     type Check = fn(&Context) -> Result<CheckResult>;
-    let unit: [(&str, Check); 7] = [
+    let unit: [(&str, Check); 8] = [
         (LEGACY[0], super::checks::w0_vertices_and_infinity),
         (LEGACY[1], super::checks::depth_clamp),
         (LEGACY[2], super::checks::watertight_fan),
@@ -479,6 +480,7 @@ pub fn run_legacy(ctx: &Context, opts: &SuiteOptions, out: &mut Vec<CaseOutcome>
         (LEGACY[4], super::checks::stencil_formats),
         (LEGACY[5], super::checks::depth_bounds),
         (LEGACY[6], super::checks::index_types),
+        (LEGACY[7], super::checks::deep_wrap_float_count),
     ];
     let mut results = Vec::new();
     for (name, f) in unit {
@@ -486,7 +488,8 @@ pub fn run_legacy(ctx: &Context, opts: &SuiteOptions, out: &mut Vec<CaseOutcome>
         if !selected(&opts.filter, &full) {
             continue;
         }
-        if !ctx.features.dynamic_rendering {
+        // Every check but the float count draws through the harness's dynamic rendering.
+        if !ctx.features.dynamic_rendering && name != "deep_wrap_float_count" {
             let mut o =
                 CaseOutcome::new(full, "legacy", None, format!("single-configuration check `{name}` (the renderer's depth format)"));
             o.status = Status::Skipped;

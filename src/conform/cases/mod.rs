@@ -11,6 +11,7 @@
 //! `stencil.d24s8.dynamic_rendering.static_state.ops.front_incr_wrap.back_decr_wrap.dfail_keep.fail_zero.comp_always.ref_3.masks_ff_0f`.
 
 mod depth;
+pub mod gaps;
 mod raster;
 mod stencil;
 mod zoo;
@@ -250,7 +251,8 @@ pub struct Case {
     pub name: String,
     /// The configuration it runs in.
     pub config: Config,
-    /// `stencil`, `depth`, `raster` or `zoo`.
+    /// `stencil`, `depth`, `raster`, `zoo`, or one of [`gaps::GROUPS`] (`wrap`, `clip`,
+    /// `watertight`, `occlusion`).
     pub group: &'static str,
     /// One line: what the case checks.
     pub what: String,
@@ -391,6 +393,7 @@ pub fn all(configs: &[Config]) -> Vec<Case> {
         v.extend(depth::cases(*c));
         v.extend(raster::cases(*c));
         v.extend(zoo::cases(*c));
+        v.extend(gaps::cases(*c));
     }
     v
 }
