@@ -198,8 +198,8 @@ enum Command {
         /// Seconds a child may run before it is killed and its cases reported as hung.
         #[arg(long, default_value_t = 300.0, value_name = "SECONDS")]
         timeout: f64,
-        /// Child processes at once.
-        #[arg(long, default_value_t = 1, value_name = "N")]
+        /// Child processes at once (0: one per CPU core, as deqp-runner does).
+        #[arg(long, default_value_t = 0, value_name = "N")]
         jobs: usize,
         /// The driver's expected failures (`case,Fail` / `case,Crash` lines, as Mesa's CI
         /// keeps them): exit 0 only when the run matches the list, no new failure and no

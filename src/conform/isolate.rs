@@ -38,8 +38,14 @@ pub enum Unit {
     Config(Config),
     /// The `legacy.*` single-configuration checks.
     Legacy,
-    /// The `pipeline.hard_cases.*` renders against the CPU reference.
-    Pipeline,
+    /// The `pipeline.hard_cases.*` renders against the CPU reference, of the hard scenes whose
+    /// index is `shard` modulo `shards` (split so that `--jobs` children share them).
+    Pipeline {
+        /// This unit's share.
+        shard: usize,
+        /// How many units share the scenes (at least 1).
+        shards: usize,
+    },
 }
 
 impl Unit {
@@ -48,7 +54,8 @@ impl Unit {
         match self {
             Unit::Config(c) => c.name(),
             Unit::Legacy => "legacy".into(),
-            Unit::Pipeline => "pipeline".into(),
+            Unit::Pipeline { shards: 1, .. } => "pipeline".into(),
+            Unit::Pipeline { shard, shards } => format!("pipeline.{shard}of{shards}"),
         }
     }
 
@@ -56,7 +63,12 @@ impl Unit {
     pub fn parse(s: &str) -> Option<Unit> {
         match s {
             "legacy" => Some(Unit::Legacy),
-            "pipeline" => Some(Unit::Pipeline),
+            "pipeline" => Some(Unit::Pipeline { shard: 0, shards: 1 }),
+            _ if s.starts_with("pipeline.") => {
+                let (k, n) = s["pipeline.".len()..].split_once("of")?;
+                let (shard, shards) = (k.parse().ok()?, n.parse().ok()?);
+                (shard < shards).then_some(Unit::Pipeline { shard, shards })
+            }
             _ => Config::all(&FORMATS).into_iter().find(|c| c.name() == s).map(Unit::Config),
         }
     }
@@ -86,9 +98,9 @@ pub fn run_unit(ctx: &Context, unit: Unit, new_context: &dyn Fn() -> Result<Cont
             let legacy = suite::run_legacy(ctx, opts, &mut cases);
             ChildResult { cases, config: None, legacy }
         }
-        Unit::Pipeline => {
+        Unit::Pipeline { shard, shards } => {
             let mut cases = Vec::new();
-            let legacy = suite::run_pipeline(ctx, new_context, opts, &mut cases);
+            let legacy = suite::run_pipeline(ctx, new_context, opts, (shard, shards), &mut cases);
             ChildResult { cases, config: None, legacy }
         }
     }
@@ -146,7 +158,9 @@ pub fn run_suite_isolated(ctx: &Context, opts: &SuiteOptions, iso: &Isolation, a
             planned.push((Unit::Config(cfg), outcomes, needs));
         }
     }
-    for unit in [Unit::Legacy, Unit::Pipeline] {
+    let shards = iso.jobs.max(1);
+    let units = std::iter::once(Unit::Legacy).chain((0..shards).map(|shard| Unit::Pipeline { shard, shards }));
+    for unit in units {
         let names = suite::unit_case_names(unit, &opts.filter);
         if names.is_empty() {
             continue;
@@ -214,6 +228,9 @@ pub fn run_suite_isolated(ctx: &Context, opts: &SuiteOptions, iso: &Isolation, a
         }
         cases.extend(outcomes);
     }
+    // In generation order, as in process (the pipeline shards interleave the scenes).
+    let order: std::collections::HashMap<String, usize> = suite::all_names().into_iter().enumerate().map(|(i, n)| (n, i)).collect();
+    cases.sort_by_key(|c| order.get(&c.name).copied().unwrap_or(usize::MAX));
     Ok(Report {
         device: ctx.info.clone(),
         features: ctx.features.clone(),
@@ -230,7 +247,7 @@ pub fn run_suite_isolated(ctx: &Context, opts: &SuiteOptions, iso: &Isolation, a
 
 fn unit_group(unit: Unit) -> &'static str {
     match unit {
-        Unit::Pipeline => "pipeline",
+        Unit::Pipeline { .. } => "pipeline",
         _ => "legacy",
     }
 }

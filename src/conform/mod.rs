@@ -257,7 +257,10 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         let iso = isolate::Isolation {
             exe,
             timeout: std::time::Duration::from_secs_f64(a.timeout_s),
-            jobs: a.jobs.max(1),
+            jobs: match a.jobs {
+                0 => std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
+                n => n,
+            },
             scratch: out.join("children"),
         };
         let mut args = vec!["--out".to_string(), out.display().to_string()];

@@ -203,8 +203,14 @@ fn pipeline_name(scene: &str, m: crate::shadow::Method) -> String {
 }
 
 fn pipeline_names() -> Vec<String> {
+    pipeline_shard_names((0, 1))
+}
+
+/// The pipeline case names of the hard scenes whose index is `shard.0` modulo `shard.1`.
+fn pipeline_shard_names(shard: (usize, usize)) -> Vec<String> {
     let mut v = Vec::new();
-    for scene in crate::scene::builtin_names().into_iter().filter(|n| n.starts_with("hard/")) {
+    let scenes = crate::scene::builtin_names().into_iter().filter(|n| n.starts_with("hard/"));
+    for (_, scene) in scenes.enumerate().filter(|(i, _)| i % shard.1.max(1) == shard.0) {
         for m in crate::shadow::Method::ALL {
             v.push(pipeline_name(scene, m));
         }
@@ -216,7 +222,7 @@ fn pipeline_names() -> Vec<String> {
 pub fn unit_case_names(unit: super::isolate::Unit, filter: &[String]) -> Vec<String> {
     let all = match unit {
         super::isolate::Unit::Legacy => LEGACY.iter().map(|n| format!("legacy.{n}")).collect(),
-        super::isolate::Unit::Pipeline => pipeline_names(),
+        super::isolate::Unit::Pipeline { shard, shards } => pipeline_shard_names((shard, shards)),
         super::isolate::Unit::Config(_) => Vec::new(),
     };
     all.into_iter().filter(|n| selected(filter, n)).collect()
@@ -454,7 +460,7 @@ pub fn run_suite(ctx: &Context, new_context: &dyn Fn() -> Result<Context>, opts:
         configs.extend(run);
     }
     let mut legacy = run_legacy(ctx, opts, &mut outcomes);
-    legacy.extend(run_pipeline(ctx, new_context, opts, &mut outcomes));
+    legacy.extend(run_pipeline(ctx, new_context, opts, (0, 1), &mut outcomes));
     Report {
         device: ctx.info.clone(),
         features: ctx.features.clone(),
@@ -513,16 +519,18 @@ pub fn run_legacy(ctx: &Context, opts: &SuiteOptions, out: &mut Vec<CaseOutcome>
     results
 }
 
-/// The selected `pipeline.hard_cases.*` cases (outcomes into `out`, the check's full result
-/// returned).
+/// The selected `pipeline.hard_cases.*` cases of the hard scenes in `shard` (`(k, n)`: those
+/// whose index is k modulo n; `(0, 1)`: all), outcomes into `out`, the check's full result
+/// returned.
 pub fn run_pipeline(
     ctx: &Context,
     new_context: &dyn Fn() -> Result<Context>,
     opts: &SuiteOptions,
+    shard: (usize, usize),
     out: &mut Vec<CaseOutcome>,
 ) -> Vec<CheckResult> {
     let mut results = Vec::new();
-    let names: Vec<String> = pipeline_names().into_iter().filter(|n| selected(&opts.filter, n)).collect();
+    let names: Vec<String> = pipeline_shard_names(shard).into_iter().filter(|n| selected(&opts.filter, n)).collect();
     if !names.is_empty() && !ctx.features.dynamic_rendering {
         for n in names {
             let mut o = CaseOutcome::new(n, "pipeline", None, "the whole shadow pipeline against the exact CPU reference".into());
