@@ -32,6 +32,7 @@ run() {
   local name=$1 version=$2
   shift 2
   local dir="$out/${name// /_}"
+  dir="${dir//=/-}" # conform-matrix reads NAME=DIR: no '=' in DIR
   rm -rf "$dir"
   local args=(conform --out "$dir" --junit "$dir/junit.xml")
   if [ $quick = 1 ]; then args+=(--filter "$QUICK" --expect "$exp/lavapipe-$version.txt"); fi

@@ -17,9 +17,10 @@ pub struct Column {
 }
 
 impl Column {
-    /// Reads `DIR/conform.json` for the column `NAME=DIR`.
+    /// Reads `DIR/conform.json` for the column `NAME=DIR` (the name may contain `=`, as in
+    /// `25.0.7 LP_DEBUG=no_fastpath`; the directory may not).
     pub fn load(spec: &str) -> Result<Column> {
-        let (name, dir) = spec.split_once('=').ok_or_else(|| Error::Other(format!("--column '{spec}': expected NAME=DIR")))?;
+        let (name, dir) = spec.rsplit_once('=').ok_or_else(|| Error::Other(format!("--column '{spec}': expected NAME=DIR")))?;
         let path = PathBuf::from(dir).join("conform.json");
         let text = std::fs::read_to_string(&path).map_err(|e| Error::io(path.display().to_string(), e))?;
         let report = serde_json::from_str(&text).map_err(|e| Error::Other(format!("{}: {e}", path.display())))?;
@@ -119,7 +120,11 @@ pub fn markdown(cols: &[Column], notes: Option<&str>) -> String {
         s.push('\n');
     }
 
-    // Every case whose status differs, grouped by family, configuration model and pattern.
+    // Every case whose status differs between the driver columns (those named by a version
+    // alone; the switch columns are summed up in the family table), grouped by family,
+    // configuration model and pattern.
+    let base: Vec<&Column> = cols.iter().filter(|c| !c.name.contains(' ')).collect();
+    let cols: Vec<&Column> = if base.len() >= 2 { base } else { cols.iter().collect() };
     let mut by_case: BTreeMap<String, (String, Vec<String>, Vec<String>)> = BTreeMap::new();
     for (ci, c) in cols.iter().enumerate() {
         for k in c.cases() {
@@ -143,14 +148,15 @@ pub fn markdown(cols: &[Column], notes: Option<&str>) -> String {
         let g = groups.entry(key).or_insert_with(|| (0, name.clone(), msgs.clone()));
         g.0 += 1;
     }
-    let _ = writeln!(s, "\n## Differences between columns ({} patterns)\n", groups.len());
+    let names: Vec<&str> = cols.iter().map(|c| c.name.as_str()).collect();
+    let _ = writeln!(s, "\n## Differences between {} ({} patterns)\n", names.join(", "), groups.len());
     if !groups.is_empty() {
         s.push_str("| family | render / state model | ");
-        for c in cols {
+        for c in &cols {
             let _ = write!(s, "{} | ", c.name);
         }
         s.push_str("cases | example (and its message where it did not pass) |\n|---|---|");
-        for _ in cols {
+        for _ in &cols {
             s.push_str("---|");
         }
         s.push_str("---|---|\n");
@@ -162,7 +168,7 @@ pub fn markdown(cols: &[Column], notes: Option<&str>) -> String {
             let why: Vec<String> = st
                 .iter()
                 .zip(msgs)
-                .zip(cols)
+                .zip(&cols)
                 .filter(|((x, _), _)| *x != "pass")
                 .map(|((_, m), c)| format!("{}: {}", c.name, shorten(m, 160)))
                 .collect();
@@ -225,7 +231,7 @@ mod tests {
         };
         let md = markdown(&[col("old", "fail"), col("new", "pass")], Some("## Notes"));
         assert!(md.contains("| raster.watertight | **0 / 1 / 0 / 0** | 1 / 0 / 0 / 0 |"), "{md}");
-        assert!(md.contains("## Differences between columns (1 patterns)"), "{md}");
+        assert!(md.contains("## Differences between old, new (1 patterns)"), "{md}");
         assert!(md.contains("| raster.watertight | render_pass.static_state | **fail** | pass | 1 |"), "{md}");
         assert!(md.ends_with("## Notes\n"));
     }
