@@ -19,6 +19,7 @@
 pub mod counters;
 pub mod frame;
 mod frame_output;
+pub(crate) mod guard;
 pub mod options;
 pub(crate) mod passes;
 mod pipelines;
@@ -33,7 +34,7 @@ pub mod targets;
 mod timing;
 
 pub use counters::PassCounters;
-pub use frame::{largest_device_heap, FrameTicket, MemoryEstimate, Renderer, Throughput};
+pub use frame::{largest_device_heap, FrameTicket, MemoryEstimate, NewError, Renderer, Throughput};
 pub use frame_output::FrameOutput;
 pub use options::{
     Counter, DepthMode, FrameSettings, IndexFormat, PassToggles, RenderConfig, RenderOptions, Technique, TransmitMode, View,

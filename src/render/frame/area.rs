@@ -51,26 +51,26 @@ impl Renderer {
     /// The scene's lights as given, area lights whole ([`Renderer::scene`]'s `lights` are the
     /// point lights the last frame rendered, every area light split into its samples).
     pub fn source_lights(&self) -> &[Light] {
-        &self.source_lights
+        &self.own.parts.source_lights
     }
 
     /// Per source light, the range of its samples in [`Renderer::scene`]'s `lights`.
     pub fn light_samples(&self) -> Vec<std::ops::Range<usize>> {
-        crate::geom::area::sample_ranges(&self.source_lights)
+        crate::geom::area::sample_ranges(&self.own.parts.source_lights)
     }
 
     /// Redraws the area lights' samples for the next frame: a new pattern per frame with
     /// [`FrameSettings::jitter`](crate::render::FrameSettings::jitter), the fixed one without.
     pub(super) fn update_area_samples(&mut self) {
-        if self.source_lights.iter().all(|l| l.area.is_none()) {
+        if self.own.parts.source_lights.iter().all(|l| l.area.is_none()) {
             return;
         }
-        let wanted = self.settings.jitter.then_some(self.serial);
-        if wanted != self.samples_for {
-            self.scene.lights = expand_lights(&self.source_lights, wanted);
-            self.samples_for = wanted;
+        let wanted = self.settings.jitter.then_some(self.own.parts.serial);
+        if wanted != self.own.parts.samples_for {
+            self.own.parts.scene.lights = expand_lights(&self.own.parts.source_lights, wanted);
+            self.own.parts.samples_for = wanted;
             // The shadow-map baseline is rebuilt when lights move.
-            self.scene_version += 1;
+            self.own.parts.scene_version += 1;
         }
     }
 }

@@ -5,6 +5,7 @@
 
 use super::counters::CounterPools;
 use super::frame_output::{parse, FrameOutput};
+use super::guard::{Destroy, Guard, Owned};
 use super::options::*;
 use super::passes::{self, debug, determine, gbuffer, illuminate, intensity, tonemap, transparent, Rec};
 use super::pipelines::FramePipelines;
@@ -79,7 +80,21 @@ struct FrameSpans {
 }
 
 /// umbrage's renderer (see the module docs).
+///
+/// Its parts and the context that made them are owned together ([`Owned`]): dropping the
+/// renderer or [`Renderer::into_context`] runs the one teardown of [`Parts`] and drops every
+/// part whole, then the context.
 pub struct Renderer {
+    /// What the next frame does (technique, counter, index format, view, capture); checked
+    /// against the device before every frame.
+    pub settings: FrameSettings,
+    own: Owned<Parts>,
+}
+
+/// Everything a renderer holds besides its settings and its context. Its Vulkan objects are
+/// destroyed in one place, [`Parts`]'s [`Destroy`]; everything else is released by dropping it
+/// as a whole (a field added later included).
+struct Parts {
     /// The scene as rendered: its `lights` are the point lights of this frame, every area
     /// light split into its samples ([`crate::geom::area`]).
     scene: Scene,
@@ -89,9 +104,7 @@ pub struct Renderer {
     /// pattern).
     samples_for: Option<u64>,
     config: RenderConfig,
-    /// What the next frame does (technique, counter, index format, view, capture); checked
-    /// against the device before every frame.
-    pub settings: FrameSettings,
+    /// Drops itself (its own device and allocator handles), before the context.
     pass: ShadowPass,
     /// Per scene mesh, its caster in the pass (`None`: casts no shadow).
     caster_ids: Vec<Option<CasterId>>,
@@ -108,14 +121,387 @@ pub struct Renderer {
     serial: u64,
     /// Bumped when the camera or a mesh moves (the shadow maps are rebuilt then).
     scene_version: u64,
-    // Last so it drops after everything above has been destroyed in `Drop`.
-    ctx: Context,
+}
+
+impl Destroy for Parts {
+    unsafe fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: forwarded to the caller's contract (the device is idle); each part is
+        // destroyed once, the pass drops itself.
+        unsafe {
+            self.slots.destroy(ctx);
+            self.pipes.destroy(ctx);
+            if let Some((sm, _)) = &mut self.shadow_mapper {
+                sm.destroy(ctx);
+            }
+            self.self_shadow.destroy(ctx);
+            self.targets.destroy(ctx);
+            self.geo.destroy(ctx);
+            self.spheres.destroy(ctx);
+        }
+    }
+}
+
+/// A failed [`Renderer::try_new`]: the error, and the context handed back whole (everything
+/// the construction had made is released).
+pub struct NewError {
+    /// Why the renderer could not be made.
+    pub error: Error,
+    /// The context the renderer was to own.
+    pub context: Context,
+}
+
+impl std::fmt::Debug for NewError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("NewError").field("error", &self.error).finish_non_exhaustive()
+    }
 }
 
 impl Renderer {
     /// A renderer for `scene`: its casters prepared and uploaded, targets of the options'
     /// size, pipelines for its fixed settings.
-    pub fn new(ctx: Context, mut scene: Scene, opts: RenderOptions) -> Result<Renderer> {
+    pub fn new(ctx: Context, scene: Scene, opts: RenderOptions) -> Result<Renderer> {
+        Renderer::try_new(ctx, scene, opts).map_err(|e| e.error)
+    }
+
+    /// [`Renderer::new`], handing the context back when it fails (to try other options, or
+    /// to check that nothing was left behind).
+    pub fn try_new(ctx: Context, scene: Scene, opts: RenderOptions) -> std::result::Result<Renderer, Box<NewError>> {
+        let settings = opts.settings();
+        match Parts::new(&ctx, scene, opts) {
+            Ok(parts) => Ok(Renderer { settings, own: Owned::new(parts, ctx) }),
+            Err(error) => Err(Box::new(NewError { error, context: ctx })),
+        }
+    }
+
+    /// Tears the renderer down and hands back its context (to render another scene).
+    pub fn into_context(self) -> Context {
+        self.own.into_context()
+    }
+
+    /// The scene as it stands (camera, lights and transforms included). Its `lights` are the
+    /// point lights the frames render: every area light split into its samples (those of the
+    /// last submitted frame under `jitter`); [`Renderer::source_lights`] has them whole.
+    pub fn scene(&self) -> &Scene {
+        &self.own.parts.scene
+    }
+    /// The fixed configuration.
+    pub fn config(&self) -> &RenderConfig {
+        &self.own.parts.config
+    }
+    /// The Vulkan context.
+    pub fn context(&self) -> &Context {
+        &self.own.ctx
+    }
+    /// The shadow pass this renderer hosts.
+    pub fn shadow_pass(&self) -> &ShadowPass {
+        &self.own.parts.pass
+    }
+    /// The prepared casters (shadow-casting meshes, in scene order).
+    pub fn casters(&self) -> &[Caster] {
+        self.own.parts.pass.casters()
+    }
+
+    /// World -> clip with the configured depth mode (used by the planner for its frustum tests).
+    fn projection(&self) -> Mat4 {
+        let aspect = self.own.parts.config.width as f32 / self.own.parts.config.height as f32;
+        match self.own.parts.config.depth_mode {
+            DepthMode::Infinite => self.own.parts.scene.camera.proj_infinite(aspect),
+            DepthMode::Clamp => {
+                // Far plane just beyond the scene: everything further is clamped to depth 1.
+                let eye = self.own.parts.scene.camera.eye;
+                let spheres =
+                    self.own.parts.scene.spheres.iter().map(|s| (s.sphere.center.distance(eye.as_dvec3()) + s.sphere.radius) as f32);
+                let far = self
+                    .own
+                    .parts
+                    .scene
+                    .meshes
+                    .iter()
+                    .flat_map(|m| m.world_bounds().corners())
+                    .map(|c| c.distance(eye))
+                    .chain(spheres)
+                    .fold(1.0f32, f32::max)
+                    * 1.5;
+                self.own.parts.scene.camera.proj_finite(aspect, far.max(self.own.parts.scene.camera.near * 2.0))
+            }
+        }
+    }
+
+    /// Renders one frame and reads it back: [`submit`](Self::submit) then
+    /// [`finish`](Self::finish).
+    pub fn render(&mut self) -> Result<FrameOutput> {
+        let t = self.submit()?;
+        self.finish(t)
+    }
+
+    /// Renders `frames` frames back to back, `frames_in_flight` of them overlapping, and
+    /// reports the throughput beside the per-frame latency.
+    pub fn throughput(&mut self, frames: usize) -> Result<Throughput> {
+        let start = Instant::now();
+        let mut queue = VecDeque::new();
+        let mut latency = Vec::with_capacity(frames);
+        for _ in 0..frames {
+            queue.push_back(self.submit()?);
+            if queue.len() >= self.own.parts.slots.len() {
+                if let Some(t) = queue.pop_front() {
+                    latency.push(self.wait(&t)?.wall.elapsed().as_secs_f64() * 1e3);
+                }
+            }
+        }
+        while let Some(t) = queue.pop_front() {
+            latency.push(self.wait(&t)?.wall.elapsed().as_secs_f64() * 1e3);
+        }
+        let secs = start.elapsed().as_secs_f64();
+        latency.sort_by(f64::total_cmp);
+        Ok(Throughput {
+            frames,
+            fps: frames as f64 / secs.max(1e-9),
+            latency_ms: latency.get(latency.len() / 2).copied().unwrap_or(f64::NAN),
+        })
+    }
+
+    /// Plans (CPU), records and submits one frame into the next ring slot, waiting first for
+    /// the frame that last used that slot.
+    pub fn submit(&mut self) -> Result<FrameTicket> {
+        let slot = self.own.parts.next_slot;
+        self.own.parts.next_slot = (slot + 1) % self.own.parts.slots.len();
+        self.retire(slot)?;
+        check_options(&self.own.ctx, &self.own.parts.config, &self.settings)?;
+        check_spheres(&self.own.parts.scene, &self.settings)?;
+        self.update_area_samples();
+        let wall = Instant::now();
+        let settings = self.settings;
+        let (w, h) = (self.own.parts.config.width, self.own.parts.config.height);
+        let proj = self.projection();
+        let cam = &self.own.parts.scene.camera;
+        // Eye-relative view: rotation only, the translation is folded in f64 into every model
+        // matrix (casters) and instance record (scene meshes).
+        let view_rel = glam::camera::rh::view::look_at_mat4(Vec3::ZERO, cam.target - cam.eye, cam.up.normalize());
+        let eye = cam.eye.as_dvec3();
+        let vp_rel = (proj.as_dmat4() * view_rel.as_dmat4()).as_mat4();
+        let view = ShadowView { eye, view: view_rel, proj, width: w, height: h };
+        self.update_shadow_mapper(settings.technique)?;
+
+        // 1. The CPU work: plans and streams (the shadow-map baseline plans scissors only).
+        let frame = match settings.technique.pass_technique() {
+            Some(t) => {
+                self.own.parts.pass.set_settings(PassSettings { technique: t, ..pass_settings(&settings) })?;
+                self.own.parts.pass.prepare(slot, &view, &self.own.parts.scene.lights)?
+            }
+            None => self.own.parts.pass.prepare_culled(slot, &view, &self.own.parts.scene.lights)?,
+        };
+        let record_start = Instant::now();
+        let instances = self.own.parts.geo.write_instances(slot, &self.own.parts.scene)?;
+        let spheres = self.own.parts.spheres.write(slot, &self.own.parts.scene)?;
+        let capture = settings.capture || settings.view == View::Stencil;
+        let float_counts = settings.counter == Counter::Float || self.own.parts.shadow_mapper.is_some();
+        let nlights = self.own.parts.scene.lights.len();
+        let texel = self.own.parts.has_transparent.then_some(if self.own.parts.config.transmit_fp32 { 16 } else { 8 });
+        let layout = Layout::new((w * h) as u64, capture, nlights, float_counts, texel);
+        let lights: Vec<LightPush> = self.own.parts.scene.lights.iter().map(|l| LightPush::new(l, eye, settings.transmit_log)).collect();
+
+        // 2. Record the paper's frame.
+        let readback = self.own.parts.slots[slot].readback.ensure(&self.own.ctx, slot, layout.total)?;
+        let s = &mut self.own.parts.slots[slot];
+        let cb = s.cmd;
+        let d = &self.own.ctx.device;
+        // SAFETY: the slot's previous submission retired (`retire`), so its command buffer
+        // may be reset and re-recorded.
+        unsafe {
+            d.reset_command_buffer(cb, vk::CommandBufferResetFlags::empty()).map_err(Error::vk("vkResetCommandBuffer"))?;
+            let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+            d.begin_command_buffer(cb, &begin).map_err(Error::vk("vkBeginCommandBuffer"))?;
+        }
+        s.timer.begin(&self.own.ctx, cb, 4 + 4 * nlights as u32)?;
+        if settings.counters {
+            s.counters.begin(&self.own.ctx, cb, nlights as u32)?;
+        }
+        let s = &self.own.parts.slots[slot];
+        let counters = settings.counters.then_some(&s.counters);
+        let full = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: self.own.parts.targets.extent };
+        let viewport = vk::Viewport { x: 0.0, y: 0.0, width: w as f32, height: h as f32, min_depth: 0.0, max_depth: 1.0 };
+        let rec = Rec { ctx: &self.own.ctx, cb, full, viewport, timer: &s.timer, readback };
+        let spans = self.record_frame(&rec, &frame, &layout, (instances, spheres), vp_rel, &lights, float_counts, counters);
+        // SAFETY: recording finished; the submission signals the slot's fence.
+        unsafe {
+            d.end_command_buffer(cb).map_err(Error::vk("vkEndCommandBuffer"))?;
+            let cbs = [cb];
+            let fence = self.own.parts.slots[slot].fence;
+            d.reset_fences(&[fence]).map_err(Error::vk("vkResetFences"))?;
+            match crate::gpu::fault::inject(crate::gpu::fault::FaultPoint::Submit) {
+                Some(injected) => Err(injected),
+                None => d.queue_submit(self.own.ctx.queue, &[vk::SubmitInfo::default().command_buffers(&cbs)], fence),
+            }
+            .map_err(Error::vk("vkQueueSubmit"))?;
+        }
+        let record_ms = record_start.elapsed().as_secs_f64() * 1e3;
+        let serial = self.own.parts.serial;
+        self.own.parts.serial += 1;
+        self.own.parts.slots[slot].in_flight =
+            Some(InFlight { serial, frame, layout, float_counts, eye, spans, wall, record_ms, settings });
+        Ok(FrameTicket { slot, serial })
+    }
+
+    /// The frame as McGuire et al. lay it out (section 8), one pass function each.
+    #[allow(clippy::too_many_arguments)]
+    fn record_frame(
+        &self,
+        rec: &Rec,
+        frame: &PreparedFrame,
+        layout: &Layout,
+        (instances, spheres): (vk::Buffer, Option<(vk::Buffer, u32)>),
+        vp_rel: Mat4,
+        lights: &[LightPush],
+        float_counts: bool,
+        counters: Option<&CounterPools>,
+    ) -> FrameSpans {
+        let (t, p, pass) = (&self.own.parts.targets, &self.own.parts.pipes, &self.own.parts.pass);
+        let stamp = |stage| rec.timer.stamp(rec.ctx, rec.cb, stage);
+        let all = vk::PipelineStageFlags2::ALL_COMMANDS;
+        let mut spans = FrameSpans::default();
+        spans.frame.begin = stamp(vk::PipelineStageFlags2::TOP_OF_PIPE);
+        spans.depth.begin = spans.frame.begin;
+        // SAFETY: every pass records into `rec.cb` (recording, outside rendering instances
+        // between passes) with this renderer's objects, alive until the slot retires; the
+        // layouts each pass expects are those the previous pass leaves.
+        unsafe {
+            pass.cmd_upload(rec.cb, frame);
+            gbuffer::record(rec, t, p, &self.own.parts.geo, instances, vp_rel, self.own.parts.scene.ambient, spheres);
+            spans.depth.end = stamp(all);
+            let into = match (&self.own.parts.shadow_mapper, self.settings.counter) {
+                (Some(_), _) => determine::CountInto::External,
+                (None, Counter::Float) => determine::CountInto::Float,
+                (None, Counter::Stencil) => determine::CountInto::Stencil,
+            };
+            for (li, light) in self.own.parts.scene.lights.iter().enumerate() {
+                let begin = stamp(all);
+                if let Some(c) = counters {
+                    c.statistics(rec.ctx, rec.cb, li as u32, true);
+                }
+                if let Some((sm, _)) = &self.own.parts.shadow_mapper {
+                    determine::begin_float(rec, t);
+                    sm.record(rec.ctx, rec.cb, t, light, self.own.parts.scene.camera.eye.as_dvec3(), frame.lights[li].scissor);
+                }
+                determine::record(rec, pass, frame, li, t, into, layout.counts.get(li).copied());
+                if let Some(c) = counters {
+                    c.statistics(rec.ctx, rec.cb, li as u32, false);
+                }
+                spans.shadow.push(passes::timing_span(begin, stamp(all)));
+                if let Some(c) = counters {
+                    determine::record_count(rec, pass, frame, li, t, c);
+                }
+                if self.own.parts.has_transparent {
+                    intensity::record(rec, pass, frame, li, t, self.settings.transmit_log, layout.transmit.get(li).copied());
+                }
+                let begin = stamp(all);
+                illuminate::record(rec, pass, frame, li, t, p, float_counts, self.own.parts.has_transparent, &lights[li]);
+                spans.illuminate.push(passes::timing_span(begin, stamp(all)));
+            }
+            if self.own.parts.geo.of(Sidedness::Transparent).next().is_some() {
+                let forward = if self.own.parts.self_shadow.is_some() { &[][..] } else { lights };
+                transparent::record(rec, t, p, &self.own.parts.geo, instances, vp_rel, self.own.parts.scene.ambient, forward);
+                if let Some(ss) = &self.own.parts.self_shadow {
+                    ss.record(rec, t, p, pass, frame, &self.own.parts.geo, instances, vp_rel, lights, self.settings.transmit_log);
+                }
+            }
+            if self.settings.view == View::Volumes {
+                debug::record_volumes(rec, pass, frame, t);
+            }
+            tonemap::record(rec, t, p);
+        }
+        spans.frame.end = stamp(all);
+        rec.copy_out(&t.output, vk::ImageAspectFlags::COLOR, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, layout.color);
+        if let (Some(pos), Some(nrm)) = (layout.positions, layout.normals) {
+            rec.copy_out(&t.position, vk::ImageAspectFlags::COLOR, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL, pos);
+            rec.copy_out(&t.normal, vk::ImageAspectFlags::COLOR, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL, nrm);
+        }
+        tonemap::host_barrier(rec);
+        spans
+    }
+
+    /// Waits for a submitted frame and reads it back.
+    pub fn finish(&mut self, ticket: FrameTicket) -> Result<FrameOutput> {
+        let mut f = self.wait(&ticket)?;
+        // GPU silhouettes: the triangle counts are in the indirect arguments.
+        self.own.parts.pass.read_back_counts(&mut f.frame)?;
+        let s = &self.own.parts.slots[ticket.slot];
+        let transmit = self
+            .own
+            .parts
+            .has_transparent
+            .then_some(TransmitMode { fp32: self.own.parts.config.transmit_fp32, log: f.settings.transmit_log });
+        let c = parse(&s.readback, &f.layout, f.float_counts, transmit, f.eye)?;
+        let stats = self.stats(&ticket, &f)?;
+        let mut out = FrameOutput {
+            width: self.own.parts.config.width,
+            height: self.own.parts.config.height,
+            color: c.color,
+            stencil: c.stencil,
+            counts: c.counts,
+            transmit: c.transmit,
+            positions: c.positions,
+            normals: c.normals,
+            stats,
+        };
+        if f.settings.view == View::Stencil {
+            if let Some(st) = out.stencil.first() {
+                out.color = debug::stencil_heatmap(st);
+            }
+        }
+        Ok(out)
+    }
+
+    /// Waits for the ticket's fence and takes the slot's record of it.
+    fn wait(&mut self, ticket: &FrameTicket) -> Result<InFlight> {
+        let s = &mut self.own.parts.slots[ticket.slot];
+        match &s.in_flight {
+            Some(f) if f.serial == ticket.serial => {}
+            _ => return Err(Error::Other(format!("frame {} was already finished or overwritten", ticket.serial))),
+        }
+        // SAFETY: the fence belongs to this device and was submitted with the frame.
+        unsafe { self.own.ctx.device.wait_for_fences(&[s.fence], true, u64::MAX) }.map_err(Error::vk("vkWaitForFences"))?;
+        self.own.ctx.check_validation()?;
+        s.in_flight.take().ok_or_else(|| Error::Other("no frame in flight".into()))
+    }
+
+    /// Makes `slot` free: waits for the frame in flight in it (its output is dropped).
+    fn retire(&mut self, slot: usize) -> Result<()> {
+        if let Some(f) = &self.own.parts.slots[slot].in_flight {
+            let t = FrameTicket { slot, serial: f.serial };
+            self.wait(&t)?;
+        }
+        Ok(())
+    }
+
+    /// (Re)builds the shadow-map baseline when asked for, or when its size or the scene's
+    /// placement changed; drops it when another technique runs.
+    fn update_shadow_mapper(&mut self, technique: Technique) -> Result<()> {
+        let wanted = match technique {
+            Technique::ShadowMap { size } => Some(size),
+            _ => None,
+        };
+        let current = self.own.parts.shadow_mapper.as_ref().map(|(m, v)| (m.size, *v));
+        if wanted.map(|s| (s, self.own.parts.scene_version)) == current {
+            return Ok(());
+        }
+        if let Some((mut old, _)) = self.own.parts.shadow_mapper.take() {
+            // SAFETY: waiting for idle before destroying objects a frame in flight may use.
+            unsafe { self.own.ctx.device.device_wait_idle() }.map_err(Error::vk("vkDeviceWaitIdle"))?;
+            old.destroy(&self.own.ctx);
+        }
+        if let Some(size) = wanted {
+            let sm = ShadowMapper::new(&self.own.ctx, &self.own.parts.scene, &self.own.parts.targets, size, self.own.parts.pipes.sampler)?;
+            self.own.parts.shadow_mapper = Some((sm, self.own.parts.scene_version));
+        }
+        Ok(())
+    }
+}
+
+impl Parts {
+    /// The renderer's parts for `scene`, made step by step with `ctx`. Each step's result is
+    /// guarded, so a failure at any step releases exactly what the steps before it made (the
+    /// guards drop in reverse order; the pass drops itself).
+    fn new(ctx: &Context, mut scene: Scene, opts: RenderOptions) -> Result<Parts> {
         let (config, settings) = (opts.config(), opts.settings());
         let source_lights = area::checked_lights(&scene.lights)?;
         scene.lights = crate::geom::area::expand_lights(&source_lights, None);
@@ -125,8 +511,8 @@ impl Renderer {
         if config.frames_in_flight == 0 || config.frames_in_flight > 16 {
             return Err(Error::Other(format!("frames in flight must be 1..=16, got {}", config.frames_in_flight)));
         }
-        check_options(&ctx, &config, &settings)?;
-        memory::check_fits(&ctx, &scene, &config)?;
+        check_options(ctx, &config, &settings)?;
+        memory::check_fits(ctx, &scene, &config)?;
         let transmit_format = opts.transmit.format();
         let f = &ctx.features;
         let accum_format = area::accum_format(&source_lights, f.rgba32f_blend);
@@ -155,438 +541,35 @@ impl Renderer {
             pass.add_sphere_caster(&s.name, s.sphere, s.segments)?;
         }
         let has_transparent = pass.casters().iter().any(|c| c.transmittance.is_some());
-        // Each step that fails releases what the steps before it made (the pass drops itself).
-        let mut geo = SceneGeometry::new(&ctx, &scene, config.frames_in_flight)?;
-        let mut spheres = match SphereGeometry::new(&ctx, &scene, config.frames_in_flight) {
-            Ok(s) => s,
-            Err(e) => {
-                geo.destroy(&ctx);
-                return Err(e);
-            }
-        };
-        let mut targets = match Targets::with_accum(&ctx, config.width, config.height, transmit_format, accum_format) {
-            Ok(t) => t,
-            Err(e) => {
-                spheres.destroy(&ctx);
-                geo.destroy(&ctx);
-                return Err(e);
-            }
-        };
-        let mut pipes = match FramePipelines::new(&ctx, &targets, pass.capabilities().depth_bounds) {
-            Ok(p) => p,
-            Err(e) => {
-                targets.destroy(&ctx);
-                spheres.destroy(&ctx);
-                geo.destroy(&ctx);
-                return Err(e);
-            }
-        };
+        let frames = config.frames_in_flight;
+        let geo = Guard::new(ctx, SceneGeometry::new(ctx, &scene, frames)?);
+        let spheres = Guard::new(ctx, SphereGeometry::new(ctx, &scene, frames)?);
+        let targets = Guard::new(ctx, Targets::with_accum(ctx, config.width, config.height, transmit_format, accum_format)?);
+        let pipes = Guard::new(ctx, FramePipelines::new(ctx, &targets, pass.capabilities().depth_bounds)?);
         let self_shadow = match config.self_shadow && geo.of(Sidedness::Transparent).next().is_some() {
-            true => match SelfShadow::new(&ctx, &pipes, targets.extent, transmit_format) {
-                Ok(s) => Some(s),
-                Err(e) => {
-                    // SAFETY: nothing was submitted with the pipelines yet.
-                    unsafe { pipes.destroy(&ctx) };
-                    targets.destroy(&ctx);
-                    spheres.destroy(&ctx);
-                    geo.destroy(&ctx);
-                    return Err(e);
-                }
-            },
+            true => Some(SelfShadow::new(ctx, &pipes, targets.extent, transmit_format)?),
             false => None,
         };
-        let slots = match FrameSlot::ring(&ctx, config.frames_in_flight) {
-            Ok(s) => s,
-            Err(e) => {
-                // SAFETY: nothing was submitted with the pipelines.
-                unsafe {
-                    if let Some(mut ss) = self_shadow {
-                        ss.destroy(&ctx);
-                    }
-                    pipes.destroy(&ctx);
-                }
-                targets.destroy(&ctx);
-                spheres.destroy(&ctx);
-                geo.destroy(&ctx);
-                return Err(e);
-            }
-        };
-        Ok(Renderer {
+        let self_shadow = Guard::new(ctx, self_shadow);
+        let slots = FrameSlot::ring(ctx, frames)?;
+        Ok(Parts {
             scene,
             source_lights,
             samples_for: None,
             config,
-            settings,
             pass,
             caster_ids,
             has_transparent,
-            geo,
-            spheres,
-            targets,
-            pipes,
-            self_shadow,
+            geo: geo.into_inner(),
+            spheres: spheres.into_inner(),
+            targets: targets.into_inner(),
+            pipes: pipes.into_inner(),
+            self_shadow: self_shadow.into_inner(),
             shadow_mapper: None,
             slots,
             next_slot: 0,
             serial: 0,
             scene_version: 0,
-            ctx,
         })
-    }
-
-    /// Tears the renderer down and hands back its context (to render another scene).
-    pub fn into_context(self) -> Context {
-        let mut me = std::mem::ManuallyDrop::new(self);
-        me.destroy_resources();
-        // SAFETY: `me` is never used or dropped again; each remaining field is dropped in
-        // place exactly once, and the context is read out last.
-        unsafe {
-            std::ptr::drop_in_place(&mut me.scene);
-            std::ptr::drop_in_place(&mut me.pass);
-            std::ptr::drop_in_place(&mut me.caster_ids);
-            std::ptr::drop_in_place(&mut me.slots);
-            std::ptr::drop_in_place(&mut me.self_shadow);
-            std::ptr::drop_in_place(&mut me.shadow_mapper);
-            std::ptr::drop_in_place(&mut me.spheres);
-            std::ptr::read(&me.ctx)
-        }
-    }
-
-    /// The scene as it stands (camera, lights and transforms included). Its `lights` are the
-    /// point lights the frames render: every area light split into its samples (those of the
-    /// last submitted frame under `jitter`); [`Renderer::source_lights`] has them whole.
-    pub fn scene(&self) -> &Scene {
-        &self.scene
-    }
-    /// The fixed configuration.
-    pub fn config(&self) -> &RenderConfig {
-        &self.config
-    }
-    /// The Vulkan context.
-    pub fn context(&self) -> &Context {
-        &self.ctx
-    }
-    /// The shadow pass this renderer hosts.
-    pub fn shadow_pass(&self) -> &ShadowPass {
-        &self.pass
-    }
-    /// The prepared casters (shadow-casting meshes, in scene order).
-    pub fn casters(&self) -> &[Caster] {
-        self.pass.casters()
-    }
-
-    /// World -> clip with the configured depth mode (used by the planner for its frustum tests).
-    fn projection(&self) -> Mat4 {
-        let aspect = self.config.width as f32 / self.config.height as f32;
-        match self.config.depth_mode {
-            DepthMode::Infinite => self.scene.camera.proj_infinite(aspect),
-            DepthMode::Clamp => {
-                // Far plane just beyond the scene: everything further is clamped to depth 1.
-                let eye = self.scene.camera.eye;
-                let spheres = self.scene.spheres.iter().map(|s| (s.sphere.center.distance(eye.as_dvec3()) + s.sphere.radius) as f32);
-                let far = self
-                    .scene
-                    .meshes
-                    .iter()
-                    .flat_map(|m| m.world_bounds().corners())
-                    .map(|c| c.distance(eye))
-                    .chain(spheres)
-                    .fold(1.0f32, f32::max)
-                    * 1.5;
-                self.scene.camera.proj_finite(aspect, far.max(self.scene.camera.near * 2.0))
-            }
-        }
-    }
-
-    /// Renders one frame and reads it back: [`submit`](Self::submit) then
-    /// [`finish`](Self::finish).
-    pub fn render(&mut self) -> Result<FrameOutput> {
-        let t = self.submit()?;
-        self.finish(t)
-    }
-
-    /// Renders `frames` frames back to back, `frames_in_flight` of them overlapping, and
-    /// reports the throughput beside the per-frame latency.
-    pub fn throughput(&mut self, frames: usize) -> Result<Throughput> {
-        let start = Instant::now();
-        let mut queue = VecDeque::new();
-        let mut latency = Vec::with_capacity(frames);
-        for _ in 0..frames {
-            queue.push_back(self.submit()?);
-            if queue.len() >= self.slots.len() {
-                if let Some(t) = queue.pop_front() {
-                    latency.push(self.wait(&t)?.wall.elapsed().as_secs_f64() * 1e3);
-                }
-            }
-        }
-        while let Some(t) = queue.pop_front() {
-            latency.push(self.wait(&t)?.wall.elapsed().as_secs_f64() * 1e3);
-        }
-        let secs = start.elapsed().as_secs_f64();
-        latency.sort_by(f64::total_cmp);
-        Ok(Throughput {
-            frames,
-            fps: frames as f64 / secs.max(1e-9),
-            latency_ms: latency.get(latency.len() / 2).copied().unwrap_or(f64::NAN),
-        })
-    }
-
-    /// Plans (CPU), records and submits one frame into the next ring slot, waiting first for
-    /// the frame that last used that slot.
-    pub fn submit(&mut self) -> Result<FrameTicket> {
-        let slot = self.next_slot;
-        self.next_slot = (slot + 1) % self.slots.len();
-        self.retire(slot)?;
-        check_options(&self.ctx, &self.config, &self.settings)?;
-        check_spheres(&self.scene, &self.settings)?;
-        self.update_area_samples();
-        let wall = Instant::now();
-        let settings = self.settings;
-        let (w, h) = (self.config.width, self.config.height);
-        let proj = self.projection();
-        let cam = &self.scene.camera;
-        // Eye-relative view: rotation only, the translation is folded in f64 into every model
-        // matrix (casters) and instance record (scene meshes).
-        let view_rel = glam::camera::rh::view::look_at_mat4(Vec3::ZERO, cam.target - cam.eye, cam.up.normalize());
-        let eye = cam.eye.as_dvec3();
-        let vp_rel = (proj.as_dmat4() * view_rel.as_dmat4()).as_mat4();
-        let view = ShadowView { eye, view: view_rel, proj, width: w, height: h };
-        self.update_shadow_mapper(settings.technique)?;
-
-        // 1. The CPU work: plans and streams (the shadow-map baseline plans scissors only).
-        let frame = match settings.technique.pass_technique() {
-            Some(t) => {
-                self.pass.set_settings(PassSettings { technique: t, ..pass_settings(&settings) })?;
-                self.pass.prepare(slot, &view, &self.scene.lights)?
-            }
-            None => self.pass.prepare_culled(slot, &view, &self.scene.lights)?,
-        };
-        let record_start = Instant::now();
-        let instances = self.geo.write_instances(slot, &self.scene)?;
-        let spheres = self.spheres.write(slot, &self.scene)?;
-        let capture = settings.capture || settings.view == View::Stencil;
-        let float_counts = settings.counter == Counter::Float || self.shadow_mapper.is_some();
-        let nlights = self.scene.lights.len();
-        let texel = self.has_transparent.then_some(if self.config.transmit_fp32 { 16 } else { 8 });
-        let layout = Layout::new((w * h) as u64, capture, nlights, float_counts, texel);
-        let lights: Vec<LightPush> = self.scene.lights.iter().map(|l| LightPush::new(l, eye, settings.transmit_log)).collect();
-
-        // 2. Record the paper's frame.
-        let readback = self.slots[slot].readback.ensure(&self.ctx, slot, layout.total)?;
-        let s = &mut self.slots[slot];
-        let cb = s.cmd;
-        let d = &self.ctx.device;
-        // SAFETY: the slot's previous submission retired (`retire`), so its command buffer
-        // may be reset and re-recorded.
-        unsafe {
-            d.reset_command_buffer(cb, vk::CommandBufferResetFlags::empty()).map_err(Error::vk("vkResetCommandBuffer"))?;
-            let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
-            d.begin_command_buffer(cb, &begin).map_err(Error::vk("vkBeginCommandBuffer"))?;
-        }
-        s.timer.begin(&self.ctx, cb, 4 + 4 * nlights as u32)?;
-        if settings.counters {
-            s.counters.begin(&self.ctx, cb, nlights as u32)?;
-        }
-        let s = &self.slots[slot];
-        let counters = settings.counters.then_some(&s.counters);
-        let full = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: self.targets.extent };
-        let viewport = vk::Viewport { x: 0.0, y: 0.0, width: w as f32, height: h as f32, min_depth: 0.0, max_depth: 1.0 };
-        let rec = Rec { ctx: &self.ctx, cb, full, viewport, timer: &s.timer, readback };
-        let spans = self.record_frame(&rec, &frame, &layout, (instances, spheres), vp_rel, &lights, float_counts, counters);
-        // SAFETY: recording finished; the submission signals the slot's fence.
-        unsafe {
-            d.end_command_buffer(cb).map_err(Error::vk("vkEndCommandBuffer"))?;
-            let cbs = [cb];
-            let fence = self.slots[slot].fence;
-            d.reset_fences(&[fence]).map_err(Error::vk("vkResetFences"))?;
-            match crate::gpu::fault::inject(crate::gpu::fault::FaultPoint::Submit) {
-                Some(injected) => Err(injected),
-                None => d.queue_submit(self.ctx.queue, &[vk::SubmitInfo::default().command_buffers(&cbs)], fence),
-            }
-            .map_err(Error::vk("vkQueueSubmit"))?;
-        }
-        let record_ms = record_start.elapsed().as_secs_f64() * 1e3;
-        let serial = self.serial;
-        self.serial += 1;
-        self.slots[slot].in_flight = Some(InFlight { serial, frame, layout, float_counts, eye, spans, wall, record_ms, settings });
-        Ok(FrameTicket { slot, serial })
-    }
-
-    /// The frame as McGuire et al. lay it out (section 8), one pass function each.
-    #[allow(clippy::too_many_arguments)]
-    fn record_frame(
-        &self,
-        rec: &Rec,
-        frame: &PreparedFrame,
-        layout: &Layout,
-        (instances, spheres): (vk::Buffer, Option<(vk::Buffer, u32)>),
-        vp_rel: Mat4,
-        lights: &[LightPush],
-        float_counts: bool,
-        counters: Option<&CounterPools>,
-    ) -> FrameSpans {
-        let (t, p, pass) = (&self.targets, &self.pipes, &self.pass);
-        let stamp = |stage| rec.timer.stamp(rec.ctx, rec.cb, stage);
-        let all = vk::PipelineStageFlags2::ALL_COMMANDS;
-        let mut spans = FrameSpans::default();
-        spans.frame.begin = stamp(vk::PipelineStageFlags2::TOP_OF_PIPE);
-        spans.depth.begin = spans.frame.begin;
-        // SAFETY: every pass records into `rec.cb` (recording, outside rendering instances
-        // between passes) with this renderer's objects, alive until the slot retires; the
-        // layouts each pass expects are those the previous pass leaves.
-        unsafe {
-            pass.cmd_upload(rec.cb, frame);
-            gbuffer::record(rec, t, p, &self.geo, instances, vp_rel, self.scene.ambient, spheres);
-            spans.depth.end = stamp(all);
-            let into = match (&self.shadow_mapper, self.settings.counter) {
-                (Some(_), _) => determine::CountInto::External,
-                (None, Counter::Float) => determine::CountInto::Float,
-                (None, Counter::Stencil) => determine::CountInto::Stencil,
-            };
-            for (li, light) in self.scene.lights.iter().enumerate() {
-                let begin = stamp(all);
-                if let Some(c) = counters {
-                    c.statistics(rec.ctx, rec.cb, li as u32, true);
-                }
-                if let Some((sm, _)) = &self.shadow_mapper {
-                    determine::begin_float(rec, t);
-                    sm.record(rec.ctx, rec.cb, t, light, self.scene.camera.eye.as_dvec3(), frame.lights[li].scissor);
-                }
-                determine::record(rec, pass, frame, li, t, into, layout.counts.get(li).copied());
-                if let Some(c) = counters {
-                    c.statistics(rec.ctx, rec.cb, li as u32, false);
-                }
-                spans.shadow.push(passes::timing_span(begin, stamp(all)));
-                if let Some(c) = counters {
-                    determine::record_count(rec, pass, frame, li, t, c);
-                }
-                if self.has_transparent {
-                    intensity::record(rec, pass, frame, li, t, self.settings.transmit_log, layout.transmit.get(li).copied());
-                }
-                let begin = stamp(all);
-                illuminate::record(rec, pass, frame, li, t, p, float_counts, self.has_transparent, &lights[li]);
-                spans.illuminate.push(passes::timing_span(begin, stamp(all)));
-            }
-            if self.geo.of(Sidedness::Transparent).next().is_some() {
-                let forward = if self.self_shadow.is_some() { &[][..] } else { lights };
-                transparent::record(rec, t, p, &self.geo, instances, vp_rel, self.scene.ambient, forward);
-                if let Some(ss) = &self.self_shadow {
-                    ss.record(rec, t, p, pass, frame, &self.geo, instances, vp_rel, lights, self.settings.transmit_log);
-                }
-            }
-            if self.settings.view == View::Volumes {
-                debug::record_volumes(rec, pass, frame, t);
-            }
-            tonemap::record(rec, t, p);
-        }
-        spans.frame.end = stamp(all);
-        rec.copy_out(&t.output, vk::ImageAspectFlags::COLOR, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, layout.color);
-        if let (Some(pos), Some(nrm)) = (layout.positions, layout.normals) {
-            rec.copy_out(&t.position, vk::ImageAspectFlags::COLOR, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL, pos);
-            rec.copy_out(&t.normal, vk::ImageAspectFlags::COLOR, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL, nrm);
-        }
-        tonemap::host_barrier(rec);
-        spans
-    }
-
-    /// Waits for a submitted frame and reads it back.
-    pub fn finish(&mut self, ticket: FrameTicket) -> Result<FrameOutput> {
-        let mut f = self.wait(&ticket)?;
-        // GPU silhouettes: the triangle counts are in the indirect arguments.
-        self.pass.read_back_counts(&mut f.frame)?;
-        let s = &self.slots[ticket.slot];
-        let transmit = self.has_transparent.then_some(TransmitMode { fp32: self.config.transmit_fp32, log: f.settings.transmit_log });
-        let c = parse(&s.readback, &f.layout, f.float_counts, transmit, f.eye)?;
-        let stats = self.stats(&ticket, &f)?;
-        let mut out = FrameOutput {
-            width: self.config.width,
-            height: self.config.height,
-            color: c.color,
-            stencil: c.stencil,
-            counts: c.counts,
-            transmit: c.transmit,
-            positions: c.positions,
-            normals: c.normals,
-            stats,
-        };
-        if f.settings.view == View::Stencil {
-            if let Some(st) = out.stencil.first() {
-                out.color = debug::stencil_heatmap(st);
-            }
-        }
-        Ok(out)
-    }
-
-    /// Waits for the ticket's fence and takes the slot's record of it.
-    fn wait(&mut self, ticket: &FrameTicket) -> Result<InFlight> {
-        let s = &mut self.slots[ticket.slot];
-        match &s.in_flight {
-            Some(f) if f.serial == ticket.serial => {}
-            _ => return Err(Error::Other(format!("frame {} was already finished or overwritten", ticket.serial))),
-        }
-        // SAFETY: the fence belongs to this device and was submitted with the frame.
-        unsafe { self.ctx.device.wait_for_fences(&[s.fence], true, u64::MAX) }.map_err(Error::vk("vkWaitForFences"))?;
-        self.ctx.check_validation()?;
-        s.in_flight.take().ok_or_else(|| Error::Other("no frame in flight".into()))
-    }
-
-    /// Makes `slot` free: waits for the frame in flight in it (its output is dropped).
-    fn retire(&mut self, slot: usize) -> Result<()> {
-        if let Some(f) = &self.slots[slot].in_flight {
-            let t = FrameTicket { slot, serial: f.serial };
-            self.wait(&t)?;
-        }
-        Ok(())
-    }
-
-    /// (Re)builds the shadow-map baseline when asked for, or when its size or the scene's
-    /// placement changed; drops it when another technique runs.
-    fn update_shadow_mapper(&mut self, technique: Technique) -> Result<()> {
-        let wanted = match technique {
-            Technique::ShadowMap { size } => Some(size),
-            _ => None,
-        };
-        let current = self.shadow_mapper.as_ref().map(|(m, v)| (m.size, *v));
-        if wanted.map(|s| (s, self.scene_version)) == current {
-            return Ok(());
-        }
-        if let Some((mut old, _)) = self.shadow_mapper.take() {
-            // SAFETY: waiting for idle before destroying objects a frame in flight may use.
-            unsafe { self.ctx.device.device_wait_idle() }.map_err(Error::vk("vkDeviceWaitIdle"))?;
-            old.destroy(&self.ctx);
-        }
-        if let Some(size) = wanted {
-            let sm = ShadowMapper::new(&self.ctx, &self.scene, &self.targets, size, self.pipes.sampler)?;
-            self.shadow_mapper = Some((sm, self.scene_version));
-        }
-        Ok(())
-    }
-
-    fn destroy_resources(&mut self) {
-        let ctx = &self.ctx;
-        // SAFETY: wait for the GPU, then destroy everything this renderer created; the pass
-        // and the context are dropped after this body (the pass first: field order).
-        unsafe {
-            let _ = ctx.device.device_wait_idle();
-            for s in &mut self.slots {
-                s.destroy(ctx);
-            }
-            self.pipes.destroy(ctx);
-        }
-        if let Some((mut sm, _)) = self.shadow_mapper.take() {
-            sm.destroy(ctx);
-        }
-        if let Some(mut ss) = self.self_shadow.take() {
-            ss.destroy(ctx);
-        }
-        self.targets.destroy(ctx);
-        self.geo.destroy(ctx);
-        self.spheres.destroy(ctx);
-    }
-}
-
-impl Drop for Renderer {
-    fn drop(&mut self) {
-        self.destroy_resources();
     }
 }

@@ -12,8 +12,8 @@ impl Renderer {
         if !(camera.eye.is_finite() && camera.target.is_finite() && camera.up.is_finite()) || camera.eye == camera.target {
             return Err(Error::Other(format!("invalid camera {camera:?}")));
         }
-        self.scene.camera = camera;
-        self.scene_version += 1;
+        self.own.parts.scene.camera = camera;
+        self.own.parts.scene_version += 1;
         Ok(())
     }
     /// Replaces the lights (any number; from the next frame). Area lights are split into
@@ -22,15 +22,15 @@ impl Renderer {
     /// had area lights then): area lights added to a scene created without any sum in RGBA16F.
     pub fn set_lights(&mut self, lights: Vec<Light>) -> Result<()> {
         let lights = super::area::checked_lights(&lights)?;
-        self.scene.lights = crate::geom::area::expand_lights(&lights, self.samples_for);
-        self.source_lights = lights;
-        self.scene_version += 1;
+        self.own.parts.scene.lights = crate::geom::area::expand_lights(&lights, self.own.parts.samples_for);
+        self.own.parts.source_lights = lights;
+        self.own.parts.scene_version += 1;
         Ok(())
     }
     /// Moves mesh `index` (object -> world; from the next frame). A transform must keep the
     /// mesh's handedness (its winding was fixed at load).
     pub fn set_mesh_transform(&mut self, index: usize, transform: Mat4) -> Result<()> {
-        let m = self.scene.meshes.get(index).ok_or_else(|| Error::Other(format!("no mesh {index}")))?;
+        let m = self.own.parts.scene.meshes.get(index).ok_or_else(|| Error::Other(format!("no mesh {index}")))?;
         let det = transform.determinant();
         if !(transform.is_finite() && det.is_finite() && det != 0.0) {
             return Err(Error::mesh(&m.name, "transform is not finite or singular"));
@@ -38,11 +38,11 @@ impl Renderer {
         if (det < 0.0) != (m.transform.determinant() < 0.0) {
             return Err(Error::mesh(&m.name, "a new transform may not mirror a mesh that was loaded unmirrored (or the reverse)"));
         }
-        if let Some(id) = self.caster_ids[index] {
-            self.pass.set_transform(id, transform.as_dmat4())?;
+        if let Some(id) = self.own.parts.caster_ids[index] {
+            self.own.parts.pass.set_transform(id, transform.as_dmat4())?;
         }
-        self.scene.meshes[index].transform = transform;
-        self.scene_version += 1;
+        self.own.parts.scene.meshes[index].transform = transform;
+        self.own.parts.scene_version += 1;
         Ok(())
     }
 }

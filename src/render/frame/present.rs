@@ -18,7 +18,7 @@ impl Renderer {
     /// to a swapchain image) in a later submission on the same queue and return it to
     /// `COLOR_ATTACHMENT_OPTIMAL` there.
     pub fn output_image(&self) -> &Image {
-        &self.targets.output
+        &self.own.parts.targets.output
     }
 
     /// Rebuilds the size-dependent targets and pipelines for `width` x `height` (the casters,
@@ -29,25 +29,25 @@ impl Renderer {
         if width == 0 || height == 0 || width > 16384 || height > 16384 {
             return Err(Error::Other(format!("invalid image size {width}x{height} (1..=16384 each)")));
         }
-        if (width, height) == (self.config.width, self.config.height) {
+        if (width, height) == (self.own.parts.config.width, self.own.parts.config.height) {
             return Ok(());
         }
-        let ctx = &self.ctx;
+        let ctx = &self.own.ctx;
         // SAFETY: waiting for every submission before destroying what they use.
         unsafe { ctx.device.device_wait_idle() }.map_err(Error::vk("vkDeviceWaitIdle"))?;
-        for s in &mut self.slots {
+        for s in &mut self.own.parts.slots {
             s.in_flight = None;
         }
-        let transmit_format = self.targets.transmit.format;
+        let transmit_format = self.own.parts.targets.transmit.format;
         let mut targets = Targets::new(ctx, width, height, transmit_format)?;
-        let mut pipes = match FramePipelines::new(ctx, &targets, self.pass.capabilities().depth_bounds) {
+        let mut pipes = match FramePipelines::new(ctx, &targets, self.own.parts.pass.capabilities().depth_bounds) {
             Ok(p) => p,
             Err(e) => {
                 targets.destroy(ctx);
                 return Err(e);
             }
         };
-        let self_shadow = match self.config.self_shadow && self.geo.of(Sidedness::Transparent).next().is_some() {
+        let self_shadow = match self.own.parts.config.self_shadow && self.own.parts.geo.of(Sidedness::Transparent).next().is_some() {
             true => match SelfShadow::new(ctx, &pipes, targets.extent, transmit_format) {
                 Ok(s) => Some(s),
                 Err(e) => {
@@ -59,26 +59,26 @@ impl Renderer {
             },
             false => None,
         };
-        let mut old_targets = std::mem::replace(&mut self.targets, targets);
-        let mut old_pipes = std::mem::replace(&mut self.pipes, pipes);
+        let mut old_targets = std::mem::replace(&mut self.own.parts.targets, targets);
+        let mut old_pipes = std::mem::replace(&mut self.own.parts.pipes, pipes);
         // SAFETY: the device is idle, so no command buffer uses the old objects.
         unsafe { old_pipes.destroy(ctx) };
         old_targets.destroy(ctx);
-        if let Some(mut ss) = std::mem::replace(&mut self.self_shadow, self_shadow) {
+        if let Some(mut ss) = std::mem::replace(&mut self.own.parts.self_shadow, self_shadow) {
             ss.destroy(ctx);
         }
         // The shadow maps' screen-space passes are sized by the targets: rebuilt next frame.
-        if let Some((mut sm, _)) = self.shadow_mapper.take() {
+        if let Some((mut sm, _)) = self.own.parts.shadow_mapper.take() {
             sm.destroy(ctx);
         }
-        self.config.width = width;
-        self.config.height = height;
-        self.scene_version += 1;
+        self.own.parts.config.width = width;
+        self.own.parts.config.height = height;
+        self.own.parts.scene_version += 1;
         Ok(())
     }
 
     /// The extent the renderer's targets have.
     pub fn extent(&self) -> vk::Extent2D {
-        self.targets.extent
+        self.own.parts.targets.extent
     }
 }

@@ -5,6 +5,7 @@ use super::InFlight;
 use crate::error::{Error, Result};
 use crate::gpu::Context;
 use crate::render::counters::CounterPools;
+use crate::render::guard::{Destroy, Guard};
 use crate::render::readback::Readback;
 use crate::render::timing::Timer;
 use ash::vk;
@@ -22,20 +23,11 @@ pub(super) struct FrameSlot {
 impl FrameSlot {
     /// `n` slots, all or nothing: when one cannot be created, those already made are destroyed.
     pub(super) fn ring(ctx: &Context, n: usize) -> Result<Vec<FrameSlot>> {
-        let mut slots = Vec::with_capacity(n);
+        let mut slots = Guard::new(ctx, Vec::with_capacity(n));
         for _ in 0..n {
-            match FrameSlot::new(ctx) {
-                Ok(s) => slots.push(s),
-                Err(e) => {
-                    for s in &mut slots {
-                        // SAFETY: nothing was submitted from these slots.
-                        unsafe { s.destroy(ctx) };
-                    }
-                    return Err(e);
-                }
-            }
+            slots.push(FrameSlot::new(ctx)?);
         }
-        Ok(slots)
+        Ok(slots.into_inner())
     }
 
     fn new(ctx: &Context) -> Result<FrameSlot> {
@@ -77,5 +69,12 @@ impl FrameSlot {
         self.counters.destroy(ctx);
         self.readback.destroy(ctx);
         self.in_flight = None;
+    }
+}
+
+impl Destroy for FrameSlot {
+    unsafe fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: the same contract (the GPU no longer uses the slot).
+        unsafe { FrameSlot::destroy(self, ctx) }
     }
 }

@@ -9,11 +9,11 @@ use crate::render::stats::{GpuMs, LightGpuMs, Stats};
 impl Renderer {
     /// The frame's `--stats`.
     pub(super) fn stats(&self, ticket: &FrameTicket, f: &InFlight) -> Result<Stats> {
-        let ctx = &self.ctx;
-        let caps = self.pass.capabilities();
+        let ctx = &self.own.ctx;
+        let caps = self.own.parts.pass.capabilities();
         let gpu_ms = match ctx.features.timestamps {
             true => {
-                let raw = self.slots[ticket.slot].timer.read(ctx)?;
+                let raw = self.own.parts.slots[ticket.slot].timer.read(ctx)?;
                 let p = ctx.features.timestamp_period_ns;
                 let per_light: Vec<LightGpuMs> = f
                     .spans
@@ -36,7 +36,7 @@ impl Renderer {
         let fe = &ctx.features;
         let u8_used = caps.index_type_uint8 && matches!(f.settings.index_format, IndexFormat::U8 | IndexFormat::Auto);
         for (name, has, used) in [
-            ("depthClamp", fe.depth_clamp, self.config.depth_mode == DepthMode::Clamp),
+            ("depthClamp", fe.depth_clamp, self.own.parts.config.depth_mode == DepthMode::Clamp),
             ("depthBounds", caps.depth_bounds, caps.depth_bounds),
             ("indexTypeUint8", caps.index_type_uint8, u8_used),
             ("timestamps", fe.timestamps, fe.timestamps),
@@ -52,15 +52,17 @@ impl Renderer {
         Ok(Stats {
             device: ctx.info.name.clone(),
             method: f.settings.technique.name().to_string(),
-            depth_mode: self.config.depth_mode.name().into(),
+            depth_mode: self.own.parts.config.depth_mode.name().into(),
             index_format: f.settings.index_format.name().into(),
             counter: f.settings.counter.name().into(),
             transmit: self
+                .own
+                .parts
                 .has_transparent
-                .then(|| TransmitMode { fp32: self.config.transmit_fp32, log: f.settings.transmit_log }.name().into()),
-            self_shadow: self.self_shadow.is_some(),
-            width: self.config.width,
-            height: self.config.height,
+                .then(|| TransmitMode { fp32: self.own.parts.config.transmit_fp32, log: f.settings.transmit_log }.name().into()),
+            self_shadow: self.own.parts.self_shadow.is_some(),
+            width: self.own.parts.config.width,
+            height: self.own.parts.config.height,
             lights: f.frame.lights.iter().map(|l| l.stats.clone()).collect(),
             totals: f.frame.totals.clone(),
             cpu_ms: cpu,
@@ -69,7 +71,7 @@ impl Renderer {
             features_used,
             features_missing,
             counters: match f.settings.counters {
-                true => Some(self.slots[ticket.slot].counters.read(ctx)?),
+                true => Some(self.own.parts.slots[ticket.slot].counters.read(ctx)?),
                 false => None,
             },
             warnings: f.frame.warnings.clone(),
