@@ -1,18 +1,21 @@
 //! umbrage: exact hard shadows with stencil shadow volumes on raw Vulkan.
 //!
-//! Layers, dependencies pointing one way: [`geom`] (meshes, topology, silhouettes, culling
-//! volumes, the camera and light models) -> [`shadow`] (pure CPU planning: per caster and
-//! light the case, caps and index lists of McGuire et al. 2003) -> [`gpu`] (thin ash
-//! wrappers). With the default feature `cli` the crate also has `scene` (TOML / OBJ / built-in
-//! scenes), `render` (umbrage's own frame), `reference` (the exact CPU ground truth, which
+//! Layers, each using only those before it: [`geom`] (meshes, topology, silhouettes, culling
+//! volumes, the camera and light models; safe Rust, no Vulkan) <- [`shadow`] (pure CPU
+//! planning: per caster and light the case, caps and index lists of McGuire et al. 2003; safe
+//! Rust, no Vulkan) <- [`pass`] (the embeddable [`pass::ShadowPass`]: the plans on the GPU)
+//! which uses [`gpu`] (thin ash wrappers, knowing nothing of shadows). With the default
+//! feature `cli` the crate also has `scene` (TOML / OBJ / built-in scenes; the one place the
+//! algorithm meets it is `Caster::from_scene_mesh`, compiled only with `cli`), `render`
+//! (umbrage's own frame, a host of the pass), `reference` (the exact CPU ground truth, which
 //! shares nothing with the shadow algorithm but the camera model), `conform`, `bench`,
-//! `accuracy`, `output` and the `umbrage` binary.
+//! `accuracy`, `output` and the `umbrage` binary on top.
 //!
 //! # Features
 //!
 //! - `cli` (default): everything above, and the crates it needs (tobj, image, clap, serde, toml,
 //!   serde_json). An engine depends on umbrage with `default-features = false` and gets
-//!   [`geom`], [`shadow`], [`gpu`] and [`Error`] on ash, glam, gpu-allocator, robust, thiserror
+//!   [`geom`], [`shadow`], [`pass`], [`gpu`] and [`Error`] on ash, glam, gpu-allocator, robust, thiserror
 //!   and bytemuck only.
 //! - `serde` (enabled by `cli`): `serde::Serialize` on the planner's public types.
 //!

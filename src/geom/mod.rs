@@ -1,4 +1,5 @@
 //! Pure CPU geometry: no Vulkan, no `unsafe`. The heart of the shadow algorithm.
+#![forbid(unsafe_code)]
 #![warn(missing_docs)]
 pub mod mesh;
 pub use mesh::{Aabb, Mesh};

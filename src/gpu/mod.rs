@@ -1,5 +1,8 @@
 //! Thin wrappers over ash: context, memory, images, pipelines. Knows nothing about shadows.
-//! All of the crate's `unsafe` lives under this module and `render`.
+//! The crate's `unsafe` lives in the GPU layer: this module, [`crate::pass`], and with `cli`
+//! the modules that record their own command buffers (`render`, `view`, and the GPU parts of
+//! `conform` and `bench`); [`crate::geom`] and [`crate::shadow`] forbid it. Every block has a
+//! `// SAFETY:` line and every `unsafe fn` a `# Safety` section (`Cargo.toml`'s `[lints]`).
 #![warn(missing_docs)]
 pub mod context;
 pub mod descriptors;

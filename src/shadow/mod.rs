@@ -1,5 +1,6 @@
 //! Shadow-volume planning (McGuire et al. 2003): casters prepared at load, and per light
 //! the culling, case selection and index lists the GPU side draws.
+#![forbid(unsafe_code)]
 #![warn(missing_docs)]
 pub mod caster;
 pub mod edgequad;
