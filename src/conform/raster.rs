@@ -72,7 +72,7 @@ const PLANES: [[f64; 4]; 6] =
     [[1.0, 0.0, 0.0, 1.0], [-1.0, 0.0, 0.0, 1.0], [0.0, 1.0, 0.0, 1.0], [0.0, -1.0, 0.0, 1.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, -1.0, 1.0]];
 
 /// Sutherland-Hodgman clipping of a clip-space triangle (f64) against the view volume
-/// ([`PLANES`]; the z planes only without `depth_clamp`). The polygon keeps the triangle's
+/// (`PLANES`: the six clip planes; the z planes only without `depth_clamp`). The polygon keeps the triangle's
 /// vertex order, so its window-space winding is the clipped primitive's facing. Empty when
 /// nothing of the triangle is inside.
 pub fn clip_polygon(tri: [DVec4; 3], depth_clamp: bool) -> Vec<DVec4> {

@@ -1,17 +1,17 @@
 //! Beyond the CTS, where shadow volumes need it: four case families the Vulkan CTS has no
 //! equivalent of (see docs/conform/cts-mapping.md, "Beyond the CTS").
 //!
-//! - `wrap.*` ([`wrap`]): hundreds of two-sided faces through one tile, front INCR_WRAP /
+//! - `wrap.*` (module `wrap`): hundreds of two-sided faces through one tile, front INCR_WRAP /
 //!   back DECR_WRAP as shadow volumes count, so the 8-bit count wraps many times and must come
 //!   back exactly to `(N - M) mod 256` (the CTS steps one or two values past a wrap point).
-//! - `clip.*` ([`clip`]): homogeneous clipping of triangles with vertices behind the eye
+//! - `clip.*` (module `clip`): homogeneous clipping of triangles with vertices behind the eye
 //!   (`w < 0`), exactly at `w = 0`, crossing the near and far planes with and without depth
 //!   clamp, and infinite-projection side quads extruded behind the eye (the CTS never draws
 //!   `w <= 0` vertices, and no infinite projections).
-//! - `watertight.*` ([`watertight`]): closed meshes and fans at object coordinates of 1e7,
+//! - `watertight.*` (module `watertight`): closed meshes and fans at object coordinates of 1e7,
 //!   split across separate draws in shuffled order: every pixel inside the outline counted
 //!   exactly once per layer (the CTS checks watertightness only on two-triangle quads).
-//! - `occlusion.*` ([`occlusion`]): precise occlusion-query counts of seeded random large,
+//! - `occlusion.*` (module `occlusion`): precise occlusion-query counts of seeded random large,
 //!   thin and sub-pixel triangles in both windings, against the model's count of covered
 //!   pixel centres.
 //!

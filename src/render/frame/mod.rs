@@ -81,8 +81,8 @@ struct FrameSpans {
 
 /// umbrage's renderer (see the module docs).
 ///
-/// Its parts and the context that made them are owned together ([`Owned`]): dropping the
-/// renderer or [`Renderer::into_context`] runs the one teardown of [`Parts`] and drops every
+/// Its parts and the context that made them are owned together (`guard::Owned`): dropping the
+/// renderer or [`Renderer::into_context`] runs the one teardown of `Parts` and drops every
 /// part whole, then the context.
 pub struct Renderer {
     /// What the next frame does (technique, counter, index format, view, capture); checked
