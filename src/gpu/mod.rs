@@ -8,6 +8,7 @@ pub mod context;
 pub mod descriptors;
 pub mod fault;
 pub mod pipeline;
+mod probe;
 pub mod resources;
 pub mod validation;
 pub mod shaders {
