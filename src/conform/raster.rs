@@ -151,34 +151,11 @@ impl ClippedPoly {
     /// `eps` pixels of any of its edges reported as [`Cover::Edge`]; the fan's inner diagonals
     /// are not edges (exactly one fan triangle covers a centre on one).
     pub fn cover_eps(&self, x: u32, y: u32, eps: f64) -> Cover {
-        let c = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
         let area = self.vk_area();
         if area == 0.0 || self.p.len() < 3 {
             return Cover::Out;
         }
-        let sign = if (-area) > 0.0 { 1.0 } else { -1.0 };
-        let mut ambiguous = false;
-        let n = self.p.len();
-        for i in 0..n {
-            let (a, b) = (self.p[i], self.p[(i + 1) % n]);
-            let e = b - a;
-            let len = e.length();
-            if len == 0.0 {
-                continue;
-            }
-            let d = sign * (e.x * (c.y - a.y) - e.y * (c.x - a.x)) / len;
-            if d < -eps {
-                return Cover::Out;
-            }
-            if d <= eps {
-                ambiguous = true;
-            }
-        }
-        if ambiguous {
-            Cover::Edge
-        } else {
-            Cover::In
-        }
+        cover_polygon(&self.p, area, x, y, eps)
     }
 }
 
@@ -191,17 +168,27 @@ pub fn cover(t: &WinTri, x: u32, y: u32) -> Cover {
 /// [`cover`] with centres within `eps` pixels of an edge reported as [`Cover::Edge`] (a wider
 /// band where the device's f32 vertex transform may snap a vertex to a neighbouring sub-pixel).
 pub fn cover_eps(t: &WinTri, x: u32, y: u32, eps: f64) -> Cover {
-    let c = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
     let area = t.vk_area();
     if area == 0.0 {
         return Cover::Out; // degenerate: never rasterised
     }
+    cover_polygon(&t.p, area, x, y, eps)
+}
+
+/// Coverage of the centre of pixel (x, y) by the convex polygon `p` of Vulkan signed area
+/// `area` (non-zero): out past any edge by more than `eps`, on an edge within `eps`, else in.
+/// Zero-length edges (repeated clipped vertices) are skipped.
+fn cover_polygon(p: &[DVec2], area: f64, x: u32, y: u32, eps: f64) -> Cover {
+    let c = DVec2::new(x as f64 + 0.5, y as f64 + 0.5);
     let sign = if (-area) > 0.0 { 1.0 } else { -1.0 };
     let mut ambiguous = false;
-    for i in 0..3 {
-        let (a, b) = (t.p[i], t.p[(i + 1) % 3]);
+    for i in 0..p.len() {
+        let (a, b) = (p[i], p[(i + 1) % p.len()]);
         let e = b - a;
         let len = e.length();
+        if len == 0.0 {
+            continue;
+        }
         let d = sign * (e.x * (c.y - a.y) - e.y * (c.x - a.x)) / len;
         if d < -eps {
             return Cover::Out;

@@ -62,15 +62,7 @@ impl Rng {
 
 /// One face's stencil state: `pass` on pass, KEEP otherwise, compare ALWAYS, masks 0xff.
 fn face(pass: vk::StencilOp) -> vk::StencilOpState {
-    vk::StencilOpState {
-        fail_op: vk::StencilOp::KEEP,
-        pass_op: pass,
-        depth_fail_op: vk::StencilOp::KEEP,
-        compare_op: vk::CompareOp::ALWAYS,
-        compare_mask: 0xff,
-        write_mask: 0xff,
-        reference: 0,
-    }
+    crate::gpu::pipeline::stencil_ops(pass, vk::StencilOp::KEEP)
 }
 
 /// Shadow-volume counting: front faces INCR_WRAP, back faces DECR_WRAP (the zoo's two-sided

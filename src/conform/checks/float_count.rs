@@ -153,15 +153,7 @@ fn counting_pipeline(ctx: &Context, layout: vk::PipelineLayout, render_pass: vk:
         .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
         .line_width(1.0);
     let ms = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
-    let op = |pass| vk::StencilOpState {
-        fail_op: vk::StencilOp::KEEP,
-        pass_op: pass,
-        depth_fail_op: vk::StencilOp::KEEP,
-        compare_op: vk::CompareOp::ALWAYS,
-        compare_mask: 0xff,
-        write_mask: 0xff,
-        reference: 0,
-    };
+    let op = |pass| crate::gpu::pipeline::stencil_ops(pass, vk::StencilOp::KEEP);
     let ds = vk::PipelineDepthStencilStateCreateInfo::default()
         .stencil_test_enable(true)
         .front(op(vk::StencilOp::INCREMENT_AND_WRAP))
