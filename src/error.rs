@@ -5,6 +5,7 @@
 
 /// Everything that can go wrong in umbrage.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum Error {
     /// Bad user input in a file: scene TOML, OBJ, dump directory. `location` is
     /// `path` or `path:line` where a line is known.
@@ -84,7 +85,20 @@ pub enum Error {
         /// The first of them, verbatim.
         first: String,
     },
-    /// Any other failure (invalid argument, misuse of an API, ...), described by its message.
+    /// A [`ShadowPassDesc`](crate::pass::ShadowPassDesc) (or another creation option) that
+    /// cannot be honoured as given, independent of the device: `field` names the option.
+    #[error("{field}: {msg}")]
+    InvalidDesc {
+        /// The option, e.g. `"ShadowPassDesc::samples"`.
+        field: &'static str,
+        /// What is wrong with its value.
+        msg: String,
+    },
+    /// The embedding API was called in a way its contract forbids (a wrong index, a frame of
+    /// another pass or slot, an argument out of range). Nothing was recorded or changed.
+    #[error("{0}")]
+    Misuse(#[from] Misuse),
+    /// Any other failure, described by its message.
     #[error("{0}")]
     Other(String),
     /// Reading or writing a file failed.
@@ -94,6 +108,71 @@ pub enum Error {
         path: String,
         /// The underlying error.
         source: std::io::Error,
+    },
+}
+
+/// How a caller broke the embedding API's contract ([`Error::Misuse`]). Each is detected
+/// before anything is recorded, so the command buffer is unchanged.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum Misuse {
+    /// A light index past the frame's lights.
+    #[error("light {index} out of range: the frame was prepared with {lights} light(s)")]
+    LightIndex {
+        /// The index given.
+        index: usize,
+        /// How many lights the frame has.
+        lights: usize,
+    },
+    /// A ring slot past `frames_in_flight`.
+    #[error("ring slot {slot} out of range (frames_in_flight = {slots})")]
+    SlotOutOfRange {
+        /// The slot given.
+        slot: usize,
+        /// How many slots the pass has.
+        slots: usize,
+    },
+    /// A frame prepared by another `ShadowPass`.
+    #[error("the frame was prepared by another ShadowPass")]
+    ForeignFrame,
+    /// A frame whose ring slot was prepared again since: its buffers now hold a newer frame.
+    #[error("stale frame: ring slot {slot} was prepared again (frame {serial}, slot now holds frame {current})")]
+    StaleFrame {
+        /// The frame's slot.
+        slot: usize,
+        /// The frame's serial.
+        serial: u64,
+        /// The serial of the frame the slot holds now.
+        current: u64,
+    },
+    /// A caster or sphere id that is not (or no longer) in the pass.
+    #[error("unknown or removed {what} {id}")]
+    UnknownId {
+        /// `"caster"` or `"sphere caster"`.
+        what: &'static str,
+        /// The id as printed.
+        id: String,
+    },
+    /// A call that needs an option the pass was not created with, or the other target model.
+    #[error("{call} needs {needs}")]
+    NotConfigured {
+        /// The call, e.g. `"cmd_count_float"`.
+        call: &'static str,
+        /// What it needs, e.g. `"the dynamic-rendering target model"`.
+        needs: &'static str,
+    },
+    /// A call made out of order (e.g. the uploads of a frame not yet recorded when the host's
+    /// render pass has begun).
+    #[error("{0}")]
+    Order(String),
+    /// An argument outside its documented range (a non-finite view, an empty target, a light
+    /// with a zero direction, a declared layout the pass cannot take).
+    #[error("{what}: {msg}")]
+    Argument {
+        /// The argument, e.g. `"ShadowView"`.
+        what: &'static str,
+        /// What is wrong with it.
+        msg: String,
     },
 }
 
@@ -112,6 +191,14 @@ impl Error {
     /// Maps a failed Vulkan call to [`Error::Vulkan`]: `.map_err(Error::vk("vkCreateBuffer"))`.
     pub fn vk(call: &'static str) -> impl Fn(ash::vk::Result) -> Error {
         move |result| Error::Vulkan { call, result }
+    }
+    /// An [`Error::Misuse`] for an argument out of range.
+    pub fn argument(what: &'static str, msg: impl Into<String>) -> Self {
+        Error::Misuse(Misuse::Argument { what, msg: msg.into() })
+    }
+    /// An [`Error::InvalidDesc`] for the creation option `field`.
+    pub fn desc(field: &'static str, msg: impl Into<String>) -> Self {
+        Error::InvalidDesc { field, msg: msg.into() }
     }
     /// An [`Error::Io`] on `path`.
     pub fn io(path: impl Into<String>, source: std::io::Error) -> Self {

@@ -96,7 +96,7 @@ impl Host {
             // SAFETY: `cb` is recording with a pipeline of `self.layout` bound; 96 bytes.
             unsafe { device.cmd_push_constants(cb, self.layout, stages, 0, bytemuck::bytes_of(&p)) };
         };
-        let target = DepthStencilTarget { view: depth.view, extent: self.extent };
+        let target = DepthStencilTarget::new(depth.raw, depth.view, self.extent);
 
         // SAFETY: (the whole recording) the slot's previous submission retired (`retire`
         // waited its fence), so its command buffer may be reset and re-recorded; every object
@@ -119,7 +119,7 @@ impl Host {
                 (vk::PipelineStageFlags2::ALL_COMMANDS, vk::AccessFlags2::NONE),
                 (frag_tests, ds_rw),
             );
-            pass.cmd_upload(cb, &frame);
+            pass.cmd_before_rendering(cb, &frame).map_err(|e| e.to_string())?;
 
             // Depth pre-pass: every mesh, depth LESS, stencil cleared to 0.
             let d = ds_att(vk::AttachmentLoadOp::CLEAR);
@@ -146,7 +146,7 @@ impl Host {
 
             for (li, draws) in lit_draws.iter().enumerate() {
                 // The shadow determination: the count in the stencil.
-                pass.cmd_determine(cb, &frame, li, &target);
+                pass.cmd_determine(cb, &frame, li, &target).map_err(|e| e.to_string())?;
                 // Stencil out (readback), then back to attachment for the lighting pass.
                 image_barrier(
                     &device,
@@ -196,7 +196,7 @@ impl Host {
                 );
                 device.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.lighting);
                 // Viewport, the light's scissor and (when used) its depth bounds.
-                pass.cmd_light_state(cb, &frame, li, self.extent);
+                pass.cmd_light_state(cb, &frame, li, self.extent).map_err(|e| e.to_string())?;
                 device.cmd_bind_index_buffer(cb, slot_ref.lit.raw, 0, vk::IndexType::UINT32);
                 for (mi, m) in self.meshes.iter().enumerate() {
                     let (offset, count) = draws[mi];

@@ -1,4 +1,4 @@
-//! Graphics pipelines for dynamic rendering, described by a plain struct so that every
+//! Graphics pipelines for dynamic rendering or a render pass's subpass, described by a plain struct so that every
 //! pipeline of the renderer reads as a table of its fixed-function state.
 
 use super::context::GpuDevice;
@@ -26,8 +26,7 @@ pub enum Blend {
 
 /// Everything that varies between the renderer's pipelines.
 ///
-/// Fixed for all of them: triangle lists, fill mode, counter-clockwise front faces, one sample,
-/// line width 1, entry point `main`, and viewport and scissor as dynamic state (one each), so
+/// Fixed for all of them: triangle lists, fill mode, counter-clockwise front faces, line width 1, entry point `main`, and viewport and scissor as dynamic state (one each), so
 /// the caller sets both before drawing.
 #[derive(Clone)]
 pub struct PipelineDesc<'a> {
@@ -73,6 +72,13 @@ pub struct PipelineDesc<'a> {
     pub depth_bias: Option<(f32, f32)>,
     /// The pipeline layout; must match the shaders' descriptor sets and push constants.
     pub layout: vk::PipelineLayout,
+    /// Rasterisation samples (the attachments' sample count).
+    pub samples: vk::SampleCountFlags,
+    /// `Some(render pass, subpass, colour attachments of the subpass)`: built for that
+    /// subpass instead of dynamic rendering. When [`PipelineDesc::color_formats`] is empty the
+    /// pipeline still has one blend state per colour attachment of the subpass, writing
+    /// nothing.
+    pub render_pass: Option<(vk::RenderPass, u32, u32)>,
 }
 
 impl<'a> PipelineDesc<'a> {
@@ -100,6 +106,8 @@ impl<'a> PipelineDesc<'a> {
             cull: vk::CullModeFlags::NONE,
             depth_bias: None,
             layout,
+            samples: vk::SampleCountFlags::TYPE_1,
+            render_pass: None,
         }
     }
 }
@@ -115,7 +123,8 @@ pub fn shader_module(ctx: &impl GpuDevice, spirv: &[u8]) -> Result<vk::ShaderMod
     unsafe { ctx.device().create_shader_module(&info, None) }.map_err(vkerr("vkCreateShaderModule"))
 }
 
-/// Creates the graphics pipeline `d` describes, for dynamic rendering (no render pass). The
+/// Creates the graphics pipeline `d` describes, for dynamic rendering or the subpass of
+/// [`PipelineDesc::render_pass`]. The
 /// shader modules are created and destroyed here; the pipeline is the caller's to destroy,
 /// and `d.layout` must outlive every use of it.
 pub fn create(ctx: &impl GpuDevice, d: &PipelineDesc) -> Result<vk::Pipeline> {
@@ -164,7 +173,7 @@ pub fn create(ctx: &impl GpuDevice, d: &PipelineDesc) -> Result<vk::Pipeline> {
         .depth_bias_constant_factor(d.depth_bias.map_or(0.0, |b| b.0))
         .depth_bias_slope_factor(d.depth_bias.map_or(0.0, |b| b.1))
         .line_width(1.0);
-    let ms = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
+    let ms = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(d.samples);
     let (front, back) = d.stencil.unwrap_or_default();
     let ds = vk::PipelineDepthStencilStateCreateInfo::default()
         .depth_test_enable(d.depth_test)
@@ -216,7 +225,13 @@ pub fn create(ctx: &impl GpuDevice, d: &PipelineDesc) -> Result<vk::Pipeline> {
             .alpha_blend_op(vk::BlendOp::ADD)
             .color_write_mask(mask),
     };
-    let atts = vec![att; d.color_formats.len()];
+    let atts = match d.render_pass {
+        // A subpass's colour attachments the pipeline does not write.
+        Some((_, _, n)) if d.color_formats.is_empty() => {
+            vec![vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::empty()); n as usize]
+        }
+        _ => vec![att; d.color_formats.len()],
+    };
     let cb = vk::PipelineColorBlendStateCreateInfo::default().attachments(&atts);
     let mut dynamic = vec![vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
     if d.depth_bounds {
@@ -229,7 +244,7 @@ pub fn create(ctx: &impl GpuDevice, d: &PipelineDesc) -> Result<vk::Pipeline> {
         .color_attachment_formats(d.color_formats)
         .depth_attachment_format(d.depth_format)
         .stencil_attachment_format(if has_stencil { d.depth_format } else { vk::Format::UNDEFINED });
-    let info = vk::GraphicsPipelineCreateInfo::default()
+    let mut info = vk::GraphicsPipelineCreateInfo::default()
         .stages(&stages)
         .vertex_input_state(&vertex_input)
         .input_assembly_state(&ia)
@@ -239,8 +254,11 @@ pub fn create(ctx: &impl GpuDevice, d: &PipelineDesc) -> Result<vk::Pipeline> {
         .depth_stencil_state(&ds)
         .color_blend_state(&cb)
         .dynamic_state(&dyn_state)
-        .layout(d.layout)
-        .push_next(&mut rendering);
+        .layout(d.layout);
+    info = match d.render_pass {
+        Some((render_pass, subpass, _)) => info.render_pass(render_pass).subpass(subpass),
+        None => info.push_next(&mut rendering),
+    };
     // SAFETY: every pointer in `info` refers to locals alive for this call; the modules are
     // destroyed right after, which Vulkan allows once the pipeline exists.
     let result = unsafe { ctx.device().create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) };

@@ -89,7 +89,7 @@ impl CasterTable {
     pub fn find(&self, id: CasterId) -> Result<usize> {
         match self.slots.get(id.index as usize) {
             Some(&(generation, Some(i))) if generation == id.generation => Ok(i),
-            _ => Err(Error::Other(format!("unknown or removed caster id {}:{}", id.index, id.generation))),
+            _ => Err(crate::error::Misuse::UnknownId { what: "caster", id: format!("{}:{}", id.index, id.generation) }.into()),
         }
     }
 

@@ -19,6 +19,128 @@ named_enum!(
 );
 
 named_enum!(
+    /// Which way the host's depth runs (fixed at creation: compare ops, depth bias and the
+    /// planner's near plane follow it).
+    DepthDirection, "depth direction", {
+        /// Depth 0 at the near plane, 1 at the far plane (or infinity); closer is LESS.
+        #[default]
+        Forward => "forward",
+        /// Reverse-Z: depth 1 at the near plane, 0 at the far plane (or infinity, where the
+        /// volumes' `w = 0` vertices land exactly); closer is GREATER. A forward projection
+        /// `P` becomes [`reverse_z`]`(P)`.
+        Reverse => "reverse",
+    }
+);
+
+/// The reverse-Z projection of a forward Vulkan projection (either way round: the map is its
+/// own inverse): clip `z' = w - z`, so depth `d' = 1 - d`. Exact for the usual infinite
+/// projection (its depth row becomes `(0, 0, 0, near)`).
+pub fn reverse_z(proj: glam::Mat4) -> glam::Mat4 {
+    let flip = glam::Mat4::from_cols(
+        glam::Vec4::new(1.0, 0.0, 0.0, 0.0),
+        glam::Vec4::new(0.0, 1.0, 0.0, 0.0),
+        glam::Vec4::new(0.0, 0.0, -1.0, 0.0),
+        glam::Vec4::new(0.0, 0.0, 1.0, 1.0),
+    );
+    flip * proj
+}
+
+/// Where the pass records its determination: its own rendering instances, or inside the host's
+/// render pass.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[non_exhaustive]
+pub enum TargetModel {
+    /// Dynamic rendering (Vulkan 1.3, or `VK_KHR_dynamic_rendering` promoted): each
+    /// `cmd_determine` begins and ends its own rendering instance on the host's image, and
+    /// records the layout transitions its [`DepthStencilTarget`](super::DepthStencilTarget)
+    /// declares. The host enables `dynamicRendering` on its device.
+    #[default]
+    DynamicRendering,
+    /// The host's `VkRenderPass`: the pipelines are built against its subpass, and
+    /// `cmd_determine` records inside that subpass after the host began it (clearing the
+    /// stencil inside the light's scissor with `vkCmdClearAttachments`). Vulkan 1.1.
+    RenderPass(RenderPassTarget),
+}
+
+/// The host's render pass and the subpass the determination records in, with what the pass
+/// needs to know about that subpass (Vulkan cannot be asked: fill the fields, or read them
+/// from the render pass's create info with [`RenderPassTarget::new`]). Checked against the
+/// [`ShadowPassDesc`] when the pass is created.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RenderPassTarget {
+    /// The host's render pass (it must outlive the pass; pipelines are built against it, so
+    /// any render pass *compatible* with it may be begun).
+    pub render_pass: vk::RenderPass,
+    /// The subpass index.
+    pub subpass: u32,
+    /// The subpass's depth-stencil attachment format.
+    pub depth_stencil_format: vk::Format,
+    /// The subpass's sample count.
+    pub samples: vk::SampleCountFlags,
+    /// The number of colour attachments of the subpass (the pass's pipelines write none).
+    pub color_attachments: u32,
+}
+
+impl RenderPassTarget {
+    /// Reads the subpass `subpass` of the `create_info` the host made `render_pass` with.
+    /// Errors: no such subpass, a subpass without a depth-stencil attachment, or one that
+    /// uses it read-only.
+    ///
+    /// # Safety
+    /// `create_info`'s pointers are valid for their counts (as when it was built with ash's
+    /// builder methods, which tie them to borrowed slices).
+    pub unsafe fn new(render_pass: vk::RenderPass, create_info: &vk::RenderPassCreateInfo, subpass: u32) -> Result<RenderPassTarget> {
+        let field = "RenderPassTarget";
+        if render_pass == vk::RenderPass::null() {
+            return Err(Error::desc(field, "the render pass is VK_NULL_HANDLE"));
+        }
+        // SAFETY: the caller's contract; a null pointer or a zero count is never dereferenced.
+        let subpasses = unsafe { raw_slice(create_info.p_subpasses, create_info.subpass_count) };
+        // SAFETY: as above.
+        let attachments = unsafe { raw_slice(create_info.p_attachments, create_info.attachment_count) };
+        let sp = subpasses
+            .get(subpass as usize)
+            .ok_or_else(|| Error::desc(field, format!("subpass {subpass} out of range (the render pass has {})", subpasses.len())))?;
+        // SAFETY: the caller's contract: null, or one attachment reference.
+        let ds = unsafe { sp.p_depth_stencil_attachment.as_ref() };
+        let ds = match ds {
+            Some(r) if r.attachment != vk::ATTACHMENT_UNUSED => r,
+            _ => return Err(Error::desc(field, format!("subpass {subpass} has no depth-stencil attachment"))),
+        };
+        let att = attachments
+            .get(ds.attachment as usize)
+            .ok_or_else(|| Error::desc(field, format!("subpass {subpass}'s depth-stencil attachment {} is out of range", ds.attachment)))?;
+        if matches!(
+            ds.layout,
+            vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL | vk::ImageLayout::DEPTH_ATTACHMENT_STENCIL_READ_ONLY_OPTIMAL
+        ) {
+            return Err(Error::desc(
+                field,
+                format!("subpass {subpass} uses its depth-stencil attachment in {:?}: the stencil must be writable", ds.layout),
+            ));
+        }
+        Ok(RenderPassTarget {
+            render_pass,
+            subpass,
+            depth_stencil_format: att.format,
+            samples: att.samples,
+            color_attachments: sp.color_attachment_count,
+        })
+    }
+}
+
+/// # Safety
+/// `ptr` is null with `len == 0`, or points at `len` valid `T`s that outlive the slice.
+unsafe fn raw_slice<'a, T>(ptr: *const T, len: u32) -> &'a [T] {
+    if ptr.is_null() || len == 0 {
+        &[]
+    } else {
+        // SAFETY: the caller's contract.
+        unsafe { std::slice::from_raw_parts(ptr, len as usize) }
+    }
+}
+
+named_enum!(
     /// How shadow geometry reaches the GPU each frame.
     IndexFormat, "index format", {
         /// 4 bytes an index: 12 bytes a shadow triangle.
@@ -122,6 +244,13 @@ pub struct ShadowPassDesc {
     pub frames_in_flight: usize,
     /// The host's projection: infinite far plane, or finite with depth clamp.
     pub depth_mode: DepthMode,
+    /// Forward depth or reverse-Z.
+    pub depth_direction: DepthDirection,
+    /// Samples per pixel of the host's depth-stencil image: 1, 2, 4 or 8 (the stencil count
+    /// is exact per sample).
+    pub samples: u32,
+    /// Dynamic rendering, or the host's render pass.
+    pub target: TargetModel,
     /// The features the host enabled on its device.
     pub features: EnabledFeatures,
     /// The first frame's settings (technique, counter, index format).
@@ -141,6 +270,9 @@ impl Default for ShadowPassDesc {
             depth_stencil_format: vk::Format::D32_SFLOAT_S8_UINT,
             frames_in_flight: 2,
             depth_mode: DepthMode::Infinite,
+            depth_direction: DepthDirection::Forward,
+            samples: 1,
+            target: TargetModel::DynamicRendering,
             features: EnabledFeatures::default(),
             settings: PassSettings::default(),
             transmit_format: None,
@@ -215,11 +347,13 @@ impl PassSettings {
     /// Whether the device can honour these settings (checked before every frame).
     pub fn check(&self, caps: &Capabilities) -> Result<()> {
         if self.index_format == IndexFormat::U8 && !caps.index_type_uint8 {
-            return Err(Error::Unsupported("--index-format u8 needs VK_EXT_index_type_uint8; use auto or u16".into()));
+            return Err(Error::Unsupported(
+                "IndexFormat::U8 needs indexTypeUint8 (VK_EXT_index_type_uint8 / VK_KHR_index_type_uint8, enabled); use IndexFormat::Auto or U16".into(),
+            ));
         }
         if self.counter == Counter::Float && !caps.r32f_blend {
             return Err(Error::Unsupported(
-                "--counter float needs R32_SFLOAT colour blending, which this device lacks; use --counter stencil".into(),
+                "Counter::Float needs R32_SFLOAT colour blending, which this device lacks; use Counter::Stencil".into(),
             ));
         }
         Ok(())

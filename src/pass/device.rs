@@ -18,4 +18,8 @@ impl GpuDevice for PassDevice {
     fn allocator(&self) -> std::sync::MutexGuard<'_, Allocator> {
         lock_allocator(&self.allocator)
     }
+    /// The pass asks for Vulkan 1.1 only: its barriers are Vulkan 1.0 `vkCmdPipelineBarrier`.
+    fn synchronization2(&self) -> bool {
+        false
+    }
 }

@@ -3,7 +3,7 @@
 
 use super::casters::{CasterTable, Upload};
 use super::compute::frame::ComputeFrame;
-use super::desc::{Counter, IndexFormat, PassSettings, Technique};
+use super::desc::{Counter, DepthDirection, IndexFormat, PassSettings, Technique};
 use super::stats::{CasterStats, CpuMs, LightStats, PartStats, Totals, Triangles};
 use crate::error::{Error, Result};
 use crate::geom::{Camera, Light, LightKind};
@@ -31,16 +31,65 @@ pub struct ShadowView {
 }
 
 impl ShadowView {
+    /// The view of a host camera given as its usual (world -> view) matrix `view`, with its
+    /// translation: the pass needs the eye in f64 and the rotation alone, so it strips the
+    /// translation here (`eye` is the camera's world position, `view` maps it to the origin).
+    /// `proj` is the host's view -> Vulkan clip projection (forward or reverse-Z, as the pass
+    /// was created for), `size` the target's `(width, height)`.
+    ///
+    /// Errors: [`Error::Misuse`] when `view` does not map `eye` to the origin (to within
+    /// 1e-4 of the scene's scale), or is not a rigid rotation plus translation.
+    ///
+    /// ```
+    /// use glam::{DVec3, Mat4, Vec3};
+    /// use umbrage::pass::ShadowView;
+    /// let eye = Vec3::new(0.0, 2.0, 6.0);
+    /// let view = Mat4::look_at_rh(eye, Vec3::ZERO, Vec3::Y);
+    /// let proj = Mat4::perspective_infinite_rh(1.0, 1.0, 0.1);
+    /// let v = ShadowView::from_view_matrix(eye.as_dvec3(), view, proj, (640, 480))?;
+    /// assert_eq!(v.view.w_axis.truncate(), Vec3::ZERO);
+    /// assert!((v.world_view_proj() - proj * view).abs_diff_eq(Mat4::ZERO, 1e-5));
+    /// # Ok::<(), umbrage::Error>(())
+    /// ```
+    pub fn from_view_matrix(eye: DVec3, view: Mat4, proj: Mat4, size: (u32, u32)) -> Result<ShadowView> {
+        let v = view.as_dmat4();
+        let at_eye = v.transform_point3(eye);
+        let scale = eye.length().max(1.0);
+        if !at_eye.is_finite() || at_eye.length() > 1e-4 * scale {
+            return Err(Error::argument(
+                "ShadowView::from_view_matrix",
+                format!("the view matrix maps the eye {eye} to {at_eye}, not to the origin: pass the camera's own view matrix"),
+            ));
+        }
+        let r = glam::DMat3::from_mat4(v);
+        if !(r * r.transpose()).abs_diff_eq(glam::DMat3::IDENTITY, 1e-4) || (v.row(3) - glam::DVec4::W).length() > 1e-9 {
+            return Err(Error::argument("ShadowView::from_view_matrix", "the view matrix is not a rotation and a translation"));
+        }
+        let rotation = Mat4::from_mat3(glam::Mat3::from_mat4(view));
+        let out = ShadowView { eye, view: rotation, proj, width: size.0, height: size.1 };
+        out.check()?;
+        Ok(out)
+    }
+
+    /// The same view with a forward projection: the planner's near plane, frustum, scissors
+    /// and depth bounds are computed on it.
+    pub(crate) fn forward(&self, direction: DepthDirection) -> ShadowView {
+        match direction {
+            DepthDirection::Forward => *self,
+            DepthDirection::Reverse => ShadowView { proj: super::desc::reverse_z(self.proj), ..*self },
+        }
+    }
+
     /// World -> clip, composed in f64 (the planner's frustum and scissor tests).
     pub fn world_view_proj(&self) -> Mat4 {
         (self.proj.as_dmat4() * self.view.as_dmat4() * DMat4::from_translation(-self.eye)).as_mat4()
     }
     pub(crate) fn check(&self) -> Result<()> {
         if !(self.eye.is_finite() && self.view.is_finite() && self.proj.is_finite()) {
-            return Err(Error::Other("ShadowView: eye, view or projection is not finite".into()));
+            return Err(Error::argument("ShadowView", "eye, view or projection is not finite"));
         }
         if self.width == 0 || self.height == 0 {
-            return Err(Error::Other(format!("ShadowView: empty target {}x{}", self.width, self.height)));
+            return Err(Error::argument("ShadowView", format!("empty target {}x{}", self.width, self.height)));
         }
         Ok(())
     }
@@ -121,6 +170,8 @@ impl LightFrame {
 /// that slot is prepared again.
 #[derive(Debug)]
 pub struct PreparedFrame {
+    /// The id of the pass that prepared it.
+    pub(crate) pass: u64,
     pub(crate) slot: usize,
     pub(crate) serial: u64,
     pub(crate) stream: vk::Buffer,
@@ -179,6 +230,8 @@ pub(crate) struct Packed {
 /// Inputs of [`pack`].
 pub(crate) struct PackInput<'a> {
     pub view: &'a ShadowView,
+    /// The host's depth direction (the planner works on the forward view).
+    pub direction: DepthDirection,
     pub lights: &'a [Light],
     pub settings: PassSettings,
     pub u8_ok: bool,
@@ -194,7 +247,10 @@ pub(crate) struct PackInput<'a> {
 /// Plans every light and packs the index streams (or naive vertices) into one byte stream.
 pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
     let view = input.view;
-    let view_proj = view.world_view_proj();
+    // The volumes are drawn with the host's projection; the planner (near plane, frustum,
+    // scissor, depth bounds) works on its forward equivalent.
+    let fwd = view.forward(input.direction);
+    let view_proj = fwd.world_view_proj();
     let vp_rel_d = view.proj.as_dmat4() * view.view.as_dmat4();
     let camera = Camera { eye: view.eye.as_vec3(), ..Camera::default() };
     let edge_quads = input.settings.technique == Technique::EdgeQuads;
@@ -348,7 +404,7 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
         if input.casters {
             let sin = super::spheres::SphereInput {
                 view,
-                scale: super::spheres::view_scale(view),
+                scale: super::spheres::view_scale(&fwd),
                 light,
                 technique: input.settings.technique,
                 planar_receiver: input.planar_receiver,
@@ -367,8 +423,12 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
             .filter(|r| r.extent.width > 0 && r.extent.height > 0 && input.settings.toggles.scissor)
             .unwrap_or(full);
         let depth_bounds = if input.depth_bounds { plan.depth_bounds } else { None };
+        let depth_bounds = match input.direction {
+            DepthDirection::Forward => depth_bounds,
+            DepthDirection::Reverse => depth_bounds.map(|(lo, hi)| reversed_bounds(lo, hi)),
+        };
         let (eye_volumes, near_plane_split) = if method == shadow::Method::ZPassClear {
-            let [c0, c1, c2, c3] = near_corners(view);
+            let [c0, c1, c2, c3] = near_corners(&fwd);
             let counts = super::eye::volumes_containing(&[view.eye, c0, c1, c2, c3], light, &plan, table);
             (Some(counts[0]), Some(counts[1..].iter().any(|&c| c != counts[0])))
         } else {
@@ -433,7 +493,21 @@ fn flatten(plan: &mut LightPlan, table: &CasterTable, light: &Light, p: glam::DV
     m
 }
 
-/// The near-plane rectangle's corners in world space (Vulkan depth 0).
+/// Forward depth bounds `[lo, hi]` as reverse-Z bounds `[1 - hi, 1 - lo]`, rounded outwards
+/// to f32 (the subtraction is exact in f64).
+fn reversed_bounds(lo: f32, hi: f32) -> (f32, f32) {
+    let (a, b) = (1.0 - hi as f64, 1.0 - lo as f64);
+    let (mut a32, mut b32) = (a as f32, b as f32);
+    if a32 as f64 > a {
+        a32 = f32::from_bits(a32.to_bits().saturating_sub(1));
+    }
+    if (b32 as f64) < b {
+        b32 = f32::from_bits(b32.to_bits() + 1);
+    }
+    (a32.clamp(0.0, 1.0), b32.clamp(0.0, 1.0))
+}
+
+/// The near-plane rectangle's corners in world space (forward Vulkan depth 0).
 fn near_corners(view: &ShadowView) -> [DVec3; 4] {
     let inv = (view.proj.as_dmat4() * view.view.as_dmat4()).inverse();
     [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(x, y)| {
@@ -454,7 +528,7 @@ pub(crate) fn overflow_warnings(table: &CasterTable, lights: &[LightFrame], coun
         let drawn: usize = l.plan.casters.iter().filter(|c| c.case != Case::Culled).map(|c| table.live[c.caster].shells).sum();
         if drawn > 255 {
             warnings.push(format!(
-                "light {li}: {drawn} closed shells cast shadow volumes; pixels inside 256k of them wrap to 0 in the 8-bit stencil and read as lit (use --counter float)"
+                "light {li}: {drawn} closed shells cast shadow volumes; pixels inside 256k of them wrap to 0 in the 8-bit stencil and read as lit (Counter::Float counts exactly)"
             ));
         }
     }
@@ -467,7 +541,16 @@ pub(crate) fn check_lights(lights: &[Light]) -> Result<()> {
         let finite = l.position.is_finite() && l.direction.is_finite() && l.color.is_finite() && l.intensity.is_finite();
         let dir_ok = l.kind == LightKind::Point || l.direction.length_squared() > 0.0;
         if !finite || !dir_ok || l.radius.is_some_and(|r| !(r > 0.0)) {
-            return Err(Error::Other(format!("light {i}: not finite, zero direction or non-positive radius ({l:?})")));
+            return Err(Error::argument("light", format!("light {i}: not finite, zero direction or non-positive radius ({l:?})")));
+        }
+        if l.area.is_some() {
+            return Err(Error::argument(
+                "light",
+                format!(
+                    "light {i} is an area light: the pass determines point, spot and directional lights; expand it into its \
+                     point-light samples first (geom::area::expand_lights), one determination and lighting pass each"
+                ),
+            ));
         }
     }
     Ok(())

@@ -63,13 +63,16 @@ mod spheres;
 pub mod stats;
 
 pub use casters::CasterId;
-pub use desc::{Capabilities, Counter, DepthMode, EnabledFeatures, IndexFormat, PassSettings, PassToggles, ShadowPassDesc, Technique};
+pub use desc::{
+    reverse_z, Capabilities, Counter, DepthDirection, DepthMode, EnabledFeatures, IndexFormat, PassSettings, PassToggles, RenderPassTarget,
+    ShadowPassDesc, TargetModel, Technique,
+};
 pub use frame::{case_name, LightFrame, PreparedFrame, ShadowView};
 pub use pipelines::COUNT_FORMAT;
 pub use record::{lit_stencil_state, DepthStencilTarget, VolumeKind};
 pub use spheres::SphereId;
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Misuse, Result};
 use crate::geom::Light;
 use crate::geom::Mesh;
 use crate::gpu::Buffer;
@@ -113,15 +116,31 @@ pub struct ShadowPass {
     /// Analytic sphere casters, in draw order (after the mesh casters).
     spheres: Vec<spheres::SphereCaster>,
     next_sphere: u64,
+    /// Unique among the process's passes: a frame carries it, so another pass's frame is refused.
+    id: u64,
 }
+
+/// The id of the next pass created.
+static NEXT_PASS_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
 impl ShadowPass {
     /// Creates the pass on the host's device. `allocator` is the host's gpu-allocator (shared:
     /// the pass allocates its caster buffers and streams from it). Optional features are the
     /// host's [`ShadowPassDesc::features`] intersected with what `physical_device` reports.
     ///
-    /// Errors: a depth-stencil format without depth or 8 stencil bits, `frames_in_flight` of 0
-    /// or over 64, [`DepthMode::Clamp`] without depthClamp, a failed Vulkan call.
+    /// The host's instance and device are Vulkan 1.1 or later ([`TargetModel::DynamicRendering`]:
+    /// 1.3 with `dynamicRendering` enabled).
+    ///
+    /// Errors, each before anything is created:
+    /// - [`Error::InvalidDesc`]: `frames_in_flight` not in 1..=64, `samples` not 1, 2, 4 or 8, a
+    ///   depth-stencil format without depth or 8 stencil bits, a [`RenderPassTarget`] whose
+    ///   format or sample count differs from the desc, or colour-target options
+    ///   (`transmit_format`, `debug_color_format`) with the render-pass model;
+    /// - [`Error::Unsupported`]: a device older than Vulkan 1.1 (1.3 for dynamic rendering), a
+    ///   format that is no depth-stencil attachment, a sample count the format or device does
+    ///   not support, [`DepthMode::Clamp`] (a finite far plane, forward or reverse-Z) without
+    ///   `depthClamp`;
+    /// - [`Error::Vulkan`]: a failed Vulkan call.
     pub fn new(
         instance: &ash::Instance,
         physical_device: vk::PhysicalDevice,
@@ -131,32 +150,78 @@ impl ShadowPass {
     ) -> Result<ShadowPass> {
         desc::check_depth_stencil_format(desc.depth_stencil_format)?;
         if desc.frames_in_flight == 0 || desc.frames_in_flight > 64 {
-            return Err(Error::Other(format!("ShadowPassDesc::frames_in_flight must be 1..=64, got {}", desc.frames_in_flight)));
+            return Err(Error::desc("ShadowPassDesc::frames_in_flight", format!("must be 1..=64, got {}", desc.frames_in_flight)));
+        }
+        if ![1, 2, 4, 8].contains(&desc.samples) {
+            return Err(Error::desc("ShadowPassDesc::samples", format!("must be 1, 2, 4 or 8, got {}", desc.samples)));
+        }
+        let samples = pipelines::sample_flags(desc.samples);
+        if let TargetModel::RenderPass(rp) = desc.target {
+            let field = "ShadowPassDesc::target";
+            if rp.depth_stencil_format != desc.depth_stencil_format {
+                return Err(Error::desc(
+                    field,
+                    format!(
+                        "the subpass's depth-stencil attachment is {:?}, the desc says {:?}",
+                        rp.depth_stencil_format, desc.depth_stencil_format
+                    ),
+                ));
+            }
+            if rp.samples != samples {
+                return Err(Error::desc(
+                    field,
+                    format!("the subpass's depth-stencil attachment has {:?} samples, the desc says {}", rp.samples, desc.samples),
+                ));
+            }
+            if desc.transmit_format.is_some() || desc.debug_color_format.is_some() {
+                return Err(Error::desc(
+                    field,
+                    "transmit_format and debug_color_format draw into colour targets of the pass's own rendering instances: \
+                     dynamic rendering only",
+                ));
+            }
         }
         // SAFETY: plain queries on a valid physical device of `instance`.
-        let (features, ds_props, r32f) = unsafe {
+        let (features, props, ds_props, r32f) = unsafe {
             (
                 instance.get_physical_device_features(physical_device),
+                instance.get_physical_device_properties(physical_device),
                 instance.get_physical_device_format_properties(physical_device, desc.depth_stencil_format),
                 instance.get_physical_device_format_properties(physical_device, COUNT_FORMAT),
             )
         };
+        let api = props.api_version;
+        let version = |v: u32| format!("{}.{}", vk::api_version_major(v), vk::api_version_minor(v));
+        if api < vk::API_VERSION_1_1 {
+            return Err(Error::Unsupported(format!("the shadow pass needs Vulkan 1.1; the device has {}", version(api))));
+        }
+        if desc.target == TargetModel::DynamicRendering && !dynamic_rendering_supported(instance, physical_device, api) {
+            return Err(Error::Unsupported(format!(
+                "TargetModel::DynamicRendering needs Vulkan 1.3 with dynamicRendering; the device has {} without it: \
+                 use TargetModel::RenderPass",
+                version(api)
+            )));
+        }
         if !ds_props.optimal_tiling_features.contains(vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT) {
             return Err(Error::Unsupported(format!(
                 "{:?} is not a depth-stencil attachment format on this device",
                 desc.depth_stencil_format
             )));
         }
+        check_samples(instance, physical_device, &props.limits, desc)?;
         let caps = Capabilities {
             depth_clamp: desc.features.depth_clamp && features.depth_clamp == vk::TRUE,
             depth_bounds: desc.features.depth_bounds && features.depth_bounds == vk::TRUE,
             index_type_uint8: desc.features.index_type_uint8 && index_type_uint8_supported(instance, physical_device),
-            r32f_blend: r32f.optimal_tiling_features.contains(vk::FormatFeatureFlags::COLOR_ATTACHMENT_BLEND),
+            r32f_blend: r32f.optimal_tiling_features.contains(vk::FormatFeatureFlags::COLOR_ATTACHMENT_BLEND)
+                && desc.target == TargetModel::DynamicRendering,
         };
         if desc.depth_mode == DepthMode::Clamp && !caps.depth_clamp {
-            return Err(Error::Unsupported(
-                "--depth-mode clamp needs the depthClamp feature (present and enabled on the device); use --depth-mode infinite".into(),
-            ));
+            return Err(Error::Unsupported(format!(
+                "DepthMode::Clamp (a finite far plane, {} depth) needs the depthClamp feature, present and enabled on the device \
+                 (EnabledFeatures::depth_clamp); use DepthMode::Infinite",
+                desc.depth_direction.name()
+            )));
         }
         desc.settings.check(&caps)?;
         let dev = PassDevice { device: device.clone(), allocator };
@@ -185,6 +250,7 @@ impl ShadowPass {
             compute_pipes: Some(compute_pipes),
             spheres: Vec::new(),
             next_sphere: 0,
+            id: NEXT_PASS_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
         })
     }
 
@@ -192,7 +258,7 @@ impl ShadowPass {
     /// `(n, d)` with `n` pointing to the side the light is on (default: y = 0, up).
     pub fn set_planar_receiver(&mut self, plane: glam::DVec4) -> Result<()> {
         if !plane.is_finite() || plane.truncate().length_squared() == 0.0 {
-            return Err(Error::Other(format!("planar receiver {plane} is not a plane")));
+            return Err(Error::argument("planar receiver", format!("{plane} is not a plane")));
         }
         self.planar_receiver = plane;
         Ok(())
@@ -236,7 +302,7 @@ impl ShadowPass {
     /// ([`VolumeKind::Transmit`]), not the opaque count. Needs [`ShadowPassDesc::transmit_format`].
     pub fn add_transparent_caster(&mut self, name: &str, mesh: &Mesh, transform: DMat4, transmittance: Vec3) -> Result<CasterId> {
         if self.pipes.transmit.is_none() {
-            return Err(Error::Other(format!("caster '{name}': transparent casters need ShadowPassDesc::transmit_format")));
+            return Err(Misuse::NotConfigured { call: "add_transparent_caster", needs: "ShadowPassDesc::transmit_format" }.into());
         }
         if !transmittance.is_finite() {
             return Err(Error::mesh(name, format!("transmittance {transmittance} is not finite")));
@@ -250,7 +316,11 @@ impl ShadowPass {
     pub fn add_prepared_caster(&mut self, caster: Caster, transform: DMat4) -> Result<CasterId> {
         casters::check_transform(&caster.name, &transform)?;
         if caster.transmittance.is_some() && self.pipes.transmit.is_none() {
-            return Err(Error::Other(format!("caster '{}': transparent casters need ShadowPassDesc::transmit_format", caster.name)));
+            return Err(Misuse::NotConfigured {
+                call: "add_prepared_caster (a transparent caster)",
+                needs: "ShadowPassDesc::transmit_format",
+            }
+            .into());
         }
         self.casters.add(&self.dev, caster, transform)
     }
@@ -348,7 +418,7 @@ impl ShadowPass {
 
     fn prepare_with(&mut self, slot: usize, view: &ShadowView, lights: &[Light], casters: bool) -> Result<PreparedFrame> {
         if slot >= self.slots.len() {
-            return Err(Error::Other(format!("ring slot {slot} out of range (frames_in_flight = {})", self.slots.len())));
+            return Err(Misuse::SlotOutOfRange { slot, slots: self.slots.len() }.into());
         }
         view.check()?;
         check_lights(lights)?;
@@ -357,7 +427,9 @@ impl ShadowPass {
         }
         self.settings.check(&self.caps)?;
         if self.casters.cpu.iter().any(|c| c.transmittance.is_some()) && self.pipes.transmit.is_none() {
-            return Err(Error::Other("transparent casters need ShadowPassDesc::transmit_format".into()));
+            return Err(
+                Misuse::NotConfigured { call: "prepare (with transparent casters)", needs: "ShadowPassDesc::transmit_format" }.into()
+            );
         }
         // The slot's previous frame has retired: free its staging copies and what waited for it.
         for mut b in self.slots[slot].staging.drain(..) {
@@ -382,6 +454,7 @@ impl ShadowPass {
             &self.casters,
             &PackInput {
                 view,
+                direction: self.desc.depth_direction,
                 lights,
                 settings: self.settings,
                 u8_ok: self.caps.index_type_uint8,
@@ -407,6 +480,7 @@ impl ShadowPass {
         self.serial += 1;
         self.slots[slot].serial = Some(serial);
         Ok(PreparedFrame {
+            pass: self.id,
             slot,
             serial,
             stream,
@@ -447,6 +521,49 @@ impl ShadowPass {
     pub fn caster_kind(&self, id: CasterId) -> Result<&CasterKind> {
         Ok(&self.casters.cpu[self.casters.find(id)?].kind)
     }
+}
+
+/// Whether the device can do dynamic rendering: Vulkan 1.3 with `dynamicRendering`.
+fn dynamic_rendering_supported(instance: &ash::Instance, pd: vk::PhysicalDevice, api: u32) -> bool {
+    if api < vk::API_VERSION_1_3 {
+        return false;
+    }
+    let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
+    let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13);
+    // SAFETY: a feature query on a valid Vulkan 1.3 physical device with a well-formed pNext chain.
+    unsafe { instance.get_physical_device_features2(pd, &mut f2) };
+    f13.dynamic_rendering == vk::TRUE
+}
+
+/// Refuses a sample count the device's framebuffer limits or the depth-stencil format lack.
+fn check_samples(instance: &ash::Instance, pd: vk::PhysicalDevice, limits: &vk::PhysicalDeviceLimits, desc: &ShadowPassDesc) -> Result<()> {
+    let flag = pipelines::sample_flags(desc.samples);
+    let framebuffer = limits.framebuffer_depth_sample_counts & limits.framebuffer_stencil_sample_counts;
+    // SAFETY: a format query on a valid physical device.
+    let image = unsafe {
+        instance.get_physical_device_image_format_properties(
+            pd,
+            desc.depth_stencil_format,
+            vk::ImageType::TYPE_2D,
+            vk::ImageTiling::OPTIMAL,
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+            vk::ImageCreateFlags::empty(),
+        )
+    }
+    .map(|p| p.sample_counts)
+    .unwrap_or(vk::SampleCountFlags::empty());
+    if !framebuffer.contains(flag) || !image.contains(flag) {
+        let counts = |f: vk::SampleCountFlags| {
+            [1u32, 2, 4, 8, 16, 32, 64].into_iter().filter(|&n| f.as_raw() & n != 0).map(|n| n.to_string()).collect::<Vec<_>>().join(", ")
+        };
+        return Err(Error::Unsupported(format!(
+            "{} samples: this device supports {} for {:?} depth-stencil attachments",
+            desc.samples,
+            counts(framebuffer & image),
+            desc.depth_stencil_format
+        )));
+    }
+    Ok(())
 }
 
 fn index_type_uint8_supported(instance: &ash::Instance, pd: vk::PhysicalDevice) -> bool {

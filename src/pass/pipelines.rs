@@ -1,7 +1,7 @@
 //! The shadow pass's pipelines: every way a volume face is counted, as a table of
 //! fixed-function state (stencil ops, depth compare). Destroyed exactly as created.
 
-use super::desc::{DepthMode, ShadowPassDesc};
+use super::desc::{DepthDirection, DepthMode, ShadowPassDesc, TargetModel};
 use super::push::VolumePush;
 use crate::error::Result;
 use crate::gpu::descriptors::pipeline_layout;
@@ -65,6 +65,28 @@ pub(crate) struct Pipelines {
     pub planar_count: Option<vk::Pipeline>,
 }
 
+/// The sample count flag of `n` samples (1, 2, 4 or 8; checked at creation).
+pub(crate) fn sample_flags(n: u32) -> vk::SampleCountFlags {
+    match n {
+        2 => vk::SampleCountFlags::TYPE_2,
+        4 => vk::SampleCountFlags::TYPE_4,
+        8 => vk::SampleCountFlags::TYPE_8,
+        _ => vk::SampleCountFlags::TYPE_1,
+    }
+}
+
+/// A depth compare for forward depth, mirrored for reverse-Z (closer is GREATER).
+pub(crate) fn mirror(op: vk::CompareOp) -> vk::CompareOp {
+    use vk::CompareOp as C;
+    match op {
+        C::LESS => C::GREATER,
+        C::GREATER => C::LESS,
+        C::LESS_OR_EQUAL => C::GREATER_OR_EQUAL,
+        C::GREATER_OR_EQUAL => C::LESS_OR_EQUAL,
+        other => other,
+    }
+}
+
 impl Pipelines {
     pub fn new(dev: &impl GpuDevice, desc: &ShadowPassDesc, depth_clamp: bool, depth_bounds: bool, r32f_blend: bool) -> Result<Pipelines> {
         let layout = pipeline_layout(dev, &[], VolumePush::SIZE, vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)?;
@@ -92,8 +114,23 @@ impl Pipelines {
         r32f_blend: bool,
         made: &mut Vec<vk::Pipeline>,
     ) -> Result<Pipelines> {
+        // Every table below is written for forward depth; reverse-Z mirrors the compares and
+        // the depth bias. Samples and the target model apply to every pipeline.
+        let reverse = desc.depth_direction == DepthDirection::Reverse;
+        let samples = sample_flags(desc.samples);
+        let render_pass = match desc.target {
+            TargetModel::RenderPass(rp) => Some((rp.render_pass, rp.subpass, rp.color_attachments)),
+            _ => None,
+        };
         let mut create = |d: &PipelineDesc| -> Result<vk::Pipeline> {
-            let p = pipeline::create(dev, d)?;
+            let mut d = d.clone();
+            if reverse {
+                d.depth_compare = mirror(d.depth_compare);
+                d.depth_bias = d.depth_bias.map(|(c, s)| (-c, -s));
+            }
+            d.samples = samples;
+            d.render_pass = render_pass;
+            let p = pipeline::create(dev, &d)?;
             made.push(p);
             Ok(p)
         };
@@ -140,7 +177,10 @@ impl Pipelines {
         c.color_formats = &count_fmt;
         c.blend = Blend::Additive;
         c.stencil = None;
-        let count = if r32f_blend {
+        // The float counter, the light-intensity map and the overlay draw into colour targets of
+        // their own rendering instances: dynamic rendering only (refused at creation otherwise).
+        let dynamic = render_pass.is_none();
+        let count = if r32f_blend && dynamic {
             c.depth_compare = vk::CompareOp::LESS;
             let zpass = create(&c)?;
             c.depth_compare = vk::CompareOp::GREATER_OR_EQUAL;
@@ -160,7 +200,7 @@ impl Pipelines {
             None
         };
 
-        let transmit = match desc.transmit_format {
+        let transmit = match desc.transmit_format.filter(|_| dynamic) {
             Some(format) => {
                 let map_fmt = [format];
                 let mut tm = c.clone();
@@ -181,7 +221,7 @@ impl Pipelines {
             None => None,
         };
 
-        let overlay = match desc.debug_color_format {
+        let overlay = match desc.debug_color_format.filter(|_| dynamic) {
             Some(format) => {
                 let fmt = [format];
                 let mut v = PipelineDesc::new(shaders::SHADOW_VERT, layout, df);
@@ -215,7 +255,7 @@ impl Pipelines {
         };
         pl.stencil = Some((replace, replace));
         let planar = create(&pl)?;
-        let planar_count = if r32f_blend {
+        let planar_count = if r32f_blend && dynamic {
             pl.stencil = None;
             pl.fragment = Some(shaders::COUNT_FRAG);
             pl.color_formats = &count_fmt;

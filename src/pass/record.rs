@@ -1,22 +1,86 @@
 //! Recording: everything the pass writes into the host's command buffers.
 
-use super::desc::IndexFormat;
+use super::desc::{IndexFormat, TargetModel};
 use super::frame::{CasterDraw, Draw, LightFrame, PreparedFrame};
 use super::pipelines::CountPipes;
 use super::push::VolumePush;
 use super::ShadowPass;
+use crate::error::{Error, Misuse, Result};
 use crate::shadow::Case;
 use ash::vk;
 
-/// The host's depth-stencil attachment for the determination.
-#[derive(Clone, Copy, Debug)]
+/// The host's depth-stencil image as the determination uses it, with the layouts the host
+/// declares (FidelityFX / NRD style): the layout it is in when the call is recorded, and the
+/// layout the host wants it left in.
+///
+/// With [`TargetModel::DynamicRendering`] the pass records the transitions itself: from
+/// [`layout`](Self::layout) to `DEPTH_STENCIL_ATTACHMENT_OPTIMAL` (waiting for every earlier
+/// command's writes), its rendering, then to [`final_layout`](Self::final_layout) (its stencil
+/// writes made visible to every later command). With [`TargetModel::RenderPass`] the image is
+/// the subpass's attachment and no transition can be recorded inside the render pass: both
+/// layouts must be the subpass's layout, and the host's subpass dependencies do the rest.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct DepthStencilTarget {
-    /// A view of the host's depth-stencil image covering both aspects, in the format the pass
-    /// was created for; the image is in `DEPTH_STENCIL_ATTACHMENT_OPTIMAL` (or
-    /// `ATTACHMENT_OPTIMAL`) layout when the pass records.
+    /// The host's depth-stencil image (both aspects are transitioned).
+    pub image: vk::Image,
+    /// A view of both aspects of [`image`](Self::image), in the format and sample count the
+    /// pass was created for.
     pub view: vk::ImageView,
-    /// The image's size (the viewport covers all of it).
+    /// The image's size (the viewport covers all of it); equal to the frame's view size.
     pub extent: vk::Extent2D,
+    /// The layout the image is in when the call is recorded (never `UNDEFINED`: the depth is
+    /// read).
+    pub layout: vk::ImageLayout,
+    /// The layout the pass leaves the image in.
+    pub final_layout: vk::ImageLayout,
+}
+
+impl DepthStencilTarget {
+    /// A target in `DEPTH_STENCIL_ATTACHMENT_OPTIMAL` before and after.
+    pub fn new(image: vk::Image, view: vk::ImageView, extent: vk::Extent2D) -> DepthStencilTarget {
+        let l = vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+        DepthStencilTarget { image, view, extent, layout: l, final_layout: l }
+    }
+
+    /// The same target, declared in `layout` and to be left in `final_layout`.
+    pub fn with_layouts(self, layout: vk::ImageLayout, final_layout: vk::ImageLayout) -> DepthStencilTarget {
+        DepthStencilTarget { layout, final_layout, ..self }
+    }
+
+    fn check(&self, frame: &PreparedFrame, model: &TargetModel) -> Result<()> {
+        use vk::ImageLayout as L;
+        if self.extent != frame.extent() {
+            return Err(Error::argument(
+                "DepthStencilTarget",
+                format!(
+                    "extent {}x{} differs from the frame's view {}x{}",
+                    self.extent.width,
+                    self.extent.height,
+                    frame.extent().width,
+                    frame.extent().height
+                ),
+            ));
+        }
+        if matches!(self.layout, L::UNDEFINED | L::PREINITIALIZED) || matches!(self.final_layout, L::UNDEFINED | L::PREINITIALIZED) {
+            return Err(Error::argument(
+                "DepthStencilTarget",
+                format!(
+                    "declared layouts {:?} -> {:?}: the depth is read, so neither may be UNDEFINED or PREINITIALIZED",
+                    self.layout, self.final_layout
+                ),
+            ));
+        }
+        if matches!(model, TargetModel::RenderPass(_)) && self.layout != self.final_layout {
+            return Err(Error::argument(
+                "DepthStencilTarget",
+                format!(
+                    "{:?} -> {:?} inside the host's render pass: no transition can be recorded there; declare the subpass's layout twice",
+                    self.layout, self.final_layout
+                ),
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// What a volume draw counts into (the pipelines differ, the geometry is the same).
@@ -53,22 +117,102 @@ fn depth_attachment(target: &DepthStencilTarget, stencil: vk::AttachmentLoadOp, 
         .image_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
         .load_op(stencil)
         .store_op(vk::AttachmentStoreOp::STORE)
-        .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: clear & 0xff } })
+        .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 0.0, stencil: clear & 0xff } })
 }
 
+/// The fragment-test stages and depth-stencil accesses of the pass's own rendering.
+const TESTS: (vk::PipelineStageFlags, vk::AccessFlags) = (
+    vk::PipelineStageFlags::from_raw(
+        vk::PipelineStageFlags::EARLY_FRAGMENT_TESTS.as_raw() | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS.as_raw(),
+    ),
+    vk::AccessFlags::from_raw(
+        vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_READ.as_raw() | vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_WRITE.as_raw(),
+    ),
+);
+
+/// Everything before or after the pass, in any layout the host declared.
+const ANY: (vk::PipelineStageFlags, vk::AccessFlags) = (
+    vk::PipelineStageFlags::ALL_COMMANDS,
+    vk::AccessFlags::from_raw(vk::AccessFlags::MEMORY_READ.as_raw() | vk::AccessFlags::MEMORY_WRITE.as_raw()),
+);
+
 impl ShadowPass {
+    /// The frame, if this pass prepared it and its slot still holds it.
+    pub(crate) fn check_frame(&self, frame: &PreparedFrame) -> Result<()> {
+        if frame.pass != self.id {
+            return Err(Misuse::ForeignFrame.into());
+        }
+        let current = self.slots.get(frame.slot).and_then(|s| s.serial);
+        match current {
+            Some(c) if c == frame.serial => Ok(()),
+            Some(c) => Err(Misuse::StaleFrame { slot: frame.slot, serial: frame.serial, current: c }.into()),
+            None => Err(Misuse::SlotOutOfRange { slot: frame.slot, slots: self.slots.len() }.into()),
+        }
+    }
+
+    /// Light `light` of a live frame of this pass.
+    fn light<'f>(&self, frame: &'f PreparedFrame, light: usize) -> Result<&'f LightFrame> {
+        self.check_frame(frame)?;
+        frame.lights.get(light).ok_or_else(|| Misuse::LightIndex { index: light, lights: frame.lights.len() }.into())
+    }
+
+    fn dynamic_only(&self, call: &'static str) -> Result<()> {
+        match self.desc.target {
+            TargetModel::DynamicRendering => Ok(()),
+            _ => Err(Misuse::NotConfigured { call, needs: "TargetModel::DynamicRendering (it begins its own rendering instance)" }.into()),
+        }
+    }
+
+    /// A layout transition (or, in the same layout, a plain dependency) of the host's image.
+    ///
+    /// # Safety
+    /// `cb` is recording outside any rendering instance or render pass; `image` is the host's
+    /// depth-stencil image in `from`.
+    unsafe fn image_barrier(
+        &self,
+        cb: vk::CommandBuffer,
+        image: vk::Image,
+        (from, to): (vk::ImageLayout, vk::ImageLayout),
+        src: (vk::PipelineStageFlags, vk::AccessFlags),
+        dst: (vk::PipelineStageFlags, vk::AccessFlags),
+    ) {
+        let b = [vk::ImageMemoryBarrier::default()
+            .src_access_mask(src.1)
+            .dst_access_mask(dst.1)
+            .old_layout(from)
+            .new_layout(to)
+            .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+            .image(image)
+            .subresource_range(vk::ImageSubresourceRange {
+                aspect_mask: vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL,
+                base_mip_level: 0,
+                level_count: vk::REMAINING_MIP_LEVELS,
+                base_array_layer: 0,
+                layer_count: vk::REMAINING_ARRAY_LAYERS,
+            })];
+        // SAFETY: the caller's contract.
+        unsafe { self.dev.device.cmd_pipeline_barrier(cb, src.0, dst.0, vk::DependencyFlags::empty(), &[], &[], &b) };
+    }
+
     /// Records the frame's pending caster uploads (buffer copies, then a barrier to vertex and
     /// index reads). Idempotent per frame: a second call, or the first `cmd_determine` after
     /// it, records nothing.
     ///
+    /// Reads the pass's staging buffers; writes its caster vertex buffers. The host's images
+    /// are not touched.
+    ///
+    /// Errors ([`Error::Misuse`]): `frame` is another pass's, or its slot was prepared again.
+    ///
     /// # Safety
     /// `cb` is a primary command buffer of the pass's device, recording, outside any rendering
-    /// instance; it is submitted before (or in the same submission as, and earlier than) every
-    /// command buffer that draws `frame`'s volumes. `frame` was prepared by this pass and its
-    /// slot has not been prepared again.
-    pub unsafe fn cmd_upload(&self, cb: vk::CommandBuffer, frame: &PreparedFrame) {
+    /// instance or render pass; it is submitted before (or in the same submission as, and
+    /// earlier than) every command buffer that draws `frame`'s volumes, and completes before
+    /// the frame's slot is prepared again.
+    pub unsafe fn cmd_upload(&self, cb: vk::CommandBuffer, frame: &PreparedFrame) -> Result<()> {
+        self.check_frame(frame)?;
         if frame.uploads_recorded.replace(true) || frame.uploads.is_empty() {
-            return;
+            return Ok(());
         }
         let d = &self.dev.device;
         // SAFETY: the caller's contract; the staging and destination buffers live until the
@@ -77,53 +221,140 @@ impl ShadowPass {
             for up in &frame.uploads {
                 d.cmd_copy_buffer(cb, up.src, up.dst, &[vk::BufferCopy { src_offset: 0, dst_offset: 0, size: up.size }]);
             }
-            let b = [vk::MemoryBarrier2::default()
-                .src_stage_mask(vk::PipelineStageFlags2::COPY)
-                .src_access_mask(vk::AccessFlags2::TRANSFER_WRITE)
-                .dst_stage_mask(vk::PipelineStageFlags2::VERTEX_INPUT | vk::PipelineStageFlags2::COMPUTE_SHADER)
-                .dst_access_mask(
-                    vk::AccessFlags2::VERTEX_ATTRIBUTE_READ | vk::AccessFlags2::INDEX_READ | vk::AccessFlags2::SHADER_STORAGE_READ,
-                )];
-            d.cmd_pipeline_barrier2(cb, &vk::DependencyInfo::default().memory_barriers(&b));
+        }
+        use vk::AccessFlags2 as A;
+        use vk::PipelineStageFlags2 as S;
+        crate::gpu::resources::memory_barrier(
+            &self.dev,
+            cb,
+            (S::TRANSFER, A::TRANSFER_WRITE),
+            (S::VERTEX_INPUT | S::COMPUTE_SHADER, A::VERTEX_ATTRIBUTE_READ | A::INDEX_READ | A::SHADER_READ),
+        );
+        Ok(())
+    }
+
+    /// Records what must precede any rendering of `frame`, outside a rendering instance or
+    /// render pass: [`cmd_upload`](Self::cmd_upload) and
+    /// [`cmd_compute_silhouettes`](Self::cmd_compute_silhouettes). Hosts of the render-pass
+    /// model call it before beginning their render pass; with dynamic rendering the first
+    /// `cmd_determine` records it when the host did not.
+    ///
+    /// # Safety
+    /// As [`cmd_upload`](Self::cmd_upload).
+    pub unsafe fn cmd_before_rendering(&self, cb: vk::CommandBuffer, frame: &PreparedFrame) -> Result<()> {
+        // SAFETY: the caller's contract.
+        unsafe {
+            self.cmd_upload(cb, frame)?;
+            self.cmd_compute_silhouettes(cb, frame)
         }
     }
 
-    /// Records light `light`'s shadow determination into the host's depth-stencil image: a
-    /// rendering instance over the light's scissor with the depth loaded and the stencil
-    /// cleared to 0 there, then every opaque caster's volume (two-sided, wrapping). Afterwards
-    /// the stencil holds the number of volumes around each pixel's visible point, modulo 256
-    /// (0 = lit). Records the frame's uploads first if [`cmd_upload`](Self::cmd_upload) was
-    /// not called.
+    /// Records light `light`'s shadow determination into the host's depth-stencil image.
+    /// Afterwards the stencil holds the number of volumes around each pixel's visible point
+    /// (each sample's, with MSAA), modulo 256 (0 = lit), inside the light's
+    /// [`scissor`](LightFrame::scissor); outside it the stencil is unchanged.
+    ///
+    /// - Reads: the depth aspect (never written), the frame's buffers.
+    /// - Writes: the stencil aspect, inside the light's scissor only (cleared to
+    ///   [`LightFrame::counter_clear`], then counted).
+    /// - Leaves: with [`TargetModel::DynamicRendering`], `target.final_layout`, with the
+    ///   stencil writes visible to every later command; it records the frame's uploads and
+    ///   GPU silhouettes first if the host did not ([`cmd_before_rendering`](Self::cmd_before_rendering)).
+    ///   With [`TargetModel::RenderPass`] it records inside the host's subpass: viewport,
+    ///   scissor and depth bounds set for the light, the stencil cleared with
+    ///   `vkCmdClearAttachments`, the volumes drawn; the host's render pass and subpass
+    ///   dependencies order it with the rest.
+    ///
+    /// Errors ([`Error::Misuse`]), with nothing recorded: `light` out of range, a frame of
+    /// another pass or a stale one, a target whose extent differs from the frame's view or
+    /// whose declared layouts the model cannot take, and (render-pass model) a frame whose
+    /// uploads or GPU silhouettes were not recorded before the render pass began.
     ///
     /// # Safety
-    /// - `cb` is recording, outside any rendering instance, on the pass's device;
-    /// - `target.view` is a view of both aspects of an image in the pass's depth-stencil
-    ///   format, in `DEPTH_STENCIL_ATTACHMENT_OPTIMAL` layout, whose depth writes are visible
-    ///   to fragment tests (the host's barrier);
-    /// - `frame` was prepared by this pass, `light < frame.lights.len()`, and the frame's
-    ///   slot is not prepared again before `cb` has completed.
-    ///
-    /// The pass writes only the stencil aspect inside the light's scissor rectangle.
-    pub unsafe fn cmd_determine(&self, cb: vk::CommandBuffer, frame: &PreparedFrame, light: usize, target: &DepthStencilTarget) {
-        let Some(lf) = frame.lights.get(light) else { return };
-        // SAFETY: the caller's contract (outside a rendering instance).
-        unsafe {
-            self.cmd_upload(cb, frame);
-            self.cmd_compute_silhouettes(cb, frame);
+    /// - `cb` is recording on the pass's device: outside any rendering instance or render pass
+    ///   (dynamic rendering), or inside the subpass of [`TargetModel::RenderPass`] (a render
+    ///   pass compatible with it, begun with `VK_SUBPASS_CONTENTS_INLINE`);
+    /// - `target` describes the host's image truthfully: both aspects, the pass's format and
+    ///   sample count, in `target.layout`;
+    /// - the frame's slot is not prepared again before `cb` has completed.
+    pub unsafe fn cmd_determine(
+        &self,
+        cb: vk::CommandBuffer,
+        frame: &PreparedFrame,
+        light: usize,
+        target: &DepthStencilTarget,
+    ) -> Result<()> {
+        let lf = self.light(frame, light)?;
+        target.check(frame, &self.desc.target)?;
+        let d = &self.dev.device;
+        if let TargetModel::RenderPass(_) = self.desc.target {
+            self.check_recorded_before_rendering(frame)?;
+            let clear = [vk::ClearAttachment {
+                aspect_mask: vk::ImageAspectFlags::STENCIL,
+                color_attachment: 0,
+                clear_value: vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 0.0, stencil: lf.counter_clear & 0xff } },
+            }];
+            let rect = [vk::ClearRect { rect: lf.scissor, base_array_layer: 0, layer_count: 1 }];
+            // SAFETY: the caller's contract (inside the subpass, whose depth-stencil attachment
+            // is the target).
+            unsafe {
+                d.cmd_clear_attachments(cb, &clear, &rect);
+                self.cmd_light_state(cb, frame, light, target.extent)?;
+                self.cmd_draw_volumes(cb, frame, light, VolumeKind::Stencil)?;
+            }
+            return Ok(());
         }
+        // SAFETY: the caller's contract (outside a rendering instance).
+        unsafe { self.cmd_before_rendering(cb, frame)? };
         let depth = depth_attachment(target, vk::AttachmentLoadOp::LOAD, 0);
         // Cleared to 0, or to the number of volumes containing the eye (zpass-clear).
         let stencil = depth_attachment(target, vk::AttachmentLoadOp::CLEAR, lf.counter_clear);
         let info =
             vk::RenderingInfo::default().render_area(lf.scissor).layer_count(1).depth_attachment(&depth).stencil_attachment(&stencil);
-        let d = &self.dev.device;
         // SAFETY: the caller's contract; the attachments are the caller's image.
         unsafe {
+            self.enter(cb, target);
             d.cmd_begin_rendering(cb, &info);
-            self.cmd_light_state(cb, frame, light, target.extent);
-            self.cmd_draw_volumes(cb, frame, light, VolumeKind::Stencil);
+            self.cmd_light_state(cb, frame, light, target.extent)?;
+            self.cmd_draw_volumes(cb, frame, light, VolumeKind::Stencil)?;
             d.cmd_end_rendering(cb);
+            self.leave(cb, target);
         }
+        Ok(())
+    }
+
+    /// The transition into the pass's rendering.
+    ///
+    /// # Safety
+    /// Outside any rendering instance; `target` describes the host's image truthfully.
+    unsafe fn enter(&self, cb: vk::CommandBuffer, target: &DepthStencilTarget) {
+        let ds = vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+        // SAFETY: the caller's contract.
+        unsafe { self.image_barrier(cb, target.image, (target.layout, ds), ANY, TESTS) };
+    }
+
+    /// The transition out of the pass's rendering, to the declared final layout.
+    ///
+    /// # Safety
+    /// As [`enter`](Self::enter), after it.
+    unsafe fn leave(&self, cb: vk::CommandBuffer, target: &DepthStencilTarget) {
+        let ds = vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+        // SAFETY: the caller's contract.
+        unsafe { self.image_barrier(cb, target.image, (ds, target.final_layout), TESTS, ANY) };
+    }
+
+    /// Refuses a frame whose uploads or GPU silhouettes would have to be recorded inside the
+    /// host's render pass.
+    fn check_recorded_before_rendering(&self, frame: &PreparedFrame) -> Result<()> {
+        let compute_pending = frame.compute.as_ref().is_some_and(|cf| !cf.recorded.get() && !cf.jobs.iter().all(|j| j.is_empty()));
+        if frame.pending_uploads() > 0 || compute_pending {
+            return Err(Misuse::Order(
+                "the frame's uploads or GPU silhouettes are not recorded: call cmd_before_rendering before beginning the render pass"
+                    .into(),
+            )
+            .into());
+        }
+        Ok(())
     }
 
     /// The counting variant of [`cmd_determine`](Self::cmd_determine): the same volumes of
@@ -131,35 +362,46 @@ impl ShadowPass {
     /// always passing and nothing written. Wrapped by the host in an occlusion query
     /// (`VK_QUERY_CONTROL_PRECISE_BIT` with `occlusionQueryPrecise`), the query counts every
     /// fragment the determination rasterises: the stencil fill it costs. The image's contents
-    /// are left as they are.
+    /// are left as they are. Dynamic rendering only.
     ///
     /// # Safety
-    /// As [`cmd_determine`](Self::cmd_determine) (the stencil aspect is loaded, not cleared);
-    /// the frame's uploads were recorded earlier in `cb` or a command buffer submitted before it.
-    pub unsafe fn cmd_count_rasterised(&self, cb: vk::CommandBuffer, frame: &PreparedFrame, light: usize, target: &DepthStencilTarget) {
-        let Some(lf) = frame.lights.get(light) else { return };
+    /// As [`cmd_determine`](Self::cmd_determine) (the stencil aspect is loaded, not cleared).
+    pub unsafe fn cmd_count_rasterised(
+        &self,
+        cb: vk::CommandBuffer,
+        frame: &PreparedFrame,
+        light: usize,
+        target: &DepthStencilTarget,
+    ) -> Result<()> {
+        let lf = self.light(frame, light)?;
+        self.dynamic_only("cmd_count_rasterised")?;
+        target.check(frame, &self.desc.target)?;
         // SAFETY: the caller's contract (outside a rendering instance).
-        unsafe { self.cmd_upload(cb, frame) };
+        unsafe { self.cmd_before_rendering(cb, frame)? };
         let att = depth_attachment(target, vk::AttachmentLoadOp::LOAD, 0);
         let info = vk::RenderingInfo::default().render_area(lf.scissor).layer_count(1).depth_attachment(&att).stencil_attachment(&att);
         let d = &self.dev.device;
         // SAFETY: the caller's contract; the attachments are the caller's image.
         unsafe {
+            self.enter(cb, target);
             d.cmd_begin_rendering(cb, &info);
-            self.cmd_light_state(cb, frame, light, target.extent);
-            self.cmd_draw_volumes(cb, frame, light, VolumeKind::Rasterised);
+            self.cmd_light_state(cb, frame, light, target.extent)?;
+            self.cmd_draw_volumes(cb, frame, light, VolumeKind::Rasterised)?;
             d.cmd_end_rendering(cb);
+            self.leave(cb, target);
         }
+        Ok(())
     }
 
     /// As [`cmd_determine`](Self::cmd_determine), but counting into `count` (an R32F image,
     /// [`COUNT_FORMAT`](super::COUNT_FORMAT), cleared to 0 inside the scissor): exact counts
-    /// with no 8-bit wrap. The depth-stencil image is only read.
+    /// with no 8-bit wrap. The depth-stencil image is only read. Dynamic rendering only, and
+    /// needs R32F blending ([`Capabilities::r32f_blend`](super::Capabilities)).
     ///
     /// # Safety
-    /// As `cmd_determine`; in addition `count` is a view of an R32F image of the same size in
-    /// `COLOR_ATTACHMENT_OPTIMAL` layout, and the pass was created on a device where R32F
-    /// blends ([`Capabilities::r32f_blend`](super::Capabilities)).
+    /// As `cmd_determine`; in addition `count` is a view of an R32F image of the same size
+    /// and sample count in `COLOR_ATTACHMENT_OPTIMAL` layout, whose earlier accesses the host
+    /// made available.
     pub unsafe fn cmd_count_float(
         &self,
         cb: vk::CommandBuffer,
@@ -167,10 +409,15 @@ impl ShadowPass {
         light: usize,
         target: &DepthStencilTarget,
         count: vk::ImageView,
-    ) {
-        let start = frame.lights.get(light).map_or(0.0, |l| l.counter_clear as f32);
+    ) -> Result<()> {
+        let start = self.light(frame, light)?.counter_clear as f32;
+        if self.pipes.count.is_none() {
+            return Err(
+                Misuse::NotConfigured { call: "cmd_count_float", needs: "R32_SFLOAT blending and TargetModel::DynamicRendering" }.into()
+            );
+        }
         // SAFETY: forwarded contract.
-        unsafe { self.cmd_counted_instance(cb, frame, light, target, count, [start, 0.0, 0.0, 0.0], VolumeKind::Float) }
+        unsafe { self.cmd_counted_instance(cb, frame, light, target, (count, [start, 0.0, 0.0, 0.0]), VolumeKind::Float) }
     }
 
     /// Records the transparent casters' light-intensity map of `light` (Kim et al. 2008) into
@@ -187,34 +434,34 @@ impl ShadowPass {
         target: &DepthStencilTarget,
         map: vk::ImageView,
         log: bool,
-    ) {
+    ) -> Result<()> {
+        if self.pipes.transmit.is_none() {
+            return Err(Misuse::NotConfigured { call: "cmd_light_intensity", needs: "ShadowPassDesc::transmit_format" }.into());
+        }
         let clear = if log { [0.0; 4] } else { [1.0; 4] };
         // SAFETY: forwarded contract.
-        unsafe { self.cmd_counted_instance(cb, frame, light, target, map, clear, VolumeKind::Transmit { log }) }
+        unsafe { self.cmd_counted_instance(cb, frame, light, target, (map, clear), VolumeKind::Transmit { log }) }
     }
 
-    /// A rendering instance over the light's scissor with one cleared colour attachment and
-    /// the depth-stencil loaded, drawing `kind`.
+    /// A rendering instance over the light's scissor with one colour attachment (`color`: the
+    /// view and its clear value) and the depth-stencil loaded, drawing `kind`.
     ///
     /// # Safety
     /// As [`cmd_count_float`](Self::cmd_count_float).
-    #[allow(clippy::too_many_arguments)]
     unsafe fn cmd_counted_instance(
         &self,
         cb: vk::CommandBuffer,
         frame: &PreparedFrame,
         light: usize,
         target: &DepthStencilTarget,
-        color: vk::ImageView,
-        clear: [f32; 4],
+        (color, clear): (vk::ImageView, [f32; 4]),
         kind: VolumeKind,
-    ) {
-        let Some(lf) = frame.lights.get(light) else { return };
+    ) -> Result<()> {
+        let lf = self.light(frame, light)?;
+        self.dynamic_only("the float counter and the light-intensity map")?;
+        target.check(frame, &self.desc.target)?;
         // SAFETY: the caller's contract (outside a rendering instance).
-        unsafe {
-            self.cmd_upload(cb, frame);
-            self.cmd_compute_silhouettes(cb, frame);
-        }
+        unsafe { self.cmd_before_rendering(cb, frame)? };
         let ds = depth_attachment(target, vk::AttachmentLoadOp::LOAD, 0);
         let att = [vk::RenderingAttachmentInfo::default()
             .image_view(color)
@@ -231,11 +478,14 @@ impl ShadowPass {
         let d = &self.dev.device;
         // SAFETY: the caller's contract.
         unsafe {
+            self.enter(cb, target);
             d.cmd_begin_rendering(cb, &info);
-            self.cmd_light_state(cb, frame, light, target.extent);
-            self.cmd_draw_volumes(cb, frame, light, kind);
+            self.cmd_light_state(cb, frame, light, target.extent)?;
+            self.cmd_draw_volumes(cb, frame, light, kind)?;
             d.cmd_end_rendering(cb);
+            self.leave(cb, target);
         }
+        Ok(())
     }
 
     /// Sets the dynamic state of a light's passes: the viewport over `extent`, the light's
@@ -243,10 +493,12 @@ impl ShadowPass {
     /// too (its pipeline needs these states dynamic: VIEWPORT, SCISSOR, and DEPTH_BOUNDS when
     /// [`Capabilities::depth_bounds`](super::Capabilities)).
     ///
+    /// Errors: as [`cmd_determine`](Self::cmd_determine)'s frame and light checks.
+    ///
     /// # Safety
     /// `cb` is recording with a graphics pipeline of that dynamic state bound or about to be.
-    pub unsafe fn cmd_light_state(&self, cb: vk::CommandBuffer, frame: &PreparedFrame, light: usize, extent: vk::Extent2D) {
-        let Some(lf) = frame.lights.get(light) else { return };
+    pub unsafe fn cmd_light_state(&self, cb: vk::CommandBuffer, frame: &PreparedFrame, light: usize, extent: vk::Extent2D) -> Result<()> {
+        let lf = self.light(frame, light)?;
         let d = &self.dev.device;
         let viewport =
             vk::Viewport { x: 0.0, y: 0.0, width: extent.width as f32, height: extent.height as f32, min_depth: 0.0, max_depth: 1.0 };
@@ -259,6 +511,7 @@ impl ShadowPass {
                 d.cmd_set_depth_bounds(cb, lo, hi);
             }
         }
+        Ok(())
     }
 
     /// Records the volumes of `light` for `kind` inside a rendering instance the caller
@@ -266,14 +519,38 @@ impl ShadowPass {
     /// for the float kinds or the transmit format for `Transmit`), with the viewport and
     /// scissor set (e.g. by [`cmd_light_state`](Self::cmd_light_state)).
     ///
+    /// With [`TargetModel::RenderPass`], inside the host's subpass (stencil and rasterised
+    /// kinds only).
+    ///
+    /// Errors ([`Error::Misuse`]): as `cmd_determine`'s frame and light checks, and a kind the
+    /// pass has no pipelines for (float kinds without R32F blending or in the render-pass
+    /// model, `Transmit` without a transmit format).
+    ///
     /// # Safety
-    /// `cb` is recording inside such a rendering instance; the frame's uploads and GPU silhouettes were recorded
-    /// earlier ([`cmd_upload`](Self::cmd_upload)); `frame` is live as for `cmd_determine`;
-    /// for the float kinds the device blends R32F, for `Transmit` the pass has a transmit format.
-    pub unsafe fn cmd_draw_volumes(&self, cb: vk::CommandBuffer, frame: &PreparedFrame, light: usize, kind: VolumeKind) {
-        let Some(lf) = frame.lights.get(light) else { return };
+    /// `cb` is recording inside such a rendering instance or subpass; the frame's uploads and
+    /// GPU silhouettes were recorded earlier ([`cmd_before_rendering`](Self::cmd_before_rendering));
+    /// `frame`'s slot is not prepared again before `cb` completes.
+    pub unsafe fn cmd_draw_volumes(&self, cb: vk::CommandBuffer, frame: &PreparedFrame, light: usize, kind: VolumeKind) -> Result<()> {
+        let lf = self.light(frame, light)?;
         let p = &self.pipes;
         let count = p.count.as_ref();
+        match kind {
+            VolumeKind::Float | VolumeKind::FloatDepthTested if count.is_none() => {
+                return Err(Misuse::NotConfigured {
+                    call: "cmd_draw_volumes (float kinds)",
+                    needs: "R32_SFLOAT blending and TargetModel::DynamicRendering",
+                }
+                .into());
+            }
+            VolumeKind::Transmit { .. } if p.transmit.is_none() => {
+                return Err(Misuse::NotConfigured {
+                    call: "cmd_draw_volumes (VolumeKind::Transmit)",
+                    needs: "ShadowPassDesc::transmit_format",
+                }
+                .into());
+            }
+            _ => {}
+        }
         let mut bound = vk::Pipeline::null();
         for c in lf.casters.iter().filter(|c| c.case != Case::Culled) {
             let wanted = match kind {
@@ -334,6 +611,7 @@ impl ShadowPass {
                 unsafe { self.record_draw(cb, frame, dr) };
             }
         }
+        Ok(())
     }
 
     /// Which pipeline counts a draw.
@@ -394,8 +672,11 @@ impl ShadowPass {
     /// [`ShadowPassDesc::debug_color_format`](super::ShadowPassDesc) (the pass must have been
     /// created with it) and the depth-stencil image loaded, viewport and scissor set; the
     /// frame's uploads and GPU silhouettes were recorded; `frame` is live.
-    pub unsafe fn cmd_draw_volume_overlay(&self, cb: vk::CommandBuffer, frame: &PreparedFrame) {
-        let Some(pipe) = self.pipes.overlay else { return };
+    pub unsafe fn cmd_draw_volume_overlay(&self, cb: vk::CommandBuffer, frame: &PreparedFrame) -> Result<()> {
+        self.check_frame(frame)?;
+        let Some(pipe) = self.pipes.overlay else {
+            return Err(Misuse::NotConfigured { call: "cmd_draw_volume_overlay", needs: "ShadowPassDesc::debug_color_format" }.into());
+        };
         // SAFETY: the caller's contract.
         unsafe { self.dev.device.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipe) };
         for lf in &frame.lights {
@@ -415,6 +696,7 @@ impl ShadowPass {
                 }
             }
         }
+        Ok(())
     }
 
     /// # Safety

@@ -46,10 +46,13 @@ pub(crate) fn check(spheres: &[SphereCaster], lights: &[Light]) -> Result<()> {
     for s in spheres {
         for (li, l) in lights.iter().enumerate() {
             if s.sphere.tangency(light_h(l)).is_none() {
-                return Err(Error::Other(format!(
-                    "light {li} at {} is inside or on sphere caster '{}' (centre {}, radius {}): no tangent cone exists",
-                    l.position, s.name, s.sphere.center, s.sphere.radius
-                )));
+                return Err(Error::argument(
+                    "light",
+                    format!(
+                        "light {li} at {} is inside or on sphere caster '{}' (centre {}, radius {}): no tangent cone exists",
+                        l.position, s.name, s.sphere.center, s.sphere.radius
+                    ),
+                ));
             }
         }
     }
@@ -190,20 +193,23 @@ pub(crate) fn pack_light(
 
 /// The index of sphere `id`.
 pub(crate) fn find(spheres: &[SphereCaster], id: SphereId) -> Result<usize> {
-    spheres.iter().position(|s| s.id == id).ok_or_else(|| Error::Other(format!("sphere caster {id:?} is not in this pass (removed?)")))
+    spheres
+        .iter()
+        .position(|s| s.id == id)
+        .ok_or_else(|| crate::error::Misuse::UnknownId { what: "sphere caster", id: format!("{id:?}") }.into())
 }
 
 /// Rejects a sphere the pass cannot draw.
 pub(crate) fn check_sphere(name: &str, sphere: &Sphere, segments: Option<u32>) -> Result<()> {
     if let Some(p) = sphere.problem() {
-        return Err(Error::Other(format!("sphere caster '{name}': {p}")));
+        return Err(Error::mesh(name, format!("sphere caster: {p}")));
     }
     if let Some(n) = segments {
         if !(3..=crate::geom::sphere::MAX_SEGMENTS).contains(&n) {
-            return Err(Error::Other(format!(
-                "sphere caster '{name}': segments must be in [3, {}], got {n}",
-                crate::geom::sphere::MAX_SEGMENTS
-            )));
+            return Err(Error::mesh(
+                name,
+                format!("sphere caster: segments must be in [3, {}], got {n}", crate::geom::sphere::MAX_SEGMENTS),
+            ));
         }
     }
     Ok(())

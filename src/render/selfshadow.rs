@@ -120,7 +120,7 @@ impl SelfShadow {
         vp_rel: Mat4,
         lights: &[LightPush],
         log: bool,
-    ) {
+    ) -> crate::error::Result<()> {
         let d = &rec.ctx.device;
         let cb = rec.cb;
         let load = vk::AttachmentLoadOp::LOAD;
@@ -155,27 +155,31 @@ impl SelfShadow {
                 // SAFETY: the caller's contract; the attachments are in attachment layout.
                 unsafe {
                     d.cmd_begin_rendering(cb, &info);
-                    pass.cmd_light_state(cb, frame, li, t.extent);
+                    pass.cmd_light_state(cb, frame, li, t.extent)
                 }
             };
             // 5a. The opaque casters' volumes counted on the transparent surface.
             rec.transition(&self.count, vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
-            begin(&[att(&self.count, clear, ZERO)]);
+            let state = begin(&[att(&self.count, clear, ZERO)]);
             // SAFETY: inside the rendering instance just begun (R32F + the pass's depth format).
-            unsafe {
-                pass.cmd_draw_volumes(cb, frame, li, VolumeKind::FloatDepthTested);
+            let drawn = unsafe {
+                let r = state.and_then(|_| pass.cmd_draw_volumes(cb, frame, li, VolumeKind::FloatDepthTested));
                 d.cmd_end_rendering(cb);
-            }
+                r
+            };
+            drawn?;
             rec.transition(&self.count, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
 
             // 5b. The transparent casters' volumes into the second light-intensity map.
             rec.transition(&self.map, vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
-            begin(&[att(&self.map, clear, map_clear)]);
+            let state = begin(&[att(&self.map, clear, map_clear)]);
             // SAFETY: as above, with the transmit format.
-            unsafe {
-                pass.cmd_draw_volumes(cb, frame, li, VolumeKind::Transmit { log });
+            let drawn = unsafe {
+                let r = state.and_then(|_| pass.cmd_draw_volumes(cb, frame, li, VolumeKind::Transmit { log }));
                 d.cmd_end_rendering(cb);
-            }
+                r
+            };
+            drawn?;
             rec.transition(&self.map, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
 
             // 6. The light's forward pass, scaled by the map (0 where the opaque count is not).
@@ -197,5 +201,6 @@ impl SelfShadow {
                 ),
             );
         }
+        Ok(())
     }
 }

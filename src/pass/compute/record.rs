@@ -26,15 +26,14 @@ fn groups(n: u32) -> u32 {
     n.div_ceil(64).min(MAX_GROUPS)
 }
 
+/// A global memory barrier, recorded as Vulkan 1.0 (the pass needs no synchronization2).
 fn barrier(
-    d: &ash::Device,
+    dev: &super::super::device::PassDevice,
     cb: vk::CommandBuffer,
     src: (vk::PipelineStageFlags2, vk::AccessFlags2),
     dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
 ) {
-    let b = [vk::MemoryBarrier2::default().src_stage_mask(src.0).src_access_mask(src.1).dst_stage_mask(dst.0).dst_access_mask(dst.1)];
-    // SAFETY: the callers record outside a rendering instance on a recording command buffer.
-    unsafe { d.cmd_pipeline_barrier2(cb, &vk::DependencyInfo::default().memory_barriers(&b)) };
+    crate::gpu::resources::memory_barrier(dev, cb, src, dst);
 }
 
 impl ShadowPass {
@@ -51,21 +50,24 @@ impl ShadowPass {
     /// As [`cmd_upload`](Self::cmd_upload): `cb` is recording outside any rendering instance on
     /// the pass's device, after the frame's uploads (same or earlier command buffer, same
     /// queue), before every draw of the frame's volumes; `frame` is live.
-    pub unsafe fn cmd_compute_silhouettes(&self, cb: vk::CommandBuffer, frame: &PreparedFrame) {
-        let Some(cf) = frame.compute.as_ref() else { return };
+    pub unsafe fn cmd_compute_silhouettes(&self, cb: vk::CommandBuffer, frame: &PreparedFrame) -> crate::error::Result<()> {
+        self.check_frame(frame)?;
+        let Some(cf) = frame.compute.as_ref() else { return Ok(()) };
         if cf.recorded.replace(true) || cf.jobs.iter().all(|j| j.is_empty()) {
-            return;
+            return Ok(());
         }
-        let Some(cp) = self.compute_pipes.as_ref() else { return };
+        let Some(cp) = self.compute_pipes.as_ref() else {
+            return Err(crate::error::Error::Other("compute silhouettes: the pass has no compute pipelines".into()));
+        };
         let d = &self.dev.device;
         use vk::AccessFlags2 as A;
         use vk::PipelineStageFlags2 as S;
-        let rw = A::SHADER_STORAGE_READ | A::SHADER_STORAGE_WRITE;
+        let rw = A::SHADER_READ | A::SHADER_WRITE;
         barrier(
-            d,
+            &self.dev,
             cb,
             (
-                S::DRAW_INDIRECT | S::VERTEX_INPUT | S::COMPUTE_SHADER | S::COPY,
+                S::DRAW_INDIRECT | S::VERTEX_INPUT | S::COMPUTE_SHADER | S::TRANSFER,
                 A::INDIRECT_COMMAND_READ | A::INDEX_READ | rw | A::TRANSFER_WRITE,
             ),
             (S::COMPUTE_SHADER, rw),
@@ -76,25 +78,26 @@ impl ShadowPass {
             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, cp.facing);
             self.dispatch_all(cb, cf, cp.layout, |p| groups(p.tris));
         }
-        barrier(d, cb, (S::COMPUTE_SHADER, A::SHADER_STORAGE_WRITE), (S::COMPUTE_SHADER, rw));
+        barrier(&self.dev, cb, (S::COMPUTE_SHADER, A::SHADER_WRITE), (S::COMPUTE_SHADER, rw));
         // SAFETY: as above.
         unsafe {
             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, cp.exact);
             // a few workgroups striding over the (usually empty) list
             self.dispatch_all(cb, cf, cp.layout, |p| groups(p.tris).min(EXACT_GROUPS));
         }
-        barrier(d, cb, (S::COMPUTE_SHADER, A::SHADER_STORAGE_WRITE), (S::COMPUTE_SHADER, rw));
+        barrier(&self.dev, cb, (S::COMPUTE_SHADER, A::SHADER_WRITE), (S::COMPUTE_SHADER, rw));
         // SAFETY: as above.
         unsafe {
             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, cp.edges);
             self.dispatch_all(cb, cf, cp.layout, |p| groups(if p.caps != 0 { p.edges.max(p.tris) } else { p.edges }));
         }
         barrier(
-            d,
+            &self.dev,
             cb,
-            (S::COMPUTE_SHADER, A::SHADER_STORAGE_WRITE),
+            (S::COMPUTE_SHADER, A::SHADER_WRITE),
             (S::DRAW_INDIRECT | S::VERTEX_INPUT | S::HOST, A::INDIRECT_COMMAND_READ | A::INDEX_READ | A::HOST_READ),
         );
+        Ok(())
     }
 
     /// # Safety

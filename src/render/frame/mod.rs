@@ -321,7 +321,7 @@ impl Renderer {
         let full = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: self.own.parts.targets.extent };
         let viewport = vk::Viewport { x: 0.0, y: 0.0, width: w as f32, height: h as f32, min_depth: 0.0, max_depth: 1.0 };
         let rec = Rec { ctx: &self.own.ctx, cb, full, viewport, timer: &s.timer, readback };
-        let spans = self.record_frame(&rec, &frame, &layout, (instances, spheres), vp_rel, &lights, float_counts, counters);
+        let spans = self.record_frame(&rec, &frame, &layout, (instances, spheres), vp_rel, &lights, float_counts, counters)?;
         // SAFETY: recording finished; the submission signals the slot's fence.
         unsafe {
             d.end_command_buffer(cb).map_err(Error::vk("vkEndCommandBuffer"))?;
@@ -354,7 +354,7 @@ impl Renderer {
         lights: &[LightPush],
         float_counts: bool,
         counters: Option<&CounterPools>,
-    ) -> FrameSpans {
+    ) -> Result<FrameSpans> {
         let (t, p, pass) = (&self.own.parts.targets, &self.own.parts.pipes, &self.own.parts.pass);
         let stamp = |stage| rec.timer.stamp(rec.ctx, rec.cb, stage);
         let all = vk::PipelineStageFlags2::ALL_COMMANDS;
@@ -365,7 +365,7 @@ impl Renderer {
         // between passes) with this renderer's objects, alive until the slot retires; the
         // layouts each pass expects are those the previous pass leaves.
         unsafe {
-            pass.cmd_upload(rec.cb, frame);
+            pass.cmd_upload(rec.cb, frame)?;
             gbuffer::record(rec, t, p, &self.own.parts.geo, instances, vp_rel, self.own.parts.scene.ambient, spheres);
             spans.depth.end = stamp(all);
             let into = match (&self.own.parts.shadow_mapper, self.settings.counter) {
@@ -382,30 +382,30 @@ impl Renderer {
                     determine::begin_float(rec, t);
                     sm.record(rec.ctx, rec.cb, t, light, self.own.parts.scene.camera.eye.as_dvec3(), frame.lights[li].scissor);
                 }
-                determine::record(rec, pass, frame, li, t, into, layout.counts.get(li).copied());
+                determine::record(rec, pass, frame, li, t, into, layout.counts.get(li).copied())?;
                 if let Some(c) = counters {
                     c.statistics(rec.ctx, rec.cb, li as u32, false);
                 }
                 spans.shadow.push(passes::timing_span(begin, stamp(all)));
                 if let Some(c) = counters {
-                    determine::record_count(rec, pass, frame, li, t, c);
+                    determine::record_count(rec, pass, frame, li, t, c)?;
                 }
                 if self.own.parts.has_transparent {
-                    intensity::record(rec, pass, frame, li, t, self.settings.transmit_log, layout.transmit.get(li).copied());
+                    intensity::record(rec, pass, frame, li, t, self.settings.transmit_log, layout.transmit.get(li).copied())?;
                 }
                 let begin = stamp(all);
-                illuminate::record(rec, pass, frame, li, t, p, float_counts, self.own.parts.has_transparent, &lights[li]);
+                illuminate::record(rec, pass, frame, li, t, p, float_counts, self.own.parts.has_transparent, &lights[li])?;
                 spans.illuminate.push(passes::timing_span(begin, stamp(all)));
             }
             if self.own.parts.geo.of(Sidedness::Transparent).next().is_some() {
                 let forward = if self.own.parts.self_shadow.is_some() { &[][..] } else { lights };
                 transparent::record(rec, t, p, &self.own.parts.geo, instances, vp_rel, self.own.parts.scene.ambient, forward);
                 if let Some(ss) = &self.own.parts.self_shadow {
-                    ss.record(rec, t, p, pass, frame, &self.own.parts.geo, instances, vp_rel, lights, self.settings.transmit_log);
+                    ss.record(rec, t, p, pass, frame, &self.own.parts.geo, instances, vp_rel, lights, self.settings.transmit_log)?;
                 }
             }
             if self.settings.view == View::Volumes {
-                debug::record_volumes(rec, pass, frame, t);
+                debug::record_volumes(rec, pass, frame, t)?;
             }
             tonemap::record(rec, t, p);
         }
@@ -416,7 +416,7 @@ impl Renderer {
             rec.copy_out(&t.normal, vk::ImageAspectFlags::COLOR, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL, nrm);
         }
         tonemap::host_barrier(rec);
-        spans
+        Ok(spans)
     }
 
     /// Waits for a submitted frame and reads it back.
@@ -520,6 +520,9 @@ impl Parts {
             depth_stencil_format: ctx.depth_format,
             frames_in_flight: config.frames_in_flight,
             depth_mode: config.depth_mode,
+            depth_direction: sp::DepthDirection::Forward,
+            samples: 1,
+            target: sp::TargetModel::DynamicRendering,
             features: sp::EnabledFeatures {
                 depth_clamp: f.depth_clamp,
                 depth_bounds: f.depth_bounds,

@@ -9,15 +9,16 @@ use ash::vk;
 /// # Safety
 /// `rec.cb` is recording outside a rendering instance; accumulation and depth in attachment
 /// layout; the pass was created with the accumulation format as its debug colour format.
-pub(crate) unsafe fn record_volumes(rec: &Rec, pass: &ShadowPass, frame: &PreparedFrame, t: &Targets) {
+pub(crate) unsafe fn record_volumes(rec: &Rec, pass: &ShadowPass, frame: &PreparedFrame, t: &Targets) -> crate::error::Result<()> {
     let load = vk::AttachmentLoadOp::LOAD;
     let accum = [att(&t.accum, load, ZERO)];
     let depth = att(&t.depth, load, DS_CLEAR);
     // SAFETY: the caller's contract.
     unsafe {
         rec.begin(rec.full, &accum, Some(&depth));
-        pass.cmd_draw_volume_overlay(rec.cb, frame);
+        let r = pass.cmd_draw_volume_overlay(rec.cb, frame);
         rec.ctx.device.cmd_end_rendering(rec.cb);
+        r
     }
 }
 

@@ -3,6 +3,7 @@
 //!     the count is copied out for the dumps and tests.
 
 use super::{Rec, DS_RW, FRAG_TESTS};
+use crate::error::Result;
 use crate::pass::{DepthStencilTarget, PreparedFrame, ShadowPass};
 use crate::render::counters::CounterPools;
 use crate::render::readback::Range;
@@ -39,15 +40,15 @@ pub(crate) unsafe fn record(
     t: &Targets,
     into: CountInto,
     capture: Option<Range>,
-) {
-    let target = DepthStencilTarget { view: t.depth.view, extent: t.extent };
+) -> Result<()> {
+    let target = DepthStencilTarget::new(t.depth.raw, t.depth.view, t.extent);
     // SAFETY: the caller's contract, which is `ShadowPass`'s.
     unsafe {
         match into {
-            CountInto::Stencil => pass.cmd_determine(rec.cb, frame, light, &target),
+            CountInto::Stencil => pass.cmd_determine(rec.cb, frame, light, &target)?,
             CountInto::Float => {
                 begin_float(rec, t);
-                pass.cmd_count_float(rec.cb, frame, light, &target, t.count.view);
+                pass.cmd_count_float(rec.cb, frame, light, &target, t.count.view)?;
             }
             CountInto::External => {}
         }
@@ -64,6 +65,7 @@ pub(crate) unsafe fn record(
     if float {
         rec.transition(&t.count, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
     }
+    Ok(())
 }
 
 /// The counting variant of light `light`'s determination inside its occlusion query (outside
@@ -71,11 +73,19 @@ pub(crate) unsafe fn record(
 ///
 /// # Safety
 /// As [`record`], after it (the depth-stencil target in attachment layout).
-pub(crate) unsafe fn record_count(rec: &Rec, pass: &ShadowPass, frame: &PreparedFrame, light: usize, t: &Targets, c: &CounterPools) {
-    let target = DepthStencilTarget { view: t.depth.view, extent: t.extent };
+pub(crate) unsafe fn record_count(
+    rec: &Rec,
+    pass: &ShadowPass,
+    frame: &PreparedFrame,
+    light: usize,
+    t: &Targets,
+    c: &CounterPools,
+) -> Result<()> {
+    let target = DepthStencilTarget::new(t.depth.raw, t.depth.view, t.extent);
     c.occlusion(rec.ctx, rec.cb, light as u32, true);
     // SAFETY: the caller's contract, which is `ShadowPass`'s.
-    unsafe { pass.cmd_count_rasterised(rec.cb, frame, light, &target) };
+    let r = unsafe { pass.cmd_count_rasterised(rec.cb, frame, light, &target) };
     c.occlusion(rec.ctx, rec.cb, light as u32, false);
     rec.barrier((FRAG_TESTS, DS_RW), (FRAG_TESTS, DS_RW));
+    r
 }

@@ -23,7 +23,7 @@ pub(crate) unsafe fn record(
     float: bool,
     transmit: bool,
     push: &LightPush,
-) {
+) -> crate::error::Result<()> {
     let load = vk::AttachmentLoadOp::LOAD;
     let accum = [att(&t.accum, load, ZERO)];
     let depth = att(&t.depth, load, DS_CLEAR);
@@ -34,7 +34,7 @@ pub(crate) unsafe fn record(
     unsafe {
         rec.begin(scissor, &accum, Some(&depth));
         d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, p.illuminate[float as usize][transmit as usize]);
-        pass.cmd_light_state(cb, frame, light, t.extent);
+        pass.cmd_light_state(cb, frame, light, t.extent)?;
         d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, p.layouts.illuminate, 0, &[p.gbuffer_set.set], &[]);
         d.cmd_push_constants(cb, p.layouts.illuminate, vk::ShaderStageFlags::FRAGMENT, 0, bytemuck::bytes_of(push));
         d.cmd_draw(cb, 3, 1, 0, 0);
@@ -42,4 +42,5 @@ pub(crate) unsafe fn record(
     }
     let stages = vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT | FRAG_TESTS;
     rec.barrier((stages, COLOR_RW | DS_RW), (stages, COLOR_RW | DS_RW));
+    Ok(())
 }

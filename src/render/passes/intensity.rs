@@ -3,6 +3,7 @@
 //!     `±log t`), depth-tested like the float counter.
 
 use super::Rec;
+use crate::error::Result;
 use crate::pass::{DepthStencilTarget, PreparedFrame, ShadowPass};
 use crate::render::readback::Range;
 use crate::render::targets::Targets;
@@ -18,13 +19,14 @@ pub(crate) unsafe fn record(
     t: &Targets,
     log: bool,
     capture: Option<Range>,
-) {
+) -> Result<()> {
     rec.transition(&t.transmit, vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
-    let target = DepthStencilTarget { view: t.depth.view, extent: t.extent };
+    let target = DepthStencilTarget::new(t.depth.raw, t.depth.view, t.extent);
     // SAFETY: the caller's contract, which is `ShadowPass`'s.
-    unsafe { pass.cmd_light_intensity(rec.cb, frame, light, &target, t.transmit.view, log) };
+    unsafe { pass.cmd_light_intensity(rec.cb, frame, light, &target, t.transmit.view, log)? };
     if let Some(range) = capture {
         rec.copy_out(&t.transmit, vk::ImageAspectFlags::COLOR, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, range);
     }
     rec.transition(&t.transmit, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
+    Ok(())
 }
