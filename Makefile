@@ -26,20 +26,22 @@ view: deps
 
 # Every test with validation on, the quick conformance matrix on three Mesa lavapipes
 # (scripts/drivers.sh installs them into .drivers/), the doc examples, and the library an engine embeds
-# (`default-features = false`) built and documented with warnings denied.
+# (`default-features = false`) built, documented with warnings denied, and run as examples/minimal.rs.
 test: deps-tests lint
 	./scripts/fetch-assets.sh || true
 	UMBRAGE_VALIDATION=1 $(CARGO) test --all-targets
 	./scripts/conform-matrix.sh --quick
 	$(CARGO) test --doc
 	$(CARGO) build --lib --no-default-features
+	UMBRAGE_VALIDATION=1 $(CARGO) run --example minimal --no-default-features
 	$(MAKE) doc
 
 # Formatting and lints (Cargo.toml's [lints]: every unsafe block and unsafe fn documented),
-# warnings denied.
+# warnings denied; examples/minimal.rs also as an engine builds it (no default features).
 lint:
 	$(CARGO) fmt --check
 	$(CARGO) clippy --all-targets -- -D warnings
+	$(CARGO) clippy --example minimal --no-default-features -- -D warnings
 
 doc:
 	RUSTDOCFLAGS="-D warnings" $(CARGO) doc --no-deps
