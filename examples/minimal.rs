@@ -270,8 +270,8 @@ pub fn run() -> Result<(), String> {
         device.begin_command_buffer(cb, &begin).map_err(vk_err("vkBeginCommandBuffer"))?;
         // The depth-stencil image into the attachment layout (its old contents discarded).
         barrier(vk::ImageLayout::UNDEFINED, attachment, (S::NONE, A::NONE), (tests, ds_rw));
-        // New casters' vertex copies (outside rendering; `cmd_determine` would record them too).
-        pass.cmd_upload(cb, &frame);
+        // New casters' vertex copies (and compute silhouettes, where used): outside rendering.
+        pass.cmd_before_rendering(cb, &frame).map_err(|e| format!("cmd_before_rendering: {e}"))?;
 
         // The engine's depth pre-pass: floor (indices 0..6) and box (6..42, vertices from 4).
         device.cmd_begin_rendering(cb, &rendering);
@@ -289,7 +289,9 @@ pub fn run() -> Result<(), String> {
 
         // The shadow determination of light 0: afterwards the stencil holds, per pixel, the
         // number of shadow volumes around the visible point (0 = lit).
-        pass.cmd_determine(cb, &frame, 0, &DepthStencilTarget { view: depth_view, extent });
+        // The target is declared in DEPTH_STENCIL_ATTACHMENT_OPTIMAL, and left there.
+        let target = DepthStencilTarget::new(depth_image, depth_view, extent);
+        pass.cmd_determine(cb, &frame, 0, &target).map_err(|e| format!("cmd_determine: {e}"))?;
 
         // An engine's lighting pass would now test `stencil == 0` (`lit_stencil_state`); we
         // copy the stencil out and make the copy visible to the host.
