@@ -35,7 +35,9 @@ impl log::Log for CountingLogger {
         }
         let text = format!("{}", record.args());
         eprintln!("[{} {}] {text}", record.level(), record.target());
-        if record.level() == log::Level::Error {
+        // wgpu-hal logs a message's queue, command-buffer and object labels as records of
+        // their own, indented: one message, one count.
+        if record.level() == log::Level::Error && !text.starts_with('\t') {
             ERRORS.fetch_add(1, Ordering::SeqCst);
             if let Ok(mut first) = FIRST_ERROR.lock() {
                 first.get_or_insert(text);

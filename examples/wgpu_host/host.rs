@@ -192,7 +192,7 @@ impl Host {
             position: target(device, "position", VECTOR_FORMAT, width, height, att | tex | src),
             output: target(device, "output", OUTPUT_FORMAT, width, height, att | src),
         };
-        let pipes = Pipes::new(device, &targets);
+        let pipes = Pipes::new(device, &targets)?;
 
         let meshes = scene
             .meshes
@@ -324,10 +324,16 @@ fn block(buffer: &wgpu::Buffer, size: usize) -> wgpu::BindingResource<'_> {
 }
 
 impl Pipes {
-    fn new(device: &wgpu::Device, t: &Targets) -> Pipes {
+    fn new(device: &wgpu::Device, t: &Targets) -> Result<Pipes, String> {
+        // Parsed here (with wgpu's naga) and handed to wgpu as naga IR rather than WGSL text:
+        // with no source text wgpu attaches no debug info, so its SPIR-V has no `OpSource
+        // WGSL`, which the validation layer of Debian 12 (1.3.239, older SPIR-V tools than
+        // naga 30) rejects as "Invalid source language operand: 10".
+        let src = include_str!("frame.wgsl");
+        let parsed = wgpu::naga::front::wgsl::parse_str(src).map_err(|e| format!("frame.wgsl: {}", e.emit_to_string(src)))?;
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("frame.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("frame.wgsl").into()),
+            source: wgpu::ShaderSource::Naga(std::borrow::Cow::Owned(parsed)),
         });
         let uniform_dynamic =
             wgpu::BindingType::Buffer { ty: wgpu::BufferBindingType::Uniform, has_dynamic_offset: true, min_binding_size: None };
@@ -458,7 +464,7 @@ impl Pipes {
             layout: &tonemap.get_bind_group_layout(0),
             entries: &[wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&t.accum.view) }],
         });
-        Pipes { gbuffer, illuminate, tonemap, tonemap_group }
+        Ok(Pipes { gbuffer, illuminate, tonemap, tonemap_group })
     }
 }
 
