@@ -39,14 +39,15 @@ fn no_device(out: &Output) -> bool {
     err.contains("no Vulkan adapter") || err.contains("no Vulkan loader")
 }
 
-/// Runs the example on `scene` with validation on and checks its dump against the reference.
-/// Returns false when there is no Vulkan device (and `CI` is not set).
-fn run_and_check(bin: &Path, scene: &str, size: &str) -> bool {
-    let dir = tmp(scene);
+/// Runs the example on `scene` for `frames` frames with validation on and checks its dump
+/// against the reference. Returns the dump's shadow masks, or None when there is no Vulkan
+/// device (and `CI` is not set).
+fn run_and_check(bin: &Path, scene: &str, size: &str, frames: usize) -> Option<Vec<Vec<u8>>> {
+    let dir = tmp(&format!("{scene}-{frames}"));
     let png = dir.join("out.png");
     let dump = dir.join("dump");
     let out = Command::new(bin)
-        .args(["--scene", scene, "--size", size, "--frames", "3", "--out"])
+        .args(["--scene", scene, "--size", size, "--frames", &frames.to_string(), "--out"])
         .arg(&png)
         .arg("--dump")
         .arg(&dump)
@@ -61,13 +62,13 @@ fn run_and_check(bin: &Path, scene: &str, size: &str) -> bool {
             panic!("no Vulkan device under CI: {stderr}");
         }
         eprintln!("SKIPPED (no Vulkan device, CI not set)");
-        return false;
+        return None;
     }
     assert!(out.status.success(), "{scene}: the example failed ({}):\n{stderr}", out.status);
     assert!(!stderr.contains("[ERROR"), "{scene}: errors were logged:\n{stderr}");
     assert!(png.is_file(), "{scene}: no PNG");
-    // Three frames with two in flight, each reported.
-    for f in 0..3 {
+    // Every frame reported, two in flight.
+    for f in 0..frames {
         assert!(stdout.contains(&format!("frame {f} (slot {})", f % 2)), "{scene}: frame {f} not reported:\n{stdout}");
     }
     let report = umbrage::reference::check_dump(&dump, 1).unwrap_or_else(|e| panic!("{scene}: check: {e}"));
@@ -77,18 +78,26 @@ fn run_and_check(bin: &Path, scene: &str, size: &str) -> bool {
         assert!(l.metrics.compared > 1000, "{scene}: light {}: only {} pixels compared", l.index, l.metrics.compared);
         assert_eq!(l.metrics.mismatches_outside_band, 0, "{scene}: light {}: mismatches outside the band", l.index);
     }
+    let masks = umbrage::reference::read_dump(&dump).expect("the dump reads back").shadow;
     let _ = std::fs::remove_dir_all(&dir);
-    true
+    Some(masks)
 }
 
 #[test]
 fn wgpu_host_matches_reference_with_validation() {
     let bin = example();
-    // The default scene (point, spot and directional lights, nine casters), the eye inside a
-    // shadow volume (z-fail), and huge volumes over the whole screen (fill).
+    // The default scene (point, spot and directional lights, seven casters), the eye inside a
+    // shadow volume (z-fail), and huge volumes over the whole screen (fill); three frames, two
+    // in flight, the last caster 0.5 units from where the scene puts it in the last one.
+    let mut moved = None;
     for scene in ["default", "hard/eye_in_volume", "bench/fill"] {
-        if !run_and_check(&bin, scene, "320x200") {
-            return;
-        }
+        let Some(masks) = run_and_check(&bin, scene, "320x200", 3) else { return };
+        moved.get_or_insert(masks);
     }
+    // One frame: the scene as loaded. The moved caster's shadow differs (the dump follows the
+    // caster, and the pass drew it where the frame put it).
+    let Some(still) = run_and_check(&bin, "default", "320x200", 1) else { return };
+    let moved = moved.expect("the default scene ran");
+    let differ: usize = still.iter().zip(&moved).map(|(a, b)| a.iter().zip(b).filter(|(x, y)| x != y).count()).sum();
+    assert!(differ > 100, "the moving caster changed only {differ} mask pixels");
 }

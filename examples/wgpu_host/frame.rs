@@ -18,10 +18,11 @@ use umbrage::geom::LightKind;
 use umbrage::pass::ShadowView;
 use umbrage::render::{FrameOutput, Stats};
 
-/// Where the moving caster is at frame `f` of `frames`, relative to where the scene puts it:
-/// it slides along -x, 0.25 a frame, and the last frame is the scene as loaded.
-pub fn displacement(f: usize, frames: usize) -> Vec3 {
-    Vec3::new(0.25 * (frames - 1 - f) as f32, 0.0, 0.0)
+/// Where the moving caster is at frame `f`, relative to where the scene puts it: it slides
+/// along +x, 0.25 a frame (frame 0, and so `--frames 1`, is the scene as loaded). The dump
+/// of the last frame has it there too, so `umbrage check` judges the moved caster's shadow.
+pub fn displacement(f: usize) -> Vec3 {
+    Vec3::new(0.25 * f as f32, 0.0, 0.0)
 }
 
 /// What a retired frame took.
@@ -45,15 +46,15 @@ pub struct Retired {
 }
 
 impl Host {
-    /// Records and submits frame `f` of `frames` into ring slot `f % 2`, after retiring the
-    /// slot's previous frame (returned). `capture`: copy out the stencil per light and the
+    /// Records and submits frame `f` into ring slot `f % 2`, after retiring the slot's
+    /// previous frame (returned). `capture`: copy out the stencil per light and the
     /// G-buffer's positions and normals (for `--dump`).
-    pub fn frame(&mut self, f: usize, frames: usize, capture: bool) -> Result<Option<Retired>, String> {
+    pub fn frame(&mut self, f: usize, capture: bool) -> Result<Option<Retired>, String> {
         let slot = f % FRAMES_IN_FLIGHT;
         let retired = self.retire(slot, false)?;
         let start = Instant::now();
         if let Some((mi, base)) = self.moving {
-            let xf = Mat4::from_translation(displacement(f, frames)) * base;
+            let xf = Mat4::from_translation(displacement(f)) * base;
             self.scene.meshes[mi].transform = xf;
             let id = self.meshes[mi].caster.ok_or("the moving mesh casts no shadow")?;
             self.pass_mut().set_transform(id, xf.as_dmat4()).map_err(|e| e.to_string())?;

@@ -9,8 +9,9 @@
 //! EQUAL, reference 0), additively over the ambient term, like umbrage's own frame
 //! (Blinn-Phong with umbrage's range attenuation and spot falloff, the same tone map).
 //! `--frames N` frames are rendered with two in flight while the last shadow-casting mesh
-//! slides between frames (0.25 a frame along -x, ending where the scene puts it); the PNG and
-//! the dump are of the last frame.
+//! slides between frames (0.25 a frame along +x from where the scene puts it, so `--frames 1`
+//! draws the scene as `umbrage render` does); the PNG and the dump are of the last frame, with
+//! the mesh where that frame drew it.
 //!
 //! What wgpu needed beyond its own API (see `gpu.rs` and `shadow.rs`):
 //! - the pass records `vkCmdBeginRendering` and `vkCmdPipelineBarrier2`: `dynamicRendering`
@@ -106,7 +107,7 @@ fn run(args: &Args) -> Result<(), String> {
     let mut timings = Vec::with_capacity(frames);
     for f in 0..frames {
         let last = f + 1 == frames;
-        if let Some(r) = host.frame(f, frames, last && args.dump.is_some())? {
+        if let Some(r) = host.frame(f, last && args.dump.is_some())? {
             timings.push(r.timing);
         }
     }
