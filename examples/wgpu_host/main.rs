@@ -28,16 +28,22 @@
 //!
 //! Run: `cargo run --example wgpu_host -- --scene default --size 960x540 --out wgpu.png
 //! --dump DIR`, then `umbrage check DIR` compares the dump with the exact CPU reference. The
-//! flags mean what they mean for `umbrage render`. `UMBRAGE_VALIDATION=1` turns on the
-//! Khronos validation layer (with synchronisation validation); any validation error makes
-//! the program exit non-zero. `UMBRAGE_DEVICE=<name>` picks the adapter.
+//! flags mean what they mean for `umbrage render` (the default `--out` is `wgpu_host.png`).
+//! `UMBRAGE_VALIDATION=1` turns on the Khronos validation layer (with synchronisation
+//! validation); any validation error makes the program exit non-zero. `UMBRAGE_DEVICE=<name>`
+//! picks the adapter.
 //!
 //! Limitations: opaque triangle meshes only (scenes with analytic spheres or transparent
 //! casters are refused); the stencil counter with McGuire's method only (no `--method`,
 //! `--counter float`, `--depth-mode clamp`); no depth-bounds test (wgpu enables no
 //! depthBounds), so the pass and the lighting pass use the scissor alone; no GPU timestamps
 //! (the frame times are host wall-clock). Needs Vulkan 1.3 with dynamicRendering and
-//! synchronization2 (lavapipe is fine).
+//! synchronization2 (lavapipe 22.3.6 and 25.0.7 are fine; 20.3.5, Vulkan 1.0, is refused).
+//! The validation layer Debian 12 ships (1.3.239) checks the wgpu side and the pass's calls,
+//! but its synchronisation validation does not follow dynamic-rendering attachments (a
+//! determination recorded twice with no barrier between goes unreported), so the barriers
+//! around the determination rest on the argument in `shadow.rs` and on the reference check,
+//! not on that layer.
 
 mod frame;
 mod gpu;
