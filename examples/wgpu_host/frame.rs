@@ -166,7 +166,7 @@ impl Host {
                     wgpu::TexelCopyBufferInfo {
                         buffer: &c.stencil,
                         layout: wgpu::TexelCopyBufferLayout {
-                            offset: li as u64 * (stencil_pitch * h) as u64,
+                            offset: li as u64 * stencil_pitch as u64 * h as u64,
                             bytes_per_row: Some(stencil_pitch),
                             rows_per_image: Some(h),
                         },

@@ -182,8 +182,15 @@ impl Gpu {
 
         let features = wgpu::Features::empty();
         // Four G-buffer targets (RGBA16F + RGBA8 + 2 x RGBA32F = 44 bytes a sample).
-        let limits = wgpu::Limits { max_color_attachment_bytes_per_sample: 64, ..wgpu::Limits::default() };
-        if adapter.limits().max_color_attachment_bytes_per_sample < limits.max_color_attachment_bytes_per_sample {
+        // Large frames: the adapter's texture size and buffer size (readbacks) limits.
+        let most = adapter.limits();
+        let limits = wgpu::Limits {
+            max_color_attachment_bytes_per_sample: 64,
+            max_texture_dimension_2d: most.max_texture_dimension_2d,
+            max_buffer_size: most.max_buffer_size,
+            ..wgpu::Limits::default()
+        };
+        if most.max_color_attachment_bytes_per_sample < limits.max_color_attachment_bytes_per_sample {
             return Err(format!("{name}: fewer than 64 colour attachment bytes a sample"));
         }
         let memory_hints = wgpu::MemoryHints::Performance;

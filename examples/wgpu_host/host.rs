@@ -169,6 +169,18 @@ impl Host {
         // Area lights become their point-light samples, as in `umbrage render`.
         scene.lights = umbrage::geom::area::expand_lights(&scene.lights, None);
         let device = &gpu.device;
+        let limits = device.limits();
+        let h = height as u64;
+        let mut largest = pitch(width, 4) as u64 * h;
+        if capture {
+            largest = largest.max(pitch(width, 16) as u64 * h).max(pitch(width, 1) as u64 * h * scene.lights.len() as u64);
+        }
+        if width.max(height) > limits.max_texture_dimension_2d || largest > limits.max_buffer_size {
+            return Err(format!(
+                "{width}x{height} is beyond this device's limits ({} texels a side, {} bytes a buffer)",
+                limits.max_texture_dimension_2d, limits.max_buffer_size
+            ));
+        }
         let att = wgpu::TextureUsages::RENDER_ATTACHMENT;
         let tex = wgpu::TextureUsages::TEXTURE_BINDING;
         let src = wgpu::TextureUsages::COPY_SRC;
@@ -297,21 +309,21 @@ impl Slot {
                 wgpu::BindGroupEntry { binding: 3, resource: block(&lights, std::mem::size_of::<LightBlock>()) },
             ],
         });
-        let readback = |label: &str, size: u32| {
+        let readback = |label: &str, size: u64| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
-                size: size as u64,
+                size,
                 usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
                 mapped_at_creation: false,
             })
         };
-        let (w, h) = (t.width, t.height);
+        let (w, h) = (t.width, t.height as u64);
         let readback = Readback {
-            color: readback("color readback", pitch(w, 4) * h),
+            color: readback("color readback", pitch(w, 4) as u64 * h),
             capture: capture.then(|| Capture {
-                stencil: readback("stencil readback", pitch(w, 1) * h * scene.lights.len().max(1) as u32),
-                positions: readback("position readback", pitch(w, 16) * h),
-                normals: readback("normal readback", pitch(w, 16) * h),
+                stencil: readback("stencil readback", pitch(w, 1) as u64 * h * scene.lights.len().max(1) as u64),
+                positions: readback("position readback", pitch(w, 16) as u64 * h),
+                normals: readback("normal readback", pitch(w, 16) as u64 * h),
             }),
         };
         Slot { meshes, lights, mesh_group, light_group, readback, in_flight: None }
