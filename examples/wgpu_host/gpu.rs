@@ -115,7 +115,7 @@ fn pick_adapter(instance: &wgpu::Instance) -> Result<wgpu::Adapter, String> {
     };
     let mut adapters: Vec<wgpu::Adapter> = block_on(instance.enumerate_adapters(wgpu::Backends::VULKAN))
         .into_iter()
-        .filter(|a| wanted.as_ref().map_or(true, |w| a.get_info().name.to_lowercase().contains(w)))
+        .filter(|a| wanted.as_ref().is_none_or(|w| a.get_info().name.to_lowercase().contains(w)))
         .collect();
     adapters.sort_by_key(|a| rank(a.get_info().device_type));
     adapters.into_iter().next().ok_or_else(|| match wanted {

@@ -224,7 +224,7 @@ mod tests {
             assert_eq!(bits.len(), m.triangles.len().div_ceil(64));
             assert_eq!(unpack_bits(&bits, m.triangles.len()), want, "light {l:?} flip {flip}");
             if let Some(&last) = bits.last() {
-                if m.triangles.len() % 64 != 0 {
+                if !m.triangles.len().is_multiple_of(64) {
                     assert_eq!(last >> (m.triangles.len() % 64), 0);
                 }
             }

@@ -575,7 +575,7 @@ fn light_kind_name(k: LightKind) -> &'static str {
 }
 
 fn align(v: &mut Vec<u8>, a: usize) {
-    while v.len() % a != 0 {
+    while !v.len().is_multiple_of(a) {
         v.push(0);
     }
 }

@@ -75,7 +75,7 @@ pub(crate) fn view_scale(view: &ShadowView) -> ViewScale {
 /// Appends `tris` to the stream as naive vertices (4 x f32 each), 16-aligned; returns the
 /// draw.
 fn stream_tris(stream: &mut Vec<u8>, tris: &[[DVec4; 3]], case: Case, light_cap: bool) -> Draw {
-    while stream.len() % 16 != 0 {
+    while !stream.len().is_multiple_of(16) {
         stream.push(0);
     }
     let offset = stream.len() as u64;

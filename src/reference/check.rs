@@ -150,7 +150,7 @@ pub fn check_dump(dir: impl AsRef<std::path::Path>, band: u32) -> Result<CheckRe
             let i = y * w + x;
             let p = pos(i);
             if !p.is_finite() {
-                out.extend(std::iter::repeat(LightState::Background).take(nl));
+                out.extend(std::iter::repeat_n(LightState::Background, nl));
                 continue;
             }
             let r = (reference.tolerance.footprint_fraction * footprint(i)).max(min_r);

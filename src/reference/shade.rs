@@ -138,7 +138,7 @@ impl Reference {
                 match self.surface_at_pixel(camera, x as u32, y as u32, width, height) {
                     None => {
                         px.push(RefPixel::BACKGROUND);
-                        st.extend(std::iter::repeat(LightState::Background).take(nl));
+                        st.extend(std::iter::repeat_n(LightState::Background, nl));
                     }
                     Some((pixel, p, n, r)) => {
                         px.push(pixel);

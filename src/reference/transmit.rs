@@ -151,7 +151,7 @@ impl Reference {
                 match self.surface_at_pixel(camera, x as u32, y as u32, width, height) {
                     None => {
                         px.push(RefPixel::BACKGROUND);
-                        vals.extend(std::iter::repeat(Transmit::Background).take(nl));
+                        vals.extend(std::iter::repeat_n(Transmit::Background, nl));
                     }
                     Some((pixel, p, n, r)) => {
                         px.push(pixel);
