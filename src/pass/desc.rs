@@ -260,7 +260,7 @@ pub struct ShadowPassDesc {
     /// blending on it). `None`: transparent casters are refused.
     pub transmit_format: Option<vk::Format>,
     /// Build the debug pipeline that draws the volumes translucent over a colour target of
-    /// this format ([`ShadowPass::cmd_draw_volume_overlay`](super::ShadowPass::cmd_draw_volume_overlay)).
+    /// this format ([`Diagnostics::cmd_draw_volume_overlay`](super::diagnostics::Diagnostics::cmd_draw_volume_overlay)).
     pub debug_color_format: Option<vk::Format>,
 }
 
@@ -287,7 +287,7 @@ pub struct PassSettings {
     /// Volumes with a case rule, or edge quads.
     pub technique: Technique,
     /// Stencil or float counting; [`ShadowPass::cmd_determine`](super::ShadowPass::cmd_determine)
-    /// counts in the stencil, [`ShadowPass::cmd_count_float`](super::ShadowPass::cmd_count_float)
+    /// counts in the stencil, [`Diagnostics::cmd_count_float`](super::diagnostics::Diagnostics::cmd_count_float)
     /// in a float target.
     pub counter: Counter,
     /// Index format of the per-frame streams.

@@ -1,6 +1,10 @@
 //! The host's device and allocator, as the GPU helpers see them.
 
+use super::desc::ShadowPassDesc;
+use super::pipelines;
+use crate::error::{Error, Result};
 use crate::gpu::context::{lock_allocator, GpuDevice};
+use ash::vk;
 use gpu_allocator::vulkan::Allocator;
 use std::sync::{Arc, Mutex};
 
@@ -22,4 +26,66 @@ impl GpuDevice for PassDevice {
     fn synchronization2(&self) -> bool {
         false
     }
+}
+
+/// Whether the device can do dynamic rendering: Vulkan 1.3 with `dynamicRendering`.
+pub(super) fn dynamic_rendering_supported(instance: &ash::Instance, pd: vk::PhysicalDevice, api: u32) -> bool {
+    if api < vk::API_VERSION_1_3 {
+        return false;
+    }
+    let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
+    let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13);
+    // SAFETY: a feature query on a valid Vulkan 1.3 physical device with a well-formed pNext chain.
+    unsafe { instance.get_physical_device_features2(pd, &mut f2) };
+    f13.dynamic_rendering == vk::TRUE
+}
+
+/// Refuses a sample count the device's framebuffer limits or the depth-stencil format lack.
+pub(super) fn check_samples(
+    instance: &ash::Instance,
+    pd: vk::PhysicalDevice,
+    limits: &vk::PhysicalDeviceLimits,
+    desc: &ShadowPassDesc,
+) -> Result<()> {
+    let flag = pipelines::sample_flags(desc.samples);
+    let framebuffer = limits.framebuffer_depth_sample_counts & limits.framebuffer_stencil_sample_counts;
+    // SAFETY: a format query on a valid physical device.
+    let image = unsafe {
+        instance.get_physical_device_image_format_properties(
+            pd,
+            desc.depth_stencil_format,
+            vk::ImageType::TYPE_2D,
+            vk::ImageTiling::OPTIMAL,
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
+            vk::ImageCreateFlags::empty(),
+        )
+    }
+    .map(|p| p.sample_counts)
+    .unwrap_or(vk::SampleCountFlags::empty());
+    if !framebuffer.contains(flag) || !image.contains(flag) {
+        let counts = |f: vk::SampleCountFlags| {
+            [1u32, 2, 4, 8, 16, 32, 64].into_iter().filter(|&n| f.as_raw() & n != 0).map(|n| n.to_string()).collect::<Vec<_>>().join(", ")
+        };
+        return Err(Error::Unsupported(format!(
+            "{} samples: this device supports {} for {:?} depth-stencil attachments",
+            desc.samples,
+            counts(framebuffer & image),
+            desc.depth_stencil_format
+        )));
+    }
+    Ok(())
+}
+
+pub(super) fn index_type_uint8_supported(instance: &ash::Instance, pd: vk::PhysicalDevice) -> bool {
+    // SAFETY: enumeration on a valid physical device.
+    let exts = unsafe { instance.enumerate_device_extension_properties(pd) }.unwrap_or_default();
+    let named = |n: &std::ffi::CStr| exts.iter().any(|e| e.extension_name_as_c_str().map(|x| x == n).unwrap_or(false));
+    if !named(ash::ext::index_type_uint8::NAME) && !named(ash::khr::index_type_uint8::NAME) {
+        return false;
+    }
+    let mut u8f = vk::PhysicalDeviceIndexTypeUint8FeaturesEXT::default();
+    let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut u8f);
+    // SAFETY: a feature query on a valid physical device with a well-formed pNext chain.
+    unsafe { instance.get_physical_device_features2(pd, &mut f2) };
+    u8f.index_type_uint8 == vk::TRUE
 }

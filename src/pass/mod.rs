@@ -54,6 +54,7 @@ mod casters;
 mod compute;
 mod desc;
 mod device;
+pub mod diagnostics;
 mod eye;
 mod frame;
 mod pipelines;
@@ -61,6 +62,7 @@ pub mod push;
 mod record;
 mod spheres;
 pub mod stats;
+mod target;
 
 pub use casters::CasterId;
 pub use desc::{
@@ -69,8 +71,9 @@ pub use desc::{
 };
 pub use frame::{case_name, LightFrame, PreparedFrame, ShadowView};
 pub use pipelines::COUNT_FORMAT;
-pub use record::{lit_stencil_state, DepthStencilTarget, VolumeKind};
+pub use record::{lit_stencil_state, VolumeKind};
 pub use spheres::SphereId;
+pub use target::DepthStencilTarget;
 
 use crate::error::{Error, Misuse, Result};
 use crate::geom::Light;
@@ -195,7 +198,7 @@ impl ShadowPass {
         if api < vk::API_VERSION_1_1 {
             return Err(Error::Unsupported(format!("the shadow pass needs Vulkan 1.1; the device has {}", version(api))));
         }
-        if desc.target == TargetModel::DynamicRendering && !dynamic_rendering_supported(instance, physical_device, api) {
+        if desc.target == TargetModel::DynamicRendering && !device::dynamic_rendering_supported(instance, physical_device, api) {
             return Err(Error::Unsupported(format!(
                 "TargetModel::DynamicRendering needs Vulkan 1.3 with dynamicRendering; the device has {} without it: \
                  use TargetModel::RenderPass",
@@ -208,11 +211,11 @@ impl ShadowPass {
                 desc.depth_stencil_format
             )));
         }
-        check_samples(instance, physical_device, &props.limits, desc)?;
+        device::check_samples(instance, physical_device, &props.limits, desc)?;
         let caps = Capabilities {
             depth_clamp: desc.features.depth_clamp && features.depth_clamp == vk::TRUE,
             depth_bounds: desc.features.depth_bounds && features.depth_bounds == vk::TRUE,
-            index_type_uint8: desc.features.index_type_uint8 && index_type_uint8_supported(instance, physical_device),
+            index_type_uint8: desc.features.index_type_uint8 && device::index_type_uint8_supported(instance, physical_device),
             r32f_blend: r32f.optimal_tiling_features.contains(vk::FormatFeatureFlags::COLOR_ATTACHMENT_BLEND)
                 && desc.target == TargetModel::DynamicRendering,
         };
@@ -521,63 +524,6 @@ impl ShadowPass {
     pub fn caster_kind(&self, id: CasterId) -> Result<&CasterKind> {
         Ok(&self.casters.cpu[self.casters.find(id)?].kind)
     }
-}
-
-/// Whether the device can do dynamic rendering: Vulkan 1.3 with `dynamicRendering`.
-fn dynamic_rendering_supported(instance: &ash::Instance, pd: vk::PhysicalDevice, api: u32) -> bool {
-    if api < vk::API_VERSION_1_3 {
-        return false;
-    }
-    let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
-    let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13);
-    // SAFETY: a feature query on a valid Vulkan 1.3 physical device with a well-formed pNext chain.
-    unsafe { instance.get_physical_device_features2(pd, &mut f2) };
-    f13.dynamic_rendering == vk::TRUE
-}
-
-/// Refuses a sample count the device's framebuffer limits or the depth-stencil format lack.
-fn check_samples(instance: &ash::Instance, pd: vk::PhysicalDevice, limits: &vk::PhysicalDeviceLimits, desc: &ShadowPassDesc) -> Result<()> {
-    let flag = pipelines::sample_flags(desc.samples);
-    let framebuffer = limits.framebuffer_depth_sample_counts & limits.framebuffer_stencil_sample_counts;
-    // SAFETY: a format query on a valid physical device.
-    let image = unsafe {
-        instance.get_physical_device_image_format_properties(
-            pd,
-            desc.depth_stencil_format,
-            vk::ImageType::TYPE_2D,
-            vk::ImageTiling::OPTIMAL,
-            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
-            vk::ImageCreateFlags::empty(),
-        )
-    }
-    .map(|p| p.sample_counts)
-    .unwrap_or(vk::SampleCountFlags::empty());
-    if !framebuffer.contains(flag) || !image.contains(flag) {
-        let counts = |f: vk::SampleCountFlags| {
-            [1u32, 2, 4, 8, 16, 32, 64].into_iter().filter(|&n| f.as_raw() & n != 0).map(|n| n.to_string()).collect::<Vec<_>>().join(", ")
-        };
-        return Err(Error::Unsupported(format!(
-            "{} samples: this device supports {} for {:?} depth-stencil attachments",
-            desc.samples,
-            counts(framebuffer & image),
-            desc.depth_stencil_format
-        )));
-    }
-    Ok(())
-}
-
-fn index_type_uint8_supported(instance: &ash::Instance, pd: vk::PhysicalDevice) -> bool {
-    // SAFETY: enumeration on a valid physical device.
-    let exts = unsafe { instance.enumerate_device_extension_properties(pd) }.unwrap_or_default();
-    let named = |n: &std::ffi::CStr| exts.iter().any(|e| e.extension_name_as_c_str().map(|x| x == n).unwrap_or(false));
-    if !named(ash::ext::index_type_uint8::NAME) && !named(ash::khr::index_type_uint8::NAME) {
-        return false;
-    }
-    let mut u8f = vk::PhysicalDeviceIndexTypeUint8FeaturesEXT::default();
-    let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut u8f);
-    // SAFETY: a feature query on a valid physical device with a well-formed pNext chain.
-    unsafe { instance.get_physical_device_features2(pd, &mut f2) };
-    u8f.index_type_uint8 == vk::TRUE
 }
 
 impl Drop for ShadowPass {

@@ -4,84 +4,11 @@ use super::desc::{IndexFormat, TargetModel};
 use super::frame::{CasterDraw, Draw, LightFrame, PreparedFrame};
 use super::pipelines::CountPipes;
 use super::push::VolumePush;
+use super::target::DepthStencilTarget;
 use super::ShadowPass;
-use crate::error::{Error, Misuse, Result};
+use crate::error::{Misuse, Result};
 use crate::shadow::Case;
 use ash::vk;
-
-/// The host's depth-stencil image as the determination uses it, with the layouts the host
-/// declares (FidelityFX / NRD style): the layout it is in when the call is recorded, and the
-/// layout the host wants it left in.
-///
-/// With [`TargetModel::DynamicRendering`] the pass records the transitions itself: from
-/// [`layout`](Self::layout) to `DEPTH_STENCIL_ATTACHMENT_OPTIMAL` (waiting for every earlier
-/// command's writes), its rendering, then to [`final_layout`](Self::final_layout) (its stencil
-/// writes made visible to every later command). With [`TargetModel::RenderPass`] the image is
-/// the subpass's attachment and no transition can be recorded inside the render pass: both
-/// layouts must be the subpass's layout, and the host's subpass dependencies do the rest.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct DepthStencilTarget {
-    /// The host's depth-stencil image (both aspects are transitioned).
-    pub image: vk::Image,
-    /// A view of both aspects of [`image`](Self::image), in the format and sample count the
-    /// pass was created for.
-    pub view: vk::ImageView,
-    /// The image's size (the viewport covers all of it); equal to the frame's view size.
-    pub extent: vk::Extent2D,
-    /// The layout the image is in when the call is recorded (never `UNDEFINED`: the depth is
-    /// read).
-    pub layout: vk::ImageLayout,
-    /// The layout the pass leaves the image in.
-    pub final_layout: vk::ImageLayout,
-}
-
-impl DepthStencilTarget {
-    /// A target in `DEPTH_STENCIL_ATTACHMENT_OPTIMAL` before and after.
-    pub fn new(image: vk::Image, view: vk::ImageView, extent: vk::Extent2D) -> DepthStencilTarget {
-        let l = vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
-        DepthStencilTarget { image, view, extent, layout: l, final_layout: l }
-    }
-
-    /// The same target, declared in `layout` and to be left in `final_layout`.
-    pub fn with_layouts(self, layout: vk::ImageLayout, final_layout: vk::ImageLayout) -> DepthStencilTarget {
-        DepthStencilTarget { layout, final_layout, ..self }
-    }
-
-    fn check(&self, frame: &PreparedFrame, model: &TargetModel) -> Result<()> {
-        use vk::ImageLayout as L;
-        if self.extent != frame.extent() {
-            return Err(Error::argument(
-                "DepthStencilTarget",
-                format!(
-                    "extent {}x{} differs from the frame's view {}x{}",
-                    self.extent.width,
-                    self.extent.height,
-                    frame.extent().width,
-                    frame.extent().height
-                ),
-            ));
-        }
-        if matches!(self.layout, L::UNDEFINED | L::PREINITIALIZED) || matches!(self.final_layout, L::UNDEFINED | L::PREINITIALIZED) {
-            return Err(Error::argument(
-                "DepthStencilTarget",
-                format!(
-                    "declared layouts {:?} -> {:?}: the depth is read, so neither may be UNDEFINED or PREINITIALIZED",
-                    self.layout, self.final_layout
-                ),
-            ));
-        }
-        if matches!(model, TargetModel::RenderPass(_)) && self.layout != self.final_layout {
-            return Err(Error::argument(
-                "DepthStencilTarget",
-                format!(
-                    "{:?} -> {:?} inside the host's render pass: no transition can be recorded there; declare the subpass's layout twice",
-                    self.layout, self.final_layout
-                ),
-            ));
-        }
-        Ok(())
-    }
-}
 
 /// What a volume draw counts into (the pipelines differ, the geometry is the same).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -101,7 +28,7 @@ pub enum VolumeKind {
     },
     /// Opaque casters with depth and stencil tests always passing and nothing written: under
     /// an occlusion query, the exact number of fragments the volumes rasterise
-    /// ([`ShadowPass::cmd_count_rasterised`](super::ShadowPass::cmd_count_rasterised)).
+    /// ([`Diagnostics::cmd_count_rasterised`](super::diagnostics::Diagnostics::cmd_count_rasterised)).
     Rasterised,
 }
 
@@ -111,7 +38,11 @@ pub fn lit_stencil_state() -> vk::StencilOpState {
     crate::gpu::pipeline::stencil_equal(0)
 }
 
-fn depth_attachment(target: &DepthStencilTarget, stencil: vk::AttachmentLoadOp, clear: u32) -> vk::RenderingAttachmentInfo<'static> {
+pub(super) fn depth_attachment(
+    target: &DepthStencilTarget,
+    stencil: vk::AttachmentLoadOp,
+    clear: u32,
+) -> vk::RenderingAttachmentInfo<'static> {
     vk::RenderingAttachmentInfo::default()
         .image_view(target.view)
         .image_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
@@ -151,12 +82,12 @@ impl ShadowPass {
     }
 
     /// Light `light` of a live frame of this pass.
-    fn light<'f>(&self, frame: &'f PreparedFrame, light: usize) -> Result<&'f LightFrame> {
+    pub(super) fn light<'f>(&self, frame: &'f PreparedFrame, light: usize) -> Result<&'f LightFrame> {
         self.check_frame(frame)?;
         frame.lights.get(light).ok_or_else(|| Misuse::LightIndex { index: light, lights: frame.lights.len() }.into())
     }
 
-    fn dynamic_only(&self, call: &'static str) -> Result<()> {
+    pub(super) fn dynamic_only(&self, call: &'static str) -> Result<()> {
         match self.desc.target {
             TargetModel::DynamicRendering => Ok(()),
             _ => Err(Misuse::NotConfigured { call, needs: "TargetModel::DynamicRendering (it begins its own rendering instance)" }.into()),
@@ -202,7 +133,7 @@ impl ShadowPass {
     /// Reads the pass's staging buffers; writes its caster vertex buffers. The host's images
     /// are not touched.
     ///
-    /// Errors ([`Error::Misuse`]): `frame` is another pass's, or its slot was prepared again.
+    /// Errors ([`Error::Misuse`](crate::Error::Misuse)): `frame` is another pass's, or its slot was prepared again.
     ///
     /// # Safety
     /// `cb` is a primary command buffer of the pass's device, recording, outside any rendering
@@ -265,7 +196,7 @@ impl ShadowPass {
     ///   `vkCmdClearAttachments`, the volumes drawn; the host's render pass and subpass
     ///   dependencies order it with the rest.
     ///
-    /// Errors ([`Error::Misuse`]), with nothing recorded: `light` out of range, a frame of
+    /// Errors ([`Error::Misuse`](crate::Error::Misuse)), with nothing recorded: `light` out of range, a frame of
     /// another pass or a stale one, a target whose extent differs from the frame's view or
     /// whose declared layouts the model cannot take, and (render-pass model) a frame whose
     /// uploads or GPU silhouettes were not recorded before the render pass began.
@@ -327,7 +258,7 @@ impl ShadowPass {
     ///
     /// # Safety
     /// Outside any rendering instance; `target` describes the host's image truthfully.
-    unsafe fn enter(&self, cb: vk::CommandBuffer, target: &DepthStencilTarget) {
+    pub(super) unsafe fn enter(&self, cb: vk::CommandBuffer, target: &DepthStencilTarget) {
         let ds = vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
         // SAFETY: the caller's contract.
         unsafe { self.image_barrier(cb, target.image, (target.layout, ds), ANY, TESTS) };
@@ -337,7 +268,7 @@ impl ShadowPass {
     ///
     /// # Safety
     /// As [`enter`](Self::enter), after it.
-    unsafe fn leave(&self, cb: vk::CommandBuffer, target: &DepthStencilTarget) {
+    pub(super) unsafe fn leave(&self, cb: vk::CommandBuffer, target: &DepthStencilTarget) {
         let ds = vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
         // SAFETY: the caller's contract.
         unsafe { self.image_barrier(cb, target.image, (ds, target.final_layout), TESTS, ANY) };
@@ -357,74 +288,11 @@ impl ShadowPass {
         Ok(())
     }
 
-    /// The counting variant of [`cmd_determine`](Self::cmd_determine): the same volumes of
-    /// light `light` over the same scissor (and depth bounds), with depth and stencil tests
-    /// always passing and nothing written. Wrapped by the host in an occlusion query
-    /// (`VK_QUERY_CONTROL_PRECISE_BIT` with `occlusionQueryPrecise`), the query counts every
-    /// fragment the determination rasterises: the stencil fill it costs. The image's contents
-    /// are left as they are. Dynamic rendering only.
-    ///
-    /// # Safety
-    /// As [`cmd_determine`](Self::cmd_determine) (the stencil aspect is loaded, not cleared).
-    pub unsafe fn cmd_count_rasterised(
-        &self,
-        cb: vk::CommandBuffer,
-        frame: &PreparedFrame,
-        light: usize,
-        target: &DepthStencilTarget,
-    ) -> Result<()> {
-        let lf = self.light(frame, light)?;
-        self.dynamic_only("cmd_count_rasterised")?;
-        target.check(frame, &self.desc.target)?;
-        // SAFETY: the caller's contract (outside a rendering instance).
-        unsafe { self.cmd_before_rendering(cb, frame)? };
-        let att = depth_attachment(target, vk::AttachmentLoadOp::LOAD, 0);
-        let info = vk::RenderingInfo::default().render_area(lf.scissor).layer_count(1).depth_attachment(&att).stencil_attachment(&att);
-        let d = &self.dev.device;
-        // SAFETY: the caller's contract; the attachments are the caller's image.
-        unsafe {
-            self.enter(cb, target);
-            d.cmd_begin_rendering(cb, &info);
-            self.cmd_light_state(cb, frame, light, target.extent)?;
-            self.cmd_draw_volumes(cb, frame, light, VolumeKind::Rasterised)?;
-            d.cmd_end_rendering(cb);
-            self.leave(cb, target);
-        }
-        Ok(())
-    }
-
-    /// As [`cmd_determine`](Self::cmd_determine), but counting into `count` (an R32F image,
-    /// [`COUNT_FORMAT`](super::COUNT_FORMAT), cleared to 0 inside the scissor): exact counts
-    /// with no 8-bit wrap. The depth-stencil image is only read. Dynamic rendering only, and
-    /// needs R32F blending ([`Capabilities::r32f_blend`](super::Capabilities)).
-    ///
-    /// # Safety
-    /// As `cmd_determine`; in addition `count` is a view of an R32F image of the same size
-    /// and sample count in `COLOR_ATTACHMENT_OPTIMAL` layout, whose earlier accesses the host
-    /// made available.
-    pub unsafe fn cmd_count_float(
-        &self,
-        cb: vk::CommandBuffer,
-        frame: &PreparedFrame,
-        light: usize,
-        target: &DepthStencilTarget,
-        count: vk::ImageView,
-    ) -> Result<()> {
-        let start = self.light(frame, light)?.counter_clear as f32;
-        if self.pipes.count.is_none() {
-            return Err(
-                Misuse::NotConfigured { call: "cmd_count_float", needs: "R32_SFLOAT blending and TargetModel::DynamicRendering" }.into()
-            );
-        }
-        // SAFETY: forwarded contract.
-        unsafe { self.cmd_counted_instance(cb, frame, light, target, (count, [start, 0.0, 0.0, 0.0]), VolumeKind::Float) }
-    }
-
     /// Records the transparent casters' light-intensity map of `light` (Kim et al. 2008) into
     /// `map` (the pass's transmit format), cleared inside the scissor to 1 (0 in log space).
     ///
     /// # Safety
-    /// As [`cmd_count_float`](Self::cmd_count_float), with `map` in the format given as
+    /// As [`Diagnostics::cmd_count_float`](super::diagnostics::Diagnostics::cmd_count_float), with `map` in the format given as
     /// [`ShadowPassDesc::transmit_format`](super::ShadowPassDesc).
     pub unsafe fn cmd_light_intensity(
         &self,
@@ -447,8 +315,8 @@ impl ShadowPass {
     /// view and its clear value) and the depth-stencil loaded, drawing `kind`.
     ///
     /// # Safety
-    /// As [`cmd_count_float`](Self::cmd_count_float).
-    unsafe fn cmd_counted_instance(
+    /// As [`Diagnostics::cmd_count_float`](super::diagnostics::Diagnostics::cmd_count_float).
+    pub(super) unsafe fn cmd_counted_instance(
         &self,
         cb: vk::CommandBuffer,
         frame: &PreparedFrame,
@@ -522,7 +390,7 @@ impl ShadowPass {
     /// With [`TargetModel::RenderPass`], inside the host's subpass (stencil and rasterised
     /// kinds only).
     ///
-    /// Errors ([`Error::Misuse`]): as `cmd_determine`'s frame and light checks, and a kind the
+    /// Errors ([`Error::Misuse`](crate::Error::Misuse)): as `cmd_determine`'s frame and light checks, and a kind the
     /// pass has no pipelines for (float kinds without R32F blending or in the render-pass
     /// model, `Transmit` without a transmit format).
     ///
@@ -664,44 +532,9 @@ impl ShadowPass {
         })
     }
 
-    /// Draws every light's volumes translucent, coloured by case (z-pass blue, z-fail red,
-    /// z-fail with light cap green), light caps left out: the `--view volumes` debug overlay.
-    ///
-    /// # Safety
-    /// `cb` is recording inside a rendering instance with one colour attachment of
-    /// [`ShadowPassDesc::debug_color_format`](super::ShadowPassDesc) (the pass must have been
-    /// created with it) and the depth-stencil image loaded, viewport and scissor set; the
-    /// frame's uploads and GPU silhouettes were recorded; `frame` is live.
-    pub unsafe fn cmd_draw_volume_overlay(&self, cb: vk::CommandBuffer, frame: &PreparedFrame) -> Result<()> {
-        self.check_frame(frame)?;
-        let Some(pipe) = self.pipes.overlay else {
-            return Err(Misuse::NotConfigured { call: "cmd_draw_volume_overlay", needs: "ShadowPassDesc::debug_color_format" }.into());
-        };
-        // SAFETY: the caller's contract.
-        unsafe { self.dev.device.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipe) };
-        for lf in &frame.lights {
-            for c in lf.casters.iter().filter(|c| c.case != Case::Culled) {
-                for dr in c.draws.iter().filter(|dr| !dr.light_cap) {
-                    let color = match dr.case {
-                        Case::Culled => continue,
-                        Case::ZPass => [0.2f32, 0.4, 1.0, 0.12],
-                        Case::ZFail => [1.0, 0.3, 0.2, 0.12],
-                        Case::ZFailLightCap => [0.1, 1.0, 0.2, 0.12],
-                    };
-                    // SAFETY: as above.
-                    unsafe {
-                        self.push(cb, c, color);
-                        self.record_draw(cb, frame, dr);
-                    }
-                }
-            }
-        }
-        Ok(())
-    }
-
     /// # Safety
     /// `cb` is recording with a pipeline of the pass's layout bound or about to be.
-    unsafe fn push(&self, cb: vk::CommandBuffer, c: &CasterDraw, color: [f32; 4]) {
+    pub(super) unsafe fn push(&self, cb: vk::CommandBuffer, c: &CasterDraw, color: [f32; 4]) {
         let push = VolumePush::new(c.mvp, c.light_object, color);
         // SAFETY: the caller's contract; the block matches the layout's range.
         unsafe {
@@ -721,7 +554,7 @@ impl ShadowPass {
     /// `cb` is recording inside a rendering instance with a volume pipeline bound; `frame` is
     /// the frame the draw belongs to (its stream, or its compute records and indices, whose
     /// writes [`cmd_compute_silhouettes`](Self::cmd_compute_silhouettes) made visible).
-    unsafe fn record_draw(&self, cb: vk::CommandBuffer, frame: &PreparedFrame, dr: &Draw) {
+    pub(super) unsafe fn record_draw(&self, cb: vk::CommandBuffer, frame: &PreparedFrame, dr: &Draw) {
         let d = &self.dev.device;
         let stream = frame.stream;
         // SAFETY: the caller's contract; offsets were computed from the stream just written.

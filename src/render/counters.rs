@@ -1,7 +1,7 @@
 //! The shadow pass's counters (`FrameSettings::counters`): per light, pipeline statistics
 //! around the determination (primitives in, vertex invocations, primitives out of clipping)
 //! and an occlusion query around its counting variant
-//! ([`ShadowPass::cmd_count_rasterised`](crate::pass::ShadowPass::cmd_count_rasterised)):
+//! ([`Diagnostics::cmd_count_rasterised`](crate::pass::diagnostics::Diagnostics::cmd_count_rasterised)):
 //! with `occlusionQueryPrecise`, the exact number of fragments the volumes rasterise.
 //! One pair of query pools per ring slot, grown with the number of lights.
 

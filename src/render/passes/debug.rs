@@ -2,6 +2,7 @@
 //! coloured by case) and `--view stencil` (light 0's counts as a heat map, on the CPU).
 
 use super::{att, Rec, DS_CLEAR, ZERO};
+use crate::pass::diagnostics::Diagnostics;
 use crate::pass::{PreparedFrame, ShadowPass};
 use crate::render::targets::Targets;
 use ash::vk;

@@ -4,6 +4,7 @@
 
 use super::{Rec, DS_RW, FRAG_TESTS};
 use crate::error::Result;
+use crate::pass::diagnostics::Diagnostics;
 use crate::pass::{DepthStencilTarget, PreparedFrame, ShadowPass};
 use crate::render::counters::CounterPools;
 use crate::render::readback::Range;
