@@ -26,24 +26,49 @@ pub fn write_frame_dump(dir: &Path, scene: &Scene, frame: &FrameOutput) -> Resul
     if frame.positions.is_empty() {
         return Err(Error::Other("frame was rendered without capture; cannot dump".into()));
     }
-    // world.obj: the opaque casters (what the binary shadow masks are about). Transparent
-    // casters attenuate rather than occlude; they go to transparent.obj, one group per mesh
-    // with its per-surface transmittance (1 - opacity) * colour.
-    let world = |m: &crate::scene::SceneMesh| -> Vec<[glam::Vec3; 3]> {
-        let xf = m.transform.as_dmat4();
-        (0..m.mesh.triangles.len()).map(|t| m.mesh.triangle(t).map(|p| xf.transform_point3(p.as_dvec3()).as_vec3())).collect()
-    };
-    let mut triangles = Vec::new();
+    let positions = frame.positions.iter().flatten().copied().collect();
+    let normals = frame.normals.iter().flatten().copied().collect();
+    let dump = scene_dump(scene, (frame.width, frame.height), positions, normals, frame.shadow_masks(scene));
+    write_scene_dump(dir, scene, &dump, &frame.stencil, &frame.color)
+}
+
+/// A frame dump of `scene` as a host saw it: its per-pixel world `positions` and `normals`
+/// (W·H·3, NaN for background) and per light its mask (255 lit, 0 not, 128 background).
+/// `world.obj`'s triangles are the scene's opaque shadow casters, in world space.
+pub fn scene_dump(scene: &Scene, (width, height): (u32, u32), positions: Vec<f32>, normals: Vec<f32>, shadow: Vec<Vec<u8>>) -> Dump {
+    let triangles = scene.meshes.iter().filter(|m| m.casts_shadow && m.opacity >= 1.0).flat_map(world_triangles).collect();
+    Dump {
+        width,
+        height,
+        camera_pos: scene.camera.eye,
+        lights: scene.lights.iter().map(DumpLight::from_light).collect(),
+        triangles,
+        positions,
+        normals,
+        shadow,
+        spheres: scene.spheres.iter().filter(|s| s.casts_shadow).map(|s| s.sphere).collect(),
+        camera: Some(scene.camera.clone()),
+        extra: Default::default(),
+    }
+}
+
+fn world_triangles(m: &crate::scene::SceneMesh) -> Vec<[glam::Vec3; 3]> {
+    let xf = m.transform.as_dmat4();
+    (0..m.mesh.triangles.len()).map(|t| m.mesh.triangle(t).map(|p| xf.transform_point3(p.as_dvec3()).as_vec3())).collect()
+}
+
+/// Writes `dump` ([`write_dump`]), `transparent.obj` when `scene` has transparent casters,
+/// `stencil_K.png` per light and `color.png` (RGBA8, W·H·4; nothing when empty).
+pub fn write_scene_dump(dir: &Path, scene: &Scene, dump: &Dump, stencil: &[Vec<u8>], color: &[u8]) -> Result<()> {
+    write_dump(dir, dump)?;
+    // Transparent casters attenuate rather than occlude: one group per mesh with its
+    // per-surface transmittance (1 - opacity) * colour.
     let mut transparent = String::from("# umbrage: transparent shadow casters, world space\n");
     let mut nv = 0usize;
-    for m in scene.meshes.iter().filter(|m| m.casts_shadow) {
-        if m.opacity >= 1.0 {
-            triangles.extend(world(m));
-            continue;
-        }
+    for m in scene.meshes.iter().filter(|m| m.casts_shadow && m.opacity < 1.0) {
         let t = (1.0 - m.opacity) * m.color;
         transparent += &format!("g {}\n# transmittance {} {} {}\n", m.name.replace(char::is_whitespace, "_"), t.x, t.y, t.z);
-        for tri in world(m) {
+        for tri in world_triangles(m) {
             for v in tri {
                 transparent += &format!("v {} {} {}\n", v.x, v.y, v.z);
             }
@@ -51,28 +76,17 @@ pub fn write_frame_dump(dir: &Path, scene: &Scene, frame: &FrameOutput) -> Resul
             nv += 3;
         }
     }
-    let dump = Dump {
-        width: frame.width,
-        height: frame.height,
-        camera_pos: scene.camera.eye,
-        lights: scene.lights.iter().map(DumpLight::from_light).collect(),
-        triangles,
-        positions: frame.positions.iter().flatten().copied().collect(),
-        normals: frame.normals.iter().flatten().copied().collect(),
-        shadow: frame.shadow_masks(scene),
-        spheres: scene.spheres.iter().filter(|s| s.casts_shadow).map(|s| s.sphere).collect(),
-        camera: Some(scene.camera.clone()),
-        extra: Default::default(),
-    };
-    write_dump(dir, &dump)?;
     if nv > 0 {
         let path = dir.join("transparent.obj");
         std::fs::write(&path, transparent).map_err(|e| Error::io(path.display().to_string(), e))?;
     }
-    for (k, s) in frame.stencil.iter().enumerate() {
-        write_grey_png(&dir.join(format!("stencil_{k}.png")), frame.width, frame.height, s)?;
+    for (k, s) in stencil.iter().enumerate() {
+        write_grey_png(&dir.join(format!("stencil_{k}.png")), dump.width, dump.height, s)?;
     }
-    write_png(&dir.join("color.png"), frame.width, frame.height, &frame.color)
+    if color.is_empty() {
+        return Ok(());
+    }
+    write_png(&dir.join("color.png"), dump.width, dump.height, color)
 }
 
 /// What `umbrage info` prints: the device, its probed features and the code paths they select.

@@ -1,14 +1,35 @@
-//! The host's frame: recording (depth pre-pass, per light the determination, the stencil
-//! copy and the lighting pass, the depth copy), submission with the slot's fence, and the
-//! readback of a retired slot compared with the reference.
+//! The host's frame: recording (the pass's uploads, the pre-pass, per light the determination,
+//! the lighting pass and the per-sample readback), submission with the slot's fence, and the
+//! readback of a retired slot turned into one frame dump per sample, each checked against the
+//! reference.
 
+use super::extract::ExtractPush;
 use super::vulkan::{image_barrier, memory_barrier, vkerr, write_buffer};
-use super::{scene, FrameResult, Host, InFlight, Layout, LightResult, BAND, FRAMES_IN_FLIGHT, HEIGHT, MOVING_MESH, WIDTH};
+use super::{FrameResult, Host, InFlight, Layout, LightResult, SampleFrame, BAND, FRAMES_IN_FLIGHT};
 use ash::vk;
-use glam::{DMat4, DVec3, Mat4, Vec3, Vec4};
-use umbrage::pass::push::VolumePush;
-use umbrage::pass::{DepthStencilTarget, ShadowView};
-use umbrage::reference::{metrics::compare_all, Reference};
+use glam::{DMat4, DVec3, DVec4, Vec3};
+use umbrage::geom::LightKind;
+use umbrage::pass::{reverse_z, DepthStencilTarget, ShadowView};
+
+/// Vulkan's standard sample locations (`standardSampleLocations`) of `samples` samples, in
+/// pixel units from the pixel's top-left corner.
+pub(super) fn sample_locations(samples: u32) -> &'static [(f64, f64)] {
+    match samples {
+        2 => &[(0.75, 0.75), (0.25, 0.25)],
+        4 => &[(0.375, 0.125), (0.875, 0.375), (0.125, 0.625), (0.625, 0.875)],
+        8 => &[
+            (0.5625, 0.3125),
+            (0.4375, 0.6875),
+            (0.8125, 0.5625),
+            (0.3125, 0.1875),
+            (0.1875, 0.8125),
+            (0.0625, 0.4375),
+            (0.6875, 0.9375),
+            (0.9375, 0.0625),
+        ],
+        _ => &[(0.5, 0.5)],
+    }
+}
 
 impl Host {
     /// Records and submits frame `f` into ring slot `f % 2`, after retiring that slot's
@@ -16,297 +37,362 @@ impl Host {
     pub(super) fn frame(&mut self, f: usize, out: &mut Vec<FrameResult>) -> Result<(), String> {
         let slot = f % FRAMES_IN_FLIGHT;
         self.retire(slot, out)?;
-        let s = scene(f);
+        let s = self.scenes.at(f);
         // Move the caster: the pass re-plans from the new transform; nothing is re-created.
-        let moving = self.meshes[MOVING_MESH].caster.ok_or("the box casts no shadow")?;
-        self.pass().set_transform(moving, s.meshes[MOVING_MESH].transform.as_dmat4()).map_err(|e| e.to_string())?;
+        if let Some((mi, _)) = self.scenes.moving {
+            let id = self.meshes[mi].caster.ok_or("the moving mesh casts no shadow")?;
+            self.pass().set_transform(id, s.meshes[mi].transform.as_dmat4()).map_err(|e| e.to_string())?;
+        }
 
         let cam = &s.camera;
-        let (w, h) = (WIDTH, HEIGHT);
+        let (w, h) = (self.extent.width, self.extent.height);
         let eye = cam.eye.as_dvec3();
-        // Eye-relative view (rotation only) and the infinite projection the pass assumes.
         let view = glam::camera::rh::view::look_at_mat4(Vec3::ZERO, cam.target - cam.eye, cam.up.normalize());
-        let proj = cam.proj_infinite(w as f32 / h as f32);
+        // The infinite projection, reversed for a reverse-Z host: the pass is told which.
+        let forward = cam.proj_infinite(w as f32 / h as f32);
+        let proj = if self.config.reverse_z { reverse_z(forward) } else { forward };
         let frame = self
             .pass()
             .prepare(slot, &ShadowView { eye, view, proj, width: w, height: h }, &s.lights)
             .map_err(|e| format!("prepare: {e}"))?;
         // Exactly as the pass composes its casters' MVPs, so the volumes land on these depths.
-        let mvps: Vec<Mat4> = s
-            .meshes
-            .iter()
-            .map(|m| (proj.as_dmat4() * view.as_dmat4() * DMat4::from_translation(-eye) * m.transform.as_dmat4()).as_mat4())
-            .collect();
+        let view_proj = proj.as_dmat4() * view.as_dmat4();
+        let rels: Vec<DMat4> = s.meshes.iter().map(|m| DMat4::from_translation(-eye) * m.transform.as_dmat4()).collect();
+        let push: Vec<[[f32; 16]; 2]> =
+            rels.iter().map(|rel| [(view_proj * *rel).as_mat4().to_cols_array(), rel.as_mat4().to_cols_array()]).collect();
 
         // The lighting pass's index lists: per light and mesh, the triangles facing the light.
         let mut lit_data: Vec<u32> = Vec::new();
         let mut lit_draws = vec![Vec::new(); s.lights.len()];
         for (li, light) in s.lights.iter().enumerate() {
-            let lp = light.position.as_dvec3();
+            let l = light.homogeneous().as_dvec4();
             for (mi, m) in s.meshes.iter().enumerate() {
                 let xf = m.transform.as_dmat4();
                 let world: Vec<DVec3> = self.meshes[mi].positions.iter().map(|p| xf.transform_point3(p.as_dvec3())).collect();
                 let first = lit_data.len();
                 for t in &self.meshes[mi].triangles {
                     let [a, b, c] = t.map(|i| world[i as usize]);
-                    if (b - a).cross(c - a).dot(lp - a) > 0.0 {
+                    let to_light = l.truncate() - a * l.w;
+                    if (b - a).cross(c - a).dot(to_light) > 0.0 {
                         lit_data.extend_from_slice(t);
                     }
                 }
-                lit_draws[li].push(((first * 4) as u64, (lit_data.len() - first) as u32));
+                lit_draws[li].push((first as u32, (lit_data.len() - first) as u32));
             }
         }
         write_buffer(&mut self.slots[slot].lit, bytemuck::cast_slice(&lit_data))?;
 
-        let device = self.dev().clone();
-        let pass = self.pass.as_ref().ok_or("no pass")?;
-        let depth = self.depth.as_ref().ok_or("no depth image")?;
-        let lit_img = self.lit_target.as_ref().ok_or("no lit target")?;
+        let started = std::time::Instant::now();
+        // SAFETY: the slot's previous submission retired (`retire` waited its fence), so its
+        // command buffer may be re-recorded; `frame` was prepared for this slot, which is not
+        // prepared again before this submission's fence is waited.
+        unsafe { self.record(slot, &frame, &push, &lit_draws)? };
         let slot_ref = &self.slots[slot];
-        let cb = slot_ref.cmd;
-        let layout = Layout { pixels: (w * h) as u64 };
-        let full = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: self.extent };
-        let viewport = vk::Viewport { x: 0.0, y: 0.0, width: w as f32, height: h as f32, min_depth: 0.0, max_depth: 1.0 };
-        let ds_aspects = vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL;
-        let frag_tests = vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS;
-        let ds_rw = vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE;
-        let ds_layout = vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
-        let src_layout = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
-        let copy = vk::PipelineStageFlags2::COPY;
-        let ds_att = |load: vk::AttachmentLoadOp| {
-            vk::RenderingAttachmentInfo::default()
-                .image_view(depth.view)
-                .image_layout(ds_layout)
-                .load_op(load)
-                .store_op(vk::AttachmentStoreOp::STORE)
-                .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } })
-        };
-        let copy_out = |img: vk::Image, aspect: vk::ImageAspectFlags, offset: u64| {
-            let region = vk::BufferImageCopy::default()
-                .buffer_offset(offset)
-                .image_subresource(vk::ImageSubresourceLayers { aspect_mask: aspect, mip_level: 0, base_array_layer: 0, layer_count: 1 })
-                .image_extent(vk::Extent3D { width: w, height: h, depth: 1 });
-            // SAFETY: `cb` is recording outside a rendering instance; the image is in
-            // TRANSFER_SRC_OPTIMAL and the range lies inside the slot's readback buffer.
-            unsafe { device.cmd_copy_image_to_buffer(cb, img, src_layout, slot_ref.readback.raw, &[region]) };
-        };
-        let push = |mvp: Mat4, color: [f32; 4]| {
-            let p = VolumePush::new(mvp, Vec4::ZERO, color);
-            let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
-            // SAFETY: `cb` is recording with a pipeline of `self.layout` bound; 96 bytes.
-            unsafe { device.cmd_push_constants(cb, self.layout, stages, 0, bytemuck::bytes_of(&p)) };
-        };
-        let target = DepthStencilTarget::new(depth.raw, depth.view, self.extent);
-
-        // SAFETY: (the whole recording) the slot's previous submission retired (`retire`
-        // waited its fence), so its command buffer may be reset and re-recorded; every object
-        // recorded belongs to this device and lives until the device is idle at teardown; the
-        // layouts named are those the preceding barriers leave; `frame` was prepared for this
-        // slot and the slot is not prepared again before this submission's fence is waited.
+        let device = self.dev();
+        // SAFETY: the command buffer was recorded and ended above; the fence is unsignalled
+        // after the reset and belongs to this device.
         unsafe {
-            device.reset_command_buffer(cb, vk::CommandBufferResetFlags::empty()).map_err(vkerr("vkResetCommandBuffer"))?;
-            device
-                .begin_command_buffer(cb, &vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT))
-                .map_err(vkerr("vkBeginCommandBuffer"))?;
-            // The depth-stencil image: its previous contents (the other frame's) are discarded;
-            // ALL_COMMANDS orders this after the previous frame's copies on the queue.
-            image_barrier(
-                &device,
-                cb,
-                depth.raw,
-                ds_aspects,
-                (vk::ImageLayout::UNDEFINED, ds_layout),
-                (vk::PipelineStageFlags2::ALL_COMMANDS, vk::AccessFlags2::NONE),
-                (frag_tests, ds_rw),
-            );
-            pass.cmd_before_rendering(cb, &frame).map_err(|e| e.to_string())?;
-
-            // Depth pre-pass: every mesh, depth LESS, stencil cleared to 0.
-            let d = ds_att(vk::AttachmentLoadOp::CLEAR);
-            device.cmd_begin_rendering(
-                cb,
-                &vk::RenderingInfo::default().render_area(full).layer_count(1).depth_attachment(&d).stencil_attachment(&d),
-            );
-            device.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.prepass);
-            device.cmd_set_viewport(cb, 0, &[viewport]);
-            device.cmd_set_scissor(cb, 0, &[full]);
-            for (mi, m) in self.meshes.iter().enumerate() {
-                push(mvps[mi], [0.0; 4]);
-                device.cmd_bind_vertex_buffers(cb, 0, &[m.vertices.raw], &[0]);
-                device.cmd_bind_index_buffer(cb, m.indices.raw, 0, vk::IndexType::UINT32);
-                device.cmd_draw_indexed(cb, m.index_count, 1, 0, 0, 0);
-            }
-            device.cmd_end_rendering(cb);
-            memory_barrier(
-                &device,
-                cb,
-                (vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS, vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE),
-                (frag_tests, ds_rw),
-            );
-
-            for (li, draws) in lit_draws.iter().enumerate() {
-                // The shadow determination: the count in the stencil.
-                pass.cmd_determine(cb, &frame, li, &target).map_err(|e| e.to_string())?;
-                // Stencil out (readback), then back to attachment for the lighting pass.
-                image_barrier(
-                    &device,
-                    cb,
-                    depth.raw,
-                    ds_aspects,
-                    (ds_layout, src_layout),
-                    (frag_tests, ds_rw),
-                    (copy, vk::AccessFlags2::TRANSFER_READ),
-                );
-                copy_out(depth.raw, vk::ImageAspectFlags::STENCIL, layout.stencil(li));
-                image_barrier(
-                    &device,
-                    cb,
-                    depth.raw,
-                    ds_aspects,
-                    (src_layout, ds_layout),
-                    (copy, vk::AccessFlags2::NONE),
-                    (frag_tests, ds_rw),
-                );
-
-                // The host's lighting pass: light-facing triangles, depth EQUAL, stencil == 0.
-                image_barrier(
-                    &device,
-                    cb,
-                    lit_img.raw,
-                    vk::ImageAspectFlags::COLOR,
-                    (vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL),
-                    (copy, vk::AccessFlags2::NONE),
-                    (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT, vk::AccessFlags2::COLOR_ATTACHMENT_WRITE),
-                );
-                let color = [vk::RenderingAttachmentInfo::default()
-                    .image_view(lit_img.view)
-                    .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                    .load_op(vk::AttachmentLoadOp::CLEAR)
-                    .store_op(vk::AttachmentStoreOp::STORE)
-                    .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: [0.0; 4] } })];
-                let d = ds_att(vk::AttachmentLoadOp::LOAD);
-                device.cmd_begin_rendering(
-                    cb,
-                    &vk::RenderingInfo::default()
-                        .render_area(full)
-                        .layer_count(1)
-                        .color_attachments(&color)
-                        .depth_attachment(&d)
-                        .stencil_attachment(&d),
-                );
-                device.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.lighting);
-                // Viewport, the light's scissor and (when used) its depth bounds.
-                pass.cmd_light_state(cb, &frame, li, self.extent).map_err(|e| e.to_string())?;
-                device.cmd_bind_index_buffer(cb, slot_ref.lit.raw, 0, vk::IndexType::UINT32);
-                for (mi, m) in self.meshes.iter().enumerate() {
-                    let (offset, count) = draws[mi];
-                    if count == 0 {
-                        continue;
-                    }
-                    push(mvps[mi], [1.0; 4]);
-                    device.cmd_bind_vertex_buffers(cb, 0, &[m.vertices.raw], &[0]);
-                    device.cmd_draw_indexed(cb, count, 1, (offset / 4) as u32, 0, 0);
-                }
-                device.cmd_end_rendering(cb);
-                image_barrier(
-                    &device,
-                    cb,
-                    lit_img.raw,
-                    vk::ImageAspectFlags::COLOR,
-                    (vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, src_layout),
-                    (vk::PipelineStageFlags2::COLOR_ATTACHMENT_OUTPUT, vk::AccessFlags2::COLOR_ATTACHMENT_WRITE),
-                    (copy, vk::AccessFlags2::TRANSFER_READ),
-                );
-                copy_out(lit_img.raw, vk::ImageAspectFlags::COLOR, layout.lit(li));
-                // The next light's determination clears the stencil the lighting pass read.
-                memory_barrier(&device, cb, (frag_tests, ds_rw), (frag_tests, ds_rw));
-            }
-
-            // The depth, once: background is depth 1.0.
-            image_barrier(
-                &device,
-                cb,
-                depth.raw,
-                ds_aspects,
-                (ds_layout, src_layout),
-                (frag_tests, ds_rw),
-                (copy, vk::AccessFlags2::TRANSFER_READ),
-            );
-            copy_out(depth.raw, vk::ImageAspectFlags::DEPTH, layout.depth());
-            memory_barrier(
-                &device,
-                cb,
-                (copy, vk::AccessFlags2::TRANSFER_WRITE),
-                (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
-            );
-            device.end_command_buffer(cb).map_err(vkerr("vkEndCommandBuffer"))?;
             device.reset_fences(&[slot_ref.fence]).map_err(vkerr("vkResetFences"))?;
-            let cbs = [cb];
+            let cbs = [slot_ref.cmd];
             device
                 .queue_submit(self.queue, &[vk::SubmitInfo::default().command_buffers(&cbs)], slot_ref.fence)
                 .map_err(vkerr("vkQueueSubmit"))?;
         }
         self.slots[slot].in_flight = Some(InFlight {
             frame: f,
+            scene: s.clone(),
+            view_proj,
             stats: frame.lights.iter().map(|l| l.stats.clone()).collect(),
             totals: frame.totals.clone(),
             cpu_ms: frame.cpu_ms.clone(),
             warnings: frame.warnings.clone(),
+            started,
         });
         Ok(())
     }
 
-    /// Waits for the frame in flight in `slot` (if any), reads its readback and compares it
-    /// with the reference of that frame's scene.
+    /// Records slot `slot`'s command buffer: per mesh its `push` block (`mvp`, `rel`), per
+    /// light and mesh its lit triangles (first index, count) in the slot's lit buffer.
+    ///
+    /// # Safety
+    /// The slot's previous submission has completed; `frame` was prepared for `slot`.
+    unsafe fn record(
+        &self,
+        slot: usize,
+        frame: &umbrage::pass::PreparedFrame,
+        push: &[[[f32; 16]; 2]],
+        lit_draws: &[Vec<(u32, u32)>],
+    ) -> Result<(), String> {
+        let device = self.dev();
+        let pass = self.pass.as_ref().ok_or("no pass")?;
+        let depth = self.depth.as_ref().ok_or("no depth image")?;
+        let lit_img = self.lit_target.as_ref().ok_or("no lit target")?;
+        let normal_img = self.normal_target.as_ref().ok_or("no normal target")?;
+        let slot_ref = &self.slots[slot];
+        let cb = slot_ref.cmd;
+        let samples = self.config.samples;
+        let layout = Layout { pixels: self.extent.width * self.extent.height, samples };
+        let full = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: self.extent };
+        let (w, h) = (self.extent.width as f32, self.extent.height as f32);
+        let viewport = vk::Viewport { x: 0.0, y: 0.0, width: w, height: h, min_depth: 0.0, max_depth: 1.0 };
+        let clear_depth = if self.config.reverse_z { 0.0 } else { 1.0 };
+        let ds_clear = vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: clear_depth, stencil: 0 } };
+        let color_clear = vk::ClearValue { color: vk::ClearColorValue { float32: [0.0; 4] } };
+        let ds_aspects = vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL;
+        let tests = vk::PipelineStageFlags::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS;
+        let ds_rw = vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_READ | vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_WRITE;
+        let (ds_att, ds_read) = (vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL, vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL);
+        let (color_att, shader_read) = (vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
+        let output = (vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT, vk::AccessFlags::COLOR_ATTACHMENT_WRITE);
+        let compute_read = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ);
+        // Whatever ran before (the previous frame's readback, on the same queue): done first.
+        let before = (vk::PipelineStageFlags::ALL_COMMANDS, vk::AccessFlags::empty());
+        let attachment = |view, load, clear| {
+            vk::RenderingAttachmentInfo::default()
+                .image_view(view)
+                .image_layout(if view == depth.view { ds_att } else { color_att })
+                .load_op(load)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(clear)
+        };
+        let draw = |pipeline, draws: Option<&Vec<(u32, u32)>>| {
+            // SAFETY: `cb` is recording inside the matching rendering instance or subpass.
+            unsafe {
+                device.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipeline);
+                for (mi, m) in self.meshes.iter().enumerate() {
+                    device.cmd_push_constants(cb, self.layout, vk::ShaderStageFlags::VERTEX, 0, bytemuck::cast_slice(&push[mi]));
+                    device.cmd_bind_vertex_buffers(cb, 0, &[m.vertices.raw], &[0]);
+                    match draws {
+                        None => {
+                            device.cmd_bind_index_buffer(cb, m.indices.raw, 0, vk::IndexType::UINT32);
+                            device.cmd_draw_indexed(cb, m.index_count, 1, 0, 0, 0);
+                        }
+                        Some(d) if d[mi].1 > 0 => {
+                            device.cmd_bind_index_buffer(cb, slot_ref.lit.raw, 0, vk::IndexType::UINT32);
+                            device.cmd_draw_indexed(cb, d[mi].1, 1, d[mi].0, 0, 0);
+                        }
+                        Some(_) => {}
+                    }
+                }
+            }
+        };
+        let begin_render_pass = |rp, fb, clears: &[vk::ClearValue]| {
+            let info = vk::RenderPassBeginInfo::default().render_pass(rp).framebuffer(fb).render_area(full).clear_values(clears);
+            // SAFETY: the framebuffer matches the render pass; `cb` is outside any render pass.
+            unsafe { device.cmd_begin_render_pass(cb, &info, vk::SubpassContents::INLINE) };
+        };
+
+        // SAFETY: (the whole recording) the caller's contract; every object recorded belongs to
+        // this device and lives until the device is idle at teardown; the layouts named are
+        // those the preceding barriers or render passes leave.
+        unsafe {
+            device.reset_command_buffer(cb, vk::CommandBufferResetFlags::empty()).map_err(vkerr("vkResetCommandBuffer"))?;
+            device
+                .begin_command_buffer(cb, &vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT))
+                .map_err(vkerr("vkBeginCommandBuffer"))?;
+            // The pass's uploads (new casters' vertices), outside any rendering.
+            pass.cmd_before_rendering(cb, frame).map_err(|e| format!("cmd_before_rendering: {e}"))?;
+
+            // The pre-pass: depth (stencil cleared to 0) and the normal of every sample.
+            if self.config.render_pass {
+                begin_render_pass(self.passes.prepass, self.passes.prepass_fb, &[color_clear, ds_clear]);
+            } else {
+                image_barrier(device, cb, depth.raw, ds_aspects, (vk::ImageLayout::UNDEFINED, ds_att), before, (tests, ds_rw));
+                image_barrier(
+                    device,
+                    cb,
+                    normal_img.raw,
+                    vk::ImageAspectFlags::COLOR,
+                    (vk::ImageLayout::UNDEFINED, color_att),
+                    before,
+                    output,
+                );
+                let color = [attachment(normal_img.view, vk::AttachmentLoadOp::CLEAR, color_clear)];
+                let d = attachment(depth.view, vk::AttachmentLoadOp::CLEAR, ds_clear);
+                let info = vk::RenderingInfo::default()
+                    .render_area(full)
+                    .layer_count(1)
+                    .color_attachments(&color)
+                    .depth_attachment(&d)
+                    .stencil_attachment(&d);
+                device.cmd_begin_rendering(cb, &info);
+            }
+            device.cmd_set_viewport(cb, 0, &[viewport]);
+            device.cmd_set_scissor(cb, 0, &[full]);
+            draw(self.prepass, None);
+            if self.config.render_pass {
+                device.cmd_end_render_pass(cb);
+            } else {
+                device.cmd_end_rendering(cb);
+                image_barrier(device, cb, normal_img.raw, vk::ImageAspectFlags::COLOR, (color_att, shader_read), output, compute_read);
+                let written = (vk::PipelineStageFlags::LATE_FRAGMENT_TESTS, vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_WRITE);
+                image_barrier(device, cb, depth.raw, ds_aspects, (ds_att, ds_read), written, compute_read);
+            }
+
+            for (li, draws) in lit_draws.iter().enumerate() {
+                if self.config.render_pass {
+                    // Inside the host's subpass: the pass clears the stencil in the light's
+                    // scissor (vkCmdClearAttachments) and counts; the lighting pass follows in
+                    // the same subpass (fragment tests run in primitive order).
+                    begin_render_pass(self.passes.lighting, self.passes.lighting_fb, &[color_clear, ds_clear]);
+                    let target = DepthStencilTarget::new(depth.raw, depth.view, self.extent);
+                    pass.cmd_determine(cb, frame, li, &target).map_err(|e| format!("cmd_determine: {e}"))?;
+                } else {
+                    // The image is declared in DEPTH_STENCIL_READ_ONLY_OPTIMAL (the readback
+                    // left it there) and wanted back in DEPTH_STENCIL_ATTACHMENT_OPTIMAL: the
+                    // pass records both transitions.
+                    let target = DepthStencilTarget::new(depth.raw, depth.view, self.extent).with_layouts(ds_read, ds_att);
+                    pass.cmd_determine(cb, frame, li, &target).map_err(|e| format!("cmd_determine: {e}"))?;
+                    image_barrier(
+                        device,
+                        cb,
+                        lit_img.raw,
+                        vk::ImageAspectFlags::COLOR,
+                        (vk::ImageLayout::UNDEFINED, color_att),
+                        before,
+                        output,
+                    );
+                    let color = [attachment(lit_img.view, vk::AttachmentLoadOp::CLEAR, color_clear)];
+                    let d = attachment(depth.view, vk::AttachmentLoadOp::LOAD, ds_clear);
+                    let info = vk::RenderingInfo::default()
+                        .render_area(full)
+                        .layer_count(1)
+                        .color_attachments(&color)
+                        .depth_attachment(&d)
+                        .stencil_attachment(&d);
+                    device.cmd_begin_rendering(cb, &info);
+                }
+                // The host's lighting pass: light-facing triangles, depth EQUAL, stencil == 0;
+                // the viewport, the light's scissor and (when used) its depth bounds.
+                device.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.lighting);
+                pass.cmd_light_state(cb, frame, li, self.extent).map_err(|e| format!("cmd_light_state: {e}"))?;
+                draw(self.lighting, Some(draws));
+                if self.config.render_pass {
+                    device.cmd_end_render_pass(cb);
+                } else {
+                    device.cmd_end_rendering(cb);
+                    image_barrier(device, cb, lit_img.raw, vk::ImageAspectFlags::COLOR, (color_att, shader_read), output, compute_read);
+                    let written = (tests, vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_WRITE);
+                    image_barrier(device, cb, depth.raw, ds_aspects, (ds_att, ds_read), written, compute_read);
+                }
+                // Every sample's stencil and lit bit (and, once, its depth and normal).
+                for sample in 0..samples {
+                    let push = ExtractPush {
+                        sample,
+                        width: self.extent.width,
+                        height: self.extent.height,
+                        geometry: (li == 0) as u32,
+                        geometry_at: layout.geometry(sample),
+                        packed_at: layout.packed(li, sample),
+                    };
+                    self.extract.record(device, cb, slot, push);
+                }
+            }
+            memory_barrier(
+                device,
+                cb,
+                (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_WRITE),
+                (vk::PipelineStageFlags::HOST, vk::AccessFlags::HOST_READ),
+            );
+            device.end_command_buffer(cb).map_err(vkerr("vkEndCommandBuffer"))?;
+        }
+        Ok(())
+    }
+
+    /// Waits for the frame in flight in `slot` (if any), turns each sample of its readback
+    /// into a frame dump and checks it against the reference.
     pub(super) fn retire(&mut self, slot: usize, out: &mut Vec<FrameResult>) -> Result<(), String> {
         let Some(fl) = self.slots[slot].in_flight.take() else { return Ok(()) };
         // SAFETY: the fence belongs to this device and was submitted with the frame.
         unsafe { self.dev().wait_for_fences(&[self.slots[slot].fence], true, u64::MAX) }.map_err(vkerr("vkWaitForFences"))?;
+        let gpu_wall_ms = fl.started.elapsed().as_secs_f64() * 1e3;
         if let Some(first) = self.log.lock().ok().and_then(|l| l.first().cloned()) {
             return Err(format!("validation error by frame {}: {first}", fl.frame));
         }
-        let s = scene(fl.frame);
-        let layout = Layout { pixels: (WIDTH * HEIGHT) as u64 };
-        let n = layout.pixels as usize;
+        let s = &fl.scene;
+        let (w, h) = (self.extent.width, self.extent.height);
+        let n = (w * h) as usize;
+        let samples = self.config.samples;
+        let layout = Layout { pixels: w * h, samples };
         let data = self.slots[slot].readback.alloc.as_ref().and_then(|a| a.mapped_slice()).ok_or("readback is not host visible")?;
-        let depth = &data[..4 * n];
-        let d24 = self.ds_format == vk::Format::D24_UNORM_S8_UINT;
-        let background: Vec<bool> = depth
-            .chunks_exact(4)
-            .map(|b| {
-                let v = u32::from_le_bytes([b[0], b[1], b[2], b[3]]);
-                if d24 {
-                    v & 0x00ff_ffff == 0x00ff_ffff
-                } else {
-                    f32::from_bits(v) == 1.0
-                }
+        let words: &[u32] = bytemuck::cast_slice(&data[..layout.bytes(s.lights.len()) as usize]);
+        let clear_depth = if self.config.reverse_z { 0.0 } else { 1.0 };
+        let unproject = fl.view_proj.inverse();
+        let eye = s.camera.eye.as_dvec3();
+        let mut lights: Vec<LightResult> = (0..s.lights.len())
+            .map(|_| LightResult {
+                stencil: Vec::new(),
+                mask: Vec::new(),
+                mismatches: Vec::new(),
+                compared: Vec::new(),
+                shadowed: Vec::new(),
             })
             .collect();
-        let mut lights = Vec::with_capacity(s.lights.len());
-        for li in 0..s.lights.len() {
-            let so = layout.stencil(li) as usize;
-            let lo = layout.lit(li) as usize;
-            let stencil = data[so..so + n].to_vec();
-            let lit = &data[lo..lo + n];
-            let mask = (0..n)
-                .map(|i| {
+        let mut sample_frames = Vec::with_capacity(samples as usize);
+        for (si, &(sx, sy)) in sample_locations(samples).iter().enumerate() {
+            let geometry = &words[layout.geometry(si as u32) as usize..][..4 * n];
+            let mut positions = Vec::with_capacity(3 * n);
+            let mut normals = Vec::with_capacity(3 * n);
+            let mut background = Vec::with_capacity(n);
+            for (i, g) in geometry.chunks_exact(4).enumerate() {
+                let depth = f32::from_bits(g[0]);
+                let bg = depth == clear_depth;
+                background.push(bg);
+                if bg {
+                    positions.extend([f32::NAN; 3]);
+                    normals.extend([f32::NAN; 3]);
+                    continue;
+                }
+                // The sample's position: its depth unprojected at its own location.
+                let (x, y) = ((i % w as usize) as f64 + sx, (i / w as usize) as f64 + sy);
+                let clip = DVec4::new(2.0 * x / w as f64 - 1.0, 2.0 * y / h as f64 - 1.0, depth as f64, 1.0);
+                let r = unproject * clip;
+                let p = eye + r.truncate() / r.w;
+                positions.extend(p.as_vec3().to_array());
+                normals.extend([g[1], g[2], g[3]].map(f32::from_bits));
+            }
+            let mut masks = Vec::with_capacity(s.lights.len());
+            let mut stencils = Vec::with_capacity(s.lights.len());
+            for (li, light) in s.lights.iter().enumerate() {
+                let packed = &words[layout.packed(li, si as u32) as usize..][..n];
+                stencils.push(packed.iter().map(|&v| (v & 0xff) as u8).collect::<Vec<u8>>());
+                // Lit: the lighting pass wrote the sample (stencil 0, light-facing) and the
+                // light reaches it (a spot's cone, a light's range: what a lighting shader's
+                // attenuation would apply, applied here as umbrage's renderer does).
+                let reaches = |i: usize| {
+                    let p = Vec3::new(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]);
+                    let l = light.homogeneous();
+                    let to = if l.w == 0.0 { l.truncate() } else { l.truncate() - p };
+                    let in_range = light.radius.is_none_or(|r| l.w == 0.0 || to.length() < r);
+                    let in_cone = light.kind != LightKind::Spot
+                        || (-to.normalize()).dot(light.direction.normalize()) > (light.cone_deg.to_radians() * 0.5).cos();
+                    in_range && in_cone
+                };
+                let mask = (0..n).map(|i| {
                     if background[i] {
                         128
-                    } else if lit[i] != 0 {
+                    } else if packed[i] & 0x100 != 0 && reaches(i) {
                         255
                     } else {
                         0
                     }
-                })
-                .collect();
-            lights.push(LightResult { stencil, mask, mismatches_outside_band: 0, compared: 0 });
-        }
-        let masks: Vec<Vec<u8>> = lights.iter().map(|l| l.mask.clone()).collect();
-        let reference = Reference::from_scene(&s).render(&s.camera, &s.lights, WIDTH, HEIGHT);
-        let metrics = compare_all(&masks, &reference, BAND).map_err(|e| format!("compare: {e}"))?;
-        for (l, m) in lights.iter_mut().zip(&metrics) {
-            l.mismatches_outside_band = m.mismatches_outside_band;
-            l.compared = m.compared;
+                });
+                masks.push(mask.collect::<Vec<u8>>());
+            }
+            let dump = umbrage::output::scene_dump(s, (w, h), positions, normals, masks);
+            let name = format!("frame {} sample {si}", fl.frame);
+            let report = umbrage::reference::check(&dump, &name, BAND).map_err(|e| format!("check {name}: {e}"))?;
+            for (li, l) in lights.iter_mut().enumerate() {
+                let m = &report.lights[li].metrics;
+                l.mismatches.push(m.mismatches_outside_band);
+                l.compared.push(m.compared);
+                l.shadowed.push(stencils[li].iter().zip(&background).filter(|(&s, &bg)| s != 0 && !bg).count() as u64);
+                if si == 0 {
+                    l.stencil = stencils[li].clone();
+                    l.mask = dump.shadow[li].clone();
+                }
+            }
+            sample_frames.push(SampleFrame { dump, stencil: stencils });
         }
         out.push(FrameResult {
             frame: fl.frame,
@@ -317,6 +403,9 @@ impl Host {
             cpu_ms: fl.cpu_ms,
             warnings: fl.warnings,
             lights,
+            samples: sample_frames,
+            scene: fl.scene,
+            gpu_wall_ms,
         });
         Ok(())
     }

@@ -1,26 +1,36 @@
 //! A host renderer of its own that embeds [`umbrage::pass::ShadowPass`] the way an engine
-//! would: its own `ash::Entry`, instance (validation layer and a debug-utils messenger when
-//! `UMBRAGE_VALIDATION` is set), physical device, logical device (Vulkan 1.3 with
-//! dynamicRendering and synchronization2; depthClamp, depthBounds and
-//! `VK_EXT_index_type_uint8` when present), one graphics queue, a gpu-allocator shared with the
-//! pass, a depth-stencil image, a command pool, two frames in flight and its own lighting pass.
-//! It uses umbrage's public API only, and never `umbrage::render::Renderer` or
-//! `umbrage::gpu::Context`.
+//! would: its own `ash::Entry`, instance (validation layer with synchronisation validation and
+//! a debug-utils messenger when `UMBRAGE_VALIDATION` is set), physical device, logical device,
+//! one queue, a gpu-allocator shared with the pass, its own WGSL shaders, a depth-stencil
+//! image, two frames in flight and its own lighting pass. It uses umbrage's public API only,
+//! never `umbrage::render::Renderer` or `umbrage::gpu::Context`.
+//!
+//! [`Config`] picks what engines differ on:
+//! - `samples` (1, 2, 4, 8): every target and pipeline at that count; each sample is read back
+//!   and checked on its own;
+//! - `reverse_z`: the host's projection maps the near plane to depth 1 and infinity to 0
+//!   (depth GREATER, cleared to 0); the pass is created with `DepthDirection::Reverse`;
+//! - `render_pass`: a Vulkan 1.1 host with classic `VkRenderPass`es and no dynamic rendering;
+//!   the pass is created for the lighting render pass's subpass and `cmd_determine` records
+//!   inside it. Otherwise a Vulkan 1.3 host with dynamic rendering, and the pass transitions
+//!   the depth-stencil image from and to the layouts the host declares.
 //!
 //! Per frame (ring slot = frame % 2, its fence waited before `prepare`):
 //! 1. `ShadowPass::prepare` plans every light's volumes on the CPU;
-//! 2. the host's depth pre-pass draws every mesh (depth LESS, stencil cleared to 0);
-//! 3. per light: `cmd_determine` leaves the count in the stencil, the host copies the stencil
-//!    out, then its lighting pass draws each mesh's light-facing triangles with depth EQUAL and
-//!    stencil EQUAL 0 into an R8 target (1 = lit), copied out too;
-//! 4. the depth is copied out once (background = depth 1.0), the frame is submitted with the
-//!    slot's fence; when the slot comes round again its readback becomes per light the masks
-//!    (128 background, 255 lit, 0 shadowed), compared with the exact CPU reference.
+//! 2. `cmd_before_rendering` records the pass's uploads;
+//! 3. the pre-pass draws every mesh (depth and the face normal of each sample);
+//! 4. per light: `cmd_determine` leaves the count in the stencil; the lighting pass draws each
+//!    mesh's light-facing triangles with depth EQUAL and stencil EQUAL 0 into an R8 target;
+//!    a compute shader reads every sample's stencil and lit bit (and, for light 0, its depth
+//!    and normal) into the slot's readback buffer;
+//! 5. when the slot comes round again, each sample becomes a frame dump (positions
+//!    unprojected from the sample's depth at its standard location) checked against the CPU
+//!    reference exactly as `umbrage check` checks `umbrage render --dump`.
 //!
-//! This file holds the scene, the host's setup and its teardown; `frame.rs` records, submits
-//! and reads back a frame; `vulkan.rs` is the Vulkan plumbing (device choice, allocations,
-//! pipelines, barriers). `examples/embed/main.rs` prints the result; `tests/embed.rs` includes
-//! this file and checks it against the reference and umbrage's own renderer.
+//! This file holds the configuration, the scene, the setup and the teardown; `frame.rs`
+//! records, submits and reads back a frame; `extract.rs` is the per-sample readback;
+//! `shaders.rs` the WGSL; `vulkan.rs` the Vulkan plumbing. `examples/embed/main.rs` is the
+//! command line; `tests/embed.rs` includes this file and runs every configuration.
 #![allow(dead_code)]
 
 use ash::vk;
@@ -30,41 +40,101 @@ use gpu_allocator::MemoryLocation;
 use std::ffi::c_void;
 use std::sync::{Arc, Mutex};
 use umbrage::geom::{Camera, Light, LightKind};
-use umbrage::gpu::shaders::{SHADOW_VERT, VOLUME_FRAG};
-use umbrage::pass::push::VolumePush;
 use umbrage::pass::stats::{CpuMs, LightStats, Totals};
-use umbrage::pass::{lit_stencil_state, CasterId, EnabledFeatures, ShadowPass, ShadowPassDesc};
+use umbrage::pass::{
+    lit_stencil_state, CasterId, DepthDirection, EnabledFeatures, RenderPassTarget, ShadowPass, ShadowPassDesc, TargetModel,
+};
+use umbrage::reference::Dump;
 use umbrage::scene::{shapes, Scene, SceneMesh};
 use vulkan::{
-    create_buffer, create_device, create_image, create_pipeline, debug_callback, free_buffer, lock, pick_device, shader_module, upload,
-    validation_requested, vkerr, Buf, Img, PipelineState,
+    color_samples_supported, create_buffer, create_device, create_image, create_pipeline, create_render_pass, create_view, debug_callback,
+    free_buffer, lock, pick_device, shader_module, upload, validation_requested, vkerr, Buf, Img, PipelineState, RenderPassDesc, Target,
 };
 
-/// The frame's size.
+/// The default frame size.
 pub const WIDTH: u32 = 320;
-/// The frame's height.
+/// The default frame height.
 pub const HEIGHT: u32 = 200;
 /// Ring slots: two frames in flight.
 pub const FRAMES_IN_FLIGHT: usize = 2;
 /// The band (pixels around shadow edges and geometric discontinuities) where mismatches with
 /// the reference are not counted.
 pub const BAND: u32 = 1;
-/// The colour target of the lighting pass (1 = lit).
+/// The lighting pass's target (1 = lit).
 const LIT_FORMAT: vk::Format = vk::Format::R8_UNORM;
+/// The pre-pass's normal target.
+const NORMAL_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 /// Index of the moving caster (the box) in [`scene`]'s meshes.
 pub const MOVING_MESH: usize = 2;
 
-/// One light of a checked frame.
+/// What the host is: the configurations engines differ on, and what it draws.
+#[derive(Clone, Debug)]
+pub struct Config {
+    /// Samples per pixel: 1, 2, 4 or 8.
+    pub samples: u32,
+    /// Reverse-Z (near plane at depth 1, infinity at 0) instead of forward.
+    pub reverse_z: bool,
+    /// A Vulkan 1.1 host with classic render passes instead of dynamic rendering.
+    pub render_pass: bool,
+    /// Frame size.
+    pub width: u32,
+    /// Frame height.
+    pub height: u32,
+    /// `None`: the embedded scene ([`scene`], the box turning and sliding); otherwise a scene
+    /// (`umbrage::scene::load`'s file or built-in name) whose last shadow-casting mesh slides
+    /// 0.25 a frame along +x (frame 0 is the scene as loaded).
+    pub scene: Option<String>,
+}
+
+impl Default for Config {
+    fn default() -> Config {
+        Config { samples: 1, reverse_z: false, render_pass: false, width: WIDTH, height: HEIGHT, scene: None }
+    }
+}
+
+impl Config {
+    /// A short name: `4x reverse-Z render-pass`.
+    pub fn name(&self) -> String {
+        format!(
+            "{}x {} {}",
+            self.samples,
+            if self.reverse_z { "reverse-Z" } else { "forward" },
+            if self.render_pass { "render-pass" } else { "dynamic-rendering" }
+        )
+    }
+}
+
+/// One sample of one frame: its dump (what `--dump` writes and `umbrage check` reads) and per
+/// light its stencil.
+#[derive(Clone, Debug)]
+pub struct SampleFrame {
+    /// The sample's frame dump: positions and normals at the sample's location, masks from
+    /// the host's lighting pass (255 lit, 0 not, 128 background).
+    pub dump: Dump,
+    /// Per light, the stencil count after its determination.
+    pub stencil: Vec<Vec<u8>>,
+}
+
+/// One light of a checked frame, summed over its samples.
 #[derive(Clone, Debug)]
 pub struct LightResult {
-    /// The stencil after the light's determination, one byte a pixel, row-major from the top.
+    /// Sample 0's stencil after the light's determination, one byte a pixel, row-major.
     pub stencil: Vec<u8>,
-    /// 128 background (depth 1.0), 255 lit, 0 shadowed or facing away.
+    /// Sample 0's mask: 128 background, 255 lit, 0 shadowed or facing away.
     pub mask: Vec<u8>,
-    /// Pixels where the mask and the reference disagree, outside the [`BAND`].
-    pub mismatches_outside_band: u64,
-    /// Pixels compared with the reference.
-    pub compared: u64,
+    /// Per sample: mismatches with the reference outside the [`BAND`].
+    pub mismatches: Vec<u64>,
+    /// Per sample: pixels compared with the reference.
+    pub compared: Vec<u64>,
+    /// Per sample: pixels with a non-zero count.
+    pub shadowed: Vec<u64>,
+}
+
+impl LightResult {
+    /// Mismatches outside the band, over all samples.
+    pub fn mismatches_outside_band(&self) -> u64 {
+        self.mismatches.iter().sum()
+    }
 }
 
 /// One frame, read back and compared with the CPU reference of that frame's scene.
@@ -86,6 +156,13 @@ pub struct FrameResult {
     pub warnings: Vec<String>,
     /// Per light, the readback and its comparison.
     pub lights: Vec<LightResult>,
+    /// Per sample, its dump and stencils (kept for the last frames only: see [`run`]).
+    pub samples: Vec<SampleFrame>,
+    /// The frame's scene (the moving caster where the frame put it).
+    pub scene: Scene,
+    /// Milliseconds from the start of recording to the fence (queue and GPU time, with the
+    /// other slot's frame in flight).
+    pub gpu_wall_ms: f64,
 }
 
 /// The moving caster's transform at `frame`: the box slides towards the torus and turns.
@@ -94,8 +171,8 @@ pub fn box_transform(frame: usize) -> Mat4 {
     Mat4::from_rotation_translation(Quat::from_rotation_y(0.25 * f), Vec3::new(1.2 - 0.3 * f, 0.5, 0.3 * f))
 }
 
-/// The scene at `frame`: a floor (open, casts nothing), a torus and a moving box casting, two
-/// point lights without radius. The reference and umbrage's renderer are given this scene.
+/// The embedded scene at `frame`: a floor (open, casts nothing), a torus and a moving box
+/// casting, two point lights without radius.
 pub fn scene(frame: usize) -> Scene {
     let mesh = |name: &str, mesh, transform, casts_shadow| SceneMesh {
         name: name.into(),
@@ -129,14 +206,52 @@ pub fn scene(frame: usize) -> Scene {
     }
 }
 
-/// Renders `frames` frames of [`scene`] with the box moving, two in flight, and checks each
-/// against the reference. Errors: no usable Vulkan device, a failed call, or any validation
-/// error (when `UMBRAGE_VALIDATION` is set), including those reported at teardown.
-pub fn run(frames: usize) -> Result<Vec<FrameResult>, String> {
+/// What the host draws, frame by frame.
+struct Scenes {
+    base: Scene,
+    /// The mesh that moves and its transform in `base` (the embedded scene: the box).
+    moving: Option<(usize, Mat4)>,
+    embedded: bool,
+}
+
+impl Scenes {
+    fn new(spec: Option<&str>) -> Result<Scenes, String> {
+        let Some(spec) = spec else { return Ok(Scenes { base: scene(0), moving: Some((MOVING_MESH, box_transform(0))), embedded: true }) };
+        let base = umbrage::scene::load(spec).map_err(|e| e.to_string())?;
+        if !base.spheres.is_empty() || base.meshes.iter().any(|m| m.casts_shadow && m.opacity < 1.0) {
+            return Err(format!(
+                "scene '{spec}': this host draws opaque triangle meshes only (no analytic spheres, no transparent casters)"
+            ));
+        }
+        if base.lights.iter().any(|l| l.area.is_some()) {
+            return Err(format!("scene '{spec}': area lights are not supported by this host"));
+        }
+        let moving = base.meshes.iter().rposition(|m| m.casts_shadow).map(|i| (i, base.meshes[i].transform));
+        Ok(Scenes { base, moving, embedded: false })
+    }
+
+    /// The scene at frame `f`.
+    fn at(&self, f: usize) -> Scene {
+        if self.embedded {
+            return scene(f);
+        }
+        let mut s = self.base.clone();
+        if let Some((mi, base)) = self.moving {
+            s.meshes[mi].transform = Mat4::from_translation(Vec3::new(0.25 * f as f32, 0.0, 0.0)) * base;
+        }
+        s
+    }
+}
+
+/// Renders `frames` frames with `config`, two in flight, and checks every sample of each
+/// against the reference. The last two frames keep their [`SampleFrame`]s. Errors: no usable
+/// Vulkan device, an unsupported configuration, a failed call, or any validation error (when
+/// `UMBRAGE_VALIDATION` is set), including those reported at teardown.
+pub fn run(config: &Config, frames: usize) -> Result<Vec<FrameResult>, String> {
     let mut results = Vec::with_capacity(frames);
     let log;
     {
-        let mut host = Host::new()?;
+        let mut host = Host::new(config)?;
         log = host.log.clone();
         for f in 0..frames {
             host.frame(f, &mut results)?;
@@ -151,11 +266,19 @@ pub fn run(frames: usize) -> Result<Vec<FrameResult>, String> {
     if let Some(first) = errors.first() {
         return Err(format!("{} validation error(s) (teardown included), first: {first}", errors.len()));
     }
+    let keep_from = results.len().saturating_sub(FRAMES_IN_FLIGHT);
+    for r in &mut results[..keep_from] {
+        r.samples.clear();
+    }
     Ok(results)
 }
 
+#[path = "extract.rs"]
+mod extract;
 #[path = "frame.rs"]
 mod frame;
+#[path = "shaders.rs"]
+mod shaders;
 #[path = "vulkan.rs"]
 mod vulkan;
 
@@ -172,10 +295,13 @@ struct MeshGpu {
 /// What a ring slot remembers of the frame in flight in it.
 struct InFlight {
     frame: usize,
+    scene: Scene,
+    view_proj: glam::DMat4,
     stats: Vec<LightStats>,
     totals: Totals,
     cpu_ms: CpuMs,
     warnings: Vec<String>,
+    started: std::time::Instant,
 }
 
 /// A ring slot: command buffer, fence, readback and the lighting pass's index list.
@@ -187,29 +313,39 @@ struct Slot {
     in_flight: Option<InFlight>,
 }
 
-/// Readback layout: the depth (4 bytes a texel), then per light its stencil and lit bytes.
+/// Readback layout, in 4-byte words: per sample its geometry (4 words a pixel: depth, normal),
+/// then per light and sample its packed stencil and lit bit (1 word a pixel).
 struct Layout {
-    pixels: u64,
+    pixels: u32,
+    samples: u32,
 }
 
 impl Layout {
-    fn depth(&self) -> u64 {
-        0
+    fn geometry(&self, sample: u32) -> u32 {
+        4 * self.pixels * sample
     }
-    fn stencil(&self, light: usize) -> u64 {
-        self.pixels * (4 + 2 * light as u64)
+    fn packed(&self, light: usize, sample: u32) -> u32 {
+        4 * self.pixels * self.samples + self.pixels * (light as u32 * self.samples + sample)
     }
-    fn lit(&self, light: usize) -> u64 {
-        self.stencil(light) + self.pixels
+    fn bytes(&self, lights: usize) -> u64 {
+        4 * self.packed(lights, 0) as u64
     }
-    fn total(&self, lights: usize) -> u64 {
-        self.stencil(lights)
-    }
+}
+
+/// The classic render passes (render-pass model) and their framebuffers.
+#[derive(Default)]
+struct RenderPasses {
+    prepass: vk::RenderPass,
+    lighting: vk::RenderPass,
+    prepass_fb: vk::Framebuffer,
+    lighting_fb: vk::Framebuffer,
 }
 
 /// Everything the host owns. Fields are filled in order by [`Host::new`]; `Drop` destroys what
 /// exists, so a failure half-way cleans up too.
 struct Host {
+    config: Config,
+    scenes: Scenes,
     _entry: ash::Entry,
     instance: ash::Instance,
     debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
@@ -223,19 +359,29 @@ struct Host {
     allocator: Option<Arc<Mutex<Allocator>>>,
     pass: Option<ShadowPass>,
     depth: Option<Img>,
+    /// Views of the depth-stencil image's depth and stencil aspects (the readback's).
+    depth_view: vk::ImageView,
+    stencil_view: vk::ImageView,
     lit_target: Option<Img>,
+    normal_target: Option<Img>,
     meshes: Vec<MeshGpu>,
     slots: Vec<Slot>,
     pool: vk::CommandPool,
     layout: vk::PipelineLayout,
     prepass: vk::Pipeline,
     lighting: vk::Pipeline,
+    passes: RenderPasses,
+    extract: extract::Extract,
     depth_bounds: bool,
     extent: vk::Extent2D,
 }
 
 impl Host {
-    fn new() -> Result<Host, String> {
+    fn new(config: &Config) -> Result<Host, String> {
+        if ![1, 2, 4, 8].contains(&config.samples) {
+            return Err(format!("--msaa {}: the sample count is 1, 2, 4 or 8", config.samples));
+        }
+        let scenes = Scenes::new(config.scene.as_deref())?;
         // SAFETY: loads the Vulkan loader; `entry` is kept in the host as long as the instance.
         let entry = unsafe { ash::Entry::load() }.map_err(|e| format!("no Vulkan loader (libvulkan.so.1): {e}"))?;
         let validation = validation_requested();
@@ -250,7 +396,9 @@ impl Host {
             layers.push(layer.as_ptr());
             extensions.push(ash::ext::debug_utils::NAME.as_ptr());
         }
-        let app = vk::ApplicationInfo::default().application_name(c"umbrage-embed").api_version(vk::API_VERSION_1_3);
+        let dynamic = !config.render_pass;
+        let api = if dynamic { vk::API_VERSION_1_3 } else { vk::API_VERSION_1_1 };
+        let app = vk::ApplicationInfo::default().application_name(c"umbrage-embed").api_version(api);
         // Synchronisation validation too: the host's barriers around the pass are checked.
         let sync = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
         let mut features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&sync);
@@ -264,6 +412,8 @@ impl Host {
             unsafe { entry.create_instance(&info, None) }.map_err(|e| format!("vkCreateInstance failed ({e:?}): no Vulkan driver?"))?;
         let log = Arc::new(Mutex::new(Vec::new()));
         let mut host = Host {
+            config: config.clone(),
+            scenes,
             _entry: entry,
             instance,
             debug: None,
@@ -277,15 +427,20 @@ impl Host {
             allocator: None,
             pass: None,
             depth: None,
+            depth_view: vk::ImageView::null(),
+            stencil_view: vk::ImageView::null(),
             lit_target: None,
+            normal_target: None,
             meshes: Vec::new(),
             slots: Vec::new(),
             pool: vk::CommandPool::null(),
             layout: vk::PipelineLayout::null(),
             prepass: vk::Pipeline::null(),
             lighting: vk::Pipeline::null(),
+            passes: RenderPasses::default(),
+            extract: extract::Extract::default(),
             depth_bounds: false,
-            extent: vk::Extent2D { width: WIDTH, height: HEIGHT },
+            extent: vk::Extent2D { width: config.width, height: config.height },
         };
         if validation {
             let du = ash::ext::debug_utils::Instance::new(&host._entry, &host.instance);
@@ -299,7 +454,15 @@ impl Host {
             let m = unsafe { du.create_debug_utils_messenger(&info, None) }.map_err(vkerr("vkCreateDebugUtilsMessengerEXT"))?;
             host.debug = Some((du, m));
         }
-        let picked = pick_device(&host.instance)?;
+        let picked = pick_device(&host.instance, dynamic)?;
+        if config.samples > 1 && !picked.standard_sample_locations {
+            return Err(format!("{}: no standard sample locations, so the samples cannot be checked", picked.name));
+        }
+        for format in [LIT_FORMAT, NORMAL_FORMAT] {
+            if !color_samples_supported(&host.instance, picked.physical, format, config.samples) {
+                return Err(format!("{}: {format:?} has no {}-sample sampled colour attachments", picked.name, config.samples));
+            }
+        }
         host.physical = picked.physical;
         host.device_name = picked.name.clone();
         host.ds_format = picked.ds_format;
@@ -308,7 +471,7 @@ impl Host {
             depth_bounds: picked.depth_bounds,
             index_type_uint8: picked.index_type_uint8,
         };
-        let device = create_device(&host.instance, &picked)?;
+        let device = create_device(&host.instance, &picked, dynamic)?;
         host.device = Some(device.clone());
         // SAFETY: queue 0 of this family was requested at device creation.
         host.queue = unsafe { device.get_device_queue(picked.queue_family, 0) };
@@ -324,10 +487,26 @@ impl Host {
         let allocator = Arc::new(Mutex::new(allocator));
         host.allocator = Some(allocator.clone());
 
+        // The render passes first (the pass's pipelines are built against the lighting one).
+        let mut target = TargetModel::DynamicRendering;
+        if config.render_pass {
+            let pre = RenderPassDesc::new(NORMAL_FORMAT, host.ds_format, config.samples, true);
+            host.passes.prepass = create_render_pass(&device, &pre, |_, _| Ok(()))?.0;
+            let light = RenderPassDesc::new(LIT_FORMAT, host.ds_format, config.samples, false);
+            let (rp, t) = create_render_pass(&device, &light, |rp, info| {
+                // SAFETY: `info` is the create info `rp` was just created from, its pointers alive.
+                unsafe { RenderPassTarget::new(rp, info, 0) }.map_err(|e| format!("RenderPassTarget::new: {e}"))
+            })?;
+            host.passes.lighting = rp;
+            target = TargetModel::RenderPass(t);
+        }
         let desc = ShadowPassDesc {
             depth_stencil_format: host.ds_format,
             frames_in_flight: FRAMES_IN_FLIGHT,
             features: host.features,
+            samples: config.samples,
+            depth_direction: if config.reverse_z { DepthDirection::Reverse } else { DepthDirection::Forward },
+            target,
             ..Default::default()
         };
         let pass = ShadowPass::new(&host.instance, host.physical, &device, allocator.clone(), &desc)
@@ -336,24 +515,28 @@ impl Host {
         host.pass = Some(pass);
 
         let extent = host.extent;
+        let sampled = vk::ImageUsageFlags::SAMPLED;
+        let ds_aspects = vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL;
         host.depth = Some(create_image(
             &device,
             &allocator,
             "depth-stencil",
             host.ds_format,
             extent,
-            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
-            vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL,
+            config.samples,
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | sampled,
+            ds_aspects,
         )?);
-        host.lit_target = Some(create_image(
-            &device,
-            &allocator,
-            "lit",
-            LIT_FORMAT,
-            extent,
-            vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
-            vk::ImageAspectFlags::COLOR,
-        )?);
+        let ds_raw = host.depth.as_ref().map(|d| d.raw).ok_or("no depth image")?;
+        host.depth_view = create_view(&device, ds_raw, host.ds_format, vk::ImageAspectFlags::DEPTH)?;
+        host.stencil_view = create_view(&device, ds_raw, host.ds_format, vk::ImageAspectFlags::STENCIL)?;
+        let color = vk::ImageUsageFlags::COLOR_ATTACHMENT | sampled;
+        let aspect = vk::ImageAspectFlags::COLOR;
+        host.lit_target = Some(create_image(&device, &allocator, "lit", LIT_FORMAT, extent, config.samples, color, aspect)?);
+        host.normal_target = Some(create_image(&device, &allocator, "normal", NORMAL_FORMAT, extent, config.samples, color, aspect)?);
+        if config.render_pass {
+            host.create_framebuffers(&device)?;
+        }
 
         // SAFETY: object creation on a valid device; destroyed in `Drop for Host`.
         host.pool = unsafe {
@@ -365,37 +548,123 @@ impl Host {
             )
         }
         .map_err(vkerr("vkCreateCommandPool"))?;
-        let range = [vk::PushConstantRange {
-            stage_flags: vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-            offset: 0,
-            size: VolumePush::SIZE,
-        }];
+        let range = [vk::PushConstantRange { stage_flags: vk::ShaderStageFlags::VERTEX, offset: 0, size: 128 }];
         // SAFETY: as above.
         host.layout = unsafe { device.create_pipeline_layout(&vk::PipelineLayoutCreateInfo::default().push_constant_ranges(&range), None) }
             .map_err(vkerr("vkCreatePipelineLayout"))?;
         host.create_pipelines(&device)?;
+        host.upload_meshes(&device, &allocator)?;
+        host.create_slots(&device, &allocator)?;
+        let views = extract::Views {
+            depth: host.depth_view,
+            stencil: host.stencil_view,
+            lit: host.lit_target.as_ref().map(|i| i.view).ok_or("no lit target")?,
+            normal: host.normal_target.as_ref().map(|i| i.view).ok_or("no normal target")?,
+        };
+        let buffers: Vec<vk::Buffer> = host.slots.iter().map(|s| s.readback.raw).collect();
+        let mut extract = extract::Extract::default();
+        let created = extract.create(&device, config.samples, &views, &buffers);
+        host.extract = extract;
+        created?;
+        Ok(host)
+    }
 
-        let s = scene(0);
+    fn dev(&self) -> &ash::Device {
+        self.device.as_ref().expect("the device exists once Host::new returned")
+    }
+
+    fn pass(&mut self) -> &mut ShadowPass {
+        self.pass.as_mut().expect("the pass exists once Host::new returned")
+    }
+
+    /// The render-pass model's framebuffers (the images are shared by both ring slots).
+    fn create_framebuffers(&mut self, device: &ash::Device) -> Result<(), String> {
+        let ds = self.depth.as_ref().map(|i| i.view).ok_or("no depth image")?;
+        let lit = self.lit_target.as_ref().map(|i| i.view).ok_or("no lit target")?;
+        let normal = self.normal_target.as_ref().map(|i| i.view).ok_or("no normal target")?;
+        for (rp, color, out) in [(self.passes.prepass, normal, 0), (self.passes.lighting, lit, 1)] {
+            let views = [color, ds];
+            let info = vk::FramebufferCreateInfo::default()
+                .render_pass(rp)
+                .attachments(&views)
+                .width(self.extent.width)
+                .height(self.extent.height)
+                .layers(1);
+            // SAFETY: the views are live and match the render pass's attachments.
+            let fb = unsafe { device.create_framebuffer(&info, None) }.map_err(vkerr("vkCreateFramebuffer"))?;
+            if out == 0 {
+                self.passes.prepass_fb = fb;
+            } else {
+                self.passes.lighting_fb = fb;
+            }
+        }
+        Ok(())
+    }
+
+    /// The pre-pass (depth LESS, or GREATER with reverse-Z; the normal written) and the
+    /// lighting pass (depth EQUAL, stencil EQUAL 0, 1 written), from [`shaders::SCENE_WGSL`].
+    fn create_pipelines(&mut self, device: &ash::Device) -> Result<(), String> {
+        let module = shader_module(device, &shaders::compile(shaders::SCENE_WGSL)?)?;
+        let samples = self.config.samples;
+        let prepass = PipelineState {
+            module,
+            fragment: c"fs_normal",
+            depth_compare: if self.config.reverse_z { vk::CompareOp::GREATER } else { vk::CompareOp::LESS },
+            depth_write: true,
+            stencil: None,
+            depth_bounds: false,
+            samples,
+        };
+        let lighting = PipelineState {
+            module,
+            fragment: c"fs_lit",
+            depth_compare: vk::CompareOp::EQUAL,
+            depth_write: false,
+            stencil: Some(lit_stencil_state()),
+            depth_bounds: self.depth_bounds,
+            samples,
+        };
+        let (pre_target, lit_target) = if self.config.render_pass {
+            (Target::RenderPass(self.passes.prepass), Target::RenderPass(self.passes.lighting))
+        } else {
+            (Target::Dynamic { color: NORMAL_FORMAT, ds: self.ds_format }, Target::Dynamic { color: LIT_FORMAT, ds: self.ds_format })
+        };
+        let r1 = create_pipeline(device, self.layout, pre_target, &prepass);
+        let r2 = create_pipeline(device, self.layout, lit_target, &lighting);
+        // SAFETY: the module may be destroyed once the pipelines exist (or failed).
+        unsafe { device.destroy_shader_module(module, None) };
+        if let Ok(p) = &r1 {
+            self.prepass = *p;
+        }
+        if let Ok(p) = &r2 {
+            self.lighting = *p;
+        }
+        r1.and(r2).map(|_| ())
+    }
+
+    /// Every mesh's vertices (w = 1) and indices; the shadow casters added to the pass.
+    fn upload_meshes(&mut self, device: &ash::Device, allocator: &Arc<Mutex<Allocator>>) -> Result<(), String> {
+        let s = self.scenes.at(0);
         for m in &s.meshes {
             let vertices: Vec<[f32; 4]> = m.mesh.positions.iter().map(|p| p.extend(1.0).to_array()).collect();
             let indices: Vec<u32> = m.mesh.triangles.iter().flatten().copied().collect();
             let vb = upload(
-                &device,
-                &allocator,
+                device,
+                allocator,
                 &format!("{} vertices", m.name),
                 bytemuck::cast_slice(&vertices),
                 vk::BufferUsageFlags::VERTEX_BUFFER,
             )?;
             let ib = match upload(
-                &device,
-                &allocator,
+                device,
+                allocator,
                 &format!("{} indices", m.name),
                 bytemuck::cast_slice(&indices),
                 vk::BufferUsageFlags::INDEX_BUFFER,
             ) {
                 Ok(b) => b,
                 Err(e) => {
-                    free_buffer(&device, &allocator, vb);
+                    free_buffer(device, allocator, vb);
                     return Err(e);
                 }
             };
@@ -408,25 +677,29 @@ impl Host {
                 caster: None,
             };
             if m.casts_shadow {
-                let pass = host.pass.as_mut().ok_or("no pass")?;
-                match pass.add_caster(&m.name, &m.mesh, m.transform.as_dmat4()) {
+                match self.pass().add_caster(&m.name, &m.mesh, m.transform.as_dmat4()) {
                     Ok(id) => gpu.caster = Some(id),
                     Err(e) => {
-                        host.meshes.push(gpu);
+                        self.meshes.push(gpu);
                         return Err(format!("add_caster({}): {e}", m.name));
                     }
                 }
             }
-            host.meshes.push(gpu);
+            self.meshes.push(gpu);
         }
+        Ok(())
+    }
 
-        let layout = Layout { pixels: (WIDTH * HEIGHT) as u64 };
+    /// Per ring slot: a command buffer, a fence, the readback buffer and the lit index list.
+    fn create_slots(&mut self, device: &ash::Device, allocator: &Arc<Mutex<Allocator>>) -> Result<(), String> {
+        let s = self.scenes.at(0);
+        let layout = Layout { pixels: self.extent.width * self.extent.height, samples: self.config.samples };
         let lit_bytes: u64 = s.meshes.iter().map(|m| m.mesh.triangles.len() as u64 * 12).sum::<u64>() * s.lights.len() as u64;
         // SAFETY: allocation from the host's pool; freed in `Drop for Host`.
         let cmds = unsafe {
             device.allocate_command_buffers(
                 &vk::CommandBufferAllocateInfo::default()
-                    .command_pool(host.pool)
+                    .command_pool(self.pool)
                     .level(vk::CommandBufferLevel::PRIMARY)
                     .command_buffer_count(FRAMES_IN_FLIGHT as u32),
             )
@@ -439,38 +712,38 @@ impl Host {
                 Ok(f) => f,
                 Err(e) => {
                     // SAFETY: the buffer was never submitted.
-                    unsafe { device.free_command_buffers(host.pool, &[cmd]) };
+                    unsafe { device.free_command_buffers(self.pool, &[cmd]) };
                     return Err(e);
                 }
             };
             let readback = create_buffer(
-                &device,
-                &allocator,
+                device,
+                allocator,
                 &format!("readback {i}"),
-                layout.total(s.lights.len()),
-                vk::BufferUsageFlags::TRANSFER_DST,
+                layout.bytes(s.lights.len()),
+                vk::BufferUsageFlags::STORAGE_BUFFER,
                 MemoryLocation::GpuToCpu,
             );
             let lit = create_buffer(
-                &device,
-                &allocator,
+                device,
+                allocator,
                 &format!("lit indices {i}"),
                 lit_bytes,
                 vk::BufferUsageFlags::INDEX_BUFFER,
                 MemoryLocation::CpuToGpu,
             );
             match (readback, lit) {
-                (Ok(readback), Ok(lit)) => host.slots.push(Slot { cmd, fence, readback, lit, in_flight: None }),
+                (Ok(readback), Ok(lit)) => self.slots.push(Slot { cmd, fence, readback, lit, in_flight: None }),
                 (r, l) => {
                     // SAFETY: neither object was ever used by the GPU.
                     unsafe {
                         device.destroy_fence(fence, None);
-                        device.free_command_buffers(host.pool, &[cmd]);
+                        device.free_command_buffers(self.pool, &[cmd]);
                     }
                     let mut err = String::new();
                     for b in [r, l] {
                         match b {
-                            Ok(b) => free_buffer(&device, &allocator, b),
+                            Ok(b) => free_buffer(device, allocator, b),
                             Err(e) => err = e,
                         }
                     }
@@ -478,71 +751,13 @@ impl Host {
                 }
             }
         }
-        Ok(host)
-    }
-
-    fn dev(&self) -> &ash::Device {
-        self.device.as_ref().expect("the device exists once Host::new returned")
-    }
-
-    fn pass(&mut self) -> &mut ShadowPass {
-        self.pass.as_mut().expect("the pass exists once Host::new returned")
-    }
-
-    /// The depth pre-pass and the lighting pass. Both use umbrage's compiled `shadow.vert`
-    /// (to keep the example short: with w = 1 positions it is just `mvp * pos`, push block
-    /// `{ mat4 mvp; vec4 light; vec4 color; }`), so the lighting pass's depth EQUAL sees
-    /// exactly the pre-pass's depths; the lighting pass writes `pc.color` with umbrage's
-    /// `volume.frag`; the pre-pass has no fragment shader.
-    fn create_pipelines(&mut self, device: &ash::Device) -> Result<(), String> {
-        let vs = shader_module(device, SHADOW_VERT)?;
-        let fs = match shader_module(device, VOLUME_FRAG) {
-            Ok(f) => f,
-            Err(e) => {
-                // SAFETY: the module is unused.
-                unsafe { device.destroy_shader_module(vs, None) };
-                return Err(e);
-            }
-        };
-        let prepass = PipelineState {
-            vs,
-            fs: None,
-            color: None,
-            depth_compare: vk::CompareOp::LESS,
-            depth_write: true,
-            stencil: None,
-            depth_bounds: false,
-        };
-        let lit = lit_stencil_state();
-        let lighting = PipelineState {
-            vs,
-            fs: Some(fs),
-            color: Some(LIT_FORMAT),
-            depth_compare: vk::CompareOp::EQUAL,
-            depth_write: false,
-            stencil: Some(lit),
-            depth_bounds: self.depth_bounds,
-        };
-        let r1 = create_pipeline(device, self.layout, self.ds_format, &prepass);
-        let r2 = create_pipeline(device, self.layout, self.ds_format, &lighting);
-        // SAFETY: modules may be destroyed once the pipelines exist (or failed).
-        unsafe {
-            device.destroy_shader_module(vs, None);
-            device.destroy_shader_module(fs, None);
-        }
-        if let Ok(p) = &r1 {
-            self.prepass = *p;
-        }
-        if let Ok(p) = &r2 {
-            self.lighting = *p;
-        }
-        r1.and(r2).map(|_| ())
+        Ok(())
     }
 }
 
 impl Drop for Host {
     /// Teardown: device idle, the pass, the host's buffers and images, the allocator (last
-    /// Arc), pipelines, pool, device, messenger, instance.
+    /// Arc), pipelines, render passes, pool, device, messenger, instance.
     fn drop(&mut self) {
         if let Some(device) = self.device.take() {
             // SAFETY: after the wait nothing on the GPU uses any object destroyed below; each
@@ -550,6 +765,13 @@ impl Drop for Host {
             unsafe {
                 let _ = device.device_wait_idle();
                 drop(self.pass.take());
+                self.extract.destroy(&device);
+                for fb in [self.passes.prepass_fb, self.passes.lighting_fb] {
+                    device.destroy_framebuffer(fb, None);
+                }
+                for v in [self.depth_view, self.stencil_view] {
+                    device.destroy_image_view(v, None);
+                }
                 if let Some(allocator) = self.allocator.take() {
                     for m in self.meshes.drain(..) {
                         free_buffer(&device, &allocator, m.vertices);
@@ -561,7 +783,7 @@ impl Drop for Host {
                         device.destroy_fence(s.fence, None);
                         device.free_command_buffers(self.pool, &[s.cmd]);
                     }
-                    for img in [self.depth.take(), self.lit_target.take()].into_iter().flatten() {
+                    for img in [self.depth.take(), self.lit_target.take(), self.normal_target.take()].into_iter().flatten() {
                         device.destroy_image_view(img.view, None);
                         device.destroy_image(img.raw, None);
                         if let Some(a) = img.alloc {
@@ -577,16 +799,13 @@ impl Drop for Host {
                     }
                 }
                 for p in [self.prepass, self.lighting] {
-                    if p != vk::Pipeline::null() {
-                        device.destroy_pipeline(p, None);
-                    }
+                    device.destroy_pipeline(p, None);
                 }
-                if self.layout != vk::PipelineLayout::null() {
-                    device.destroy_pipeline_layout(self.layout, None);
+                device.destroy_pipeline_layout(self.layout, None);
+                for rp in [self.passes.prepass, self.passes.lighting] {
+                    device.destroy_render_pass(rp, None);
                 }
-                if self.pool != vk::CommandPool::null() {
-                    device.destroy_command_pool(self.pool, None);
-                }
+                device.destroy_command_pool(self.pool, None);
                 device.destroy_device(None);
             }
         }

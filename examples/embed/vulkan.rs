@@ -66,39 +66,49 @@ pub(super) struct Picked {
     pub(super) depth_clamp: bool,
     pub(super) depth_bounds: bool,
     pub(super) index_type_uint8: bool,
+    /// `VkPhysicalDeviceLimits::standardSampleLocations`.
+    pub(super) standard_sample_locations: bool,
 }
 
 pub(super) fn lock(a: &Mutex<Allocator>) -> std::sync::MutexGuard<'_, Allocator> {
     a.lock().unwrap_or_else(|p| p.into_inner())
 }
 
-/// The first Vulkan 1.3 device with a graphics queue, dynamicRendering, synchronization2 and
-/// a depth-stencil attachment format with 8 stencil bits: discrete before integrated before
-/// virtual before CPU (`UMBRAGE_DEVICE=<name substring>` picks one).
-pub(super) fn pick_device(instance: &ash::Instance) -> Result<Picked, String> {
+/// The first device the host can use with a graphics queue and a depth-stencil format with 8
+/// stencil bits that can be an attachment and be sampled (the readback reads every sample in a
+/// compute shader): Vulkan 1.3 with dynamicRendering for the dynamic-rendering model, Vulkan
+/// 1.1 for the render-pass model. Discrete before integrated before virtual before CPU
+/// (`UMBRAGE_DEVICE=<name substring>` picks one).
+pub(super) fn pick_device(instance: &ash::Instance, dynamic_rendering: bool) -> Result<Picked, String> {
     // SAFETY: enumeration on a valid instance.
     let physicals = unsafe { instance.enumerate_physical_devices() }.map_err(vkerr("vkEnumeratePhysicalDevices"))?;
     let wanted = std::env::var("UMBRAGE_DEVICE").ok().map(|s| s.to_lowercase());
+    let min_api = if dynamic_rendering { vk::API_VERSION_1_3 } else { vk::API_VERSION_1_1 };
     let mut best: Option<(u32, Picked)> = None;
     for pd in physicals {
         // SAFETY: `pd` comes from the enumeration above (and so below).
         let props = unsafe { instance.get_physical_device_properties(pd) };
         let name = props.device_name_as_c_str().map(|c| c.to_string_lossy().into_owned()).unwrap_or_default();
-        if props.api_version < vk::API_VERSION_1_3 || wanted.as_ref().is_some_and(|w| !name.to_lowercase().contains(w)) {
+        if props.api_version < min_api || wanted.as_ref().is_some_and(|w| !name.to_lowercase().contains(w)) {
             continue;
         }
         // SAFETY: as above.
         let families = unsafe { instance.get_physical_device_queue_family_properties(pd) };
-        let Some(qf) = families.iter().position(|f| f.queue_flags.contains(vk::QueueFlags::GRAPHICS)) else { continue };
-        let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
-        let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13);
+        let Some(qf) = families.iter().position(|f| f.queue_flags.contains(vk::QueueFlags::GRAPHICS | vk::QueueFlags::COMPUTE)) else {
+            continue;
+        };
+        let mut dynamic = vk::PhysicalDeviceDynamicRenderingFeatures::default();
+        let mut f2 = vk::PhysicalDeviceFeatures2::default();
+        if dynamic_rendering {
+            f2 = f2.push_next(&mut dynamic);
+        }
         // SAFETY: the pNext chain points at a local alive for the call.
         unsafe { instance.get_physical_device_features2(pd, &mut f2) };
         let base = f2.features;
-        if f13.dynamic_rendering != vk::TRUE || f13.synchronization2 != vk::TRUE {
+        if dynamic_rendering && dynamic.dynamic_rendering != vk::TRUE {
             continue;
         }
-        let needed = vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT | vk::FormatFeatureFlags::TRANSFER_SRC;
+        let needed = vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT | vk::FormatFeatureFlags::SAMPLED_IMAGE;
         let ds_format = [vk::Format::D32_SFLOAT_S8_UINT, vk::Format::D24_UNORM_S8_UINT].into_iter().find(|&f| {
             // SAFETY: a format query on a valid physical device.
             let p = unsafe { instance.get_physical_device_format_properties(pd, f) };
@@ -131,19 +141,42 @@ pub(super) fn pick_device(instance: &ash::Instance) -> Result<Picked, String> {
                 depth_clamp: base.depth_clamp == vk::TRUE,
                 depth_bounds: base.depth_bounds == vk::TRUE,
                 index_type_uint8,
+                standard_sample_locations: props.limits.standard_sample_locations == vk::TRUE,
             };
             best = Some((rank, picked));
         }
     }
-    best.map(|(_, p)| p)
-        .ok_or_else(|| "no Vulkan 1.3 device with graphics, dynamicRendering, synchronization2 and a D32S8/D24S8 attachment".into())
+    best.map(|(_, p)| p).ok_or_else(|| {
+        if dynamic_rendering {
+            "no Vulkan 1.3 device with graphics, dynamicRendering and a sampled D32S8/D24S8 attachment (--render-pass needs only Vulkan 1.1)"
+                .into()
+        } else {
+            "no Vulkan 1.1 device with graphics and a sampled D32S8/D24S8 attachment".into()
+        }
+    })
 }
 
-/// The logical device: one graphics queue, Vulkan 1.3's dynamicRendering and
-/// synchronization2, depthClamp / depthBounds / indexTypeUint8 where present.
-pub(super) fn create_device(instance: &ash::Instance, p: &Picked) -> Result<ash::Device, String> {
+/// Whether `format` can be a colour attachment with `samples` samples that is also sampled.
+pub(super) fn color_samples_supported(instance: &ash::Instance, pd: vk::PhysicalDevice, format: vk::Format, samples: u32) -> bool {
+    // SAFETY: a format query on a valid physical device.
+    let p = unsafe {
+        instance.get_physical_device_image_format_properties(
+            pd,
+            format,
+            vk::ImageType::TYPE_2D,
+            vk::ImageTiling::OPTIMAL,
+            vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
+            vk::ImageCreateFlags::empty(),
+        )
+    };
+    p.is_ok_and(|p| p.sample_counts.as_raw() & samples != 0)
+}
+
+/// The logical device: one graphics queue; dynamicRendering in the dynamic-rendering model;
+/// depthClamp / depthBounds / indexTypeUint8 where present.
+pub(super) fn create_device(instance: &ash::Instance, p: &Picked, dynamic_rendering: bool) -> Result<ash::Device, String> {
     let enabled = vk::PhysicalDeviceFeatures::default().depth_clamp(p.depth_clamp).depth_bounds(p.depth_bounds);
-    let mut f13 = vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true).synchronization2(true);
+    let mut dynamic = vk::PhysicalDeviceDynamicRenderingFeatures::default().dynamic_rendering(true);
     let mut u8f = vk::PhysicalDeviceIndexTypeUint8FeaturesEXT::default().index_type_uint8(true);
     let mut exts = Vec::new();
     if p.index_type_uint8 {
@@ -151,11 +184,10 @@ pub(super) fn create_device(instance: &ash::Instance, p: &Picked) -> Result<ash:
     }
     let prio = [1.0f32];
     let queues = [vk::DeviceQueueCreateInfo::default().queue_family_index(p.queue_family).queue_priorities(&prio)];
-    let mut info = vk::DeviceCreateInfo::default()
-        .queue_create_infos(&queues)
-        .enabled_features(&enabled)
-        .enabled_extension_names(&exts)
-        .push_next(&mut f13);
+    let mut info = vk::DeviceCreateInfo::default().queue_create_infos(&queues).enabled_features(&enabled).enabled_extension_names(&exts);
+    if dynamic_rendering {
+        info = info.push_next(&mut dynamic);
+    }
     if p.index_type_uint8 {
         info = info.push_next(&mut u8f);
     }
@@ -229,12 +261,15 @@ pub(super) fn upload(
     Ok(b)
 }
 
+/// A 2D image of `samples` samples, its memory, and a view of `aspect`.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn create_image(
     device: &ash::Device,
     allocator: &Mutex<Allocator>,
     name: &str,
     format: vk::Format,
     extent: vk::Extent2D,
+    samples: u32,
     usage: vk::ImageUsageFlags,
     aspect: vk::ImageAspectFlags,
 ) -> Result<Img, String> {
@@ -244,7 +279,7 @@ pub(super) fn create_image(
         .extent(vk::Extent3D { width: extent.width, height: extent.height, depth: 1 })
         .mip_levels(1)
         .array_layers(1)
-        .samples(vk::SampleCountFlags::TYPE_1)
+        .samples(vk::SampleCountFlags::from_raw(samples))
         .tiling(vk::ImageTiling::OPTIMAL)
         .usage(usage)
         .initial_layout(vk::ImageLayout::UNDEFINED);
@@ -267,53 +302,75 @@ pub(super) fn create_image(
             return Err(format!("allocating image {name}: {e}"));
         }
     };
-    let range = vk::ImageSubresourceRange { aspect_mask: aspect, base_mip_level: 0, level_count: 1, base_array_layer: 0, layer_count: 1 };
-    let view_info =
-        vk::ImageViewCreateInfo::default().image(raw).view_type(vk::ImageViewType::TYPE_2D).format(format).subresource_range(range);
     // SAFETY: the allocation satisfies the image's requirements; the view covers its only
     // subresource once the memory is bound.
-    let view =
-        unsafe { device.bind_image_memory(raw, alloc.memory(), alloc.offset()).and_then(|_| device.create_image_view(&view_info, None)) };
+    let view = unsafe { device.bind_image_memory(raw, alloc.memory(), alloc.offset()) }
+        .map_err(vkerr("vkBindImageMemory"))
+        .and_then(|_| create_view(device, raw, format, aspect));
     match view {
         Ok(view) => Ok(Img { raw, view, alloc: Some(alloc) }),
         Err(e) => {
             // SAFETY: the image was never used.
             unsafe { device.destroy_image(raw, None) };
             let _ = lock(allocator).free(alloc);
-            Err(format!("binding / viewing image {name}: {e:?}"))
+            Err(format!("image {name}: {e}"))
         }
     }
 }
 
-pub(super) fn shader_module(device: &ash::Device, spirv: &[u8]) -> Result<vk::ShaderModule, String> {
-    let words: Vec<u32> = spirv.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
-    // SAFETY: `words` is SPIR-V compiled and validated by naga in umbrage's build script.
-    unsafe { device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(&words), None) }.map_err(vkerr("vkCreateShaderModule"))
+/// A 2D view of `aspect` of the image's only subresource.
+pub(super) fn create_view(
+    device: &ash::Device,
+    image: vk::Image,
+    format: vk::Format,
+    aspect: vk::ImageAspectFlags,
+) -> Result<vk::ImageView, String> {
+    let range = vk::ImageSubresourceRange { aspect_mask: aspect, base_mip_level: 0, level_count: 1, base_array_layer: 0, layer_count: 1 };
+    let info =
+        vk::ImageViewCreateInfo::default().image(image).view_type(vk::ImageViewType::TYPE_2D).format(format).subresource_range(range);
+    // SAFETY: `image` is a live image of this device with memory bound.
+    unsafe { device.create_image_view(&info, None) }.map_err(vkerr("vkCreateImageView"))
+}
+
+/// A shader module from SPIR-V words (naga's output, validated by naga).
+pub(super) fn shader_module(device: &ash::Device, words: &[u32]) -> Result<vk::ShaderModule, String> {
+    // SAFETY: `words` is SPIR-V written by naga from a module naga validated.
+    unsafe { device.create_shader_module(&vk::ShaderModuleCreateInfo::default().code(words), None) }.map_err(vkerr("vkCreateShaderModule"))
+}
+
+/// Where a graphics pipeline renders: dynamic rendering with these formats, or a subpass.
+#[derive(Clone, Copy)]
+pub(super) enum Target {
+    /// Dynamic rendering: one colour attachment of this format and the depth-stencil format.
+    Dynamic { color: vk::Format, ds: vk::Format },
+    /// Subpass 0 of this render pass (one colour attachment and the depth-stencil).
+    RenderPass(vk::RenderPass),
 }
 
 /// What differs between the host's two pipelines.
 pub(super) struct PipelineState {
-    pub(super) vs: vk::ShaderModule,
-    pub(super) fs: Option<vk::ShaderModule>,
-    pub(super) color: Option<vk::Format>,
+    pub(super) module: vk::ShaderModule,
+    pub(super) fragment: &'static CStr,
     pub(super) depth_compare: vk::CompareOp,
     pub(super) depth_write: bool,
     pub(super) stencil: Option<vk::StencilOpState>,
     pub(super) depth_bounds: bool,
+    pub(super) samples: u32,
 }
 
-/// A dynamic-rendering pipeline (depth AND stencil formats), vertex input `vec4 pos` at
-/// location 0, two-sided, dynamic viewport and scissor (and depth bounds when used).
+/// A pipeline with vertex input `vec4 pos` at location 0 (entry `vs`), the fragment entry
+/// `s.fragment` writing one colour attachment, two-sided, `s.samples` samples, dynamic viewport
+/// and scissor (and depth bounds when used).
 pub(super) fn create_pipeline(
     device: &ash::Device,
     layout: vk::PipelineLayout,
-    ds_format: vk::Format,
+    target: Target,
     s: &PipelineState,
 ) -> Result<vk::Pipeline, String> {
-    let mut stages = vec![vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(s.vs).name(c"main")];
-    if let Some(fs) = s.fs {
-        stages.push(vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::FRAGMENT).module(fs).name(c"main"));
-    }
+    let stages = [
+        vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(s.module).name(c"vs"),
+        vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::FRAGMENT).module(s.module).name(s.fragment),
+    ];
     let bindings = [vk::VertexInputBindingDescription { binding: 0, stride: 16, input_rate: vk::VertexInputRate::VERTEX }];
     let attrs = [vk::VertexInputAttributeDescription { location: 0, binding: 0, format: vk::Format::R32G32B32A32_SFLOAT, offset: 0 }];
     let vertex_input =
@@ -325,7 +382,7 @@ pub(super) fn create_pipeline(
         .cull_mode(vk::CullModeFlags::NONE)
         .front_face(vk::FrontFace::COUNTER_CLOCKWISE)
         .line_width(1.0);
-    let ms = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::TYPE_1);
+    let ms = vk::PipelineMultisampleStateCreateInfo::default().rasterization_samples(vk::SampleCountFlags::from_raw(s.samples));
     let st = s.stencil.unwrap_or_default();
     let ds = vk::PipelineDepthStencilStateCreateInfo::default()
         .depth_test_enable(true)
@@ -338,18 +395,15 @@ pub(super) fn create_pipeline(
         .front(st)
         .back(st);
     let blend = [vk::PipelineColorBlendAttachmentState::default().color_write_mask(vk::ColorComponentFlags::RGBA)];
-    let formats: Vec<vk::Format> = s.color.into_iter().collect();
-    let cb = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend[..formats.len()]);
+    let cb = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend);
     let mut dynamic = vec![vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
     if s.depth_bounds {
         dynamic.push(vk::DynamicState::DEPTH_BOUNDS);
     }
     let dyn_state = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic);
-    let mut rendering = vk::PipelineRenderingCreateInfo::default()
-        .color_attachment_formats(&formats)
-        .depth_attachment_format(ds_format)
-        .stencil_attachment_format(ds_format);
-    let info = vk::GraphicsPipelineCreateInfo::default()
+    let formats;
+    let mut rendering;
+    let mut info = vk::GraphicsPipelineCreateInfo::default()
         .stages(&stages)
         .vertex_input_state(&vertex_input)
         .input_assembly_state(&ia)
@@ -359,31 +413,140 @@ pub(super) fn create_pipeline(
         .depth_stencil_state(&ds)
         .color_blend_state(&cb)
         .dynamic_state(&dyn_state)
-        .layout(layout)
-        .push_next(&mut rendering);
+        .layout(layout);
+    match target {
+        Target::Dynamic { color, ds } => {
+            formats = [color];
+            rendering = vk::PipelineRenderingCreateInfo::default()
+                .color_attachment_formats(&formats)
+                .depth_attachment_format(ds)
+                .stencil_attachment_format(ds);
+            info = info.push_next(&mut rendering);
+        }
+        Target::RenderPass(rp) => info = info.render_pass(rp).subpass(0),
+    }
     // SAFETY: every pointer in `info` refers to locals alive for the call.
     unsafe { device.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) }
         .map(|p| p[0])
         .map_err(|(_, e)| format!("vkCreateGraphicsPipelines failed: {e:?}"))
 }
 
-/// An image layout transition (synchronization2) of one image's whole subresource.
+/// The classic render pass of one of the host's passes: colour attachment 0 (`color`, cleared,
+/// left in SHADER_READ_ONLY_OPTIMAL for the readback) and the depth-stencil attachment 1
+/// (`clear_ds`: cleared from UNDEFINED, the pre-pass; otherwise loaded from
+/// DEPTH_STENCIL_READ_ONLY_OPTIMAL, the lighting pass), left in DEPTH_STENCIL_READ_ONLY_OPTIMAL;
+/// one subpass. Returns the render pass and the create info's attachments, subpass and
+/// dependencies (for [`umbrage::pass::RenderPassTarget::new`]).
+pub(super) struct RenderPassDesc {
+    pub(super) attachments: [vk::AttachmentDescription; 2],
+    pub(super) color_ref: [vk::AttachmentReference; 1],
+    pub(super) ds_ref: vk::AttachmentReference,
+    pub(super) dependencies: [vk::SubpassDependency; 2],
+}
+
+impl RenderPassDesc {
+    pub(super) fn new(color: vk::Format, ds: vk::Format, samples: u32, clear_ds: bool) -> RenderPassDesc {
+        let samples = vk::SampleCountFlags::from_raw(samples);
+        let read_only = vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL;
+        let (ds_load, ds_initial) =
+            if clear_ds { (vk::AttachmentLoadOp::CLEAR, vk::ImageLayout::UNDEFINED) } else { (vk::AttachmentLoadOp::LOAD, read_only) };
+        let attachments = [
+            vk::AttachmentDescription::default()
+                .format(color)
+                .samples(samples)
+                .load_op(vk::AttachmentLoadOp::CLEAR)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .initial_layout(vk::ImageLayout::UNDEFINED)
+                .final_layout(vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL),
+            vk::AttachmentDescription::default()
+                .format(ds)
+                .samples(samples)
+                .load_op(ds_load)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .stencil_load_op(ds_load)
+                .stencil_store_op(vk::AttachmentStoreOp::STORE)
+                .initial_layout(ds_initial)
+                .final_layout(read_only),
+        ];
+        let tests = vk::PipelineStageFlags::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS;
+        let output = vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT;
+        let writes = vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_WRITE | vk::AccessFlags::COLOR_ATTACHMENT_WRITE;
+        let dependencies = [
+            // Everything earlier (the previous readback's compute reads, the uploads): done
+            // before the attachments are cleared, loaded or written.
+            vk::SubpassDependency::default()
+                .src_subpass(vk::SUBPASS_EXTERNAL)
+                .dst_subpass(0)
+                .src_stage_mask(vk::PipelineStageFlags::ALL_COMMANDS)
+                .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
+                .dst_stage_mask(tests | output)
+                .dst_access_mask(writes | vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_READ | vk::AccessFlags::COLOR_ATTACHMENT_READ),
+            // The attachments' writes visible to the readback's compute shader.
+            vk::SubpassDependency::default()
+                .src_subpass(0)
+                .dst_subpass(vk::SUBPASS_EXTERNAL)
+                .src_stage_mask(tests | output)
+                .src_access_mask(writes)
+                .dst_stage_mask(vk::PipelineStageFlags::COMPUTE_SHADER)
+                .dst_access_mask(vk::AccessFlags::SHADER_READ),
+        ];
+        RenderPassDesc {
+            attachments,
+            color_ref: [vk::AttachmentReference { attachment: 0, layout: vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL }],
+            ds_ref: vk::AttachmentReference { attachment: 1, layout: vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL },
+            dependencies,
+        }
+    }
+
+    /// The subpass; its pointers refer to `self`.
+    pub(super) fn subpass(&self) -> vk::SubpassDescription<'_> {
+        vk::SubpassDescription::default()
+            .pipeline_bind_point(vk::PipelineBindPoint::GRAPHICS)
+            .color_attachments(&self.color_ref)
+            .depth_stencil_attachment(&self.ds_ref)
+    }
+}
+
+/// Creates the render pass `desc` describes; `info` is handed the create info too (for the
+/// shadow pass's [`umbrage::pass::RenderPassTarget::new`]) while its pointers are alive.
+pub(super) fn create_render_pass<T>(
+    device: &ash::Device,
+    desc: &RenderPassDesc,
+    info: impl FnOnce(vk::RenderPass, &vk::RenderPassCreateInfo) -> Result<T, String>,
+) -> Result<(vk::RenderPass, T), String> {
+    let subpasses = [desc.subpass()];
+    let create = vk::RenderPassCreateInfo::default().attachments(&desc.attachments).subpasses(&subpasses).dependencies(&desc.dependencies);
+    // SAFETY: every pointer in `create` refers to `desc` or locals alive for the call.
+    let rp = unsafe { device.create_render_pass(&create, None) }.map_err(vkerr("vkCreateRenderPass"))?;
+    match info(rp, &create) {
+        Ok(t) => Ok((rp, t)),
+        Err(e) => {
+            // SAFETY: the render pass was never used.
+            unsafe { device.destroy_render_pass(rp, None) };
+            Err(e)
+        }
+    }
+}
+
+/// An image layout transition of one image's whole subresource (Vulkan 1.0 barrier: the
+/// host runs on Vulkan 1.1 devices too).
+#[allow(clippy::too_many_arguments)]
 pub(super) fn image_barrier(
     device: &ash::Device,
     cb: vk::CommandBuffer,
     image: vk::Image,
     aspect: vk::ImageAspectFlags,
     layouts: (vk::ImageLayout, vk::ImageLayout),
-    src: (vk::PipelineStageFlags2, vk::AccessFlags2),
-    dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
+    src: (vk::PipelineStageFlags, vk::AccessFlags),
+    dst: (vk::PipelineStageFlags, vk::AccessFlags),
 ) {
-    let b = [vk::ImageMemoryBarrier2::default()
-        .src_stage_mask(src.0)
+    let b = [vk::ImageMemoryBarrier::default()
         .src_access_mask(src.1)
-        .dst_stage_mask(dst.0)
         .dst_access_mask(dst.1)
         .old_layout(layouts.0)
         .new_layout(layouts.1)
+        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
         .image(image)
         .subresource_range(vk::ImageSubresourceRange {
             aspect_mask: aspect,
@@ -392,18 +555,19 @@ pub(super) fn image_barrier(
             base_array_layer: 0,
             layer_count: 1,
         })];
-    // SAFETY: `cb` is recording outside a rendering instance; the image belongs to this device.
-    unsafe { device.cmd_pipeline_barrier2(cb, &vk::DependencyInfo::default().image_memory_barriers(&b)) };
+    // SAFETY: `cb` is recording outside a rendering instance or render pass; the image
+    // belongs to this device.
+    unsafe { device.cmd_pipeline_barrier(cb, src.0, dst.0, vk::DependencyFlags::empty(), &[], &[], &b) };
 }
 
-/// A global memory barrier (synchronization2).
+/// A global memory barrier (Vulkan 1.0).
 pub(super) fn memory_barrier(
     device: &ash::Device,
     cb: vk::CommandBuffer,
-    src: (vk::PipelineStageFlags2, vk::AccessFlags2),
-    dst: (vk::PipelineStageFlags2, vk::AccessFlags2),
+    src: (vk::PipelineStageFlags, vk::AccessFlags),
+    dst: (vk::PipelineStageFlags, vk::AccessFlags),
 ) {
-    let b = [vk::MemoryBarrier2::default().src_stage_mask(src.0).src_access_mask(src.1).dst_stage_mask(dst.0).dst_access_mask(dst.1)];
-    // SAFETY: `cb` is recording outside a rendering instance.
-    unsafe { device.cmd_pipeline_barrier2(cb, &vk::DependencyInfo::default().memory_barriers(&b)) };
+    let b = [vk::MemoryBarrier::default().src_access_mask(src.1).dst_access_mask(dst.1)];
+    // SAFETY: `cb` is recording outside a rendering instance or render pass.
+    unsafe { device.cmd_pipeline_barrier(cb, src.0, dst.0, vk::DependencyFlags::empty(), &b, &[], &[]) };
 }

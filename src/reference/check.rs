@@ -2,7 +2,7 @@
 
 use super::metrics::{self, Metrics};
 use super::shade::par_rows;
-use super::{read_dump, LightState, Reference};
+use super::{read_dump, Dump, LightState, Reference};
 use crate::error::Result;
 use crate::scene::{Light, LightKind};
 use glam::DVec3;
@@ -91,7 +91,13 @@ impl fmt::Display for CheckReport {
 /// discontinuities of the dump itself (no camera needed).
 pub fn check_dump(dir: impl AsRef<std::path::Path>, band: u32) -> Result<CheckReport> {
     let dir = dir.as_ref();
-    let dump = read_dump(dir)?;
+    check(&read_dump(dir)?, &dir.display().to_string(), band)
+}
+
+/// [`check_dump`] on a dump in memory (a host checking its own frames without writing them):
+/// `name` is what the report's `dir` says.
+pub fn check(dump: &Dump, name: &str, band: u32) -> Result<CheckReport> {
+    dump.validate(name)?;
     let lights: Vec<Light> = dump.lights.iter().map(|l| l.to_light()).collect::<Result<_>>()?;
     let spheres: Vec<super::RefSphere> =
         dump.spheres.iter().enumerate().map(|(i, &sphere)| super::RefSphere { sphere, occluder: true, mesh: i as u32 }).collect();
@@ -163,7 +169,7 @@ pub fn check_dump(dir: impl AsRef<std::path::Path>, band: u32) -> Result<CheckRe
     let all: Vec<LightState> = rows.into_iter().flatten().collect();
     let geo_edges = metrics::geometry_edges(&geo, w, h);
     let mut report = CheckReport {
-        dir: dir.display().to_string(),
+        dir: name.to_string(),
         width: dump.width,
         height: dump.height,
         band,

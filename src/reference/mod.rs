@@ -48,7 +48,7 @@ use bvh::Bvh;
 use glam::{DVec3, Vec3};
 
 pub use area::{area_error, sample_fraction, AreaImage, AreaMetrics};
-pub use check::{check_dump, CheckReport, LightCheck};
+pub use check::{check, check_dump, CheckReport, LightCheck};
 pub use dump::{read_dump, write_dump, Dump, DumpLight};
 pub use metrics::Metrics;
 pub(crate) use shade::par_rows;
