@@ -34,21 +34,17 @@
 #![allow(dead_code)]
 
 use ash::vk;
-use glam::{Mat4, Quat, Vec2, Vec3};
+use glam::Vec3;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
-use gpu_allocator::MemoryLocation;
 use std::ffi::c_void;
 use std::sync::{Arc, Mutex};
-use umbrage::geom::{Camera, Light, LightKind};
 use umbrage::pass::stats::{CpuMs, LightStats, Totals};
-use umbrage::pass::{
-    lit_stencil_state, CasterId, DepthDirection, EnabledFeatures, RenderPassTarget, ShadowPass, ShadowPassDesc, TargetModel,
-};
+use umbrage::pass::{CasterId, DepthDirection, EnabledFeatures, RenderPassTarget, ShadowPass, ShadowPassDesc, TargetModel};
 use umbrage::reference::Dump;
-use umbrage::scene::{shapes, Scene, SceneMesh};
+use umbrage::scene::Scene;
 use vulkan::{
-    color_samples_supported, create_buffer, create_device, create_image, create_pipeline, create_render_pass, create_view, debug_callback,
-    free_buffer, lock, pick_device, shader_module, upload, validation_requested, vkerr, Buf, Img, PipelineState, RenderPassDesc, Target,
+    color_samples_supported, create_device, create_image, create_render_pass, create_view, debug_callback, free_buffer, lock, pick_device,
+    validation_requested, vkerr, Buf, Img, RenderPassDesc,
 };
 
 /// The default frame size.
@@ -165,84 +161,6 @@ pub struct FrameResult {
     pub gpu_wall_ms: f64,
 }
 
-/// The moving caster's transform at `frame`: the box slides towards the torus and turns.
-pub fn box_transform(frame: usize) -> Mat4 {
-    let f = frame as f32;
-    Mat4::from_rotation_translation(Quat::from_rotation_y(0.25 * f), Vec3::new(1.2 - 0.3 * f, 0.5, 0.3 * f))
-}
-
-/// The embedded scene at `frame`: a floor (open, casts nothing), a torus and a moving box
-/// casting, two point lights without radius.
-pub fn scene(frame: usize) -> Scene {
-    let mesh = |name: &str, mesh, transform, casts_shadow| SceneMesh {
-        name: name.into(),
-        mesh,
-        transform,
-        color: Vec3::new(0.8, 0.7, 0.6),
-        opacity: 1.0,
-        casts_shadow,
-    };
-    let light = |position| Light {
-        kind: LightKind::Point,
-        position,
-        direction: Vec3::NEG_Y,
-        color: Vec3::ONE,
-        intensity: 1.0,
-        radius: None,
-        cone_deg: 45.0,
-        area: None,
-    };
-    Scene {
-        name: "embedded".into(),
-        camera: Camera { eye: Vec3::new(0.0, 4.0, 7.0), target: Vec3::new(0.0, 0.5, 0.0), ..Default::default() },
-        lights: vec![light(Vec3::new(2.0, 6.0, 2.0)), light(Vec3::new(-3.0, 5.0, 3.5))],
-        meshes: vec![
-            mesh("floor", shapes::plane(Vec2::splat(20.0)), Mat4::IDENTITY, false),
-            mesh("torus", shapes::torus(0.8, 0.25, 48, 24), Mat4::from_translation(Vec3::new(-1.2, 1.0, 0.0)), true),
-            mesh("box", shapes::cuboid(Vec3::ONE), box_transform(frame), true),
-        ],
-        ambient: Vec3::splat(0.06),
-        spheres: Vec::new(),
-    }
-}
-
-/// What the host draws, frame by frame.
-struct Scenes {
-    base: Scene,
-    /// The mesh that moves and its transform in `base` (the embedded scene: the box).
-    moving: Option<(usize, Mat4)>,
-    embedded: bool,
-}
-
-impl Scenes {
-    fn new(spec: Option<&str>) -> Result<Scenes, String> {
-        let Some(spec) = spec else { return Ok(Scenes { base: scene(0), moving: Some((MOVING_MESH, box_transform(0))), embedded: true }) };
-        let base = umbrage::scene::load(spec).map_err(|e| e.to_string())?;
-        if !base.spheres.is_empty() || base.meshes.iter().any(|m| m.casts_shadow && m.opacity < 1.0) {
-            return Err(format!(
-                "scene '{spec}': this host draws opaque triangle meshes only (no analytic spheres, no transparent casters)"
-            ));
-        }
-        if base.lights.iter().any(|l| l.area.is_some()) {
-            return Err(format!("scene '{spec}': area lights are not supported by this host"));
-        }
-        let moving = base.meshes.iter().rposition(|m| m.casts_shadow).map(|i| (i, base.meshes[i].transform));
-        Ok(Scenes { base, moving, embedded: false })
-    }
-
-    /// The scene at frame `f`.
-    fn at(&self, f: usize) -> Scene {
-        if self.embedded {
-            return scene(f);
-        }
-        let mut s = self.base.clone();
-        if let Some((mi, base)) = self.moving {
-            s.meshes[mi].transform = Mat4::from_translation(Vec3::new(0.25 * f as f32, 0.0, 0.0)) * base;
-        }
-        s
-    }
-}
-
 /// Renders `frames` frames with `config`, two in flight, and checks every sample of each
 /// against the reference. The last two frames keep their [`SampleFrame`]s. Errors: no usable
 /// Vulkan device, an unsupported configuration, a failed call, or any validation error (when
@@ -277,6 +195,13 @@ pub fn run(config: &Config, frames: usize) -> Result<Vec<FrameResult>, String> {
 mod extract;
 #[path = "frame.rs"]
 mod frame;
+#[path = "scenes.rs"]
+mod scenes;
+#[path = "setup.rs"]
+mod setup;
+use scenes::Scenes;
+#[allow(unused_imports)] // used by tests/embed.rs
+pub use scenes::{box_transform, scene};
 #[path = "shaders.rs"]
 mod shaders;
 #[path = "vulkan.rs"]
@@ -575,183 +500,6 @@ impl Host {
 
     fn pass(&mut self) -> &mut ShadowPass {
         self.pass.as_mut().expect("the pass exists once Host::new returned")
-    }
-
-    /// The render-pass model's framebuffers (the images are shared by both ring slots).
-    fn create_framebuffers(&mut self, device: &ash::Device) -> Result<(), String> {
-        let ds = self.depth.as_ref().map(|i| i.view).ok_or("no depth image")?;
-        let lit = self.lit_target.as_ref().map(|i| i.view).ok_or("no lit target")?;
-        let normal = self.normal_target.as_ref().map(|i| i.view).ok_or("no normal target")?;
-        for (rp, color, out) in [(self.passes.prepass, normal, 0), (self.passes.lighting, lit, 1)] {
-            let views = [color, ds];
-            let info = vk::FramebufferCreateInfo::default()
-                .render_pass(rp)
-                .attachments(&views)
-                .width(self.extent.width)
-                .height(self.extent.height)
-                .layers(1);
-            // SAFETY: the views are live and match the render pass's attachments.
-            let fb = unsafe { device.create_framebuffer(&info, None) }.map_err(vkerr("vkCreateFramebuffer"))?;
-            if out == 0 {
-                self.passes.prepass_fb = fb;
-            } else {
-                self.passes.lighting_fb = fb;
-            }
-        }
-        Ok(())
-    }
-
-    /// The pre-pass (depth LESS, or GREATER with reverse-Z; the normal written) and the
-    /// lighting pass (depth EQUAL, stencil EQUAL 0, 1 written), from [`shaders::SCENE_WGSL`].
-    fn create_pipelines(&mut self, device: &ash::Device) -> Result<(), String> {
-        let module = shader_module(device, &shaders::compile(shaders::SCENE_WGSL)?)?;
-        let samples = self.config.samples;
-        let prepass = PipelineState {
-            module,
-            fragment: c"fs_normal",
-            depth_compare: if self.config.reverse_z { vk::CompareOp::GREATER } else { vk::CompareOp::LESS },
-            depth_write: true,
-            stencil: None,
-            depth_bounds: false,
-            samples,
-        };
-        let lighting = PipelineState {
-            module,
-            fragment: c"fs_lit",
-            depth_compare: vk::CompareOp::EQUAL,
-            depth_write: false,
-            stencil: Some(lit_stencil_state()),
-            depth_bounds: self.depth_bounds,
-            samples,
-        };
-        let (pre_target, lit_target) = if self.config.render_pass {
-            (Target::RenderPass(self.passes.prepass), Target::RenderPass(self.passes.lighting))
-        } else {
-            (Target::Dynamic { color: NORMAL_FORMAT, ds: self.ds_format }, Target::Dynamic { color: LIT_FORMAT, ds: self.ds_format })
-        };
-        let r1 = create_pipeline(device, self.layout, pre_target, &prepass);
-        let r2 = create_pipeline(device, self.layout, lit_target, &lighting);
-        // SAFETY: the module may be destroyed once the pipelines exist (or failed).
-        unsafe { device.destroy_shader_module(module, None) };
-        if let Ok(p) = &r1 {
-            self.prepass = *p;
-        }
-        if let Ok(p) = &r2 {
-            self.lighting = *p;
-        }
-        r1.and(r2).map(|_| ())
-    }
-
-    /// Every mesh's vertices (w = 1) and indices; the shadow casters added to the pass.
-    fn upload_meshes(&mut self, device: &ash::Device, allocator: &Arc<Mutex<Allocator>>) -> Result<(), String> {
-        let s = self.scenes.at(0);
-        for m in &s.meshes {
-            let vertices: Vec<[f32; 4]> = m.mesh.positions.iter().map(|p| p.extend(1.0).to_array()).collect();
-            let indices: Vec<u32> = m.mesh.triangles.iter().flatten().copied().collect();
-            let vb = upload(
-                device,
-                allocator,
-                &format!("{} vertices", m.name),
-                bytemuck::cast_slice(&vertices),
-                vk::BufferUsageFlags::VERTEX_BUFFER,
-            )?;
-            let ib = match upload(
-                device,
-                allocator,
-                &format!("{} indices", m.name),
-                bytemuck::cast_slice(&indices),
-                vk::BufferUsageFlags::INDEX_BUFFER,
-            ) {
-                Ok(b) => b,
-                Err(e) => {
-                    free_buffer(device, allocator, vb);
-                    return Err(e);
-                }
-            };
-            let mut gpu = MeshGpu {
-                vertices: vb,
-                indices: ib,
-                index_count: indices.len() as u32,
-                positions: m.mesh.positions.clone(),
-                triangles: m.mesh.triangles.clone(),
-                caster: None,
-            };
-            if m.casts_shadow {
-                match self.pass().add_caster(&m.name, &m.mesh, m.transform.as_dmat4()) {
-                    Ok(id) => gpu.caster = Some(id),
-                    Err(e) => {
-                        self.meshes.push(gpu);
-                        return Err(format!("add_caster({}): {e}", m.name));
-                    }
-                }
-            }
-            self.meshes.push(gpu);
-        }
-        Ok(())
-    }
-
-    /// Per ring slot: a command buffer, a fence, the readback buffer and the lit index list.
-    fn create_slots(&mut self, device: &ash::Device, allocator: &Arc<Mutex<Allocator>>) -> Result<(), String> {
-        let s = self.scenes.at(0);
-        let layout = Layout { pixels: self.extent.width * self.extent.height, samples: self.config.samples };
-        let lit_bytes: u64 = s.meshes.iter().map(|m| m.mesh.triangles.len() as u64 * 12).sum::<u64>() * s.lights.len() as u64;
-        // SAFETY: allocation from the host's pool; freed in `Drop for Host`.
-        let cmds = unsafe {
-            device.allocate_command_buffers(
-                &vk::CommandBufferAllocateInfo::default()
-                    .command_pool(self.pool)
-                    .level(vk::CommandBufferLevel::PRIMARY)
-                    .command_buffer_count(FRAMES_IN_FLIGHT as u32),
-            )
-        }
-        .map_err(vkerr("vkAllocateCommandBuffers"))?;
-        for (i, cmd) in cmds.into_iter().enumerate() {
-            // SAFETY: as above.
-            let fence = unsafe { device.create_fence(&vk::FenceCreateInfo::default(), None) }.map_err(vkerr("vkCreateFence"));
-            let fence = match fence {
-                Ok(f) => f,
-                Err(e) => {
-                    // SAFETY: the buffer was never submitted.
-                    unsafe { device.free_command_buffers(self.pool, &[cmd]) };
-                    return Err(e);
-                }
-            };
-            let readback = create_buffer(
-                device,
-                allocator,
-                &format!("readback {i}"),
-                layout.bytes(s.lights.len()),
-                vk::BufferUsageFlags::STORAGE_BUFFER,
-                MemoryLocation::GpuToCpu,
-            );
-            let lit = create_buffer(
-                device,
-                allocator,
-                &format!("lit indices {i}"),
-                lit_bytes,
-                vk::BufferUsageFlags::INDEX_BUFFER,
-                MemoryLocation::CpuToGpu,
-            );
-            match (readback, lit) {
-                (Ok(readback), Ok(lit)) => self.slots.push(Slot { cmd, fence, readback, lit, in_flight: None }),
-                (r, l) => {
-                    // SAFETY: neither object was ever used by the GPU.
-                    unsafe {
-                        device.destroy_fence(fence, None);
-                        device.free_command_buffers(self.pool, &[cmd]);
-                    }
-                    let mut err = String::new();
-                    for b in [r, l] {
-                        match b {
-                            Ok(b) => free_buffer(device, allocator, b),
-                            Err(e) => err = e,
-                        }
-                    }
-                    return Err(err);
-                }
-            }
-        }
-        Ok(())
     }
 }
 
