@@ -44,8 +44,8 @@ impl ShadowView {
     /// use glam::{DVec3, Mat4, Vec3};
     /// use umbrage::pass::ShadowView;
     /// let eye = Vec3::new(0.0, 2.0, 6.0);
-    /// let view = Mat4::look_at_rh(eye, Vec3::ZERO, Vec3::Y);
-    /// let proj = Mat4::perspective_infinite_rh(1.0, 1.0, 0.1);
+    /// let view = glam::camera::rh::view::look_at_mat4(eye, Vec3::ZERO, Vec3::Y);
+    /// let proj = glam::camera::rh::proj::vulkan::perspective_infinite(1.0, 1.0, 0.1);
     /// let v = ShadowView::from_view_matrix(eye.as_dvec3(), view, proj, (640, 480))?;
     /// assert_eq!(v.view.w_axis.truncate(), Vec3::ZERO);
     /// assert!((v.world_view_proj() - proj * view).abs_diff_eq(Mat4::ZERO, 1e-5));
