@@ -192,6 +192,18 @@ impl Host {
                 .map_err(vkerr("vkBeginCommandBuffer"))?;
             // The pass's uploads (new casters' vertices), outside any rendering.
             pass.cmd_before_rendering(cb, frame).map_err(|e| format!("cmd_before_rendering: {e}"))?;
+            let lights = lit_draws.len() as u32;
+            let first_query = slot as u32 * 2 * (lights + 1);
+            if self.queries != vk::QueryPool::null() {
+                device.cmd_reset_query_pool(cb, self.queries, first_query, 2 * (lights + 1));
+            }
+            let timestamp = |stage, query| {
+                if self.queries != vk::QueryPool::null() {
+                    // (Inside the recording's unsafe block: the query was reset above.)
+                    device.cmd_write_timestamp(cb, stage, self.queries, first_query + query);
+                }
+            };
+            timestamp(vk::PipelineStageFlags::TOP_OF_PIPE, 2 * lights);
 
             // The pre-pass: depth (stencil cleared to 0) and the normal of every sample.
             if self.config.render_pass {
@@ -236,13 +248,17 @@ impl Host {
                     // the same subpass (fragment tests run in primitive order).
                     begin_render_pass(self.passes.lighting, self.passes.lighting_fb, &[color_clear, ds_clear]);
                     let target = DepthStencilTarget::new(depth.raw, depth.view, self.extent);
+                    timestamp(vk::PipelineStageFlags::TOP_OF_PIPE, 2 * li as u32);
                     pass.cmd_determine(cb, frame, li, &target).map_err(|e| format!("cmd_determine: {e}"))?;
+                    timestamp(vk::PipelineStageFlags::BOTTOM_OF_PIPE, 2 * li as u32 + 1);
                 } else {
                     // The image is declared in DEPTH_STENCIL_READ_ONLY_OPTIMAL (the readback
                     // left it there) and wanted back in DEPTH_STENCIL_ATTACHMENT_OPTIMAL: the
                     // pass records both transitions.
                     let target = DepthStencilTarget::new(depth.raw, depth.view, self.extent).with_layouts(ds_read, ds_att);
+                    timestamp(vk::PipelineStageFlags::TOP_OF_PIPE, 2 * li as u32);
                     pass.cmd_determine(cb, frame, li, &target).map_err(|e| format!("cmd_determine: {e}"))?;
+                    timestamp(vk::PipelineStageFlags::BOTTOM_OF_PIPE, 2 * li as u32 + 1);
                     image_barrier(
                         device,
                         cb,
@@ -288,6 +304,7 @@ impl Host {
                     self.extract.record(device, cb, slot, push);
                 }
             }
+            timestamp(vk::PipelineStageFlags::BOTTOM_OF_PIPE, 2 * lights + 1);
             memory_barrier(
                 device,
                 cb,
@@ -310,6 +327,25 @@ impl Host {
             return Err(format!("validation error by frame {}: {first}", fl.frame));
         }
         let s = &fl.scene;
+        let (mut determine_ms, mut frame_gpu_ms) = (Vec::new(), f64::NAN);
+        if self.queries != vk::QueryPool::null() {
+            let n = 2 * (s.lights.len() + 1);
+            let mut stamps = vec![0u64; n];
+            // SAFETY: the queries were written by the submission whose fence was just waited.
+            unsafe {
+                self.dev().get_query_pool_results(
+                    self.queries,
+                    (slot * n) as u32,
+                    &mut stamps,
+                    vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+                )
+            }
+            .map_err(vkerr("vkGetQueryPoolResults"))?;
+            let period = self.timestamp_period as f64;
+            let mut ms: Vec<f64> = stamps.chunks_exact(2).map(|t| t[1].saturating_sub(t[0]) as f64 * period * 1e-6).collect();
+            frame_gpu_ms = ms.pop().unwrap_or(f64::NAN);
+            determine_ms = ms;
+        }
         let (w, h) = (self.extent.width, self.extent.height);
         let n = (w * h) as usize;
         let samples = self.config.samples;
@@ -406,6 +442,8 @@ impl Host {
             samples: sample_frames,
             scene: fl.scene,
             gpu_wall_ms,
+            determine_ms,
+            frame_gpu_ms,
         });
         Ok(())
     }

@@ -159,6 +159,12 @@ pub struct FrameResult {
     /// Milliseconds from the start of recording to the fence (queue and GPU time, with the
     /// other slot's frame in flight).
     pub gpu_wall_ms: f64,
+    /// Per light, the GPU time of its `cmd_determine` (timestamps around it), ms; empty when
+    /// the queue has no timestamps.
+    pub determine_ms: Vec<f64>,
+    /// The GPU time of the whole command buffer (timestamps at its start and end), ms; NaN
+    /// when the queue has no timestamps.
+    pub frame_gpu_ms: f64,
 }
 
 /// Renders `frames` frames with `config`, two in flight, and checks every sample of each
@@ -297,6 +303,10 @@ struct Host {
     lighting: vk::Pipeline,
     passes: RenderPasses,
     extract: extract::Extract,
+    /// Per ring slot, two timestamps per light around `cmd_determine` and two around the
+    /// whole command buffer (null: no timestamps).
+    queries: vk::QueryPool,
+    timestamp_period: f32,
     depth_bounds: bool,
     extent: vk::Extent2D,
 }
@@ -364,6 +374,8 @@ impl Host {
             lighting: vk::Pipeline::null(),
             passes: RenderPasses::default(),
             extract: extract::Extract::default(),
+            queries: vk::QueryPool::null(),
+            timestamp_period: 0.0,
             depth_bounds: false,
             extent: vk::Extent2D { width: config.width, height: config.height },
         };
@@ -486,6 +498,13 @@ impl Host {
             lit: host.lit_target.as_ref().map(|i| i.view).ok_or("no lit target")?,
             normal: host.normal_target.as_ref().map(|i| i.view).ok_or("no normal target")?,
         };
+        if let Some(period) = picked.timestamp_period {
+            let count = (FRAMES_IN_FLIGHT * (host.scenes.base.lights.len() + 1) * 2) as u32;
+            let info = vk::QueryPoolCreateInfo::default().query_type(vk::QueryType::TIMESTAMP).query_count(count.max(1));
+            // SAFETY: object creation on a valid device; destroyed in `Drop for Host`.
+            host.queries = unsafe { device.create_query_pool(&info, None) }.map_err(vkerr("vkCreateQueryPool"))?;
+            host.timestamp_period = period;
+        }
         let buffers: Vec<vk::Buffer> = host.slots.iter().map(|s| s.readback.raw).collect();
         let mut extract = extract::Extract::default();
         let created = extract.create(&device, config.samples, &views, &buffers);
@@ -514,6 +533,7 @@ impl Drop for Host {
                 let _ = device.device_wait_idle();
                 drop(self.pass.take());
                 self.extract.destroy(&device);
+                device.destroy_query_pool(self.queries, None);
                 for fb in [self.passes.prepass_fb, self.passes.lighting_fb] {
                     device.destroy_framebuffer(fb, None);
                 }

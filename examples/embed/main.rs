@@ -133,6 +133,20 @@ fn run(args: &Args) -> Result<bool, String> {
             bad += lr.mismatches_outside_band();
         }
     }
+    // The determination's GPU time (timestamps around cmd_determine), median over frames of
+    // the sum over lights, and the frame's time to its fence.
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+    };
+    let determine = median(results.iter().filter(|r| !r.determine_ms.is_empty()).map(|r| r.determine_ms.iter().sum()).collect());
+    let frame_gpu = median(results.iter().map(|r| r.frame_gpu_ms).collect());
+    let fence = median(results.iter().map(|r| r.gpu_wall_ms).collect());
+    println!(
+        "embed: {}: median determination {determine:.3} ms GPU (all lights), median frame {frame_gpu:.3} ms GPU (readback included), \
+         {fence:.1} ms record to fence",
+        config.name()
+    );
     let last = results.last().ok_or("no frame rendered")?;
     if let Some(path) = &args.out {
         let rgba = resolve(last);

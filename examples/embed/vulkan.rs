@@ -68,6 +68,8 @@ pub(super) struct Picked {
     pub(super) index_type_uint8: bool,
     /// `VkPhysicalDeviceLimits::standardSampleLocations`.
     pub(super) standard_sample_locations: bool,
+    /// Nanoseconds a timestamp tick, when the queue has timestamps.
+    pub(super) timestamp_period: Option<f32>,
 }
 
 pub(super) fn lock(a: &Mutex<Allocator>) -> std::sync::MutexGuard<'_, Allocator> {
@@ -142,6 +144,8 @@ pub(super) fn pick_device(instance: &ash::Instance, dynamic_rendering: bool) -> 
                 depth_bounds: base.depth_bounds == vk::TRUE,
                 index_type_uint8,
                 standard_sample_locations: props.limits.standard_sample_locations == vk::TRUE,
+                timestamp_period: (families[qf].timestamp_valid_bits > 0 && props.limits.timestamp_period > 0.0)
+                    .then_some(props.limits.timestamp_period),
             };
             best = Some((rank, picked));
         }
