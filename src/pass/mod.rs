@@ -14,19 +14,28 @@
 //! | host | instance, device, queue, command buffers, the depth-stencil image, fences, the lighting pass |
 //! | pass | its pipelines, the casters' vertex buffers, one index stream per ring slot |
 //!
+//! Created for the host's configuration ([`ShadowPassDesc`]): its depth-stencil format,
+//! sample count (1, 2, 4 or 8; the count is exact per sample), depth direction (forward or
+//! reverse-Z), depth mode (infinite or clamped far plane) and target model (dynamic rendering,
+//! or the host's `VkRenderPass` subpass: [`TargetModel`]). Each is checked against the device
+//! at creation with a typed error. The pass needs Vulkan 1.1 (1.3 with `dynamicRendering` for
+//! the dynamic-rendering model); its barriers are Vulkan 1.0's.
+//!
 //! A frame:
 //! 1. the host waits until the frame that last used ring slot `s` has retired (its fence);
-//! 2. [`ShadowPass::prepare`]`(s, view, lights)`: the CPU work (cases, silhouettes, index
-//!    streams written into slot `s`);
-//! 3. the host records its depth pre-pass / G-buffer into its depth-stencil image;
-//! 4. [`ShadowPass::cmd_upload`] (new or deformed casters' vertex copies; also recorded by the
-//!    first `cmd_determine` of the frame when the host did not call it), then
-//!    [`ShadowPass::cmd_compute_silhouettes`] ([`Technique::Compute`] only: the GPU possible
-//!    silhouettes of every light, dispatched outside rendering; also recorded by the first
-//!    `cmd_determine` of the frame when the host did not call it);
+//! 2. [`ShadowPass::prepare`]`(s, view, lights)` ([`ShadowView::from_view_matrix`] builds the
+//!    view from the camera's own view matrix): the CPU work (cases, silhouettes, index
+//!    streams written into slot `s`). Area lights are refused: expand them first
+//!    ([`crate::geom::area::expand_lights`]);
+//! 3. outside any rendering: [`ShadowPass::cmd_before_rendering`] (new or deformed casters'
+//!    vertex copies, and with [`Technique::Compute`] the GPU possible silhouettes of every
+//!    light; in the dynamic-rendering model the first `cmd_determine` of the frame records
+//!    them when the host did not, in the render-pass model not calling it first is an error);
+//! 4. the host records its depth pre-pass / G-buffer into its depth-stencil image;
 //! 5. per light: [`ShadowPass::cmd_determine`] leaves the count in the stencil (cleared inside
 //!    the light's scissor), then the host's lighting pass tests `stencil == 0`
-//!    ([`lit_stencil_state`]), with the light's [`LightFrame::scissor`] and depth bounds;
+//!    ([`lit_stencil_state`]), with [`ShadowPass::cmd_light_state`] setting the light's
+//!    viewport, scissor and depth bounds;
 //! 6. the host submits; a later `prepare(s, ..)` may only come after that submission retired
 //!    (with [`Technique::Compute`], [`ShadowPass::read_back_counts`] after the fence puts the
 //!    GPU's triangle counts into the frame's stats).
@@ -36,13 +45,21 @@
 //! releases its old buffers only once every slot has been prepared again (so no frame in
 //! flight can still read them).
 //!
-//! **Synchronisation:** inside `cmd_determine` the pass reads the depth and writes the stencil
-//! of the host's image between `vkCmdBeginRendering` and `vkCmdEndRendering`. The host makes
-//! its depth writes visible before (a barrier from late fragment tests to early fragment
-//! tests, depth-stencil read), and makes the stencil writes visible to its lighting pass after.
-//! `cmd_upload` records transfer writes followed by a barrier to vertex-attribute, index and
-//! compute reads; `cmd_compute_silhouettes` records compute writes followed by a barrier to
+//! **Layouts and synchronisation:** the host declares the layout its image is in and the one it
+//! wants after ([`DepthStencilTarget::with_layouts`]). With dynamic rendering the pass records
+//! both transitions around its rendering instance, waiting for every earlier command and making
+//! its stencil writes visible to every later one, so the host needs no barrier of its own. In
+//! the render-pass model `cmd_determine` records inside the host's subpass, where no barrier
+//! can go: the declared layouts are the subpass's and the host's subpass dependencies order
+//! the rest. `cmd_upload` records transfer writes followed by a barrier to vertex-attribute,
+//! index and compute reads; `cmd_compute_silhouettes` compute writes followed by a barrier to
 //! indirect-command and index reads.
+//!
+//! **Misuse** (a light index out of range, another pass's frame, a stale frame, a target of the
+//! wrong size or layout, a call the pass was not configured for or made out of order) is an
+//! [`Error::Misuse`](crate::Error::Misuse) returned before anything is recorded, in release
+//! builds too. The counting variants and the debug overlay umbrage's own renderer uses are in
+//! [`diagnostics`].
 //!
 //! **Drop order:** drop the pass while its device and allocator are alive, after every command
 //! buffer that uses it has completed (it does not wait for the device: the host owns the
