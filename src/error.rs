@@ -85,6 +85,10 @@ pub enum Error {
         /// The first of them, verbatim.
         first: String,
     },
+    /// An invariant of umbrage's own code did not hold (a bug in umbrage: please report it
+    /// with the message).
+    #[error("internal error (a bug in umbrage): {0}")]
+    Internal(String),
     /// A [`ShadowPassDesc`](crate::pass::ShadowPassDesc) (or another creation option) that
     /// cannot be honoured as given, independent of the device: `field` names the option.
     #[error("{field}: {msg}")]

@@ -76,11 +76,14 @@ impl Buffer {
     /// visible or the write would end past the allocation. The caller must make sure the GPU is
     /// not using that range meanwhile (memory is host-coherent: no flush needed).
     pub fn write(&mut self, offset: usize, data: &[u8]) -> Result<()> {
-        let slice =
-            self.allocation.as_mut().and_then(|a| a.mapped_slice_mut()).ok_or_else(|| Error::Other("buffer is not host visible".into()))?;
+        let slice = self
+            .allocation
+            .as_mut()
+            .and_then(|a| a.mapped_slice_mut())
+            .ok_or_else(|| Error::argument("Buffer::write", "the buffer is not host visible"))?;
         let end = offset + data.len();
         if end > slice.len() {
-            return Err(Error::Other(format!("buffer write out of range: {end} > {}", slice.len())));
+            return Err(Error::argument("Buffer::write", format!("write out of range: {end} > {}", slice.len())));
         }
         slice[offset..end].copy_from_slice(data);
         Ok(())
@@ -90,7 +93,11 @@ impl Buffer {
     /// visible. Meaningful only after the GPU writes have completed (fence wait) and been made
     /// visible to the host (a barrier to `HOST_READ`).
     pub fn read(&self) -> Result<&[u8]> {
-        let s = self.allocation.as_ref().and_then(|a| a.mapped_slice()).ok_or_else(|| Error::Other("buffer is not host visible".into()))?;
+        let s = self
+            .allocation
+            .as_ref()
+            .and_then(|a| a.mapped_slice())
+            .ok_or_else(|| Error::argument("Buffer::read", "the buffer is not host visible"))?;
         Ok(&s[..self.size as usize])
     }
 
@@ -218,7 +225,7 @@ impl Image {
                 }
             }
         }
-        made.try_into().map_err(|_| Error::Other("image count mismatch".into()))
+        made.try_into().map_err(|_| Error::Internal("image count mismatch".into()))
     }
 
     /// The subresource range of the whole image (its single mip level and layer, [`Image::aspect`]).

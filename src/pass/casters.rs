@@ -265,7 +265,7 @@ impl CasterTable {
             }
             let mut it = made.into_iter();
             let (Some(planes), Some(tris), Some(positions), Some(edges)) = (it.next(), it.next(), it.next(), it.next()) else {
-                return Err(Error::Other("compute tables".into()));
+                return Err(Error::Internal("compute tables".into()));
             };
             self.live[i].compute = Some(ComputeStatic {
                 planes,
@@ -357,4 +357,21 @@ pub(crate) fn shell_count(mesh: &Mesh) -> usize {
     roots.sort_unstable();
     roots.dedup();
     roots.len()
+}
+
+impl super::ShadowPass {
+    /// The prepared casters, in draw order (the planner's view).
+    pub fn casters(&self) -> &[Caster] {
+        &self.casters.cpu
+    }
+
+    /// The id of the caster at `index` of [`casters`](Self::casters).
+    pub fn caster_id(&self, index: usize) -> Option<CasterId> {
+        self.casters.live.get(index).map(|c| c.id)
+    }
+
+    /// Whether a caster is on the multiplicity path (open, non-manifold or transparent).
+    pub fn caster_kind(&self, id: CasterId) -> Result<&CasterKind> {
+        Ok(&self.casters.cpu[self.casters.find(id)?].kind)
+    }
 }

@@ -89,6 +89,18 @@ impl RenderPassTarget {
     /// # Safety
     /// `create_info`'s pointers are valid for their counts (as when it was built with ash's
     /// builder methods, which tie them to borrowed slices).
+    ///
+    /// ```no_run
+    /// # use umbrage::pass::*; use ash::vk;
+    /// # fn f(device: &ash::Device, info: &vk::RenderPassCreateInfo) -> umbrage::Result<()> {
+    /// // The host's lighting render pass, whose subpass 0 has the depth-stencil attachment.
+    /// // SAFETY: `info` is a well-formed create info; the render pass is destroyed by the host.
+    /// let render_pass = unsafe { device.create_render_pass(info, None) }.map_err(umbrage::Error::vk("vkCreateRenderPass"))?;
+    /// // SAFETY: `info` is the create info `render_pass` was made from, its pointers alive.
+    /// let target = TargetModel::RenderPass(unsafe { RenderPassTarget::new(render_pass, info, 0)? });
+    /// let desc = ShadowPassDesc { target, ..Default::default() };
+    /// # let _ = desc; Ok(()) }
+    /// ```
     pub unsafe fn new(render_pass: vk::RenderPass, create_info: &vk::RenderPassCreateInfo, subpass: u32) -> Result<RenderPassTarget> {
         let field = "RenderPassTarget";
         if render_pass == vk::RenderPass::null() {

@@ -57,7 +57,7 @@
 //!
 //! **Misuse** (a light index out of range, another pass's frame, a stale frame, a target of the
 //! wrong size or layout, a call the pass was not configured for or made out of order) is an
-//! [`Error::Misuse`](crate::Error::Misuse) returned before anything is recorded, in release
+//! [`Error::Misuse`] returned before anything is recorded, in release
 //! builds too. The counting variants and the debug overlay umbrage's own renderer uses are in
 //! [`diagnostics`].
 //!
@@ -72,6 +72,7 @@ mod compute;
 mod desc;
 mod device;
 pub mod diagnostics;
+mod draw;
 mod eye;
 mod frame;
 mod pipelines;
@@ -96,7 +97,7 @@ use crate::error::{Error, Misuse, Result};
 use crate::geom::Light;
 use crate::geom::Mesh;
 use crate::gpu::Buffer;
-use crate::shadow::{Caster, CasterKind};
+use crate::shadow::Caster;
 use ash::vk;
 use casters::CasterTable;
 use device::PassDevice;
@@ -161,6 +162,23 @@ impl ShadowPass {
     ///   not support, [`DepthMode::Clamp`] (a finite far plane, forward or reverse-Z) without
     ///   `depthClamp`;
     /// - [`Error::Vulkan`]: a failed Vulkan call.
+    ///
+    /// ```no_run
+    /// # use umbrage::pass::*; use ash::vk;
+    /// # use std::sync::{Arc, Mutex};
+    /// # fn f(instance: &ash::Instance, physical: vk::PhysicalDevice, device: &ash::Device,
+    /// #      allocator: Arc<Mutex<gpu_allocator::vulkan::Allocator>>) -> umbrage::Result<()> {
+    /// let desc = ShadowPassDesc {
+    ///     depth_stencil_format: vk::Format::D32_SFLOAT_S8_UINT, // the host's depth-stencil image
+    ///     frames_in_flight: 2,
+    ///     samples: 4,
+    ///     depth_direction: DepthDirection::Reverse,
+    ///     ..Default::default()
+    /// };
+    /// let pass = ShadowPass::new(instance, physical, device, allocator, &desc)?;
+    /// println!("depth bounds used: {}", pass.capabilities().depth_bounds);
+    /// # Ok(()) }
+    /// ```
     pub fn new(
         instance: &ash::Instance,
         physical_device: vk::PhysicalDevice,
@@ -310,7 +328,19 @@ impl ShadowPass {
     /// Adds an opaque caster: the mesh is validated (NaN, empty), welded, classified (closed
     /// 2-manifold: McGuire's three cases; anything else: Kim et al.'s multiplicities) and
     /// split into chunks of at most 32768 vertices (16-bit indices), never refused for size.
-    /// Its vertex buffers are copied by the next frame's [`cmd_upload`](Self::cmd_upload).
+    /// Its vertex buffers are copied by the next frame's [`cmd_before_rendering`](Self::cmd_before_rendering).
+    ///
+    /// ```no_run
+    /// # use umbrage::pass::*; use glam::{DMat4, DVec3, Vec3};
+    /// # fn f(pass: &mut ShadowPass) -> umbrage::Result<()> {
+    /// let tetrahedron = umbrage::geom::Mesh {
+    ///     positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z],
+    ///     triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+    /// };
+    /// // Once per mesh: its silhouette tables and dual-length vertex buffer are built here.
+    /// let id = pass.add_caster("tetrahedron", &tetrahedron, DMat4::from_translation(DVec3::Y))?;
+    /// # let _ = id; Ok(()) }
+    /// ```
     pub fn add_caster(&mut self, name: &str, mesh: &Mesh, transform: DMat4) -> Result<CasterId> {
         casters::check_transform(name, &transform)?;
         let caster = Caster::new(name, mesh, transform.as_mat4())?;
@@ -347,6 +377,14 @@ impl ShadowPass {
 
     /// Moves a caster (object -> world, f64): takes effect from the next `prepare`; nothing is
     /// re-created.
+    ///
+    /// ```no_run
+    /// # use umbrage::pass::*; use glam::{DMat4, DQuat, DVec3};
+    /// # fn f(pass: &mut ShadowPass, id: CasterId, t: f64) -> umbrage::Result<()> {
+    /// // Between frames: nothing is re-created, the next `prepare` plans from the new pose.
+    /// pass.set_transform(id, DMat4::from_rotation_translation(DQuat::from_rotation_y(t), DVec3::new(t, 0.5, 0.0)))?;
+    /// # Ok(()) }
+    /// ```
     pub fn set_transform(&mut self, id: CasterId, transform: DMat4) -> Result<()> {
         let i = self.casters.find(id)?;
         casters::check_transform(&self.casters.cpu[i].name, &transform)?;
@@ -358,6 +396,14 @@ impl ShadowPass {
     /// New object-space positions for a deforming caster: the same vertices (in the order of
     /// the mesh it was added with) and triangles. The new dual-length copies are uploaded by
     /// the next frame; the old ones are released once the frames in flight have retired.
+    ///
+    /// ```no_run
+    /// # use umbrage::pass::*; use glam::Vec3;
+    /// # fn f(pass: &mut ShadowPass, id: CasterId, skinned: &[Vec3]) -> umbrage::Result<()> {
+    /// // A deforming caster (skinning, cloth): same vertex count and triangles, new positions.
+    /// pass.update_positions(id, skinned)?;
+    /// # Ok(()) }
+    /// ```
     pub fn update_positions(&mut self, id: CasterId, positions: &[Vec3]) -> Result<()> {
         let all = self.all_slots();
         self.casters.update_positions(&self.dev, id, positions, all)
@@ -365,53 +411,17 @@ impl ShadowPass {
 
     /// Removes a caster; its buffers are released once every frame in flight that may use
     /// them has retired.
+    ///
+    /// ```no_run
+    /// # use umbrage::pass::*;
+    /// # fn f(pass: &mut ShadowPass, id: CasterId) -> umbrage::Result<()> {
+    /// pass.remove_caster(id)?; // its buffers go once every frame in flight has retired
+    /// assert!(pass.set_transform(id, glam::DMat4::IDENTITY).is_err()); // the id is dead
+    /// # Ok(()) }
+    /// ```
     pub fn remove_caster(&mut self, id: CasterId) -> Result<()> {
         let all = self.all_slots();
         self.casters.remove(id, all)
-    }
-
-    /// Adds an analytic sphere caster (lecture notes §2.1): its volume is built every frame
-    /// and light from the tangency circle as an n-gon circumscribed about it, `segments`
-    /// fixing n (3..=4096) or `None` choosing it so the shadow's error stays under half a
-    /// pixel. Opaque; drawn z-fail with its light cap, whatever the method (the polygon is
-    /// flattened onto the receiver with [`Technique::Planar`]). A frame whose positional
-    /// light is inside or on a sphere caster is refused by `prepare`.
-    pub fn add_sphere_caster(&mut self, name: &str, sphere: crate::geom::Sphere, segments: Option<u32>) -> Result<SphereId> {
-        spheres::check_sphere(name, &sphere, segments)?;
-        let id = SphereId(self.next_sphere);
-        self.next_sphere += 1;
-        self.spheres.push(spheres::SphereCaster { id, name: name.to_string(), sphere, segments });
-        Ok(id)
-    }
-
-    /// Moves or resizes a sphere caster (from the next `prepare`).
-    pub fn set_sphere(&mut self, id: SphereId, sphere: crate::geom::Sphere) -> Result<()> {
-        let i = spheres::find(&self.spheres, id)?;
-        spheres::check_sphere(&self.spheres[i].name, &sphere, self.spheres[i].segments)?;
-        self.spheres[i].sphere = sphere;
-        Ok(())
-    }
-
-    /// Removes a sphere caster (its volumes live in the per-frame stream: nothing to release).
-    pub fn remove_sphere(&mut self, id: SphereId) -> Result<()> {
-        let i = spheres::find(&self.spheres, id)?;
-        self.spheres.remove(i);
-        Ok(())
-    }
-
-    /// The sphere casters, in draw order: (id, name, sphere, fixed segments).
-    pub fn spheres(&self) -> impl Iterator<Item = (SphereId, &str, crate::geom::Sphere, Option<u32>)> + '_ {
-        self.spheres.iter().map(|s| (s.id, s.name.as_str(), s.sphere, s.segments))
-    }
-
-    /// The prepared casters, in draw order (the planner's view).
-    pub fn casters(&self) -> &[Caster] {
-        &self.casters.cpu
-    }
-
-    /// The id of the caster at `index` of [`casters`](Self::casters).
-    pub fn caster_id(&self, index: usize) -> Option<CasterId> {
-        self.casters.live.get(index).map(|c| c.id)
     }
 
     fn all_slots(&self) -> u64 {
@@ -425,6 +435,22 @@ impl ShadowPass {
     /// The CPU work of one frame into ring slot `slot`: per light culling, cases, possible
     /// silhouettes and index streams. The host guarantees that the frame that last used
     /// `slot` has retired (its buffers are rewritten and its retired buffers freed).
+    ///
+    /// ```no_run
+    /// # use umbrage::pass::*; use glam::{DVec3, Mat4, Vec3};
+    /// # use umbrage::geom::{Light, LightKind};
+    /// # fn f(pass: &mut ShadowPass, frame_number: usize, camera_view: Mat4, proj: Mat4) -> umbrage::Result<()> {
+    /// let eye = DVec3::new(0.0, 4.0, 7.0);
+    /// let view = ShadowView::from_view_matrix(eye, camera_view, proj, (1280, 720))?;
+    /// let light = Light { kind: LightKind::Point, position: Vec3::new(2.0, 6.0, 2.0), direction: Vec3::NEG_Y,
+    ///     color: Vec3::ONE, intensity: 1.0, radius: None, cone_deg: 180.0, area: None };
+    /// // Slot `frame_number % 2`: the host waited for that slot's previous frame first.
+    /// let frame = pass.prepare(frame_number % 2, &view, &[light])?;
+    /// for l in &frame.lights {
+    ///     println!("scissor {:?}, {} casters planned", l.scissor, l.stats.casters.len());
+    /// }
+    /// # Ok(()) }
+    /// ```
     pub fn prepare(&mut self, slot: usize, view: &ShadowView, lights: &[Light]) -> Result<PreparedFrame> {
         self.prepare_with(slot, view, lights, true)
     }
@@ -532,14 +558,9 @@ impl ShadowPass {
                 MemoryLocation::CpuToGpu,
             )?);
         }
-        let buf = s.stream.as_mut().ok_or_else(|| Error::Other("no stream buffer".into()))?;
+        let buf = s.stream.as_mut().ok_or_else(|| Error::Internal("no stream buffer".into()))?;
         buf.write(0, data)?;
         Ok(buf.raw)
-    }
-
-    /// Whether a caster is on the multiplicity path (open, non-manifold or transparent).
-    pub fn caster_kind(&self, id: CasterId) -> Result<&CasterKind> {
-        Ok(&self.casters.cpu[self.casters.find(id)?].kind)
     }
 }
 

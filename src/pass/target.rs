@@ -33,12 +33,28 @@ pub struct DepthStencilTarget {
 
 impl DepthStencilTarget {
     /// A target in `DEPTH_STENCIL_ATTACHMENT_OPTIMAL` before and after.
+    ///
+    /// ```
+    /// use ash::vk;
+    /// use umbrage::pass::DepthStencilTarget;
+    /// let t = DepthStencilTarget::new(vk::Image::null(), vk::ImageView::null(), vk::Extent2D { width: 1280, height: 720 });
+    /// assert_eq!(t.layout, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
+    /// assert_eq!(t.final_layout, t.layout);
+    /// ```
     pub fn new(image: vk::Image, view: vk::ImageView, extent: vk::Extent2D) -> DepthStencilTarget {
         let l = vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
         DepthStencilTarget { image, view, extent, layout: l, final_layout: l }
     }
 
     /// The same target, declared in `layout` and to be left in `final_layout`.
+    ///
+    /// ```
+    /// use ash::vk::{self, ImageLayout as L};
+    /// use umbrage::pass::DepthStencilTarget;
+    /// let t = DepthStencilTarget::new(vk::Image::null(), vk::ImageView::null(), vk::Extent2D { width: 64, height: 64 })
+    ///     .with_layouts(L::DEPTH_STENCIL_READ_ONLY_OPTIMAL, L::SHADER_READ_ONLY_OPTIMAL);
+    /// assert_eq!((t.layout, t.final_layout), (L::DEPTH_STENCIL_READ_ONLY_OPTIMAL, L::SHADER_READ_ONLY_OPTIMAL));
+    /// ```
     pub fn with_layouts(self, layout: vk::ImageLayout, final_layout: vk::ImageLayout) -> DepthStencilTarget {
         DepthStencilTarget { layout, final_layout, ..self }
     }

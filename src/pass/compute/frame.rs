@@ -180,9 +180,9 @@ impl ComputeFrame {
             return Ok(());
         }
         for m in &self.metas {
-            let r = words.get(m.word..m.word + RECORD_WORDS).ok_or_else(|| Error::Other("compute records short".into()))?;
+            let r = words.get(m.word..m.word + RECORD_WORDS).ok_or_else(|| Error::Internal("compute records short".into()))?;
             if r[rec::OVERFLOW] != 0 || r[rec::VOL_COUNT] > r[rec::VOL_CAP] || r[rec::CAP_COUNT] > r[rec::CAP_CAP] {
-                return Err(Error::Other(format!(
+                return Err(Error::Internal(format!(
                     "compute silhouettes: a chunk's index region overflowed ({} of {} volume, {} of {} light-cap indices)",
                     r[rec::VOL_COUNT],
                     r[rec::VOL_CAP],

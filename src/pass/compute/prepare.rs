@@ -3,7 +3,7 @@
 
 use super::frame::ComputeFrame;
 use super::SlotCompute;
-use crate::error::{Error, Result};
+use crate::error::{Error, Misuse, Result};
 use crate::pass::{PreparedFrame, ShadowPass};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -13,7 +13,9 @@ impl ShadowPass {
     /// per caster with jobs. The slot's previous frame has retired.
     pub(crate) fn prepare_compute(&mut self, slot: usize, mut cf: ComputeFrame) -> Result<ComputeFrame> {
         let Some(pipes) = self.compute_pipes.as_ref() else {
-            return Err(Error::Other("compute silhouettes: no compute pipelines".into()));
+            return Err(
+                Misuse::NotConfigured { call: "Technique::Compute", needs: "a device with compute silhouettes (Capabilities)" }.into()
+            );
         };
         let set_layout = pipes.set_layout;
         let dev = &self.dev;
@@ -44,7 +46,7 @@ impl ShadowPass {
             MemoryLocation::GpuOnly,
         )?;
         let (Some(records), Some(out), Some(facing)) = (sc.records.as_mut(), sc.out.as_ref(), sc.facing.as_ref()) else {
-            return Err(Error::Other("compute silhouettes: slot buffers missing".into()));
+            return Err(Error::Internal("compute silhouettes: slot buffers missing".into()));
         };
         records.write(0, bytemuck::cast_slice(&cf.records))?;
         let (records_raw, out_raw, facing_raw) = (records.raw, out.raw, facing.raw);
@@ -64,7 +66,7 @@ impl ShadowPass {
             .map_err(Error::vk("vkAllocateDescriptorSets"))?;
             let mut infos: Vec<[vk::DescriptorBufferInfo; 1]> = Vec::with_capacity(casters.len() * 7);
             for &ci in &casters {
-                let st = self.casters.live[ci].compute.as_ref().ok_or_else(|| Error::Other("compute tables missing".into()))?;
+                let st = self.casters.live[ci].compute.as_ref().ok_or_else(|| Error::Internal("compute tables missing".into()))?;
                 for b in [st.planes.raw, st.tris.raw, st.positions.raw, st.edges.raw, facing_raw, records_raw, out_raw] {
                     infos.push([vk::DescriptorBufferInfo { buffer: b, offset: 0, range: vk::WHOLE_SIZE }]);
                 }
@@ -105,10 +107,8 @@ impl ShadowPass {
         let Some(cf) = frame.compute.as_ref() else { return Ok(()) };
         let slot = &self.slots[frame.slot];
         if slot.serial != Some(frame.serial) {
-            return Err(Error::Other(format!(
-                "read_back_counts: ring slot {} was prepared again since frame {}",
-                frame.slot, frame.serial
-            )));
+            let current = slot.serial.unwrap_or(0);
+            return Err(Misuse::StaleFrame { slot: frame.slot, serial: frame.serial, current }.into());
         }
         if cf.metas.is_empty() {
             return Ok(());
@@ -116,7 +116,7 @@ impl ShadowPass {
         let Some(records) = slot.compute.records.as_ref() else { return Ok(()) };
         let bytes = records.read()?;
         let words: &[u32] =
-            bytemuck::try_cast_slice(&bytes[..cf.records.len() * 4]).map_err(|e| Error::Other(format!("compute records: {e}")))?;
+            bytemuck::try_cast_slice(&bytes[..cf.records.len() * 4]).map_err(|e| Error::Internal(format!("compute records: {e}")))?;
         cf.read_back(words, &mut frame.lights, &mut frame.totals)
     }
 }

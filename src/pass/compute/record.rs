@@ -57,7 +57,11 @@ impl ShadowPass {
             return Ok(());
         }
         let Some(cp) = self.compute_pipes.as_ref() else {
-            return Err(crate::error::Error::Other("compute silhouettes: the pass has no compute pipelines".into()));
+            return Err(crate::error::Misuse::NotConfigured {
+                call: "cmd_compute_silhouettes",
+                needs: "Technique::Compute on a device with compute silhouettes",
+            }
+            .into());
         };
         let d = &self.dev.device;
         use vk::AccessFlags2 as A;
