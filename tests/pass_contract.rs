@@ -247,6 +247,14 @@ fn recording_misuse_is_a_typed_error_before_anything_is_recorded() {
             _ => assert!(matches!(e, Error::Misuse(Misuse::Argument { .. })), "{what}: {e}"),
         }
     }
+    // The sphere casters, listed by name.
+    let ball = umbrage::geom::Sphere { center: DVec3::new(0.0, 1.0, 2.0), radius: 0.5 };
+    let sid = p.add_sphere_caster("ball", ball, Some(32)).unwrap();
+    let listed: Vec<_> = p.spheres().collect();
+    assert_eq!(listed.len(), 1);
+    assert_eq!((listed[0].id, listed[0].name, listed[0].sphere, listed[0].segments), (sid, "ball", ball, Some(32)));
+    p.remove_sphere(sid).unwrap();
+    assert_eq!(p.spheres().count(), 0);
     // An area light is refused, pointing at its expansion.
     let mut area = light();
     area.area = Some(umbrage::geom::AreaLight::new(umbrage::geom::AreaShape::Disc { radius: 0.5 }, Vec3::NEG_Y, 4));

@@ -90,7 +90,7 @@ pub use desc::{
 pub use frame::{case_name, LightFrame, PreparedFrame, ShadowView};
 pub use pipelines::COUNT_FORMAT;
 pub use record::{lit_stencil_state, VolumeKind};
-pub use spheres::SphereId;
+pub use spheres::{SphereId, SphereInfo};
 pub use target::DepthStencilTarget;
 
 use crate::error::{Error, Misuse, Result};

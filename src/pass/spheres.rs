@@ -23,6 +23,19 @@ use glam::{DMat4, DVec4};
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct SphereId(pub(crate) u64);
 
+/// A sphere caster as [`ShadowPass::spheres`](super::ShadowPass::spheres) lists it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SphereInfo<'a> {
+    /// Its id.
+    pub id: SphereId,
+    /// The name it was added with.
+    pub name: &'a str,
+    /// Centre and radius, world space.
+    pub sphere: Sphere,
+    /// The fixed polygon size, or `None` (chosen per frame for half a pixel of error).
+    pub segments: Option<u32>,
+}
+
 /// One sphere caster of the pass.
 #[derive(Clone, Debug)]
 pub(crate) struct SphereCaster {
@@ -245,8 +258,8 @@ impl super::ShadowPass {
         Ok(())
     }
 
-    /// The sphere casters, in draw order: (id, name, sphere, fixed segments).
-    pub fn spheres(&self) -> impl Iterator<Item = (SphereId, &str, crate::geom::Sphere, Option<u32>)> + '_ {
-        self.spheres.iter().map(|s| (s.id, s.name.as_str(), s.sphere, s.segments))
+    /// The sphere casters, in draw order.
+    pub fn spheres(&self) -> impl Iterator<Item = SphereInfo<'_>> + '_ {
+        self.spheres.iter().map(|s| SphereInfo { id: s.id, name: s.name.as_str(), sphere: s.sphere, segments: s.segments })
     }
 }
