@@ -243,9 +243,9 @@ impl Host {
 
             for (li, draws) in lit_draws.iter().enumerate() {
                 if self.config.render_pass {
-                    // Inside the host's subpass: the pass clears the stencil in the light's
-                    // scissor (vkCmdClearAttachments) and counts; the lighting pass follows in
-                    // the same subpass (fragment tests run in primitive order).
+                    // Inside the host's shadow subpass (depth-stencil only): the pass clears the
+                    // stencil in the light's scissor (vkCmdClearAttachments) and counts; the
+                    // lighting follows in the next subpass.
                     begin_render_pass(self.passes.lighting, self.passes.lighting_fb, &[color_clear, ds_clear]);
                     let target = DepthStencilTarget::new(depth.raw, depth.view, self.extent);
                     timestamp(vk::PipelineStageFlags::TOP_OF_PIPE, 2 * li as u32);
@@ -277,6 +277,10 @@ impl Host {
                         .depth_attachment(&d)
                         .stencil_attachment(&d);
                     device.cmd_begin_rendering(cb, &info);
+                }
+                if self.config.render_pass {
+                    // The lighting subpass (the count's stencil writes ordered before it).
+                    device.cmd_next_subpass(cb, vk::SubpassContents::INLINE);
                 }
                 // The host's lighting pass: light-facing triangles, depth EQUAL, stencil == 0;
                 // the viewport, the light's scissor and (when used) its depth bounds.

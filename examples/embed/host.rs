@@ -427,9 +427,9 @@ impl Host {
         // The render passes first (the pass's pipelines are built against the lighting one).
         let mut target = TargetModel::DynamicRendering;
         if config.render_pass {
-            let pre = RenderPassDesc::new(NORMAL_FORMAT, host.ds_format, config.samples, true);
+            let pre = RenderPassDesc::new(NORMAL_FORMAT, host.ds_format, config.samples, true, false);
             host.passes.prepass = create_render_pass(&device, &pre, |_, _| Ok(()))?.0;
-            let light = RenderPassDesc::new(LIT_FORMAT, host.ds_format, config.samples, false);
+            let light = RenderPassDesc::new(LIT_FORMAT, host.ds_format, config.samples, false, true);
             let (rp, t) = create_render_pass(&device, &light, |rp, info| {
                 // SAFETY: `info` is the create info `rp` was just created from, its pointers alive.
                 unsafe { RenderPassTarget::new(rp, info, 0) }.map_err(|e| format!("RenderPassTarget::new: {e}"))

@@ -59,7 +59,7 @@ impl Host {
             samples,
         };
         let (pre_target, lit_target) = if self.config.render_pass {
-            (Target::RenderPass(self.passes.prepass), Target::RenderPass(self.passes.lighting))
+            (Target::RenderPass(self.passes.prepass, 0), Target::RenderPass(self.passes.lighting, 1))
         } else {
             (Target::Dynamic { color: NORMAL_FORMAT, ds: self.ds_format }, Target::Dynamic { color: LIT_FORMAT, ds: self.ds_format })
         };

@@ -347,8 +347,8 @@ pub(super) fn shader_module(device: &ash::Device, words: &[u32]) -> Result<vk::S
 pub(super) enum Target {
     /// Dynamic rendering: one colour attachment of this format and the depth-stencil format.
     Dynamic { color: vk::Format, ds: vk::Format },
-    /// Subpass 0 of this render pass (one colour attachment and the depth-stencil).
-    RenderPass(vk::RenderPass),
+    /// This subpass of this render pass (one colour attachment and the depth-stencil).
+    RenderPass(vk::RenderPass, u32),
 }
 
 /// What differs between the host's two pipelines.
@@ -427,7 +427,7 @@ pub(super) fn create_pipeline(
                 .stencil_attachment_format(ds);
             info = info.push_next(&mut rendering);
         }
-        Target::RenderPass(rp) => info = info.render_pass(rp).subpass(0),
+        Target::RenderPass(rp, subpass) => info = info.render_pass(rp).subpass(subpass),
     }
     // SAFETY: every pointer in `info` refers to locals alive for the call.
     unsafe { device.create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) }
@@ -438,18 +438,20 @@ pub(super) fn create_pipeline(
 /// The classic render pass of one of the host's passes: colour attachment 0 (`color`, cleared,
 /// left in SHADER_READ_ONLY_OPTIMAL for the readback) and the depth-stencil attachment 1
 /// (`clear_ds`: cleared from UNDEFINED, the pre-pass; otherwise loaded from
-/// DEPTH_STENCIL_READ_ONLY_OPTIMAL, the lighting pass), left in DEPTH_STENCIL_READ_ONLY_OPTIMAL;
-/// one subpass. Returns the render pass and the create info's attachments, subpass and
-/// dependencies (for [`umbrage::pass::RenderPassTarget::new`]).
+/// DEPTH_STENCIL_READ_ONLY_OPTIMAL, the lighting pass), left in DEPTH_STENCIL_READ_ONLY_OPTIMAL.
+/// The pre-pass has one subpass. The lighting pass (`shadow_subpass`) has two: subpass 0 with
+/// the depth-stencil attachment only, where the shadow pass records (no colour attachment, so
+/// a driver can run its depth/stencil-only path), then subpass 1, the lighting, with both.
 pub(super) struct RenderPassDesc {
     pub(super) attachments: [vk::AttachmentDescription; 2],
     pub(super) color_ref: [vk::AttachmentReference; 1],
     pub(super) ds_ref: vk::AttachmentReference,
-    pub(super) dependencies: [vk::SubpassDependency; 2],
+    pub(super) dependencies: Vec<vk::SubpassDependency>,
+    pub(super) shadow_subpass: bool,
 }
 
 impl RenderPassDesc {
-    pub(super) fn new(color: vk::Format, ds: vk::Format, samples: u32, clear_ds: bool) -> RenderPassDesc {
+    pub(super) fn new(color: vk::Format, ds: vk::Format, samples: u32, clear_ds: bool, shadow_subpass: bool) -> RenderPassDesc {
         let samples = vk::SampleCountFlags::from_raw(samples);
         let read_only = vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL;
         let (ds_load, ds_initial) =
@@ -475,7 +477,8 @@ impl RenderPassDesc {
         let tests = vk::PipelineStageFlags::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags::LATE_FRAGMENT_TESTS;
         let output = vk::PipelineStageFlags::COLOR_ATTACHMENT_OUTPUT;
         let writes = vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_WRITE | vk::AccessFlags::COLOR_ATTACHMENT_WRITE;
-        let dependencies = [
+        let last = shadow_subpass as u32;
+        let mut dependencies = vec![
             // Everything earlier (the previous readback's compute reads, the uploads): done
             // before the attachments are cleared, loaded or written.
             vk::SubpassDependency::default()
@@ -487,27 +490,58 @@ impl RenderPassDesc {
                 .dst_access_mask(writes | vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_READ | vk::AccessFlags::COLOR_ATTACHMENT_READ),
             // The attachments' writes visible to the readback's compute shader.
             vk::SubpassDependency::default()
-                .src_subpass(0)
+                .src_subpass(last)
                 .dst_subpass(vk::SUBPASS_EXTERNAL)
                 .src_stage_mask(tests | output)
                 .src_access_mask(writes)
                 .dst_stage_mask(vk::PipelineStageFlags::COMPUTE_SHADER)
                 .dst_access_mask(vk::AccessFlags::SHADER_READ),
         ];
+        if shadow_subpass {
+            // The colour attachment's first use (and layout transition) is subpass 1: after
+            // the previous light's readback read it.
+            dependencies.push(
+                vk::SubpassDependency::default()
+                    .src_subpass(vk::SUBPASS_EXTERNAL)
+                    .dst_subpass(1)
+                    .src_stage_mask(vk::PipelineStageFlags::ALL_COMMANDS)
+                    .src_access_mask(vk::AccessFlags::MEMORY_WRITE)
+                    .dst_stage_mask(output)
+                    .dst_access_mask(vk::AccessFlags::COLOR_ATTACHMENT_WRITE | vk::AccessFlags::COLOR_ATTACHMENT_READ),
+            );
+            // The shadow pass's stencil count before the lighting's stencil test.
+            dependencies.push(
+                vk::SubpassDependency::default()
+                    .src_subpass(0)
+                    .dst_subpass(1)
+                    .src_stage_mask(tests)
+                    .src_access_mask(vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_WRITE)
+                    .dst_stage_mask(tests)
+                    .dst_access_mask(vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_READ | vk::AccessFlags::DEPTH_STENCIL_ATTACHMENT_WRITE)
+                    .dependency_flags(vk::DependencyFlags::BY_REGION),
+            );
+        }
         RenderPassDesc {
             attachments,
             color_ref: [vk::AttachmentReference { attachment: 0, layout: vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL }],
             ds_ref: vk::AttachmentReference { attachment: 1, layout: vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL },
             dependencies,
+            shadow_subpass,
         }
     }
 
-    /// The subpass; its pointers refer to `self`.
-    pub(super) fn subpass(&self) -> vk::SubpassDescription<'_> {
-        vk::SubpassDescription::default()
+    /// The subpasses; their pointers refer to `self`.
+    pub(super) fn subpasses(&self) -> Vec<vk::SubpassDescription<'_>> {
+        let both = vk::SubpassDescription::default()
             .pipeline_bind_point(vk::PipelineBindPoint::GRAPHICS)
             .color_attachments(&self.color_ref)
-            .depth_stencil_attachment(&self.ds_ref)
+            .depth_stencil_attachment(&self.ds_ref);
+        if !self.shadow_subpass {
+            return vec![both];
+        }
+        let shadow =
+            vk::SubpassDescription::default().pipeline_bind_point(vk::PipelineBindPoint::GRAPHICS).depth_stencil_attachment(&self.ds_ref);
+        vec![shadow, both]
     }
 }
 
@@ -518,7 +552,7 @@ pub(super) fn create_render_pass<T>(
     desc: &RenderPassDesc,
     info: impl FnOnce(vk::RenderPass, &vk::RenderPassCreateInfo) -> Result<T, String>,
 ) -> Result<(vk::RenderPass, T), String> {
-    let subpasses = [desc.subpass()];
+    let subpasses = desc.subpasses();
     let create = vk::RenderPassCreateInfo::default().attachments(&desc.attachments).subpasses(&subpasses).dependencies(&desc.dependencies);
     // SAFETY: every pointer in `create` refers to `desc` or locals alive for the call.
     let rp = unsafe { device.create_render_pass(&create, None) }.map_err(vkerr("vkCreateRenderPass"))?;
