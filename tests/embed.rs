@@ -139,3 +139,64 @@ fn bad_configurations_are_clear_errors() {
         assert!(e.contains(expected), "{}: '{e}' does not say '{expected}'", config.name());
     }
 }
+
+/// The example binary, built like `tests/wgpu_host.rs` builds its host (a no-op under
+/// `cargo test --all-targets`, which built it already).
+fn example_binary() -> std::path::PathBuf {
+    let mut build = std::process::Command::new(env!("CARGO"));
+    build.args(["build", "--example", "embed"]).current_dir(env!("CARGO_MANIFEST_DIR"));
+    if !cfg!(debug_assertions) {
+        build.arg("--release");
+    }
+    assert!(build.status().expect("cargo runs").success(), "cargo build --example embed failed");
+    let exe = std::env::current_exe().expect("the test's own path");
+    let dir = exe.parent().and_then(std::path::Path::parent).expect("target/<profile>/deps");
+    dir.join("examples").join(format!("embed{}", std::env::consts::EXE_SUFFIX))
+}
+
+/// `--dump DIR` with `--msaa 4` writes `DIR/sample_0` .. `DIR/sample_3`, each a complete dump
+/// that `umbrage check` (here `reference::check_dump`) holds against the reference; with one
+/// sample the dump is `DIR` itself, as `umbrage render --dump` writes it. The PNG is written.
+#[test]
+fn dumps_hold_every_sample() {
+    let bin = example_binary();
+    for samples in [1u32, 4] {
+        let dir = std::env::temp_dir().join(format!("umbrage-embed-dump-{}-{samples}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        let png = dir.join("embed.png");
+        let out = std::process::Command::new(&bin)
+            .args(["--msaa", &samples.to_string(), "--frames", "2", "--size", "200x120", "--render-pass", "--reverse-z", "--dump"])
+            .arg(dir.join("dump"))
+            .arg("--out")
+            .arg(&png)
+            .env("UMBRAGE_VALIDATION", "1")
+            .output()
+            .expect("the example runs");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        if !out.status.success() && (stderr.contains("no Vulkan loader") || stderr.contains("no Vulkan driver")) {
+            assert!(std::env::var_os("CI").is_none(), "no Vulkan device under CI: {stderr}");
+            eprintln!("SKIPPED (no Vulkan device, CI not set)");
+            return;
+        }
+        assert!(out.status.success(), "{samples} samples: the example failed:\n{stderr}");
+        assert!(png.is_file(), "no PNG");
+        let dumps: Vec<std::path::PathBuf> = if samples == 1 {
+            vec![dir.join("dump")]
+        } else {
+            assert!(!dir.join("dump/frame.json").exists(), "a multisampled dump has no top-level frame");
+            (0..samples).map(|s| dir.join(format!("dump/sample_{s}"))).collect()
+        };
+        for d in &dumps {
+            let report = umbrage::reference::check_dump(d, host::BAND).unwrap_or_else(|e| panic!("{}: {e}", d.display()));
+            for l in &report.lights {
+                assert!(l.metrics.compared > 5_000, "{}: light {}: {} compared", d.display(), l.index, l.metrics.compared);
+                assert_eq!(l.metrics.mismatches_outside_band, 0, "{}: light {}", d.display(), l.index);
+            }
+            for f in ["stencil_0.png", "color.png", "world.obj", "positions.f32", "normals.f32"] {
+                assert!(d.join(f).is_file(), "{}: no {f}", d.display());
+            }
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
