@@ -9,7 +9,7 @@ mod common;
 use ash::vk;
 use glam::{DMat4, DVec3, Mat4, Vec3};
 use umbrage::error::Misuse;
-use umbrage::geom::{Camera, Light, LightKind};
+use umbrage::geom::{Camera, Light};
 use umbrage::pass::{
     DepthDirection, DepthMode, DepthStencilTarget, EnabledFeatures, RenderPassTarget, ShadowPass, ShadowPassDesc, ShadowView, TargetModel,
 };
@@ -33,16 +33,7 @@ fn view() -> ShadowView {
 }
 
 fn light() -> Light {
-    Light {
-        kind: LightKind::Point,
-        position: Vec3::new(1.0, 5.0, 2.0),
-        direction: Vec3::NEG_Y,
-        color: Vec3::ONE,
-        intensity: 1.0,
-        radius: None,
-        cone_deg: 45.0,
-        area: None,
-    }
+    Light::point(Vec3::new(1.0, 5.0, 2.0))
 }
 
 fn misuse(r: umbrage::Result<()>) -> Misuse {

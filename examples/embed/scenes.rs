@@ -3,7 +3,7 @@
 
 use super::MOVING_MESH;
 use glam::{Mat4, Quat, Vec2, Vec3};
-use umbrage::geom::{Camera, Light, LightKind};
+use umbrage::geom::{Camera, Light};
 use umbrage::scene::{shapes, Scene, SceneMesh};
 
 /// The moving caster's transform at `frame`: the box slides towards the torus and turns.
@@ -23,16 +23,7 @@ pub fn scene(frame: usize) -> Scene {
         opacity: 1.0,
         casts_shadow,
     };
-    let light = |position| Light {
-        kind: LightKind::Point,
-        position,
-        direction: Vec3::NEG_Y,
-        color: Vec3::ONE,
-        intensity: 1.0,
-        radius: None,
-        cone_deg: 45.0,
-        area: None,
-    };
+    let light = Light::point;
     Scene {
         name: "embedded".into(),
         camera: Camera { eye: Vec3::new(0.0, 4.0, 7.0), target: Vec3::new(0.0, 0.5, 0.0), ..Default::default() },

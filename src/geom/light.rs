@@ -112,6 +112,28 @@ pub struct Light {
 }
 
 impl Light {
+    /// A white point light of intensity 1 at `position`, reaching everything (no radius).
+    ///
+    /// ```
+    /// use glam::Vec3;
+    /// use umbrage::geom::{Light, LightKind};
+    /// let l = Light::point(Vec3::new(2.0, 6.0, 2.0));
+    /// assert_eq!((l.kind, l.radius, l.intensity), (LightKind::Point, None, 1.0));
+    /// assert_eq!(l.homogeneous(), glam::Vec4::new(2.0, 6.0, 2.0, 1.0));
+    /// ```
+    pub fn point(position: Vec3) -> Light {
+        Light {
+            kind: LightKind::Point,
+            position,
+            direction: Vec3::NEG_Y,
+            color: Vec3::ONE,
+            intensity: 1.0,
+            radius: None,
+            cone_deg: 180.0,
+            area: None,
+        }
+    }
+
     /// Homogeneous position: (position, 1) for point and spot, (-direction, 0) for directional
     /// (xyz pointing towards the light), as in McGuire et al. and the dump format.
     pub fn homogeneous(&self) -> Vec4 {

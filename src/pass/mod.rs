@@ -438,12 +438,11 @@ impl ShadowPass {
     ///
     /// ```no_run
     /// # use umbrage::pass::*; use glam::{DVec3, Mat4, Vec3};
-    /// # use umbrage::geom::{Light, LightKind};
+    /// # use umbrage::geom::Light;
     /// # fn f(pass: &mut ShadowPass, frame_number: usize, camera_view: Mat4, proj: Mat4) -> umbrage::Result<()> {
     /// let eye = DVec3::new(0.0, 4.0, 7.0);
     /// let view = ShadowView::from_view_matrix(eye, camera_view, proj, (1280, 720))?;
-    /// let light = Light { kind: LightKind::Point, position: Vec3::new(2.0, 6.0, 2.0), direction: Vec3::NEG_Y,
-    ///     color: Vec3::ONE, intensity: 1.0, radius: None, cone_deg: 180.0, area: None };
+    /// let light = Light::point(Vec3::new(2.0, 6.0, 2.0));
     /// // Slot `frame_number % 2`: the host waited for that slot's previous frame first.
     /// let frame = pass.prepare(frame_number % 2, &view, &[light])?;
     /// for l in &frame.lights {
