@@ -176,6 +176,22 @@ impl Host {
                 }
             }
         };
+        // Dynamic rendering: `color` (its old contents discarded, cleared) and the depth-stencil
+        // (`ds_load`: CLEAR for the pre-pass, LOAD for the lighting), over the whole frame.
+        let begin_rendering = |color: &super::vulkan::Img, ds_load| {
+            image_barrier(device, cb, color.raw, vk::ImageAspectFlags::COLOR, (vk::ImageLayout::UNDEFINED, color_att), before, output);
+            let c = [attachment(color.view, vk::AttachmentLoadOp::CLEAR, color_clear)];
+            let d = attachment(depth.view, ds_load, ds_clear);
+            let info = vk::RenderingInfo::default()
+                .render_area(full)
+                .layer_count(1)
+                .color_attachments(&c)
+                .depth_attachment(&d)
+                .stencil_attachment(&d);
+            // SAFETY: `cb` is recording outside any rendering; the views are live attachments
+            // in the layouts the barriers before left them in.
+            unsafe { device.cmd_begin_rendering(cb, &info) };
+        };
         let begin_render_pass = |rp, fb, clears: &[vk::ClearValue]| {
             let info = vk::RenderPassBeginInfo::default().render_pass(rp).framebuffer(fb).render_area(full).clear_values(clears);
             // SAFETY: the framebuffer matches the render pass; `cb` is outside any render pass.
@@ -210,24 +226,7 @@ impl Host {
                 begin_render_pass(self.passes.prepass, self.passes.prepass_fb, &[color_clear, ds_clear]);
             } else {
                 image_barrier(device, cb, depth.raw, ds_aspects, (vk::ImageLayout::UNDEFINED, ds_att), before, (tests, ds_rw));
-                image_barrier(
-                    device,
-                    cb,
-                    normal_img.raw,
-                    vk::ImageAspectFlags::COLOR,
-                    (vk::ImageLayout::UNDEFINED, color_att),
-                    before,
-                    output,
-                );
-                let color = [attachment(normal_img.view, vk::AttachmentLoadOp::CLEAR, color_clear)];
-                let d = attachment(depth.view, vk::AttachmentLoadOp::CLEAR, ds_clear);
-                let info = vk::RenderingInfo::default()
-                    .render_area(full)
-                    .layer_count(1)
-                    .color_attachments(&color)
-                    .depth_attachment(&d)
-                    .stencil_attachment(&d);
-                device.cmd_begin_rendering(cb, &info);
+                begin_rendering(normal_img, vk::AttachmentLoadOp::CLEAR);
             }
             device.cmd_set_viewport(cb, 0, &[viewport]);
             device.cmd_set_scissor(cb, 0, &[full]);
@@ -259,24 +258,7 @@ impl Host {
                     timestamp(vk::PipelineStageFlags::TOP_OF_PIPE, 2 * li as u32);
                     pass.cmd_determine(cb, frame, li, &target).map_err(|e| format!("cmd_determine: {e}"))?;
                     timestamp(vk::PipelineStageFlags::BOTTOM_OF_PIPE, 2 * li as u32 + 1);
-                    image_barrier(
-                        device,
-                        cb,
-                        lit_img.raw,
-                        vk::ImageAspectFlags::COLOR,
-                        (vk::ImageLayout::UNDEFINED, color_att),
-                        before,
-                        output,
-                    );
-                    let color = [attachment(lit_img.view, vk::AttachmentLoadOp::CLEAR, color_clear)];
-                    let d = attachment(depth.view, vk::AttachmentLoadOp::LOAD, ds_clear);
-                    let info = vk::RenderingInfo::default()
-                        .render_area(full)
-                        .layer_count(1)
-                        .color_attachments(&color)
-                        .depth_attachment(&d)
-                        .stencil_attachment(&d);
-                    device.cmd_begin_rendering(cb, &info);
+                    begin_rendering(lit_img, vk::AttachmentLoadOp::LOAD);
                 }
                 if self.config.render_pass {
                     // The lighting subpass (the count's stencil writes ordered before it).
