@@ -5,7 +5,7 @@
 //! `use umbrage::pass::diagnostics::Diagnostics`.
 
 use super::frame::PreparedFrame;
-use super::record::{depth_attachment, VolumeKind};
+use super::record::VolumeKind;
 use super::target::DepthStencilTarget;
 use super::ShadowPass;
 use crate::error::{Misuse, Result};
@@ -69,24 +69,14 @@ impl Diagnostics for ShadowPass {
         light: usize,
         target: &DepthStencilTarget,
     ) -> Result<()> {
-        let lf = self.light(frame, light)?;
+        self.light(frame, light)?;
         self.dynamic_only("cmd_count_rasterised")?;
         target.check(frame, &self.desc.target)?;
         // SAFETY: the caller's contract (outside a rendering instance).
-        unsafe { self.cmd_before_rendering(cb, frame)? };
-        let att = depth_attachment(target, vk::AttachmentLoadOp::LOAD, 0);
-        let info = vk::RenderingInfo::default().render_area(lf.scissor).layer_count(1).depth_attachment(&att).stencil_attachment(&att);
-        let d = &self.dev.device;
-        // SAFETY: the caller's contract; the attachments are the caller's image.
         unsafe {
-            self.enter(cb, target);
-            d.cmd_begin_rendering(cb, &info);
-            self.cmd_light_state(cb, frame, light, target.extent)?;
-            self.cmd_draw_volumes(cb, frame, light, VolumeKind::Rasterised)?;
-            d.cmd_end_rendering(cb);
-            self.leave(cb, target);
+            self.cmd_before_rendering(cb, frame)?;
+            self.cmd_volume_instance(cb, frame, light, target, (vk::AttachmentLoadOp::LOAD, 0), VolumeKind::Rasterised)
         }
-        Ok(())
     }
 
     unsafe fn cmd_count_float(

@@ -268,18 +268,41 @@ impl ShadowPass {
             return Ok(());
         }
         // SAFETY: the caller's contract (outside a rendering instance).
-        unsafe { self.cmd_before_rendering(cb, frame)? };
+        unsafe {
+            self.cmd_before_rendering(cb, frame)?;
+            // Cleared to 0, or to the number of volumes containing the eye (zpass-clear).
+            self.cmd_volume_instance(cb, frame, light, target, (vk::AttachmentLoadOp::CLEAR, lf.counter_clear), VolumeKind::Stencil)
+        }
+    }
+
+    /// One rendering instance of the pass over light `light`'s scissor on `target`, between
+    /// the declared layout transitions: depth loaded, stencil `stencil` (LOAD, or CLEAR to the
+    /// value), the light's state and its volumes of `kind`.
+    ///
+    /// # Safety
+    /// As [`cmd_determine`](Self::cmd_determine) with dynamic rendering, the frame's uploads
+    /// recorded; `frame`, `light` and `target` checked.
+    pub(super) unsafe fn cmd_volume_instance(
+        &self,
+        cb: vk::CommandBuffer,
+        frame: &PreparedFrame,
+        light: usize,
+        target: &DepthStencilTarget,
+        (load, clear): (vk::AttachmentLoadOp, u32),
+        kind: VolumeKind,
+    ) -> Result<()> {
+        let lf = self.light(frame, light)?;
         let depth = depth_attachment(target, vk::AttachmentLoadOp::LOAD, 0);
-        // Cleared to 0, or to the number of volumes containing the eye (zpass-clear).
-        let stencil = depth_attachment(target, vk::AttachmentLoadOp::CLEAR, lf.counter_clear);
+        let stencil = depth_attachment(target, load, clear);
         let info =
             vk::RenderingInfo::default().render_area(lf.scissor).layer_count(1).depth_attachment(&depth).stencil_attachment(&stencil);
+        let d = &self.dev.device;
         // SAFETY: the caller's contract; the attachments are the caller's image.
         unsafe {
             self.enter(cb, target);
             d.cmd_begin_rendering(cb, &info);
             self.cmd_light_state(cb, frame, light, target.extent)?;
-            self.cmd_draw_volumes(cb, frame, light, VolumeKind::Stencil)?;
+            self.cmd_draw_volumes(cb, frame, light, kind)?;
             d.cmd_end_rendering(cb);
             self.leave(cb, target);
         }
