@@ -8,7 +8,6 @@ use super::vulkan::{image_barrier, memory_barrier, vkerr, write_buffer};
 use super::{FrameResult, Host, InFlight, Layout, LightResult, SampleFrame, BAND, FRAMES_IN_FLIGHT};
 use ash::vk;
 use glam::{DMat4, DVec3, DVec4, Vec3};
-use umbrage::geom::LightKind;
 use umbrage::pass::{reverse_z, DepthStencilTarget, ShadowView};
 
 /// Vulkan's standard sample locations (`standardSampleLocations`) of `samples` samples, in
@@ -381,15 +380,7 @@ impl Host {
                 // Lit: the lighting pass wrote the sample (stencil 0, light-facing) and the
                 // light reaches it (a spot's cone, a light's range: what a lighting shader's
                 // attenuation would apply, applied here as umbrage's renderer does).
-                let reaches = |i: usize| {
-                    let p = Vec3::new(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]);
-                    let l = light.homogeneous();
-                    let to = if l.w == 0.0 { l.truncate() } else { l.truncate() - p };
-                    let in_range = light.radius.is_none_or(|r| l.w == 0.0 || to.length() < r);
-                    let in_cone = light.kind != LightKind::Spot
-                        || (-to.normalize()).dot(light.direction.normalize()) > (light.cone_deg.to_radians() * 0.5).cos();
-                    in_range && in_cone
-                };
+                let reaches = |i: usize| light.reaches(Vec3::new(positions[3 * i], positions[3 * i + 1], positions[3 * i + 2]));
                 let mask = (0..n).map(|i| {
                     if background[i] {
                         128

@@ -134,6 +134,17 @@ impl Light {
         }
     }
 
+    /// Whether the light reaches `p` at all, shadows aside: within its range (`radius`) and,
+    /// for a spot light, inside its cone. Directional lights reach everything.
+    pub fn reaches(&self, p: Vec3) -> bool {
+        let l = self.homogeneous();
+        let to_light = if l.w == 0.0 { l.truncate() } else { l.truncate() - p };
+        let in_range = self.radius.map(|r| l.w == 0.0 || to_light.length() < r).unwrap_or(true);
+        let in_cone = self.kind != LightKind::Spot
+            || (-to_light.normalize()).dot(self.direction.normalize()) > (self.cone_deg.to_radians() * 0.5).cos();
+        in_range && in_cone
+    }
+
     /// Homogeneous position: (position, 1) for point and spot, (-direction, 0) for directional
     /// (xyz pointing towards the light), as in McGuire et al. and the dump format.
     pub fn homogeneous(&self) -> Vec4 {

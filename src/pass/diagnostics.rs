@@ -5,7 +5,7 @@
 //! `use umbrage::pass::diagnostics::Diagnostics`.
 
 use super::frame::PreparedFrame;
-use super::record::VolumeKind;
+use super::record::{Instance, VolumeKind};
 use super::target::DepthStencilTarget;
 use super::ShadowPass;
 use crate::error::{Misuse, Result};
@@ -75,7 +75,13 @@ impl Diagnostics for ShadowPass {
         // SAFETY: the caller's contract (outside a rendering instance).
         unsafe {
             self.cmd_before_rendering(cb, frame)?;
-            self.cmd_volume_instance(cb, frame, light, target, (vk::AttachmentLoadOp::LOAD, 0), VolumeKind::Rasterised)
+            self.cmd_volume_instance(
+                cb,
+                frame,
+                light,
+                target,
+                Instance { stencil: (vk::AttachmentLoadOp::LOAD, 0), color: None, kind: VolumeKind::Rasterised },
+            )
         }
     }
 

@@ -55,6 +55,17 @@ pub(super) fn depth_attachment(
         .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 0.0, stencil: clear & 0xff } })
 }
 
+/// What one of the pass's own rendering instances draws into and with
+/// ([`ShadowPass::cmd_volume_instance`]).
+pub(super) struct Instance {
+    /// The stencil's load op, and its clear value when it is CLEAR.
+    pub stencil: (vk::AttachmentLoadOp, u32),
+    /// An optional colour attachment: a view in COLOR_ATTACHMENT_OPTIMAL, cleared to the value.
+    pub color: Option<(vk::ImageView, [f32; 4])>,
+    /// The volumes' pipelines.
+    pub kind: VolumeKind,
+}
+
 /// The fragment-test stages and depth-stencil accesses of the pass's own rendering.
 const TESTS: (vk::PipelineStageFlags, vk::AccessFlags) = (
     vk::PipelineStageFlags::from_raw(
@@ -271,13 +282,20 @@ impl ShadowPass {
         unsafe {
             self.cmd_before_rendering(cb, frame)?;
             // Cleared to 0, or to the number of volumes containing the eye (zpass-clear).
-            self.cmd_volume_instance(cb, frame, light, target, (vk::AttachmentLoadOp::CLEAR, lf.counter_clear), VolumeKind::Stencil)
+            self.cmd_volume_instance(
+                cb,
+                frame,
+                light,
+                target,
+                Instance { stencil: (vk::AttachmentLoadOp::CLEAR, lf.counter_clear), color: None, kind: VolumeKind::Stencil },
+            )
         }
     }
 
     /// One rendering instance of the pass over light `light`'s scissor on `target`, between
-    /// the declared layout transitions: depth loaded, stencil `stencil` (LOAD, or CLEAR to the
-    /// value), the light's state and its volumes of `kind`.
+    /// the declared layout transitions: depth loaded, the stencil (LOAD, or CLEAR to the
+    /// value), optionally one colour attachment (a view in COLOR_ATTACHMENT_OPTIMAL and
+    /// the value it is cleared to), the light's state and its volumes of `kind`.
     ///
     /// # Safety
     /// As [`cmd_determine`](Self::cmd_determine) with dynamic rendering, the frame's uploads
@@ -288,14 +306,29 @@ impl ShadowPass {
         frame: &PreparedFrame,
         light: usize,
         target: &DepthStencilTarget,
-        (load, clear): (vk::AttachmentLoadOp, u32),
-        kind: VolumeKind,
+        instance: Instance,
     ) -> Result<()> {
+        let Instance { stencil: (load, clear), color, kind } = instance;
         let lf = self.light(frame, light)?;
         let depth = depth_attachment(target, vk::AttachmentLoadOp::LOAD, 0);
         let stencil = depth_attachment(target, load, clear);
-        let info =
-            vk::RenderingInfo::default().render_area(lf.scissor).layer_count(1).depth_attachment(&depth).stencil_attachment(&stencil);
+        let colors: Vec<vk::RenderingAttachmentInfo> = color
+            .into_iter()
+            .map(|(view, value)| {
+                vk::RenderingAttachmentInfo::default()
+                    .image_view(view)
+                    .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+                    .load_op(vk::AttachmentLoadOp::CLEAR)
+                    .store_op(vk::AttachmentStoreOp::STORE)
+                    .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: value } })
+            })
+            .collect();
+        let info = vk::RenderingInfo::default()
+            .render_area(lf.scissor)
+            .layer_count(1)
+            .color_attachments(&colors)
+            .depth_attachment(&depth)
+            .stencil_attachment(&stencil);
         let d = &self.dev.device;
         // SAFETY: the caller's contract; the attachments are the caller's image.
         unsafe {
@@ -380,35 +413,20 @@ impl ShadowPass {
         (color, clear): (vk::ImageView, [f32; 4]),
         kind: VolumeKind,
     ) -> Result<()> {
-        let lf = self.light(frame, light)?;
+        self.light(frame, light)?;
         self.dynamic_only("the float counter and the light-intensity map")?;
         target.check(frame, &self.desc.target)?;
         // SAFETY: the caller's contract (outside a rendering instance).
-        unsafe { self.cmd_before_rendering(cb, frame)? };
-        let ds = depth_attachment(target, vk::AttachmentLoadOp::LOAD, 0);
-        let att = [vk::RenderingAttachmentInfo::default()
-            .image_view(color)
-            .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-            .load_op(vk::AttachmentLoadOp::CLEAR)
-            .store_op(vk::AttachmentStoreOp::STORE)
-            .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: clear } })];
-        let info = vk::RenderingInfo::default()
-            .render_area(lf.scissor)
-            .layer_count(1)
-            .color_attachments(&att)
-            .depth_attachment(&ds)
-            .stencil_attachment(&ds);
-        let d = &self.dev.device;
-        // SAFETY: the caller's contract.
         unsafe {
-            self.enter(cb, target);
-            d.cmd_begin_rendering(cb, &info);
-            self.cmd_light_state(cb, frame, light, target.extent)?;
-            self.cmd_draw_volumes(cb, frame, light, kind)?;
-            d.cmd_end_rendering(cb);
-            self.leave(cb, target);
+            self.cmd_before_rendering(cb, frame)?;
+            self.cmd_volume_instance(
+                cb,
+                frame,
+                light,
+                target,
+                Instance { stencil: (vk::AttachmentLoadOp::LOAD, 0), color: Some((color, clear)), kind },
+            )
         }
-        Ok(())
     }
 
     /// Sets the dynamic state of a light's passes: the viewport over `extent`, the light's

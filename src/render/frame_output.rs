@@ -5,7 +5,7 @@ use super::readback::{Layout, Readback};
 use super::stats::Stats;
 use super::TransmitMode;
 use crate::error::Result;
-use crate::scene::{LightKind, Scene};
+use crate::scene::Scene;
 use glam::{DVec3, Vec3};
 
 /// What a frame produced.
@@ -51,15 +51,11 @@ impl FrameOutput {
                         }
                         let to_light = if l.w == 0.0 { l.truncate() } else { l.truncate() - p };
                         let faces = n.dot(to_light) > 0.0;
-                        // The light reaches the point at all: within its range and its cone.
-                        let in_range = light.radius.map(|r| l.w == 0.0 || to_light.length() < r).unwrap_or(true);
-                        let in_cone = light.kind != LightKind::Spot
-                            || (-to_light.normalize()).dot(light.direction.normalize()) > (light.cone_deg.to_radians() * 0.5).cos();
                         let count = match self.counts.get(k) {
                             Some(c) => c[i],
                             None => self.stencil.get(k).map(|s| s[i] as i32).unwrap_or(0),
                         };
-                        if faces && in_range && in_cone && count == 0 {
+                        if faces && light.reaches(p) && count == 0 {
                             255
                         } else {
                             0
