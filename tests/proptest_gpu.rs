@@ -4,7 +4,7 @@
 mod common;
 use glam::{EulerRot, Mat4, Quat, Vec2, Vec3};
 use proptest::prelude::*;
-use proptest::test_runner::{Config, TestRunner};
+use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use std::cell::RefCell;
 use umbrage::accuracy::{evaluate, THRESHOLD};
 use umbrage::render::{RenderOptions, Renderer};
@@ -113,27 +113,84 @@ fn scene(c: &Case) -> Scene {
     }
 }
 
+/// Renders `case` with every exact volume method and checks each against the reference.
+fn check(ctx: &RefCell<Option<umbrage::gpu::Context>>, case: &Case, drawn: &std::cell::Cell<u64>) -> Result<(), TestCaseError> {
+    let methods = [Method::McGuire, Method::ZFail, Method::Lengyel].map(umbrage::render::Technique::Volumes);
+    let c = ctx.borrow_mut().take().expect("context");
+    let mut r = Renderer::new(c, scene(case), RenderOptions { width: 128, height: 96, ..Default::default() }).expect("renderer");
+    let rows = evaluate(&mut r, "proptest", &methods, 1).expect("evaluate");
+    r.context().check_validation().expect("validation");
+    *ctx.borrow_mut() = Some(r.into_context());
+    let mut failures = Vec::new();
+    for row in rows {
+        drawn.set(drawn.get() + row.shadow_triangles);
+        prop_assert!(row.compared > 0, "nothing visible: {:?}", case);
+        if row.fraction > THRESHOLD {
+            failures.push(format!("{} mismatches {} of {}", row.method, row.mismatches, row.compared));
+        }
+    }
+    prop_assert!(failures.is_empty(), "{} ({:?})", failures.join(", "), case);
+    Ok(())
+}
+
+/// The property's random source: a fixed seed by default, so that CI is reproducible (a case
+/// it finds is kept in [`regressions`]); `UMBRAGE_PROPTEST_SEED=<u64>` replays a run and
+/// `UMBRAGE_PROPTEST_SEED=random` explores, with `UMBRAGE_PROPTEST_CASES` cases (24 by default).
+fn runner() -> (TestRunner, String) {
+    let cases = std::env::var("UMBRAGE_PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(24);
+    let config = Config { cases, failure_persistence: None, ..Config::default() };
+    let seed = match std::env::var("UMBRAGE_PROPTEST_SEED").as_deref() {
+        Ok("random") => rand_seed(),
+        Ok(v) => v.parse().expect("UMBRAGE_PROPTEST_SEED: a u64 or `random`"),
+        Err(_) => 0x2026_1203,
+    };
+    let mut bytes = [0u8; 32];
+    bytes[..8].copy_from_slice(&seed.to_le_bytes());
+    let rng = TestRng::from_seed(RngAlgorithm::ChaCha, &bytes);
+    (TestRunner::new_with_rng(config, rng), format!("UMBRAGE_PROPTEST_SEED={seed}, {cases} cases"))
+}
+
+fn rand_seed() -> u64 {
+    use std::hash::{BuildHasher, Hasher};
+    let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+    h.write_u128(std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_nanos()).unwrap_or(0));
+    h.finish()
+}
+
 #[test]
 fn random_closed_casters_match_the_reference() {
     let Some(ctx) = common::context() else { return };
     let ctx = RefCell::new(Some(ctx));
-    let mut runner = TestRunner::new(Config { cases: 24, failure_persistence: None, ..Config::default() });
-    let methods = [Method::McGuire, Method::ZFail, Method::Lengyel].map(umbrage::render::Technique::Volumes);
+    let (mut runner, replay) = runner();
     let drawn = std::cell::Cell::new(0u64);
-    runner
-        .run(&strategy(), |case| {
-            let c = ctx.borrow_mut().take().expect("context");
-            let mut r = Renderer::new(c, scene(&case), RenderOptions { width: 128, height: 96, ..Default::default() }).expect("renderer");
-            let rows = evaluate(&mut r, "proptest", &methods, 1).expect("evaluate");
-            r.context().check_validation().expect("validation");
-            *ctx.borrow_mut() = Some(r.into_context());
-            for row in rows {
-                drawn.set(drawn.get() + row.shadow_triangles);
-                prop_assert!(row.compared > 0, "nothing visible: {:?}", case);
-                prop_assert!(row.fraction <= THRESHOLD, "{} mismatches {} of {} ({:?})", row.method, row.mismatches, row.compared, case);
-            }
-            Ok(())
-        })
-        .unwrap();
+    if let Err(e) = runner.run(&strategy(), |case| check(&ctx, &case, &drawn)) {
+        panic!("{e} (replay with {replay})");
+    }
     assert!(drawn.get() > 0, "no case drew any shadow volume: the property was vacuous");
+}
+
+/// Cases the property once found, kept as fixed tests.
+#[test]
+fn regressions() {
+    let Some(ctx) = common::context() else { return };
+    let ctx = RefCell::new(Some(ctx));
+    let drawn = std::cell::Cell::new(0u64);
+    let cases = [
+        // CI, 2026-12-03: every method read 2 self-shadowed pixels next to the terminator as lit
+        // (cos 0.0016: the triangle's own silhouette face lies 3e-6 behind the surface, about
+        // one ulp of forward float depth); the terminator is now part of the band.
+        Case {
+            seeds: vec![17357496371626629310],
+            offsets: vec![(-1.9853572, 2.240309, 0.22414118)],
+            rotations: vec![(3.76996, 3.5952725, 0.3239059)],
+            light: (-2.9614964, 3.8641555, 1.4883822),
+            directional: false,
+            cam_angle: 1.8544235,
+            cam_height: 2.0392418,
+            cam_dist: 4.7142024,
+        },
+    ];
+    for case in &cases {
+        check(&ctx, case, &drawn).unwrap();
+    }
 }

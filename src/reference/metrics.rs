@@ -3,7 +3,8 @@
 //! Mask values: 255 lit, 0 not lit, 128 background (other values are read as the nearest
 //! of the three). The *band* is every pixel within `N` pixels (Chebyshev distance) of
 //! * a reference shadow edge: a pixel whose lit/not-lit state differs from a 4-neighbour's,
-//!   or an Ambiguous pixel, or
+//!   a terminator pixel (facing the light differs from a 4-neighbour's: see
+//!   [`shadow_edges`]), or an Ambiguous pixel, or
 //! * a geometric discontinuity between 4-neighbours: different meshes (when known), one of
 //!   them background, normals more than 30° apart, or a depth (distance to the camera) jump
 //!   of more than 10% of the smaller depth.
@@ -88,11 +89,19 @@ pub fn geometry_edges(geo: &[GeoSample], w: usize, h: usize) -> Vec<bool> {
     pair_edges(w, h, |i, j| discontinuous(&geo[i], &geo[j]))
 }
 
-/// Pixels on a reference shadow edge (lit-ness differs from a 4-neighbour's) or Ambiguous.
+/// Pixels on a reference shadow edge (lit-ness differs from a 4-neighbour's), on a terminator
+/// (facing the light differs from a 4-neighbour's, even where both are unlit) or Ambiguous.
+///
+/// The terminator is an edge because a shadow volume's side faces start there: the faces
+/// extruded from the visible triangle's own silhouette edges leave the surface at the
+/// grazing angle of the light, so a pixel next to the terminator lies within `cos * footprint`
+/// of a volume face, which a depth buffer cannot resolve (the same reason the pixels along
+/// a cast shadow's edge are in the band). A self-shadowed pixel there may read lit.
 pub fn shadow_edges(states: &[LightState], w: usize, h: usize) -> Vec<bool> {
-    let mut e = pair_edges(w, h, |i, j| match (states[i].lit(), states[j].lit()) {
-        (Some(a), Some(b)) => a != b,
-        _ => false,
+    let differ = |a: Option<bool>, b: Option<bool>| matches!((a, b), (Some(a), Some(b)) if a != b);
+    let mut e = pair_edges(w, h, |i, j| {
+        let (a, b) = (states[i], states[j]);
+        differ(a.lit(), b.lit()) || differ(a.faces_light(), b.faces_light())
     });
     for (i, s) in states.iter().enumerate() {
         if *s == LightState::Ambiguous {

@@ -85,6 +85,15 @@ impl LightState {
             LightState::Ambiguous | LightState::Background => None,
         }
     }
+    /// `Some(true)` where the surface faces the light (Lit or Shadowed), `Some(false)` where it
+    /// faces away, `None` where the state does not say (cone, range, Ambiguous, Background).
+    pub fn faces_light(self) -> Option<bool> {
+        match self {
+            LightState::Lit | LightState::Shadowed => Some(true),
+            LightState::BackFacing => Some(false),
+            LightState::OutsideCone | LightState::OutOfRange | LightState::Ambiguous | LightState::Background => None,
+        }
+    }
     /// The mask value the GPU would write: 255 lit, 0 not lit, 128 background.
     /// Ambiguous maps to 0.
     pub fn mask_value(self) -> u8 {
