@@ -83,6 +83,8 @@ enum MethodArg {
     Compute,
     /// The shadow-map baseline (PCF 3x3).
     Shadowmap,
+    /// One shadow ray per pixel with VK_KHR_ray_query (Mesa lavapipe 25: scripts/drivers.sh).
+    Rayquery,
 }
 
 impl MethodArg {
@@ -99,6 +101,7 @@ impl MethodArg {
             MethodArg::Planar => Technique::Planar,
             MethodArg::Compute => Technique::Compute,
             MethodArg::Shadowmap => Technique::ShadowMap { size: shadow_map_size },
+            MethodArg::Rayquery => Technique::RayQuery,
         }
     }
 }

@@ -18,18 +18,28 @@ pub fn volume_methods() -> Vec<Method> {
     all.to_vec()
 }
 
-/// Every technique, shadow maps once per size in `shadow_map_sizes` (none when empty).
-pub fn all_techniques(shadow_map_sizes: &[u32]) -> Vec<Technique> {
+/// Every technique, shadow maps once per size in `shadow_map_sizes` (none when empty), and
+/// ray query when the device has it (`ray_query`: [`crate::gpu::Features::ray_query`]).
+pub fn all_techniques(shadow_map_sizes: &[u32], ray_query: bool) -> Vec<Technique> {
     let mut out: Vec<Technique> = volume_methods().into_iter().map(Technique::Volumes).collect();
     // Exhaustive on purpose: a new Technique variant is a compile error until listed below.
     let listed = |t: Technique| match t {
-        Technique::Volumes(_) | Technique::EdgeQuads | Technique::Compute | Technique::Planar | Technique::ShadowMap { .. } => (),
+        Technique::Volumes(_)
+        | Technique::EdgeQuads
+        | Technique::Compute
+        | Technique::Planar
+        | Technique::ShadowMap { .. }
+        | Technique::RayQuery => (),
     };
     for t in [Technique::EdgeQuads, Technique::Compute, Technique::Planar] {
         listed(t);
         out.push(t);
     }
     out.extend(shadow_map_sizes.iter().map(|&size| Technique::ShadowMap { size }));
+    if ray_query {
+        listed(Technique::RayQuery);
+        out.push(Technique::RayQuery);
+    }
     out
 }
 
@@ -38,7 +48,7 @@ pub fn all_techniques(shadow_map_sizes: &[u32]) -> Vec<Technique> {
 pub fn is_exact(t: Technique) -> bool {
     match t {
         Technique::Volumes(m) => !matches!(m, Method::ZPass | Method::ZPassClear),
-        Technique::EdgeQuads | Technique::Compute => true,
+        Technique::EdgeQuads | Technique::Compute | Technique::RayQuery => true,
         Technique::Planar | Technique::ShadowMap { .. } => false,
     }
 }
@@ -48,8 +58,8 @@ mod tests {
     use super::*;
     #[test]
     fn every_method_once() {
-        let all = all_techniques(&[512, 4096]);
-        assert_eq!(all.len(), volume_methods().len() + 5);
+        let all = all_techniques(&[512, 4096], true);
+        assert_eq!(all.len(), volume_methods().len() + 6);
         for (i, a) in all.iter().enumerate() {
             assert!(!all[i + 1..].contains(a), "{a:?} listed twice");
         }

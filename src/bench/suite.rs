@@ -257,7 +257,7 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
         sliver_tri_mtri_s: limits.sliver_tri_mtri_s,
         draws_per_s: limits.draws_per_s,
     };
-    let techniques = all_techniques(&scale.shadow_map_sizes());
+    let techniques = all_techniques(&scale.shadow_map_sizes(), ctx.features.ray_query);
     let points = sweeps::points(scale);
     // The tiny suite (tests) leaves the 435k-triangle vertex scene out.
     let named: &[&str] = if scale == Scale::Tiny { &["bench/fill", "default"] } else { &["bench/fill", "bench/vertex"] };

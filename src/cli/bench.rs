@@ -89,7 +89,7 @@ pub(crate) fn bench_command(a: BenchArgs) -> Result<ExitCode> {
         frames_in_flight: a.frames_in_flight,
         ..Default::default()
     };
-    bench(a.scenes, techniques, a.counters, a.frames, opts, a.json.as_deref(), a.markdown.as_deref())
+    bench(a.scenes, (techniques, a.methods.is_empty()), a.counters, a.frames, opts, a.json.as_deref(), a.markdown.as_deref())
 }
 
 /// `bench --suite fill-vertex`: runs the suite, writes its outputs, prints the Markdown.
@@ -181,7 +181,8 @@ fn bench_techniques(methods: &[MethodArg], shadow_map_size: u32) -> Vec<Techniqu
     let mut out: Vec<Technique> = Vec::new();
     if methods.is_empty() {
         let sizes: &[u32] = if shadow_map_size > 0 { &[size] } else { &[] };
-        out = umbrage::bench::methods::all_techniques(sizes);
+        // Ray query joins once the device is known (`bench`).
+        out = umbrage::bench::methods::all_techniques(sizes, false);
     } else {
         for m in methods {
             let t = m.technique(size);
@@ -195,7 +196,7 @@ fn bench_techniques(methods: &[MethodArg], shadow_map_size: u32) -> Vec<Techniqu
 
 fn bench(
     scenes: Vec<String>,
-    techniques: Vec<Technique>,
+    (techniques, default_list): (Vec<Technique>, bool),
     counters: Vec<Counter>,
     frames: usize,
     opts: RenderOptions,
@@ -204,6 +205,10 @@ fn bench(
 ) -> Result<ExitCode> {
     let scenes = if scenes.is_empty() { vec!["bench/fill".into(), "bench/vertex".into(), "default".into()] } else { scenes };
     let ctx = umbrage::gpu::Context::new()?;
+    let mut techniques = techniques;
+    if default_list && ctx.features.ray_query {
+        techniques.push(Technique::RayQuery);
+    }
     let cfg = umbrage::bench::BenchConfig { scenes, techniques, counters, frames, opts };
     let report = umbrage::bench::run(ctx, &cfg, |r| {
         eprintln!(

@@ -65,6 +65,10 @@ pub struct Features {
     pub r32f_blend: bool,
     /// R32G32B32A32_SFLOAT can be blended (optional): the fp32 light-intensity map needs it.
     pub rgba32f_blend: bool,
+    /// `VK_KHR_ray_query` and `VK_KHR_acceleration_structure` (with `rayQuery`,
+    /// `accelerationStructure` and `bufferDeviceAddress`) are present and enabled:
+    /// `--method rayquery` can run (Mesa lavapipe 25 has them; 22.3 has not).
+    pub ray_query: bool,
 }
 
 /// Identification of the chosen physical device, for `umbrage info`, logs and the stats JSON.
@@ -316,7 +320,8 @@ impl Context {
                     device: device.clone(),
                     physical_device: physical,
                     debug_settings: Default::default(),
-                    buffer_device_address: false,
+                    // Acceleration-structure inputs and storage need device addresses.
+                    buffer_device_address: features.ray_query,
                     allocation_sizes: Default::default(),
                 })
                 .map_err(|source| Error::Allocation { name: "gpu-allocator".into(), size: 0, source })?;

@@ -1,5 +1,6 @@
 //! One-shot descriptor sets for full-screen passes: a layout, an exactly-sized pool and one set,
-//! written once (images in SHADER_READ_ONLY_OPTIMAL, fragment stage).
+//! written once (images in SHADER_READ_ONLY_OPTIMAL, samplers, top-level acceleration
+//! structures; fragment stage).
 
 use super::context::GpuDevice;
 use crate::error::{Error, Result};
@@ -17,6 +18,9 @@ pub enum Binding {
     Image(vk::ImageView),
     /// A `SAMPLER` (GLSL `sampler`).
     Sampler(vk::Sampler),
+    /// An `ACCELERATION_STRUCTURE_KHR` (WGSL `acceleration_structure`): a top level that
+    /// must be built whenever the set is used.
+    AccelerationStructure(vk::AccelerationStructureKHR),
 }
 
 /// A descriptor set layout with one set allocated from its own pool; binding `i` is the `i`-th
@@ -38,6 +42,7 @@ impl DescriptorSet {
         let ty = |b: &Binding| match b {
             Binding::Image(_) => vk::DescriptorType::SAMPLED_IMAGE,
             Binding::Sampler(_) => vk::DescriptorType::SAMPLER,
+            Binding::AccelerationStructure(_) => vk::DescriptorType::ACCELERATION_STRUCTURE_KHR,
         };
         let layout_bindings: Vec<_> = bindings
             .iter()
@@ -50,9 +55,10 @@ impl DescriptorSet {
                     .stage_flags(vk::ShaderStageFlags::FRAGMENT)
             })
             .collect();
-        let images = bindings.iter().filter(|b| matches!(b, Binding::Image(_))).count() as u32;
-        let samplers = bindings.len() as u32 - images;
-        let sizes: Vec<_> = [(vk::DescriptorType::SAMPLED_IMAGE, images), (vk::DescriptorType::SAMPLER, samplers)]
+        let count = |t: vk::DescriptorType| bindings.iter().filter(|b| ty(b) == t).count() as u32;
+        let sizes: Vec<_> = [vk::DescriptorType::SAMPLED_IMAGE, vk::DescriptorType::SAMPLER, vk::DescriptorType::ACCELERATION_STRUCTURE_KHR]
+            .into_iter()
+            .map(|t| (t, count(t)))
             .into_iter()
             .filter(|&(_, n)| n > 0)
             .map(|(ty, descriptor_count)| vk::DescriptorPoolSize { ty, descriptor_count })
@@ -82,14 +88,29 @@ impl DescriptorSet {
                     Binding::Sampler(sampler) => {
                         [vk::DescriptorImageInfo { sampler, image_view: vk::ImageView::null(), image_layout: vk::ImageLayout::UNDEFINED }]
                     }
+                    Binding::AccelerationStructure(_) => [vk::DescriptorImageInfo::default()],
                 })
                 .collect();
+            let accels: Vec<[vk::AccelerationStructureKHR; 1]> = bindings
+                .iter()
+                .map(|b| match *b {
+                    Binding::AccelerationStructure(a) => [a],
+                    _ => [vk::AccelerationStructureKHR::null()],
+                })
+                .collect();
+            let mut accel_writes: Vec<vk::WriteDescriptorSetAccelerationStructureKHR> =
+                accels.iter().map(|a| vk::WriteDescriptorSetAccelerationStructureKHR::default().acceleration_structures(a)).collect();
             let writes: Vec<_> = bindings
                 .iter()
                 .zip(&infos)
+                .zip(accel_writes.iter_mut())
                 .enumerate()
-                .map(|(i, (b, info))| {
-                    vk::WriteDescriptorSet::default().dst_set(set).dst_binding(i as u32).descriptor_type(ty(b)).image_info(info)
+                .map(|(i, ((b, info), aw))| {
+                    let w = vk::WriteDescriptorSet::default().dst_set(set).dst_binding(i as u32).descriptor_type(ty(b));
+                    match b {
+                        Binding::AccelerationStructure(_) => w.descriptor_count(1).push_next(aw),
+                        _ => w.image_info(info),
+                    }
                 })
                 .collect();
             d.update_descriptor_sets(&writes, &[]);

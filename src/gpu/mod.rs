@@ -4,6 +4,7 @@
 //! `conform` and `bench`); [`crate::geom`] and [`crate::shadow`] forbid it. Every block has a
 //! `// SAFETY:` line and every `unsafe fn` a `# Safety` section (`Cargo.toml`'s `[lints]`).
 #![warn(missing_docs)]
+pub mod accel;
 pub mod context;
 pub mod descriptors;
 pub mod fault;

@@ -103,6 +103,16 @@ pub(super) fn open_device(
     let can_query2 = v11 || gpdp2.is_some();
     let has_u8_ext = has_ext(ash::ext::index_type_uint8::NAME) && can_query2;
     let has_dru = has_ext(ash::ext::depth_range_unrestricted::NAME);
+    // Ray query (`--method rayquery`): the two extensions, deferred host operations (which
+    // acceleration structures require) and buffer device addresses (Vulkan 1.2 core).
+    let v12 = api >= vk::API_VERSION_1_2;
+    let has_rq_exts = v12
+        && [ash::khr::acceleration_structure::NAME, ash::khr::ray_query::NAME, ash::khr::deferred_host_operations::NAME]
+            .into_iter()
+            .all(has_ext);
+    let mut f_as = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default();
+    let mut f_rq = vk::PhysicalDeviceRayQueryFeaturesKHR::default();
+    let mut f12 = vk::PhysicalDeviceVulkan12Features::default();
     let mut f_u8 = vk::PhysicalDeviceIndexTypeUint8FeaturesEXT::default();
     let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
     let mut f2 = vk::PhysicalDeviceFeatures2::default();
@@ -111,6 +121,9 @@ pub(super) fn open_device(
     }
     if has_u8_ext {
         f2 = f2.push_next(&mut f_u8);
+    }
+    if has_rq_exts {
+        f2 = f2.push_next(&mut f_as).push_next(&mut f_rq).push_next(&mut f12);
     }
     // SAFETY: the chain points at locals alive for this call; a struct is chained only when
     // the device's version or extensions define it.
@@ -124,6 +137,10 @@ pub(super) fn open_device(
     let base = f2.features;
     let (dyn_rendering, sync2) = (f13.dynamic_rendering == vk::TRUE, f13.synchronization2 == vk::TRUE);
     let u8_supported = has_u8_ext && f_u8.index_type_uint8 == vk::TRUE;
+    let ray_query = has_rq_exts
+        && f_as.acceleration_structure == vk::TRUE
+        && f_rq.ray_query == vk::TRUE
+        && f12.buffer_device_address == vk::TRUE;
     if minimum == Minimum::Vulkan13 && (!dyn_rendering || !sync2) {
         return Err(Error::Unsupported(format!("{name}: umbrage needs dynamicRendering and synchronization2 (Vulkan 1.3)")));
     }
@@ -166,6 +183,7 @@ pub(super) fn open_device(
         geometry_shader: base.geometry_shader == vk::TRUE,
         r32f_blend: blendable(vk::Format::R32_SFLOAT),
         rgba32f_blend: blendable(vk::Format::R32G32B32A32_SFLOAT),
+        ray_query,
     };
 
     let enabled = vk::PhysicalDeviceFeatures::default()
@@ -177,7 +195,15 @@ pub(super) fn open_device(
         .dynamic_rendering(features.dynamic_rendering)
         .synchronization2(features.synchronization2);
     let mut e_u8 = vk::PhysicalDeviceIndexTypeUint8FeaturesEXT::default().index_type_uint8(true);
+    let mut e_as = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default().acceleration_structure(true);
+    let mut e_rq = vk::PhysicalDeviceRayQueryFeaturesKHR::default().ray_query(true);
+    let mut e12 = vk::PhysicalDeviceVulkan12Features::default().buffer_device_address(true);
     let mut dev_exts = Vec::new();
+    if ray_query {
+        for e in [ash::khr::acceleration_structure::NAME, ash::khr::ray_query::NAME, ash::khr::deferred_host_operations::NAME] {
+            dev_exts.push(e.as_ptr());
+        }
+    }
     if u8_supported {
         dev_exts.push(ash::ext::index_type_uint8::NAME.as_ptr());
     }
@@ -199,6 +225,9 @@ pub(super) fn open_device(
     }
     if u8_supported {
         dinfo = dinfo.push_next(&mut e_u8);
+    }
+    if ray_query {
+        dinfo = dinfo.push_next(&mut e_as).push_next(&mut e_rq).push_next(&mut e12);
     }
     // SAFETY: all pointers refer to locals alive for the call.
     let device = unsafe { instance.create_device(physical, &dinfo, None) }.map_err(vkerr("vkCreateDevice"))?;

@@ -27,6 +27,7 @@ pub mod push;
 mod readback;
 mod scene_gpu;
 mod selfshadow;
+pub(crate) mod raytrace;
 pub mod shadowmap;
 mod sphere_gpu;
 pub mod stats;

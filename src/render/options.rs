@@ -87,14 +87,18 @@ pub enum Technique {
         /// Texels per side of one map (16..=8192).
         size: u32,
     },
+    /// One shadow ray per pixel with `VK_KHR_ray_query` against acceleration structures of the
+    /// casters, writing the volumes' stencil (see [`super::raytrace`]).
+    RayQuery,
 }
 
 impl Technique {
     /// The name in `--stats` and the bench (`mcguire`, `edgequad`, `shadowmap`...).
     pub fn name(self) -> &'static str {
-        match self.pass_technique() {
-            Some(t) => t.name(),
-            None => "shadowmap",
+        match (self, self.pass_technique()) {
+            (_, Some(t)) => t.name(),
+            (Technique::RayQuery, None) => "rayquery",
+            _ => "shadowmap",
         }
     }
     /// The five volume methods (z-pass, z-fail, Everitt-Kilgard, Lengyel, McGuire).
@@ -108,7 +112,7 @@ impl Technique {
             Technique::EdgeQuads => Some(crate::pass::Technique::EdgeQuads),
             Technique::Planar => Some(crate::pass::Technique::Planar),
             Technique::Compute => Some(crate::pass::Technique::Compute),
-            Technique::ShadowMap { .. } => None,
+            Technique::ShadowMap { .. } | Technique::RayQuery => None,
         }
     }
     /// Parses a `--method` value: `auto` (= mcguire), a volume method, `edgequad`, or
@@ -119,10 +123,11 @@ impl Technique {
             "planar" => Ok(Technique::Planar),
             "compute" => Ok(Technique::Compute),
             "shadowmap" => Ok(Technique::ShadowMap { size: shadow_map_size }),
+            "rayquery" => Ok(Technique::RayQuery),
             _ => s.parse::<Method>().map(Technique::Volumes).map_err(|_| Error::UnknownName {
                 what: "method",
                 name: s.into(),
-                expected: format!("auto, {}, edgequad, planar, compute, shadowmap", Method::ALL.map(|m| m.name()).join(", ")),
+                expected: format!("auto, {}, edgequad, planar, compute, shadowmap, rayquery", Method::ALL.map(|m| m.name()).join(", ")),
             }),
         }
     }

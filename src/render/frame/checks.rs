@@ -15,6 +15,11 @@ pub(super) fn check_spheres(scene: &Scene, s: &FrameSettings) -> Result<()> {
             return Err(Error::Other(problem));
         }
     }
+    if s.technique == Technique::RayQuery {
+        if let Some(why) = crate::render::raytrace::unsupported(scene) {
+            return Err(Error::Unsupported(why));
+        }
+    }
     if matches!(s.technique, Technique::ShadowMap { .. }) && scene.spheres.iter().any(|s| s.casts_shadow) {
         return Err(Error::Unsupported(
             "--method shadowmap does not draw analytic sphere casters into its maps; use a shadow-volume method".into(),
@@ -42,6 +47,9 @@ pub(super) fn check_options(ctx: &Context, config: &RenderConfig, s: &FrameSetti
     }
     if s.index_format == IndexFormat::U8 && !f.index_type_uint8 {
         return Err(Error::Unsupported("--index-format u8 needs VK_EXT_index_type_uint8; use auto or u16".into()));
+    }
+    if s.technique == Technique::RayQuery && !f.ray_query {
+        return Err(crate::gpu::accel::missing_ray_query(&ctx.info.name));
     }
     let shadow_map = matches!(s.technique, Technique::ShadowMap { .. });
     if (s.counter == Counter::Float || shadow_map || config.self_shadow) && !f.r32f_blend {

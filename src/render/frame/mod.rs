@@ -13,6 +13,7 @@ use super::push::LightPush;
 use super::readback::Layout;
 use super::scene_gpu::{SceneGeometry, Sidedness};
 use super::selfshadow::SelfShadow;
+use super::raytrace::RayTracer;
 use super::shadowmap::ShadowMapper;
 use super::sphere_gpu::SphereGeometry;
 use super::targets::*;
@@ -116,6 +117,8 @@ struct Parts {
     self_shadow: Option<SelfShadow>,
     /// The shadow-map baseline and the scene version it was built for.
     shadow_mapper: Option<(ShadowMapper, u64)>,
+    /// The ray-query technique's acceleration structures and the scene version they hold.
+    ray_tracer: Option<(RayTracer, u64)>,
     slots: Vec<FrameSlot>,
     next_slot: usize,
     serial: u64,
@@ -132,6 +135,9 @@ impl Destroy for Parts {
             self.pipes.destroy(ctx);
             if let Some((sm, _)) = &mut self.shadow_mapper {
                 sm.destroy(ctx);
+            }
+            if let Some((rt, _)) = &mut self.ray_tracer {
+                rt.destroy(ctx);
             }
             self.self_shadow.destroy(ctx);
             self.targets.destroy(ctx);
@@ -281,6 +287,7 @@ impl Renderer {
         let vp_rel = (proj.as_dmat4() * view_rel.as_dmat4()).as_mat4();
         let view = ShadowView { eye, view: view_rel, proj, width: w, height: h };
         self.update_shadow_mapper(settings.technique)?;
+        self.update_ray_tracer(settings.technique)?;
 
         // 1. The CPU work: plans and streams (the shadow-map baseline plans scissors only).
         let frame = match settings.technique.pass_technique() {
@@ -313,6 +320,10 @@ impl Renderer {
             d.begin_command_buffer(cb, &begin).map_err(Error::vk("vkBeginCommandBuffer"))?;
         }
         s.timer.begin(&self.own.ctx, cb, 4 + 4 * nlights as u32)?;
+        if let Some((rt, _)) = &mut self.own.parts.ray_tracer {
+            // SAFETY: `cb` is recording outside a rendering instance; the slot retired.
+            unsafe { rt.cmd_build(&self.own.ctx, cb, slot, &self.own.parts.scene, eye)? };
+        }
         if settings.counters {
             s.counters.begin(&self.own.ctx, cb, nlights as u32)?;
         }
@@ -370,6 +381,7 @@ impl Renderer {
             spans.depth.end = stamp(all);
             let into = match (&self.own.parts.shadow_mapper, self.settings.counter) {
                 (Some(_), _) => determine::CountInto::External,
+                _ if self.own.parts.ray_tracer.is_some() => determine::CountInto::Written,
                 (None, Counter::Float) => determine::CountInto::Float,
                 (None, Counter::Stencil) => determine::CountInto::Stencil,
             };
@@ -381,6 +393,11 @@ impl Renderer {
                 if let Some((sm, _)) = &self.own.parts.shadow_mapper {
                     determine::begin_float(rec, t);
                     sm.record(rec.ctx, rec.cb, t, light, self.own.parts.scene.camera.eye.as_dvec3(), frame.lights[li].scissor);
+                }
+                if let Some((rt, _)) = &self.own.parts.ray_tracer {
+                    let l = light.homogeneous().as_dvec4();
+                    let rel = if l.w == 0.0 { l } else { (l.truncate() - self.own.parts.scene.camera.eye.as_dvec3()).extend(1.0) };
+                    rt.cmd_determine(rec, t, frame.slot(), rel.as_vec4().to_array(), frame.lights[li].scissor);
                 }
                 determine::record(rec, pass, frame, li, t, into, layout.counts.get(li).copied())?;
                 if let Some(c) = counters {
@@ -469,6 +486,30 @@ impl Renderer {
         if let Some(f) = &self.own.parts.slots[slot].in_flight {
             let t = FrameTicket { slot, serial: f.serial };
             self.wait(&t)?;
+        }
+        Ok(())
+    }
+
+    /// Builds the ray tracer's acceleration structures when ray query is asked for, or again
+    /// when the scene's placement changed (a deformed mesh's positions included); drops them
+    /// when another technique runs.
+    fn update_ray_tracer(&mut self, technique: Technique) -> Result<()> {
+        let wanted = technique == Technique::RayQuery;
+        let version = self.own.parts.scene_version;
+        match &self.own.parts.ray_tracer {
+            Some((_, v)) if wanted && *v == version => return Ok(()),
+            None if !wanted => return Ok(()),
+            _ => {}
+        }
+        if let Some((mut old, _)) = self.own.parts.ray_tracer.take() {
+            // SAFETY: waiting for idle before destroying objects a frame in flight may use.
+            unsafe { self.own.ctx.device.device_wait_idle() }.map_err(Error::vk("vkDeviceWaitIdle"))?;
+            old.destroy(&self.own.ctx);
+        }
+        if wanted {
+            let p = &self.own.parts;
+            let rt = RayTracer::new(&self.own.ctx, &p.scene, &p.targets, p.slots.len())?;
+            self.own.parts.ray_tracer = Some((rt, version));
         }
         Ok(())
     }
@@ -569,6 +610,7 @@ impl Parts {
             pipes: pipes.into_inner(),
             self_shadow: self_shadow.into_inner(),
             shadow_mapper: None,
+            ray_tracer: None,
             slots,
             next_slot: 0,
             serial: 0,

@@ -21,6 +21,8 @@ pub(crate) enum CountInto {
     /// The R32F count target, written by the caller (the shadow-map lookup): only the layout
     /// transitions and the capture happen here.
     External,
+    /// The stencil, written by the caller (the ray-query pass): only the capture happens here.
+    Written,
 }
 
 /// Makes the count target writable (float counting).
@@ -51,11 +53,11 @@ pub(crate) unsafe fn record(
                 begin_float(rec, t);
                 pass.cmd_count_float(rec.cb, frame, light, &target, t.count.view)?;
             }
-            CountInto::External => {}
+            CountInto::External | CountInto::Written => {}
         }
     }
     rec.barrier((FRAG_TESTS, DS_RW), (FRAG_TESTS, DS_RW));
-    let float = into != CountInto::Stencil;
+    let float = matches!(into, CountInto::Float | CountInto::External);
     if let Some(range) = capture {
         if float {
             rec.copy_out(&t.count, vk::ImageAspectFlags::COLOR, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, range);

@@ -1,0 +1,289 @@
+//! Ray-query shadows (`--method rayquery`): the exact alternative engines weigh against
+//! volumes today. Per light, a full-screen pass inside the light's scissor traces one shadow
+//! ray per pixel from the G-buffer's position towards the light and writes the same stencil
+//! the volumes leave (non-zero = shadowed), so the illumination pass, the masks, the dumps and
+//! the stats are the same whichever technique runs.
+//!
+//! Acceleration structures: one bottom level per shadow-casting scene mesh and kind of part
+//! (closed and consistently oriented, or open / two-sided / non-manifold), built once with
+//! `PREFER_FAST_TRACE` and compacted; a top level per ring slot, its instances (the meshes'
+//! current transforms, relative to the eye) rewritten and rebuilt in every frame's command
+//! buffer. A mesh whose positions change is rebuilt with the scene (the renderer drops the
+//! tracer when the scene's version changes).
+//!
+//! Self-shadowing (`shaders/rayquery.wgsl`): closed parts are traced with back faces culled,
+//! their triangles wound counter-clockwise from outside (an inside-out part is re-wound), so a
+//! ray leaving a light-facing surface can only find real occluders, which it enters through a
+//! front face; open parts are two-sided, and their rays start [`RayTracer::offset`] off the
+//! surface along its normal. Transparent casters and analytic spheres are not traced yet:
+//! a scene with either is refused with a clear error.
+
+use super::targets::Targets;
+use crate::error::{Error, Result};
+use crate::gpu::accel::{build_blas, Accel, AccelLoader, Geometry, Instance, Tlas};
+use crate::gpu::descriptors::{pipeline_layout, Binding, DescriptorSet};
+use crate::gpu::pipeline::{self, PipelineDesc};
+use crate::gpu::{shaders, Context};
+use crate::scene::Scene;
+use crate::shadow::{Caster, CasterKind};
+use ash::vk;
+use glam::{DMat4, DVec3};
+
+/// `rayquery.wgsl`'s push constants.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct Push {
+    light: [f32; 4],
+    params: [f32; 4],
+}
+
+/// Instance masks (the shader's `CLOSED` and `OPEN`).
+const CLOSED: u8 = 1;
+const OPEN: u8 = 2;
+
+/// One bottom level and the scene mesh it belongs to.
+struct Entry {
+    mesh: usize,
+    blas: Accel,
+    mask: u8,
+    triangles: usize,
+}
+
+/// The ray-query technique's GPU objects.
+pub struct RayTracer {
+    loader: AccelLoader,
+    entries: Vec<Entry>,
+    tlas: Vec<Tlas>,
+    sets: Vec<DescriptorSet>,
+    layout: vk::PipelineLayout,
+    pipeline: vk::Pipeline,
+    /// World units the open casters' rays start off the surface (and every ray stops short of
+    /// a point light): the CPU reference's surface offset, 2e-5 of the scene's diagonal, or
+    /// 2^-16 of the largest eye-relative coordinate if that is larger (128 f32 ulps: far above
+    /// the few ulps the G-buffer's interpolated position can be off by).
+    pub offset: f32,
+    /// Bytes of bottom-level storage (after compaction).
+    pub blas_bytes: u64,
+    /// Milliseconds (CPU wall) the bottom levels took to build, compaction included.
+    pub blas_build_ms: f64,
+}
+
+/// The welded triangles of `caster`'s parts of one kind, closed parts wound counter-clockwise
+/// from outside (by the sign of their volume).
+fn part_triangles(caster: &Caster, closed: bool) -> Vec<[u32; 3]> {
+    let mesh = &caster.topology.mesh;
+    let mut out = Vec::new();
+    for part in &caster.parts {
+        if (part.kind == CasterKind::Manifold) != closed {
+            continue;
+        }
+        let tris = part.triangles.iter().map(|&t| mesh.triangles[t as usize]);
+        let volume: f64 = tris
+            .clone()
+            .map(|[a, b, c]| {
+                let p = |i: u32| mesh.positions[i as usize].as_dvec3();
+                p(a).dot(p(b).cross(p(c)))
+            })
+            .sum();
+        let flip = closed && volume < 0.0;
+        out.extend(tris.map(|[a, b, c]| if flip { [a, c, b] } else { [a, b, c] }));
+    }
+    out
+}
+
+/// Why `scene` cannot be traced yet, if it cannot.
+pub fn unsupported(scene: &Scene) -> Option<String> {
+    if scene.meshes.iter().any(|m| m.casts_shadow && m.opacity < 1.0) {
+        return Some("--method rayquery does not trace transparent casters yet (their coloured shadows need the light-intensity map); use a shadow-volume method".into());
+    }
+    if scene.spheres.iter().any(|s| s.casts_shadow) {
+        return Some("--method rayquery does not trace analytic sphere casters yet; use a shadow-volume method".into());
+    }
+    None
+}
+
+/// The diagonal of the bounds of every scene triangle (the reference's `scene_size`).
+fn scene_size(scene: &Scene) -> f64 {
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for m in &scene.meshes {
+        let b = m.world_bounds();
+        if b.min.x <= b.max.x {
+            lo = lo.min(b.min.as_dvec3());
+            hi = hi.max(b.max.as_dvec3());
+        }
+    }
+    if lo.x <= hi.x {
+        (hi - lo).length()
+    } else {
+        1.0
+    }
+}
+
+impl RayTracer {
+    /// Builds the bottom levels of `scene`'s opaque casters, a top level and a descriptor set
+    /// per ring slot (reading `targets`' positions and normals), and the pipeline.
+    pub fn new(ctx: &Context, scene: &Scene, targets: &Targets, slots: usize) -> Result<RayTracer> {
+        if let Some(why) = unsupported(scene) {
+            return Err(Error::Unsupported(why));
+        }
+        let loader = AccelLoader::new(ctx)?;
+        let mut t = RayTracer {
+            loader,
+            entries: Vec::new(),
+            tlas: Vec::new(),
+            sets: Vec::new(),
+            layout: vk::PipelineLayout::null(),
+            pipeline: vk::Pipeline::null(),
+            offset: 0.0,
+            blas_bytes: 0,
+            blas_build_ms: 0.0,
+        };
+        match t.build(ctx, scene, targets, slots) {
+            Ok(()) => Ok(t),
+            Err(e) => {
+                t.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    fn build(&mut self, ctx: &Context, scene: &Scene, targets: &Targets, slots: usize) -> Result<()> {
+        let start = std::time::Instant::now();
+        for (i, m) in scene.meshes.iter().enumerate() {
+            if !m.casts_shadow {
+                continue;
+            }
+            let caster = Caster::new(&m.name, &m.mesh, glam::Mat4::IDENTITY)?;
+            let positions: Vec<[f32; 3]> = caster.topology.mesh.positions.iter().map(|p| p.to_array()).collect();
+            for (closed, mask) in [(true, CLOSED), (false, OPEN)] {
+                let indices = part_triangles(&caster, closed);
+                if indices.is_empty() {
+                    continue;
+                }
+                let blas = build_blas(ctx, &self.loader, &m.name, Geometry::Triangles { positions: &positions, indices: &indices })?;
+                self.blas_bytes += blas.size;
+                self.entries.push(Entry { mesh: i, blas, mask, triangles: indices.len() });
+            }
+        }
+        self.blas_build_ms = start.elapsed().as_secs_f64() * 1e3;
+        for _ in 0..slots {
+            self.tlas.push(Tlas::new(ctx, &self.loader, self.entries.len() as u32)?);
+        }
+        for tlas in &self.tlas {
+            self.sets.push(DescriptorSet::new(
+                ctx,
+                &[
+                    Binding::AccelerationStructure(tlas.accel.raw),
+                    Binding::Image(targets.position.view),
+                    Binding::Image(targets.normal.view),
+                ],
+            )?);
+        }
+        self.layout = pipeline_layout(ctx, &[self.sets[0].layout], std::mem::size_of::<Push>() as u32, vk::ShaderStageFlags::FRAGMENT)?;
+        let mark = vk::StencilOpState {
+            fail_op: vk::StencilOp::KEEP,
+            pass_op: vk::StencilOp::REPLACE,
+            depth_fail_op: vk::StencilOp::KEEP,
+            compare_op: vk::CompareOp::ALWAYS,
+            compare_mask: 0xff,
+            write_mask: 0xff,
+            reference: 1,
+        };
+        let mut d = PipelineDesc::new(shaders::FULLSCREEN_VERT, self.layout, ctx.depth_format);
+        d.fragment = Some(shaders::RAYQUERY_WGSL);
+        d.stencil = Some((mark, mark));
+        self.pipeline = pipeline::create(ctx, &d)?;
+        let size = scene_size(scene);
+        self.offset = (2e-5 * size) as f32;
+        Ok(())
+    }
+
+    /// Triangles in the bottom levels.
+    pub fn triangles(&self) -> usize {
+        self.entries.iter().map(|e| e.triangles).sum()
+    }
+
+    /// Rewrites slot `slot`'s top level from the meshes' current transforms (relative to
+    /// `eye`) and records its build; also raises [`RayTracer::offset`] if the scene's
+    /// eye-relative extent needs it.
+    ///
+    /// # Safety
+    /// `cb` is recording outside a rendering instance, and the slot's previous frame retired.
+    pub unsafe fn cmd_build(&mut self, ctx: &Context, cb: vk::CommandBuffer, slot: usize, scene: &Scene, eye: DVec3) -> Result<()> {
+        let to_eye = DMat4::from_translation(-eye);
+        let mut extent = 0.0f64;
+        let instances: Vec<Instance> = self
+            .entries
+            .iter()
+            .map(|e| {
+                let m = &scene.meshes[e.mesh];
+                let b = m.world_bounds();
+                for c in [b.min, b.max] {
+                    extent = extent.max((c.as_dvec3() - eye).abs().max_element());
+                }
+                let x = (to_eye * m.transform.as_dmat4()).transpose();
+                let rows = [x.x_axis.as_vec4().to_array(), x.y_axis.as_vec4().to_array(), x.z_axis.as_vec4().to_array()];
+                // Closed parts: Vulkan's default facing makes a triangle wound counter-clockwise
+                // from outside (right-handed) a front face for a ray entering the solid, which
+                // is what culling back faces needs (tests/rayquery.rs holds it to the reference).
+                let flags = if e.mask == CLOSED {
+                    vk::GeometryInstanceFlagsKHR::empty()
+                } else {
+                    vk::GeometryInstanceFlagsKHR::TRIANGLE_FACING_CULL_DISABLE
+                };
+                Instance { transform: rows, custom: e.mesh as u32, mask: e.mask, flags, blas: e.blas.address }
+            })
+            .collect();
+        self.offset = self.offset.max((extent * 2f64.powi(-16)) as f32);
+        // SAFETY: forwarded to the caller's contract.
+        unsafe { self.tlas[slot].cmd_build(ctx, &self.loader, cb, &instances) }
+    }
+
+    /// Records light `light`'s determination: the stencil cleared to 0 inside `scissor`, then
+    /// set to 1 where the pixel's shadow ray is blocked. `light` is the eye-relative
+    /// homogeneous light (position, 1) or (direction towards the light, 0).
+    ///
+    /// # Safety
+    /// `cb` is recording outside a rendering instance, after [`RayTracer::cmd_build`] for
+    /// `slot`; the depth-stencil target is in attachment layout, the G-buffer's positions and
+    /// normals in `SHADER_READ_ONLY_OPTIMAL`.
+    pub unsafe fn cmd_determine(&self, rec: &super::passes::Rec, t: &Targets, slot: usize, light: [f32; 4], scissor: vk::Rect2D) {
+        let d = &rec.ctx.device;
+        let ds = super::passes::att(&t.depth, vk::AttachmentLoadOp::LOAD, super::passes::DS_CLEAR);
+        let push = Push { light, params: [self.offset, 0.0, 0.0, 0.0] };
+        // SAFETY: the caller's contract; the set's images and top level are this slot's.
+        unsafe {
+            rec.begin(scissor, &[], Some(&ds));
+            let clear = vk::ClearAttachment {
+                aspect_mask: vk::ImageAspectFlags::STENCIL,
+                color_attachment: 0,
+                clear_value: vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } },
+            };
+            d.cmd_clear_attachments(rec.cb, &[clear], &[vk::ClearRect { rect: scissor, base_array_layer: 0, layer_count: 1 }]);
+            d.cmd_bind_pipeline(rec.cb, vk::PipelineBindPoint::GRAPHICS, self.pipeline);
+            d.cmd_bind_descriptor_sets(rec.cb, vk::PipelineBindPoint::GRAPHICS, self.layout, 0, &[self.sets[slot].set], &[]);
+            d.cmd_push_constants(rec.cb, self.layout, vk::ShaderStageFlags::FRAGMENT, 0, bytemuck::bytes_of(&push));
+            d.cmd_draw(rec.cb, 3, 1, 0, 0);
+            d.cmd_end_rendering(rec.cb);
+        }
+    }
+
+    /// Destroys everything (the owner waited for the device).
+    pub fn destroy(&mut self, ctx: &Context) {
+        // SAFETY: the owner waited for the device to be idle; null handles are ignored.
+        unsafe {
+            ctx.device.destroy_pipeline(self.pipeline, None);
+            ctx.device.destroy_pipeline_layout(self.layout, None);
+        }
+        for mut s in self.sets.drain(..) {
+            s.destroy(ctx);
+        }
+        for mut t in self.tlas.drain(..) {
+            t.destroy(ctx, &self.loader);
+        }
+        for mut e in self.entries.drain(..) {
+            e.blas.destroy(ctx, &self.loader);
+        }
+    }
+}
