@@ -5,17 +5,14 @@
 //
 // Space: world, relative to the eye (the G-buffer's positions and the instances' transforms).
 //
-// Self-shadowing without a fixed tMin epsilon:
-// - Closed, consistently oriented casters (instance mask CLOSED) are traced with back faces
-//   culled, their fronts counter-clockwise from outside: a ray from a point on such a surface
-//   that faces the light leaves through a back face (never counted), so the receiver's own
-//   surface cannot shadow it whatever the rounding of its position. A real occluder is always
-//   entered through a front face first.
-// - Open, two-sided and non-manifold casters (mask OPEN, face culling disabled per instance)
-//   can be hit from either side, so the ray starts `offset` off the surface along the normal on
-//   the light's side and stops `offset` short of a point light: `offset` is the CPU
-//   reference's own surface offset (2e-5 of the scene's size), checked on the CPU to be far
-//   above the error bound of the G-buffer's f32 position (see render/raytrace.rs).
+// The rule is the CPU reference's, to the letter: a shadow ray from P + N * offset (N the
+// surface normal on its visible side, facing the light) towards the light, stopping offset
+// short of a point light; every caster triangle two-sided. `offset` is the reference's own
+// surface offset (2e-5 of the scene's size), raised on the CPU to at least 2^-16 of the
+// scene's largest eye-relative coordinate (128 f32 ulps), far above the few ulps the
+// G-buffer's interpolated position can be off by: the receiver's own triangle lies behind the
+// ray's origin and cannot shadow it, whatever the rounding. No culling: a receiver inside a
+// closed caster (the eye inside it) is shadowed by the wall its ray leaves through.
 
 enable wgpu_ray_query;
 
@@ -32,12 +29,10 @@ var<immediate> pc: Push;
 @group(0) @binding(1) var positions: texture_2d<f32>;
 @group(0) @binding(2) var normals: texture_2d<f32>;
 
-const CLOSED: u32 = 1u;
-const OPEN: u32 = 2u;
-
-fn occluded(origin: vec3<f32>, dir: vec3<f32>, t_max: f32, mask: u32, flags: u32) -> bool {
+fn occluded(origin: vec3<f32>, dir: vec3<f32>, t_max: f32) -> bool {
     var rq: ray_query;
-    rayQueryInitialize(&rq, scene, RayDesc(flags | RAY_FLAG_TERMINATE_ON_FIRST_HIT | RAY_FLAG_FORCE_OPAQUE, mask, 0.0, t_max, origin, dir));
+    let flags = RAY_FLAG_TERMINATE_ON_FIRST_HIT | RAY_FLAG_FORCE_OPAQUE;
+    rayQueryInitialize(&rq, scene, RayDesc(flags, 0xffu, 0.0, t_max, origin, dir));
     rayQueryProceed(&rq);
     return rayQueryGetCommittedIntersection(&rq).kind != RAY_QUERY_INTERSECTION_NONE;
 }
@@ -51,24 +46,25 @@ fn main(@builtin(position) coord: vec4<f32>) {
     }
     let p = p4.xyz;
     let n = textureLoad(normals, px, 0).xyz;
-    var dir: vec3<f32>;
-    var dist: f32;
-    if pc.light.w == 0.0 {
-        dir = pc.light.xyz;
-        dist = 1.0e30;
-    } else {
-        let d = pc.light.xyz - p;
-        dist = length(d);
-        dir = d / dist;
-    }
-    // Facing away (or exactly edge-on): the lighting pass leaves it unlit whatever the stencil.
-    if !(dot(n, dir) > 0.0) {
+    // The reference's facing test, from the surface point itself.
+    let to_light = select(pc.light.xyz - p, pc.light.xyz, pc.light.w == 0.0);
+    if !(dot(n, to_light) > 0.0) {
         discard;
     }
     let offset = pc.params.x;
-    let hit = occluded(p, dir, dist, CLOSED, RAY_FLAG_CULL_BACK_FACING)
-        || occluded(p + n * offset, dir, dist - offset, OPEN, RAY_FLAG_NONE);
-    if !hit {
+    let origin = p + n * offset;
+    var dir: vec3<f32>;
+    var t_max: f32;
+    if pc.light.w == 0.0 {
+        dir = pc.light.xyz;
+        t_max = 1.0e30;
+    } else {
+        let d = pc.light.xyz - origin;
+        let dist = length(d);
+        dir = d / dist;
+        t_max = dist - offset;
+    }
+    if !occluded(origin, dir, t_max) {
         discard;
     }
 }

@@ -4,19 +4,16 @@
 //! the volumes leave (non-zero = shadowed), so the illumination pass, the masks, the dumps and
 //! the stats are the same whichever technique runs.
 //!
-//! Acceleration structures: one bottom level per shadow-casting scene mesh and kind of part
-//! (closed and consistently oriented, or open / two-sided / non-manifold), built once with
-//! `PREFER_FAST_TRACE` and compacted; a top level per ring slot, its instances (the meshes'
-//! current transforms, relative to the eye) rewritten and rebuilt in every frame's command
-//! buffer. A mesh whose positions change is rebuilt with the scene (the renderer drops the
-//! tracer when the scene's version changes).
+//! Acceleration structures: one bottom level per shadow-casting scene mesh (its welded
+//! triangles), built once with `PREFER_FAST_TRACE` and compacted; a top level per ring slot,
+//! its instances (the meshes' current transforms, relative to the eye) rewritten and rebuilt in
+//! every frame's command buffer, so a moving caster costs a top-level build and nothing else.
 //!
-//! Self-shadowing (`shaders/rayquery.wgsl`): closed parts are traced with back faces culled,
-//! their triangles wound counter-clockwise from outside (an inside-out part is re-wound), so a
-//! ray leaving a light-facing surface can only find real occluders, which it enters through a
-//! front face; open parts are two-sided, and their rays start [`RayTracer::offset`] off the
-//! surface along its normal. Transparent casters and analytic spheres are not traced yet:
-//! a scene with either is refused with a clear error.
+//! The shadow ray follows the CPU reference's rule to the letter (`shaders/rayquery.wgsl`):
+//! from `P + N * offset` towards the light, stopping `offset` short of a point light, every
+//! caster triangle two-sided, with [`RayTracer::offset`] the reference's own surface offset
+//! (raised where the scene's eye-relative extent needs more). Transparent casters and analytic
+//! spheres are not traced yet: a scene with either is refused with a clear error.
 
 use super::targets::Targets;
 use crate::error::{Error, Result};
@@ -25,7 +22,7 @@ use crate::gpu::descriptors::{pipeline_layout, Binding, DescriptorSet};
 use crate::gpu::pipeline::{self, PipelineDesc};
 use crate::gpu::{shaders, Context};
 use crate::scene::Scene;
-use crate::shadow::{Caster, CasterKind};
+use crate::shadow::Caster;
 use ash::vk;
 use glam::{DMat4, DVec3};
 
@@ -37,16 +34,10 @@ struct Push {
     params: [f32; 4],
 }
 
-/// Instance masks (the shader's `CLOSED` and `OPEN`).
-const CLOSED: u8 = 1;
-const OPEN: u8 = 2;
-
 /// One bottom level and the scene mesh it belongs to.
 struct Entry {
     mesh: usize,
     blas: Accel,
-    mask: u8,
-    triangles: usize,
 }
 
 /// The ray-query technique's GPU objects.
@@ -66,29 +57,6 @@ pub struct RayTracer {
     pub blas_bytes: u64,
     /// Milliseconds (CPU wall) the bottom levels took to build, compaction included.
     pub blas_build_ms: f64,
-}
-
-/// The welded triangles of `caster`'s parts of one kind, closed parts wound counter-clockwise
-/// from outside (by the sign of their volume).
-fn part_triangles(caster: &Caster, closed: bool) -> Vec<[u32; 3]> {
-    let mesh = &caster.topology.mesh;
-    let mut out = Vec::new();
-    for part in &caster.parts {
-        if (part.kind == CasterKind::Manifold) != closed {
-            continue;
-        }
-        let tris = part.triangles.iter().map(|&t| mesh.triangles[t as usize]);
-        let volume: f64 = tris
-            .clone()
-            .map(|[a, b, c]| {
-                let p = |i: u32| mesh.positions[i as usize].as_dvec3();
-                p(a).dot(p(b).cross(p(c)))
-            })
-            .sum();
-        let flip = closed && volume < 0.0;
-        out.extend(tris.map(|[a, b, c]| if flip { [a, c, b] } else { [a, b, c] }));
-    }
-    out
 }
 
 /// Why `scene` cannot be traced yet, if it cannot.
@@ -155,16 +123,15 @@ impl RayTracer {
                 continue;
             }
             let caster = Caster::new(&m.name, &m.mesh, glam::Mat4::IDENTITY)?;
-            let positions: Vec<[f32; 3]> = caster.topology.mesh.positions.iter().map(|p| p.to_array()).collect();
-            for (closed, mask) in [(true, CLOSED), (false, OPEN)] {
-                let indices = part_triangles(&caster, closed);
-                if indices.is_empty() {
-                    continue;
-                }
-                let blas = build_blas(ctx, &self.loader, &m.name, Geometry::Triangles { positions: &positions, indices: &indices })?;
-                self.blas_bytes += blas.size;
-                self.entries.push(Entry { mesh: i, blas, mask, triangles: indices.len() });
+            let welded = &caster.topology.mesh;
+            let positions: Vec<[f32; 3]> = welded.positions.iter().map(|p| p.to_array()).collect();
+            let indices = &welded.triangles;
+            if indices.is_empty() {
+                continue;
             }
+            let blas = build_blas(ctx, &self.loader, &m.name, Geometry::Triangles { positions: &positions, indices })?;
+            self.blas_bytes += blas.size;
+            self.entries.push(Entry { mesh: i, blas });
         }
         self.blas_build_ms = start.elapsed().as_secs_f64() * 1e3;
         for _ in 0..slots {
@@ -199,11 +166,6 @@ impl RayTracer {
         Ok(())
     }
 
-    /// Triangles in the bottom levels.
-    pub fn triangles(&self) -> usize {
-        self.entries.iter().map(|e| e.triangles).sum()
-    }
-
     /// Rewrites slot `slot`'s top level from the meshes' current transforms (relative to
     /// `eye`) and records its build; also raises [`RayTracer::offset`] if the scene's
     /// eye-relative extent needs it.
@@ -224,15 +186,8 @@ impl RayTracer {
                 }
                 let x = (to_eye * m.transform.as_dmat4()).transpose();
                 let rows = [x.x_axis.as_vec4().to_array(), x.y_axis.as_vec4().to_array(), x.z_axis.as_vec4().to_array()];
-                // Closed parts: Vulkan's default facing makes a triangle wound counter-clockwise
-                // from outside (right-handed) a front face for a ray entering the solid, which
-                // is what culling back faces needs (tests/rayquery.rs holds it to the reference).
-                let flags = if e.mask == CLOSED {
-                    vk::GeometryInstanceFlagsKHR::empty()
-                } else {
-                    vk::GeometryInstanceFlagsKHR::TRIANGLE_FACING_CULL_DISABLE
-                };
-                Instance { transform: rows, custom: e.mesh as u32, mask: e.mask, flags, blas: e.blas.address }
+                let flags = vk::GeometryInstanceFlagsKHR::TRIANGLE_FACING_CULL_DISABLE;
+                Instance { transform: rows, custom: e.mesh as u32, mask: 0xff, flags, blas: e.blas.address }
             })
             .collect();
         self.offset = self.offset.max((extent * 2f64.powi(-16)) as f32);

@@ -19,3 +19,60 @@ pub fn context() -> Option<Context> {
         }
     }
 }
+
+/// A validated context on a device with ray query, for the test named `test` (its path in the
+/// test binary, e.g. `rayquery_matches_the_reference`).
+///
+/// When the default device has none (the system's lavapipe 22.3 has none), the test re-runs
+/// itself in a child process on Mesa lavapipe 25.0.7 (`scripts/drivers.sh env 25.0.7`, from
+/// `.drivers/`), asserts that the child passed and returns `None`. Without that driver: a
+/// failure under `CI`, otherwise a loud skip.
+pub fn ray_query_context(test: &str) -> Option<Context> {
+    let ctx = context()?;
+    if ctx.features.ray_query {
+        return Some(ctx);
+    }
+    drop(ctx);
+    let child = std::env::var_os("UMBRAGE_RAY_QUERY_CHILD").is_some();
+    assert!(!child, "the ray-query driver selected for this child has no ray query");
+    let root = env!("CARGO_MANIFEST_DIR");
+    let env = std::process::Command::new(format!("{root}/scripts/drivers.sh")).args(["env", "25.0.7"]).output();
+    let env = match env {
+        Ok(o) if o.status.success() => String::from_utf8_lossy(&o.stdout).into_owned(),
+        other => {
+            let why = format!("no ray-query device, and Mesa lavapipe 25.0.7 is not installed (scripts/drivers.sh install 25.0.7): {other:?}");
+            assert!(std::env::var_os("CI").is_none(), "{why}");
+            eprintln!("SKIPPED: {why}");
+            return None;
+        }
+    };
+    let mut cmd = std::process::Command::new(std::env::current_exe().expect("test binary"));
+    cmd.args(["--exact", test, "--nocapture", "--test-threads", "1"]).env("UMBRAGE_RAY_QUERY_CHILD", "1");
+    for line in env.lines() {
+        let line = line.trim();
+        if let Some(rest) = line.strip_prefix("export ") {
+            if let Some((k, v)) = rest.split_once('=') {
+                // `LD_LIBRARY_PATH=dir"${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}"`: the directory, then ours.
+                let v = v.trim_matches('"');
+                let v = match v.split_once("\"${") {
+                    Some((dir, _)) => match std::env::var("LD_LIBRARY_PATH") {
+                        Ok(old) if !old.is_empty() => format!("{dir}:{old}"),
+                        _ => dir.to_string(),
+                    },
+                    None => v.to_string(),
+                };
+                cmd.env(k, v);
+            }
+        } else if let Some(rest) = line.strip_prefix("unset ") {
+            for k in rest.split_whitespace() {
+                cmd.env_remove(k);
+            }
+        }
+    }
+    let out = cmd.output().expect("run the test on lavapipe 25.0.7");
+    print!("{}", String::from_utf8_lossy(&out.stdout));
+    eprint!("{}", String::from_utf8_lossy(&out.stderr));
+    assert!(out.status.success(), "{test} failed on Mesa lavapipe 25.0.7 (output above)");
+    assert!(String::from_utf8_lossy(&out.stdout).contains("1 passed"), "{test} did not run in the child");
+    None
+}

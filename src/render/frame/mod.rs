@@ -117,8 +117,8 @@ struct Parts {
     self_shadow: Option<SelfShadow>,
     /// The shadow-map baseline and the scene version it was built for.
     shadow_mapper: Option<(ShadowMapper, u64)>,
-    /// The ray-query technique's acceleration structures and the scene version they hold.
-    ray_tracer: Option<(RayTracer, u64)>,
+    /// The ray-query technique's acceleration structures.
+    ray_tracer: Option<RayTracer>,
     slots: Vec<FrameSlot>,
     next_slot: usize,
     serial: u64,
@@ -136,7 +136,7 @@ impl Destroy for Parts {
             if let Some((sm, _)) = &mut self.shadow_mapper {
                 sm.destroy(ctx);
             }
-            if let Some((rt, _)) = &mut self.ray_tracer {
+            if let Some(rt) = &mut self.ray_tracer {
                 rt.destroy(ctx);
             }
             self.self_shadow.destroy(ctx);
@@ -320,7 +320,7 @@ impl Renderer {
             d.begin_command_buffer(cb, &begin).map_err(Error::vk("vkBeginCommandBuffer"))?;
         }
         s.timer.begin(&self.own.ctx, cb, 4 + 4 * nlights as u32)?;
-        if let Some((rt, _)) = &mut self.own.parts.ray_tracer {
+        if let Some(rt) = &mut self.own.parts.ray_tracer {
             // SAFETY: `cb` is recording outside a rendering instance; the slot retired.
             unsafe { rt.cmd_build(&self.own.ctx, cb, slot, &self.own.parts.scene, eye)? };
         }
@@ -394,7 +394,7 @@ impl Renderer {
                     determine::begin_float(rec, t);
                     sm.record(rec.ctx, rec.cb, t, light, self.own.parts.scene.camera.eye.as_dvec3(), frame.lights[li].scissor);
                 }
-                if let Some((rt, _)) = &self.own.parts.ray_tracer {
+                if let Some(rt) = &self.own.parts.ray_tracer {
                     let l = light.homogeneous().as_dvec4();
                     let rel = if l.w == 0.0 { l } else { (l.truncate() - self.own.parts.scene.camera.eye.as_dvec3()).extend(1.0) };
                     rt.cmd_determine(rec, t, frame.slot(), rel.as_vec4().to_array(), frame.lights[li].scissor);
@@ -490,26 +490,22 @@ impl Renderer {
         Ok(())
     }
 
-    /// Builds the ray tracer's acceleration structures when ray query is asked for, or again
-    /// when the scene's placement changed (a deformed mesh's positions included); drops them
-    /// when another technique runs.
+    /// Builds the ray tracer's bottom levels when ray query is first asked for (the renderer's
+    /// meshes never change shape; their transforms reach the top level every frame); drops
+    /// them when another technique runs.
     fn update_ray_tracer(&mut self, technique: Technique) -> Result<()> {
         let wanted = technique == Technique::RayQuery;
-        let version = self.own.parts.scene_version;
-        match &self.own.parts.ray_tracer {
-            Some((_, v)) if wanted && *v == version => return Ok(()),
-            None if !wanted => return Ok(()),
-            _ => {}
+        if wanted == self.own.parts.ray_tracer.is_some() {
+            return Ok(());
         }
-        if let Some((mut old, _)) = self.own.parts.ray_tracer.take() {
+        if let Some(mut old) = self.own.parts.ray_tracer.take() {
             // SAFETY: waiting for idle before destroying objects a frame in flight may use.
             unsafe { self.own.ctx.device.device_wait_idle() }.map_err(Error::vk("vkDeviceWaitIdle"))?;
             old.destroy(&self.own.ctx);
         }
         if wanted {
             let p = &self.own.parts;
-            let rt = RayTracer::new(&self.own.ctx, &p.scene, &p.targets, p.slots.len())?;
-            self.own.parts.ray_tracer = Some((rt, version));
+            self.own.parts.ray_tracer = Some(RayTracer::new(&self.own.ctx, &p.scene, &p.targets, p.slots.len())?);
         }
         Ok(())
     }
