@@ -5,12 +5,17 @@ CARGO ?= cargo
 
 .PHONY: deps deps-tests drivers lint run view test bench conform conform-docs conform-matrix doc clean fuzz
 
+# The loader, a driver and the tools; then Mesa lavapipe 25.0.7 in .drivers/ (ray query,
+# Vulkan 1.4) beside the system's driver, for `--method rayquery` (a warning if it cannot be had).
 deps:
 	@./scripts/deps.sh
+	@./scripts/drivers.sh install 25.0.7 >/dev/null || echo "warning: Mesa lavapipe 25.0.7 not installed (scripts/drivers.sh install 25.0.7): no --method rayquery here" >&2
 
-# What the tests and the conformance runs need as well (off Debian: the validation layer too).
+# What the tests and the conformance runs need as well (off Debian: the validation layer too),
+# and lavapipe 25.0.7, which tests/rayquery.rs runs on when the system's driver has no ray query.
 deps-tests:
 	@./scripts/deps.sh --tests
+	./scripts/drivers.sh install 25.0.7
 
 # Three Mesa lavapipe versions (Vulkan 1.0, 1.3, 1.4) in .drivers/, beside the system's; select
 # one with eval "$$(scripts/drivers.sh env 25.0.7)" (scripts/drivers.sh --help).

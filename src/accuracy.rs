@@ -92,10 +92,10 @@ pub fn evaluate(renderer: &mut Renderer, scene_name: &str, techniques: &[Techniq
             // One shadow ray a pixel writes 1, not a count: no 8-bit wrap, no near plane.
             (Technique::RayQuery, _) => None,
             (_, method) => match method {
-            Method::ZPassClear if split => Some("zpass-clear with a volume crossing the near plane (partly shadowed viewport)"),
-            // Otherwise it fails where any correct method does (the 8-bit wrap).
-            Method::ZPassClear => expected_failure(scene_name, Method::McGuire, renderer.settings.counter),
-            _ => expected_failure(scene_name, method, renderer.settings.counter),
+                Method::ZPassClear if split => Some("zpass-clear with a volume crossing the near plane (partly shadowed viewport)"),
+                // Otherwise it fails where any correct method does (the 8-bit wrap).
+                Method::ZPassClear => expected_failure(scene_name, Method::McGuire, renderer.settings.counter),
+                _ => expected_failure(scene_name, method, renderer.settings.counter),
             },
         };
         let ok = fraction <= THRESHOLD;

@@ -154,6 +154,14 @@ pub fn info_report(ctx: &Context) -> InfoReport {
             "RGBA32F blending".into(),
             yes_no(f.rgba32f_blend, "available: --transmit log32|mul32", "missing: fp16 light-intensity maps only"),
         ),
+        (
+            "VK_KHR_ray_query".into(),
+            yes_no(
+                f.ray_query,
+                "used: --method rayquery (acceleration structures, one shadow ray a pixel)",
+                "missing: no --method rayquery (Mesa lavapipe 25.0.7 has it: scripts/drivers.sh install 25.0.7)",
+            ),
+        ),
         ("depth-stencil format".into(), format!("{} (8 stencil bits, wrap increments)", f.depth_stencil_format)),
     ];
     InfoReport { device: ctx.info.clone(), features: f.clone(), validation: ctx.validation, paths }

@@ -56,7 +56,8 @@ fn rayquery_follows_a_moving_caster() {
     let mut r = Renderer::new(ctx, scene, opts).unwrap();
     for step in 0..3 {
         let i = r.scene().meshes.iter().position(|m| m.casts_shadow).unwrap();
-        let moved = glam::Mat4::from_translation(glam::Vec3::new(0.3 * step as f32, 0.0, -0.2 * step as f32)) * r.scene().meshes[i].transform;
+        let moved =
+            glam::Mat4::from_translation(glam::Vec3::new(0.3 * step as f32, 0.0, -0.2 * step as f32)) * r.scene().meshes[i].transform;
         r.set_mesh_transform(i, moved).unwrap();
         let rows = evaluate(&mut r, "default", &[Technique::RayQuery], 1).unwrap();
         assert!(rows[0].passed, "step {step}: {} mismatches of {}", rows[0].mismatches, rows[0].compared);

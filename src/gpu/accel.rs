@@ -77,7 +77,9 @@ impl Accel {
         };
         // SAFETY: `raw` was just created on this device.
         let address = unsafe {
-            l.fns.get_acceleration_structure_device_address(&vk::AccelerationStructureDeviceAddressInfoKHR::default().acceleration_structure(raw))
+            l.fns.get_acceleration_structure_device_address(
+                &vk::AccelerationStructureDeviceAddressInfoKHR::default().acceleration_structure(raw),
+            )
         };
         Ok(Accel { raw, address, buffer, size })
     }
@@ -137,7 +139,14 @@ pub fn build_blas(ctx: &Context, l: &AccelLoader, name: &str, geometry: Geometry
     result
 }
 
-fn build_blas_inner(ctx: &Context, l: &AccelLoader, name: &str, geometry: &Geometry, count: u32, inputs: &mut Vec<Buffer>) -> Result<Accel> {
+fn build_blas_inner(
+    ctx: &Context,
+    l: &AccelLoader,
+    name: &str,
+    geometry: &Geometry,
+    count: u32,
+    inputs: &mut Vec<Buffer>,
+) -> Result<Accel> {
     let geom = match geometry {
         Geometry::Triangles { positions, indices } => {
             inputs.push(Buffer::with_data(ctx, "blas vertices", bytes(positions), INPUT)?);
@@ -193,7 +202,12 @@ fn build_blas_inner(ctx: &Context, l: &AccelLoader, name: &str, geometry: &Geome
             l.fns.cmd_build_acceleration_structures(cb, std::slice::from_ref(&build), &[&range[..]]);
             if let Some(q) = query {
                 let b = (vk::PipelineStageFlags2::ACCELERATION_STRUCTURE_BUILD_KHR, vk::AccessFlags2::ACCELERATION_STRUCTURE_WRITE_KHR);
-                memory_barrier(ctx, cb, b, (vk::PipelineStageFlags2::ACCELERATION_STRUCTURE_BUILD_KHR, vk::AccessFlags2::ACCELERATION_STRUCTURE_READ_KHR));
+                memory_barrier(
+                    ctx,
+                    cb,
+                    b,
+                    (vk::PipelineStageFlags2::ACCELERATION_STRUCTURE_BUILD_KHR, vk::AccessFlags2::ACCELERATION_STRUCTURE_READ_KHR),
+                );
                 ctx.device.cmd_reset_query_pool(cb, q, 0, 1);
                 l.fns.cmd_write_acceleration_structures_properties(
                     cb,

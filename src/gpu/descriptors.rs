@@ -56,13 +56,13 @@ impl DescriptorSet {
             })
             .collect();
         let count = |t: vk::DescriptorType| bindings.iter().filter(|b| ty(b) == t).count() as u32;
-        let sizes: Vec<_> = [vk::DescriptorType::SAMPLED_IMAGE, vk::DescriptorType::SAMPLER, vk::DescriptorType::ACCELERATION_STRUCTURE_KHR]
-            .into_iter()
-            .map(|t| (t, count(t)))
-            .into_iter()
-            .filter(|&(_, n)| n > 0)
-            .map(|(ty, descriptor_count)| vk::DescriptorPoolSize { ty, descriptor_count })
-            .collect();
+        let sizes: Vec<_> =
+            [vk::DescriptorType::SAMPLED_IMAGE, vk::DescriptorType::SAMPLER, vk::DescriptorType::ACCELERATION_STRUCTURE_KHR]
+                .into_iter()
+                .map(|t| (t, count(t)))
+                .filter(|&(_, n)| n > 0)
+                .map(|(ty, descriptor_count)| vk::DescriptorPoolSize { ty, descriptor_count })
+                .collect();
         let d = ctx.device();
         // SAFETY: creation on a valid device with create infos built from locals; the objects
         // are destroyed in `destroy` (pool before layout, the set with its pool).

@@ -137,10 +137,8 @@ pub(super) fn open_device(
     let base = f2.features;
     let (dyn_rendering, sync2) = (f13.dynamic_rendering == vk::TRUE, f13.synchronization2 == vk::TRUE);
     let u8_supported = has_u8_ext && f_u8.index_type_uint8 == vk::TRUE;
-    let ray_query = has_rq_exts
-        && f_as.acceleration_structure == vk::TRUE
-        && f_rq.ray_query == vk::TRUE
-        && f12.buffer_device_address == vk::TRUE;
+    let ray_query =
+        has_rq_exts && f_as.acceleration_structure == vk::TRUE && f_rq.ray_query == vk::TRUE && f12.buffer_device_address == vk::TRUE;
     if minimum == Minimum::Vulkan13 && (!dyn_rendering || !sync2) {
         return Err(Error::Unsupported(format!("{name}: umbrage needs dynamicRendering and synchronization2 (Vulkan 1.3)")));
     }

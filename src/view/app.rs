@@ -177,13 +177,16 @@ pub(super) struct Live {
 }
 
 /// The techniques `M` cycles through, in the order of `render --method`.
-pub(super) fn technique_cycle(shadow_map_size: u32) -> Vec<Technique> {
+pub(super) fn technique_cycle(shadow_map_size: u32, ray_query: bool) -> Vec<Technique> {
     let mut v: Vec<Technique> =
         [Method::McGuire, Method::Lengyel, Method::EverittKilgard, Method::ZFail, Method::ZPass, Method::ZPassClear]
             .into_iter()
             .map(Technique::Volumes)
             .collect();
     v.extend([Technique::EdgeQuads, Technique::Planar, Technique::ShadowMap { size: shadow_map_size }]);
+    if ray_query {
+        v.push(Technique::RayQuery);
+    }
     v
 }
 
@@ -237,7 +240,7 @@ impl Live {
             Technique::ShadowMap { size } => size,
             _ => 2048,
         };
-        let mut techniques = technique_cycle(shadow_map_size);
+        let mut techniques = technique_cycle(shadow_map_size, ctx.features.ray_query);
         let technique = match techniques.iter().position(|t| *t == opts.technique) {
             Some(i) => i,
             None => {

@@ -40,7 +40,8 @@ pub fn ray_query_context(test: &str) -> Option<Context> {
     let env = match env {
         Ok(o) if o.status.success() => String::from_utf8_lossy(&o.stdout).into_owned(),
         other => {
-            let why = format!("no ray-query device, and Mesa lavapipe 25.0.7 is not installed (scripts/drivers.sh install 25.0.7): {other:?}");
+            let why =
+                format!("no ray-query device, and Mesa lavapipe 25.0.7 is not installed (scripts/drivers.sh install 25.0.7): {other:?}");
             assert!(std::env::var_os("CI").is_none(), "{why}");
             eprintln!("SKIPPED: {why}");
             return None;

@@ -10,10 +10,10 @@ use super::options::*;
 use super::passes::{self, debug, determine, gbuffer, illuminate, intensity, tonemap, transparent, Rec};
 use super::pipelines::FramePipelines;
 use super::push::LightPush;
+use super::raytrace::RayTracer;
 use super::readback::Layout;
 use super::scene_gpu::{SceneGeometry, Sidedness};
 use super::selfshadow::SelfShadow;
-use super::raytrace::RayTracer;
 use super::shadowmap::ShadowMapper;
 use super::sphere_gpu::SphereGeometry;
 use super::targets::*;
@@ -28,6 +28,7 @@ mod motion;
 pub use memory::{largest_device_heap, MemoryEstimate};
 mod present;
 mod stats;
+mod techniques;
 
 use crate::error::{Error, Result};
 use crate::gpu::Context;
@@ -320,7 +321,7 @@ impl Renderer {
             d.begin_command_buffer(cb, &begin).map_err(Error::vk("vkBeginCommandBuffer"))?;
         }
         s.timer.begin(&self.own.ctx, cb, 4 + 4 * nlights as u32)?;
-        if let Some(rt) = &mut self.own.parts.ray_tracer {
+        if let (Some(rt), Technique::RayQuery) = (&mut self.own.parts.ray_tracer, settings.technique) {
             // SAFETY: `cb` is recording outside a rendering instance; the slot retired.
             unsafe { rt.cmd_build(&self.own.ctx, cb, slot, &self.own.parts.scene, eye)? };
         }
@@ -381,7 +382,7 @@ impl Renderer {
             spans.depth.end = stamp(all);
             let into = match (&self.own.parts.shadow_mapper, self.settings.counter) {
                 (Some(_), _) => determine::CountInto::External,
-                _ if self.own.parts.ray_tracer.is_some() => determine::CountInto::Written,
+                _ if self.settings.technique == Technique::RayQuery => determine::CountInto::Written,
                 (None, Counter::Float) => determine::CountInto::Float,
                 (None, Counter::Stencil) => determine::CountInto::Stencil,
             };
@@ -394,7 +395,7 @@ impl Renderer {
                     determine::begin_float(rec, t);
                     sm.record(rec.ctx, rec.cb, t, light, self.own.parts.scene.camera.eye.as_dvec3(), frame.lights[li].scissor);
                 }
-                if let Some(rt) = &self.own.parts.ray_tracer {
+                if let (Some(rt), Technique::RayQuery) = (&self.own.parts.ray_tracer, self.settings.technique) {
                     let l = light.homogeneous().as_dvec4();
                     let rel = if l.w == 0.0 { l } else { (l.truncate() - self.own.parts.scene.camera.eye.as_dvec3()).extend(1.0) };
                     rt.cmd_determine(rec, t, frame.slot(), rel.as_vec4().to_array(), frame.lights[li].scissor);
@@ -486,49 +487,6 @@ impl Renderer {
         if let Some(f) = &self.own.parts.slots[slot].in_flight {
             let t = FrameTicket { slot, serial: f.serial };
             self.wait(&t)?;
-        }
-        Ok(())
-    }
-
-    /// Builds the ray tracer's bottom levels when ray query is first asked for (the renderer's
-    /// meshes never change shape; their transforms reach the top level every frame); drops
-    /// them when another technique runs.
-    fn update_ray_tracer(&mut self, technique: Technique) -> Result<()> {
-        let wanted = technique == Technique::RayQuery;
-        if wanted == self.own.parts.ray_tracer.is_some() {
-            return Ok(());
-        }
-        if let Some(mut old) = self.own.parts.ray_tracer.take() {
-            // SAFETY: waiting for idle before destroying objects a frame in flight may use.
-            unsafe { self.own.ctx.device.device_wait_idle() }.map_err(Error::vk("vkDeviceWaitIdle"))?;
-            old.destroy(&self.own.ctx);
-        }
-        if wanted {
-            let p = &self.own.parts;
-            self.own.parts.ray_tracer = Some(RayTracer::new(&self.own.ctx, &p.scene, &p.targets, p.slots.len())?);
-        }
-        Ok(())
-    }
-
-    /// (Re)builds the shadow-map baseline when asked for, or when its size or the scene's
-    /// placement changed; drops it when another technique runs.
-    fn update_shadow_mapper(&mut self, technique: Technique) -> Result<()> {
-        let wanted = match technique {
-            Technique::ShadowMap { size } => Some(size),
-            _ => None,
-        };
-        let current = self.own.parts.shadow_mapper.as_ref().map(|(m, v)| (m.size, *v));
-        if wanted.map(|s| (s, self.own.parts.scene_version)) == current {
-            return Ok(());
-        }
-        if let Some((mut old, _)) = self.own.parts.shadow_mapper.take() {
-            // SAFETY: waiting for idle before destroying objects a frame in flight may use.
-            unsafe { self.own.ctx.device.device_wait_idle() }.map_err(Error::vk("vkDeviceWaitIdle"))?;
-            old.destroy(&self.own.ctx);
-        }
-        if let Some(size) = wanted {
-            let sm = ShadowMapper::new(&self.own.ctx, &self.own.parts.scene, &self.own.parts.targets, size, self.own.parts.pipes.sampler)?;
-            self.own.parts.shadow_mapper = Some((sm, self.own.parts.scene_version));
         }
         Ok(())
     }
