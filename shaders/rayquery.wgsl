@@ -28,12 +28,45 @@ var<immediate> pc: Push;
 @group(0) @binding(0) var scene: acceleration_structure;
 @group(0) @binding(1) var positions: texture_2d<f32>;
 @group(0) @binding(2) var normals: texture_2d<f32>;
+// Analytic sphere casters: (centre relative to their instance's origin, radius), indexed by
+// the AABB primitive. The instance is a translation, so object-space directions are world's.
+@group(0) @binding(3) var<storage, read> balls: array<vec4<f32>>;
+
+// The entry distance of the ray `o + t d` (unit d) into ball `b`, clamped to 0 when `o` is
+// inside, or -1 when it misses [0, t_max].
+fn ball_hit(o: vec3<f32>, d: vec3<f32>, b: vec4<f32>, t_max: f32) -> f32 {
+    let oc = o - b.xyz;
+    let half_b = dot(oc, d);
+    let c = dot(oc, oc) - b.w * b.w;
+    let h = half_b * half_b - c;
+    if h < 0.0 {
+        return -1.0;
+    }
+    let s = sqrt(h);
+    let t0 = -half_b - s;
+    let t1 = -half_b + s;
+    if t1 < 0.0 || t0 > t_max {
+        return -1.0;
+    }
+    return max(t0, 0.0);
+}
 
 fn occluded(origin: vec3<f32>, dir: vec3<f32>, t_max: f32) -> bool {
     var rq: ray_query;
     let flags = RAY_FLAG_TERMINATE_ON_FIRST_HIT | RAY_FLAG_FORCE_OPAQUE;
     rayQueryInitialize(&rq, scene, RayDesc(flags, 0xffu, 0.0, t_max, origin, dir));
-    rayQueryProceed(&rq);
+    // Triangles are opaque and commit themselves; a sphere's box is a candidate that commits
+    // only when the exact ray-sphere test hits.
+    while rayQueryProceed(&rq) {
+        let c = rayQueryGetCandidateIntersection(&rq);
+        if c.kind == RAY_QUERY_INTERSECTION_AABB {
+            let o = c.world_to_object * vec4<f32>(origin, 1.0);
+            let t = ball_hit(o, dir, balls[c.primitive_index], t_max);
+            if t >= 0.0 {
+                rayQueryGenerateIntersection(&rq, t);
+            }
+        }
+    }
     return rayQueryGetCommittedIntersection(&rq).kind != RAY_QUERY_INTERSECTION_NONE;
 }
 

@@ -15,7 +15,7 @@ pub(crate) struct BenchArgs {
     #[arg(long = "scene")]
     scenes: Vec<String>,
     /// Comma-separated techniques, every one `render --method` accepts (default: the five
-    /// volume methods, edgequad and shadowmap).
+    /// volume methods, edgequad and shadowmap, and rayquery where the device has ray query).
     #[arg(long, value_enum, value_delimiter = ',')]
     methods: Vec<MethodArg>,
     #[arg(long, default_value_t = 10)]

@@ -1,6 +1,6 @@
 //! One-shot descriptor sets for full-screen passes: a layout, an exactly-sized pool and one set,
 //! written once (images in SHADER_READ_ONLY_OPTIMAL, samplers, top-level acceleration
-//! structures; fragment stage).
+//! structures, read-only storage buffers; fragment stage).
 
 use super::context::GpuDevice;
 use crate::error::{Error, Result};
@@ -21,6 +21,8 @@ pub enum Binding {
     /// An `ACCELERATION_STRUCTURE_KHR` (WGSL `acceleration_structure`): a top level that
     /// must be built whenever the set is used.
     AccelerationStructure(vk::AccelerationStructureKHR),
+    /// A read-only `STORAGE_BUFFER`, the whole buffer.
+    StorageBuffer(vk::Buffer),
 }
 
 /// A descriptor set layout with one set allocated from its own pool; binding `i` is the `i`-th
@@ -43,6 +45,7 @@ impl DescriptorSet {
             Binding::Image(_) => vk::DescriptorType::SAMPLED_IMAGE,
             Binding::Sampler(_) => vk::DescriptorType::SAMPLER,
             Binding::AccelerationStructure(_) => vk::DescriptorType::ACCELERATION_STRUCTURE_KHR,
+            Binding::StorageBuffer(_) => vk::DescriptorType::STORAGE_BUFFER,
         };
         let layout_bindings: Vec<_> = bindings
             .iter()
@@ -56,13 +59,17 @@ impl DescriptorSet {
             })
             .collect();
         let count = |t: vk::DescriptorType| bindings.iter().filter(|b| ty(b) == t).count() as u32;
-        let sizes: Vec<_> =
-            [vk::DescriptorType::SAMPLED_IMAGE, vk::DescriptorType::SAMPLER, vk::DescriptorType::ACCELERATION_STRUCTURE_KHR]
-                .into_iter()
-                .map(|t| (t, count(t)))
-                .filter(|&(_, n)| n > 0)
-                .map(|(ty, descriptor_count)| vk::DescriptorPoolSize { ty, descriptor_count })
-                .collect();
+        let sizes: Vec<_> = [
+            vk::DescriptorType::SAMPLED_IMAGE,
+            vk::DescriptorType::SAMPLER,
+            vk::DescriptorType::ACCELERATION_STRUCTURE_KHR,
+            vk::DescriptorType::STORAGE_BUFFER,
+        ]
+        .into_iter()
+        .map(|t| (t, count(t)))
+        .filter(|&(_, n)| n > 0)
+        .map(|(ty, descriptor_count)| vk::DescriptorPoolSize { ty, descriptor_count })
+        .collect();
         let d = ctx.device();
         // SAFETY: creation on a valid device with create infos built from locals; the objects
         // are destroyed in `destroy` (pool before layout, the set with its pool).
@@ -88,7 +95,14 @@ impl DescriptorSet {
                     Binding::Sampler(sampler) => {
                         [vk::DescriptorImageInfo { sampler, image_view: vk::ImageView::null(), image_layout: vk::ImageLayout::UNDEFINED }]
                     }
-                    Binding::AccelerationStructure(_) => [vk::DescriptorImageInfo::default()],
+                    Binding::AccelerationStructure(_) | Binding::StorageBuffer(_) => [vk::DescriptorImageInfo::default()],
+                })
+                .collect();
+            let buffers: Vec<[vk::DescriptorBufferInfo; 1]> = bindings
+                .iter()
+                .map(|b| match *b {
+                    Binding::StorageBuffer(buffer) => [vk::DescriptorBufferInfo { buffer, offset: 0, range: vk::WHOLE_SIZE }],
+                    _ => [vk::DescriptorBufferInfo::default()],
                 })
                 .collect();
             let accels: Vec<[vk::AccelerationStructureKHR; 1]> = bindings
@@ -104,11 +118,13 @@ impl DescriptorSet {
                 .iter()
                 .zip(&infos)
                 .zip(accel_writes.iter_mut())
+                .zip(&buffers)
                 .enumerate()
-                .map(|(i, ((b, info), aw))| {
+                .map(|(i, (((b, info), aw), buf))| {
                     let w = vk::WriteDescriptorSet::default().dst_set(set).dst_binding(i as u32).descriptor_type(ty(b));
                     match b {
                         Binding::AccelerationStructure(_) => w.descriptor_count(1).push_next(aw),
+                        Binding::StorageBuffer(_) => w.buffer_info(buf),
                         _ => w.image_info(info),
                     }
                 })

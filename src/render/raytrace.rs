@@ -12,15 +12,17 @@
 //! The shadow ray follows the CPU reference's rule to the letter (`shaders/rayquery.wgsl`):
 //! from `P + N * offset` towards the light, stopping `offset` short of a point light, every
 //! caster triangle two-sided, with [`RayTracer::offset`] the reference's own surface offset
-//! (raised where the scene's eye-relative extent needs more). Transparent casters and analytic
-//! spheres are not traced yet: a scene with either is refused with a clear error.
+//! (raised where the scene's eye-relative extent needs more). Analytic sphere casters are
+//! procedural boxes in one more bottom level, intersected exactly in the shader's ray-query
+//! loop. Transparent casters are not traced yet: a scene with one is refused with a clear
+//! error.
 
 use super::targets::Targets;
 use crate::error::{Error, Result};
 use crate::gpu::accel::{build_blas, Accel, AccelLoader, Geometry, Instance, Tlas};
 use crate::gpu::descriptors::{pipeline_layout, Binding, DescriptorSet};
 use crate::gpu::pipeline::{self, PipelineDesc};
-use crate::gpu::{shaders, Context};
+use crate::gpu::{shaders, Buffer, Context};
 use crate::scene::Scene;
 use crate::shadow::Caster;
 use ash::vk;
@@ -40,10 +42,21 @@ struct Entry {
     blas: Accel,
 }
 
+/// The sphere casters: their boxes' bottom level, the balls the shader tests (centre relative
+/// to `origin`, radius; f32), and that origin (world).
+struct Balls {
+    blas: Accel,
+    buffer: Buffer,
+    origin: DVec3,
+}
+
 /// The ray-query technique's GPU objects.
 pub struct RayTracer {
     loader: AccelLoader,
     entries: Vec<Entry>,
+    balls: Option<Balls>,
+    /// Bound at binding 3 when there are no spheres (a descriptor needs a buffer).
+    no_balls: Option<Buffer>,
     tlas: Vec<Tlas>,
     sets: Vec<DescriptorSet>,
     layout: vk::PipelineLayout,
@@ -64,9 +77,6 @@ pub fn unsupported(scene: &Scene) -> Option<String> {
     if scene.meshes.iter().any(|m| m.casts_shadow && m.opacity < 1.0) {
         return Some("--method rayquery does not trace transparent casters yet (their coloured shadows need the light-intensity map); use a shadow-volume method".into());
     }
-    if scene.spheres.iter().any(|s| s.casts_shadow) {
-        return Some("--method rayquery does not trace analytic sphere casters yet; use a shadow-volume method".into());
-    }
     None
 }
 
@@ -80,6 +90,10 @@ fn scene_size(scene: &Scene) -> f64 {
             lo = lo.min(b.min.as_dvec3());
             hi = hi.max(b.max.as_dvec3());
         }
+    }
+    for s in &scene.spheres {
+        lo = lo.min(s.sphere.center - s.sphere.radius);
+        hi = hi.max(s.sphere.center + s.sphere.radius);
     }
     if lo.x <= hi.x {
         (hi - lo).length()
@@ -99,6 +113,8 @@ impl RayTracer {
         let mut t = RayTracer {
             loader,
             entries: Vec::new(),
+            balls: None,
+            no_balls: None,
             tlas: Vec::new(),
             sets: Vec::new(),
             layout: vk::PipelineLayout::null(),
@@ -133,9 +149,51 @@ impl RayTracer {
             self.blas_bytes += blas.size;
             self.entries.push(Entry { mesh: i, blas });
         }
+        let casting: Vec<&crate::geom::Sphere> = scene.spheres.iter().filter(|s| s.casts_shadow).map(|s| &s.sphere).collect();
+        if let Some(first) = casting.first() {
+            let origin = first.center;
+            let balls: Vec<[f32; 4]> = casting
+                .iter()
+                .map(|s| {
+                    let c = (s.center - origin).as_vec3();
+                    [c.x, c.y, c.z, s.radius as f32]
+                })
+                .collect();
+            // Each box holds its f32 ball with a margin of a few ulps (the test is exact on
+            // the f32 ball; the box only has to contain it).
+            let boxes: Vec<[[f32; 3]; 2]> = balls
+                .iter()
+                .map(|b| {
+                    let r = b[3] * (1.0 + 1e-5) + 1e-30;
+                    [[b[0] - r, b[1] - r, b[2] - r], [b[0] + r, b[1] + r, b[2] + r]]
+                })
+                .collect();
+            let blas = build_blas(ctx, &self.loader, "spheres", Geometry::Aabbs(&boxes))?;
+            self.blas_bytes += blas.size;
+            let data: Vec<u8> = balls.iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
+            let buffer = match Buffer::with_data(ctx, "ray-query balls", &data, vk::BufferUsageFlags::STORAGE_BUFFER) {
+                Ok(b) => b,
+                Err(e) => {
+                    let mut blas = blas;
+                    blas.destroy(ctx, &self.loader);
+                    return Err(e);
+                }
+            };
+            self.balls = Some(Balls { blas, buffer, origin });
+        }
         self.blas_build_ms = start.elapsed().as_secs_f64() * 1e3;
+        let ball_buffer = match &self.balls {
+            Some(b) => b.buffer.raw,
+            None => {
+                let b = Buffer::with_data(ctx, "ray-query no balls", &[0u8; 16], vk::BufferUsageFlags::STORAGE_BUFFER)?;
+                let raw = b.raw;
+                self.no_balls = Some(b);
+                raw
+            }
+        };
+        let instances = self.entries.len() as u32 + self.balls.is_some() as u32;
         for _ in 0..slots {
-            self.tlas.push(Tlas::new(ctx, &self.loader, self.entries.len() as u32)?);
+            self.tlas.push(Tlas::new(ctx, &self.loader, instances)?);
         }
         for tlas in &self.tlas {
             self.sets.push(DescriptorSet::new(
@@ -144,6 +202,7 @@ impl RayTracer {
                     Binding::AccelerationStructure(tlas.accel.raw),
                     Binding::Image(targets.position.view),
                     Binding::Image(targets.normal.view),
+                    Binding::StorageBuffer(ball_buffer),
                 ],
             )?);
         }
@@ -175,7 +234,7 @@ impl RayTracer {
     pub unsafe fn cmd_build(&mut self, ctx: &Context, cb: vk::CommandBuffer, slot: usize, scene: &Scene, eye: DVec3) -> Result<()> {
         let to_eye = DMat4::from_translation(-eye);
         let mut extent = 0.0f64;
-        let instances: Vec<Instance> = self
+        let mut instances: Vec<Instance> = self
             .entries
             .iter()
             .map(|e| {
@@ -190,6 +249,15 @@ impl RayTracer {
                 Instance { transform: rows, custom: e.mesh as u32, mask: 0xff, flags, blas: e.blas.address }
             })
             .collect();
+        if let Some(b) = &self.balls {
+            let t = (b.origin - eye).as_vec3();
+            let rows = [[1.0, 0.0, 0.0, t.x], [0.0, 1.0, 0.0, t.y], [0.0, 0.0, 1.0, t.z]];
+            let flags = vk::GeometryInstanceFlagsKHR::empty();
+            instances.push(Instance { transform: rows, custom: 0, mask: 0xff, flags, blas: b.blas.address });
+            for s in scene.spheres.iter().filter(|s| s.casts_shadow) {
+                extent = extent.max((s.sphere.center - eye).abs().max_element() + s.sphere.radius);
+            }
+        }
         self.offset = self.offset.max((extent * 2f64.powi(-16)) as f32);
         // SAFETY: forwarded to the caller's contract.
         unsafe { self.tlas[slot].cmd_build(ctx, &self.loader, cb, &instances) }
@@ -239,6 +307,13 @@ impl RayTracer {
         }
         for mut e in self.entries.drain(..) {
             e.blas.destroy(ctx, &self.loader);
+        }
+        if let Some(mut b) = self.balls.take() {
+            b.blas.destroy(ctx, &self.loader);
+            b.buffer.destroy(ctx);
+        }
+        if let Some(mut b) = self.no_balls.take() {
+            b.destroy(ctx);
         }
     }
 }
