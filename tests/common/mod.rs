@@ -21,35 +21,50 @@ pub fn context() -> Option<Context> {
 }
 
 /// A validated context on a device with ray query, for the test named `test` (its path in the
-/// test binary, e.g. `rayquery_matches_the_reference`).
+/// test binary, e.g. `rayquery_follows_a_moving_caster`).
 ///
 /// When the default device has none (the system's lavapipe 22.3 has none), the test re-runs
-/// itself in a child process on Mesa lavapipe 25.0.7 (`scripts/drivers.sh env 25.0.7`, from
-/// `.drivers/`), asserts that the child passed and returns `None`. Without that driver: a
-/// failure under `CI`, otherwise a loud skip.
+/// itself in a child process on Mesa lavapipe 25.0.7 ([`rerun_on_lavapipe_25`]), asserts that
+/// the child passed and returns `None`.
 pub fn ray_query_context(test: &str) -> Option<Context> {
     let ctx = context()?;
     if ctx.features.ray_query {
         return Some(ctx);
     }
     drop(ctx);
+    rerun_on_lavapipe_25(test, false, &[]);
+    None
+}
+
+/// Runs test `test` of this binary (`ignored`: an `#[ignore]`d helper test) in a child process
+/// whose only Vulkan device is Mesa lavapipe 25.0.7 from `.drivers/` (`scripts/drivers.sh env
+/// 25.0.7`), with `env` added, and asserts that it passed. Returns false when that driver is
+/// not installed and `CI` is not set (a loud skip); under `CI` that is a failure. A child that
+/// finds no ray query there fails.
+pub fn rerun_on_lavapipe_25(test: &str, ignored: bool, env: &[(&str, &str)]) -> bool {
     let child = std::env::var_os("UMBRAGE_RAY_QUERY_CHILD").is_some();
     assert!(!child, "the ray-query driver selected for this child has no ray query");
     let root = env!("CARGO_MANIFEST_DIR");
-    let env = std::process::Command::new(format!("{root}/scripts/drivers.sh")).args(["env", "25.0.7"]).output();
-    let env = match env {
+    let exports = std::process::Command::new(format!("{root}/scripts/drivers.sh")).args(["env", "25.0.7"]).output();
+    let exports = match exports {
         Ok(o) if o.status.success() => String::from_utf8_lossy(&o.stdout).into_owned(),
         other => {
             let why =
                 format!("no ray-query device, and Mesa lavapipe 25.0.7 is not installed (scripts/drivers.sh install 25.0.7): {other:?}");
             assert!(std::env::var_os("CI").is_none(), "{why}");
             eprintln!("SKIPPED: {why}");
-            return None;
+            return false;
         }
     };
     let mut cmd = std::process::Command::new(std::env::current_exe().expect("test binary"));
     cmd.args(["--exact", test, "--nocapture", "--test-threads", "1"]).env("UMBRAGE_RAY_QUERY_CHILD", "1");
-    for line in env.lines() {
+    if ignored {
+        cmd.arg("--ignored");
+    }
+    for (k, v) in env {
+        cmd.env(k, v);
+    }
+    for line in exports.lines() {
         let line = line.trim();
         if let Some(rest) = line.strip_prefix("export ") {
             if let Some((k, v)) = rest.split_once('=') {
@@ -75,5 +90,5 @@ pub fn ray_query_context(test: &str) -> Option<Context> {
     eprint!("{}", String::from_utf8_lossy(&out.stderr));
     assert!(out.status.success(), "{test} failed on Mesa lavapipe 25.0.7 (output above)");
     assert!(String::from_utf8_lossy(&out.stdout).contains("1 passed"), "{test} did not run in the child");
-    None
+    true
 }
