@@ -331,6 +331,7 @@ impl Host {
             features_missing: features.iter().filter(|f| !f.1).map(|f| f.0.clone()).collect(),
             counters: None,
             warnings: fl.warnings.clone(),
+            ray_query: None,
         }
     }
 }

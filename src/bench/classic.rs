@@ -45,6 +45,12 @@ pub struct BenchRow {
     pub error_fraction: f64,
     /// (caster, light) pairs per case in one frame: `[culled, z-pass, z-fail, z-fail + light cap]`.
     pub cases: [u64; 4],
+    /// Ray query: median GPU time of the frame's top-level build, ms (`None` otherwise).
+    pub gpu_tlas_ms: Option<f64>,
+    /// Ray query: CPU wall time of the bottom-level builds (once, compaction included), ms.
+    pub blas_build_ms: Option<f64>,
+    /// Ray query: bottom-level storage after compaction, bytes.
+    pub blas_bytes: Option<u64>,
 }
 
 /// A whole `umbrage bench` run: the device and every row (the JSON `--out` writes).
@@ -129,6 +135,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
             gpu: Vec<f64>,
             shadow: Vec<f64>,
             illum: Vec<f64>,
+            accel: Vec<f64>,
             wall: Vec<f64>,
             plan: Vec<f64>,
             last: Option<crate::render::Stats>,
@@ -147,6 +154,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                     a.gpu.push(g.frame);
                     a.shadow.push(g.shadow);
                     a.illum.push(g.illuminate);
+                    a.accel.push(g.accel);
                 }
                 a.wall.push(f.stats.wall_ms);
                 a.plan.push(f.stats.cpu_ms.plan + f.stats.cpu_ms.silhouettes);
@@ -176,6 +184,9 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 shadow_bytes: s.totals.index_bytes + s.totals.vertex_bytes,
                 error_fraction: err.fraction,
                 cases: [c.culled, c.zpass, c.zfail, c.zfail_light_cap],
+                gpu_tlas_ms: (technique == Technique::RayQuery && !a.accel.is_empty()).then(|| median(a.accel)),
+                blas_build_ms: s.ray_query.as_ref().map(|q| q.bottom_level_build_ms),
+                blas_bytes: s.ray_query.as_ref().map(|q| q.bottom_level_bytes),
             };
             progress(&row);
             rows.push(row);

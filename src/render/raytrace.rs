@@ -292,6 +292,18 @@ impl RayTracer {
         }
     }
 
+    /// What the frame's stats say about the structures.
+    pub fn stats(&self) -> super::stats::RayQueryStats {
+        let levels = self.entries.len() + self.balls.is_some() as usize;
+        super::stats::RayQueryStats {
+            bottom_levels: levels,
+            bottom_level_bytes: self.blas_bytes,
+            bottom_level_build_ms: self.blas_build_ms,
+            instances: levels,
+            offset: self.offset,
+        }
+    }
+
     /// Destroys everything (the owner waited for the device).
     pub fn destroy(&mut self, ctx: &Context) {
         // SAFETY: the owner waited for the device to be idle; null handles are ignored.

@@ -15,6 +15,8 @@ pub struct GpuMs {
     pub illuminate: f64,
     /// The whole frame.
     pub frame: f64,
+    /// The frame's acceleration-structure builds (ray query: the top level; 0 otherwise).
+    pub accel: f64,
     /// Per light, in the frame's light order.
     pub per_light: Vec<LightGpuMs>,
 }
@@ -69,4 +71,21 @@ pub struct Stats {
     pub counters: Option<super::PassCounters>,
     /// Things the user should know about this frame (e.g. possible 8-bit stencil overflow).
     pub warnings: Vec<String>,
+    /// The ray-query technique's acceleration structures (`None` for the other techniques).
+    pub ray_query: Option<RayQueryStats>,
+}
+
+/// What `--method rayquery` traces against.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct RayQueryStats {
+    /// Bottom levels: one per shadow-casting mesh, one for the analytic spheres.
+    pub bottom_levels: usize,
+    /// Their storage after compaction, bytes.
+    pub bottom_level_bytes: u64,
+    /// CPU wall time the bottom levels took to build and compact, once (ms).
+    pub bottom_level_build_ms: f64,
+    /// Top-level instances rebuilt every frame.
+    pub instances: usize,
+    /// The offset the shadow rays start off the surface (world units).
+    pub offset: f32,
 }

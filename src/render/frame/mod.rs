@@ -75,6 +75,8 @@ struct InFlight {
 
 #[derive(Default)]
 struct FrameSpans {
+    /// The frame's acceleration-structure builds (ray query).
+    accel: Span,
     depth: Span,
     frame: Span,
     shadow: Vec<Span>,
@@ -320,20 +322,25 @@ impl Renderer {
             let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
             d.begin_command_buffer(cb, &begin).map_err(Error::vk("vkBeginCommandBuffer"))?;
         }
-        s.timer.begin(&self.own.ctx, cb, 4 + 4 * nlights as u32)?;
-        if let (Some(rt), Technique::RayQuery) = (&mut self.own.parts.ray_tracer, settings.technique) {
-            // SAFETY: `cb` is recording outside a rendering instance; the slot retired.
-            unsafe { rt.cmd_build(&self.own.ctx, cb, slot, &self.own.parts.scene, eye)? };
-        }
+        s.timer.begin(&self.own.ctx, cb, 6 + 4 * nlights as u32)?;
         if settings.counters {
             s.counters.begin(&self.own.ctx, cb, nlights as u32)?;
+        }
+        let mut accel = Span::default();
+        if let (Some(rt), Technique::RayQuery) = (&mut self.own.parts.ray_tracer, settings.technique) {
+            let timer = &self.own.parts.slots[slot].timer;
+            accel.begin = timer.stamp(&self.own.ctx, cb, vk::PipelineStageFlags2::ALL_COMMANDS);
+            // SAFETY: `cb` is recording outside a rendering instance; the slot retired.
+            unsafe { rt.cmd_build(&self.own.ctx, cb, slot, &self.own.parts.scene, eye)? };
+            accel.end = timer.stamp(&self.own.ctx, cb, vk::PipelineStageFlags2::ALL_COMMANDS);
         }
         let s = &self.own.parts.slots[slot];
         let counters = settings.counters.then_some(&s.counters);
         let full = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: self.own.parts.targets.extent };
         let viewport = vk::Viewport { x: 0.0, y: 0.0, width: w as f32, height: h as f32, min_depth: 0.0, max_depth: 1.0 };
         let rec = Rec { ctx: &self.own.ctx, cb, full, viewport, timer: &s.timer, readback };
-        let spans = self.record_frame(&rec, &frame, &layout, (instances, spheres), vp_rel, &lights, float_counts, counters)?;
+        let mut spans = self.record_frame(&rec, &frame, &layout, (instances, spheres), vp_rel, &lights, float_counts, counters)?;
+        spans.accel = accel;
         // SAFETY: recording finished; the submission signals the slot's fence.
         unsafe {
             d.end_command_buffer(cb).map_err(Error::vk("vkEndCommandBuffer"))?;

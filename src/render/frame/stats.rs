@@ -27,6 +27,7 @@ impl Renderer {
                     shadow: per_light.iter().map(|l| l.shadow).sum(),
                     illuminate: per_light.iter().map(|l| l.illuminate).sum(),
                     frame: f.spans.frame.ms(&raw, p),
+                    accel: f.spans.accel.ms(&raw, p),
                     per_light,
                 })
             }
@@ -75,6 +76,10 @@ impl Renderer {
                 false => None,
             },
             warnings: f.frame.warnings.clone(),
+            ray_query: match (f.settings.technique, &self.own.parts.ray_tracer) {
+                (crate::render::Technique::RayQuery, Some(rt)) => Some(rt.stats()),
+                _ => None,
+            },
         })
     }
 }
