@@ -88,7 +88,7 @@ pub enum Technique {
         size: u32,
     },
     /// One shadow ray per pixel with `VK_KHR_ray_query` against acceleration structures of the
-    /// casters, writing the volumes' stencil (see [`super::raytrace`]).
+    /// casters, writing the volumes' stencil (docs/raytrace.md).
     RayQuery,
 }
 
