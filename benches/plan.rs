@@ -10,8 +10,7 @@ use umbrage::shadow::{plan_light, Caster, Method, PlanInput};
 
 fn bench(c: &mut Criterion) {
     let scene = umbrage::scene::load("bench/vertex").expect("bench/vertex loads");
-    let casters: Vec<Caster> =
-        scene.meshes.iter().filter(|m| m.casts_shadow).map(|m| Caster::from_scene_mesh(m).expect("caster builds")).collect();
+    let casters: Vec<Caster> = scene.meshes.iter().filter(|m| m.casts_shadow).map(|m| m.caster().expect("caster builds")).collect();
     let tris: usize = casters.iter().map(|c| c.triangle_count).sum();
     let (w, h) = (640u32, 480u32);
     let cam = &scene.camera;

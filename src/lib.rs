@@ -6,7 +6,7 @@
 //! Rust, no Vulkan) <- [`pass`] (the embeddable [`pass::ShadowPass`]: the plans on the GPU)
 //! which uses [`gpu`] (thin ash wrappers, knowing nothing of shadows). With the default
 //! feature `cli` the crate also has `scene` (TOML / OBJ / built-in scenes; the one place the
-//! algorithm meets it is `Caster::from_scene_mesh`, compiled only with `cli`), `render`
+//! algorithm meets it is `SceneMesh::caster`, in `scene`: `shadow` imports nothing of it), `render`
 //! (umbrage's own frame, a host of the pass), `reference` (the exact CPU ground truth, which
 //! shares nothing with the shadow algorithm but the camera model), `conform`, `bench`,
 //! `accuracy`, `output` and the `umbrage` binary on top.

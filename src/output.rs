@@ -278,7 +278,7 @@ fn mesh_caster_report(scene: &Scene) -> Result<Vec<CasterInfo>> {
         .iter()
         .filter(|m| m.casts_shadow)
         .map(|m| {
-            let c = crate::shadow::Caster::from_scene_mesh(m)?;
+            let c = m.caster()?;
             Ok(CasterInfo {
                 name: c.name.clone(),
                 path: c.kind.path().to_string(),

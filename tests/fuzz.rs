@@ -699,7 +699,7 @@ fn scene_text(rng: &mut Rng) -> String {
 
 /// Plans every caster of a loaded scene for every light and checks the volumes.
 fn plan_scene(scene: &umbrage::scene::Scene, method: Method) {
-    let casters: Vec<Caster> = scene.meshes.iter().filter(|m| m.casts_shadow).filter_map(|m| Caster::from_scene_mesh(m).ok()).collect();
+    let casters: Vec<Caster> = scene.meshes.iter().filter(|m| m.casts_shadow).filter_map(|m| m.caster().ok()).collect();
     for light in &scene.lights {
         let vp = scene.camera.proj_infinite(1.5) * scene.camera.view();
         let input = PlanInput { camera: &scene.camera, width: 96, height: 64, view_proj: vp, light, method };

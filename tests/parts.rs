@@ -19,7 +19,7 @@ use umbrage::shadow::{plan_light_opts, plan_light_with, Caster, Method, PlanInpu
 fn triangles(scene: &Scene, li: usize, w: u32, h: u32) -> (usize, usize) {
     let view_proj = scene.camera.proj_infinite(w as f32 / h as f32) * scene.camera.view();
     let input = PlanInput { camera: &scene.camera, width: w, height: h, view_proj, light: &scene.lights[li], method: Method::McGuire };
-    let parts: Vec<Caster> = scene.meshes.iter().filter(|m| m.casts_shadow).map(|m| Caster::from_scene_mesh(m).unwrap()).collect();
+    let parts: Vec<Caster> = scene.meshes.iter().filter(|m| m.casts_shadow).map(|m| m.caster().unwrap()).collect();
     let whole: Vec<Caster> = parts
         .iter()
         .cloned()

@@ -11,7 +11,6 @@ use gpu_allocator::vulkan::Allocator;
 use std::sync::{Arc, Mutex};
 use umbrage::pass::{lit_stencil_state, CasterId, DepthStencilTarget, EnabledFeatures, ShadowPass, ShadowPassDesc};
 use umbrage::scene::Scene;
-use umbrage::shadow::Caster;
 use wgpu::util::DeviceExt;
 
 /// Ring slots: two frames in flight.
@@ -258,7 +257,7 @@ impl Host {
             .map_err(|e| format!("ShadowPass::new: {e}"))?;
         for (mi, m) in host.scene.meshes.iter().enumerate() {
             if m.casts_shadow {
-                let caster = Caster::from_scene_mesh(m).map_err(|e| e.to_string())?;
+                let caster = m.caster().map_err(|e| e.to_string())?;
                 let id = pass.add_prepared_caster(caster, m.transform.as_dmat4()).map_err(|e| format!("caster '{}': {e}", m.name))?;
                 host.meshes[mi].caster = Some(id);
             }

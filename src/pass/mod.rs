@@ -362,7 +362,7 @@ impl ShadowPass {
         self.casters.add(&self.dev, caster, transform)
     }
 
-    /// Adds a caster prepared by the caller (e.g. `Caster::from_scene_mesh` with the `cli` feature, or [`Caster::new`] then [`Caster::into_transparent`]).
+    /// Adds a caster prepared by the caller (e.g. `SceneMesh::caster` with the `cli` feature, or [`Caster::new`] then [`Caster::into_transparent`]).
     pub fn add_prepared_caster(&mut self, caster: Caster, transform: DMat4) -> Result<CasterId> {
         casters::check_transform(&caster.name, &transform)?;
         if caster.transmittance.is_some() && self.pipes.transmit.is_none() {

@@ -31,6 +31,23 @@ pub struct SceneMesh {
 }
 
 impl SceneMesh {
+    /// This mesh as a shadow caster. A transparent mesh (opacity < 1) always takes the
+    /// multiplicity path, whose count is the number of surfaces crossed (Kim et al. 2008): each
+    /// one attenuates the light by `(1 - opacity) * color`.
+    pub fn caster(&self) -> crate::error::Result<crate::shadow::Caster> {
+        use crate::shadow::{Caster, CasterKind, TRANSMITTANCE_FLOOR};
+        let mut c = Caster::new(&self.name, &self.mesh, self.transform)?;
+        if self.opacity < 1.0 {
+            let reason = match &c.kind {
+                CasterKind::Manifold => format!("transparent (opacity {}): every surface crossed attenuates the light", self.opacity),
+                CasterKind::Multiplicity { reason } => reason.clone(),
+            };
+            c.make_whole_multiplicity(reason);
+            c.transmittance = Some(((1.0 - self.opacity) * self.color).max(Vec3::splat(TRANSMITTANCE_FLOOR)));
+        }
+        Ok(c)
+    }
+
     /// World-space box of the object bounds' transformed corners (conservative).
     pub fn world_bounds(&self) -> Aabb {
         self.mesh.bounds().transformed(&self.transform)

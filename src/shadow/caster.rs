@@ -10,8 +10,6 @@ use crate::error::{Error, Result};
 use crate::geom::silhouette::{EdgeScan, FacePlanes};
 use crate::geom::topology::Topology;
 use crate::geom::{Aabb, Mesh};
-#[cfg(feature = "cli")]
-use crate::scene::SceneMesh;
 use glam::{Mat4, Vec3};
 
 /// Most vertices a chunk may hold INCLUDING its apex, so that `2n - 1` fits in a u16.
@@ -141,23 +139,6 @@ pub struct Caster {
 }
 
 impl Caster {
-    /// A caster for a scene mesh. A transparent mesh (opacity < 1) always takes the
-    /// multiplicity path, whose count is the number of surfaces crossed (Kim et al. 2008): each
-    /// one attenuates the light by `(1 - opacity) * color`.
-    #[cfg(feature = "cli")]
-    pub fn from_scene_mesh(m: &SceneMesh) -> Result<Caster> {
-        let mut c = Caster::new(&m.name, &m.mesh, m.transform)?;
-        if m.opacity < 1.0 {
-            let reason = match &c.kind {
-                CasterKind::Manifold => format!("transparent (opacity {}): every surface crossed attenuates the light", m.opacity),
-                CasterKind::Multiplicity { reason } => reason.clone(),
-            };
-            c.make_whole_multiplicity(reason);
-            c.transmittance = Some(((1.0 - m.opacity) * m.color).max(glam::Vec3::splat(TRANSMITTANCE_FLOOR)));
-        }
-        Ok(c)
-    }
-
     /// A caster for `mesh` placed by `transform` (object -> world): validates the mesh, welds it,
     /// classifies it (manifold or multiplicity) and splits it into chunks. Fails on an invalid
     /// mesh or a singular transform.

@@ -7,7 +7,7 @@ pub mod edgequad;
 pub mod plan;
 pub mod testmesh;
 
-pub use caster::{Caster, CasterKind, Chunk, Part};
+pub use caster::{Caster, CasterKind, Chunk, Part, TRANSMITTANCE_FLOOR};
 pub use plan::{
     plan_light, plan_light_opts, plan_light_with, Case, CasterPlan, ChunkDraw, DarkCap, LightPlan, Method, PartPlan, PlanInput, PlanOptions,
 };

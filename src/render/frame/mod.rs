@@ -538,7 +538,7 @@ impl Parts {
         let mut caster_ids = Vec::with_capacity(scene.meshes.len());
         for m in &scene.meshes {
             caster_ids.push(match m.casts_shadow {
-                true => Some(pass.add_prepared_caster(Caster::from_scene_mesh(m)?, m.transform.as_dmat4())?),
+                true => Some(pass.add_prepared_caster(m.caster()?, m.transform.as_dmat4())?),
                 false => None,
             });
         }
