@@ -150,8 +150,8 @@ impl<T: Destroy> Drop for Owned<T> {
 mod impls {
     use super::{Context, Destroy};
     use crate::render::{
-        pipelines::FramePipelines, scene_gpu::SceneGeometry, selfshadow::SelfShadow, shadowmap::ShadowMapper, sphere_gpu::SphereGeometry,
-        targets::Targets,
+        passes::selfshadow::SelfShadow, passes::shadowmap::ShadowMapper, pipelines::FramePipelines, scene_gpu::SceneGeometry,
+        sphere_gpu::SphereGeometry, targets::Targets,
     };
 
     macro_rules! safe_destroy {

@@ -27,8 +27,8 @@ pub mod push;
 pub(crate) mod raytrace;
 mod readback;
 mod scene_gpu;
-mod selfshadow;
-pub mod shadowmap;
+/// The shadow-map baseline (a pass of the frame, in `passes/`).
+pub use passes::shadowmap;
 mod sphere_gpu;
 pub mod stats;
 pub mod targets;

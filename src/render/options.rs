@@ -151,7 +151,7 @@ pub struct RenderConfig {
     pub depth_mode: DepthMode,
     /// The light-intensity map's format: RGBA32F (true) or RGBA16F.
     pub transmit_fp32: bool,
-    /// Partial self-shadowing of transparent casters (src/render/selfshadow.rs).
+    /// Partial self-shadowing of transparent casters (src/render/passes/selfshadow.rs).
     pub self_shadow: bool,
     /// Frames the renderer keeps in flight (command buffers, fences, readbacks per slot).
     pub frames_in_flight: usize,
@@ -205,7 +205,7 @@ pub struct RenderOptions {
     pub transmit: TransmitMode,
     /// Read back per-light stencil counts, positions and normals (dumps, tests).
     pub capture: bool,
-    /// Partial self-shadowing of transparent casters (src/render/selfshadow.rs); no effect on
+    /// Partial self-shadowing of transparent casters (src/render/passes/selfshadow.rs); no effect on
     /// scenes without them.
     pub self_shadow: bool,
     /// Frames in flight (at least 1).

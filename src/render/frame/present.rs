@@ -4,9 +4,9 @@
 use super::Renderer;
 use crate::error::{Error, Result};
 use crate::gpu::Image;
+use crate::render::passes::selfshadow::SelfShadow;
 use crate::render::pipelines::FramePipelines;
 use crate::render::scene_gpu::Sidedness;
-use crate::render::selfshadow::SelfShadow;
 use crate::render::targets::Targets;
 use ash::vk;
 

@@ -1,12 +1,15 @@
 //! The frame's passes, one file each, in the order [`Renderer::render`](super::Renderer) runs
-//! them: G-buffer, per light determination (+ light-intensity map) and illumination, the
-//! transparent casters, the debug views, the tone map.
+//! them: G-buffer, per light determination (+ light-intensity map; the shadow-map baseline's
+//! maps and lookup, `shadowmap`) and illumination, the transparent casters (with
+//! `--self-shadow`, `selfshadow`), the debug views, the tone map.
 
 pub(crate) mod debug;
 pub(crate) mod determine;
 pub(crate) mod gbuffer;
 pub(crate) mod illuminate;
 pub(crate) mod intensity;
+pub(crate) mod selfshadow;
+pub mod shadowmap;
 pub(crate) mod tonemap;
 pub(crate) mod transparent;
 

@@ -11,12 +11,12 @@
 //! acne and peter-panning — so unlike shadow volumes, its error is not zero, and the bench says
 //! how large it is.
 
-use super::targets::{Targets, COUNT_FORMAT};
 use crate::error::{Error, Result};
 use crate::gpu::descriptors::{pipeline_layout, Binding, DescriptorSet};
 use crate::gpu::pipeline::{self, Blend, PipelineDesc};
 use crate::gpu::resources::{memory_barrier, transition};
 use crate::gpu::{shaders, Buffer, Context, Image};
+use crate::render::targets::{Targets, COUNT_FORMAT};
 use crate::scene::{Camera, LightKind, Scene};
 use ash::vk;
 use glam::{DVec3, Mat4, Vec3, Vec4};

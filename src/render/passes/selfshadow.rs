@@ -30,16 +30,16 @@
 //! Everything here runs only when `RenderOptions::self_shadow` is set and the scene has
 //! transparent casters; otherwise the frame records exactly the passes it did before.
 
-use super::passes::{att, transparent, Rec, COLOR_RW, DS_CLEAR, DS_RW, FRAG_TESTS, ZERO};
-use super::pipelines::{scene_pipeline, FramePipelines};
-use super::push::{ForwardPush, LightPush};
-use super::scene_gpu::SceneGeometry;
-use super::targets::*;
+use super::{att, transparent, Rec, COLOR_RW, DS_CLEAR, DS_RW, FRAG_TESTS, ZERO};
 use crate::error::Result;
 use crate::gpu::descriptors::{pipeline_layout, Binding, DescriptorSet};
 use crate::gpu::pipeline::{self, Blend};
 use crate::gpu::{shaders, Context, Image};
 use crate::pass::{PreparedFrame, ShadowPass, VolumeKind};
+use crate::render::pipelines::{scene_pipeline, FramePipelines};
+use crate::render::push::{ForwardPush, LightPush};
+use crate::render::scene_gpu::SceneGeometry;
+use crate::render::targets::*;
 use ash::vk;
 use glam::Mat4;
 
