@@ -115,11 +115,6 @@ impl Geometry<'_> {
     }
 }
 
-fn bytes<T: Copy>(v: &[T]) -> &[u8] {
-    // SAFETY: plain-old-data arrays of f32/u32 (no padding, no pointers) viewed as bytes.
-    unsafe { std::slice::from_raw_parts(v.as_ptr() as *const u8, std::mem::size_of_val(v)) }
-}
-
 fn scratch(ctx: &Context, name: &str, size: u64) -> Result<(Buffer, u64)> {
     let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS;
     let b = Buffer::new(ctx, name, size + SCRATCH_SLACK, usage, MemoryLocation::GpuOnly)?;
@@ -149,8 +144,8 @@ fn build_blas_inner(
 ) -> Result<Accel> {
     let geom = match geometry {
         Geometry::Triangles { positions, indices } => {
-            inputs.push(Buffer::with_data(ctx, "blas vertices", bytes(positions), INPUT)?);
-            inputs.push(Buffer::with_data(ctx, "blas indices", bytes(indices), INPUT)?);
+            inputs.push(Buffer::with_data(ctx, "blas vertices", bytemuck::cast_slice(positions), INPUT)?);
+            inputs.push(Buffer::with_data(ctx, "blas indices", bytemuck::cast_slice(indices), INPUT)?);
             let tri = vk::AccelerationStructureGeometryTrianglesDataKHR::default()
                 .vertex_format(vk::Format::R32G32B32_SFLOAT)
                 .vertex_data(vk::DeviceOrHostAddressConstKHR { device_address: address(ctx, &inputs[0]) })
@@ -164,7 +159,7 @@ fn build_blas_inner(
                 .flags(vk::GeometryFlagsKHR::OPAQUE)
         }
         Geometry::Aabbs(boxes) => {
-            inputs.push(Buffer::with_data(ctx, "blas boxes", bytes(boxes), INPUT)?);
+            inputs.push(Buffer::with_data(ctx, "blas boxes", bytemuck::cast_slice(boxes), INPUT)?);
             let aabbs = vk::AccelerationStructureGeometryAabbsDataKHR::default()
                 .data(vk::DeviceOrHostAddressConstKHR { device_address: address(ctx, &inputs[0]) })
                 .stride(24);
@@ -341,7 +336,7 @@ impl Tlas {
         let raw: Vec<vk::AccelerationStructureInstanceKHR> = instances
             .iter()
             .map(|i| vk::AccelerationStructureInstanceKHR {
-                transform: vk::TransformMatrixKHR { matrix: bytemuck_rows(&i.transform) },
+                transform: vk::TransformMatrixKHR { matrix: bytemuck::cast(i.transform) },
                 instance_custom_index_and_mask: vk::Packed24_8::new(i.custom & 0xff_ffff, i.mask),
                 instance_shader_binding_table_record_offset_and_flags: vk::Packed24_8::new(0, i.flags.as_raw() as u8),
                 acceleration_structure_reference: vk::AccelerationStructureReferenceKHR { device_handle: i.blas },
@@ -378,14 +373,6 @@ impl Tlas {
         self.instances.destroy(ctx);
         self.scratch.destroy(ctx);
     }
-}
-
-fn bytemuck_rows(rows: &[[f32; 4]; 3]) -> [f32; 12] {
-    let mut m = [0.0; 12];
-    for (r, row) in rows.iter().enumerate() {
-        m[r * 4..r * 4 + 4].copy_from_slice(row);
-    }
-    m
 }
 
 fn top_geometry(instances: u64) -> vk::AccelerationStructureGeometryKHR<'static> {

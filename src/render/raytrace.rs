@@ -61,10 +61,12 @@ pub struct RayTracer {
     sets: Vec<DescriptorSet>,
     layout: vk::PipelineLayout,
     pipeline: vk::Pipeline,
-    /// World units the open casters' rays start off the surface (and every ray stops short of
-    /// a point light): the CPU reference's surface offset, 2e-5 of the scene's diagonal, or
-    /// 2^-16 of the largest eye-relative coordinate if that is larger (128 f32 ulps: far above
-    /// the few ulps the G-buffer's interpolated position can be off by).
+    /// The CPU reference's surface offset, 2e-5 of the scene's diagonal (world units).
+    reference_offset: f32,
+    /// World units this frame's rays start off the surface (and stop short of a point light):
+    /// [`RayTracer::reference_offset`], or 2^-16 of the largest eye-relative coordinate if that
+    /// is larger (128 f32 ulps: far above the few ulps the G-buffer's interpolated position can
+    /// be off by). Set by [`RayTracer::cmd_build`] for the eye of the frame it records.
     pub offset: f32,
     /// Bytes of bottom-level storage (after compaction).
     pub blas_bytes: u64,
@@ -119,6 +121,7 @@ impl RayTracer {
             sets: Vec::new(),
             layout: vk::PipelineLayout::null(),
             pipeline: vk::Pipeline::null(),
+            reference_offset: 0.0,
             offset: 0.0,
             blas_bytes: 0,
             blas_build_ms: 0.0,
@@ -221,12 +224,13 @@ impl RayTracer {
         d.stencil = Some((mark, mark));
         self.pipeline = pipeline::create(ctx, &d)?;
         let size = scene_size(scene);
-        self.offset = (2e-5 * size) as f32;
+        self.reference_offset = (2e-5 * size) as f32;
+        self.offset = self.reference_offset;
         Ok(())
     }
 
     /// Rewrites slot `slot`'s top level from the meshes' current transforms (relative to
-    /// `eye`) and records its build; also raises [`RayTracer::offset`] if the scene's
+    /// `eye`) and records its build; sets [`RayTracer::offset`] for the scene's
     /// eye-relative extent needs it.
     ///
     /// # Safety
@@ -258,7 +262,7 @@ impl RayTracer {
                 extent = extent.max((s.sphere.center - eye).abs().max_element() + s.sphere.radius);
             }
         }
-        self.offset = self.offset.max((extent * 2f64.powi(-16)) as f32);
+        self.offset = self.reference_offset.max((extent * 2f64.powi(-16)) as f32);
         // SAFETY: forwarded to the caller's contract.
         unsafe { self.tlas[slot].cmd_build(ctx, &self.loader, cb, &instances) }
     }

@@ -403,9 +403,7 @@ impl Renderer {
                     sm.record(rec.ctx, rec.cb, t, light, self.own.parts.scene.camera.eye.as_dvec3(), frame.lights[li].scissor);
                 }
                 if let (Some(rt), Technique::RayQuery) = (&self.own.parts.ray_tracer, self.settings.technique) {
-                    let l = light.homogeneous().as_dvec4();
-                    let rel = if l.w == 0.0 { l } else { (l.truncate() - self.own.parts.scene.camera.eye.as_dvec3()).extend(1.0) };
-                    rt.cmd_determine(rec, t, frame.slot(), rel.as_vec4().to_array(), frame.lights[li].scissor);
+                    rt.cmd_determine(rec, t, frame.slot(), lights[li].light_pos, frame.lights[li].scissor);
                 }
                 determine::record(rec, pass, frame, li, t, into, layout.counts.get(li).copied())?;
                 if let Some(c) = counters {
