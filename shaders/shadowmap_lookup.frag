@@ -1,8 +1,10 @@
 #version 450
 // Shadow-map baseline, lookup: for each visible surface point (G-buffer), the fraction of
 // 3x3 percentage-closer-filtering taps that see an occluder nearer the light, written into
-// the float counter target (0 = lit). A point light has six faces in one atlas; one pass per
-// face handles the points whose direction from the light falls in that face.
+// the float counter target (0 = lit). One full-screen pass per light: a point light's six
+// faces sit in one atlas, and each point picks its face here (the face matrices come from a
+// storage buffer the pass updates per light). The depth comparison is the sampler's (a
+// hardware compare sampler, nearest filtering: the same nine taps as a shader compare).
 layout(set = 0, binding = 0) uniform texture2D t_albedo;
 layout(set = 0, binding = 1) uniform texture2D t_normal;
 layout(set = 0, binding = 2) uniform texture2D t_position;
@@ -10,12 +12,21 @@ layout(set = 0, binding = 3) uniform sampler s_nearest;
 layout(set = 0, binding = 4) uniform texture2D t_count;
 layout(set = 0, binding = 5) uniform texture2D t_transmit;
 layout(set = 0, binding = 6) uniform texture2D t_map;
+layout(set = 0, binding = 7) uniform samplerShadow s_compare;
+
+struct Face {
+    mat4 view_proj;  // eye-relative world -> this face's clip space
+    vec4 tile;       // atlas tile: x0, y0, width, height (texels)
+    vec4 params;     // x: unused, y: compare bias, z: normal offset
+};
+
+layout(std430, set = 0, binding = 8) readonly buffer Faces {
+    Face faces[6];
+};
 
 layout(push_constant) uniform Push {
-    mat4 light_view_proj;  // eye-relative world -> this face's clip space
-    vec4 tile;             // atlas tile: x0, y0, width, height (texels)
-    vec4 light;            // xyz eye-relative light position (w = 1) or towards-light direction (w = 0)
-    vec4 params;           // x: face (0..5, -1 = single map), y: compare bias, z: normal offset
+    vec4 light;   // xyz eye-relative light position (w = 1) or towards-light direction (w = 0)
+    vec4 params;  // x: faces (1 or 6), yz: 1 / atlas size (texels)
 } pc;
 
 layout(location = 0) out vec4 out_shadow;
@@ -27,23 +38,21 @@ void main() {
         discard;
     }
     vec3 n = normalize(texelFetch(sampler2D(t_normal, s_nearest), px, 0).xyz);
-    if (pc.params.x >= 0.0) {
+    int face = 0;
+    if (pc.params.x > 1.0) {
         // Cube face of the direction from the light: 0 +x, 1 -x, 2 +y, 3 -y, 4 +z, 5 -z.
         vec3 d = pos.xyz - pc.light.xyz;
         vec3 a = abs(d);
-        float face;
         if (a.x >= a.y && a.x >= a.z) {
-            face = d.x > 0.0 ? 0.0 : 1.0;
+            face = d.x > 0.0 ? 0 : 1;
         } else if (a.y >= a.z) {
-            face = d.y > 0.0 ? 2.0 : 3.0;
+            face = d.y > 0.0 ? 2 : 3;
         } else {
-            face = d.z > 0.0 ? 4.0 : 5.0;
-        }
-        if (face != pc.params.x) {
-            discard;
+            face = d.z > 0.0 ? 4 : 5;
         }
     }
-    vec4 q = pc.light_view_proj * vec4(pos.xyz + n * pc.params.z, 1.0);
+    vec4 tile = faces[face].tile;
+    vec4 q = faces[face].view_proj * vec4(pos.xyz + n * faces[face].params.z, 1.0);
     if (q.w <= 0.0) {
         out_shadow = vec4(0.0);
         return;
@@ -56,14 +65,15 @@ void main() {
         out_shadow = vec4(0.0);
         return;
     }
-    vec2 texel = pc.tile.xy + uv * pc.tile.zw;
-    float shadowed = 0.0;
+    vec2 texel = tile.xy + uv * tile.zw;
+    float reference = ndc.z - faces[face].params.y;
+    float lit = 0.0;
     for (int j = -1; j <= 1; j++) {
         for (int i = -1; i <= 1; i++) {
-            ivec2 t = ivec2(clamp(texel + vec2(float(i), float(j)), pc.tile.xy, pc.tile.xy + pc.tile.zw - 1.0));
-            float stored = texelFetch(sampler2D(t_map, s_nearest), t, 0).r;
-            shadowed += (ndc.z - pc.params.y > stored) ? 1.0 : 0.0;
+            // The tap's texel, kept inside this face's tile, sampled at its centre.
+            vec2 t = floor(clamp(texel + vec2(float(i), float(j)), tile.xy, tile.xy + tile.zw - 1.0)) + 0.5;
+            lit += textureLod(sampler2DShadow(t_map, s_compare), vec3(t * pc.params.yz, reference), 0.0);
         }
     }
-    out_shadow = vec4(shadowed / 9.0, 0.0, 0.0, 0.0);
+    out_shadow = vec4(1.0 - lit / 9.0, 0.0, 0.0, 0.0);
 }

@@ -17,6 +17,9 @@ pub struct GpuMs {
     pub frame: f64,
     /// The frame's acceleration-structure builds (ray query: the top level; 0 otherwise).
     pub accel: f64,
+    /// Of `shadow`, the shadow-map baseline's map rendering (every light's maps; 0 for the
+    /// other techniques). `shadow - shadow_map` is its lookup.
+    pub shadow_map: f64,
     /// Per light, in the frame's light order.
     pub per_light: Vec<LightGpuMs>,
 }
@@ -26,6 +29,8 @@ pub struct GpuMs {
 pub struct LightGpuMs {
     /// Its determination (and the shadow-map passes for the baseline).
     pub shadow: f64,
+    /// Of `shadow`, rendering its shadow maps (the baseline; 0 otherwise).
+    pub shadow_map: f64,
     /// Its illumination.
     pub illuminate: f64,
 }

@@ -80,6 +80,8 @@ struct FrameSpans {
     depth: Span,
     frame: Span,
     shadow: Vec<Span>,
+    /// Per light, the shadow-map baseline's map rendering (a prefix of its `shadow` span).
+    shadow_map: Vec<Span>,
     illuminate: Vec<Span>,
 }
 
@@ -120,6 +122,9 @@ struct Parts {
     self_shadow: Option<SelfShadow>,
     /// The shadow-map baseline and the scene version it was built for.
     shadow_mapper: Option<(ShadowMapper, u64)>,
+    /// Baselines of other map sizes built earlier and kept (a bench alternating techniques
+    /// neither rebuilds them nor times a freshly allocated atlas); dropped when stale.
+    spare_shadow_mappers: Vec<(ShadowMapper, u64)>,
     /// The ray-query technique's acceleration structures.
     ray_tracer: Option<RayTracer>,
     slots: Vec<FrameSlot>,
@@ -136,7 +141,7 @@ impl Destroy for Parts {
         unsafe {
             self.slots.destroy(ctx);
             self.pipes.destroy(ctx);
-            if let Some((sm, _)) = &mut self.shadow_mapper {
+            for (sm, _) in self.shadow_mapper.iter_mut().chain(self.spare_shadow_mappers.iter_mut()) {
                 sm.destroy(ctx);
             }
             if let Some(rt) = &mut self.ray_tracer {
@@ -322,7 +327,7 @@ impl Renderer {
             let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
             d.begin_command_buffer(cb, &begin).map_err(Error::vk("vkBeginCommandBuffer"))?;
         }
-        s.timer.begin(&self.own.ctx, cb, 6 + 4 * nlights as u32)?;
+        s.timer.begin(&self.own.ctx, cb, 6 + 5 * nlights as u32)?;
         if settings.counters {
             s.counters.begin(&self.own.ctx, cb, nlights as u32)?;
         }
@@ -400,7 +405,10 @@ impl Renderer {
                 }
                 if let Some((sm, _)) = &self.own.parts.shadow_mapper {
                     determine::begin_float(rec, t);
-                    sm.record(rec.ctx, rec.cb, t, light, self.own.parts.scene.camera.eye.as_dvec3(), frame.lights[li].scissor);
+                    let eye = self.own.parts.scene.camera.eye.as_dvec3();
+                    let faces = sm.record_maps(rec.ctx, rec.cb, light, eye);
+                    spans.shadow_map.push(passes::timing_span(begin, stamp(all)));
+                    sm.record_lookup(rec.ctx, rec.cb, t, light, eye, &faces, frame.lights[li].scissor);
                 }
                 if let (Some(rt), Technique::RayQuery) = (&self.own.parts.ray_tracer, self.settings.technique) {
                     rt.cmd_determine(rec, t, frame.slot(), lights[li].light_pos, frame.lights[li].scissor);
@@ -569,6 +577,7 @@ impl Parts {
             pipes: pipes.into_inner(),
             self_shadow: self_shadow.into_inner(),
             shadow_mapper: None,
+            spare_shadow_mappers: Vec::new(),
             ray_tracer: None,
             slots,
             next_slot: 0,

@@ -68,7 +68,7 @@ impl Renderer {
             ss.destroy(ctx);
         }
         // The shadow maps' screen-space passes are sized by the targets: rebuilt next frame.
-        if let Some((mut sm, _)) = self.own.parts.shadow_mapper.take() {
+        for (mut sm, _) in self.own.parts.shadow_mapper.take().into_iter().chain(self.own.parts.spare_shadow_mappers.drain(..)) {
             sm.destroy(ctx);
         }
         self.own.parts.config.width = width;

@@ -20,7 +20,12 @@ impl Renderer {
                     .shadow
                     .iter()
                     .zip(&f.spans.illuminate)
-                    .map(|(s, i)| LightGpuMs { shadow: s.ms(&raw, p), illuminate: i.ms(&raw, p) })
+                    .enumerate()
+                    .map(|(li, (s, i))| LightGpuMs {
+                        shadow: s.ms(&raw, p),
+                        shadow_map: f.spans.shadow_map.get(li).map_or(0.0, |m| m.ms(&raw, p)),
+                        illuminate: i.ms(&raw, p),
+                    })
                     .collect();
                 Some(GpuMs {
                     depth: f.spans.depth.ms(&raw, p),
@@ -28,6 +33,7 @@ impl Renderer {
                     illuminate: per_light.iter().map(|l| l.illuminate).sum(),
                     frame: f.spans.frame.ms(&raw, p),
                     accel: f.spans.accel.ms(&raw, p),
+                    shadow_map: per_light.iter().map(|l| l.shadow_map).sum(),
                     per_light,
                 })
             }

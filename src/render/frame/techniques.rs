@@ -20,25 +20,40 @@ impl Renderer {
         Ok(())
     }
 
-    /// (Re)builds the shadow-map baseline when asked for, or when its size or the scene's
-    /// placement changed; drops it when another technique runs.
+    /// Makes the shadow-map baseline of the asked size current (built, or taken from the
+    /// kept ones when built for the scene's placement now), and sets it aside when another
+    /// technique runs; baselines built for an older placement are destroyed.
     pub(super) fn update_shadow_mapper(&mut self, technique: Technique) -> Result<()> {
         let wanted = match technique {
             Technique::ShadowMap { size } => Some(size),
             _ => None,
         };
-        let current = self.own.parts.shadow_mapper.as_ref().map(|(m, v)| (m.size, *v));
-        if wanted.map(|s| (s, self.own.parts.scene_version)) == current {
+        let version = self.own.parts.scene_version;
+        let parts = &mut self.own.parts;
+        let current = parts.shadow_mapper.as_ref().map(|(m, v)| (m.size, *v));
+        if wanted.map(|s| (s, version)) == current {
             return Ok(());
         }
-        if let Some((mut old, _)) = self.own.parts.shadow_mapper.take() {
+        if let Some(old) = parts.shadow_mapper.take() {
+            parts.spare_shadow_mappers.push(old);
+        }
+        if parts.spare_shadow_mappers.iter().any(|(_, v)| *v != version) {
             // SAFETY: waiting for idle before destroying objects a frame in flight may use.
             unsafe { self.own.ctx.device.device_wait_idle() }.map_err(Error::vk("vkDeviceWaitIdle"))?;
-            old.destroy(&self.own.ctx);
+            let (stale, kept): (Vec<_>, Vec<_>) =
+                std::mem::take(&mut parts.spare_shadow_mappers).into_iter().partition(|(_, v)| *v != version);
+            parts.spare_shadow_mappers = kept;
+            for (mut sm, _) in stale {
+                sm.destroy(&self.own.ctx);
+            }
         }
         if let Some(size) = wanted {
-            let sm = ShadowMapper::new(&self.own.ctx, &self.own.parts.scene, &self.own.parts.targets, size, self.own.parts.pipes.sampler)?;
-            self.own.parts.shadow_mapper = Some((sm, self.own.parts.scene_version));
+            if let Some(i) = parts.spare_shadow_mappers.iter().position(|(m, _)| m.size == size) {
+                parts.shadow_mapper = Some(parts.spare_shadow_mappers.swap_remove(i));
+            } else {
+                let sm = ShadowMapper::new(&self.own.ctx, &parts.scene, &parts.targets, size, parts.pipes.sampler)?;
+                parts.shadow_mapper = Some((sm, version));
+            }
         }
         Ok(())
     }
