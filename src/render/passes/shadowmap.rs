@@ -86,9 +86,15 @@ struct LookupPush {
     params: [f32; 4],
 }
 
-/// One map to render and look up: the eye-relative light view-projection, its atlas tile,
-/// and the cube face it stands for (-1 for a single map).
-pub(crate) struct Face {
+/// One light's rendered maps, for [`ShadowMapper::record_lookup`].
+pub(crate) struct LightMaps {
+    faces: Vec<Face>,
+    /// Eye-relative light position (w = 1) or towards-light direction (w = 0).
+    light: Vec4,
+}
+
+/// One map to render and look up: the eye-relative light view-projection and its atlas tile.
+struct Face {
     view_proj: Mat4,
     tile: [u32; 2],
     /// World size of one texel near the casters (for the normal offset).
@@ -327,7 +333,7 @@ impl ShadowMapper {
     /// Renders light `light`'s maps into the atlas (one rendering instance, each caster mesh
     /// only into the faces it can be seen in) and returns the faces for
     /// [`ShadowMapper::record_lookup`]. Leaves the atlas in SHADER_READ_ONLY_OPTIMAL.
-    pub(crate) fn record_maps(&self, ctx: &Context, cb: vk::CommandBuffer, light: &crate::scene::Light, eye: DVec3) -> Vec<Face> {
+    pub(crate) fn record_maps(&self, ctx: &Context, cb: vk::CommandBuffer, light: &crate::scene::Light, eye: DVec3) -> LightMaps {
         let d = &ctx.device;
         let faces = self.faces(light, eye);
         let full = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: self.atlas.extent };
@@ -379,22 +385,18 @@ impl ShadowMapper {
             d.cmd_end_rendering(cb);
         }
         transition(ctx, cb, &self.atlas, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
-        faces
+        let light = match light.kind {
+            LightKind::Directional => (-light.direction.normalize()).extend(0.0),
+            _ => (light.position.as_dvec3() - eye).as_vec3().extend(1.0),
+        };
+        LightMaps { faces, light }
     }
 
     /// Writes light `light`'s shadow fractions into `targets.count` (which must be in
     /// COLOR_ATTACHMENT_OPTIMAL; it is left there) from the maps [`ShadowMapper::record_maps`]
-    /// just rendered: one full-screen pass inside `scissor`.
-    pub(crate) fn record_lookup(
-        &self,
-        ctx: &Context,
-        cb: vk::CommandBuffer,
-        targets: &Targets,
-        light: &crate::scene::Light,
-        eye: DVec3,
-        faces: &[Face],
-        scissor: vk::Rect2D,
-    ) {
+    /// rendered for that light: one full-screen pass inside `scissor`.
+    pub(crate) fn record_lookup(&self, ctx: &Context, cb: vk::CommandBuffer, targets: &Targets, maps: &LightMaps, scissor: vk::Rect2D) {
+        let faces = &maps.faces;
         let d = &ctx.device;
         let mut rows = [FaceRow::default(); 6];
         for (row, f) in rows.iter_mut().zip(faces) {
@@ -410,12 +412,8 @@ impl ShadowMapper {
             .load_op(vk::AttachmentLoadOp::CLEAR)
             .store_op(vk::AttachmentStoreOp::STORE)
             .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: [0.0; 4] } })];
-        let light_h = match light.kind {
-            LightKind::Directional => (-light.direction.normalize()).extend(0.0),
-            _ => (light.position.as_dvec3() - eye).as_vec3().extend(1.0),
-        };
         let (aw, ah) = (self.atlas.extent.width as f32, self.atlas.extent.height as f32);
-        let push = LookupPush { light: light_h.to_array(), params: [faces.len() as f32, 1.0 / aw, 1.0 / ah, 0.0] };
+        let push = LookupPush { light: maps.light.to_array(), params: [faces.len() as f32, 1.0 / aw, 1.0 / ah, 0.0] };
         let (w, h) = (targets.extent.width as f32, targets.extent.height as f32);
         let shader_read = (vk::PipelineStageFlags2::FRAGMENT_SHADER, vk::AccessFlags2::SHADER_STORAGE_READ);
         let transfer_write = (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE);
