@@ -67,9 +67,21 @@ fn tiny_suite_writes_the_contract_and_the_plots() {
         keys(&r["limits"], &["stencil_fill_gfrag_s", "small_tri_mtri_s", "draws_per_s"], "row limits");
         let bound = r["bound"].as_str().unwrap();
         assert!(["fill", "vertex", "draw", "cpu"].contains(&bound), "bound {bound}");
+        keys(r, &["gpu_shadow_ms_p10", "gpu_shadow_ms_p90", "predicted_shadow_ms", "bound_clear", "fixed_fraction"], "row");
+        let (lo, mid, hi) =
+            (r["gpu_shadow_ms_p10"].as_f64().unwrap(), r["gpu_shadow_ms"].as_f64().unwrap(), r["gpu_shadow_ms_p90"].as_f64().unwrap());
+        assert!(lo <= mid && mid <= hi, "spread {lo} {mid} {hi}");
+        // The model's shares of the time: none above the time, together at most all of it.
+        let share: f64 =
+            ["fill_fraction", "vertex_fraction", "draw_fraction", "fixed_fraction"].iter().map(|k| r[*k].as_f64().unwrap()).sum();
+        assert!(share <= 1.0 + 1e-9 && share > 0.0, "fractions sum to {share}");
+        if r["method"].as_str().unwrap().starts_with("shadowmap") {
+            let (map, lookup) = (r["gpu_map_ms"].as_f64().unwrap(), r["gpu_lookup_ms"].as_f64().unwrap());
+            assert!(map > 0.0 && lookup > 0.0, "shadow map split {map} + {lookup}");
+        }
     }
     // Every sweep and every technique is there.
-    for s in ["scenes", "resolution", "tessellation", "lights", "light_distance", "casters", "ablation"] {
+    for s in ["scenes", "resolution", "tessellation", "lights", "light_distance", "casters", "caps", "ablation"] {
         assert!(rows.iter().any(|r| r["sweep"] == s), "no {s} rows");
     }
     let methods: Vec<&str> = rows.iter().filter(|r| r["sweep"] == "tessellation").filter_map(|r| r["method"].as_str()).collect();
@@ -88,7 +100,13 @@ fn tiny_suite_writes_the_contract_and_the_plots() {
     let csv = std::fs::read_to_string(dir.join("bench.csv")).unwrap();
     assert_eq!(csv.lines().count(), rows.len() + 1);
     assert!(csv.lines().next().unwrap().starts_with("suite,sweep,x,"));
-    for p in ["time_vs_triangles", "time_vs_resolution", "roofline", "pareto"] {
+    // The cost model, checked on held-out rows.
+    let model = &v["model"];
+    keys(model, &["form", "coefficients", "median_rel_error", "p80_rel_error"], "model");
+    assert!(model["coefficients"].as_object().unwrap().values().all(|c| c.as_f64().unwrap() >= 0.0));
+    assert!(model["median_rel_error"].as_f64().unwrap().is_finite());
+    keys(limits, &["setup_tri_mtri_s", "clip_tri_mtri_s", "sweeps"], "limits");
+    for p in ["time_vs_triangles", "time_vs_resolution", "roofline", "pareto", "model_fit"] {
         for ext in ["svg", "png"] {
             let f = dir.join(format!("{p}.{ext}"));
             let len = std::fs::metadata(&f).map(|m| m.len()).unwrap_or(0);
@@ -101,6 +119,7 @@ fn tiny_suite_writes_the_contract_and_the_plots() {
     assert_eq!(&png[1..4], b"PNG");
     let md = std::fs::read_to_string(dir.join("bench.md")).unwrap();
     assert!(md.contains("## Limits") && md.contains("## Crossovers") && md.contains("## Ablations"));
+    assert!(md.contains("## Cost model") && md.contains("## Shadow maps: map against lookup") && md.contains("## The paper's claim"));
     let _ = std::fs::remove_dir_all(&dir);
 }
 

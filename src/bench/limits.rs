@@ -1,20 +1,26 @@
 //! The device's limits, measured in the same run as the suite by micro-benchmarks of their own,
-//! each a small pipeline of [`crate::gpu`] on an offscreen target of the suite's base size:
+//! each a small pipeline of [`crate::gpu`] on an offscreen target of the suite's base size.
+//! Each limit isolates one cost and is swept: the workload doubles until its rate stops
+//! growing (saturation: per-submission and warm-up costs amortised), and the peak is reported,
+//! the sweep itself kept in `Limits::sweeps`.
 //!
-//! | limit | what is drawn | counted as |
+//! | limit | what is drawn | why it bounds |
 //! |---|---|---|
-//! | stencil fill | full-screen quads, alternate windings, two-sided INCR_WRAP / DECR_WRAP, depth test LESS on | fragments / s |
-//! | colour fill | full-screen quads into RGBA16F, additive blending, depth test LEQUAL on (the illumination pass's state) | fragments / s |
-//! | small triangles | a grid of 2-pixel triangles over the whole target (stencil-only, as the shadow pass) | triangles / s |
-//! | big triangles | screen-covering triangles (stencil-only) | triangles / s |
-//! | slivers | 1-pixel-wide triangles from the centre past the edges (shadow-volume sides) | triangles / s |
-//! | index fetch | one 256-vertex patch drawn through u8, u16 and u32 indices and as streamed 4 x f32 vertices | triangles / s |
-//! | draw calls | one tiny triangle per `vkCmdDraw`, each with its push constants and vertex binding (as the shadow pass) | draws / s |
-//! | CPU stream | a sum over a buffer far larger than the caches | GiB / s |
+//! | stencil fill | full-screen quads, alternate windings, two-sided INCR_WRAP / DECR_WRAP, depth test LESS on | two triangles a layer: next to no setup, every sample a stencil fragment |
+//! | colour fill | the same quads into RGBA16F, additive blending, depth test LEQUAL (the illumination pass's state) | as above, with colour |
+//! | triangle setup | tiny triangles inside a pixel's corner, covering no sample centre (not degenerate, not culled before setup) | setup and the coverage test, no fragment |
+//! | clipped triangles | triangles from behind the near plane to a vertex at w = 0 (as volume sides at infinity), a few pixels long on screen inside a band between sample rows | clipping and setup, no fragment |
+//! | small triangles | a grid of 2-pixel triangles over the whole target | setup plus two fragments each |
+//! | big triangles | screen-covering triangles | setup plus a screen of fragments each |
+//! | slivers | 1-pixel-wide triangles from the centre past the edges | setup of a screen-sized bounding box, few fragments |
+//! | index fetch | one 256-vertex patch drawn through u8, u16 and u32 indices and as streamed 4 x f32 vertices | vertex and index fetch of small triangles |
+//! | draw calls | one tiny triangle per `vkCmdDraw`, each with its push constants and vertex binding (as the shadow pass) | per-draw cost |
+//! | CPU stream | a sum over a buffer far larger than the caches | host memory bandwidth |
 //!
 //! GPU times come from timestamps written outside the rendering instances (on lavapipe those
-//! inside do not include rasterisation); each limit is the median of several repetitions.
-//! u8 indices need `VK_EXT_index_type_uint8`: without it the limit is skipped with the reason.
+//! inside do not include rasterisation); each point of a sweep is the median of several
+//! repetitions. u8 indices need `VK_EXT_index_type_uint8`: without it the limit is skipped
+//! with the reason.
 
 use crate::error::{Error, Result};
 use crate::gpu::descriptors::pipeline_layout;
@@ -28,20 +34,25 @@ use serde::Serialize;
 use std::collections::BTreeMap;
 
 /// The measured limits (the `limits` object of `bench.json`; units in the key names and in
-/// [`Limits::units`]).
+/// [`Limits::units`]): each the peak rate of its sweep.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Limits {
     /// Stencil-only fill, two-sided wrapping ops with the depth test on: Gfragments / s.
     pub stencil_fill_gfrag_s: f64,
     /// Depth-tested additive colour fill into RGBA16F: Gfragments / s.
     pub color_fill_gfrag_s: f64,
+    /// Triangle setup: triangles covering no sample centre, stencil-only: Mtriangles / s.
+    pub setup_tri_mtri_s: f64,
+    /// Clipped triangles: crossing the near plane, with a vertex at w = 0, covering no
+    /// sample centre: Mtriangles / s.
+    pub clip_tri_mtri_s: f64,
     /// Small (2-pixel) triangles, stencil-only: Mtriangles / s.
     pub small_tri_mtri_s: f64,
     /// Screen-covering triangles, stencil-only: Mtriangles / s.
     pub big_tri_mtri_s: f64,
     /// Slivers: triangles from the centre to past the target's edge, a pixel wide there (the
     /// shape of shadow-volume sides extruded to infinity: few fragments, a screen-sized
-    /// bounding box), stencil-only: Mtriangles / s.
+    /// bounding box), stencil-only: Mtriangles / s. Setup and fill together.
     pub sliver_tri_mtri_s: f64,
     /// Draw calls of one tiny triangle each: draws / s.
     pub draws_per_s: f64,
@@ -62,18 +73,21 @@ pub struct Limits {
     pub units: BTreeMap<String, String>,
     /// Limits that were not measured, and why.
     pub skipped: BTreeMap<String, String>,
+    /// Each GPU limit's sweep: `[workload size (layers, triangles or draws), rate in the key's
+    /// unit]` per point, in the order measured; the peak is the limit.
+    pub sweeps: BTreeMap<String, Vec<[f64; 2]>>,
 }
 
-/// How much to measure: repetitions per limit and the size of each workload.
+/// How much to measure: repetitions per point and the size of each workload.
 #[derive(Clone, Copy, Debug)]
 pub struct LimitsConfig {
     /// Target size (the suite's base resolution).
     pub width: u32,
     /// Target height.
     pub height: u32,
-    /// Repetitions per limit (median taken), at least 1.
+    /// Repetitions per point of a sweep (median taken), at least 1.
     pub reps: usize,
-    /// Workload scale: 1.0 full, smaller for `--quick` (fewer layers, triangles, draws).
+    /// Workload scale: 1.0 full, smaller for `--quick` (shorter sweeps).
     pub scale: f64,
 }
 
@@ -86,37 +100,44 @@ struct Target {
 }
 
 /// A pipeline and its draws: what one timed repetition records.
-struct Workload<'a> {
+#[derive(Clone, Copy)]
+struct Workload {
     pipe: vk::Pipeline,
     vertices: vk::Buffer,
     indices: Option<(vk::Buffer, vk::IndexType, u32)>,
-    /// Vertices per non-indexed draw and how many such draws (one push each).
-    draw: (u32, u32),
-    clear_depth: f32,
-    _p: std::marker::PhantomData<&'a ()>,
+    /// Vertices per non-indexed draw.
+    vertex_count: u32,
+    /// Draws of the whole buffer (one push and vertex binding each when more than one).
+    draws: u32,
+}
+
+/// The objects a measurement made, destroyed by [`measure`] whatever happens.
+#[derive(Default)]
+struct Made {
+    pipelines: Vec<vk::Pipeline>,
+    buffers: Vec<Buffer>,
+    target: Option<Target>,
 }
 
 /// Measures every limit on `ctx` (GPU) and this machine (CPU stream).
 pub fn measure(ctx: &Context, cfg: &LimitsConfig) -> Result<Limits> {
-    let mut made: Vec<vk::Pipeline> = Vec::new();
-    let mut buffers: Vec<Buffer> = Vec::new();
-    let mut target: Option<Target> = None;
-    let r = measure_with(ctx, cfg, &mut made, &mut buffers, &mut target);
+    let mut made = Made::default();
+    let r = measure_with(ctx, cfg, &mut made);
     // SAFETY: one_shot waited for every submission: nothing in use.
     unsafe {
         let _ = ctx.device.device_wait_idle();
-        for p in made {
+        for p in made.pipelines {
             ctx.device.destroy_pipeline(p, None);
         }
-        if let Some(t) = &target {
+        if let Some(t) = &made.target {
             ctx.device.destroy_query_pool(t.pool, None);
             ctx.device.destroy_pipeline_layout(t.layout, None);
         }
     }
-    for b in &mut buffers {
+    for b in &mut made.buffers {
         b.destroy(ctx);
     }
-    if let Some(mut t) = target {
+    if let Some(mut t) = made.target {
         t.ds.destroy(ctx);
         t.color.destroy(ctx);
     }
@@ -136,16 +157,54 @@ fn quad(z: f32, ccw: bool) -> [[f32; 4]; 6] {
     }
 }
 
-fn measure_with(
-    ctx: &Context,
-    cfg: &LimitsConfig,
-    made: &mut Vec<vk::Pipeline>,
-    buffers: &mut Vec<Buffer>,
-    target: &mut Option<Target>,
-) -> Result<Limits> {
+/// The lab: the target, the two pipelines and the sweep's rules.
+struct Lab<'a> {
+    ctx: &'a Context,
+    t: &'a Target,
+    reps: usize,
+    /// Most doublings a sweep takes.
+    max_steps: u32,
+    /// A point whose repetition takes longer than this ends the sweep, ms.
+    max_ms: f64,
+    sweeps: BTreeMap<String, Vec<[f64; 2]>>,
+}
+
+impl Lab<'_> {
+    /// Sweeps `base` drawn 1, 2, 4, ... times (`k` draws of the whole buffer, or the draw
+    /// count for per-draw workloads) until the rate (`units` per repetition x k / time, in
+    /// `unit`) gains under 5 % twice running, a point takes `max_ms`, or `max_steps` points
+    /// ran; returns the peak and records the sweep under `key`.
+    fn peak(&mut self, key: &str, base: Workload, units: f64, unit: f64, per_draw: bool) -> Result<f64> {
+        let (mut best, mut flat) = (0.0f64, 0);
+        let mut points = Vec::new();
+        let mut k = 1u32;
+        for _ in 0..self.max_steps {
+            let wl = Workload { draws: if per_draw { base.draws * k } else { k }, ..base };
+            let ms = time(self.ctx, self.t, &wl, self.reps)?;
+            let rate = units * k as f64 / (ms.max(1e-6) * 1e-3) / unit;
+            points.push([units * k as f64, rate]);
+            if rate > best * 1.05 {
+                flat = 0;
+            } else {
+                flat += 1;
+            }
+            best = best.max(rate);
+            if flat >= 2 || ms > self.max_ms {
+                break;
+            }
+            k *= 2;
+        }
+        self.sweeps.insert(key.to_string(), points);
+        Ok(best)
+    }
+}
+
+fn measure_with(ctx: &Context, cfg: &LimitsConfig, made: &mut Made) -> Result<Limits> {
     let (w, h) = (cfg.width.max(16), cfg.height.max(16));
-    let reps = cfg.reps.max(1);
     let extent = vk::Extent2D { width: w, height: h };
+    if !ctx.features.timestamps {
+        return Err(Error::Unsupported("the suite's limits need timestamp queries, which this device lacks".into()));
+    }
     let ds = Image::new_2d(
         ctx,
         "limits-ds",
@@ -154,25 +213,46 @@ fn measure_with(
         vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
         vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL,
     )?;
-    let color = Image::new_2d(
+    let color = match Image::new_2d(
         ctx,
         "limits-color",
         crate::render::targets::ACCUM_FORMAT,
         extent,
         vk::ImageUsageFlags::COLOR_ATTACHMENT,
         vk::ImageAspectFlags::COLOR,
-    )?;
-    let layout = pipeline_layout(ctx, &[], VolumePush::SIZE, vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)?;
+    ) {
+        Ok(c) => c,
+        Err(e) => {
+            let mut ds = ds;
+            ds.destroy(ctx);
+            return Err(e);
+        }
+    };
+    let layout = pipeline_layout(ctx, &[], VolumePush::SIZE, vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT);
     // SAFETY: creation on a valid device; destroyed by `measure`.
     let pool = unsafe {
         ctx.device.create_query_pool(&vk::QueryPoolCreateInfo::default().query_type(vk::QueryType::TIMESTAMP).query_count(2), None)
     }
-    .map_err(Error::vk("vkCreateQueryPool"))?;
-    *target = Some(Target { ds, color, pool, layout, extent });
-    let t = target.as_ref().ok_or_else(|| Error::Other("limits target".into()))?;
-    if !ctx.features.timestamps {
-        return Err(Error::Unsupported("the suite's limits need timestamp queries, which this device lacks".into()));
-    }
+    .map_err(Error::vk("vkCreateQueryPool"));
+    let (layout, pool) = match (layout, pool) {
+        (Ok(l), Ok(p)) => (l, p),
+        (l, p) => {
+            // SAFETY: nothing submitted yet.
+            unsafe {
+                if let Ok(l) = &l {
+                    ctx.device.destroy_pipeline_layout(*l, None);
+                }
+                if let Ok(p) = &p {
+                    ctx.device.destroy_query_pool(*p, None);
+                }
+            }
+            let (mut ds, mut color) = (ds, color);
+            ds.destroy(ctx);
+            color.destroy(ctx);
+            return Err(l.err().or(p.err()).unwrap_or_else(|| Error::Other("limits target".into())));
+        }
+    };
+    let t = made.target.insert(Target { ds, color, pool, layout, extent });
 
     // Pipelines: stencil-only (the shadow pass's state) and depth-tested additive colour.
     let color_formats = [crate::render::targets::ACCUM_FORMAT];
@@ -185,92 +265,120 @@ fn measure_with(
     base.depth_compare = vk::CompareOp::LESS;
     use vk::StencilOp as S;
     base.stencil = Some((pipeline::stencil_ops(S::INCREMENT_AND_WRAP, S::KEEP), pipeline::stencil_ops(S::DECREMENT_AND_WRAP, S::KEEP)));
-    let stencil_pipe = pipeline::create(ctx, &base)?;
-    made.push(stencil_pipe);
+    let stencil = pipeline::create(ctx, &base)?;
+    made.pipelines.push(stencil);
     let mut c = base.clone();
     c.fragment = Some(shaders::VOLUME_FRAG);
     c.color_write = true;
     c.blend = Blend::Additive;
     c.stencil = None;
     c.depth_compare = vk::CompareOp::LESS_OR_EQUAL;
-    let color_pipe = pipeline::create(ctx, &c)?;
-    made.push(color_pipe);
+    let color = pipeline::create(ctx, &c)?;
+    made.pipelines.push(color);
 
+    let quick = cfg.scale < 1.0;
+    let mut lab = Lab {
+        ctx,
+        t: &*t,
+        reps: cfg.reps.max(1),
+        max_steps: if quick { 7 } else { 9 },
+        max_ms: if quick { 150.0 } else { 400.0 },
+        sweeps: BTreeMap::new(),
+    };
+    let buffers = &mut made.buffers;
     let mut upload = |name: &str, data: &[u8], usage: vk::BufferUsageFlags| -> Result<vk::Buffer> {
         let b = Buffer::with_data(ctx, name, data, usage)?;
         let raw = b.raw;
         buffers.push(b);
         Ok(raw)
     };
-    let scaled = |n: f64| ((n * cfg.scale).round() as u32).max(1);
     let px = (w as f64) * (h as f64);
+    let (pw, ph) = (2.0 / w as f32, 2.0 / h as f32); // one pixel in NDC
+    let vb = vk::BufferUsageFlags::VERTEX_BUFFER;
+    let draw = |pipe, vertices, n: usize| Workload { pipe, vertices, indices: None, vertex_count: n as u32, draws: 1 };
 
     // Fill: full-screen layers, alternate windings (two-sided ops both exercised).
-    let layers = scaled(32.0);
-    let mut fill: Vec<[f32; 4]> = Vec::new();
-    for i in 0..layers {
-        fill.extend(quad(0.5, i % 2 == 0));
-    }
-    let fill_vb = upload("limits-fill", bytes(&fill), vk::BufferUsageFlags::VERTEX_BUFFER)?;
-    let mk =
-        |pipe, _color: bool, vertices, indices, draw| Workload { pipe, vertices, indices, draw, clear_depth: 1.0, _p: Default::default() };
-    let fill_frags = layers as f64 * 2.0 * px / 2.0; // two triangles a layer cover the target once
-    let stencil_ms = time(ctx, t, &mk(stencil_pipe, false, fill_vb, None, (6 * layers, 1)), reps)?;
-    let color_ms = time(ctx, t, &mk(color_pipe, true, fill_vb, None, (6 * layers, 1)), reps)?;
+    let layers = 4u32;
+    let fill: Vec<[f32; 4]> = (0..layers).flat_map(|i| quad(0.5, i % 2 == 0)).collect();
+    let fill_vb = upload("limits-fill", bytes(&fill), vb)?;
+    let stencil_fill = lab.peak("stencil_fill_gfrag_s", draw(stencil, fill_vb, fill.len()), layers as f64 * px, 1e9, false)?;
+    let color_fill = lab.peak("color_fill_gfrag_s", draw(color, fill_vb, fill.len()), layers as f64 * px, 1e9, false)?;
 
-    // Small triangles: a grid of 2x2-pixel cells, each two 2-pixel triangles.
-    let (gx, gy) = ((w / 2).max(1), (h / 2).max(1));
-    let cells_wanted = (scaled(200_000.0) / 2) as u64;
-    let step = ((gx as u64 * gy as u64) as f64 / cells_wanted as f64).sqrt().max(1.0);
-    let mut small: Vec<[f32; 4]> = Vec::new();
-    let (sx, sy) = (2.0 / w as f32 * 2.0, 2.0 / h as f32 * 2.0);
-    let mut y = 0.0f64;
-    while (y as u32) < gy {
-        let mut x = 0.0f64;
-        while (x as u32) < gx {
-            let (x0, y0) = (-1.0 + (x as u32) as f32 * sx, -1.0 + (y as u32) as f32 * sy);
-            let (a, b, c, d) = ([x0, y0, 0.5, 1.0], [x0 + sx, y0, 0.5, 1.0], [x0 + sx, y0 + sy, 0.5, 1.0], [x0, y0 + sy, 0.5, 1.0]);
-            small.extend([a, b, c, a, c, d]);
-            x += step;
+    // Setup: one tiny triangle per 2x2-pixel block, inside the corner of a pixel, away from
+    // its sample centre (x+0.6 .. x+0.9).
+    let mut setup: Vec<[f32; 4]> = Vec::new();
+    for y in (0..h).step_by(2) {
+        for x in (0..w).step_by(2) {
+            let (x0, y0) = (-1.0 + (x as f32 + 0.6) * pw, -1.0 + (y as f32 + 0.6) * ph);
+            setup.extend([[x0, y0, 0.5, 1.0], [x0 + 0.3 * pw, y0, 0.5, 1.0], [x0, y0 + 0.3 * ph, 0.5, 1.0]]);
         }
-        y += step;
     }
-    let small_tris = (small.len() / 3) as f64;
-    let small_vb = upload("limits-small", bytes(&small), vk::BufferUsageFlags::VERTEX_BUFFER)?;
-    let small_ms = time(ctx, t, &mk(stencil_pipe, false, small_vb, None, (small.len() as u32, 1)), reps)?;
+    let setup_tris = (setup.len() / 3) as f64;
+    let setup_vb = upload("limits-setup", bytes(&setup), vb)?;
+    let setup_rate = lab.peak("setup_tri_mtri_s", draw(stencil, setup_vb, setup.len()), setup_tris, 1e6, false)?;
+
+    // Clipped: A behind the near plane, B in front, C at w = 0 towards +x: the strip between
+    // two lines inside one pixel row (y+0.6 .. y+0.9), from 4 pixels left of the right edge to
+    // infinity, cut by the near plane and the right clip plane: short on screen (one tile,
+    // like a clipped side's corner), no sample centre in it.
+    let clip_n = 65_536usize;
+    let mut clip: Vec<[f32; 4]> = Vec::with_capacity(3 * clip_n);
+    let x = 1.0 - 4.0 * pw;
+    for i in 0..clip_n {
+        let row = (i as u32 * 7) % h;
+        let (y1, y2) = (-1.0 + (row as f32 + 0.6) * ph, -1.0 + (row as f32 + 0.9) * ph);
+        clip.extend([[x, y1, -0.5, 1.0], [x, y2, 0.5, 1.0], [1.0, 0.0, 0.0, 0.0]]);
+    }
+    let clip_vb = upload("limits-clip", bytes(&clip), vb)?;
+    let clip_rate = lab.peak("clip_tri_mtri_s", draw(stencil, clip_vb, clip.len()), clip_n as f64, 1e6, false)?;
+
+    // Small triangles: a grid of 2x2-pixel cells over the target, each two 2-pixel triangles.
+    let mut small: Vec<[f32; 4]> = Vec::new();
+    for y in (0..h.saturating_sub(1)).step_by(2) {
+        for x in (0..w.saturating_sub(1)).step_by(2) {
+            let (x0, y0) = (-1.0 + x as f32 * pw, -1.0 + y as f32 * ph);
+            let (a, b, c, d) = (
+                [x0, y0, 0.5, 1.0],
+                [x0 + 2.0 * pw, y0, 0.5, 1.0],
+                [x0 + 2.0 * pw, y0 + 2.0 * ph, 0.5, 1.0],
+                [x0, y0 + 2.0 * ph, 0.5, 1.0],
+            );
+            small.extend([a, b, c, a, c, d]);
+        }
+    }
+    let small_vb = upload("limits-small", bytes(&small), vb)?;
+    let small_rate = lab.peak("small_tri_mtri_s", draw(stencil, small_vb, small.len()), (small.len() / 3) as f64, 1e6, false)?;
 
     // Big triangles: each covers the target (a triangle twice its size, clipped).
-    let big_n = scaled(48.0);
-    let mut big: Vec<[f32; 4]> = Vec::new();
-    for i in 0..big_n {
-        let (a, b, c) = ([-1.0, -1.0, 0.5, 1.0], [3.0, -1.0, 0.5, 1.0], [-1.0, 3.0, 0.5, 1.0]);
-        big.extend(if i % 2 == 0 { [a, b, c] } else { [a, c, b] });
-    }
-    let big_vb = upload("limits-big", bytes(&big), vk::BufferUsageFlags::VERTEX_BUFFER)?;
-    let big_ms = time(ctx, t, &mk(stencil_pipe, false, big_vb, None, (3 * big_n, 1)), reps)?;
+    let big: Vec<[f32; 4]> = (0..4)
+        .flat_map(|i| {
+            let (a, b, c) = ([-1.0, -1.0, 0.5, 1.0], [3.0, -1.0, 0.5, 1.0], [-1.0, 3.0, 0.5, 1.0]);
+            if i % 2 == 0 {
+                [a, b, c]
+            } else {
+                [a, c, b]
+            }
+        })
+        .collect();
+    let big_vb = upload("limits-big", bytes(&big), vb)?;
+    let big_rate = lab.peak("big_tri_mtri_s", draw(stencil, big_vb, big.len()), 4.0, 1e6, false)?;
 
     // Slivers: a fan of 1-pixel-wide triangles from the centre out past the edges.
-    let slivers = scaled(20_000.0);
+    let slivers = 4096u32;
     let mut sliver: Vec<[f32; 4]> = Vec::new();
     for i in 0..slivers {
         let a = std::f32::consts::TAU * i as f32 / slivers as f32;
         let (s, c) = a.sin_cos();
         let (ex, ey) = (1.5 * c, 1.5 * s);
-        // One pixel across at the far end, perpendicular to the sliver.
-        let (px, py) = (-s * 2.0 / w as f32, c * 2.0 / h as f32);
-        sliver.extend([[0.0, 0.0, 0.5, 1.0], [ex, ey, 0.5, 1.0], [ex + px, ey + py, 0.5, 1.0]]);
+        let (qx, qy) = (-s * pw, c * ph); // one pixel across at the far end
+        sliver.extend([[0.0, 0.0, 0.5, 1.0], [ex, ey, 0.5, 1.0], [ex + qx, ey + qy, 0.5, 1.0]]);
     }
-    let sliver_vb = upload("limits-sliver", bytes(&sliver), vk::BufferUsageFlags::VERTEX_BUFFER)?;
-    let sliver_ms = time(ctx, t, &mk(stencil_pipe, false, sliver_vb, None, (3 * slivers, 1)), reps)?;
+    let sliver_vb = upload("limits-sliver", bytes(&sliver), vb)?;
+    let sliver_rate = lab.peak("sliver_tri_mtri_s", draw(stencil, sliver_vb, sliver.len()), slivers as f64, 1e6, false)?;
 
     // Index fetch: a 16x16-vertex patch (256 vertices: u8 can address it) of 2-pixel cells,
     // its 450 triangles repeated.
-    let mut patch: Vec<[f32; 4]> = Vec::new();
-    for j in 0..16 {
-        for i in 0..16 {
-            patch.push([-0.5 + i as f32 * sx, -0.5 + j as f32 * sy, 0.5, 1.0]);
-        }
-    }
+    let patch: Vec<[f32; 4]> = (0..256).map(|k| [-0.5 + (k % 16) as f32 * 2.0 * pw, -0.5 + (k / 16) as f32 * 2.0 * ph, 0.5, 1.0]).collect();
     let mut tri_idx: Vec<u32> = Vec::new();
     for j in 0..15u32 {
         for i in 0..15u32 {
@@ -278,39 +386,42 @@ fn measure_with(
             tri_idx.extend([a, b, c, a, c, d]);
         }
     }
-    let repeats = (scaled(200_000.0) as usize / 450).max(1);
-    let idx32: Vec<u32> = tri_idx.iter().copied().cycle().take(tri_idx.len() * repeats).collect();
+    let idx32: Vec<u32> = tri_idx.iter().copied().cycle().take(tri_idx.len() * 100).collect();
     let n_idx = idx32.len() as u32;
     let idx_tris = n_idx as f64 / 3.0;
-    let patch_vb = upload("limits-patch", bytes(&patch), vk::BufferUsageFlags::VERTEX_BUFFER)?;
-    let i32b = upload("limits-u32", bytes(&idx32), vk::BufferUsageFlags::INDEX_BUFFER)?;
+    let patch_vb = upload("limits-patch", bytes(&patch), vb)?;
+    let ib = vk::BufferUsageFlags::INDEX_BUFFER;
+    let indexed = |buf, ty| Workload { pipe: stencil, vertices: patch_vb, indices: Some((buf, ty, n_idx)), vertex_count: 0, draws: 1 };
+    let i32b = upload("limits-u32", bytes(&idx32), ib)?;
     let idx16: Vec<u16> = idx32.iter().map(|&i| i as u16).collect();
-    let i16b = upload("limits-u16", bytes(&idx16), vk::BufferUsageFlags::INDEX_BUFFER)?;
-    let u16_ms = time(ctx, t, &mk(stencil_pipe, false, patch_vb, Some((i16b, vk::IndexType::UINT16, n_idx)), (0, 1)), reps)?;
-    let u32_ms = time(ctx, t, &mk(stencil_pipe, false, patch_vb, Some((i32b, vk::IndexType::UINT32, n_idx)), (0, 1)), reps)?;
+    let i16b = upload("limits-u16", bytes(&idx16), ib)?;
+    let u16_rate = lab.peak("index_u16_mtri_s", indexed(i16b, vk::IndexType::UINT16), idx_tris, 1e6, false)?;
+    let u32_rate = lab.peak("index_u32_mtri_s", indexed(i32b, vk::IndexType::UINT32), idx_tris, 1e6, false)?;
     let mut skipped = BTreeMap::new();
-    let u8_ms = if ctx.features.index_type_uint8 {
+    let u8_rate = if ctx.features.index_type_uint8 {
         let idx8: Vec<u8> = idx32.iter().map(|&i| i as u8).collect();
-        let i8b = upload("limits-u8", &idx8, vk::BufferUsageFlags::INDEX_BUFFER)?;
-        Some(time(ctx, t, &mk(stencil_pipe, false, patch_vb, Some((i8b, vk::IndexType::UINT8_EXT, n_idx)), (0, 1)), reps)?)
+        let i8b = upload("limits-u8", &idx8, ib)?;
+        Some(lab.peak("index_u8_mtri_s", indexed(i8b, vk::IndexType::UINT8_EXT), idx_tris, 1e6, false)?)
     } else {
         skipped.insert("index_u8_mtri_s".to_string(), "VK_EXT_index_type_uint8 (indexTypeUint8) missing".to_string());
         None
     };
     let naive: Vec<[f32; 4]> = idx32.iter().map(|&i| patch[i as usize]).collect();
-    let naive_vb = upload("limits-naive", bytes(&naive), vk::BufferUsageFlags::VERTEX_BUFFER)?;
-    let naive_ms = time(ctx, t, &mk(stencil_pipe, false, naive_vb, None, (n_idx, 1)), reps)?;
+    let naive_vb = upload("limits-naive", bytes(&naive), vb)?;
+    let naive_rate = lab.peak("index_naive_mtri_s", draw(stencil, naive_vb, naive.len()), idx_tris, 1e6, false)?;
 
-    // Draw calls: one 1-pixel triangle each.
-    let draws = scaled(20_000.0);
-    let tiny: [[f32; 4]; 3] = [[0.0, 0.0, 0.5, 1.0], [sx / 2.0, 0.0, 0.5, 1.0], [0.0, sy / 2.0, 0.5, 1.0]];
-    let tiny_vb = upload("limits-tiny", bytes(&tiny), vk::BufferUsageFlags::VERTEX_BUFFER)?;
-    let draw_ms = time(ctx, t, &mk(stencil_pipe, false, tiny_vb, None, (3, draws)), reps)?;
+    // Draw calls: one 1-pixel triangle each, 1024 draws doubled.
+    let tiny: [[f32; 4]; 3] = [[0.0, 0.0, 0.5, 1.0], [pw, 0.0, 0.5, 1.0], [0.0, ph, 0.5, 1.0]];
+    let tiny_vb = upload("limits-tiny", bytes(&tiny), vb)?;
+    let draws = 1024u32;
+    let draw_rate = lab.peak("draws_per_s", Workload { draws, ..draw(stencil, tiny_vb, 3) }, draws as f64, 1.0, true)?;
 
     let mut units = BTreeMap::new();
     for (k, u) in [
         ("stencil_fill_gfrag_s", "Gfragments/s"),
         ("color_fill_gfrag_s", "Gfragments/s"),
+        ("setup_tri_mtri_s", "Mtriangles/s"),
+        ("clip_tri_mtri_s", "Mtriangles/s"),
         ("small_tri_mtri_s", "Mtriangles/s"),
         ("big_tri_mtri_s", "Mtriangles/s"),
         ("sliver_tri_mtri_s", "Mtriangles/s"),
@@ -323,22 +434,24 @@ fn measure_with(
     ] {
         units.insert(k.to_string(), u.to_string());
     }
-    let rate = |n: f64, ms: f64, unit: f64| n / (ms.max(1e-6) * 1e-3) / unit;
     Ok(Limits {
-        stencil_fill_gfrag_s: rate(fill_frags, stencil_ms, 1e9),
-        color_fill_gfrag_s: rate(fill_frags, color_ms, 1e9),
-        small_tri_mtri_s: rate(small_tris, small_ms, 1e6),
-        big_tri_mtri_s: rate(big_n as f64, big_ms, 1e6),
-        sliver_tri_mtri_s: rate(slivers as f64, sliver_ms, 1e6),
-        draws_per_s: rate(draws as f64, draw_ms, 1.0),
-        cpu_stream_gib_s: cpu_stream_gib_s(cfg.scale, reps),
-        index_u8_mtri_s: u8_ms.map(|ms| rate(idx_tris, ms, 1e6)),
-        index_u16_mtri_s: rate(idx_tris, u16_ms, 1e6),
-        index_u32_mtri_s: rate(idx_tris, u32_ms, 1e6),
-        index_naive_mtri_s: rate(idx_tris, naive_ms, 1e6),
+        stencil_fill_gfrag_s: stencil_fill,
+        color_fill_gfrag_s: color_fill,
+        setup_tri_mtri_s: setup_rate,
+        clip_tri_mtri_s: clip_rate,
+        small_tri_mtri_s: small_rate,
+        big_tri_mtri_s: big_rate,
+        sliver_tri_mtri_s: sliver_rate,
+        draws_per_s: draw_rate,
+        cpu_stream_gib_s: cpu_stream_gib_s(cfg.scale, cfg.reps),
+        index_u8_mtri_s: u8_rate,
+        index_u16_mtri_s: u16_rate,
+        index_u32_mtri_s: u32_rate,
+        index_naive_mtri_s: naive_rate,
         target: [w, h],
         units,
         skipped,
+        sweeps: lab.sweeps,
     })
 }
 
@@ -362,7 +475,7 @@ fn time(ctx: &Context, t: &Target, wl: &Workload, reps: usize) -> Result<f64> {
                     .image_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
                     .load_op(load)
                     .store_op(vk::AttachmentStoreOp::STORE)
-                    .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: wl.clear_depth, stencil: 0 } });
+                    .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } });
                 let col = vk::RenderingAttachmentInfo::default()
                     .image_view(t.color.view)
                     .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
@@ -408,27 +521,25 @@ fn time(ctx: &Context, t: &Target, wl: &Workload, reps: usize) -> Result<f64> {
                     bytemuck::bytes_of(&push),
                 );
                 d.cmd_bind_vertex_buffers(cb, 0, &[wl.vertices], &[0]);
-                match wl.indices {
-                    Some((ib, ty, n)) => {
-                        d.cmd_bind_index_buffer(cb, ib, 0, ty);
-                        d.cmd_draw_indexed(cb, n, 1, 0, 0, 0);
+                if let Some((ib, ty, _)) = wl.indices {
+                    d.cmd_bind_index_buffer(cb, ib, 0, ty);
+                }
+                // Many draws: each with its own push constants and vertex binding, as the
+                // shadow pass issues one per caster chunk.
+                for _ in 0..wl.draws {
+                    if wl.draws > 1 {
+                        d.cmd_push_constants(
+                            cb,
+                            t.layout,
+                            vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                            0,
+                            bytemuck::bytes_of(&push),
+                        );
+                        d.cmd_bind_vertex_buffers(cb, 0, &[wl.vertices], &[0]);
                     }
-                    None => {
-                        // Many draws: each with its own push constants and vertex binding,
-                        // as the shadow pass issues one per caster chunk.
-                        for _ in 0..wl.draw.1 {
-                            if wl.draw.1 > 1 {
-                                d.cmd_push_constants(
-                                    cb,
-                                    t.layout,
-                                    vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                                    0,
-                                    bytemuck::bytes_of(&push),
-                                );
-                                d.cmd_bind_vertex_buffers(cb, 0, &[wl.vertices], &[0]);
-                            }
-                            d.cmd_draw(cb, wl.draw.0, 1, 0, 0);
-                        }
+                    match wl.indices {
+                        Some((_, _, n)) => d.cmd_draw_indexed(cb, n, 1, 0, 0, 0),
+                        None => d.cmd_draw(cb, wl.vertex_count, 1, 0, 0),
                     }
                 }
                 d.cmd_end_rendering(cb);

@@ -7,7 +7,9 @@
 //! - `time_vs_resolution`: against pixels (bench/fill), with the fill limit line;
 //! - `roofline`: every row's fill fraction against its vertex fraction: the diagonal splits
 //!   fill-bound from vertex-bound, 100% on an axis is the device's limit;
-//! - `pareto`: speed against error on the named scenes, shadow maps at each size included.
+//! - `pareto`: speed against error on the named scenes, one panel per scene, both axes log,
+//!   exact methods on a labelled floor, the Pareto front drawn;
+//! - `model_fit`: each row's measured shadow time against the cost model's prediction.
 
 use super::report::{SuiteReport, SuiteRow};
 use crate::error::{Error, Result};
@@ -56,6 +58,7 @@ pub fn write_all(report: &SuiteReport, dir: &Path) -> Result<Vec<String>> {
     emit!("time_vs_resolution", time_vs_resolution);
     emit!("roofline", roofline);
     emit!("pareto", pareto);
+    emit!("model_fit", model_fit);
     Ok(out)
 }
 
@@ -191,14 +194,20 @@ where
         .y_label_area_size(60)
         .build_cartesian_2d((a0..a1).log_scale(), (a0..a1).log_scale())
         .map_err(err(&title))?;
-    chart.configure_mesh().x_desc("fill fraction (fragments / fill limit / time)").y_desc("vertex fraction").draw().map_err(err(&title))?;
+    chart
+        .configure_mesh()
+        .x_desc("fill fraction (model's fill terms / time)")
+        .y_desc("vertex fraction (model's vertex terms / time)")
+        .draw()
+        .map_err(err(&title))?;
     chart.draw_series(LineSeries::new(vec![(a0, a0), (a1, a1)], BLACK.stroke_width(1))).map_err(err(&title))?.label("fill = vertex");
     chart
         .draw_series(LineSeries::new(vec![(1.0, a0), (1.0, a1)], RED.mix(0.6).stroke_width(2)))
         .map_err(err(&title))?
         .label("limit (100%)");
     chart.draw_series(LineSeries::new(vec![(a0, 1.0), (a1, 1.0)], RED.mix(0.6).stroke_width(2))).map_err(err(&title))?;
-    for (i, sweep) in ["scenes", "resolution", "tessellation", "lights", "light_distance", "casters", "ablation"].iter().enumerate() {
+    for (i, sweep) in ["scenes", "resolution", "tessellation", "lights", "light_distance", "casters", "caps", "ablation"].iter().enumerate()
+    {
         let color = Palette99::pick(i).to_rgba();
         let pts: Vec<(f64, f64)> =
             rows.iter().filter(|x| x.sweep == *sweep).filter_map(|x| Some((x.fill_fraction?, x.vertex_fraction?))).collect();
@@ -231,41 +240,141 @@ where
     root.fill(&WHITE).map_err(err(&title))?;
     let rows: Vec<&SuiteRow> =
         r.rows.iter().filter(|x| x.sweep == "scenes" && x.error_fraction.is_some() && x.gpu_shadow_ms.is_some()).collect();
+    // Error on a log axis; exact methods (no mismatched pixel) sit on a labelled floor a
+    // decade below the smallest error measured.
+    let smallest = rows.iter().filter_map(|x| x.error_fraction).filter(|e| *e > 0.0).fold(f64::INFINITY, f64::min) * 100.0;
+    let floor = if smallest.is_finite() { smallest / 10.0 } else { 1e-4 };
     let e_max = rows.iter().filter_map(|x| x.error_fraction).fold(0.0f64, f64::max) * 100.0;
-    let (y0, y1) = range(rows.iter().filter_map(|x| x.gpu_shadow_ms));
+    let (y0, y1) = (floor / 3.0, (e_max.max(floor * 10.0)) * 3.0);
+    let (x0, x1) = range(rows.iter().filter_map(|x| x.gpu_shadow_ms));
     let mut scenes: Vec<&str> = Vec::new();
     for x in &rows {
         if !scenes.contains(&x.scene.as_str()) {
             scenes.push(&x.scene);
         }
     }
-    let areas = root.split_evenly((1, scenes.len().max(1)));
+    let (top, body) = root.split_vertically(30);
+    top.titled(&title, ("sans-serif", 18)).map_err(err(&title))?;
+    let areas = body.split_evenly((1, scenes.len().max(1)));
+    let all_methods = methods(rows.iter().copied());
     for (area, scene) in areas.iter().zip(scenes) {
         let mut chart = ChartBuilder::on(area)
             .caption(scene, ("sans-serif", 16))
             .margin(10)
             .x_label_area_size(40)
-            .y_label_area_size(55)
-            .build_cartesian_2d(-0.05 * e_max.max(0.01)..e_max.max(0.01) * 1.15, (y0..y1).log_scale())
+            .y_label_area_size(65)
+            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
             .map_err(err(&title))?;
-        chart.configure_mesh().x_desc("error, % of pixels").y_desc("GPU shadow ms").draw().map_err(err(&title))?;
-        for (i, m) in methods(rows.iter().copied()).iter().enumerate() {
-            let color = Palette99::pick(i).to_rgba();
-            let pts: Vec<(f64, f64)> = rows
-                .iter()
-                .filter(|x| x.scene == scene && &x.method == m)
-                .filter_map(|x| Some((x.error_fraction? * 100.0, x.gpu_shadow_ms?)))
-                .collect();
-            let label = m.clone();
+        chart
+            .configure_mesh()
+            .x_desc("GPU shadow ms (log)")
+            .y_desc("error, % of pixels (log)")
+            .y_label_formatter(&|v| if *v <= floor * 1.0001 { "exact".into() } else { format!("{v:.0e}") })
+            .draw()
+            .map_err(err(&title))?;
+        chart.draw_series(LineSeries::new(vec![(x0, floor), (x1, floor)], BLACK.mix(0.4).stroke_width(1))).map_err(err(&title))?;
+        chart
+            .draw_series(std::iter::once(Text::new("exact: 0 mismatched pixels", (x0 * 1.05, floor * 0.6), ("sans-serif", 11).into_font())))
+            .map_err(err(&title))?;
+        let mut pts: Vec<(f64, f64, String, usize)> = rows
+            .iter()
+            .filter(|x| x.scene == scene)
+            .filter_map(|x| {
+                let e = x.error_fraction? * 100.0;
+                let i = all_methods.iter().position(|m| m == &x.method).unwrap_or(0);
+                Some((x.gpu_shadow_ms?, if e > 0.0 { e.max(floor) } else { floor }, x.method.clone(), i))
+            })
+            .collect();
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        // The front: each point no other point is both faster and more exact than.
+        let mut front: Vec<(f64, f64)> = Vec::new();
+        for p in &pts {
+            if front.last().is_none_or(|l| p.1 < l.1) {
+                if let Some(l) = front.last().copied() {
+                    front.push((p.0, l.1));
+                }
+                front.push((p.0, p.1));
+            }
+        }
+        if let Some(l) = front.last().copied() {
+            front.push((x1, l.1));
+        }
+        chart
+            .draw_series(LineSeries::new(front, RGBColor(40, 120, 40).stroke_width(2)))
+            .map_err(err(&title))?
+            .label("Pareto front")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], RGBColor(40, 120, 40).stroke_width(2)));
+        // Labels alternate above and below so that neighbours on the floor stay readable.
+        for (k, (t, e, m, i)) in pts.iter().enumerate() {
+            let color = Palette99::pick(*i).to_rgba();
+            let dy = if k % 2 == 0 { -14 } else { 6 };
             chart
-                .draw_series(pts.iter().map(|&p| {
-                    EmptyElement::at(p)
+                .draw_series(std::iter::once(
+                    EmptyElement::at((*t, *e))
                         + Circle::new((0, 0), 4, color.filled())
-                        + Text::new(label.clone(), (6, -6), ("sans-serif", 11).into_font())
-                }))
+                        + Text::new(m.clone(), (5, dy), ("sans-serif", 11).into_font()),
+                ))
                 .map_err(err(&title))?;
         }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::UpperRight)
+            .label_font(("sans-serif", 11))
+            .draw()
+            .map_err(err(&title))?;
     }
+    root.present().map_err(err(&title))?;
+    Ok(())
+}
+
+/// The cost model: each row's measured GPU shadow ms against the model's prediction (log-log),
+/// the diagonal and the ±30 % band.
+fn model_fit<DB: DrawingBackend>(r: &SuiteReport, root: DrawingArea<DB, Shift>) -> Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    let m = &r.model;
+    let title = format!(
+        "Cost model: measured vs predicted ({}; held-out median {:.0}%, {:.0}% within 30%)",
+        r.device,
+        m.median_rel_error * 100.0,
+        m.within_30_percent * 100.0
+    );
+    root.fill(&WHITE).map_err(err(&title))?;
+    let rows: Vec<&SuiteRow> = r.rows.iter().filter(|x| x.predicted_shadow_ms.is_some() && x.gpu_shadow_ms.is_some()).collect();
+    let (a0, a1) = range(rows.iter().flat_map(|x| [x.gpu_shadow_ms.unwrap_or(1.0), x.predicted_shadow_ms.unwrap_or(1.0)]));
+    let mut chart = ChartBuilder::on(&root)
+        .caption(&title, ("sans-serif", 16))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d((a0..a1).log_scale(), (a0..a1).log_scale())
+        .map_err(err(&title))?;
+    chart.configure_mesh().x_desc("predicted GPU shadow ms").y_desc("measured GPU shadow ms").draw().map_err(err(&title))?;
+    chart.draw_series(LineSeries::new(vec![(a0, a0), (a1, a1)], BLACK.stroke_width(1))).map_err(err(&title))?.label("measured = predicted");
+    for f in [1.3, 1.0 / 1.3] {
+        chart.draw_series(LineSeries::new(vec![(a0, a0 * f), (a1, a1 * f)], BLACK.mix(0.3).stroke_width(1))).map_err(err(&title))?;
+    }
+    for (i, m) in methods(rows.iter().copied()).iter().enumerate() {
+        let color = Palette99::pick(i).to_rgba();
+        let pts: Vec<(f64, f64)> =
+            rows.iter().filter(|x| &x.method == m).filter_map(|x| Some((x.predicted_shadow_ms?, x.gpu_shadow_ms?))).collect();
+        chart
+            .draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))
+            .map_err(err(&title))?
+            .label(m.as_str())
+            .legend(move |(x, y)| Circle::new((x + 8, y), 4, color.filled()));
+    }
+    chart
+        .configure_series_labels()
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .position(SeriesLabelPosition::UpperLeft)
+        .label_font(("sans-serif", 11))
+        .draw()
+        .map_err(err(&title))?;
     root.present().map_err(err(&title))?;
     Ok(())
 }

@@ -18,6 +18,10 @@ pub struct RowLimits {
     pub sliver_tri_mtri_s: f64,
     /// Draw calls / s.
     pub draws_per_s: f64,
+    /// Triangle setup (no fragments), Mtriangles / s.
+    pub setup_tri_mtri_s: f64,
+    /// Clipped triangles (near plane and w = 0, no fragments), Mtriangles / s.
+    pub clip_tri_mtri_s: f64,
 }
 
 /// One measured point: a scene at a size, one technique, medians over the timed frames, the
@@ -57,6 +61,20 @@ pub struct SuiteRow {
     pub frames: usize,
     /// Median GPU time of the shadow determination (all lights), ms.
     pub gpu_shadow_ms: Option<f64>,
+    /// 10th percentile of the timed frames' shadow times, ms (the spread's low end).
+    pub gpu_shadow_ms_p10: Option<f64>,
+    /// 90th percentile of the same, ms.
+    pub gpu_shadow_ms_p90: Option<f64>,
+    /// Shadow maps: median GPU time rendering the maps, ms (`None` for other techniques).
+    pub gpu_map_ms: Option<f64>,
+    /// Shadow maps: median GPU time of the PCF lookup (shadow time less map time), ms.
+    pub gpu_lookup_ms: Option<f64>,
+    /// The cost model's prediction of `gpu_shadow_ms` (fitted on every row; see
+    /// [`super::model`]), ms.
+    pub predicted_shadow_ms: Option<f64>,
+    /// The model's held-out relative error on this row (predicted by the folds that did not
+    /// contain it).
+    pub model_rel_error: Option<f64>,
     /// Median GPU time of the whole frame, ms.
     pub gpu_frame_ms: Option<f64>,
     /// Median GPU time of the G-buffer pass, ms.
@@ -75,6 +93,19 @@ pub struct SuiteRow {
     pub primitives: Option<u64>,
     /// Primitives out of clipping in the shadow span.
     pub clipped_primitives: Option<u64>,
+    /// Vertex-shader invocations in the shadow span (pipeline statistics).
+    pub vertex_invocations: Option<u64>,
+    /// Volume triangles with a vertex at infinity (sides and dark caps): clipped by
+    /// construction.
+    pub clipped_triangles: u64,
+    /// Shadow maps: texels cleared and rendered per frame (faces x size^2 over lights); 0
+    /// otherwise.
+    pub map_texels: u64,
+    /// (light, caster) pairs the pass did not cull.
+    pub caster_passes: u64,
+    /// Triangles of the casters' meshes over those pairs (what the volume draws index into,
+    /// not what they draw).
+    pub bound_triangles: u64,
     /// Volume draw calls.
     pub draws: u64,
     /// Median CPU planning time (silhouettes included), ms.
@@ -84,18 +115,23 @@ pub struct SuiteRow {
     /// Worst light's mismatched pixels outside a 1-pixel band / compared pixels, where the
     /// reference was rendered for this point (`scenes` rows); `None` elsewhere.
     pub error_fraction: Option<f64>,
-    /// `stencil_fragments / stencil fill limit / gpu_shadow_ms`: the share of the pass's time
-    /// its fill costs at the measured limit.
+    /// The cost model's per-fragment and per-pixel terms over `gpu_shadow_ms` (over the
+    /// prediction where it is larger): the share of the pass's time its fill costs.
     pub fill_fraction: Option<f64>,
-    /// `(sides / sliver limit + other shadow triangles / small-triangle limit) / gpu_shadow_ms`
-    /// (shadow maps: primitives / small-triangle limit).
+    /// The model's per-triangle and per-vertex terms (setup, clipping, vertex shading,
+    /// compute silhouettes) over `gpu_shadow_ms`.
     pub vertex_fraction: Option<f64>,
-    /// `draws / draw-call limit / gpu_shadow_ms`.
+    /// The model's per-draw term over `gpu_shadow_ms`.
     pub draw_fraction: Option<f64>,
+    /// The model's per-light and per-frame constants over `gpu_shadow_ms`.
+    pub fixed_fraction: Option<f64>,
     /// `cpu_plan_ms / gpu_shadow_ms`: above 1 the CPU's planning outlasts the GPU pass.
     pub cpu_fraction: Option<f64>,
     /// The largest fraction's name: `fill`, `vertex`, `draw` or `cpu` (`none` without timings).
     pub bound: String,
+    /// Whether the bound is claimed: the largest fraction leads the next by more than the
+    /// row's spread ((p90 - p10) / median) and the model's error on it.
+    pub bound_clear: bool,
     /// The limits the fractions were computed against.
     pub limits: RowLimits,
 }
@@ -170,6 +206,8 @@ pub struct SuiteReport {
     pub limits: Limits,
     /// Every measured point.
     pub rows: Vec<SuiteRow>,
+    /// The cost model fitted on the rows.
+    pub model: super::model::Model,
     /// Where the bound changes or one method overtakes another along a sweep.
     pub crossovers: Vec<Crossover>,
     /// The constant-factor claims, as measured ratios.
@@ -215,6 +253,19 @@ pub const CSV_COLUMNS: &[&str] = &[
     "draw_fraction",
     "cpu_fraction",
     "bound",
+    "gpu_shadow_ms_p10",
+    "gpu_shadow_ms_p90",
+    "gpu_map_ms",
+    "gpu_lookup_ms",
+    "predicted_shadow_ms",
+    "model_rel_error",
+    "vertex_invocations",
+    "clipped_triangles",
+    "map_texels",
+    "caster_passes",
+    "bound_triangles",
+    "fixed_fraction",
+    "bound_clear",
 ];
 
 fn opt<T: ToString>(v: Option<T>) -> String {
@@ -257,6 +308,19 @@ impl SuiteRow {
             opt(r.draw_fraction),
             opt(r.cpu_fraction),
             r.bound.clone(),
+            opt(r.gpu_shadow_ms_p10),
+            opt(r.gpu_shadow_ms_p90),
+            opt(r.gpu_map_ms),
+            opt(r.gpu_lookup_ms),
+            opt(r.predicted_shadow_ms),
+            opt(r.model_rel_error),
+            opt(r.vertex_invocations),
+            r.clipped_triangles.to_string(),
+            r.map_texels.to_string(),
+            r.caster_passes.to_string(),
+            r.bound_triangles.to_string(),
+            opt(r.fixed_fraction),
+            r.bound_clear.to_string(),
         ]
         .iter()
         .map(|f| if f.contains(',') { format!("\"{f}\"") } else { f.clone() })
@@ -266,6 +330,141 @@ impl SuiteRow {
 }
 
 impl SuiteReport {
+    /// The cost model's section: its form, held-out errors, coefficients against the limits,
+    /// and where it fits worst.
+    fn model_markdown(&self) -> String {
+        let m = &self.model;
+        let mut s = String::from("## Cost model\n\n");
+        let _ = writeln!(
+            s,
+            "GPU shadow ms ≈ 10⁻⁶ · Σ c·count (c in ns per unit, c ≥ 0), fitted by non-negative least squares in relative error on the {} timed rows of this run. Checked on rows it was not fitted on ({}-fold cross-validation): median error **{:.1}%**, 80th percentile **{:.1}%**, **{:.0}%** of rows within 30% (on the fitted rows: median {:.1}%). Each row's fill, vertex and draw fractions are its model terms over its measured time (over the prediction where the model predicts more, so no share exceeds the time); `fixed` is the per-light and per-frame constant. A bound is claimed (bold) only where the largest fraction leads the next by more than the row's spread and the model's error on it.\n",
+            m.rows,
+            m.folds,
+            m.median_rel_error * 100.0,
+            m.p80_rel_error * 100.0,
+            m.within_30_percent * 100.0,
+            m.fit_median_rel_error * 100.0
+        );
+        let _ = writeln!(s, "| term | counts | c (ns per unit) | at the measured limit (ns) |\n|---|---|---|---|");
+        for (name, _, what) in super::model::TERMS {
+            let c = m.coefficients.get(*name).copied().unwrap_or(0.0);
+            let lim = m.limit_ns.get(*name).map(|v| format!("{v:.3}")).unwrap_or_else(|| "—".into());
+            let _ = writeln!(s, "| {name} | {what} | {c:.4} | {lim} |");
+        }
+        let _ = writeln!(s, "\n| technique | median held-out error |\n|---|---|");
+        for (k, e) in &m.median_rel_error_by_method {
+            let _ = writeln!(s, "| {k} | {:.1}% |", e * 100.0);
+        }
+        let mut worst: Vec<&SuiteRow> = self.rows.iter().filter(|r| r.model_rel_error.is_some()).collect();
+        worst.sort_by(|a, b| b.model_rel_error.unwrap_or(0.0).total_cmp(&a.model_rel_error.unwrap_or(0.0)));
+        let _ = writeln!(s, "\nWorst-predicted rows (held out):\n\n| sweep | scene | variant | method | size | measured ms | predicted ms | error |\n|---|---|---|---|---|---|---|---|");
+        for r in worst.iter().take(8) {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {} | {}x{} | {:.2} | {:.2} | {:.0}% |",
+                r.sweep,
+                r.scene,
+                r.variant,
+                r.method,
+                r.width,
+                r.height,
+                r.gpu_shadow_ms.unwrap_or(0.0),
+                r.predicted_shadow_ms.unwrap_or(0.0),
+                r.model_rel_error.unwrap_or(0.0) * 100.0
+            );
+        }
+        s.push('\n');
+        s
+    }
+
+    /// McGuire et al.'s claim ("the simplification method trades vertex rate for fill rate
+    /// and will slow down applications that are fill rate bound"), measured on the `caps`
+    /// sweep: McGuire's O(s) fan caps against Everitt-Kilgard's O(f) caps, per size.
+    fn claim_markdown(&self) -> String {
+        let caps: Vec<&SuiteRow> = self.rows.iter().filter(|r| r.sweep == "caps").collect();
+        let mut xs: Vec<f64> = caps.iter().map(|r| r.x).collect();
+        xs.sort_by(f64::total_cmp);
+        xs.dedup();
+        if xs.is_empty() {
+            return String::new();
+        }
+        let mut s = String::from("## The paper's claim: O(s) caps trade vertex rate for fill rate\n\nMcGuire et al. 2003: \"the simplification method trades vertex rate for fill rate and will slow down applications that are fill rate bound\". On `bench/caps` (tilted tori above the eye, which stands in their shadow looking away from the light: McGuire's case 2, z-fail without light cap) McGuire draws each dark cap as a fan over the possible silhouette, O(s) triangles that overlap themselves where the silhouette is not convex; Everitt-Kilgard draws the O(f) caps. Ratios are McGuire / Everitt-Kilgard; the time ratio's range comes from the two rows' p10–p90.\n\n| size | triangles | stencil fragments | shadow ms (mcguire / e-k) | time ratio | range | faster |\n|---|---|---|---|---|---|---|\n");
+        let mut slower = Vec::new();
+        for x in xs {
+            let find = |m: &str| caps.iter().find(|r| r.x == x && r.method == m).copied();
+            let (Some(a), Some(b)) = (find("mcguire"), find("everitt-kilgard")) else { continue };
+            let (Some(ta), Some(tb)) = (a.gpu_shadow_ms, b.gpu_shadow_ms) else { continue };
+            let lo = a.gpu_shadow_ms_p10.unwrap_or(ta) / b.gpu_shadow_ms_p90.unwrap_or(tb);
+            let hi = a.gpu_shadow_ms_p90.unwrap_or(ta) / b.gpu_shadow_ms_p10.unwrap_or(tb);
+            let verdict = if lo > 1.0 {
+                slower.push(format!("{}x{}", a.width, a.height));
+                "everitt-kilgard"
+            } else if hi < 1.0 {
+                "mcguire"
+            } else {
+                "within spread"
+            };
+            let ratio = |p: Option<u64>, q: Option<u64>| match (p, q) {
+                (Some(p), Some(q)) if q > 0 => format!("{:.2}", p as f64 / q as f64),
+                _ => "—".into(),
+            };
+            let _ = writeln!(
+                s,
+                "| {}x{} | {} / {} ({:.2}) | {} / {} ({}) | {ta:.2} / {tb:.2} | {:.2} | {lo:.2}–{hi:.2} | {verdict} |",
+                a.width,
+                a.height,
+                a.shadow_triangles,
+                b.shadow_triangles,
+                a.shadow_triangles as f64 / b.shadow_triangles.max(1) as f64,
+                a.stencil_fragments.map_or("—".into(), |v| v.to_string()),
+                b.stencil_fragments.map_or("—".into(), |v| v.to_string()),
+                ratio(a.stencil_fragments, b.stencil_fragments),
+                ta / tb
+            );
+        }
+        let _ = writeln!(
+            s,
+            "\n{}\n",
+            if slower.is_empty() {
+                "On this device McGuire's caps were not slower than Everitt-Kilgard's beyond the spread at any size measured: the claim's slowdown did not show here.".to_string()
+            } else {
+                format!(
+                    "On this device McGuire's caps were slower than Everitt-Kilgard's beyond the spread at {}: the claim holds there.",
+                    slower.join(", ")
+                )
+            }
+        );
+        s
+    }
+
+    /// The shadow-map rows' time split into rendering the maps and the PCF lookup.
+    fn shadow_map_markdown(&self) -> String {
+        let rows: Vec<&SuiteRow> = self.rows.iter().filter(|r| r.gpu_map_ms.is_some() && r.sweep != "ablation").collect();
+        if rows.is_empty() {
+            return String::new();
+        }
+        let mut s = String::from("## Shadow maps: map against lookup\n\n| sweep | scene | method | size | lights | map texels | map ms | lookup ms | shadow ms | error |\n|---|---|---|---|---|---|---|---|---|---|\n");
+        for r in rows {
+            let _ = writeln!(
+                s,
+                "| {} | {} | {} | {}x{} | {} | {} | {:.2} | {:.2} | {:.2} | {} |",
+                r.sweep,
+                r.scene,
+                r.method,
+                r.width,
+                r.height,
+                r.lights,
+                r.map_texels,
+                r.gpu_map_ms.unwrap_or(0.0),
+                r.gpu_lookup_ms.unwrap_or(0.0),
+                r.gpu_shadow_ms.unwrap_or(0.0),
+                r.error_fraction.map(|e| format!("{:.4}%", e * 100.0)).unwrap_or_else(|| "—".into())
+            );
+        }
+        s.push('\n');
+        s
+    }
+
     /// `bench.csv`: a header line, then one line per row.
     pub fn csv(&self) -> String {
         let mut s = CSV_COLUMNS.join(",");
@@ -317,6 +516,8 @@ impl SuiteReport {
         let _ = writeln!(s, "| limit | value |\n|---|---|");
         let _ = writeln!(s, "| stencil fill (two-sided wrap, depth test) | {:.2} Gfragments/s |", l.stencil_fill_gfrag_s);
         let _ = writeln!(s, "| colour fill (RGBA16F additive, depth test) | {:.2} Gfragments/s |", l.color_fill_gfrag_s);
+        let _ = writeln!(s, "| triangle setup (no sample covered) | {:.2} Mtriangles/s |", l.setup_tri_mtri_s);
+        let _ = writeln!(s, "| clipped triangles (near plane and w = 0, no sample covered) | {:.3} Mtriangles/s |", l.clip_tri_mtri_s);
         let _ = writeln!(s, "| small triangles (2 px) | {:.2} Mtriangles/s |", l.small_tri_mtri_s);
         let _ = writeln!(s, "| screen-sized triangles | {:.4} Mtriangles/s |", l.big_tri_mtri_s);
         let _ = writeln!(s, "| slivers (1 px wide, centre to edge: volume sides) | {:.3} Mtriangles/s |", l.sliver_tri_mtri_s);
@@ -333,7 +534,14 @@ impl SuiteReport {
         for (k, why) in &l.skipped {
             let _ = writeln!(s, "| {k} | skipped: {why} |");
         }
-        let _ = writeln!(s, "\nfill = rasterised stencil fragments / stencil fill limit / GPU shadow time; vertex = (side triangles / sliver limit + cap triangles / small-triangle limit) / GPU shadow time (shadow maps: primitives / small-triangle limit); draw = draws / draw limit / time; cpu = CPU plan time / GPU shadow time. The bound is the largest.\n");
+        let _ = writeln!(
+            s,
+            "\nEach GPU limit is the peak of a sweep that doubles its workload until the rate stops growing (`limits.sweeps` in bench.json has every point): {}.\n",
+            l.sweeps.iter().map(|(k, v)| format!("{k} {} points", v.len())).collect::<Vec<_>>().join(", ")
+        );
+        s += &self.model_markdown();
+        s += &self.shadow_map_markdown();
+        s += &self.claim_markdown();
         let _ = writeln!(s, "## Named scenes\n");
         s += &table(self.rows.iter().filter(|r| r.sweep == "scenes"), true);
         let _ = writeln!(s, "\n## Crossovers\n");
@@ -376,7 +584,7 @@ impl SuiteReport {
                 let _ = writeln!(s, "\n![{p}]({plot_dir}/{p})");
             }
         }
-        for sweep in ["resolution", "tessellation", "lights", "light_distance", "casters", "ablation"] {
+        for sweep in ["resolution", "tessellation", "lights", "light_distance", "casters", "caps", "ablation"] {
             let rows: Vec<&SuiteRow> = self.rows.iter().filter(|r| r.sweep == sweep).collect();
             if rows.is_empty() {
                 continue;
@@ -392,11 +600,11 @@ impl SuiteReport {
 fn table<'a>(rows: impl Iterator<Item = &'a SuiteRow>, error: bool) -> String {
     let f2 = |v: Option<f64>| v.map(|x| format!("{x:.2}")).unwrap_or_else(|| "—".into());
     let pct = |v: Option<f64>| v.map(|x| format!("{:.0}%", x * 100.0)).unwrap_or_else(|| "—".into());
-    let mut s = String::from("| scene | x | variant | method | size | tris | lights | shadow ms | frame ms | stencil frags | shadow tris | draws | plan ms | fill | vertex | draw | cpu | bound |");
+    let mut s = String::from("| scene | x | variant | method | size | tris | lights | shadow ms | p10–p90 | model ms | frame ms | stencil frags | shadow tris | draws | plan ms | fill | vertex | draw | fixed | cpu | bound |");
     if error {
         s += " error |";
     }
-    s += "\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|";
+    s += "\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|";
     if error {
         s += "---|";
     }
@@ -404,7 +612,7 @@ fn table<'a>(rows: impl Iterator<Item = &'a SuiteRow>, error: bool) -> String {
     for r in rows {
         let _ = write!(
             s,
-            "| {} | {} | {} | {} | {}x{} | {} | {} | {} | {} | {} | {} | {} | {:.3} | {} | {} | {} | {} | **{}** |",
+            "| {} | {} | {} | {} | {}x{} | {} | {} | {} | {}–{} | {} | {} | {} | {} | {} | {:.3} | {} | {} | {} | {} | {} | {} |",
             r.scene,
             r.x,
             r.variant,
@@ -414,6 +622,9 @@ fn table<'a>(rows: impl Iterator<Item = &'a SuiteRow>, error: bool) -> String {
             r.triangles,
             r.lights,
             f2(r.gpu_shadow_ms),
+            f2(r.gpu_shadow_ms_p10),
+            f2(r.gpu_shadow_ms_p90),
+            f2(r.predicted_shadow_ms),
             f2(r.gpu_frame_ms),
             r.stencil_fragments.map(|v| v.to_string()).unwrap_or_else(|| "—".into()),
             r.shadow_triangles,
@@ -422,8 +633,9 @@ fn table<'a>(rows: impl Iterator<Item = &'a SuiteRow>, error: bool) -> String {
             pct(r.fill_fraction),
             pct(r.vertex_fraction),
             pct(r.draw_fraction),
+            pct(r.fixed_fraction),
             pct(r.cpu_fraction),
-            r.bound
+            if r.bound_clear { format!("**{}**", r.bound) } else { format!("{} (within spread)", r.bound) }
         );
         if error {
             let _ = write!(s, " {} |", r.error_fraction.map(|e| format!("{:.4}%", e * 100.0)).unwrap_or_else(|| "—".into()));

@@ -52,6 +52,17 @@ impl Variant {
     }
 }
 
+/// What a point's scene holds, for its rows.
+struct PointShape<'a> {
+    casters: u64,
+    triangles: u64,
+    nlights: usize,
+    /// Shadow-map faces a frame (6 per point light, 1 per other light).
+    map_faces: u64,
+    /// Each shadow-casting mesh's triangles, by name.
+    mesh_triangles: &'a HashMap<String, u64>,
+}
+
 struct Runner {
     ctx: Option<Context>,
     /// Print a line per point (progress requested but stderr is not a terminal).
@@ -93,8 +104,13 @@ impl Runner {
         let casters = scene.meshes.iter().filter(|m| m.casts_shadow).count() as u64;
         let triangles: u64 = scene.meshes.iter().filter(|m| m.casts_shadow).map(|m| m.mesh.triangles.len() as u64).sum();
         let nlights = scene.lights.len();
+        // Shadow-map faces a frame: six per point light, one per spot or directional light.
+        let map_faces: u64 = scene.lights.iter().map(|l| if l.kind == crate::scene::LightKind::Point { 6 } else { 1 }).sum();
+        let mesh_triangles: HashMap<String, u64> =
+            scene.meshes.iter().filter(|m| m.casts_shadow).map(|m| (m.name.clone(), m.mesh.triangles.len() as u64)).collect();
         let mut r = Renderer::new(ctx, scene, opts)?;
-        let result = self.measure(&mut r, sweep, x, name, variants, errors, casters, triangles, nlights);
+        let shape = PointShape { casters, triangles, nlights, map_faces, mesh_triangles: &mesh_triangles };
+        let result = self.measure(&mut r, sweep, x, name, variants, errors, shape);
         self.ctx = Some(r.into_context());
         result
     }
@@ -108,10 +124,9 @@ impl Runner {
         name: &str,
         variants: &[Variant],
         errors: bool,
-        casters: u64,
-        triangles: u64,
-        nlights: usize,
+        shape: PointShape,
     ) -> Result<Vec<SuiteRow>> {
+        let PointShape { casters, triangles, nlights, map_faces, mesh_triangles } = shape;
         let mut kept: Vec<&Variant> = Vec::with_capacity(variants.len());
         for v in variants {
             match v.technique {
@@ -156,6 +171,7 @@ impl Runner {
         #[derive(Default)]
         struct Acc {
             shadow: Vec<f64>,
+            map: Vec<f64>,
             frame: Vec<f64>,
             depth: Vec<f64>,
             illum: Vec<f64>,
@@ -172,6 +188,7 @@ impl Runner {
                 let a = &mut acc[k];
                 if let Some(g) = &f.stats.gpu_ms {
                     a.shadow.push(g.shadow);
+                    a.map.push(g.shadow_map);
                     a.frame.push(g.frame);
                     a.depth.push(g.depth);
                     a.illum.push(g.illuminate);
@@ -184,8 +201,23 @@ impl Runner {
         let mut rows = Vec::new();
         for ((v, s), a) in variants.iter().zip(counted).zip(acc) {
             let c = s.counters.clone().unwrap_or_default();
-            let shadow_map = matches!(v.technique, Technique::ShadowMap { .. });
+            let map_size = match v.technique {
+                Technique::ShadowMap { size } => Some(size as u64),
+                _ => None,
+            };
+            let shadow_map = map_size.is_some();
             let med = |x: Vec<f64>| (!x.is_empty()).then(|| median(x));
+            let q = |x: &[f64], p: f64| (!x.is_empty()).then(|| super::model::quantile(x, p));
+            let (p10, p90) = (q(&a.shadow, 0.1), q(&a.shadow, 0.9));
+            // Per light, the casters it did not cull, and their meshes' triangles.
+            let drawn = s.lights.iter().flat_map(|l| l.casters.iter()).filter(|c| c.case != "culled");
+            let (caster_passes, bound_triangles) =
+                drawn.fold((0u64, 0u64), |(n, t), c| (n + 1, t + mesh_triangles.get(&c.name).copied().unwrap_or(0)));
+            let lookup: Vec<f64> = a.shadow.iter().zip(&a.map).map(|(s, m)| s - m).collect();
+            let (map_ms, lookup_ms) = match shadow_map {
+                true => (med(a.map.clone()), med(lookup)),
+                false => (None, None),
+            };
             let mut row = SuiteRow {
                 suite: "fill-vertex".into(),
                 sweep: sweep.into(),
@@ -202,6 +234,10 @@ impl Runner {
                 lights: nlights as u64,
                 frames: self.frames,
                 gpu_shadow_ms: med(a.shadow),
+                gpu_shadow_ms_p10: p10,
+                gpu_shadow_ms_p90: p90,
+                gpu_map_ms: map_ms,
+                gpu_lookup_ms: lookup_ms,
                 gpu_frame_ms: med(a.frame),
                 gpu_depth_ms: med(a.depth),
                 gpu_illuminate_ms: med(a.illum),
@@ -210,13 +246,18 @@ impl Runner {
                 shadow_sides: s.totals.triangles.sides,
                 primitives: c.primitives,
                 clipped_primitives: c.clipped_primitives,
+                vertex_invocations: c.vertex_invocations,
+                clipped_triangles: s.totals.triangles.sides + s.totals.triangles.dark_cap,
+                map_texels: map_size.map_or(0, |n| n * n * map_faces),
+                caster_passes,
+                bound_triangles,
                 draws: s.totals.draws,
                 cpu_plan_ms: median(a.plan),
                 bytes: s.totals.bytes_sent,
                 error_fraction: error.get(&v.technique).copied(),
                 ..Default::default()
             };
-            sweeps::classify(&mut row, self.limits);
+            row.limits = self.limits;
             self.bar.inc(1);
             rows.push(row);
         }
@@ -256,6 +297,8 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
         small_tri_mtri_s: limits.small_tri_mtri_s,
         sliver_tri_mtri_s: limits.sliver_tri_mtri_s,
         draws_per_s: limits.draws_per_s,
+        setup_tri_mtri_s: limits.setup_tri_mtri_s,
+        clip_tri_mtri_s: limits.clip_tri_mtri_s,
     };
     let techniques = all_techniques(&scale.shadow_map_sizes(), ctx.features.ray_query);
     let points = sweeps::points(scale);
@@ -265,8 +308,11 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
     let index_scene = if scale == Scale::Tiny { "default" } else { "bench/vertex" };
     let toggle_variants = toggle_variants(&ctx);
     let index_variants = index_variants();
-    let units =
-        (named.len() + points.len()) * techniques.len() + (ablation_scenes.len() + 1) * toggle_variants.len() + index_variants.len();
+    let caps_points = points.iter().filter(|p| p.sweep == "caps").count();
+    let units = (named.len() + points.len() - caps_points) * techniques.len()
+        + caps_points * 4
+        + (ablation_scenes.len() + 1) * toggle_variants.len()
+        + index_variants.len();
     let bar = if cfg.progress {
         let b = indicatif::ProgressBar::new(units as u64);
         if let Ok(style) = indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} {msg}") {
@@ -287,11 +333,17 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
         let scene = crate::scene::load(n)?;
         rows.extend(run.point("scenes", 0.0, scene, n, base, &all, true)?);
     }
+    // The caps sweep compares the z-fail methods only (the paper's claim).
+    let caps: Vec<Variant> = [Method::McGuire, Method::EverittKilgard, Method::ZFail, Method::Lengyel]
+        .into_iter()
+        .map(|m| Variant::of(Technique::Volumes(m)))
+        .collect();
     for p in &points {
         let SweepPoint { sweep, x, scene, size } = p;
         let (scene, name) = scene_of(scene)?;
         run.bar.set_message(format!("{sweep} {name} {}x{}", size.0, size.1));
-        rows.extend(run.point(sweep, *x, scene, &name, *size, &all, false)?);
+        let variants = if *sweep == "caps" { &caps } else { &all };
+        rows.extend(run.point(sweep, *x, scene, &name, *size, variants, false)?);
     }
     // Ablations: McGuire with each optimisation off; index formats on the vertex scene.
     for &n in ablation_scenes {
@@ -307,6 +359,20 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
     run.bar.finish_and_clear();
     let ctx = run.ctx.take().ok_or_else(|| Error::Other("context lost".into()))?;
     ctx.check_validation()?;
+    let limit_ns = [
+        ("fragments", 1.0 / limits.stencil_fill_gfrag_s),
+        ("setup_triangles", 1e3 / limits.setup_tri_mtri_s),
+        ("clipped_triangles", 1e3 / limits.clip_tri_mtri_s),
+        ("draws", 1e9 / limits.draws_per_s),
+    ]
+    .iter()
+    .filter(|(_, v)| v.is_finite())
+    .map(|(k, v)| (k.to_string(), *v))
+    .collect();
+    let model = super::model::fit(&mut rows, limit_ns);
+    for r in &mut rows {
+        sweeps::classify(r, row_limits);
+    }
     let crossovers = sweeps::crossovers(&rows);
     let mut ablations = ablations(&rows);
     if !ctx.features.depth_bounds {
@@ -334,6 +400,7 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
         cpu_threads: std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
         limits,
         rows,
+        model,
         crossovers,
         ablations,
         plots: Vec::new(),

@@ -28,7 +28,8 @@ pub enum PointScene {
 /// One point of a sweep.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SweepPoint {
-    /// The sweep's name (`resolution`, `tessellation`, `lights`, `light_distance`, `casters`).
+    /// The sweep's name (`resolution`, `tessellation`, `lights`, `light_distance`, `casters`,
+    /// `caps`: the z-fail methods only, on `bench/caps`).
     pub sweep: &'static str,
     /// The sweep variable's value.
     pub x: f64,
@@ -49,8 +50,8 @@ impl Scale {
     /// Timed frames per variant (after a warm-up frame).
     pub fn frames(self) -> usize {
         match self {
-            Scale::Full => 7,
-            Scale::Quick => 3,
+            Scale::Full => 9,
+            Scale::Quick => 7,
             Scale::Tiny => 1,
         }
     }
@@ -98,6 +99,15 @@ pub fn points(scale: Scale) -> Vec<SweepPoint> {
     for c in pick(&[1.0, 4.0, 16.0, 64.0, 256.0], &[1.0, 16.0, 256.0], &[1.0, 4.0]) {
         out.push(param("casters", c, SweepScene { casters: c as u32, triangles: c as u64 * 512, ..d }));
     }
+    // The paper's claim: McGuire's O(s) dark-cap fans against the O(f) caps, growing pixels.
+    let caps: Vec<(u32, u32)> = match scale {
+        Scale::Full => vec![(480, 270), (960, 540), (1280, 720), (1920, 1080), (2560, 1440)],
+        Scale::Quick => vec![(480, 270), (960, 540), (1920, 1080), (2560, 1440)],
+        Scale::Tiny => vec![(80, 45), (160, 90)],
+    };
+    for s in caps {
+        out.push(SweepPoint { sweep: "caps", x: (s.0 * s.1) as f64, scene: PointScene::Named("bench/caps".into()), size: s });
+    }
     out
 }
 
@@ -107,40 +117,35 @@ pub fn shadow_map_fits(size: u32, lights: usize) -> bool {
     lights as u64 * (size as u64).pow(2) <= 1 << 26
 }
 
-/// Fills in a row's fractions of `limits` and its bound.
+/// Fills in a row's CPU fraction, its bound (the largest of its fill, vertex and draw
+/// fractions, which the cost model filled in, and its CPU fraction) and whether the bound is
+/// claimed: the lead over the next fraction exceeds both the row's spread
+/// ((p90 - p10) / median of its timed frames) and the model's held-out error on it.
 pub fn classify(row: &mut SuiteRow, limits: RowLimits) {
     row.limits = limits;
     let Some(t) = row.gpu_shadow_ms.filter(|t| *t > 0.0) else {
         row.bound = "none".into();
+        row.bound_clear = false;
         return;
     };
-    let secs = t * 1e-3;
-    let shadow_map = row.method.starts_with("shadowmap");
-    // Shadow maps draw no volumes: their fill (the maps' depth fragments) is not counted.
-    row.fill_fraction = match shadow_map {
-        true => None,
-        false => row.stencil_fragments.map(|f| f as f64 / (limits.stencil_fill_gfrag_s * 1e9) / secs),
-    };
-    // Volume sides reach the screen's edge (slivers); caps are small on screen.
-    let vertex_secs = match shadow_map {
-        true => row.primitives.unwrap_or(0) as f64 / (limits.small_tri_mtri_s * 1e6),
-        false => {
-            let sides = row.shadow_sides.min(row.shadow_triangles) as f64;
-            let caps = (row.shadow_triangles as f64 - sides).max(0.0);
-            let sliver = if limits.sliver_tri_mtri_s > 0.0 { limits.sliver_tri_mtri_s } else { limits.small_tri_mtri_s };
-            sides / (sliver * 1e6) + caps / (limits.small_tri_mtri_s * 1e6)
-        }
-    };
-    row.vertex_fraction = Some(vertex_secs / secs);
-    row.draw_fraction = (!shadow_map).then(|| row.draws as f64 / limits.draws_per_s / secs);
     row.cpu_fraction = Some(row.cpu_plan_ms / t);
-    let candidates = [("fill", row.fill_fraction), ("vertex", row.vertex_fraction), ("draw", row.draw_fraction), ("cpu", row.cpu_fraction)];
-    row.bound = candidates
-        .iter()
-        .filter_map(|(n, f)| f.filter(|f| f.is_finite()).map(|f| (*n, f)))
-        .max_by(|a, b| a.1.total_cmp(&b.1))
-        .map(|(n, _)| n.to_string())
-        .unwrap_or_else(|| "none".into());
+    let mut candidates: Vec<(&str, f64)> =
+        [("fill", row.fill_fraction), ("vertex", row.vertex_fraction), ("draw", row.draw_fraction), ("cpu", row.cpu_fraction)]
+            .iter()
+            .filter_map(|(n, f)| f.filter(|f| f.is_finite()).map(|f| (*n, f)))
+            .collect();
+    candidates.sort_by(|a, b| b.1.total_cmp(&a.1));
+    row.bound = candidates.first().map_or("none", |c| c.0).to_string();
+    let spread = match (row.gpu_shadow_ms_p10, row.gpu_shadow_ms_p90) {
+        (Some(lo), Some(hi)) => (hi - lo) / t,
+        _ => 0.0,
+    };
+    let margin = spread.max(row.model_rel_error.unwrap_or(0.0));
+    row.bound_clear = match candidates.as_slice() {
+        [] => false,
+        [_] => true,
+        [a, b, ..] => a.1 - b.1 > margin,
+    };
 }
 
 /// `x` where `a(x) - b(x)` crosses zero between two points, on a log scale of x (linear
@@ -166,7 +171,16 @@ fn fraction(r: &SuiteRow, bound: &str) -> f64 {
     .unwrap_or(0.0)
 }
 
-/// Along each sweep: per method, where its bound changes; per pair of methods, where the
+/// Whether two rows' timed-frame spreads ([p10, p90]) do not overlap (without spreads: the
+/// medians differ).
+fn apart(a: &SuiteRow, b: &SuiteRow) -> bool {
+    match (a.gpu_shadow_ms_p10, a.gpu_shadow_ms_p90, b.gpu_shadow_ms_p10, b.gpu_shadow_ms_p90) {
+        (Some(alo), Some(ahi), Some(blo), Some(bhi)) => ahi < blo || bhi < alo,
+        _ => a.gpu_shadow_ms != b.gpu_shadow_ms,
+    }
+}
+
+/// Along each sweep: per method, where its (claimed) bound changes; per pair of methods, where the
 /// faster one changes (GPU shadow time).
 pub fn crossovers(rows: &[SuiteRow]) -> Vec<Crossover> {
     let mut out = Vec::new();
@@ -192,7 +206,7 @@ pub fn crossovers(rows: &[SuiteRow]) -> Vec<Crossover> {
             let s = series(m);
             for w in s.windows(2) {
                 let (a, b) = (w[0], w[1]);
-                if a.bound != b.bound && a.bound != "none" && b.bound != "none" {
+                if a.bound != b.bound && a.bound_clear && b.bound_clear {
                     let d0 = fraction(a, &a.bound) - fraction(a, &b.bound);
                     let d1 = fraction(b, &a.bound) - fraction(b, &b.bound);
                     out.push(Crossover {
@@ -210,16 +224,17 @@ pub fn crossovers(rows: &[SuiteRow]) -> Vec<Crossover> {
         for (i, &ma) in methods.iter().enumerate() {
             for &mb in &methods[i + 1..] {
                 let (sa, sb) = (series(ma), series(mb));
-                let pairs: Vec<(f64, f64, f64)> = sa
+                let pairs: Vec<(f64, f64, f64, bool)> = sa
                     .iter()
                     .filter_map(|a| {
                         let b = sb.iter().find(|b| b.x == a.x)?;
-                        Some((a.x, a.gpu_shadow_ms?, b.gpu_shadow_ms?))
+                        Some((a.x, a.gpu_shadow_ms?, b.gpu_shadow_ms?, apart(a, b)))
                     })
                     .collect();
                 for w in pairs.windows(2) {
                     let (d0, d1) = (w[0].1 - w[0].2, w[1].1 - w[1].2);
-                    if d0 * d1 < 0.0 {
+                    // Claimed only where the order holds beyond the spread at both points.
+                    if d0 * d1 < 0.0 && w[0].3 && w[1].3 {
                         let (before, after) = if d0 < 0.0 { (ma, mb) } else { (mb, ma) };
                         out.push(Crossover {
                             kind: "overtake".into(),
@@ -242,7 +257,10 @@ pub fn crossovers(rows: &[SuiteRow]) -> Vec<Crossover> {
 mod tests {
     use super::*;
 
+    /// A row whose model fractions are fill = frags / 1e9 / s and vertex = tris / 1e6 / s (a
+    /// 1 Gfragment/s, 1 Mtriangle/s device), with a 1 % spread.
     fn row(sweep: &str, method: &str, x: f64, frags: u64, tris: u64, ms: f64) -> SuiteRow {
+        let secs = ms * 1e-3;
         let mut r = SuiteRow {
             sweep: sweep.into(),
             method: method.into(),
@@ -250,22 +268,31 @@ mod tests {
             stencil_fragments: Some(frags),
             shadow_triangles: tris,
             gpu_shadow_ms: Some(ms),
+            gpu_shadow_ms_p10: Some(ms * 0.995),
+            gpu_shadow_ms_p90: Some(ms * 1.005),
+            fill_fraction: Some(frags as f64 / 1e9 / secs),
+            vertex_fraction: Some(tris as f64 / 1e6 / secs),
+            draw_fraction: Some(0.0),
             draws: 1,
             ..Default::default()
         };
-        classify(&mut r, RowLimits { stencil_fill_gfrag_s: 1.0, small_tri_mtri_s: 1.0, sliver_tri_mtri_s: 1.0, draws_per_s: 1e6 });
+        classify(&mut r, RowLimits::default());
         r
     }
 
     #[test]
     fn fractions_and_bound() {
-        // 1e6 fragments at 1 Gfrag/s = 1 ms of a 2 ms pass; 100 triangles at 1 Mtri/s = 0.1 ms.
         let r = row("t", "m", 1.0, 1_000_000, 100, 2.0);
-        assert!((r.fill_fraction.unwrap() - 0.5).abs() < 1e-9);
-        assert!((r.vertex_fraction.unwrap() - 0.05).abs() < 1e-9);
         assert_eq!(r.bound, "fill");
+        assert!(r.bound_clear);
         let r = row("t", "m", 1.0, 1000, 1_000_000, 2.0);
         assert_eq!(r.bound, "vertex");
+        // Fill and vertex within the spread: the bound is not claimed.
+        let mut close = row("t", "m", 1.0, 1_000_000, 1_000, 2.0);
+        close.gpu_shadow_ms_p10 = Some(1.0);
+        close.gpu_shadow_ms_p90 = Some(3.0);
+        classify(&mut close, RowLimits::default());
+        assert!(!close.bound_clear);
         let mut none = SuiteRow::default();
         classify(&mut none, RowLimits::default());
         assert_eq!(none.bound, "none");
@@ -299,7 +326,7 @@ mod tests {
         let quick = points(Scale::Quick);
         let full = points(Scale::Full);
         assert!(quick.len() < full.len());
-        for s in ["resolution", "tessellation", "lights", "light_distance", "casters"] {
+        for s in ["resolution", "tessellation", "lights", "light_distance", "casters", "caps"] {
             assert!(points(Scale::Tiny).iter().filter(|p| p.sweep == s).count() == 2, "{s}");
         }
         let tess: Vec<f64> = full.iter().filter(|p| p.sweep == "tessellation").map(|p| p.x).collect();

@@ -9,6 +9,7 @@ pub const SCENES: &[(&str, &str)] = &[
     ("stress", include_str!("../../scenes/stress.toml")),
     ("bench/fill", include_str!("../../scenes/bench/fill.toml")),
     ("bench/vertex", include_str!("../../scenes/bench/vertex.toml")),
+    ("bench/caps", include_str!("../../scenes/bench/caps.toml")),
     ("hard/big_caster", include_str!("../../scenes/hard/big_caster.toml")),
     ("hard/light_inside_caster", include_str!("../../scenes/hard/light_inside_caster.toml")),
     ("hard/nested_256", include_str!("../../scenes/hard/nested_256.toml")),

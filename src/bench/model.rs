@@ -1,0 +1,287 @@
+//! The suite's cost model: per device, the GPU shadow time of a row as a non-negative sum of
+//! its counted work,
+//!
+//! ```text
+//! gpu_shadow_ms ≈ 1e-6 · Σ c_k · count_k   (c_k in ns per unit, c_k ≥ 0)
+//! ```
+//!
+//! over [`TERMS`] (fragments, per-pixel light passes, shadow-map lookups and texels, rays,
+//! triangles set up, clipped triangles, vertices shaded, caster triangles bound, compute
+//! silhouette triangles, draws, caster passes, lights and a constant), fitted by non-negative least squares on the suite's own rows, in relative error
+//! (each row weighted by 1 / its time, so a 0.3 ms row counts as much as a 300 ms one). It is
+//! checked on rows it was not fitted on: `FOLDS`-fold cross-validation, every row predicted
+//! by the fit of the other folds; `median_rel_error` and `p80_rel_error` are those held-out
+//! errors. Each row's `predicted_shadow_ms` is the fit on every row, and its fill, vertex,
+//! draw and fixed fractions are its terms of that fit, grouped, over its measured time — or
+//! over the prediction where that is larger (the terms then share the time in proportion),
+//! so the fractions sum to at most one, and to about one where the model fits.
+
+use super::report::SuiteRow;
+use serde::Serialize;
+use std::collections::BTreeMap;
+
+/// Which fraction a term counts towards.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Group {
+    /// Per-fragment or per-pixel work (`fill_fraction`).
+    Fill,
+    /// Per-triangle or per-vertex work (`vertex_fraction`).
+    Vertex,
+    /// Per-draw work (`draw_fraction`).
+    Draw,
+    /// Per-light and per-frame constants (`fixed_fraction`).
+    Fixed,
+}
+
+/// The model's terms: name, group, what is counted.
+pub const TERMS: &[(&str, Group, &str)] = &[
+    ("fragments", Group::Fill, "stencil fragments the volumes rasterise (precise occlusion query)"),
+    ("pixel_passes", Group::Fill, "lights x frame pixels (per-light stencil clears and full-screen passes)"),
+    ("lookup_pixels", Group::Fill, "lights x frame pixels of the shadow-map PCF lookup (shadow maps only)"),
+    ("map_texels", Group::Fill, "shadow-map texels cleared and rendered (faces x size^2, per light)"),
+    ("rays", Group::Fill, "ray-query rays (lights x frame pixels, ray query only)"),
+    ("setup_triangles", Group::Vertex, "primitives out of clipping (pipeline statistics): what reaches setup"),
+    ("clipped_triangles", Group::Vertex, "volume triangles with a vertex at infinity (sides and dark caps): always clipped"),
+    ("vertices", Group::Vertex, "vertex-shader invocations (pipeline statistics)"),
+    (
+        "bound_triangles",
+        Group::Vertex,
+        "caster triangles per light not culled, in the buffers the CPU-planned volumes index (not what they draw)",
+    ),
+    ("silhouette_triangles", Group::Vertex, "lights x caster triangles the compute silhouette pass reads (compute only)"),
+    ("draws", Group::Draw, "volume draw calls"),
+    ("caster_passes", Group::Draw, "(light, caster) pairs not culled (per pair: state, buffers, dispatches)"),
+    ("lights", Group::Fixed, "lights (per-light passes, barriers, rendering instances)"),
+    ("constant", Group::Fixed, "1 per frame"),
+];
+
+/// Held-out folds.
+pub const FOLDS: usize = 5;
+
+/// The fitted model (`bench.json`'s `model`).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Model {
+    /// The model's form, in words.
+    pub form: String,
+    /// Each term's coefficient, ns per unit.
+    pub coefficients: BTreeMap<String, f64>,
+    /// Median relative error |predicted - measured| / measured on held-out rows
+    /// (cross-validated).
+    pub median_rel_error: f64,
+    /// 80th percentile of the same.
+    pub p80_rel_error: f64,
+    /// Share of held-out rows within 30 %.
+    pub within_30_percent: f64,
+    /// Median relative error of the fit on the rows it was fitted on.
+    pub fit_median_rel_error: f64,
+    /// Rows fitted (timed, with counters).
+    pub rows: usize,
+    /// Cross-validation folds.
+    pub folds: usize,
+    /// What each term counts.
+    pub terms: BTreeMap<String, String>,
+    /// Each term's cost at the device's measured limit, ns per unit, where a limit measures it
+    /// (fragments: stencil fill; setup: triangle setup; clipped: clipped triangles; draws:
+    /// draw calls): the coefficient should not be below it.
+    pub limit_ns: BTreeMap<String, f64>,
+    /// Per technique, the median held-out relative error (where the model fits worst).
+    pub median_rel_error_by_method: BTreeMap<String, f64>,
+}
+
+/// A row's counts, in [`TERMS`] order (`None`: the row cannot be modelled: untimed or without
+/// counters).
+pub fn features(r: &SuiteRow) -> Option<Vec<f64>> {
+    r.gpu_shadow_ms.filter(|t| *t > 0.0)?;
+    let ray = r.method == "rayquery";
+    let map = r.method.starts_with("shadowmap");
+    // The CPU-planned volumes index each caster's dual-length vertex buffer.
+    let planned = matches!(r.method.as_str(), "zpass" | "zfail" | "everitt-kilgard" | "lengyel" | "mcguire" | "zpass-clear");
+    let lights = r.lights as f64;
+    let pixels = r.width as f64 * r.height as f64 * lights;
+    let only = |yes: bool, v: f64| if yes { v } else { 0.0 };
+    Some(vec![
+        r.stencil_fragments.unwrap_or(0) as f64,
+        pixels,
+        only(map, pixels),
+        r.map_texels as f64,
+        only(ray, pixels),
+        r.clipped_primitives? as f64,
+        r.clipped_triangles as f64,
+        r.vertex_invocations? as f64,
+        only(planned, r.bound_triangles as f64),
+        only(r.method == "compute", r.triangles as f64 * lights),
+        r.draws as f64,
+        r.caster_passes as f64,
+        lights,
+        1.0,
+    ])
+}
+
+/// Non-negative least squares: `min Σ_i (x_i · c - y_i)^2 w_i`, `c ≥ 0`, by cyclic coordinate
+/// descent on the column-scaled normal equations (a handful of unknowns: exact enough after
+/// a few thousand sweeps; converges because the normal matrix is positive semi-definite).
+pub fn nnls(x: &[Vec<f64>], y: &[f64], w: &[f64]) -> Vec<f64> {
+    let n = x.first().map_or(0, |r| r.len());
+    // Column scales: the weighted norm of each column (unused columns stay 0).
+    let scale: Vec<f64> = (0..n).map(|j| x.iter().zip(w).map(|(r, w)| w * r[j] * r[j]).sum::<f64>().sqrt()).collect();
+    let mut a = vec![vec![0.0; n]; n];
+    let mut b = vec![0.0; n];
+    for ((r, &yi), &wi) in x.iter().zip(y).zip(w) {
+        for j in 0..n {
+            if scale[j] == 0.0 {
+                continue;
+            }
+            let xj = r[j] / scale[j];
+            b[j] += wi * xj * yi;
+            for k in 0..n {
+                if scale[k] > 0.0 {
+                    a[j][k] += wi * xj * r[k] / scale[k];
+                }
+            }
+        }
+    }
+    let mut c = vec![0.0f64; n];
+    for _ in 0..20_000 {
+        let mut moved = 0.0f64;
+        for j in 0..n {
+            if a[j][j] <= 0.0 {
+                continue;
+            }
+            let g: f64 = b[j] - (0..n).map(|k| a[j][k] * c[k]).sum::<f64>();
+            let next = (c[j] + g / a[j][j]).max(0.0);
+            moved = moved.max((next - c[j]).abs());
+            c[j] = next;
+        }
+        if moved < 1e-13 {
+            break;
+        }
+    }
+    (0..n).map(|j| if scale[j] > 0.0 { c[j] / scale[j] } else { 0.0 }).collect()
+}
+
+/// The least-absolute-relative-error fit: non-negative least squares reweighted
+/// ([`IRLS_STEPS`] times) by 1 / (t^2 · max(|relative residual|, 2 %)), so that a few rows the
+/// model cannot explain (noise on a shared machine, costs no counter sees) do not pull every
+/// coefficient towards them.
+pub fn fit_relative(x: &[Vec<f64>], y: &[f64]) -> Vec<f64> {
+    let mut w: Vec<f64> = y.iter().map(|t| 1.0 / (t * t)).collect();
+    let mut c = nnls(x, y, &w);
+    for _ in 0..IRLS_STEPS {
+        for ((wi, xi), &t) in w.iter_mut().zip(x).zip(y) {
+            let res = (dot(&c, xi) - t).abs() / t;
+            *wi = 1.0 / (t * t * res.max(0.02));
+        }
+        c = nnls(x, y, &w);
+    }
+    c
+}
+
+/// Reweighting steps of [`fit_relative`].
+pub const IRLS_STEPS: usize = 20;
+
+fn dot(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+/// The `q`-quantile of `v` (linear between order statistics; NaN when empty).
+pub fn quantile(v: &[f64], q: f64) -> f64 {
+    let mut s: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
+    if s.is_empty() {
+        return f64::NAN;
+    }
+    s.sort_by(f64::total_cmp);
+    let p = q.clamp(0.0, 1.0) * (s.len() - 1) as f64;
+    let (i, f) = (p.floor() as usize, p - p.floor());
+    if i + 1 < s.len() {
+        s[i] * (1.0 - f) + s[i + 1] * f
+    } else {
+        s[i]
+    }
+}
+
+/// Fits the model on `rows` (fitted in ms, reported in ns per unit), fills in each row's
+/// prediction and model fractions, and returns the model. `limit_ns`: each term's cost at
+/// the measured limit.
+pub fn fit(rows: &mut [SuiteRow], limit_ns: BTreeMap<String, f64>) -> Model {
+    let idx: Vec<usize> = (0..rows.len()).filter(|&i| features(&rows[i]).is_some()).collect();
+    let x: Vec<Vec<f64>> = idx.iter().filter_map(|&i| features(&rows[i])).collect();
+    let y: Vec<f64> = idx.iter().map(|&i| rows[i].gpu_shadow_ms.unwrap_or(0.0)).collect();
+    let all = fit_relative(&x, &y);
+    // Held out: each fold predicted by the fit on the others.
+    let mut held = vec![f64::NAN; idx.len()];
+    for f in 0..FOLDS {
+        let train: Vec<usize> = (0..idx.len()).filter(|k| k % FOLDS != f).collect();
+        if train.is_empty() {
+            continue;
+        }
+        let c = fit_relative(&train.iter().map(|&k| x[k].clone()).collect::<Vec<_>>(), &train.iter().map(|&k| y[k]).collect::<Vec<_>>());
+        for k in (0..idx.len()).filter(|k| k % FOLDS == f) {
+            held[k] = (dot(&c, &x[k]) - y[k]).abs() / y[k];
+        }
+    }
+    let mut fit_err = Vec::with_capacity(idx.len());
+    let mut by_method: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+    for (k, &i) in idx.iter().enumerate() {
+        let r = &mut rows[i];
+        let t = y[k];
+        let terms: Vec<f64> = all.iter().zip(&x[k]).map(|(c, v)| c * v).collect();
+        let pred = terms.iter().sum::<f64>();
+        r.predicted_shadow_ms = Some(pred);
+        fit_err.push((pred - t).abs() / t);
+        by_method.entry(r.method.clone()).or_default().push(held[k]);
+        // Shares of the row's time: over the measured time, or over the prediction where the
+        // model predicts more than was measured (no share of a time can exceed the time).
+        let whole = t.max(pred);
+        let group = |g: Group| TERMS.iter().zip(&terms).filter(|((_, tg, _), _)| *tg == g).map(|(_, v)| v).sum::<f64>() / whole;
+        r.fill_fraction = Some(group(Group::Fill));
+        r.vertex_fraction = Some(group(Group::Vertex));
+        r.draw_fraction = Some(group(Group::Draw));
+        r.fixed_fraction = Some(group(Group::Fixed));
+        r.model_rel_error = Some(held[k]);
+    }
+    Model {
+        form: "gpu_shadow_ms = 1e-6 * sum_k c_k * count_k, c_k >= 0 in ns per unit; non-negative least squares in relative error, reweighted to least absolute relative error"
+            .into(),
+        coefficients: TERMS.iter().zip(&all).map(|((n, _, _), c)| (n.to_string(), c * 1e6)).collect(),
+        median_rel_error: quantile(&held, 0.5),
+        p80_rel_error: quantile(&held, 0.8),
+        within_30_percent: held.iter().filter(|e| **e <= 0.3).count() as f64 / held.len().max(1) as f64,
+        fit_median_rel_error: quantile(&fit_err, 0.5),
+        rows: idx.len(),
+        folds: FOLDS,
+        terms: TERMS.iter().map(|(n, _, what)| (n.to_string(), what.to_string())).collect(),
+        limit_ns,
+        median_rel_error_by_method: by_method.into_iter().map(|(m, e)| (m, quantile(&e, 0.5))).collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nnls_recovers_non_negative_coefficients() {
+        // y = 2 a + 0 b + 3 (b not a combination of the others).
+        let x: Vec<Vec<f64>> = (0..20).map(|i| vec![i as f64, ((i * i) % 7) as f64, 1.0]).collect();
+        let y: Vec<f64> = x.iter().map(|r| 2.0 * r[0] + 3.0).collect();
+        let w = vec![1.0; 20];
+        let c = nnls(&x, &y, &w);
+        assert!((c[0] - 2.0).abs() < 1e-6 && c[1].abs() < 1e-6 && (c[2] - 3.0).abs() < 1e-5, "{c:?}");
+        // A negative truth is clamped to 0, the rest refitted.
+        let y: Vec<f64> = x.iter().map(|r| r[0] - 50.0 * r[1] + 1000.0).collect();
+        let c = nnls(&x, &y, &w);
+        assert!(c.iter().all(|c| *c >= 0.0) && c[1] == 0.0, "{c:?}");
+        // The relative fit ignores one wild row where least squares would bend to it.
+        let mut y: Vec<f64> = x.iter().map(|r| 2.0 * r[0] + 3.0).collect();
+        y[7] *= 10.0;
+        let c = fit_relative(&x, &y);
+        assert!((c[0] - 2.0).abs() < 0.05 && (c[2] - 3.0).abs() < 0.3, "{c:?}");
+    }
+
+    #[test]
+    fn quantiles() {
+        assert_eq!(quantile(&[3.0, 1.0, 2.0], 0.5), 2.0);
+        assert!((quantile(&[0.0, 10.0], 0.1) - 1.0).abs() < 1e-12);
+        assert!(quantile(&[], 0.5).is_nan());
+    }
+}
