@@ -199,7 +199,9 @@ impl Lab<'_> {
     }
 }
 
-fn measure_with(ctx: &Context, cfg: &LimitsConfig, made: &mut Made) -> Result<Limits> {
+/// Creates the offscreen target (into `made`) and the two pipelines: stencil-only (the shadow
+/// pass's state) and depth-tested additive colour.
+fn setup(ctx: &Context, cfg: &LimitsConfig, made: &mut Made) -> Result<(vk::Pipeline, vk::Pipeline)> {
     let (w, h) = (cfg.width.max(16), cfg.height.max(16));
     let extent = vk::Extent2D { width: w, height: h };
     if !ctx.features.timestamps {
@@ -252,7 +254,7 @@ fn measure_with(ctx: &Context, cfg: &LimitsConfig, made: &mut Made) -> Result<Li
             return Err(l.err().or(p.err()).unwrap_or_else(|| Error::Other("limits target".into())));
         }
     };
-    let t = made.target.insert(Target { ds, color, pool, layout, extent });
+    made.target = Some(Target { ds, color, pool, layout, extent });
 
     // Pipelines: stencil-only (the shadow pass's state) and depth-tested additive colour.
     let color_formats = [crate::render::targets::ACCUM_FORMAT];
@@ -275,11 +277,17 @@ fn measure_with(ctx: &Context, cfg: &LimitsConfig, made: &mut Made) -> Result<Li
     c.depth_compare = vk::CompareOp::LESS_OR_EQUAL;
     let color = pipeline::create(ctx, &c)?;
     made.pipelines.push(color);
+    Ok((stencil, color))
+}
 
+fn measure_with(ctx: &Context, cfg: &LimitsConfig, made: &mut Made) -> Result<Limits> {
+    let (w, h) = (cfg.width.max(16), cfg.height.max(16));
+    let (stencil, color) = setup(ctx, cfg, made)?;
+    let t = made.target.as_ref().ok_or_else(|| Error::Other("limits target".into()))?;
     let quick = cfg.scale < 1.0;
     let mut lab = Lab {
         ctx,
-        t: &*t,
+        t,
         reps: cfg.reps.max(1),
         max_steps: if quick { 7 } else { 9 },
         max_ms: if quick { 150.0 } else { 400.0 },
@@ -376,39 +384,8 @@ fn measure_with(ctx: &Context, cfg: &LimitsConfig, made: &mut Made) -> Result<Li
     let sliver_vb = upload("limits-sliver", bytes(&sliver), vb)?;
     let sliver_rate = lab.peak("sliver_tri_mtri_s", draw(stencil, sliver_vb, sliver.len()), slivers as f64, 1e6, false)?;
 
-    // Index fetch: a 16x16-vertex patch (256 vertices: u8 can address it) of 2-pixel cells,
-    // its 450 triangles repeated.
-    let patch: Vec<[f32; 4]> = (0..256).map(|k| [-0.5 + (k % 16) as f32 * 2.0 * pw, -0.5 + (k / 16) as f32 * 2.0 * ph, 0.5, 1.0]).collect();
-    let mut tri_idx: Vec<u32> = Vec::new();
-    for j in 0..15u32 {
-        for i in 0..15u32 {
-            let (a, b, c, d) = (j * 16 + i, j * 16 + i + 1, (j + 1) * 16 + i + 1, (j + 1) * 16 + i);
-            tri_idx.extend([a, b, c, a, c, d]);
-        }
-    }
-    let idx32: Vec<u32> = tri_idx.iter().copied().cycle().take(tri_idx.len() * 100).collect();
-    let n_idx = idx32.len() as u32;
-    let idx_tris = n_idx as f64 / 3.0;
-    let patch_vb = upload("limits-patch", bytes(&patch), vb)?;
-    let ib = vk::BufferUsageFlags::INDEX_BUFFER;
-    let indexed = |buf, ty| Workload { pipe: stencil, vertices: patch_vb, indices: Some((buf, ty, n_idx)), vertex_count: 0, draws: 1 };
-    let i32b = upload("limits-u32", bytes(&idx32), ib)?;
-    let idx16: Vec<u16> = idx32.iter().map(|&i| i as u16).collect();
-    let i16b = upload("limits-u16", bytes(&idx16), ib)?;
-    let u16_rate = lab.peak("index_u16_mtri_s", indexed(i16b, vk::IndexType::UINT16), idx_tris, 1e6, false)?;
-    let u32_rate = lab.peak("index_u32_mtri_s", indexed(i32b, vk::IndexType::UINT32), idx_tris, 1e6, false)?;
-    let mut skipped = BTreeMap::new();
-    let u8_rate = if ctx.features.index_type_uint8 {
-        let idx8: Vec<u8> = idx32.iter().map(|&i| i as u8).collect();
-        let i8b = upload("limits-u8", &idx8, ib)?;
-        Some(lab.peak("index_u8_mtri_s", indexed(i8b, vk::IndexType::UINT8_EXT), idx_tris, 1e6, false)?)
-    } else {
-        skipped.insert("index_u8_mtri_s".to_string(), "VK_EXT_index_type_uint8 (indexTypeUint8) missing".to_string());
-        None
-    };
-    let naive: Vec<[f32; 4]> = idx32.iter().map(|&i| patch[i as usize]).collect();
-    let naive_vb = upload("limits-naive", bytes(&naive), vb)?;
-    let naive_rate = lab.peak("index_naive_mtri_s", draw(stencil, naive_vb, naive.len()), idx_tris, 1e6, false)?;
+    let IndexRates { u16: u16_rate, u32: u32_rate, u8: u8_rate, naive: naive_rate, skipped } =
+        index_limits(&mut lab, &mut upload, stencil, (pw, ph))?;
 
     // Draw calls: one 1-pixel triangle each, 1024 draws doubled.
     let tiny: [[f32; 4]; 3] = [[0.0, 0.0, 0.5, 1.0], [pw, 0.0, 0.5, 1.0], [0.0, ph, 0.5, 1.0]];
@@ -453,6 +430,62 @@ fn measure_with(ctx: &Context, cfg: &LimitsConfig, made: &mut Made) -> Result<Li
         skipped,
         sweeps: lab.sweeps,
     })
+}
+
+/// The index-fetch limits, Mtriangles / s.
+struct IndexRates {
+    u16: f64,
+    u32: f64,
+    /// `None` without `VK_EXT_index_type_uint8` (the reason in `skipped`).
+    u8: Option<f64>,
+    naive: f64,
+    skipped: BTreeMap<String, String>,
+}
+
+/// Measures [`IndexRates`].
+fn index_limits(
+    lab: &mut Lab,
+    upload: &mut impl FnMut(&str, &[u8], vk::BufferUsageFlags) -> Result<vk::Buffer>,
+    stencil: vk::Pipeline,
+    (pw, ph): (f32, f32),
+) -> Result<IndexRates> {
+    let ctx = lab.ctx;
+    let vb = vk::BufferUsageFlags::VERTEX_BUFFER;
+    // Index fetch: a 16x16-vertex patch (256 vertices: u8 can address it) of 2-pixel cells,
+    // its 450 triangles repeated.
+    let patch: Vec<[f32; 4]> = (0..256).map(|k| [-0.5 + (k % 16) as f32 * 2.0 * pw, -0.5 + (k / 16) as f32 * 2.0 * ph, 0.5, 1.0]).collect();
+    let mut tri_idx: Vec<u32> = Vec::new();
+    for j in 0..15u32 {
+        for i in 0..15u32 {
+            let (a, b, c, d) = (j * 16 + i, j * 16 + i + 1, (j + 1) * 16 + i + 1, (j + 1) * 16 + i);
+            tri_idx.extend([a, b, c, a, c, d]);
+        }
+    }
+    let idx32: Vec<u32> = tri_idx.iter().copied().cycle().take(tri_idx.len() * 100).collect();
+    let n_idx = idx32.len() as u32;
+    let idx_tris = n_idx as f64 / 3.0;
+    let patch_vb = upload("limits-patch", bytes(&patch), vb)?;
+    let ib = vk::BufferUsageFlags::INDEX_BUFFER;
+    let indexed = |buf, ty| Workload { pipe: stencil, vertices: patch_vb, indices: Some((buf, ty, n_idx)), vertex_count: 0, draws: 1 };
+    let i32b = upload("limits-u32", bytes(&idx32), ib)?;
+    let idx16: Vec<u16> = idx32.iter().map(|&i| i as u16).collect();
+    let i16b = upload("limits-u16", bytes(&idx16), ib)?;
+    let u16_rate = lab.peak("index_u16_mtri_s", indexed(i16b, vk::IndexType::UINT16), idx_tris, 1e6, false)?;
+    let u32_rate = lab.peak("index_u32_mtri_s", indexed(i32b, vk::IndexType::UINT32), idx_tris, 1e6, false)?;
+    let mut skipped = BTreeMap::new();
+    let u8_rate = if ctx.features.index_type_uint8 {
+        let idx8: Vec<u8> = idx32.iter().map(|&i| i as u8).collect();
+        let i8b = upload("limits-u8", &idx8, ib)?;
+        Some(lab.peak("index_u8_mtri_s", indexed(i8b, vk::IndexType::UINT8_EXT), idx_tris, 1e6, false)?)
+    } else {
+        skipped.insert("index_u8_mtri_s".to_string(), "VK_EXT_index_type_uint8 (indexTypeUint8) missing".to_string());
+        None
+    };
+    let naive: Vec<[f32; 4]> = idx32.iter().map(|&i| patch[i as usize]).collect();
+    let naive_vb = upload("limits-naive", bytes(&naive), vb)?;
+    let naive_wl = Workload { pipe: stencil, vertices: naive_vb, indices: None, vertex_count: naive.len() as u32, draws: 1 };
+    let naive_rate = lab.peak("index_naive_mtri_s", naive_wl, idx_tris, 1e6, false)?;
+    Ok(IndexRates { u16: u16_rate, u32: u32_rate, u8: u8_rate, naive: naive_rate, skipped })
 }
 
 /// Median GPU ms of `reps` repetitions of `wl` (each in its own submission, the target cleared

@@ -6,7 +6,7 @@
 //! ```
 //!
 //! over [`TERMS`] (fragments, per-pixel light passes, shadow-map lookups and texels, rays,
-//! triangles set up, clipped triangles, vertices shaded, caster triangles bound, compute
+//! triangles submitted and set up, clipped triangles, vertices shaded, caster triangles bound, compute
 //! silhouette triangles, draws, caster passes, lights and a constant), fitted by non-negative least squares on the suite's own rows, in relative error
 //! (each row weighted by 1 / its time, so a 0.3 ms row counts as much as a 300 ms one). It is
 //! checked on rows it was not fitted on: `FOLDS`-fold cross-validation, every row predicted
@@ -40,6 +40,7 @@ pub const TERMS: &[(&str, Group, &str)] = &[
     ("lookup_pixels", Group::Fill, "lights x frame pixels of the shadow-map PCF lookup (shadow maps only)"),
     ("map_texels", Group::Fill, "shadow-map texels cleared and rendered (faces x size^2, per light)"),
     ("rays", Group::Fill, "ray-query rays (lights x frame pixels, ray query only)"),
+    ("input_triangles", Group::Vertex, "input-assembly primitives (pipeline statistics): every triangle submitted, culled or not"),
     ("setup_triangles", Group::Vertex, "primitives out of clipping (pipeline statistics): what reaches setup"),
     ("clipped_triangles", Group::Vertex, "volume triangles with a vertex at infinity (sides and dark caps): always clipped"),
     ("vertices", Group::Vertex, "vertex-shader invocations (pipeline statistics)"),
@@ -105,6 +106,7 @@ pub fn features(r: &SuiteRow) -> Option<Vec<f64>> {
         only(map, pixels),
         r.map_texels as f64,
         only(ray, pixels),
+        r.primitives? as f64,
         r.clipped_primitives? as f64,
         r.clipped_triangles as f64,
         r.vertex_invocations? as f64,
@@ -276,6 +278,20 @@ mod tests {
         y[7] *= 10.0;
         let c = fit_relative(&x, &y);
         assert!((c[0] - 2.0).abs() < 0.05 && (c[2] - 3.0).abs() < 0.3, "{c:?}");
+    }
+
+    #[test]
+    fn a_feature_per_term() {
+        let r = SuiteRow {
+            method: "mcguire".into(),
+            gpu_shadow_ms: Some(1.0),
+            primitives: Some(1),
+            clipped_primitives: Some(1),
+            vertex_invocations: Some(3),
+            ..Default::default()
+        };
+        assert_eq!(features(&r).map(|f| f.len()), Some(TERMS.len()));
+        assert_eq!(features(&SuiteRow::default()), None, "untimed rows are not modelled");
     }
 
     #[test]

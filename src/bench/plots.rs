@@ -304,17 +304,29 @@ where
             .map_err(err(&title))?
             .label("Pareto front")
             .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], RGBColor(40, 120, 40).stroke_width(2)));
-        // Labels alternate above and below so that neighbours on the floor stay readable.
-        for (k, (t, e, m, i)) in pts.iter().enumerate() {
+        // Inexact points are labelled where they sit; the exact ones, which share the floor,
+        // are listed fastest first in the panel's middle right, each with its marker colour.
+        let mut exact = Vec::new();
+        for (t, e, m, i) in &pts {
             let color = Palette99::pick(*i).to_rgba();
-            let dy = if k % 2 == 0 { -14 } else { 6 };
-            chart
-                .draw_series(std::iter::once(
-                    EmptyElement::at((*t, *e))
-                        + Circle::new((0, 0), 4, color.filled())
-                        + Text::new(m.clone(), (5, dy), ("sans-serif", 11).into_font()),
-                ))
-                .map_err(err(&title))?;
+            let marker = EmptyElement::at((*t, *e)) + Circle::new((0, 0), 4, color.filled());
+            if *e <= floor {
+                chart.draw_series(std::iter::once(marker)).map_err(err(&title))?;
+                exact.push((format!("{m}  {t:.2} ms"), color));
+            } else {
+                let label = Text::new(m.clone(), (5, -14), ("sans-serif", 11).into_font());
+                chart.draw_series(std::iter::once(marker + label)).map_err(err(&title))?;
+            }
+        }
+        if !exact.is_empty() {
+            let (w, h) = area.dim_in_pixel();
+            let (x, y0) = (w as i32 - 215, h as i32 / 2 - 10 * exact.len() as i32);
+            area.draw(&Text::new("exact, fastest first:", (x, y0 - 16), ("sans-serif", 12).into_font())).map_err(err(&title))?;
+            for (k, (line, color)) in exact.iter().enumerate() {
+                let y = y0 + 15 * k as i32;
+                area.draw(&Circle::new((x + 4, y + 6), 4, color.filled())).map_err(err(&title))?;
+                area.draw(&Text::new(line.clone(), (x + 14, y), ("sans-serif", 11).into_font())).map_err(err(&title))?;
+            }
         }
         chart
             .configure_series_labels()
@@ -354,8 +366,10 @@ where
         .map_err(err(&title))?;
     chart.configure_mesh().x_desc("predicted GPU shadow ms").y_desc("measured GPU shadow ms").draw().map_err(err(&title))?;
     chart.draw_series(LineSeries::new(vec![(a0, a0), (a1, a1)], BLACK.stroke_width(1))).map_err(err(&title))?.label("measured = predicted");
-    for f in [1.3, 1.0 / 1.3] {
-        chart.draw_series(LineSeries::new(vec![(a0, a0 * f), (a1, a1 * f)], BLACK.mix(0.3).stroke_width(1))).map_err(err(&title))?;
+    // The ±30 % band, clipped to the chart.
+    let band = [vec![(a0, a0 * 1.3), (a1 / 1.3, a1)], vec![(a0 * 1.3, a0), (a1, a1 / 1.3)]];
+    for line in band {
+        chart.draw_series(LineSeries::new(line, BLACK.mix(0.3).stroke_width(1))).map_err(err(&title))?;
     }
     for (i, m) in methods(rows.iter().copied()).iter().enumerate() {
         let color = Palette99::pick(i).to_rgba();

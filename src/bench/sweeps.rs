@@ -50,8 +50,8 @@ impl Scale {
     /// Timed frames per variant (after a warm-up frame).
     pub fn frames(self) -> usize {
         match self {
-            Scale::Full => 9,
-            Scale::Quick => 7,
+            Scale::Full => 11,
+            Scale::Quick => 9,
             Scale::Tiny => 1,
         }
     }

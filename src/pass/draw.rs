@@ -1,216 +1,78 @@
-//! The volumes' draws: the pipeline each draw takes, its push block and its bind-and-draw.
+//! The draws a prepared frame holds (a leaf: the planner's output as the recording reads it,
+//! imported by the frame, the compute silhouettes and the sphere casters alike).
 
 use super::desc::IndexFormat;
-use super::frame::{CasterDraw, Draw, PreparedFrame};
-use super::pipelines::CountPipes;
-use super::push::VolumePush;
-use super::record::VolumeKind;
-use super::ShadowPass;
-use crate::error::{Misuse, Result};
-use crate::shadow::Case;
+use super::stats::LightStats;
+use crate::shadow::{Case, LightPlan};
 use ash::vk;
+use glam::{Mat4, Vec3, Vec4};
 
-impl ShadowPass {
-    /// Records the volumes of `light` for `kind` inside a rendering instance the caller
-    /// began (attachments: the pass's depth-stencil format, plus an R32F colour attachment
-    /// for the float kinds or the transmit format for `Transmit`), with the viewport and
-    /// scissor set (e.g. by [`cmd_light_state`](Self::cmd_light_state)).
-    ///
-    /// With [`TargetModel::RenderPass`](super::TargetModel::RenderPass), inside the host's subpass (stencil and rasterised
-    /// kinds only).
-    ///
-    /// Errors ([`Error::Misuse`](crate::Error::Misuse)): as `cmd_determine`'s frame and light checks, and a kind the
-    /// pass has no pipelines for (float kinds without R32F blending or in the render-pass
-    /// model, `Transmit` without a transmit format).
-    ///
-    /// # Safety
-    /// `cb` is recording inside such a rendering instance or subpass; the frame's uploads and
-    /// GPU silhouettes were recorded earlier ([`cmd_before_rendering`](Self::cmd_before_rendering));
-    /// `frame`'s slot is not prepared again before `cb` completes.
-    pub unsafe fn cmd_draw_volumes(&self, cb: vk::CommandBuffer, frame: &PreparedFrame, light: usize, kind: VolumeKind) -> Result<()> {
-        let lf = self.light(frame, light)?;
-        let p = &self.pipes;
-        let count = p.count.as_ref();
-        match kind {
-            VolumeKind::Float | VolumeKind::FloatDepthTested if count.is_none() => {
-                return Err(Misuse::NotConfigured {
-                    call: "cmd_draw_volumes (float kinds)",
-                    needs: "R32_SFLOAT blending and TargetModel::DynamicRendering",
-                }
-                .into());
-            }
-            VolumeKind::Transmit { .. } if p.transmit.is_none() => {
-                return Err(Misuse::NotConfigured {
-                    call: "cmd_draw_volumes (VolumeKind::Transmit)",
-                    needs: "ShadowPassDesc::transmit_format",
-                }
-                .into());
-            }
-            _ => {}
-        }
-        let mut bound = vk::Pipeline::null();
-        for c in lf.casters.iter().filter(|c| c.case != Case::Culled) {
-            let wanted = match kind {
-                VolumeKind::Transmit { .. } => c.transmittance.is_some(),
-                _ => c.transmittance.is_none(),
-            };
-            if !wanted {
-                continue;
-            }
-            // Float counter: the sign a front face contributes (+1 z-pass, -1 z-fail);
-            // light-intensity map: and the caster's transmittance.
-            let color = |case: Case| {
-                let sign = if case == Case::ZPass { 1.0 } else { -1.0 };
-                let t = c.transmittance.unwrap_or_default();
-                [sign, t.x, t.y, t.z]
-            };
-            if let Some(eq) = &c.edge_quad {
-                // SAFETY: the caller's contract; push constants match the pipeline layout.
-                unsafe { self.push(cb, c, color(c.case)) };
-                let (faces, sides) = match (kind, count) {
-                    (VolumeKind::Stencil, _) => (p.stencil.eq_faces, p.stencil.eq_sides),
-                    (VolumeKind::Rasterised, _) => (p.raster.edge_quads, p.raster.edge_quads),
-                    (VolumeKind::Float, Some(cp)) => (cp.eq_faces, cp.eq_sides),
-                    // Self-shadowing leaves edge-quad casters out (their faces are not a
-                    // depth-tested volume); transparent casters never take edge quads.
-                    _ => continue,
-                };
-                let d = &self.dev.device;
-                // SAFETY: as above; the edge-quad buffers live until the slot retires.
-                unsafe {
-                    d.cmd_bind_vertex_buffers(cb, 0, &[eq.vertices], &[0]);
-                    d.cmd_bind_index_buffer(cb, eq.indices, 0, vk::IndexType::UINT32);
-                    d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, faces);
-                    d.cmd_draw_indexed(cb, eq.face_indices, 1, 0, 0, 0);
-                    d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, sides);
-                    d.cmd_draw_indexed(cb, eq.quad_indices, 1, eq.face_indices, 0, 0);
-                }
-                bound = sides;
-                continue;
-            }
-            let mut pushed = None;
-            for dr in &c.draws {
-                let planar = frame.settings.technique == super::desc::Technique::Planar;
-                let Some(pipe) = self.pipeline_for(kind, count, dr.case, dr.light_cap, planar) else { continue };
-                // Parts of one caster may take different cases: the sign follows the draw's.
-                let block = color(dr.case);
-                if pushed != Some(block) {
-                    // SAFETY: as above.
-                    unsafe { self.push(cb, c, block) };
-                    pushed = Some(block);
-                }
-                if pipe != bound {
-                    // SAFETY: as above.
-                    unsafe { self.dev.device.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipe) };
-                    bound = pipe;
-                }
-                // SAFETY: as above.
-                unsafe { self.record_draw(cb, frame, dr) };
-            }
-        }
-        Ok(())
+/// One index-stream draw of a caster chunk.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Draw {
+    /// The chunk's dual-length vertex buffer.
+    pub vertices: vk::Buffer,
+    /// Byte offset of the indices (or naive vertices) in the frame's stream.
+    pub offset: u64,
+    pub count: u32,
+    pub format: IndexFormat,
+    /// The case of the caster part this chunk belongs to (its pipeline and sign follow it).
+    pub case: Case,
+    /// A light cap (drawn with the depth-NEVER pipeline by the stencil counter).
+    pub light_cap: bool,
+    /// GPU silhouettes: `offset` is the byte offset of the draw's
+    /// `VkDrawIndexedIndirectCommand` in the frame's compute records, the indices (u16) are in
+    /// its compute output buffer, and `count` is unknown (0) until read back.
+    pub indirect: bool,
+}
+
+/// Edge-quad geometry of a caster (static buffers).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct EdgeQuadDraw {
+    pub vertices: vk::Buffer,
+    pub indices: vk::Buffer,
+    pub face_indices: u32,
+    pub quad_indices: u32,
+}
+
+/// One caster's volume for one light.
+#[derive(Clone, Debug)]
+pub(crate) struct CasterDraw {
+    pub case: Case,
+    pub mvp: Mat4,
+    pub light_object: Vec4,
+    /// `Some(t)` for a transparent caster (light-intensity map, not the opaque counter).
+    pub transmittance: Option<Vec3>,
+    pub draws: Vec<Draw>,
+    pub edge_quad: Option<EdgeQuadDraw>,
+}
+
+/// One light of a prepared frame.
+#[derive(Clone, Debug)]
+pub struct LightFrame {
+    /// The light's scissor rectangle (the whole target when unbounded): the determination
+    /// clears and draws only inside it, and the host's lighting pass should use it too.
+    pub scissor: vk::Rect2D,
+    /// The light's depth range when the pass uses depth bounds; `(0, 1)` passes everything.
+    pub depth_bounds: Option<(f32, f32)>,
+    /// What `--stats` reports for this light.
+    pub stats: LightStats,
+    /// The plan as the planner made it (cases, silhouettes, counts per caster).
+    pub plan: LightPlan,
+    /// The value the determination clears the counter to inside the scissor: 0, or with
+    /// [`Method::ZPassClear`](crate::shadow::Method) the number of volumes containing the eye.
+    pub counter_clear: u32,
+    pub(crate) casters: Vec<CasterDraw>,
+}
+
+impl LightFrame {
+    /// Whether any opaque volume is drawn for this light (else the stencil stays 0 inside
+    /// the scissor and every pixel there is lit).
+    pub fn has_opaque_volumes(&self) -> bool {
+        self.casters.iter().any(|c| c.case != Case::Culled && c.transmittance.is_none())
     }
-
-    /// Which pipeline counts a draw.
-    fn pipeline_for(
-        &self,
-        kind: VolumeKind,
-        count: Option<&CountPipes>,
-        case: Case,
-        light_cap: bool,
-        planar: bool,
-    ) -> Option<vk::Pipeline> {
-        let s = &self.pipes.stencil;
-        if kind == VolumeKind::Rasterised {
-            return Some(self.pipes.raster.volume);
-        }
-        if planar {
-            // Flattened casters: the sign pushed is +1 (z-pass), so the float count adds 1.
-            return match kind {
-                VolumeKind::Stencil => Some(self.pipes.planar),
-                VolumeKind::Float => self.pipes.planar_count,
-                _ => None,
-            };
-        }
-        let zpass = case == Case::ZPass;
-        Some(match kind {
-            VolumeKind::Stencil => match (zpass, light_cap) {
-                (true, _) => s.zpass,
-                (false, false) => s.zfail,
-                (false, true) => s.zfail_cap,
-            },
-            VolumeKind::Float => {
-                let c = count?;
-                match (zpass, light_cap) {
-                    (true, _) => c.zpass,
-                    (false, false) => c.zfail,
-                    (false, true) => c.cap,
-                }
-            }
-            VolumeKind::FloatDepthTested => {
-                let c = count?;
-                if zpass {
-                    c.zpass
-                } else {
-                    c.zfail
-                }
-            }
-            // Transparent casters' caps are all in the volume list (not NEVER).
-            VolumeKind::Transmit { log } => self.pipes.transmit?[log as usize][(!zpass) as usize],
-            VolumeKind::Rasterised => self.pipes.raster.volume,
-        })
-    }
-
-    /// # Safety
-    /// `cb` is recording with a pipeline of the pass's layout bound or about to be.
-    pub(super) unsafe fn push(&self, cb: vk::CommandBuffer, c: &CasterDraw, color: [f32; 4]) {
-        let push = VolumePush::new(c.mvp, c.light_object, color);
-        // SAFETY: the caller's contract; the block matches the layout's range.
-        unsafe {
-            self.dev.device.cmd_push_constants(
-                cb,
-                self.pipes.layout,
-                vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                0,
-                bytemuck::bytes_of(&push),
-            )
-        };
-    }
-
-    /// Binds the chunk's vertices (or the streamed naive vertices) and draws.
-    ///
-    /// # Safety
-    /// `cb` is recording inside a rendering instance with a volume pipeline bound; `frame` is
-    /// the frame the draw belongs to (its stream, or its compute records and indices, whose
-    /// writes [`cmd_compute_silhouettes`](Self::cmd_compute_silhouettes) made visible).
-    pub(super) unsafe fn record_draw(&self, cb: vk::CommandBuffer, frame: &PreparedFrame, dr: &Draw) {
-        let d = &self.dev.device;
-        let stream = frame.stream;
-        // SAFETY: the caller's contract; offsets were computed from the stream just written.
-        unsafe {
-            if dr.indirect {
-                let Some(cf) = frame.compute.as_ref() else { return };
-                d.cmd_bind_vertex_buffers(cb, 0, &[dr.vertices], &[0]);
-                d.cmd_bind_index_buffer(cb, cf.out_buffer, 0, vk::IndexType::UINT16);
-                d.cmd_draw_indexed_indirect(cb, cf.records_buffer, dr.offset, 1, 20);
-                return;
-            }
-            match dr.format {
-                IndexFormat::Naive => {
-                    d.cmd_bind_vertex_buffers(cb, 0, &[stream], &[dr.offset]);
-                    d.cmd_draw(cb, dr.count, 1, 0, 0);
-                }
-                f => {
-                    let ty = match f {
-                        IndexFormat::U8 => vk::IndexType::UINT8_EXT,
-                        IndexFormat::U32 => vk::IndexType::UINT32,
-                        _ => vk::IndexType::UINT16,
-                    };
-                    d.cmd_bind_vertex_buffers(cb, 0, &[dr.vertices], &[0]);
-                    d.cmd_bind_index_buffer(cb, stream, dr.offset, ty);
-                    d.cmd_draw_indexed(cb, dr.count, 1, 0, 0, 0);
-                }
-            }
-        }
+    /// Whether any transparent caster's volume is drawn (the light-intensity map is needed).
+    pub fn has_transparent_volumes(&self) -> bool {
+        self.casters.iter().any(|c| c.case != Case::Culled && c.transmittance.is_some())
     }
 }

@@ -75,23 +75,29 @@ pub mod diagnostics;
 mod draw;
 mod eye;
 mod frame;
+mod pack;
 mod pipelines;
+mod planar;
 pub mod push;
 mod record;
 mod spheres;
 pub mod stats;
 mod target;
+mod view;
+mod volumes;
 
 pub use casters::CasterId;
 pub use desc::{
     reverse_z, Capabilities, Counter, DepthDirection, DepthMode, EnabledFeatures, IndexFormat, PassSettings, PassToggles, RenderPassTarget,
     ShadowPassDesc, TargetModel, Technique,
 };
-pub use frame::{case_name, LightFrame, PreparedFrame, ShadowView};
+pub use draw::LightFrame;
+pub use frame::{case_name, PreparedFrame};
 pub use pipelines::COUNT_FORMAT;
 pub use record::{lit_stencil_state, VolumeKind};
 pub use spheres::{SphereId, SphereInfo};
 pub use target::DepthStencilTarget;
+pub use view::ShadowView;
 
 use crate::error::{Error, Misuse, Result};
 use crate::geom::Light;
@@ -101,10 +107,11 @@ use crate::shadow::Caster;
 use ash::vk;
 use casters::CasterTable;
 use device::PassDevice;
-use frame::{check_lights, overflow_warnings, pack, PackInput};
+use frame::{check_lights, overflow_warnings};
 use glam::{DMat4, Vec3};
 use gpu_allocator::vulkan::Allocator;
 use gpu_allocator::MemoryLocation;
+use pack::{pack, PackInput};
 use pipelines::Pipelines;
 use std::cell::Cell;
 use std::sync::{Arc, Mutex};

@@ -1,7 +1,8 @@
 //! Recording: everything the pass writes into the host's command buffers.
 
 use super::desc::TargetModel;
-use super::frame::{LightFrame, PreparedFrame};
+use super::draw::LightFrame;
+use super::frame::PreparedFrame;
 use super::target::DepthStencilTarget;
 use super::ShadowPass;
 use crate::error::{Misuse, Result};

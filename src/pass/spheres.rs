@@ -10,8 +10,9 @@
 //! the polygon is flattened onto the receiver plane instead.
 
 use super::desc::{IndexFormat, Technique};
-use super::frame::{CasterDraw, Draw, ShadowView};
+use super::draw::{CasterDraw, Draw};
 use super::stats::{CasterStats, SphereStats, Totals, Triangles};
+use super::view::ShadowView;
 use crate::error::{Error, Result};
 use crate::geom::sphere::{auto_segments, shadow_error_px, volume_triangles, ViewScale};
 use crate::geom::{Light, LightKind, Sphere};

@@ -10,7 +10,7 @@
 
 use super::{rec, ComputeStatic, SilhouettePush, RECORD_WORDS};
 use crate::error::{Error, Result};
-use crate::pass::frame::{Draw, LightFrame};
+use crate::pass::draw::{Draw, LightFrame};
 use crate::pass::stats::{CasterStats, Totals};
 use crate::pass::IndexFormat;
 use crate::shadow::plan::{Case, CasterPlan, DarkCap, Formulation};
