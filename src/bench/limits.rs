@@ -546,30 +546,20 @@ fn time(ctx: &Context, t: &Target, wl: &Workload, reps: usize) -> Result<f64> {
                 d.cmd_set_viewport(cb, 0, &[viewport]);
                 d.cmd_set_scissor(cb, 0, &[area]);
                 d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, wl.pipe);
-                d.cmd_push_constants(
-                    cb,
-                    t.layout,
-                    vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                    0,
-                    bytemuck::bytes_of(&push),
-                );
-                d.cmd_bind_vertex_buffers(cb, 0, &[wl.vertices], &[0]);
                 if let Some((ib, ty, _)) = wl.indices {
                     d.cmd_bind_index_buffer(cb, ib, 0, ty);
                 }
-                // Many draws: each with its own push constants and vertex binding, as the
-                // shadow pass issues one per caster chunk.
+                // Each draw with its own push constants and vertex binding, as the shadow pass
+                // issues one per caster chunk.
                 for _ in 0..wl.draws {
-                    if wl.draws > 1 {
-                        d.cmd_push_constants(
-                            cb,
-                            t.layout,
-                            vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                            0,
-                            bytemuck::bytes_of(&push),
-                        );
-                        d.cmd_bind_vertex_buffers(cb, 0, &[wl.vertices], &[0]);
-                    }
+                    d.cmd_push_constants(
+                        cb,
+                        t.layout,
+                        vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                        0,
+                        bytemuck::bytes_of(&push),
+                    );
+                    d.cmd_bind_vertex_buffers(cb, 0, &[wl.vertices], &[0]);
                     match wl.indices {
                         Some((_, _, n)) => d.cmd_draw_indexed(cb, n, 1, 0, 0, 0),
                         None => d.cmd_draw(cb, wl.vertex_count, 1, 0, 0),
