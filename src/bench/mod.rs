@@ -3,14 +3,15 @@
 //!
 //! - [`classic`]: the fixed scenes, every method side by side, medians (`umbrage bench`);
 //! - [`suite`]: `umbrage bench --suite fill-vertex`: the device's limits measured in the same
-//!   run ([`limits`]), a cost model fitted on the suite's rows ([`model`]), the shadow pass's counters per point, sweeps that cross from
-//!   vertex-bound to fill-bound ([`sweeps`]), each pass's fraction of its limits and the
-//!   bound it is closest to, the crossovers, ablations, and the outputs ([`report`]: JSON,
-//!   CSV, Markdown; [`plots`]: SVG and PNG).
+//!   run ([`limits`]), the shadow pass's counters per point, sweeps that cross from
+//!   vertex-bound to fill-bound ([`sweeps`]), a cost model fitted on the rows ([`model`]) that
+//!   gives each pass its fill, vertex and draw shares and the bound it is closest to, the crossovers, ablations, and the outputs ([`report`]: JSON,
+//!   CSV; `markdown`: the report; [`plots`]: SVG and PNG).
 #![warn(missing_docs)]
 
 pub mod classic;
 pub mod limits;
+mod markdown;
 pub mod methods;
 pub mod model;
 pub mod plots;

@@ -205,8 +205,7 @@ pub fn quantile(v: &[f64], q: f64) -> f64 {
 /// prediction and model fractions, and returns the model. `limit_ns`: each term's cost at
 /// the measured limit.
 pub fn fit(rows: &mut [SuiteRow], limit_ns: BTreeMap<String, f64>) -> Model {
-    let idx: Vec<usize> = (0..rows.len()).filter(|&i| features(&rows[i]).is_some()).collect();
-    let x: Vec<Vec<f64>> = idx.iter().filter_map(|&i| features(&rows[i])).collect();
+    let (idx, x): (Vec<usize>, Vec<Vec<f64>>) = rows.iter().enumerate().filter_map(|(i, r)| Some((i, features(r)?))).unzip();
     let y: Vec<f64> = idx.iter().map(|&i| rows[i].gpu_shadow_ms.unwrap_or(0.0)).collect();
     let all = fit_relative(&x, &y);
     // Held out: each fold predicted by the fit on the others.

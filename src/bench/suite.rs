@@ -308,9 +308,14 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
     let index_scene = if scale == Scale::Tiny { "default" } else { "bench/vertex" };
     let toggle_variants = toggle_variants(&ctx);
     let index_variants = index_variants();
+    // The caps sweep compares the z-fail methods only (the paper's claim).
+    let caps: Vec<Variant> = [Method::McGuire, Method::EverittKilgard, Method::ZFail, Method::Lengyel]
+        .into_iter()
+        .map(|m| Variant::of(Technique::Volumes(m)))
+        .collect();
     let caps_points = points.iter().filter(|p| p.sweep == "caps").count();
     let units = (named.len() + points.len() - caps_points) * techniques.len()
-        + caps_points * 4
+        + caps_points * caps.len()
         + (ablation_scenes.len() + 1) * toggle_variants.len()
         + index_variants.len();
     let bar = if cfg.progress {
@@ -333,11 +338,6 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
         let scene = crate::scene::load(n)?;
         rows.extend(run.point("scenes", 0.0, scene, n, base, &all, true)?);
     }
-    // The caps sweep compares the z-fail methods only (the paper's claim).
-    let caps: Vec<Variant> = [Method::McGuire, Method::EverittKilgard, Method::ZFail, Method::Lengyel]
-        .into_iter()
-        .map(|m| Variant::of(Technique::Volumes(m)))
-        .collect();
     for p in &points {
         let SweepPoint { sweep, x, scene, size } = p;
         let (scene, name) = scene_of(scene)?;

@@ -407,7 +407,7 @@ impl Renderer {
                     determine::begin_float(rec, t);
                     let maps = sm.record_maps(rec.ctx, rec.cb, light, self.own.parts.scene.camera.eye.as_dvec3());
                     spans.shadow_map.push(passes::timing_span(begin, stamp(all)));
-                    sm.record_lookup(rec.ctx, rec.cb, t, &maps, frame.lights[li].scissor);
+                    sm.record_lookup(rec.ctx, rec.cb, t, &maps, lights[li].light_pos, frame.lights[li].scissor);
                 }
                 if let (Some(rt), Technique::RayQuery) = (&self.own.parts.ray_tracer, self.settings.technique) {
                     rt.cmd_determine(rec, t, frame.slot(), lights[li].light_pos, frame.lights[li].scissor);

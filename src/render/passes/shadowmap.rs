@@ -89,8 +89,6 @@ struct LookupPush {
 /// One light's rendered maps, for [`ShadowMapper::record_lookup`].
 pub(crate) struct LightMaps {
     faces: Vec<Face>,
-    /// Eye-relative light position (w = 1) or towards-light direction (w = 0).
-    light: Vec4,
 }
 
 /// One map to render and look up: the eye-relative light view-projection and its atlas tile.
@@ -385,17 +383,23 @@ impl ShadowMapper {
             d.cmd_end_rendering(cb);
         }
         transition(ctx, cb, &self.atlas, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
-        let light = match light.kind {
-            LightKind::Directional => (-light.direction.normalize()).extend(0.0),
-            _ => (light.position.as_dvec3() - eye).as_vec3().extend(1.0),
-        };
-        LightMaps { faces, light }
+        LightMaps { faces }
     }
 
     /// Writes light `light`'s shadow fractions into `targets.count` (which must be in
     /// COLOR_ATTACHMENT_OPTIMAL; it is left there) from the maps [`ShadowMapper::record_maps`]
-    /// rendered for that light: one full-screen pass inside `scissor`.
-    pub(crate) fn record_lookup(&self, ctx: &Context, cb: vk::CommandBuffer, targets: &Targets, maps: &LightMaps, scissor: vk::Rect2D) {
+    /// rendered for that light (`light_pos`: the frame's eye-relative light,
+    /// [`LightPush::light_pos`](crate::render::push::LightPush)): one full-screen pass inside
+    /// `scissor`.
+    pub(crate) fn record_lookup(
+        &self,
+        ctx: &Context,
+        cb: vk::CommandBuffer,
+        targets: &Targets,
+        maps: &LightMaps,
+        light_pos: [f32; 4],
+        scissor: vk::Rect2D,
+    ) {
         let faces = &maps.faces;
         let d = &ctx.device;
         let mut rows = [FaceRow::default(); 6];
@@ -413,7 +417,7 @@ impl ShadowMapper {
             .store_op(vk::AttachmentStoreOp::STORE)
             .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: [0.0; 4] } })];
         let (aw, ah) = (self.atlas.extent.width as f32, self.atlas.extent.height as f32);
-        let push = LookupPush { light: maps.light.to_array(), params: [faces.len() as f32, 1.0 / aw, 1.0 / ah, 0.0] };
+        let push = LookupPush { light: light_pos, params: [faces.len() as f32, 1.0 / aw, 1.0 / ah, 0.0] };
         let (w, h) = (targets.extent.width as f32, targets.extent.height as f32);
         let shader_read = (vk::PipelineStageFlags2::FRAGMENT_SHADER, vk::AccessFlags2::SHADER_STORAGE_READ);
         let transfer_write = (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE);
