@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The hosts side by side, in one run on this machine's Vulkan device: umbrage's own renderer
-# (`umbrage render`), the raw-ash host (`examples/embed`) in its configurations (samples,
+# (`umbrage render`, at 1 and 4 samples), the raw-ash host (`examples/embed`) in its configurations (samples,
 # reverse-Z, render pass) and the wgpu host (`examples/wgpu_host`), on the same scenes and
 # size. Writes docs/hosts.md (or $1). Validation is off (it costs more than the work measured).
 #
@@ -38,15 +38,17 @@ device=$($bin/umbrage info 2>/dev/null | grep -m1 -i "device" | sed 's/^[^:]*: *
   echo "| scene | host | configuration | determination ms | frame GPU ms | frame wall ms |"
   echo "|---|---|---|---|---|---|"
   for scene in "${scenes[@]}"; do
-    shadow=() gpu=() frame=()
-    for _ in $(seq "$runs"); do
-      line=$($bin/umbrage render --scene "$scene" --size "$size" --out /tmp/umbrage-measure.png 2>&1 | tail -1)
-      shadow+=("$(sed -n 's/.*: shadow \([0-9.]*\),.*/\1/p' <<<"$line")")
-      gpu+=("$(sed -n 's/.*(gpu \([0-9.]*\) ms.*/\1/p' <<<"$line")")
-      frame+=("$(sed -n 's/.*| frame \([0-9.]*\) ms.*/\1/p' <<<"$line")")
+    for msaa in 1 4; do
+      shadow=() gpu=() frame=()
+      for _ in $(seq "$runs"); do
+        line=$($bin/umbrage render --scene "$scene" --size "$size" --msaa "$msaa" --out /tmp/umbrage-measure.png 2>&1 | tail -1)
+        shadow+=("$(sed -n 's/.*: shadow \([0-9.]*\),.*/\1/p' <<<"$line")")
+        gpu+=("$(sed -n 's/.*(gpu \([0-9.]*\) ms.*/\1/p' <<<"$line")")
+        frame+=("$(sed -n 's/.*| frame \([0-9.]*\) ms.*/\1/p' <<<"$line")")
+      done
+      m() { printf '%s\n' "$@" | grep . | median; }
+      echo "| \`$scene\` | umbrage render | ${msaa}x forward, dynamic rendering | $(m "${shadow[@]}") | $(m "${gpu[@]}") | $(m "${frame[@]}") |"
     done
-    m() { printf '%s\n' "$@" | grep . | median; }
-    echo "| \`$scene\` | umbrage render | 1x forward, dynamic rendering | $(m "${shadow[@]}") | $(m "${gpu[@]}") | $(m "${frame[@]}") |"
     for flags in "" "--msaa 4" "--reverse-z" "--render-pass" "--msaa 4 --render-pass" "--msaa 4 --reverse-z --render-pass"; do
       # shellcheck disable=SC2086
       line=$($bin/examples/embed --scene "$scene" --size "$size" --frames "$frames" $flags 2>&1 | grep "median determination" || true)

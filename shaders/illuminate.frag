@@ -4,10 +4,21 @@
 // @variant COUNT FLOAT_COUNT
 // @variant T TRANSMIT
 // @variant COUNT_T FLOAT_COUNT,TRANSMIT
-// The COUNT variant reads the volume count from a float target instead of the stencil.
+// @variant MS MSAA
+// The COUNT variant reads the volume count from a float target instead of the stencil. The
+// MS variant reads multisampled G-buffer targets at this invocation's sample, which shades
+// per sample (each sample lit where its own stencil count is zero).
+#ifdef MSAA
+layout(set = 0, binding = 0) uniform texture2DMS t_albedo;
+layout(set = 0, binding = 1) uniform texture2DMS t_normal;
+layout(set = 0, binding = 2) uniform texture2DMS t_position;
+#define FETCH(t, px) texelFetch(sampler2DMS(t, s_nearest), px, int(gl_SampleID))
+#else
 layout(set = 0, binding = 0) uniform texture2D t_albedo;
 layout(set = 0, binding = 1) uniform texture2D t_normal;
 layout(set = 0, binding = 2) uniform texture2D t_position;
+#define FETCH(t, px) texelFetch(sampler2D(t, s_nearest), px, 0)
+#endif
 layout(set = 0, binding = 3) uniform sampler s_nearest;
 #ifdef FLOAT_COUNT
 layout(set = 0, binding = 4) uniform texture2D t_count;
@@ -33,12 +44,12 @@ void main() {
         discard;
     }
 #endif
-    vec4 pos = texelFetch(sampler2D(t_position, s_nearest), px, 0);
+    vec4 pos = FETCH(t_position, px);
     if (pos.w == 0.0) {
         discard;
     }
-    vec3 n = normalize(texelFetch(sampler2D(t_normal, s_nearest), px, 0).xyz);
-    vec3 albedo = texelFetch(sampler2D(t_albedo, s_nearest), px, 0).rgb;
+    vec3 n = normalize(FETCH(t_normal, px).xyz);
+    vec3 albedo = FETCH(t_albedo, px).rgb;
     vec3 to_light = pc.light_pos.xyz - pos.xyz * pc.light_pos.w;
     float dist = length(to_light);
     vec3 l = to_light / max(dist, 1e-30);

@@ -8,9 +8,19 @@ layout(location = 1) flat in vec3 v_center;
 layout(location = 2) flat in vec3 v_color;
 layout(location = 3) flat in float v_radius;
 
+// @variant MS MSAA
+// The MS variant (multisampled targets) shades per sample (it reads gl_SampleID) and casts
+// each sample's ray through its own location, gl_FragCoord under sample shading, unprojected
+// with the block's ray terms (SpherePush): every sample gets the exact depth, normal and
+// position of its own ray's hit.
 layout(push_constant) uniform Push {
     mat4 view_proj;
     vec4 ambient;
+#ifdef MSAA
+    vec4 ray_x;
+    vec4 ray_y;
+    vec4 ray_0;
+#endif
 } pc;
 
 layout(location = 0) out vec4 out_accum;
@@ -19,7 +29,13 @@ layout(location = 2) out vec4 out_normal;
 layout(location = 3) out vec4 out_position;
 
 void main() {
+#ifdef MSAA
+    vec4 near = pc.ray_x * gl_FragCoord.x + pc.ray_y * gl_FragCoord.y + pc.ray_0;
+    // gl_SampleID in the interface makes the pass shade per sample (its value is not needed).
+    vec3 d = normalize(near.xyz / near.w + vec3(0.0 * float(gl_SampleID)));
+#else
     vec3 d = normalize(v_pos);
+#endif
     // |t d - c|^2 = r^2 with |d| = 1: t^2 - 2 t b + |c|^2 - r^2 = 0, b = d.c. Computed the
     // robust way (Haines et al., Ray Tracing Gems ch. 7): the discriminant as r^2 minus the
     // squared distance from the centre to the ray (accurate near the silhouette, where

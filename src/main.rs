@@ -54,6 +54,11 @@ struct FrameArgs {
     /// pattern every frame).
     #[arg(long)]
     jitter: bool,
+    /// Samples per pixel: 1, 2, 4 or 8. The G-buffer, the shadow volumes' stencil and the
+    /// lighting run at every sample and the PNG is their resolve; --dump writes DIR/sample_K
+    /// per sample. Stencil shadow-volume methods only.
+    #[arg(long, default_value_t = 1)]
+    msaa: u32,
 }
 
 /// `--method`: every technique `render` and `bench` accept.
@@ -249,6 +254,7 @@ impl Default for FrameArgs {
             shadow_map_size: 2048,
             self_shadow: false,
             jitter: false,
+            msaa: 1,
         }
     }
 }
@@ -319,6 +325,7 @@ impl FrameArgs {
             transmit: self.transmit.mode(),
             self_shadow: self.self_shadow,
             jitter: self.jitter,
+            samples: self.msaa,
             ..Default::default()
         })
     }

@@ -21,8 +21,19 @@ pub fn write_grey_png(path: &Path, width: u32, height: u32, grey: &[u8]) -> Resu
 }
 
 /// The dump of a captured frame: frame.json, world.obj, positions.f32, normals.f32,
-/// shadow_K.png, stencil_K.png and color.png (format in docs/formats.md).
+/// shadow_K.png, stencil_K.png and color.png (format in docs/formats.md). A multisampled frame
+/// writes one such dump per sample, into `DIR/sample_0` … `DIR/sample_{N-1}` (each with the
+/// resolved color.png).
 pub fn write_frame_dump(dir: &Path, scene: &Scene, frame: &FrameOutput) -> Result<()> {
+    if !frame.samples.is_empty() {
+        for k in 0..frame.samples.len() {
+            let sample = frame.sample(k).ok_or_else(|| Error::Internal(format!("sample {k} of the frame")))?;
+            let sub = dir.join(format!("sample_{k}"));
+            std::fs::create_dir_all(&sub).map_err(|e| Error::io(sub.display().to_string(), e))?;
+            write_frame_dump(&sub, scene, &sample)?;
+        }
+        return Ok(());
+    }
     if frame.positions.is_empty() {
         return Err(Error::Other("frame was rendered without capture; cannot dump".into()));
     }

@@ -187,3 +187,30 @@ fn info_lists_sphere_casters() {
     std::fs::write(&f, "[camera]\neye = [0, 2, 5]\ntarget = [0, 0, 0]\n[[sphere]]\ncenter = [0, 1, 0]\nradius = -1\n").unwrap();
     fails_with(&umbrage(&["render", "--scene", f.to_str().unwrap(), "--out", d.join("a.png").to_str().unwrap()]), "radius");
 }
+
+/// `render --msaa 4 --dump DIR`: one complete dump per sample in `DIR/sample_K`, each passing
+/// `umbrage check`; the PNG is the resolve. A count the device or method cannot do is refused.
+#[test]
+fn render_msaa_dumps_every_sample() {
+    let d = tmp("msaa");
+    let dump = d.join("dump");
+    let png = d.join("msaa.png");
+    let out = umbrage(&["render", "--size", "120x90", "--msaa", "4", "--out", png.to_str().unwrap(), "--dump", dump.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(png.exists());
+    assert!(!dump.join("positions.f32").exists(), "a multisampled dump is per sample");
+    for k in 0..4 {
+        let s = dump.join(format!("sample_{k}"));
+        for f in ["frame.json", "world.obj", "positions.f32", "normals.f32", "shadow_0.png", "stencil_0.png", "color.png"] {
+            assert!(s.join(f).exists(), "sample {k} lacks {f}");
+        }
+        assert_eq!(std::fs::metadata(s.join("positions.f32")).unwrap().len(), 120 * 90 * 3 * 4);
+        let check = umbrage(&["check", s.to_str().unwrap()]);
+        assert!(check.status.success(), "sample {k}: {}", String::from_utf8_lossy(&check.stdout));
+    }
+    fails_with(&umbrage(&["render", "--size", "32x32", "--msaa", "3", "--out", png.to_str().unwrap()]), "1, 2, 4 or 8");
+    fails_with(
+        &umbrage(&["render", "--size", "32x32", "--msaa", "4", "--method", "shadowmap", "--out", png.to_str().unwrap()]),
+        "one sample",
+    );
+}

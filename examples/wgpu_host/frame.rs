@@ -277,6 +277,7 @@ impl Host {
             transmit: Vec::new(),
             positions: Vec::new(),
             normals: Vec::new(),
+            samples: Vec::new(),
             stats: self.stats(&fl, latency_ms),
         };
         if let (true, Some(c)) = (fl.captured, rb.capture.as_ref()) {

@@ -69,6 +69,16 @@ pub struct Features {
     /// `accelerationStructure` and `bufferDeviceAddress`) are present and enabled:
     /// `--method rayquery` can run (Mesa lavapipe 25 has them; 22.3 has not).
     pub ray_query: bool,
+    /// `sampleRateShading` is supported and enabled: the renderer's multisampled frame
+    /// (`--msaa N`) shades its G-buffer and lighting per sample.
+    pub sample_rate_shading: bool,
+    /// Sample counts (bit `N` for N samples) that every target of the renderer's multisampled
+    /// frame supports: the colour and depth-stencil framebuffer counts and the sampled-image
+    /// counts (colour, integer for the stencil, depth) together.
+    pub frame_sample_counts: u32,
+    /// `standardSampleLocations`: multisampled images use Vulkan's standard sample locations
+    /// (a multisampled capture is unprojected at them).
+    pub standard_sample_locations: bool,
 }
 
 /// Identification of the chosen physical device, for `umbrage info`, logs and the stats JSON.

@@ -182,13 +182,26 @@ pub(super) fn open_device(
         r32f_blend: blendable(vk::Format::R32_SFLOAT),
         rgba32f_blend: blendable(vk::Format::R32G32B32A32_SFLOAT),
         ray_query,
+        sample_rate_shading: base.sample_rate_shading == vk::TRUE,
+        standard_sample_locations: props.limits.standard_sample_locations == vk::TRUE,
+        frame_sample_counts: {
+            let l = &props.limits;
+            (l.framebuffer_color_sample_counts
+                & l.framebuffer_depth_sample_counts
+                & l.framebuffer_stencil_sample_counts
+                & l.sampled_image_color_sample_counts
+                & l.sampled_image_integer_sample_counts
+                & l.sampled_image_stencil_sample_counts)
+                .as_raw()
+        },
     };
 
     let enabled = vk::PhysicalDeviceFeatures::default()
         .depth_clamp(features.depth_clamp)
         .depth_bounds(features.depth_bounds)
         .pipeline_statistics_query(features.pipeline_statistics_query)
-        .occlusion_query_precise(features.occlusion_query_precise);
+        .occlusion_query_precise(features.occlusion_query_precise)
+        .sample_rate_shading(features.sample_rate_shading);
     let mut e13 = vk::PhysicalDeviceVulkan13Features::default()
         .dynamic_rendering(features.dynamic_rendering)
         .synchronization2(features.synchronization2);

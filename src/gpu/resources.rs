@@ -117,8 +117,9 @@ impl Buffer {
 /// What [`Image::new_all`] creates: name, format, usage and aspect of one image.
 pub type ImageSpec<'a> = (&'a str, vk::Format, vk::ImageUsageFlags, vk::ImageAspectFlags);
 
-/// A 2D image (one mip level, one layer, one sample, optimal tiling) in device-local memory,
-/// with a view of the whole image. Not freed on drop: call [`Image::destroy`].
+/// A 2D image (one mip level, one layer, optimal tiling; one sample unless made by
+/// [`Image::new_2d_samples`]) in device-local memory, with a view of the whole image. Not freed
+/// on drop: call [`Image::destroy`].
 pub struct Image {
     /// The image handle.
     pub raw: vk::Image,
@@ -131,6 +132,8 @@ pub struct Image {
     /// The aspects the view and [`Image::range`] cover (`COLOR`, or `DEPTH | STENCIL` for the
     /// depth-stencil buffer).
     pub aspect: vk::ImageAspectFlags,
+    /// Samples per pixel.
+    pub samples: vk::SampleCountFlags,
     allocation: Option<Allocation>,
 }
 
@@ -146,13 +149,40 @@ impl Image {
         usage: vk::ImageUsageFlags,
         aspect: vk::ImageAspectFlags,
     ) -> Result<Image> {
+        Image::new_2d_samples(ctx, name, format, extent, usage, aspect, vk::SampleCountFlags::TYPE_1)
+    }
+
+    /// No image (null handles, no memory): a placeholder that [`Image::destroy`] ignores.
+    pub fn null() -> Image {
+        Image {
+            raw: vk::Image::null(),
+            view: vk::ImageView::null(),
+            format: vk::Format::UNDEFINED,
+            extent: vk::Extent2D::default(),
+            aspect: vk::ImageAspectFlags::COLOR,
+            samples: vk::SampleCountFlags::TYPE_1,
+            allocation: None,
+        }
+    }
+
+    /// [`Image::new_2d`] with `samples` samples per pixel (the device must support that count
+    /// for the format and usage: the caller checks).
+    pub fn new_2d_samples(
+        ctx: &impl GpuDevice,
+        name: &str,
+        format: vk::Format,
+        extent: vk::Extent2D,
+        usage: vk::ImageUsageFlags,
+        aspect: vk::ImageAspectFlags,
+        samples: vk::SampleCountFlags,
+    ) -> Result<Image> {
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(format)
             .extent(vk::Extent3D { width: extent.width, height: extent.height, depth: 1 })
             .mip_levels(1)
             .array_layers(1)
-            .samples(vk::SampleCountFlags::TYPE_1)
+            .samples(samples)
             .tiling(vk::ImageTiling::OPTIMAL)
             .usage(usage)
             .initial_layout(vk::ImageLayout::UNDEFINED);
@@ -207,15 +237,25 @@ impl Image {
                 return Err(Error::Vulkan { call: "vkCreateImageView", result: e });
             }
         };
-        Ok(Image { raw, view, format, extent, aspect, allocation: Some(allocation) })
+        Ok(Image { raw, view, format, extent, aspect, samples, allocation: Some(allocation) })
     }
 
     /// Creates one image of `extent` per spec, all or nothing: when one fails, those already
     /// made are destroyed again before the error is returned.
     pub fn new_all<const N: usize>(ctx: &impl GpuDevice, extent: vk::Extent2D, specs: [ImageSpec<'_>; N]) -> Result<[Image; N]> {
+        Image::new_all_samples(ctx, extent, vk::SampleCountFlags::TYPE_1, specs)
+    }
+
+    /// [`Image::new_all`] with `samples` samples per pixel each.
+    pub fn new_all_samples<const N: usize>(
+        ctx: &impl GpuDevice,
+        extent: vk::Extent2D,
+        samples: vk::SampleCountFlags,
+        specs: [ImageSpec<'_>; N],
+    ) -> Result<[Image; N]> {
         let mut made: Vec<Image> = Vec::with_capacity(N);
         for (name, format, usage, aspect) in specs {
-            match Image::new_2d(ctx, name, format, extent, usage, aspect) {
+            match Image::new_2d_samples(ctx, name, format, extent, usage, aspect, samples) {
                 Ok(img) => made.push(img),
                 Err(e) => {
                     for mut img in made {
@@ -237,11 +277,14 @@ impl Image {
     /// allocator it was created with, and the GPU must no longer use it (e.g. after
     /// `vkDeviceWaitIdle`). Call once: the handles are not reset.
     pub fn destroy(&mut self, ctx: &impl GpuDevice) {
-        // SAFETY: the owner guarantees the GPU no longer uses the image (device idle).
+        // SAFETY: the owner guarantees the GPU no longer uses the image (device idle); null
+        // handles (a null image, or one destroyed before) are ignored by Vulkan.
         unsafe {
             ctx.device().destroy_image_view(self.view, None);
             ctx.device().destroy_image(self.raw, None);
         }
+        self.view = vk::ImageView::null();
+        self.raw = vk::Image::null();
         if let Some(a) = self.allocation.take() {
             let _ = GpuDevice::allocator(ctx).free(a);
         }

@@ -6,7 +6,7 @@ use super::stats::Stats;
 use super::TransmitMode;
 use crate::error::Result;
 use crate::scene::Scene;
-use glam::{DVec3, Vec3};
+use glam::{DMat4, DVec3, DVec4, Vec3};
 
 /// What a frame produced.
 pub struct FrameOutput {
@@ -28,43 +28,86 @@ pub struct FrameOutput {
     pub positions: Vec<[f32; 3]>,
     /// Geometric face normal per pixel (NaN for background), captured frames only.
     pub normals: Vec<[f32; 3]>,
+    /// A multisampled captured frame ([`RenderOptions::samples`] > 1): every sample's positions,
+    /// normals and stencil counts, in Vulkan's standard sample order; `positions`, `normals`
+    /// and `stencil` above are sample 0's. Empty for a single-sampled frame.
+    ///
+    /// [`RenderOptions::samples`]: crate::render::RenderOptions::samples
+    pub samples: Vec<SampleOutput>,
     /// What the frame did (`--stats`).
     pub stats: Stats,
+}
+
+/// One sample of a multisampled captured frame: what [`FrameOutput`] has per pixel, at the
+/// sample's own position in every pixel (Vulkan's standard sample locations).
+#[derive(Clone, Debug, Default)]
+pub struct SampleOutput {
+    /// World position (NaN for background).
+    pub positions: Vec<[f32; 3]>,
+    /// Geometric face normal (NaN for background).
+    pub normals: Vec<[f32; 3]>,
+    /// Per light: the stencil count.
+    pub stencil: Vec<Vec<u8>>,
 }
 
 impl FrameOutput {
     /// Per light: 255 where the light reaches the pixel (stencil count zero and the surface
     /// faces the light), 0 where it does not, 128 for background. Captured frames only.
     pub fn shadow_masks(&self, scene: &Scene) -> Vec<Vec<u8>> {
-        scene
-            .lights
-            .iter()
-            .enumerate()
-            .map(|(k, light)| {
-                let l = light.homogeneous();
-                (0..(self.width * self.height) as usize)
-                    .map(|i| {
-                        let p = Vec3::from(self.positions[i]);
-                        let n = Vec3::from(self.normals[i]);
-                        if !p.x.is_finite() {
-                            return 128;
-                        }
-                        let to_light = if l.w == 0.0 { l.truncate() } else { l.truncate() - p };
-                        let faces = n.dot(to_light) > 0.0;
-                        let count = match self.counts.get(k) {
-                            Some(c) => c[i],
-                            None => self.stencil.get(k).map(|s| s[i] as i32).unwrap_or(0),
-                        };
-                        if faces && light.reaches(p) && count == 0 {
-                            255
-                        } else {
-                            0
-                        }
-                    })
-                    .collect()
-            })
-            .collect()
+        shadow_masks(scene, &self.positions, &self.normals, |k, i| match self.counts.get(k) {
+            Some(c) => c[i],
+            None => self.stencil.get(k).map(|s| s[i] as i32).unwrap_or(0),
+        })
     }
+
+    /// The frame of sample `k` of a multisampled captured frame (colour and stats are the
+    /// whole frame's, the rest is the sample's); `None` when there is no such sample.
+    pub fn sample(&self, k: usize) -> Option<FrameOutput> {
+        let s = self.samples.get(k)?;
+        Some(FrameOutput {
+            width: self.width,
+            height: self.height,
+            color: self.color.clone(),
+            stencil: s.stencil.clone(),
+            counts: Vec::new(),
+            transmit: Vec::new(),
+            positions: s.positions.clone(),
+            normals: s.normals.clone(),
+            samples: Vec::new(),
+            stats: self.stats.clone(),
+        })
+    }
+}
+
+/// Per light: 255 where the light reaches the pixel (`count(light, pixel)` zero and the
+/// surface faces the light), 0 where it does not, 128 for background.
+fn shadow_masks(scene: &Scene, positions: &[[f32; 3]], normals: &[[f32; 3]], count: impl Fn(usize, usize) -> i32) -> Vec<Vec<u8>> {
+    scene
+        .lights
+        .iter()
+        .enumerate()
+        .map(|(k, light)| {
+            let l = light.homogeneous();
+            positions
+                .iter()
+                .zip(normals)
+                .enumerate()
+                .map(|(i, (p, n))| {
+                    let (p, n) = (Vec3::from(*p), Vec3::from(*n));
+                    if !p.x.is_finite() {
+                        return 128;
+                    }
+                    let to_light = if l.w == 0.0 { l.truncate() } else { l.truncate() - p };
+                    let faces = n.dot(to_light) > 0.0;
+                    if faces && light.reaches(p) && count(k, i) == 0 {
+                        255
+                    } else {
+                        0
+                    }
+                })
+                .collect()
+        })
+        .collect()
 }
 
 impl FrameOutput {
@@ -91,23 +134,33 @@ impl FrameOutput {
 
 /// Parses a frame's readback (colour always; the rest when captured). Positions come back
 /// eye-relative (NaN where nothing was drawn) and are made world-space in f64.
-pub(crate) fn parse(rb: &Readback, layout: &Layout, float_counts: bool, transmit: Option<TransmitMode>, eye: DVec3) -> Result<Captured> {
+pub(crate) fn parse(
+    rb: &Readback,
+    layout: &Layout,
+    float_counts: bool,
+    transmit: Option<TransmitMode>,
+    view: &CaptureView,
+) -> Result<Captured> {
+    let eye = view.eye;
     let color = rb.bytes(layout.color)?.to_vec();
     let mut c = Captured { color, ..Captured::default() };
     let (Some(pos_r), Some(nrm_r)) = (layout.positions, layout.normals) else { return Ok(c) };
-    let floats = |bytes: &[u8]| -> Vec<[f32; 4]> { bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(bytes) };
-    let pos = floats(rb.bytes(pos_r)?);
-    let nrm = floats(rb.bytes(nrm_r)?);
-    for (p, n) in pos.iter().zip(&nrm) {
-        if p[3] == 0.0 {
-            c.positions.push([f32::NAN; 3]);
-            c.normals.push([f32::NAN; 3]);
-        } else {
-            let wp = DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64) + eye;
-            c.positions.push(wp.as_vec3().to_array());
-            c.normals.push([n[0], n[1], n[2]]);
+    let n = layout.samples.max(1);
+    if n > 1 {
+        for (k, &location) in (0..n).zip(standard_sample_locations(n)) {
+            let mut s = SampleOutput::default();
+            (s.positions, s.normals) = sample_geometry(rb.bytes(pos_r.sample(k, n))?, rb.bytes(nrm_r.sample(k, n))?, view, location);
+            for &range in &layout.counts {
+                s.stencil.push(rb.bytes(range.sample(k, n))?.to_vec());
+            }
+            c.samples.push(s);
         }
+        if let Some(s0) = c.samples.first() {
+            (c.positions, c.normals, c.stencil) = (s0.positions.clone(), s0.normals.clone(), s0.stencil.clone());
+        }
+        return Ok(c);
     }
+    (c.positions, c.normals) = geometry(rb.bytes(pos_r)?, rb.bytes(nrm_r)?, eye);
     for (li, &range) in layout.counts.iter().enumerate() {
         let raw = rb.bytes(range)?;
         if float_counts {
@@ -144,9 +197,79 @@ pub(crate) fn parse(rb: &Readback, layout: &Layout, float_counts: bool, transmit
     Ok(c)
 }
 
+/// World positions and normals (NaN for background) from the read-back eye-relative position
+/// and normal targets (RGBA32F; w = 0 where nothing was drawn).
+fn geometry(pos: &[u8], nrm: &[u8], eye: DVec3) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
+    let floats = |bytes: &[u8]| -> Vec<[f32; 4]> { bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(bytes) };
+    floats(pos)
+        .iter()
+        .zip(&floats(nrm))
+        .map(|(p, n)| match p[3] == 0.0 {
+            true => ([f32::NAN; 3], [f32::NAN; 3]),
+            false => ((DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64) + eye).as_vec3().to_array(), [n[0], n[1], n[2]]),
+        })
+        .unzip()
+}
+
+/// What a captured frame's positions are recovered with: the eye, and for a multisampled frame
+/// the frame's size and the inverse of its eye-relative view-projection.
+pub(crate) struct CaptureView {
+    pub eye: DVec3,
+    /// Clip space to eye-relative space: the inverse, in f64, of the matrix the G-buffer pass
+    /// projected with.
+    pub clip_to_rel: DMat4,
+    pub width: u32,
+    pub height: u32,
+}
+
+/// Vulkan's standard sample locations (`standardSampleLocations`) of `samples` samples, in
+/// pixel units from the pixel's top-left corner; the pixel centre for one sample.
+pub fn standard_sample_locations(samples: u32) -> &'static [(f64, f64)] {
+    match samples {
+        2 => &[(0.75, 0.75), (0.25, 0.25)],
+        4 => &[(0.375, 0.125), (0.875, 0.375), (0.125, 0.625), (0.625, 0.875)],
+        8 => &[
+            (0.5625, 0.3125),
+            (0.4375, 0.6875),
+            (0.8125, 0.5625),
+            (0.3125, 0.1875),
+            (0.1875, 0.8125),
+            (0.0625, 0.4375),
+            (0.6875, 0.9375),
+            (0.9375, 0.0625),
+        ],
+        _ => &[(0.5, 0.5)],
+    }
+}
+
+/// One sample's world positions and normals (NaN for background) from its read-back depth
+/// (`r` of RGBA32F; 1, the clear value, where nothing was drawn) and normal: each position is
+/// the depth unprojected in f64 at the sample's own location, which is exactly the point the
+/// sample's depth and stencil tests saw (the G-buffer's shading position is the pixel's).
+fn sample_geometry(depth: &[u8], nrm: &[u8], view: &CaptureView, (sx, sy): (f64, f64)) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
+    let floats = |bytes: &[u8]| -> Vec<[f32; 4]> { bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(bytes) };
+    let (w, h) = (view.width as usize, view.height.max(1) as usize);
+    floats(depth)
+        .iter()
+        .zip(&floats(nrm))
+        .enumerate()
+        .map(|(i, (d, n))| {
+            if d[0] >= 1.0 {
+                return ([f32::NAN; 3], [f32::NAN; 3]);
+            }
+            let x = (i % w.max(1)) as f64 + sx;
+            let y = (i / w.max(1)) as f64 + sy;
+            let clip = DVec4::new(2.0 * x / w as f64 - 1.0, 2.0 * y / h as f64 - 1.0, d[0] as f64, 1.0);
+            let r = view.clip_to_rel * clip;
+            ((r.truncate() / r.w + view.eye).as_vec3().to_array(), [n[0], n[1], n[2]])
+        })
+        .unzip()
+}
+
 /// What [`parse`] returns (see [`FrameOutput`] for each field).
 #[derive(Default)]
 pub(crate) struct Captured {
+    pub samples: Vec<SampleOutput>,
     pub color: Vec<u8>,
     pub positions: Vec<[f32; 3]>,
     pub normals: Vec<[f32; 3]>,

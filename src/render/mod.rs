@@ -36,7 +36,7 @@ mod timing;
 
 pub use counters::PassCounters;
 pub use frame::{largest_device_heap, FrameTicket, MemoryEstimate, NewError, Renderer, Throughput};
-pub use frame_output::FrameOutput;
+pub use frame_output::{standard_sample_locations, FrameOutput, SampleOutput};
 pub use options::{
     Counter, DepthMode, FrameSettings, IndexFormat, PassToggles, RenderConfig, RenderOptions, Technique, TransmitMode, View,
 };

@@ -155,6 +155,8 @@ pub struct RenderConfig {
     pub self_shadow: bool,
     /// Frames the renderer keeps in flight (command buffers, fences, readbacks per slot).
     pub frames_in_flight: usize,
+    /// Samples per pixel of the frame's targets (1, 2, 4 or 8; see [`RenderOptions::samples`]).
+    pub samples: u32,
 }
 
 /// What may change from one frame to the next.
@@ -212,6 +214,16 @@ pub struct RenderOptions {
     pub frames_in_flight: usize,
     /// Animate the area lights' sample pattern ([`FrameSettings::jitter`]).
     pub jitter: bool,
+    /// Samples per pixel (`--msaa N`: 1, 2, 4 or 8). With more than one, the G-buffer, the
+    /// shadow determination and the lighting run at every sample (the stencil count is exact
+    /// per sample; the G-buffer and lighting shade per sample), the output is their resolve,
+    /// and a captured frame reads back every sample ([`FrameOutput::samples`]). The stencil
+    /// shadow-volume methods only: the float counter, the shadow-map and ray-query baselines,
+    /// transparent casters and `--view volumes` render at one sample. Needs the device's
+    /// `sampleRateShading` and the sample count on every target.
+    ///
+    /// [`FrameOutput::samples`]: crate::render::FrameOutput::samples
+    pub samples: u32,
 }
 
 impl RenderOptions {
@@ -224,6 +236,7 @@ impl RenderOptions {
             transmit_fp32: self.transmit.fp32,
             self_shadow: self.self_shadow,
             frames_in_flight: self.frames_in_flight,
+            samples: self.samples,
         }
     }
     /// The per-frame half.
@@ -257,6 +270,7 @@ impl Default for RenderOptions {
             self_shadow: false,
             frames_in_flight: 2,
             jitter: false,
+            samples: 1,
         }
     }
 }

@@ -2,7 +2,7 @@
 //! [`ShadowPass`](crate::pass::ShadowPass)'s), their layouts and descriptor sets: a set that
 //! destroys exactly what it created.
 
-use super::push::{ForwardPush, GBufferPush, LightPush};
+use super::push::{ForwardPush, GBufferPush, LightPush, SpherePush};
 use super::scene_gpu::{INSTANCE_ATTRIBUTES, INSTANCE_STRIDE, VERTEX_ATTRIBUTES, VERTEX_STRIDE};
 use super::targets::*;
 use crate::error::Result;
@@ -21,6 +21,23 @@ pub(crate) struct Layouts {
     pub tonemap: vk::PipelineLayout,
     /// Transparent forward passes: [`ForwardPush`].
     pub forward: vk::PipelineLayout,
+    /// The analytic spheres of a multisampled frame: [`SpherePush`].
+    pub sphere_ms: vk::PipelineLayout,
+}
+
+/// The per-sample readback of a multisampled frame ([`SampleReadback`]): a full-screen pass
+/// copies one sample of the depth, normal or stencil target into a single-sample image.
+pub(crate) struct SampleReadbackPipes {
+    /// One source image and the sampler; push: the sample index (an `i32`).
+    pub layout: vk::PipelineLayout,
+    /// Into the RGBA32F readback image.
+    pub geometry: vk::Pipeline,
+    /// Into the R8_UINT readback image.
+    pub stencil: vk::Pipeline,
+    /// The depth, normal and stencil sources.
+    pub depth_set: DescriptorSet,
+    pub normal_set: DescriptorSet,
+    pub stencil_set: DescriptorSet,
 }
 
 pub(crate) struct FramePipelines {
@@ -41,6 +58,8 @@ pub(crate) struct FramePipelines {
     pub tonemap: vk::Pipeline,
     /// The accumulation target's format the pipelines draw into.
     pub accum_format: vk::Format,
+    /// With multisampled targets, the per-sample readback.
+    pub sample_readback: Option<SampleReadbackPipes>,
     made: Vec<vk::Pipeline>,
 }
 
@@ -77,14 +96,18 @@ impl FramePipelines {
             ],
         )?;
         let accum_set = DescriptorSet::new(ctx, &[Binding::Image(t.accum.view), Binding::Sampler(sampler)])?;
+        let ms = t.samples > 1;
+        let samples = vk::SampleCountFlags::from_raw(t.samples);
         let vf = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
         let frag = vk::ShaderStageFlags::FRAGMENT;
         let size = |n: usize| n as u32;
         let layouts = Layouts {
             gbuffer: pipeline_layout(ctx, &[], size(std::mem::size_of::<GBufferPush>()), vf)?,
             illuminate: pipeline_layout(ctx, &[gbuffer_set.layout], size(std::mem::size_of::<LightPush>()), frag)?,
-            tonemap: pipeline_layout(ctx, &[accum_set.layout], 0, frag)?,
+            // The resolving variant's push: the sample count.
+            tonemap: pipeline_layout(ctx, &[accum_set.layout], 4, frag)?,
             forward: pipeline_layout(ctx, &[], size(std::mem::size_of::<ForwardPush>()), vf)?,
+            sphere_ms: pipeline_layout(ctx, &[], size(std::mem::size_of::<SpherePush>()), vf)?,
         };
         let mut made = Vec::new();
         let mut create = |desc: &PipelineDesc| -> Result<vk::Pipeline> {
@@ -96,6 +119,7 @@ impl FramePipelines {
         let gbuffer_formats = [t.accum_format, ALBEDO_FORMAT, NORMAL_FORMAT, POSITION_FORMAT];
         let mut g = scene_pipeline(shaders::GBUFFER_VERT, layouts.gbuffer, df);
         g.fragment = Some(shaders::GBUFFER_FRAG);
+        g.samples = samples;
         g.attributes = &VERTEX_ATTRIBUTES[..3];
         g.color_formats = &gbuffer_formats;
         g.depth_test = true;
@@ -105,8 +129,9 @@ impl FramePipelines {
         let gbuffer = create(&g)?;
         g.cull = vk::CullModeFlags::NONE;
         let gbuffer_two_sided = create(&g)?;
-        let mut gs = PipelineDesc::new(shaders::SPHERE_VERT, layouts.gbuffer, df);
-        gs.fragment = Some(shaders::SPHERE_FRAG);
+        let mut gs = PipelineDesc::new(shaders::SPHERE_VERT, if ms { layouts.sphere_ms } else { layouts.gbuffer }, df);
+        gs.fragment = Some(if ms { shaders::SPHERE_MS_FRAG } else { shaders::SPHERE_FRAG });
+        gs.samples = samples;
         gs.vertex_stride = VERTEX_STRIDE;
         gs.attributes = &VERTEX_ATTRIBUTES;
         gs.color_formats = &gbuffer_formats;
@@ -122,11 +147,13 @@ impl FramePipelines {
         i.color_formats = &accum;
         i.blend = Blend::Additive;
         i.depth_bounds = depth_bounds;
+        i.samples = samples;
         let lit = Some((crate::pass::lit_stencil_state(), crate::pass::lit_stencil_state()));
         let mut illuminate = [[vk::Pipeline::null(); 2]; 2];
         for (ci, counted) in [false, true].into_iter().enumerate() {
             for (ti, transmit) in [false, true].into_iter().enumerate() {
                 i.fragment = Some(match (counted, transmit) {
+                    (false, false) if ms => shaders::ILLUMINATE_MS_FRAG,
                     (false, false) => shaders::ILLUMINATE_FRAG,
                     (false, true) => shaders::ILLUMINATE_T_FRAG,
                     (true, false) => shaders::ILLUMINATE_COUNT_FRAG,
@@ -143,15 +170,20 @@ impl FramePipelines {
         tp.depth_test = true;
         tp.depth_compare = vk::CompareOp::LESS;
         tp.blend = Blend::Over;
+        tp.samples = samples;
         let transparent_over = create(&tp)?;
         tp.blend = Blend::Additive;
         let transparent_light = create(&tp)?;
 
         let out = [OUTPUT_FORMAT];
         let mut tm = PipelineDesc::new(shaders::FULLSCREEN_VERT, layouts.tonemap, vk::Format::UNDEFINED);
-        tm.fragment = Some(shaders::TONEMAP_FRAG);
+        tm.fragment = Some(if ms { shaders::TONEMAP_MS_FRAG } else { shaders::TONEMAP_FRAG });
         tm.color_formats = &out;
         let tonemap = create(&tm)?;
+        let sample_readback = match &t.per_sample {
+            Some(rb) => Some(SampleReadbackPipes::new(ctx, t, (rb.depth_view, rb.stencil_view), sampler, &mut create)?),
+            None => None,
+        };
         Ok(FramePipelines {
             layouts,
             gbuffer_set,
@@ -165,6 +197,7 @@ impl FramePipelines {
             transparent_light,
             tonemap,
             accum_format: t.accum_format,
+            sample_readback,
             made,
         })
     }
@@ -181,12 +214,73 @@ impl FramePipelines {
                 d.destroy_pipeline(p, None);
             }
             let l = &self.layouts;
-            for layout in [l.gbuffer, l.illuminate, l.tonemap, l.forward] {
+            for layout in [l.gbuffer, l.illuminate, l.tonemap, l.forward, l.sphere_ms] {
                 d.destroy_pipeline_layout(layout, None);
             }
             d.destroy_sampler(self.sampler, None);
         }
         self.gbuffer_set.destroy(ctx);
         self.accum_set.destroy(ctx);
+        if let Some(mut r) = self.sample_readback.take() {
+            // SAFETY: as above (its pipelines are in `made`).
+            unsafe { d.destroy_pipeline_layout(r.layout, None) };
+            r.depth_set.destroy(ctx);
+            r.normal_set.destroy(ctx);
+            r.stencil_set.destroy(ctx);
+        }
+    }
+}
+
+impl SampleReadbackPipes {
+    /// The readback's sets and pipelines; `create` makes (and owns) the pipelines.
+    fn new(
+        ctx: &Context,
+        t: &Targets,
+        (depth_view, stencil_view): (vk::ImageView, vk::ImageView),
+        sampler: vk::Sampler,
+        create: &mut impl FnMut(&PipelineDesc) -> Result<vk::Pipeline>,
+    ) -> Result<SampleReadbackPipes> {
+        let set = |view| DescriptorSet::new(ctx, &[Binding::Image(view), Binding::Sampler(sampler)]);
+        let mut sets = Vec::with_capacity(3);
+        let made = (|| -> Result<(vk::PipelineLayout, vk::Pipeline, vk::Pipeline)> {
+            for view in [depth_view, t.normal.view, stencil_view] {
+                sets.push(set(view)?);
+            }
+            let layout = pipeline_layout(ctx, &[sets[0].layout], 4, vk::ShaderStageFlags::FRAGMENT)?;
+            let geometry_formats = [SAMPLE_GEOMETRY_FORMAT];
+            let stencil_formats = [SAMPLE_STENCIL_FORMAT];
+            let mut p = PipelineDesc::new(shaders::FULLSCREEN_VERT, layout, vk::Format::UNDEFINED);
+            p.fragment = Some(shaders::SAMPLE_READBACK_FRAG);
+            p.color_formats = &geometry_formats;
+            let made = (|| {
+                let geometry = create(&p)?;
+                p.fragment = Some(shaders::SAMPLE_READBACK_STENCIL_FRAG);
+                p.color_formats = &stencil_formats;
+                Ok((geometry, create(&p)?))
+            })();
+            match made {
+                Ok((g, s)) => Ok((layout, g, s)),
+                Err(e) => {
+                    // SAFETY: no pipeline made with the layout is in use.
+                    unsafe { ctx.device.destroy_pipeline_layout(layout, None) };
+                    Err(e)
+                }
+            }
+        })();
+        match made {
+            Ok((layout, geometry, stencil)) => {
+                let mut it = sets.into_iter();
+                let (Some(depth_set), Some(normal_set), Some(stencil_set)) = (it.next(), it.next(), it.next()) else {
+                    return Err(crate::Error::Internal("sample readback sets".into()));
+                };
+                Ok(SampleReadbackPipes { layout, geometry, stencil, depth_set, normal_set, stencil_set })
+            }
+            Err(e) => {
+                for mut s in sets {
+                    s.destroy(ctx);
+                }
+                Err(e)
+            }
+        }
     }
 }

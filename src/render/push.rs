@@ -15,6 +15,40 @@ pub struct GBufferPush {
     pub ambient: [f32; 4],
 }
 
+/// `sphere.frag`'s MS variant (the analytic spheres of a multisampled frame):
+/// `{ mat4 view_proj; vec4 ambient; vec4 ray_x; vec4 ray_y; vec4 ray_0; }`, 128 bytes (the
+/// push-constant size every device has). `ray_x * x + ray_y * y + ray_0` is the homogeneous
+/// eye-relative point on the near plane under window position (x, y): the inverse
+/// view-projection with the viewport folded in, so each sample casts its ray through its own
+/// location (`gl_FragCoord` under sample shading).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+pub struct SpherePush {
+    /// The G-buffer block.
+    pub gbuffer: GBufferPush,
+    /// The inverse view-projection's x column, over the viewport's half width.
+    pub ray_x: [f32; 4],
+    /// Its y column, over the viewport's half height.
+    pub ray_y: [f32; 4],
+    /// Its w column minus the x and y columns (window origin at the near plane).
+    pub ray_0: [f32; 4],
+}
+
+impl SpherePush {
+    /// The block for a frame projecting eye-relative positions with `view_proj` into a
+    /// `width` x `height` viewport.
+    pub fn new(gbuffer: GBufferPush, view_proj: Mat4, width: u32, height: u32) -> SpherePush {
+        let inv = view_proj.as_dmat4().inverse();
+        let (sx, sy) = (2.0 / width.max(1) as f64, 2.0 / height.max(1) as f64);
+        // ndc = 2 * window / size - 1, z = 0 (the near plane; z = 1 is at infinity).
+        let ray_x = inv.x_axis * sx;
+        let ray_y = inv.y_axis * sy;
+        let ray_0 = inv.w_axis - inv.x_axis - inv.y_axis;
+        let f = |v: glam::DVec4| v.as_vec4().to_array();
+        SpherePush { gbuffer, ray_x: f(ray_x), ray_y: f(ray_y), ray_0: f(ray_0) }
+    }
+}
+
 /// `illuminate.frag` (and the light half of the forward block):
 /// `{ vec4 light_pos; vec4 color; vec4 spot; vec4 params; }`.
 #[repr(C)]

@@ -13,9 +13,20 @@ pub(crate) struct Range {
     pub size: u64,
 }
 
-/// Where each image of a frame lands.
+impl Range {
+    /// Sample `k`'s block of a range holding `samples` equal blocks.
+    pub fn sample(self, k: u32, samples: u32) -> Range {
+        let size = self.size / samples.max(1) as u64;
+        Range { offset: self.offset + k as u64 * size, size }
+    }
+}
+
+/// Where each image of a frame lands. A multisampled frame's positions, normals and counts
+/// hold one block per sample, sample after sample ([`Range::sample`]).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Layout {
+    /// Samples per pixel (1 when single-sampled).
+    pub samples: u32,
     pub color: Range,
     pub positions: Option<Range>,
     pub normals: Option<Range>,
@@ -28,7 +39,8 @@ pub(crate) struct Layout {
 
 impl Layout {
     /// `capture`: positions, normals and per-light counts / maps too.
-    pub fn new(pixels: u64, capture: bool, lights: usize, float_counts: bool, transmit_texel: Option<u64>) -> Layout {
+    pub fn new(pixels: u64, capture: bool, lights: usize, float_counts: bool, transmit_texel: Option<u64>, samples: u32) -> Layout {
+        let n = samples.max(1) as u64;
         let mut next = 0u64;
         let mut take = |size: u64| {
             let r = Range { offset: next, size };
@@ -36,11 +48,11 @@ impl Layout {
             r
         };
         let color = take(pixels * 4);
-        let mut l = Layout { color, ..Layout::default() };
+        let mut l = Layout { color, samples: n as u32, ..Layout::default() };
         if capture {
-            l.positions = Some(take(pixels * 16));
-            l.normals = Some(take(pixels * 16));
-            let per_light = if float_counts { pixels * 4 } else { pixels };
+            l.positions = Some(take(n * pixels * 16));
+            l.normals = Some(take(n * pixels * 16));
+            let per_light = n * if float_counts { pixels * 4 } else { pixels };
             l.counts = (0..lights).map(|_| take(per_light)).collect();
             if let Some(texel) = transmit_texel {
                 l.transmit = (0..lights).map(|_| take(pixels * texel)).collect();

@@ -19,13 +19,36 @@ pub const NORMAL_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 pub const POSITION_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 /// The tone-mapped output.
 pub const OUTPUT_FORMAT: vk::Format = vk::Format::R8G8B8A8_SRGB;
+/// One sample of the position or normal target, read back ([`SampleReadback::geometry`]).
+pub const SAMPLE_GEOMETRY_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+/// One sample of the stencil, read back ([`SampleReadback::stencil`]).
+pub const SAMPLE_STENCIL_FORMAT: vk::Format = vk::Format::R8_UINT;
 /// The float shadow-volume counter (`--counter float`).
 pub use crate::pass::COUNT_FORMAT;
+
+/// The per-sample readback of a multisampled frame (images of more than one sample cannot be
+/// copied to a buffer): one sample at a time is drawn into these single-sample images and
+/// copied out.
+pub struct SampleReadback {
+    /// One sample of the depth (in `r`) or of the normal target (RGBA32F).
+    pub geometry: Image,
+    /// One sample of the stencil (R8_UINT).
+    pub stencil: Image,
+    /// The depth-stencil target's stencil aspect, sampled.
+    pub stencil_view: vk::ImageView,
+    /// The depth-stencil target's depth aspect, sampled.
+    pub depth_view: vk::ImageView,
+}
 
 /// The renderer's offscreen targets, all of one size.
 pub struct Targets {
     /// Their size.
     pub extent: vk::Extent2D,
+    /// Samples per pixel of the accumulation, G-buffer and depth-stencil targets (the count
+    /// and intensity maps and the output have one).
+    pub samples: u32,
+    /// With more than one sample, what reads them back.
+    pub per_sample: Option<SampleReadback>,
     /// Float accumulation (RGBA16F, or RGBA32F for area lights: [`Targets::with_accum`]).
     pub accum: Image,
     /// The format of `accum`.
@@ -54,25 +77,117 @@ impl Targets {
     /// [`Targets::new`] with the accumulation target in `accum_format` ([`ACCUM_FORMAT`] or
     /// [`ACCUM_FORMAT_FP32`]).
     pub fn with_accum(ctx: &Context, width: u32, height: u32, transmit_format: vk::Format, accum_format: vk::Format) -> Result<Targets> {
+        Targets::with_samples(ctx, width, height, transmit_format, accum_format, 1)
+    }
+
+    /// [`Targets::with_accum`] with `samples` samples per pixel (1, 2, 4 or 8, checked by the
+    /// caller against the device) on the accumulation, G-buffer and depth-stencil targets.
+    pub fn with_samples(
+        ctx: &Context,
+        width: u32,
+        height: u32,
+        transmit_format: vk::Format,
+        accum_format: vk::Format,
+        samples: u32,
+    ) -> Result<Targets> {
         let extent = vk::Extent2D { width, height };
         let color = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
         let c = vk::ImageAspectFlags::COLOR;
         let ds = vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL;
-        let [accum, albedo, normal, position, depth, count, transmit, output] = Image::new_all(
+        let ms = vk::SampleCountFlags::from_raw(samples);
+        // Multisampled, the stencil is read by a shader (one sample at a time), not copied.
+        let ds_usage = match samples {
+            1 => vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC,
+            _ => vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
+        };
+        let [accum, albedo, normal, position, depth] = Image::new_all_samples(
             ctx,
             extent,
+            ms,
             [
                 ("accum", accum_format, color, c),
                 ("albedo", ALBEDO_FORMAT, color, c),
                 ("normal", NORMAL_FORMAT, color, c),
                 ("position", POSITION_FORMAT, color, c),
-                ("depth-stencil", ctx.depth_format, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC, ds),
-                ("count", COUNT_FORMAT, color, c),
-                ("light-intensity map", transmit_format, color, c),
-                ("output", OUTPUT_FORMAT, vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC, c),
+                ("depth-stencil", ctx.depth_format, ds_usage, ds),
             ],
         )?;
-        Ok(Targets { extent, accum, accum_format, albedo, normal, position, depth, output, count, transmit })
+        let mut t = Targets {
+            extent,
+            samples,
+            per_sample: None,
+            accum,
+            accum_format,
+            albedo,
+            normal,
+            position,
+            depth,
+            output: Image::null(),
+            count: Image::null(),
+            transmit: Image::null(),
+        };
+        // From here on a failure destroys what was made (null images destroy as nothing).
+        match t.single_sampled(ctx, transmit_format) {
+            Ok(()) => Ok(t),
+            Err(e) => {
+                t.destroy(ctx);
+                Err(e)
+            }
+        }
+    }
+
+    /// The single-sample targets, and with more than one sample the per-sample readback.
+    fn single_sampled(&mut self, ctx: &Context, transmit_format: vk::Format) -> Result<()> {
+        let color = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_SRC;
+        let c = vk::ImageAspectFlags::COLOR;
+        let readback = vk::ImageUsageFlags::COLOR_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
+        [self.count, self.transmit, self.output] = Image::new_all(
+            ctx,
+            self.extent,
+            [("count", COUNT_FORMAT, color, c), ("light-intensity map", transmit_format, color, c), ("output", OUTPUT_FORMAT, readback, c)],
+        )?;
+        if self.samples > 1 {
+            let [geometry, stencil] = Image::new_all(
+                ctx,
+                self.extent,
+                [("sample readback", SAMPLE_GEOMETRY_FORMAT, readback, c), ("sample stencil readback", SAMPLE_STENCIL_FORMAT, readback, c)],
+            )?;
+            let mut rb = SampleReadback { geometry, stencil, stencil_view: vk::ImageView::null(), depth_view: vk::ImageView::null() };
+            let view = |aspect_mask| {
+                let info = vk::ImageViewCreateInfo::default()
+                    .image(self.depth.raw)
+                    .view_type(vk::ImageViewType::TYPE_2D)
+                    .format(self.depth.format)
+                    .subresource_range(vk::ImageSubresourceRange {
+                        aspect_mask,
+                        base_mip_level: 0,
+                        level_count: 1,
+                        base_array_layer: 0,
+                        layer_count: 1,
+                    });
+                // SAFETY: the depth-stencil image is bound and sampled-usable; the view is
+                // destroyed in `destroy`, before the image.
+                unsafe { ctx.device.create_image_view(&info, None) }.map_err(crate::Error::vk("vkCreateImageView"))
+            };
+            let views = view(vk::ImageAspectFlags::STENCIL).and_then(|s| match view(vk::ImageAspectFlags::DEPTH) {
+                Ok(d) => Ok((s, d)),
+                Err(e) => {
+                    // SAFETY: made just above, used by nothing.
+                    unsafe { ctx.device.destroy_image_view(s, None) };
+                    Err(e)
+                }
+            });
+            match views {
+                Ok((s, d)) => (rb.stencil_view, rb.depth_view) = (s, d),
+                Err(e) => {
+                    rb.geometry.destroy(ctx);
+                    rb.stencil.destroy(ctx);
+                    return Err(e);
+                }
+            }
+            self.per_sample = Some(rb);
+        }
+        Ok(())
     }
 
     /// The G-buffer pass's colour attachments, in attachment order.
@@ -82,6 +197,15 @@ impl Targets {
 
     /// Destroys every target (the owner waited for the device).
     pub fn destroy(&mut self, ctx: &Context) {
+        if let Some(mut rb) = self.per_sample.take() {
+            // SAFETY: the owner waited for the device; the views are destroyed once.
+            unsafe {
+                ctx.device.destroy_image_view(rb.stencil_view, None);
+                ctx.device.destroy_image_view(rb.depth_view, None);
+            }
+            rb.geometry.destroy(ctx);
+            rb.stencil.destroy(ctx);
+        }
         for img in [
             &mut self.accum,
             &mut self.albedo,

@@ -57,10 +57,59 @@ pub(super) fn check_options(ctx: &Context, config: &RenderConfig, s: &FrameSetti
             "--counter float, --method shadowmap and --self-shadow need R32_SFLOAT colour blending, which this device lacks; use --counter stencil".into(),
         ));
     }
+    check_samples(ctx, config, s)?;
     if config.transmit_fp32 && !f.rgba32f_blend {
         return Err(Error::Unsupported(
             "--transmit log32/mul32 need R32G32B32A32_SFLOAT blending, which this device lacks; use log16".into(),
         ));
     }
     Ok(())
+}
+
+/// The multisampled frame's options ([`RenderConfig::samples`]): a count of 1, 2, 4 or 8 that
+/// every target supports, `sampleRateShading`, and what renders per sample (the stencil
+/// shadow-volume methods, shaded or stencil views).
+fn check_samples(ctx: &Context, config: &RenderConfig, s: &FrameSettings) -> Result<()> {
+    let n = config.samples;
+    if !matches!(n, 1 | 2 | 4 | 8) {
+        return Err(Error::InvalidDesc { field: "RenderOptions::samples", msg: format!("{n} samples; the count is 1, 2, 4 or 8") });
+    }
+    if n == 1 {
+        return Ok(());
+    }
+    let f = &ctx.features;
+    if f.frame_sample_counts & n == 0 {
+        return Err(Error::Unsupported(format!(
+            "{}: {n} samples are not supported on every target of the frame (colour, depth-stencil, sampled); supported: {}",
+            ctx.info.name,
+            [1u32, 2, 4, 8, 16, 32, 64]
+                .iter()
+                .filter(|&&c| f.frame_sample_counts & c != 0)
+                .map(|c| c.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        )));
+    }
+    if !f.sample_rate_shading {
+        return Err(Error::Unsupported(format!("{}: a multisampled frame shades per sample and needs sampleRateShading", ctx.info.name)));
+    }
+    if s.capture && !f.standard_sample_locations {
+        return Err(Error::Unsupported(format!(
+            "{}: a multisampled capture is read back at Vulkan's standard sample locations, which this device does not use",
+            ctx.info.name
+        )));
+    }
+    let why = match (s.technique.pass_technique(), s.counter, s.view) {
+        (None, _, _) => Some(format!("the {} baseline", s.technique.name())),
+        (_, Counter::Float, _) => Some("the float counter".to_string()),
+        (_, _, View::Volumes) => Some("the volume overlay view".to_string()),
+        _ => None,
+    };
+    match why {
+        Some(what) => Err(Error::InvalidDesc {
+            field: "RenderOptions::samples",
+            msg: format!("{what} renders at one sample; multisampling ({n} samples) is for the stencil shadow-volume methods"),
+        }),
+        None => Ok(()),
+    }
 }

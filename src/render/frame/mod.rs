@@ -4,12 +4,12 @@
 //! per ring slot, with frames in flight.
 
 use super::counters::CounterPools;
-use super::frame_output::{parse, FrameOutput};
+use super::frame_output::{parse, CaptureView, FrameOutput};
 use super::guard::{Destroy, Guard, Owned};
 use super::options::*;
 use super::passes::selfshadow::SelfShadow;
 use super::passes::shadowmap::ShadowMapper;
-use super::passes::{self, debug, determine, gbuffer, illuminate, intensity, tonemap, transparent, Rec};
+use super::passes::{self, debug, determine, gbuffer, illuminate, intensity, samples, tonemap, transparent, Rec};
 use super::pipelines::FramePipelines;
 use super::push::LightPush;
 use super::raytrace::RayTracer;
@@ -67,6 +67,9 @@ struct InFlight {
     layout: Layout,
     float_counts: bool,
     eye: glam::DVec3,
+    /// The inverse of the G-buffer's eye-relative view-projection (a multisampled capture's
+    /// positions are unprojected from each sample's depth).
+    clip_to_rel: glam::DMat4,
     spans: FrameSpans,
     wall: Instant,
     record_ms: f64,
@@ -312,7 +315,7 @@ impl Renderer {
         let float_counts = settings.counter == Counter::Float || self.own.parts.shadow_mapper.is_some();
         let nlights = self.own.parts.scene.lights.len();
         let texel = self.own.parts.has_transparent.then_some(if self.own.parts.config.transmit_fp32 { 16 } else { 8 });
-        let layout = Layout::new((w * h) as u64, capture, nlights, float_counts, texel);
+        let layout = Layout::new((w * h) as u64, capture, nlights, float_counts, texel, self.own.parts.config.samples);
         let lights: Vec<LightPush> = self.own.parts.scene.lights.iter().map(|l| LightPush::new(l, eye, settings.transmit_log)).collect();
 
         // 2. Record the paper's frame.
@@ -361,8 +364,18 @@ impl Renderer {
         let record_ms = record_start.elapsed().as_secs_f64() * 1e3;
         let serial = self.own.parts.serial;
         self.own.parts.serial += 1;
-        self.own.parts.slots[slot].in_flight =
-            Some(InFlight { serial, frame, layout, float_counts, eye, spans, wall, record_ms, settings });
+        self.own.parts.slots[slot].in_flight = Some(InFlight {
+            serial,
+            frame,
+            layout,
+            float_counts,
+            eye,
+            clip_to_rel: vp_rel.as_dmat4().inverse(),
+            spans,
+            wall,
+            record_ms,
+            settings,
+        });
         Ok(FrameTicket { slot, serial })
     }
 
@@ -412,7 +425,8 @@ impl Renderer {
                 if let (Some(rt), Technique::RayQuery) = (&self.own.parts.ray_tracer, self.settings.technique) {
                     rt.cmd_determine(rec, t, frame.slot(), lights[li].light_pos, frame.lights[li].scissor);
                 }
-                determine::record(rec, pass, frame, li, t, into, layout.counts.get(li).copied())?;
+                determine::record(rec, pass, frame, li, t, into)?;
+                determine::finish(rec, t, p, into, layout.counts.get(li).copied())?;
                 if let Some(c) = counters {
                     c.statistics(rec.ctx, rec.cb, li as u32, false);
                 }
@@ -441,9 +455,20 @@ impl Renderer {
         }
         spans.frame.end = stamp(all);
         rec.copy_out(&t.output, vk::ImageAspectFlags::COLOR, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, layout.color);
-        if let (Some(pos), Some(nrm)) = (layout.positions, layout.normals) {
-            rec.copy_out(&t.position, vk::ImageAspectFlags::COLOR, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL, pos);
-            rec.copy_out(&t.normal, vk::ImageAspectFlags::COLOR, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL, nrm);
+        match (layout.positions, layout.normals) {
+            (Some(pos), Some(nrm)) if t.samples > 1 => {
+                // SAFETY: recording outside a rendering instance; the G-buffer is in shader-read
+                // layout since its pass.
+                unsafe {
+                    samples::record(rec, t, p, samples::Source::Depth, pos)?;
+                    samples::record(rec, t, p, samples::Source::Normal, nrm)?;
+                }
+            }
+            (Some(pos), Some(nrm)) => {
+                rec.copy_out(&t.position, vk::ImageAspectFlags::COLOR, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL, pos);
+                rec.copy_out(&t.normal, vk::ImageAspectFlags::COLOR, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL, nrm);
+            }
+            _ => {}
         }
         tonemap::host_barrier(rec);
         Ok(spans)
@@ -460,7 +485,9 @@ impl Renderer {
             .parts
             .has_transparent
             .then_some(TransmitMode { fp32: self.own.parts.config.transmit_fp32, log: f.settings.transmit_log });
-        let c = parse(&s.readback, &f.layout, f.float_counts, transmit, f.eye)?;
+        let (width, height) = (self.own.parts.config.width, self.own.parts.config.height);
+        let view = CaptureView { eye: f.eye, clip_to_rel: f.clip_to_rel, width, height };
+        let c = parse(&s.readback, &f.layout, f.float_counts, transmit, &view)?;
         let stats = self.stats(&ticket, &f)?;
         let mut out = FrameOutput {
             width: self.own.parts.config.width,
@@ -471,6 +498,7 @@ impl Renderer {
             transmit: c.transmit,
             positions: c.positions,
             normals: c.normals,
+            samples: c.samples,
             stats,
         };
         if f.settings.view == View::Stencil {
@@ -528,7 +556,7 @@ impl Parts {
             frames_in_flight: config.frames_in_flight,
             depth_mode: config.depth_mode,
             depth_direction: sp::DepthDirection::Forward,
-            samples: 1,
+            samples: config.samples,
             target: sp::TargetModel::DynamicRendering,
             features: sp::EnabledFeatures {
                 depth_clamp: f.depth_clamp,
@@ -551,10 +579,20 @@ impl Parts {
             pass.add_sphere_caster(&s.name, s.sphere, s.segments)?;
         }
         let has_transparent = pass.casters().iter().any(|c| c.transmittance.is_some());
+        if has_transparent && config.samples > 1 {
+            return Err(Error::InvalidDesc {
+                field: "RenderOptions::samples",
+                msg: format!(
+                    "transparent shadow casters' light-intensity map renders at one sample; multisampling ({} samples) is for opaque casters",
+                    config.samples
+                ),
+            });
+        }
         let frames = config.frames_in_flight;
         let geo = Guard::new(ctx, SceneGeometry::new(ctx, &scene, frames)?);
         let spheres = Guard::new(ctx, SphereGeometry::new(ctx, &scene, frames)?);
-        let targets = Guard::new(ctx, Targets::with_accum(ctx, config.width, config.height, transmit_format, accum_format)?);
+        let targets =
+            Guard::new(ctx, Targets::with_samples(ctx, config.width, config.height, transmit_format, accum_format, config.samples)?);
         let pipes = Guard::new(ctx, FramePipelines::new(ctx, &targets, pass.capabilities().depth_bounds)?);
         let self_shadow = match config.self_shadow && geo.of(Sidedness::Transparent).next().is_some() {
             true => Some(SelfShadow::new(ctx, &pipes, targets.extent, transmit_format)?),

@@ -38,8 +38,9 @@ impl Renderer {
         for s in &mut self.own.parts.slots {
             s.in_flight = None;
         }
-        let transmit_format = self.own.parts.targets.transmit.format;
-        let mut targets = Targets::new(ctx, width, height, transmit_format)?;
+        let old = &self.own.parts.targets;
+        let transmit_format = old.transmit.format;
+        let mut targets = Targets::with_samples(ctx, width, height, transmit_format, old.accum_format, old.samples)?;
         let mut pipes = match FramePipelines::new(ctx, &targets, self.own.parts.pass.capabilities().depth_bounds) {
             Ok(p) => p,
             Err(e) => {

@@ -7,6 +7,7 @@ use crate::error::Result;
 use crate::pass::diagnostics::Diagnostics;
 use crate::pass::{DepthStencilTarget, PreparedFrame, ShadowPass};
 use crate::render::counters::CounterPools;
+use crate::render::pipelines::FramePipelines;
 use crate::render::readback::Range;
 use crate::render::targets::Targets;
 use ash::vk;
@@ -35,15 +36,7 @@ pub(crate) fn begin_float(rec: &Rec, t: &Targets) {
 /// `rec.cb` is recording outside a rendering instance, the depth-stencil target is in
 /// attachment layout with the G-buffer's depth written; `frame` was prepared by `pass` for
 /// this slot.
-pub(crate) unsafe fn record(
-    rec: &Rec,
-    pass: &ShadowPass,
-    frame: &PreparedFrame,
-    light: usize,
-    t: &Targets,
-    into: CountInto,
-    capture: Option<Range>,
-) -> Result<()> {
+pub(crate) unsafe fn record(rec: &Rec, pass: &ShadowPass, frame: &PreparedFrame, light: usize, t: &Targets, into: CountInto) -> Result<()> {
     let target = DepthStencilTarget::new(t.depth.raw, t.depth.view, t.extent);
     // SAFETY: the caller's contract, which is `ShadowPass`'s.
     unsafe {
@@ -57,9 +50,21 @@ pub(crate) unsafe fn record(
         }
     }
     rec.barrier((FRAG_TESTS, DS_RW), (FRAG_TESTS, DS_RW));
+    Ok(())
+}
+
+/// After [`record`]: copies the light's count into `capture` (captured frames) and makes the
+/// float count target readable by the lighting pass.
+///
+/// # Safety
+/// As [`record`], after it.
+pub(crate) unsafe fn finish(rec: &Rec, t: &Targets, p: &FramePipelines, into: CountInto, capture: Option<Range>) -> Result<()> {
     let float = matches!(into, CountInto::Float | CountInto::External);
     if let Some(range) = capture {
-        if float {
+        if t.samples > 1 {
+            // SAFETY: the caller's contract: the stencil is written and in attachment layout.
+            unsafe { super::samples::record(rec, t, p, super::samples::Source::Stencil, range)? };
+        } else if float {
             rec.copy_out(&t.count, vk::ImageAspectFlags::COLOR, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, range);
         } else {
             rec.copy_out(&t.depth, vk::ImageAspectFlags::STENCIL, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL, range);

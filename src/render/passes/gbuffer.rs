@@ -6,7 +6,7 @@
 
 use super::{att, Rec, DS_CLEAR, ZERO};
 use crate::render::pipelines::FramePipelines;
-use crate::render::push::GBufferPush;
+use crate::render::push::{GBufferPush, SpherePush};
 use crate::render::scene_gpu::{SceneGeometry, Sidedness};
 use crate::render::targets::Targets;
 use ash::vk;
@@ -53,6 +53,11 @@ pub(crate) unsafe fn record(
         }
         if let Some((buffer, count)) = spheres {
             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, p.gbuffer_sphere);
+            if t.samples > 1 {
+                let sp = SpherePush::new(push, vp_rel, t.extent.width, t.extent.height);
+                let stages = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
+                d.cmd_push_constants(cb, p.layouts.sphere_ms, stages, 0, bytemuck::bytes_of(&sp));
+            }
             d.cmd_bind_vertex_buffers(cb, 0, &[buffer], &[0]);
             d.cmd_draw(cb, count, 1, 0, 0);
         }

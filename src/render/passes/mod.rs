@@ -8,6 +8,7 @@ pub(crate) mod determine;
 pub(crate) mod gbuffer;
 pub(crate) mod illuminate;
 pub(crate) mod intensity;
+pub(crate) mod samples;
 pub(crate) mod selfshadow;
 pub mod shadowmap;
 pub(crate) mod tonemap;

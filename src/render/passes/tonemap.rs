@@ -19,6 +19,8 @@ pub(crate) unsafe fn record(rec: &Rec, t: &Targets, p: &FramePipelines) {
         rec.begin(rec.full, &out, None);
         d.cmd_bind_pipeline(rec.cb, vk::PipelineBindPoint::GRAPHICS, p.tonemap);
         d.cmd_bind_descriptor_sets(rec.cb, vk::PipelineBindPoint::GRAPHICS, p.layouts.tonemap, 0, &[p.accum_set.set], &[]);
+        // The resolving variant's sample count (unused by the single-sample one).
+        d.cmd_push_constants(rec.cb, p.layouts.tonemap, vk::ShaderStageFlags::FRAGMENT, 0, &(t.samples as i32).to_le_bytes());
         d.cmd_draw(rec.cb, 3, 1, 0, 0);
         d.cmd_end_rendering(rec.cb);
     }
