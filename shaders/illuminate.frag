@@ -32,10 +32,38 @@ layout(push_constant) uniform Push {
     vec4 light_pos;   // xyz relative to the eye, w = 1; or xyz towards the light, w = 0
     vec4 color;       // rgb = colour * intensity
     vec4 spot;        // xyz = travel direction, w = cos(half cone) (-2 when not a spot)
-    vec4 params;      // x = radius (0: unbounded), y = 1 when the intensity map is in log space
+    vec4 params;      // x = radius (0: unbounded), y = 1 when the intensity map is in log space,
+                      // w = shading: 0 smooth, 1 naive smooth (no bound), 2 flat
 } pc;
 
 layout(location = 0) out vec4 out_color;
+
+// illuminate.frag's inverse of gbuffer.frag's pack_normal.
+vec3 unpack_normal(float f) {
+    float qx = floor(f / 4096.0);
+    vec2 e = vec2(qx, f - qx * 4096.0) / 4095.0 * 2.0 - 1.0;
+    vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
+    float t = max(-n.z, 0.0);
+    n.x += n.x >= 0.0 ? -t : t;
+    n.y += n.y >= 0.0 ? -t : t;
+    return normalize(n);
+}
+
+// The smooth n.L with the terminator bound t (geom/shading.rs): 0 up to t (every face turned
+// away from the light is there), then a cubic rising with zero slope from t that meets n.L
+// itself, slope 1, at min(3 t, 1). Continuous with its slope, so the fade shows no crease, and
+// plain smooth shading wherever n.L >= 3 t (on a fine mesh, almost everywhere).
+float terminator(float x, float t) {
+    if (x <= t) {
+        return 0.0;
+    }
+    float x1 = min(3.0 * t, 1.0);
+    if (x >= x1) {
+        return x;
+    }
+    float u = (x - t) / (x1 - t);
+    return (3.0 - 2.0 * u) * u * u * x1 + (u - 1.0) * u * u * (x1 - t);
+}
 
 void main() {
     ivec2 px = ivec2(gl_FragCoord.xy);
@@ -48,15 +76,21 @@ void main() {
     if (pos.w == 0.0) {
         discard;
     }
-    vec3 n = normalize(FETCH(t_normal, px).xyz);
-    vec3 albedo = FETCH(t_albedo, px).rgb;
+    vec4 normal = FETCH(t_normal, px);
+    vec4 albedo = FETCH(t_albedo, px);
     vec3 to_light = pc.light_pos.xyz - pos.xyz * pc.light_pos.w;
     float dist = length(to_light);
     vec3 l = to_light / max(dist, 1e-30);
-    float ndotl = dot(n, l);
-    if (ndotl <= 0.0) {
+    // Facing by the face normal: what the shadow volumes and the reference decide by.
+    if (dot(normalize(normal.xyz), l) <= 0.0) {
         discard;
     }
+    // Shading by the smooth normal, shifted by the terminator bound: 0 on every face that looks
+    // away from the light, so it reaches 0 before the volumes' polygonal terminator (no step
+    // along the triangle edges there; see geom/shading.rs).
+    vec3 n = pc.params.w > 1.5 ? normalize(normal.xyz) : unpack_normal(normal.w);
+    float bound = pc.params.w > 0.5 ? 0.0 : albedo.a;
+    float diffuse = terminator(dot(n, l), bound);
     float atten = 1.0;
     if (pc.params.x > 0.0) {
         float r = clamp(dist / pc.params.x, 0.0, 1.0);
@@ -68,11 +102,11 @@ void main() {
     }
     vec3 v = normalize(-pos.xyz);
     vec3 h = normalize(l + v);
-    float spec = pow(max(dot(n, h), 0.0), 48.0) * 0.3;
+    float spec = pow(max(dot(n, h), 0.0), 48.0) * 0.3 * clamp(diffuse * 8.0, 0.0, 1.0);
     vec3 light = pc.color.rgb * atten;
 #ifdef TRANSMIT
     vec3 t = texelFetch(sampler2D(t_transmit, s_nearest), px, 0).rgb;
     light *= pc.params.y > 0.5 ? exp(t) : t;
 #endif
-    out_color = vec4((albedo * ndotl + vec3(spec)) * light, 0.0);
+    out_color = vec4((albedo.rgb * diffuse + vec3(spec)) * light, 0.0);
 }

@@ -28,6 +28,18 @@ layout(location = 1) out vec4 out_albedo;
 layout(location = 2) out vec4 out_normal;
 layout(location = 3) out vec4 out_position;
 
+// The smooth shading normal in one float (normal.w): octahedral, 12 bits a component, an
+// integer below 2^24 (exact in f32; illuminate.frag unpacks it).
+float pack_normal(vec3 n) {
+    n /= abs(n.x) + abs(n.y) + abs(n.z);
+    vec2 e = n.xy;
+    if (n.z < 0.0) {
+        e = (vec2(1.0) - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
+    }
+    vec2 q = floor(clamp(e * 0.5 + 0.5, 0.0, 1.0) * 4095.0 + 0.5);
+    return q.x * 4096.0 + q.y;
+}
+
 void main() {
 #ifdef MSAA
     vec4 near = pc.ray_x * gl_FragCoord.x + pc.ray_y * gl_FragCoord.y + pc.ray_0;
@@ -61,7 +73,9 @@ void main() {
     }
     gl_FragDepth = depth;
     out_accum = vec4(v_color * pc.ambient.rgb, 1.0);
-    out_albedo = vec4(v_color, 1.0);
-    out_normal = vec4((hit - v_center) / v_radius, 0.0);
+    // The exact normal shades too: bound 0.
+    out_albedo = vec4(v_color, 0.0);
+    vec3 n = (hit - v_center) / v_radius;
+    out_normal = vec4(n, pack_normal(n));
     out_position = vec4(hit, 1.0);
 }

@@ -59,6 +59,29 @@ struct FrameArgs {
     /// per sample. Stencil shadow-volume methods only.
     #[arg(long, default_value_t = 1)]
     msaa: u32,
+    /// smooth (smooth normals, the light reaching zero before the shadow volumes' polygonal
+    /// terminator), smooth-naive (smooth normals as they are: a step along the terminator's
+    /// edges) or flat. Shadows are the same in every mode.
+    #[arg(long, value_enum, default_value = "smooth")]
+    shading: ShadingArg,
+}
+
+/// `--shading`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum ShadingArg {
+    Smooth,
+    SmoothNaive,
+    Flat,
+}
+
+impl ShadingArg {
+    fn shading(self) -> umbrage::render::Shading {
+        match self {
+            ShadingArg::Smooth => umbrage::render::Shading::Smooth,
+            ShadingArg::SmoothNaive => umbrage::render::Shading::SmoothNaive,
+            ShadingArg::Flat => umbrage::render::Shading::Flat,
+        }
+    }
 }
 
 /// `--method`: every technique `render` and `bench` accept.
@@ -255,6 +278,7 @@ impl Default for FrameArgs {
             self_shadow: false,
             jitter: false,
             msaa: 1,
+            shading: ShadingArg::Smooth,
         }
     }
 }
@@ -326,6 +350,7 @@ impl FrameArgs {
             self_shadow: self.self_shadow,
             jitter: self.jitter,
             samples: self.msaa,
+            shading: self.shading.shading(),
             ..Default::default()
         })
     }

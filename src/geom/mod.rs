@@ -11,6 +11,7 @@ pub mod light;
 pub use light::{Camera, Light, LightKind};
 pub mod planes;
 pub mod predicates;
+pub mod shading;
 pub mod silhouette;
 pub mod sphere;
 pub use sphere::Sphere;

@@ -19,6 +19,33 @@ named_enum!(
     }
 );
 
+named_enum!(
+    /// How lit surfaces are shaded (shadows are the same in every mode; see
+    /// [`crate::geom::shading`]).
+    Shading, "shading", {
+        /// Smooth normals, shifted by their terminator bound so the light reaches zero before
+        /// the shadow volumes' polygonal terminator.
+        #[default]
+        Smooth => "smooth",
+        /// Smooth normals as they are: the light steps to zero along the terminator's
+        /// triangle edges (shown for comparison).
+        SmoothNaive => "smooth-naive",
+        /// One normal per triangle.
+        Flat => "flat",
+    }
+);
+
+impl Shading {
+    /// Its code in the lighting pass's push block (`LightPush::params.w`).
+    pub(crate) fn code(self) -> f32 {
+        match self {
+            Shading::Smooth => 0.0,
+            Shading::SmoothNaive => 1.0,
+            Shading::Flat => 2.0,
+        }
+    }
+}
+
 /// How transparent casters' light-intensity map is stored and accumulated (Kim et al. 2008).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TransmitMode {
@@ -170,6 +197,8 @@ pub struct FrameSettings {
     pub index_format: IndexFormat,
     /// Shaded, volumes overlay, or the stencil heat map.
     pub view: View,
+    /// Smooth (default), naive smooth or flat shading.
+    pub shading: Shading,
     /// Log-space or multiplicative light-intensity map (its format is fixed at creation).
     pub transmit_log: bool,
     /// Read back per-light counts, positions and normals (dumps, tests).
@@ -201,6 +230,8 @@ pub struct RenderOptions {
     pub index_format: IndexFormat,
     /// What the final image shows.
     pub view: View,
+    /// How lit surfaces are shaded.
+    pub shading: Shading,
     /// Stencil or float counting.
     pub counter: Counter,
     /// Transparent casters' light-intensity map: format fixed at creation, log/mul per frame.
@@ -246,6 +277,7 @@ impl RenderOptions {
             counter: self.counter,
             index_format: self.index_format,
             view: self.view,
+            shading: self.shading,
             transmit_log: self.transmit.log,
             capture: self.capture,
             jitter: self.jitter,
@@ -264,6 +296,7 @@ impl Default for RenderOptions {
             depth_mode: DepthMode::Infinite,
             index_format: IndexFormat::Auto,
             view: View::Shaded,
+            shading: Shading::Smooth,
             counter: Counter::Stencil,
             transmit: TransmitMode { fp32: false, log: true },
             capture: false,

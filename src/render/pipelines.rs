@@ -3,7 +3,7 @@
 //! destroys exactly what it created.
 
 use super::push::{ForwardPush, GBufferPush, LightPush, SpherePush};
-use super::scene_gpu::{INSTANCE_ATTRIBUTES, INSTANCE_STRIDE, VERTEX_ATTRIBUTES, VERTEX_STRIDE};
+use super::scene_gpu::{GBUFFER_ATTRIBUTES, INSTANCE_ATTRIBUTES, INSTANCE_STRIDE, SCENE_VERTEX_STRIDE, VERTEX_ATTRIBUTES, VERTEX_STRIDE};
 use super::targets::*;
 use crate::error::Result;
 use crate::gpu::descriptors::{pipeline_layout, Binding, DescriptorSet};
@@ -66,7 +66,7 @@ pub(crate) struct FramePipelines {
 /// A scene-geometry pipeline description (vertex + instance bindings).
 pub(crate) fn scene_pipeline<'a>(vertex: &'a [u8], layout: vk::PipelineLayout, depth_format: vk::Format) -> PipelineDesc<'a> {
     let mut p = PipelineDesc::new(vertex, layout, depth_format);
-    p.vertex_stride = VERTEX_STRIDE;
+    p.vertex_stride = SCENE_VERTEX_STRIDE;
     p.attributes = &VERTEX_ATTRIBUTES;
     p.instance_stride = INSTANCE_STRIDE;
     p.instance_attributes = &INSTANCE_ATTRIBUTES;
@@ -120,7 +120,7 @@ impl FramePipelines {
         let mut g = scene_pipeline(shaders::GBUFFER_VERT, layouts.gbuffer, df);
         g.fragment = Some(shaders::GBUFFER_FRAG);
         g.samples = samples;
-        g.attributes = &VERTEX_ATTRIBUTES[..3];
+        g.attributes = &GBUFFER_ATTRIBUTES;
         g.color_formats = &gbuffer_formats;
         g.depth_test = true;
         g.depth_write = true;

@@ -61,11 +61,18 @@ pub struct LightPush {
     /// xyz = travel direction, w = cos(half cone); w = -2 when not a spot.
     pub spot: [f32; 4],
     /// x = radius (0: unbounded), y = 1 when the light-intensity map is in log space,
-    /// z = 1 for a forward light pass (0: the ambient "over" pass).
+    /// z = 1 for a forward light pass (0: the ambient "over" pass), w = the shading mode
+    /// ([`Shading`](super::Shading): 0 smooth, 1 naive smooth, 2 flat).
     pub params: [f32; 4],
 }
 
 impl LightPush {
+    /// This block with shading mode `shading` (`params.w`).
+    pub fn with_shading(mut self, shading: super::Shading) -> LightPush {
+        self.params[3] = shading.code();
+        self
+    }
+
     /// A light's block for a frame whose eye is `eye`.
     pub fn new(l: &Light, eye: DVec3, log: bool) -> LightPush {
         let pos = match l.kind {

@@ -1,10 +1,11 @@
-//! The scene's own geometry on the GPU (what the G-buffer and forward passes draw): flat-shaded
-//! triangles baked once relative to an anchor (the eye at creation) in f64, one contiguous
+//! The scene's own geometry on the GPU (what the G-buffer and forward passes draw): flat
+//! triangles with smooth shading normals baked once relative to an anchor (the eye at creation) in f64, one contiguous
 //! range per mesh, and per frame a small instance buffer placing each mesh relative to the
 //! current eye, so meshes and the camera move without re-creating anything.
 
 use super::upload;
 use crate::error::{Error, Result};
+use crate::geom::shading;
 use crate::geom::topology::Topology;
 use crate::gpu::{Buffer, Context};
 use crate::scene::Scene;
@@ -12,8 +13,18 @@ use ash::vk;
 use glam::{DMat3, DMat4, DVec3};
 use gpu_allocator::MemoryLocation;
 
-/// Vertex layout: position (anchor-relative), face normal, colour, opacity.
+/// The analytic spheres' cube vertices ([`VERTEX_ATTRIBUTES`]): 10 floats.
 pub(crate) const VERTEX_STRIDE: u32 = 40;
+/// Scene vertex layout: position (anchor-relative), face normal, colour, opacity, then the
+/// smooth shading normal and its terminator bound ([`crate::geom::shading`]): 14 floats.
+pub(crate) const SCENE_VERTEX_STRIDE: u32 = 56;
+/// The scene vertices' shading attributes (binding 0, after [`VERTEX_ATTRIBUTES`]): the smooth
+/// normal (location 10) and the bound (location 11).
+pub(crate) const SHADING_ATTRIBUTES: [(u32, vk::Format, u32); 2] =
+    [(10, vk::Format::R32G32B32_SFLOAT, 40), (11, vk::Format::R32_SFLOAT, 52)];
+/// The G-buffer pass's vertex attributes: position, face normal, colour, smooth normal, bound.
+pub(crate) const GBUFFER_ATTRIBUTES: [(u32, vk::Format, u32); 5] =
+    [VERTEX_ATTRIBUTES[0], VERTEX_ATTRIBUTES[1], VERTEX_ATTRIBUTES[2], SHADING_ATTRIBUTES[0], SHADING_ATTRIBUTES[1]];
 /// Per-mesh instance data: 3 rows of the position map, 3 rows of the normal map.
 pub(crate) const INSTANCE_BYTES: u64 = 96;
 /// The instance binding's stride: 0, every vertex of a draw reads the one record bound at
@@ -21,7 +32,7 @@ pub(crate) const INSTANCE_BYTES: u64 = 96;
 /// sizes instance-rate reads by the vertex count, which reported false hazards on the
 /// buffers next to the instance buffer).
 pub(crate) const INSTANCE_STRIDE: u32 = 0;
-/// The vertex attributes (binding 0) of every scene pipeline.
+/// The first four vertex attributes (binding 0) of every scene pipeline (and the spheres').
 pub(crate) const VERTEX_ATTRIBUTES: [(u32, vk::Format, u32); 4] = [
     (0, vk::Format::R32G32B32_SFLOAT, 0),
     (1, vk::Format::R32G32B32_SFLOAT, 12),
@@ -74,7 +85,7 @@ pub(crate) struct SceneGeometry {
 impl SceneGeometry {
     pub fn new(ctx: &Context, scene: &Scene, slots: usize) -> Result<SceneGeometry> {
         let eye = scene.camera.eye.as_dvec3();
-        let mut per_side: [Vec<(u32, Vec<[f32; 10]>)>; 3] = [Vec::new(), Vec::new(), Vec::new()];
+        let mut per_side: [Vec<(u32, Vec<[f32; 14]>)>; 3] = [Vec::new(), Vec::new(), Vec::new()];
         for (mi, m) in scene.meshes.iter().enumerate() {
             let topo = Topology::build(&m.mesh);
             // A camera inside a closed mesh sees its inside: draw that one two-sided too.
@@ -90,22 +101,26 @@ impl SceneGeometry {
                 1
             };
             let xf = m.transform.as_dmat4();
+            let world: Vec<[DVec3; 3]> =
+                (0..m.mesh.triangles.len()).map(|t| m.mesh.triangle(t).map(|v| xf.transform_point3(v.as_dvec3()))).collect();
+            let smooth = shading::corner_normals(&world, &topo.mesh.triangles, shading::CREASE_DEG);
             let mut verts = Vec::with_capacity(m.mesh.triangles.len() * 3);
-            for t in 0..m.mesh.triangles.len() {
-                let p = m.mesh.triangle(t).map(|v| xf.transform_point3(v.as_dvec3()));
+            for (p, corners) in world.iter().zip(&smooth) {
                 let n = (p[1] - p[0]).cross(p[2] - p[0]);
                 if !(n.length_squared() > 0.0) {
                     continue; // zero-area: nothing to rasterise, and no normal to shade with
                 }
                 let n = n.normalize().as_vec3();
-                for v in p {
-                    let r = (v - eye).as_vec3();
-                    verts.push([r.x, r.y, r.z, n.x, n.y, n.z, m.color.x, m.color.y, m.color.z, m.opacity]);
+                for (v, c) in p.iter().zip(corners) {
+                    let r = (*v - eye).as_vec3();
+                    let s = c.normal.as_vec3();
+                    let (x, y, z) = (m.color.x, m.color.y, m.color.z);
+                    verts.push([r.x, r.y, r.z, n.x, n.y, n.z, x, y, z, m.opacity, s.x, s.y, s.z, c.bound as f32]);
                 }
             }
             per_side[side].push((mi as u32, verts));
         }
-        let mut all: Vec<[f32; 10]> = Vec::new();
+        let mut all: Vec<[f32; 14]> = Vec::new();
         let mut ranges = Vec::new();
         for (side, list) in per_side.into_iter().enumerate() {
             for (mesh, verts) in list {
@@ -119,7 +134,7 @@ impl SceneGeometry {
                 return Err(Error::Other(format!("scene '{}' has no triangle or sphere to draw", scene.name)));
             }
             // Spheres only: a buffer to bind (never drawn from; no mesh ranges).
-            all.push([0.0; 10]);
+            all.push([0.0; 14]);
         }
         let vertices = upload(ctx, "scene", bytemuck::cast_slice(&all), vk::BufferUsageFlags::VERTEX_BUFFER)?;
         let baked = scene.meshes.iter().map(|m| m.transform.as_dmat4()).collect();

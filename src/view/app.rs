@@ -8,7 +8,7 @@ use super::ViewArgs;
 use crate::error::{Error, Result};
 use crate::gpu::context::ValidationLog;
 use crate::gpu::{Buffer, Context};
-use crate::render::{Counter, FrameOutput, FrameSettings, FrameTicket, RenderOptions, Renderer, Technique, View};
+use crate::render::{Counter, FrameOutput, FrameSettings, FrameTicket, RenderOptions, Renderer, Shading, Technique, View};
 use crate::scene::motion::Motion;
 use crate::scene::Scene;
 use crate::shadow::Method;
@@ -411,6 +411,14 @@ impl Live {
                         View::Shaded => View::Volumes,
                         View::Volumes => View::Stencil,
                         View::Stencil => View::Shaded,
+                    };
+                }
+                "s" => {
+                    let s = &mut self.renderer.settings;
+                    s.shading = match s.shading {
+                        Shading::Smooth => Shading::SmoothNaive,
+                        Shading::SmoothNaive => Shading::Flat,
+                        Shading::Flat => Shading::Smooth,
                     };
                 }
                 "p" => self.shot_requested = true,

@@ -3,13 +3,12 @@
 //! (G-buffer -> per light determination + illumination -> final pass) into one command buffer
 //! per ring slot, with frames in flight.
 
-use super::counters::CounterPools;
 use super::frame_output::{parse, CaptureView, FrameOutput};
 use super::guard::{Destroy, Guard, Owned};
 use super::options::*;
 use super::passes::selfshadow::SelfShadow;
 use super::passes::shadowmap::ShadowMapper;
-use super::passes::{self, debug, determine, gbuffer, illuminate, intensity, samples, tonemap, transparent, Rec};
+use super::passes::{debug, Rec};
 use super::pipelines::FramePipelines;
 use super::push::LightPush;
 use super::raytrace::RayTracer;
@@ -27,6 +26,7 @@ mod memory;
 mod motion;
 pub use memory::{largest_device_heap, MemoryEstimate};
 mod present;
+mod record;
 mod stats;
 mod techniques;
 
@@ -316,7 +316,14 @@ impl Renderer {
         let nlights = self.own.parts.scene.lights.len();
         let texel = self.own.parts.has_transparent.then_some(if self.own.parts.config.transmit_fp32 { 16 } else { 8 });
         let layout = Layout::new((w * h) as u64, capture, nlights, float_counts, texel, self.own.parts.config.samples);
-        let lights: Vec<LightPush> = self.own.parts.scene.lights.iter().map(|l| LightPush::new(l, eye, settings.transmit_log)).collect();
+        let lights: Vec<LightPush> = self
+            .own
+            .parts
+            .scene
+            .lights
+            .iter()
+            .map(|l| LightPush::new(l, eye, settings.transmit_log).with_shading(settings.shading))
+            .collect();
 
         // 2. Record the paper's frame.
         let readback = self.own.parts.slots[slot].readback.ensure(&self.own.ctx, slot, layout.total)?;
@@ -347,7 +354,9 @@ impl Renderer {
         let full = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: self.own.parts.targets.extent };
         let viewport = vk::Viewport { x: 0.0, y: 0.0, width: w as f32, height: h as f32, min_depth: 0.0, max_depth: 1.0 };
         let rec = Rec { ctx: &self.own.ctx, cb, full, viewport, timer: &s.timer, readback };
-        let mut spans = self.record_frame(&rec, &frame, &layout, (instances, spheres), vp_rel, &lights, float_counts, counters)?;
+        let input =
+            record::FrameInputs { frame: &frame, layout: &layout, instances, spheres, vp_rel, lights: &lights, float_counts, counters };
+        let mut spans = self.record_frame(&rec, &input)?;
         spans.accel = accel;
         // SAFETY: recording finished; the submission signals the slot's fence.
         unsafe {
@@ -377,101 +386,6 @@ impl Renderer {
             settings,
         });
         Ok(FrameTicket { slot, serial })
-    }
-
-    /// The frame as McGuire et al. lay it out (section 8), one pass function each.
-    #[allow(clippy::too_many_arguments)]
-    fn record_frame(
-        &self,
-        rec: &Rec,
-        frame: &PreparedFrame,
-        layout: &Layout,
-        (instances, spheres): (vk::Buffer, Option<(vk::Buffer, u32)>),
-        vp_rel: Mat4,
-        lights: &[LightPush],
-        float_counts: bool,
-        counters: Option<&CounterPools>,
-    ) -> Result<FrameSpans> {
-        let (t, p, pass) = (&self.own.parts.targets, &self.own.parts.pipes, &self.own.parts.pass);
-        let stamp = |stage| rec.timer.stamp(rec.ctx, rec.cb, stage);
-        let all = vk::PipelineStageFlags2::ALL_COMMANDS;
-        let mut spans = FrameSpans::default();
-        spans.frame.begin = stamp(vk::PipelineStageFlags2::TOP_OF_PIPE);
-        spans.depth.begin = spans.frame.begin;
-        // SAFETY: every pass records into `rec.cb` (recording, outside rendering instances
-        // between passes) with this renderer's objects, alive until the slot retires; the
-        // layouts each pass expects are those the previous pass leaves.
-        unsafe {
-            pass.cmd_upload(rec.cb, frame)?;
-            gbuffer::record(rec, t, p, &self.own.parts.geo, instances, vp_rel, self.own.parts.scene.ambient, spheres);
-            spans.depth.end = stamp(all);
-            let into = match (&self.own.parts.shadow_mapper, self.settings.counter) {
-                (Some(_), _) => determine::CountInto::External,
-                _ if self.settings.technique == Technique::RayQuery => determine::CountInto::Written,
-                (None, Counter::Float) => determine::CountInto::Float,
-                (None, Counter::Stencil) => determine::CountInto::Stencil,
-            };
-            for (li, light) in self.own.parts.scene.lights.iter().enumerate() {
-                let begin = stamp(all);
-                if let Some(c) = counters {
-                    c.statistics(rec.ctx, rec.cb, li as u32, true);
-                }
-                if let Some((sm, _)) = &self.own.parts.shadow_mapper {
-                    determine::begin_float(rec, t);
-                    let maps = sm.record_maps(rec.ctx, rec.cb, light, self.own.parts.scene.camera.eye.as_dvec3());
-                    spans.shadow_map.push(passes::timing_span(begin, stamp(all)));
-                    sm.record_lookup(rec.ctx, rec.cb, t, &maps, lights[li].light_pos, frame.lights[li].scissor);
-                }
-                if let (Some(rt), Technique::RayQuery) = (&self.own.parts.ray_tracer, self.settings.technique) {
-                    rt.cmd_determine(rec, t, frame.slot(), lights[li].light_pos, frame.lights[li].scissor);
-                }
-                determine::record(rec, pass, frame, li, t, into)?;
-                determine::finish(rec, t, p, into, layout.counts.get(li).copied())?;
-                if let Some(c) = counters {
-                    c.statistics(rec.ctx, rec.cb, li as u32, false);
-                }
-                spans.shadow.push(passes::timing_span(begin, stamp(all)));
-                if let Some(c) = counters {
-                    determine::record_count(rec, pass, frame, li, t, c)?;
-                }
-                if self.own.parts.has_transparent {
-                    intensity::record(rec, pass, frame, li, t, self.settings.transmit_log, layout.transmit.get(li).copied())?;
-                }
-                let begin = stamp(all);
-                illuminate::record(rec, pass, frame, li, t, p, float_counts, self.own.parts.has_transparent, &lights[li])?;
-                spans.illuminate.push(passes::timing_span(begin, stamp(all)));
-            }
-            if self.own.parts.geo.of(Sidedness::Transparent).next().is_some() {
-                let forward = if self.own.parts.self_shadow.is_some() { &[][..] } else { lights };
-                transparent::record(rec, t, p, &self.own.parts.geo, instances, vp_rel, self.own.parts.scene.ambient, forward);
-                if let Some(ss) = &self.own.parts.self_shadow {
-                    ss.record(rec, t, p, pass, frame, &self.own.parts.geo, instances, vp_rel, lights, self.settings.transmit_log)?;
-                }
-            }
-            if self.settings.view == View::Volumes {
-                debug::record_volumes(rec, pass, frame, t)?;
-            }
-            tonemap::record(rec, t, p);
-        }
-        spans.frame.end = stamp(all);
-        rec.copy_out(&t.output, vk::ImageAspectFlags::COLOR, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, layout.color);
-        match (layout.positions, layout.normals) {
-            (Some(pos), Some(nrm)) if t.samples > 1 => {
-                // SAFETY: recording outside a rendering instance; the G-buffer is in shader-read
-                // layout since its pass.
-                unsafe {
-                    samples::record(rec, t, p, samples::Source::Depth, pos)?;
-                    samples::record(rec, t, p, samples::Source::Normal, nrm)?;
-                }
-            }
-            (Some(pos), Some(nrm)) => {
-                rec.copy_out(&t.position, vk::ImageAspectFlags::COLOR, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL, pos);
-                rec.copy_out(&t.normal, vk::ImageAspectFlags::COLOR, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL, nrm);
-            }
-            _ => {}
-        }
-        tonemap::host_barrier(rec);
-        Ok(spans)
     }
 
     /// Waits for a submitted frame and reads it back.

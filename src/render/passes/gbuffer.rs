@@ -4,7 +4,7 @@
 //!    opaque mesh two-sided. Analytic spheres are ray-cast in their bounding cubes (exact
 //!    depth, normal and position).
 
-use super::{att, Rec, DS_CLEAR, ZERO};
+use super::{att, Rec, DS_CLEAR, SKY, ZERO};
 use crate::render::pipelines::FramePipelines;
 use crate::render::push::{GBufferPush, SpherePush};
 use crate::render::scene_gpu::{SceneGeometry, Sidedness};
@@ -30,7 +30,10 @@ pub(crate) unsafe fn record(
         rec.transition(img, vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
     }
     rec.transition(&t.depth, vk::ImageLayout::UNDEFINED, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
-    let colors: Vec<_> = t.gbuffer().iter().map(|i| att(i, vk::AttachmentLoadOp::CLEAR, ZERO)).collect();
+    // The accumulation starts at the sky colour (what the background shows); the G-buffer at
+    // zero (position w = 0: nothing drawn).
+    let clear = |i: usize| if i == 0 { SKY } else { ZERO };
+    let colors: Vec<_> = t.gbuffer().iter().enumerate().map(|(i, img)| att(img, vk::AttachmentLoadOp::CLEAR, clear(i))).collect();
     let depth = att(&t.depth, vk::AttachmentLoadOp::CLEAR, DS_CLEAR);
     let d = &rec.ctx.device;
     let cb = rec.cb;

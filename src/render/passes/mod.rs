@@ -31,6 +31,9 @@ pub(crate) struct Rec<'a> {
     pub readback: vk::Buffer,
 }
 
+/// The background: a muted sky blue in the linear accumulation target (about sRGB 145, 157,
+/// 176 after the tone map).
+pub(crate) const SKY: vk::ClearValue = vk::ClearValue { color: vk::ClearColorValue { float32: [0.30, 0.38, 0.52, 0.0] } };
 pub(crate) const ZERO: vk::ClearValue = vk::ClearValue { color: vk::ClearColorValue { float32: [0.0; 4] } };
 pub(crate) const DS_CLEAR: vk::ClearValue = vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } };
 pub(crate) const FRAG_TESTS: vk::PipelineStageFlags2 = vk::PipelineStageFlags2::from_raw(
