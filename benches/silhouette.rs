@@ -17,7 +17,11 @@ use glam::Vec4;
 use std::hint::black_box;
 use umbrage::geom::silhouette::{possible_silhouette_packed_into, EdgeScan, FacePlanes, SilhouetteEdge};
 use umbrage::geom::topology::Topology;
-use umbrage::shadow::testmesh::{shuffled, uv_sphere};
+#[path = "../src/geom/testmesh.rs"]
+#[allow(dead_code)]
+mod testmesh;
+use testmesh::{shuffled, uv_sphere};
+use umbrage::geom::Mesh;
 
 fn bytes_of(planes: &FacePlanes, scan: &EdgeScan) -> u64 {
     (planes.bytes() + scan.bytes()) as u64

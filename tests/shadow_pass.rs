@@ -3,9 +3,12 @@
 //! released only once every frame in flight has retired.
 
 mod common;
+#[path = "../src/geom/testmesh.rs"]
+#[allow(dead_code)]
+mod testmesh;
 
 use glam::{DMat4, DVec3, Vec3};
-use umbrage::geom::{Camera, Light, LightKind};
+use umbrage::geom::{Camera, Light, LightKind, Mesh};
 use umbrage::pass::{ShadowPass, ShadowPassDesc, ShadowView};
 use umbrage::scene::shapes;
 
@@ -104,7 +107,7 @@ fn big_casters_are_split_into_16_bit_chunks() {
     let Some(ctx) = common::context() else { return };
     {
         let mut p = pass(&ctx, &desc(&ctx)).unwrap();
-        let sphere = umbrage::shadow::testmesh::uv_sphere(1.0, 400, 200);
+        let sphere = testmesh::uv_sphere(1.0, 400, 200);
         assert!(sphere.positions.len() > 65536);
         p.add_caster("sphere", &sphere, DMat4::IDENTITY).unwrap();
         assert!(p.casters()[0].chunks.len() >= 3, "{} chunks", p.casters()[0].chunks.len());

@@ -22,6 +22,7 @@
 //! repetitions. u8 indices need `VK_EXT_index_type_uint8`: without it the limit is skipped
 //! with the reason.
 
+use super::workloads::{big_triangles, clipped_triangles, limit_units, setup_triangles, sliver_fan, small_triangles};
 use crate::error::{Error, Result};
 use crate::gpu::descriptors::pipeline_layout;
 use crate::gpu::pipeline::{self, Blend, PipelineDesc};
@@ -314,13 +315,7 @@ fn measure_with(ctx: &Context, cfg: &LimitsConfig, made: &mut Made) -> Result<Li
 
     // Setup: one tiny triangle per 2x2-pixel block, inside the corner of a pixel, away from
     // its sample centre (x+0.6 .. x+0.9).
-    let mut setup: Vec<[f32; 4]> = Vec::new();
-    for y in (0..h).step_by(2) {
-        for x in (0..w).step_by(2) {
-            let (x0, y0) = (-1.0 + (x as f32 + 0.6) * pw, -1.0 + (y as f32 + 0.6) * ph);
-            setup.extend([[x0, y0, 0.5, 1.0], [x0 + 0.3 * pw, y0, 0.5, 1.0], [x0, y0 + 0.3 * ph, 0.5, 1.0]]);
-        }
-    }
+    let setup = setup_triangles(w, h);
     let setup_tris = (setup.len() / 3) as f64;
     let setup_vb = upload("limits-setup", bytes(&setup), vb)?;
     let setup_rate = lab.peak("setup_tri_mtri_s", draw(stencil, setup_vb, setup.len()), setup_tris, 1e6, false)?;
@@ -330,57 +325,23 @@ fn measure_with(ctx: &Context, cfg: &LimitsConfig, made: &mut Made) -> Result<Li
     // infinity, cut by the near plane and the right clip plane: short on screen (one tile,
     // like a clipped side's corner), no sample centre in it.
     let clip_n = 65_536usize;
-    let mut clip: Vec<[f32; 4]> = Vec::with_capacity(3 * clip_n);
-    let x = 1.0 - 4.0 * pw;
-    for i in 0..clip_n {
-        let row = (i as u32 * 7) % h;
-        let (y1, y2) = (-1.0 + (row as f32 + 0.6) * ph, -1.0 + (row as f32 + 0.9) * ph);
-        clip.extend([[x, y1, -0.5, 1.0], [x, y2, 0.5, 1.0], [1.0, 0.0, 0.0, 0.0]]);
-    }
+    let clip = clipped_triangles(w, h, clip_n);
     let clip_vb = upload("limits-clip", bytes(&clip), vb)?;
     let clip_rate = lab.peak("clip_tri_mtri_s", draw(stencil, clip_vb, clip.len()), clip_n as f64, 1e6, false)?;
 
     // Small triangles: a grid of 2x2-pixel cells over the target, each two 2-pixel triangles.
-    let mut small: Vec<[f32; 4]> = Vec::new();
-    for y in (0..h.saturating_sub(1)).step_by(2) {
-        for x in (0..w.saturating_sub(1)).step_by(2) {
-            let (x0, y0) = (-1.0 + x as f32 * pw, -1.0 + y as f32 * ph);
-            let (a, b, c, d) = (
-                [x0, y0, 0.5, 1.0],
-                [x0 + 2.0 * pw, y0, 0.5, 1.0],
-                [x0 + 2.0 * pw, y0 + 2.0 * ph, 0.5, 1.0],
-                [x0, y0 + 2.0 * ph, 0.5, 1.0],
-            );
-            small.extend([a, b, c, a, c, d]);
-        }
-    }
+    let small = small_triangles(w, h);
     let small_vb = upload("limits-small", bytes(&small), vb)?;
     let small_rate = lab.peak("small_tri_mtri_s", draw(stencil, small_vb, small.len()), (small.len() / 3) as f64, 1e6, false)?;
 
     // Big triangles: each covers the target (a triangle twice its size, clipped).
-    let big: Vec<[f32; 4]> = (0..4)
-        .flat_map(|i| {
-            let (a, b, c) = ([-1.0, -1.0, 0.5, 1.0], [3.0, -1.0, 0.5, 1.0], [-1.0, 3.0, 0.5, 1.0]);
-            if i % 2 == 0 {
-                [a, b, c]
-            } else {
-                [a, c, b]
-            }
-        })
-        .collect();
+    let big = big_triangles();
     let big_vb = upload("limits-big", bytes(&big), vb)?;
     let big_rate = lab.peak("big_tri_mtri_s", draw(stencil, big_vb, big.len()), 4.0, 1e6, false)?;
 
     // Slivers: a fan of 1-pixel-wide triangles from the centre out past the edges.
     let slivers = 4096u32;
-    let mut sliver: Vec<[f32; 4]> = Vec::new();
-    for i in 0..slivers {
-        let a = std::f32::consts::TAU * i as f32 / slivers as f32;
-        let (s, c) = a.sin_cos();
-        let (ex, ey) = (1.5 * c, 1.5 * s);
-        let (qx, qy) = (-s * pw, c * ph); // one pixel across at the far end
-        sliver.extend([[0.0, 0.0, 0.5, 1.0], [ex, ey, 0.5, 1.0], [ex + qx, ey + qy, 0.5, 1.0]]);
-    }
+    let sliver = sliver_fan(slivers, (pw, ph));
     let sliver_vb = upload("limits-sliver", bytes(&sliver), vb)?;
     let sliver_rate = lab.peak("sliver_tri_mtri_s", draw(stencil, sliver_vb, sliver.len()), slivers as f64, 1e6, false)?;
 
@@ -393,24 +354,6 @@ fn measure_with(ctx: &Context, cfg: &LimitsConfig, made: &mut Made) -> Result<Li
     let draws = 1024u32;
     let draw_rate = lab.peak("draws_per_s", Workload { draws, ..draw(stencil, tiny_vb, 3) }, draws as f64, 1.0, true)?;
 
-    let mut units = BTreeMap::new();
-    for (k, u) in [
-        ("stencil_fill_gfrag_s", "Gfragments/s"),
-        ("color_fill_gfrag_s", "Gfragments/s"),
-        ("setup_tri_mtri_s", "Mtriangles/s"),
-        ("clip_tri_mtri_s", "Mtriangles/s"),
-        ("small_tri_mtri_s", "Mtriangles/s"),
-        ("big_tri_mtri_s", "Mtriangles/s"),
-        ("sliver_tri_mtri_s", "Mtriangles/s"),
-        ("draws_per_s", "draws/s"),
-        ("cpu_stream_gib_s", "GiB/s"),
-        ("index_u8_mtri_s", "Mtriangles/s"),
-        ("index_u16_mtri_s", "Mtriangles/s"),
-        ("index_u32_mtri_s", "Mtriangles/s"),
-        ("index_naive_mtri_s", "Mtriangles/s"),
-    ] {
-        units.insert(k.to_string(), u.to_string());
-    }
     Ok(Limits {
         stencil_fill_gfrag_s: stencil_fill,
         color_fill_gfrag_s: color_fill,
@@ -426,7 +369,7 @@ fn measure_with(ctx: &Context, cfg: &LimitsConfig, made: &mut Made) -> Result<Li
         index_u32_mtri_s: u32_rate,
         index_naive_mtri_s: naive_rate,
         target: [w, h],
-        units,
+        units: limit_units(),
         skipped,
         sweeps: lab.sweeps,
     })

@@ -19,5 +19,6 @@ pub mod report;
 pub mod scenes;
 pub mod suite;
 pub mod sweeps;
+mod workloads;
 
 pub use classic::{run, technique_label, BenchConfig, BenchReport, BenchRow};

@@ -145,38 +145,9 @@ pub fn render(
         )?);
         let img = image.as_ref().expect("just created");
         // Pipelines and geometry.
-        let mut recorded = Vec::new();
+        let mut recorded = Vec::with_capacity(draws.len());
         for d in draws {
-            let mut desc = PipelineDesc::new(shaders::SHADOW_VERT, layout, format);
-            desc.vertex_stride = 16;
-            desc.attributes = &[(0, vk::Format::R32G32B32A32_SFLOAT, 0)];
-            desc.depth_test = d.spec.depth_test;
-            desc.depth_write = d.spec.depth_write;
-            desc.depth_compare = d.spec.depth_compare;
-            desc.depth_clamp = d.spec.depth_clamp;
-            desc.depth_bounds = d.spec.depth_bounds.is_some();
-            desc.stencil = Some((d.spec.front, d.spec.back));
-            let p = pipeline::create(ctx, &desc)?;
-            pipelines.push(p);
-            let vb = Buffer::with_data(ctx, "conform-vertices", &bytes(&d.vertices), vk::BufferUsageFlags::VERTEX_BUFFER)?;
-            buffers.push(vb);
-            let vb_raw = buffers.last().expect("pushed").raw;
-            let index = match &d.indices {
-                Indices::None => None,
-                Indices::U8(i) => Some((bytes(i), vk::IndexType::UINT8_EXT, i.len())),
-                Indices::U16(i) => Some((bytes(i), vk::IndexType::UINT16, i.len())),
-                Indices::U32(i) => Some((bytes(i), vk::IndexType::UINT32, i.len())),
-            };
-            let ib = match index {
-                Some((data, ty, n)) => {
-                    buffers.push(Buffer::with_data(ctx, "conform-indices", &data, vk::BufferUsageFlags::INDEX_BUFFER)?);
-                    Some((buffers.last().expect("pushed").raw, ty, n as u32))
-                }
-                None => None,
-            };
-            // shadow.vert's block; light (0, 0, 0, 1): w = 0 vertices extrude away from the origin.
-            let push = crate::pass::push::VolumePush::new(d.mvp, glam::Vec4::W, [0.0; 4]);
-            recorded.push((p, vb_raw, ib, d.vertices.len() as u32, bytemuck::bytes_of(&push).to_vec(), d.spec.depth_bounds));
+            recorded.push(prepare_draw(ctx, layout, format, d, &mut pipelines, &mut buffers)?);
         }
         let n = (width * height) as u64;
         buffers.push(Buffer::new(ctx, "conform-depth-readback", n * 4, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?);
@@ -195,55 +166,11 @@ pub fn render(
             let viewport = vk::Viewport { x: 0.0, y: 0.0, width: width as f32, height: height as f32, min_depth: 0.0, max_depth: 1.0 };
             // SAFETY: `cb` is recording (one_shot); every handle used was created above on this
             // device and outlives the submission, which one_shot waits for.
-            unsafe {
-                let d = &ctx.device;
-                d.cmd_begin_rendering(cb, &info);
-                d.cmd_set_viewport(cb, 0, &[viewport]);
-                d.cmd_set_scissor(cb, 0, &[area]);
-                for (p, vb, ib, nv, push, bounds) in &recorded {
-                    d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, *p);
-                    d.cmd_push_constants(cb, layout, vk::ShaderStageFlags::VERTEX, 0, push);
-                    if let Some((lo, hi)) = bounds {
-                        d.cmd_set_depth_bounds(cb, *lo, *hi);
-                    }
-                    d.cmd_bind_vertex_buffers(cb, 0, &[*vb], &[0]);
-                    match ib {
-                        Some((ib, ty, count)) => {
-                            d.cmd_bind_index_buffer(cb, *ib, 0, *ty);
-                            d.cmd_draw_indexed(cb, *count, 1, 0, 0, 0);
-                        }
-                        None => d.cmd_draw(cb, *nv, 1, 0, 0),
-                    }
-                }
-                d.cmd_end_rendering(cb);
-            }
+            unsafe { record_draws(ctx, cb, layout, &info, viewport, area, &recorded) };
             transition(ctx, cb, img, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
-            let region = |aspect| vk::BufferImageCopy {
-                buffer_offset: 0,
-                buffer_row_length: 0,
-                buffer_image_height: 0,
-                image_subresource: vk::ImageSubresourceLayers { aspect_mask: aspect, mip_level: 0, base_array_layer: 0, layer_count: 1 },
-                image_offset: vk::Offset3D::default(),
-                image_extent: vk::Extent3D { width, height, depth: 1 },
-            };
             // SAFETY: recording; the image is in TRANSFER_SRC_OPTIMAL and the buffers are large
             // enough for one aspect each (4 bytes per depth texel, 1 per stencil texel).
-            unsafe {
-                ctx.device.cmd_copy_image_to_buffer(
-                    cb,
-                    img.raw,
-                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                    depth_buf,
-                    &[region(vk::ImageAspectFlags::DEPTH)],
-                );
-                ctx.device.cmd_copy_image_to_buffer(
-                    cb,
-                    img.raw,
-                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                    stencil_buf,
-                    &[region(vk::ImageAspectFlags::STENCIL)],
-                );
-            }
+            unsafe { copy_aspects(ctx, cb, img, (depth_buf, stencil_buf)) };
             memory_barrier(
                 ctx,
                 cb,
@@ -271,6 +198,128 @@ pub fn render(
         i.destroy(ctx);
     }
     result
+}
+
+/// One draw, ready to record: its pipeline, vertex and index buffers, push block and bounds.
+struct RecordedDraw {
+    pipeline: vk::Pipeline,
+    vertices: vk::Buffer,
+    indices: Option<(vk::Buffer, vk::IndexType, u32)>,
+    vertex_count: u32,
+    push: Vec<u8>,
+    depth_bounds: Option<(f32, f32)>,
+}
+
+/// Creates `d`'s pipeline and buffers, handing them to `pipelines` and `buffers` (which the
+/// caller destroys, whatever fails later).
+fn prepare_draw(
+    ctx: &Context,
+    layout: vk::PipelineLayout,
+    format: vk::Format,
+    d: &DrawCall,
+    pipelines: &mut Vec<vk::Pipeline>,
+    buffers: &mut Vec<Buffer>,
+) -> Result<RecordedDraw> {
+    let mut desc = PipelineDesc::new(shaders::SHADOW_VERT, layout, format);
+    desc.vertex_stride = 16;
+    desc.attributes = &[(0, vk::Format::R32G32B32A32_SFLOAT, 0)];
+    desc.depth_test = d.spec.depth_test;
+    desc.depth_write = d.spec.depth_write;
+    desc.depth_compare = d.spec.depth_compare;
+    desc.depth_clamp = d.spec.depth_clamp;
+    desc.depth_bounds = d.spec.depth_bounds.is_some();
+    desc.stencil = Some((d.spec.front, d.spec.back));
+    let pipeline = pipeline::create(ctx, &desc)?;
+    pipelines.push(pipeline);
+    let vb = Buffer::with_data(ctx, "conform-vertices", &bytes(&d.vertices), vk::BufferUsageFlags::VERTEX_BUFFER)?;
+    let vertices = vb.raw;
+    buffers.push(vb);
+    let index = match &d.indices {
+        Indices::None => None,
+        Indices::U8(i) => Some((bytes(i), vk::IndexType::UINT8_EXT, i.len())),
+        Indices::U16(i) => Some((bytes(i), vk::IndexType::UINT16, i.len())),
+        Indices::U32(i) => Some((bytes(i), vk::IndexType::UINT32, i.len())),
+    };
+    let indices = match index {
+        Some((data, ty, n)) => {
+            let ib = Buffer::with_data(ctx, "conform-indices", &data, vk::BufferUsageFlags::INDEX_BUFFER)?;
+            let raw = ib.raw;
+            buffers.push(ib);
+            Some((raw, ty, n as u32))
+        }
+        None => None,
+    };
+    // shadow.vert's block; light (0, 0, 0, 1): w = 0 vertices extrude away from the origin.
+    let push = crate::pass::push::VolumePush::new(d.mvp, glam::Vec4::W, [0.0; 4]);
+    Ok(RecordedDraw {
+        pipeline,
+        vertices,
+        indices,
+        vertex_count: d.vertices.len() as u32,
+        push: bytemuck::bytes_of(&push).to_vec(),
+        depth_bounds: d.spec.depth_bounds,
+    })
+}
+
+/// Records the rendering instance `info` with `draws`, in order.
+///
+/// # Safety
+/// `cb` is recording outside a rendering instance; `info`'s attachment is in its layout and
+/// every handle in `draws` belongs to `ctx`'s device and outlives the submission.
+unsafe fn record_draws(
+    ctx: &Context,
+    cb: vk::CommandBuffer,
+    layout: vk::PipelineLayout,
+    info: &vk::RenderingInfo,
+    viewport: vk::Viewport,
+    area: vk::Rect2D,
+    draws: &[RecordedDraw],
+) {
+    let d = &ctx.device;
+    // SAFETY: the caller's contract.
+    unsafe {
+        d.cmd_begin_rendering(cb, info);
+        d.cmd_set_viewport(cb, 0, &[viewport]);
+        d.cmd_set_scissor(cb, 0, &[area]);
+        for r in draws {
+            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, r.pipeline);
+            d.cmd_push_constants(cb, layout, vk::ShaderStageFlags::VERTEX, 0, &r.push);
+            if let Some((lo, hi)) = r.depth_bounds {
+                d.cmd_set_depth_bounds(cb, lo, hi);
+            }
+            d.cmd_bind_vertex_buffers(cb, 0, &[r.vertices], &[0]);
+            match r.indices {
+                Some((ib, ty, count)) => {
+                    d.cmd_bind_index_buffer(cb, ib, 0, ty);
+                    d.cmd_draw_indexed(cb, count, 1, 0, 0, 0);
+                }
+                None => d.cmd_draw(cb, r.vertex_count, 1, 0, 0),
+            }
+        }
+        d.cmd_end_rendering(cb);
+    }
+}
+
+/// Copies `img`'s depth and stencil aspects into `buffers` (depth, stencil).
+///
+/// # Safety
+/// `cb` is recording outside a rendering instance; `img` is in TRANSFER_SRC_OPTIMAL and the
+/// buffers hold 4 bytes (depth) and 1 byte (stencil) per texel.
+unsafe fn copy_aspects(ctx: &Context, cb: vk::CommandBuffer, img: &Image, (depth, stencil): (vk::Buffer, vk::Buffer)) {
+    let region = |aspect| vk::BufferImageCopy {
+        buffer_offset: 0,
+        buffer_row_length: 0,
+        buffer_image_height: 0,
+        image_subresource: vk::ImageSubresourceLayers { aspect_mask: aspect, mip_level: 0, base_array_layer: 0, layer_count: 1 },
+        image_offset: vk::Offset3D::default(),
+        image_extent: vk::Extent3D { width: img.extent.width, height: img.extent.height, depth: 1 },
+    };
+    let src = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
+    // SAFETY: the caller's contract.
+    unsafe {
+        ctx.device.cmd_copy_image_to_buffer(cb, img.raw, src, depth, &[region(vk::ImageAspectFlags::DEPTH)]);
+        ctx.device.cmd_copy_image_to_buffer(cb, img.raw, src, stencil, &[region(vk::ImageAspectFlags::STENCIL)]);
+    }
 }
 
 /// Orthographic pixel mapping: object (x, y) in pixels (row 0 at the top), z as given -> depth.

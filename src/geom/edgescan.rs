@@ -309,7 +309,7 @@ mod tests {
     use super::*;
     use crate::geom::silhouette::{possible_silhouette_packed, FacePlanes};
     use crate::geom::topology::Topology;
-    use crate::shadow::testmesh::{cube, shuffled, uv_sphere};
+    use crate::geom::testmesh::{cube, shuffled, uv_sphere};
     use glam::{Vec3, Vec4};
     use proptest::prelude::*;
 

@@ -15,4 +15,6 @@ pub mod shading;
 pub mod silhouette;
 pub mod sphere;
 pub use sphere::Sphere;
+#[cfg(test)]
+pub(crate) mod testmesh;
 pub mod topology;

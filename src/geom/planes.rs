@@ -428,7 +428,7 @@ fn block64_w(nx: &[f32], ny: &[f32], nz: &[f32], d: &[f32], l: Vec4, e: f32, dw:
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shadow::testmesh::uv_sphere;
+    use crate::geom::testmesh::uv_sphere;
     use proptest::prelude::*;
 
     impl FacePlanes {

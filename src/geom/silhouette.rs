@@ -164,7 +164,7 @@ mod tests {
     use super::*;
     use crate::geom::planes::exact_bit;
     use crate::geom::topology::Topology;
-    use crate::shadow::testmesh::{cube, uv_sphere};
+    use crate::geom::testmesh::{cube, uv_sphere};
     use glam::Vec3;
 
     #[test]

@@ -254,7 +254,14 @@ impl Topology {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shadow::testmesh::{cube, torus, uv_sphere};
+    use crate::geom::testmesh::{cube, signed_volume, torus, uv_sphere};
+
+    #[test]
+    fn test_meshes_are_outward() {
+        assert!((signed_volume(&cube(Vec3::ONE, 1.0)) - 8.0).abs() < 1e-9);
+        assert!(signed_volume(&uv_sphere(1.0, 32, 16)) > 3.5);
+        assert!(signed_volume(&torus(1.0, 0.25, 32, 16)) > 0.5);
+    }
 
     #[test]
     fn cube_closed() {

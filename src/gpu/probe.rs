@@ -30,65 +30,7 @@ pub(super) fn open_device(
     extra_extensions: &[&CStr],
     minimum: Minimum,
 ) -> Result<(vk::PhysicalDevice, ash::Device, u32, Features, DeviceInfo, vk::Format, vk::PhysicalDeviceLimits)> {
-    let min_version = match minimum {
-        Minimum::Vulkan13 => vk::API_VERSION_1_3,
-        Minimum::Vulkan10 => vk::API_VERSION_1_0,
-    };
-    let min_name = match minimum {
-        Minimum::Vulkan13 => "Vulkan 1.3",
-        Minimum::Vulkan10 => "Vulkan",
-    };
-    // SAFETY: enumeration on a valid instance.
-    let physicals = unsafe { instance.enumerate_physical_devices() }.map_err(vkerr("vkEnumeratePhysicalDevices"))?;
-    if physicals.is_empty() {
-        return Err(Error::NoDevice("the Vulkan loader found no physical device".into()));
-    }
-    let wanted = std::env::var("UMBRAGE_DEVICE").ok().map(|s| s.to_lowercase());
-    let mut candidates = Vec::new();
-    let mut too_old = Vec::new();
-    for &pd in &physicals {
-        // SAFETY: `pd` comes from the enumeration above.
-        let props = unsafe { instance.get_physical_device_properties(pd) };
-        let name = props.device_name_as_c_str().map(|c| c.to_string_lossy().into_owned()).unwrap_or_default();
-        if let Some(w) = &wanted {
-            if !name.to_lowercase().contains(w) {
-                continue;
-            }
-        }
-        if props.api_version < min_version {
-            too_old.push(format!("{name} (Vulkan {})", version_string(props.api_version)));
-            continue;
-        }
-        // SAFETY: as above.
-        let families = unsafe { instance.get_physical_device_queue_family_properties(pd) };
-        let Some(qf) = families.iter().position(|f| f.queue_flags.contains(vk::QueueFlags::GRAPHICS)) else {
-            continue;
-        };
-        let rank = match props.device_type {
-            vk::PhysicalDeviceType::DISCRETE_GPU => 0,
-            vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
-            vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
-            vk::PhysicalDeviceType::CPU => 3,
-            _ => 4,
-        };
-        candidates.push((rank, pd, qf as u32, props, name));
-    }
-    candidates.sort_by_key(|c| c.0);
-    let Some((_, physical, queue_family, props, name)) = candidates.into_iter().next() else {
-        if !too_old.is_empty() {
-            // A device is there, only too old: not a missing driver.
-            return Err(Error::Unsupported(format!(
-                "{} has no dynamicRendering and synchronization2 (Vulkan 1.3), which this needs; \
-                 `umbrage conform` and `umbrage info` run on any Vulkan 1.0 device, and \
-                 `scripts/drivers.sh install 25.0.7` gives a Vulkan 1.4 lavapipe",
-                too_old.join(", ")
-            )));
-        }
-        return Err(Error::NoDevice(match wanted {
-            Some(w) => format!("no {min_name} device with graphics whose name contains '{w}' (UMBRAGE_DEVICE)"),
-            None => format!("no {min_name} device with a graphics queue"),
-        }));
-    };
+    let Picked { physical, queue_family, props, name } = pick_physical(instance, minimum)?;
     let api = props.api_version;
     let v11 = api >= vk::API_VERSION_1_1;
     let v13 = api >= vk::API_VERSION_1_3;
@@ -110,35 +52,8 @@ pub(super) fn open_device(
         && [ash::khr::acceleration_structure::NAME, ash::khr::ray_query::NAME, ash::khr::deferred_host_operations::NAME]
             .into_iter()
             .all(has_ext);
-    let mut f_as = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default();
-    let mut f_rq = vk::PhysicalDeviceRayQueryFeaturesKHR::default();
-    let mut f12 = vk::PhysicalDeviceVulkan12Features::default();
-    let mut f_u8 = vk::PhysicalDeviceIndexTypeUint8FeaturesEXT::default();
-    let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
-    let mut f2 = vk::PhysicalDeviceFeatures2::default();
-    if v13 {
-        f2 = f2.push_next(&mut f13);
-    }
-    if has_u8_ext {
-        f2 = f2.push_next(&mut f_u8);
-    }
-    if has_rq_exts {
-        f2 = f2.push_next(&mut f_as).push_next(&mut f_rq).push_next(&mut f12);
-    }
-    // SAFETY: the chain points at locals alive for this call; a struct is chained only when
-    // the device's version or extensions define it.
-    unsafe {
-        match (v11, gpdp2) {
-            (true, _) => instance.get_physical_device_features2(physical, &mut f2),
-            (false, Some(g)) => g.get_physical_device_features2(physical, &mut f2),
-            (false, None) => f2.features = instance.get_physical_device_features(physical),
-        }
-    }
-    let base = f2.features;
-    let (dyn_rendering, sync2) = (f13.dynamic_rendering == vk::TRUE, f13.synchronization2 == vk::TRUE);
-    let u8_supported = has_u8_ext && f_u8.index_type_uint8 == vk::TRUE;
-    let ray_query =
-        has_rq_exts && f_as.acceleration_structure == vk::TRUE && f_rq.ray_query == vk::TRUE && f12.buffer_device_address == vk::TRUE;
+    let Probed { base, dyn_rendering, sync2, u8_supported, ray_query } =
+        probe_features(instance, gpdp2, physical, (v11, v13), has_u8_ext, has_rq_exts);
     if minimum == Minimum::Vulkan13 && (!dyn_rendering || !sync2) {
         return Err(Error::Unsupported(format!("{name}: umbrage needs dynamicRendering and synchronization2 (Vulkan 1.3)")));
     }
@@ -146,18 +61,7 @@ pub(super) fn open_device(
     let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
     let timestamps = families[queue_family as usize].timestamp_valid_bits > 0 && props.limits.timestamp_period > 0.0;
 
-    // Depth-stencil format with 8 stencil bits, usable as attachment and transfer source.
-    let needed = vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT | vk::FormatFeatureFlags::TRANSFER_SRC;
-    let depth_format = [vk::Format::D32_SFLOAT_S8_UINT, vk::Format::D24_UNORM_S8_UINT]
-        .into_iter()
-        .find(|&f| {
-            // SAFETY: format query on a valid physical device.
-            let p = unsafe { instance.get_physical_device_format_properties(physical, f) };
-            // Vulkan 1.0 has no TRANSFER_SRC format feature (VK_KHR_maintenance1): every
-            // attachment format may be copied there.
-            p.optimal_tiling_features.contains(if v11 { needed } else { vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT })
-        })
-        .ok_or_else(|| Error::Unsupported(format!("{name}: no depth-stencil format with 8 stencil bits (D32S8 or D24S8)")))?;
+    let depth_format = depth_stencil_format(instance, physical, v11, &name)?;
 
     let blendable = |f: vk::Format| {
         // SAFETY: format query on a valid physical device.
@@ -243,20 +147,175 @@ pub(super) fn open_device(
     // SAFETY: all pointers refer to locals alive for the call.
     let device = unsafe { instance.create_device(physical, &dinfo, None) }.map_err(vkerr("vkCreateDevice"))?;
 
-    // The driver's name and version string: core in 1.2, else VK_KHR_driver_properties.
-    let mut driver = vk::PhysicalDeviceDriverProperties::default();
     let has_driver_props = api >= vk::API_VERSION_1_2 || (has_ext(ash::khr::driver_properties::NAME) && can_query2);
+    let info = device_info(instance, gpdp2, physical, &props, name, has_driver_props);
+    Ok((physical, device, queue_family, features, info, depth_format, props.limits))
+}
+
+/// What [`probe_features`] found.
+struct Probed {
+    base: vk::PhysicalDeviceFeatures,
+    dyn_rendering: bool,
+    sync2: bool,
+    u8_supported: bool,
+    ray_query: bool,
+}
+
+/// The device's features: through the Vulkan 1.1 core query, or on a Vulkan 1.0 device through
+/// `VK_KHR_get_physical_device_properties2` (`gpdp2`, when the loader has it; otherwise only
+/// the 1.0 features). A structure is chained only where the device's version (`v11`, `v13`)
+/// or extensions (`has_u8_ext`, `has_rq_exts`) define it.
+fn probe_features(
+    instance: &ash::Instance,
+    gpdp2: Option<&ash::khr::get_physical_device_properties2::Instance>,
+    physical: vk::PhysicalDevice,
+    (v11, v13): (bool, bool),
+    has_u8_ext: bool,
+    has_rq_exts: bool,
+) -> Probed {
+    let mut f_as = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default();
+    let mut f_rq = vk::PhysicalDeviceRayQueryFeaturesKHR::default();
+    let mut f12 = vk::PhysicalDeviceVulkan12Features::default();
+    let mut f_u8 = vk::PhysicalDeviceIndexTypeUint8FeaturesEXT::default();
+    let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
+    let mut f2 = vk::PhysicalDeviceFeatures2::default();
+    if v13 {
+        f2 = f2.push_next(&mut f13);
+    }
+    if has_u8_ext {
+        f2 = f2.push_next(&mut f_u8);
+    }
+    if has_rq_exts {
+        f2 = f2.push_next(&mut f_as).push_next(&mut f_rq).push_next(&mut f12);
+    }
+    // SAFETY: the chain points at locals alive for this call; a struct is chained only when
+    // the device's version or extensions define it.
+    unsafe {
+        match (v11, gpdp2) {
+            (true, _) => instance.get_physical_device_features2(physical, &mut f2),
+            (false, Some(g)) => g.get_physical_device_features2(physical, &mut f2),
+            (false, None) => f2.features = instance.get_physical_device_features(physical),
+        }
+    }
+    let base = f2.features;
+    let (dyn_rendering, sync2) = (f13.dynamic_rendering == vk::TRUE, f13.synchronization2 == vk::TRUE);
+    let u8_supported = has_u8_ext && f_u8.index_type_uint8 == vk::TRUE;
+    let ray_query =
+        has_rq_exts && f_as.acceleration_structure == vk::TRUE && f_rq.ray_query == vk::TRUE && f12.buffer_device_address == vk::TRUE;
+    Probed { base, dyn_rendering, sync2, u8_supported, ray_query }
+}
+
+/// The physical device [`open_device`] uses.
+struct Picked {
+    physical: vk::PhysicalDevice,
+    queue_family: u32,
+    props: vk::PhysicalDeviceProperties,
+    name: String,
+}
+
+/// The best device of at least `minimum` with a graphics queue (discrete, integrated, virtual,
+/// CPU, in that order; only those whose name contains `UMBRAGE_DEVICE` when it is set).
+fn pick_physical(instance: &ash::Instance, minimum: Minimum) -> Result<Picked> {
+    let min_version = match minimum {
+        Minimum::Vulkan13 => vk::API_VERSION_1_3,
+        Minimum::Vulkan10 => vk::API_VERSION_1_0,
+    };
+    let min_name = match minimum {
+        Minimum::Vulkan13 => "Vulkan 1.3",
+        Minimum::Vulkan10 => "Vulkan",
+    };
+    // SAFETY: enumeration on a valid instance.
+    let physicals = unsafe { instance.enumerate_physical_devices() }.map_err(vkerr("vkEnumeratePhysicalDevices"))?;
+    if physicals.is_empty() {
+        return Err(Error::NoDevice("the Vulkan loader found no physical device".into()));
+    }
+    let wanted = std::env::var("UMBRAGE_DEVICE").ok().map(|s| s.to_lowercase());
+    let mut candidates = Vec::new();
+    let mut too_old = Vec::new();
+    for &pd in &physicals {
+        // SAFETY: `pd` comes from the enumeration above.
+        let props = unsafe { instance.get_physical_device_properties(pd) };
+        let name = props.device_name_as_c_str().map(|c| c.to_string_lossy().into_owned()).unwrap_or_default();
+        if let Some(w) = &wanted {
+            if !name.to_lowercase().contains(w) {
+                continue;
+            }
+        }
+        if props.api_version < min_version {
+            too_old.push(format!("{name} (Vulkan {})", version_string(props.api_version)));
+            continue;
+        }
+        // SAFETY: as above.
+        let families = unsafe { instance.get_physical_device_queue_family_properties(pd) };
+        let Some(qf) = families.iter().position(|f| f.queue_flags.contains(vk::QueueFlags::GRAPHICS)) else {
+            continue;
+        };
+        let rank = match props.device_type {
+            vk::PhysicalDeviceType::DISCRETE_GPU => 0,
+            vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
+            vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
+            vk::PhysicalDeviceType::CPU => 3,
+            _ => 4,
+        };
+        candidates.push((rank, pd, qf as u32, props, name));
+    }
+    candidates.sort_by_key(|c| c.0);
+    let Some((_, physical, queue_family, props, name)) = candidates.into_iter().next() else {
+        if !too_old.is_empty() {
+            // A device is there, only too old: not a missing driver.
+            return Err(Error::Unsupported(format!(
+                "{} has no dynamicRendering and synchronization2 (Vulkan 1.3), which this needs; \
+                 `umbrage conform` and `umbrage info` run on any Vulkan 1.0 device, and \
+                 `scripts/drivers.sh install 25.0.7` gives a Vulkan 1.4 lavapipe",
+                too_old.join(", ")
+            )));
+        }
+        return Err(Error::NoDevice(match wanted {
+            Some(w) => format!("no {min_name} device with graphics whose name contains '{w}' (UMBRAGE_DEVICE)"),
+            None => format!("no {min_name} device with a graphics queue"),
+        }));
+    };
+    Ok(Picked { physical, queue_family, props, name })
+}
+
+/// A depth-stencil format with 8 stencil bits, usable as attachment and transfer source.
+fn depth_stencil_format(instance: &ash::Instance, physical: vk::PhysicalDevice, v11: bool, name: &str) -> Result<vk::Format> {
+    let needed = vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT | vk::FormatFeatureFlags::TRANSFER_SRC;
+    [vk::Format::D32_SFLOAT_S8_UINT, vk::Format::D24_UNORM_S8_UINT]
+        .into_iter()
+        .find(|&f| {
+            // SAFETY: format query on a valid physical device.
+            let p = unsafe { instance.get_physical_device_format_properties(physical, f) };
+            // Vulkan 1.0 has no TRANSFER_SRC format feature (VK_KHR_maintenance1): every
+            // attachment format may be copied there.
+            p.optimal_tiling_features.contains(if v11 { needed } else { vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT })
+        })
+        .ok_or_else(|| Error::Unsupported(format!("{name}: no depth-stencil format with 8 stencil bits (D32S8 or D24S8)")))
+}
+
+/// The device's identification; the driver's name and version string where the device has
+/// them (core in 1.2, else `VK_KHR_driver_properties`: `has_driver_props`).
+fn device_info(
+    instance: &ash::Instance,
+    gpdp2: Option<&ash::khr::get_physical_device_properties2::Instance>,
+    physical: vk::PhysicalDevice,
+    props: &vk::PhysicalDeviceProperties,
+    name: String,
+    has_driver_props: bool,
+) -> DeviceInfo {
+    let api = props.api_version;
+    let mut driver = vk::PhysicalDeviceDriverProperties::default();
     if has_driver_props {
         let mut p2 = vk::PhysicalDeviceProperties2::default().push_next(&mut driver);
         // SAFETY: chain of locals; the driver-properties struct is defined for this device.
         unsafe {
-            match (v11, gpdp2) {
+            match (api >= vk::API_VERSION_1_1, gpdp2) {
                 (false, Some(g)) => g.get_physical_device_properties2(physical, &mut p2),
                 _ => instance.get_physical_device_properties2(physical, &mut p2),
             }
         }
     }
-    let info = DeviceInfo {
+    DeviceInfo {
         name,
         kind: format!("{:?}", props.device_type),
         driver: driver.driver_name_as_c_str().map(|c| c.to_string_lossy().into_owned()).unwrap_or_default(),
@@ -264,6 +323,5 @@ pub(super) fn open_device(
         api_version: version_string(api),
         vendor_id: props.vendor_id,
         device_id: props.device_id,
-    };
-    Ok((physical, device, queue_family, features, info, depth_format, props.limits))
+    }
 }

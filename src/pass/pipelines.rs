@@ -180,44 +180,13 @@ impl Pipelines {
         // The float counter, the light-intensity map and the overlay draw into colour targets of
         // their own rendering instances: dynamic rendering only (refused at creation otherwise).
         let dynamic = render_pass.is_none();
-        let count = if r32f_blend && dynamic {
-            c.depth_compare = vk::CompareOp::LESS;
-            let zpass = create(&c)?;
-            c.depth_compare = vk::CompareOp::GREATER_OR_EQUAL;
-            let zfail = create(&c)?;
-            c.depth_compare = vk::CompareOp::ALWAYS;
-            let cap = create(&c)?;
-            let mut ec = c.clone();
-            ec.vertex = shaders::EDGEQUAD_VERT;
-            ec.vertex_stride = 32;
-            ec.attributes = &eq_attrs;
-            ec.depth_compare = vk::CompareOp::ALWAYS;
-            let eq_faces = create(&ec)?;
-            ec.depth_compare = vk::CompareOp::GREATER_OR_EQUAL;
-            let eq_sides = create(&ec)?;
-            Some(CountPipes { zpass, zfail, cap, eq_faces, eq_sides })
-        } else {
-            None
+        let count = match r32f_blend && dynamic {
+            true => Some(count_pipes(&mut create, &c, &eq_attrs)?),
+            false => None,
         };
 
         let transmit = match desc.transmit_format.filter(|_| dynamic) {
-            Some(format) => {
-                let map_fmt = [format];
-                let mut tm = c.clone();
-                tm.color_formats = &map_fmt;
-                let mut t = [[vk::Pipeline::null(); 2]; 2];
-                for (li, (frag, blend)) in
-                    [(shaders::TRANSMIT_FRAG, Blend::Multiply), (shaders::TRANSMIT_LOG_FRAG, Blend::Additive)].into_iter().enumerate()
-                {
-                    tm.fragment = Some(frag);
-                    tm.blend = blend;
-                    for (zi, cmp) in [vk::CompareOp::LESS, vk::CompareOp::GREATER_OR_EQUAL].into_iter().enumerate() {
-                        tm.depth_compare = cmp;
-                        t[li][zi] = create(&tm)?;
-                    }
-                }
-                Some(t)
-            }
+            Some(format) => Some(transmit_pipes(&mut create, &c, format)?),
             None => None,
         };
 
@@ -294,4 +263,47 @@ impl Pipelines {
             device.destroy_pipeline_layout(self.layout, None);
         }
     }
+}
+
+/// Makes a pipeline from a description (and keeps it for destruction).
+type Create<'c> = dyn FnMut(&PipelineDesc) -> Result<vk::Pipeline> + 'c;
+
+/// The float counter's pipelines from the counting description `c` (additive R32F, no stencil):
+/// z-pass, z-fail and caps, and the edge quads' faces and sides (`eq_attrs`: their vertex
+/// attributes).
+fn count_pipes(create: &mut Create, c: &PipelineDesc, eq_attrs: &[(u32, vk::Format, u32)]) -> Result<CountPipes> {
+    let mut c = c.clone();
+    c.depth_compare = vk::CompareOp::LESS;
+    let zpass = create(&c)?;
+    c.depth_compare = vk::CompareOp::GREATER_OR_EQUAL;
+    let zfail = create(&c)?;
+    c.depth_compare = vk::CompareOp::ALWAYS;
+    let cap = create(&c)?;
+    let mut ec = c.clone();
+    ec.vertex = shaders::EDGEQUAD_VERT;
+    ec.vertex_stride = 32;
+    ec.attributes = eq_attrs;
+    ec.depth_compare = vk::CompareOp::ALWAYS;
+    let eq_faces = create(&ec)?;
+    ec.depth_compare = vk::CompareOp::GREATER_OR_EQUAL;
+    let eq_sides = create(&ec)?;
+    Ok(CountPipes { zpass, zfail, cap, eq_faces, eq_sides })
+}
+
+/// The light-intensity map's pipelines into `format`: `[multiplicative, log][z-pass, z-fail]`.
+fn transmit_pipes(create: &mut Create, c: &PipelineDesc, format: vk::Format) -> Result<[[vk::Pipeline; 2]; 2]> {
+    let map_fmt = [format];
+    let mut tm = c.clone();
+    tm.color_formats = &map_fmt;
+    let mut t = [[vk::Pipeline::null(); 2]; 2];
+    for (li, (frag, blend)) in [(shaders::TRANSMIT_FRAG, Blend::Multiply), (shaders::TRANSMIT_LOG_FRAG, Blend::Additive)].into_iter().enumerate()
+    {
+        tm.fragment = Some(frag);
+        tm.blend = blend;
+        for (zi, cmp) in [vk::CompareOp::LESS, vk::CompareOp::GREATER_OR_EQUAL].into_iter().enumerate() {
+            tm.depth_compare = cmp;
+            t[li][zi] = create(&tm)?;
+        }
+    }
+    Ok(t)
 }

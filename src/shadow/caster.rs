@@ -474,7 +474,7 @@ impl Caster {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shadow::testmesh::{cube, uv_sphere};
+    use crate::geom::testmesh::{cube, uv_sphere};
 
     #[test]
     fn open_mesh_takes_multiplicity_path() {

@@ -64,7 +64,7 @@ impl EdgeQuadMesh {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shadow::testmesh::{torus, uv_sphere};
+    use crate::geom::testmesh::{torus, uv_sphere};
     use glam::{Mat4, Vec3, Vec4};
 
     /// CPU emulation of the vertex shader: position after EXTRUDE, as (point, is_infinite).

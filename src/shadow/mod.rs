@@ -5,7 +5,6 @@
 pub mod caster;
 pub mod edgequad;
 pub mod plan;
-pub mod testmesh;
 
 pub use caster::{Caster, CasterKind, Chunk, Part, TRANSMITTANCE_FLOOR};
 pub use plan::{

@@ -444,28 +444,7 @@ pub fn plan_light_with(input: &PlanInput, casters: &[Caster], opts: &PlanOptions
         }
         // A caster marked multiplicity as a whole (one part) keeps that path.
         let whole_multiplicity = caster.kind != CasterKind::Manifold && caster.parts.len() == 1;
-        let single = caster.parts.len() == 1;
-        let mut cases: Vec<Case> = caster
-            .parts
-            .iter()
-            .map(|p| {
-                let pb = if single { wb } else { p.object_bounds.transformed(&caster.transform) };
-                if !single && culls(&pb) {
-                    Case::Culled
-                } else {
-                    select_case(input.method, &pyramid, &frustum, &pb)
-                }
-            })
-            .collect();
-        if !opts.case_per_part {
-            let mut live = cases.iter().copied().filter(|&c| c != Case::Culled);
-            if let Some(first) = live.next() {
-                let uniform = if live.all(|c| c == first) { first } else { Case::ZFailLightCap };
-                for c in cases.iter_mut().filter(|c| **c != Case::Culled) {
-                    *c = uniform;
-                }
-            }
-        }
+        let cases = part_cases(caster, wb, opts.case_per_part, &culls, |b| select_case(input.method, &pyramid, &frustum, b));
         let mut cp = culled_plan(Case::Culled);
         if cases.iter().all(|&c| c == Case::Culled) {
             plans.push(cp);
@@ -489,18 +468,7 @@ pub fn plan_light_with(input: &PlanInput, casters: &[Caster], opts: &PlanOptions
             let multiplicity = whole_multiplicity || part.kind != CasterKind::Manifold;
             if case != Case::Culled && on_gpu(pi) {
                 let e = manifold_emit(input.method, part, case, l_obj);
-                cp.parts.push(PartPlan {
-                    part: pi,
-                    case,
-                    path: "compute",
-                    silhouette_edges: 0,
-                    multiplicity_max: 0,
-                    sides: 0,
-                    dark_cap: 0,
-                    light_cap: 0,
-                    dark_cap_kind: e.dark_cap,
-                    formulation: e.formulation,
-                });
+                cp.parts.push(PartPlan::undrawn(pi, case, "compute", e.dark_cap, e.formulation));
                 if case_rank(case) > best {
                     best = case_rank(case);
                     cp.case = case;
@@ -510,18 +478,8 @@ pub fn plan_light_with(input: &PlanInput, casters: &[Caster], opts: &PlanOptions
                 continue;
             }
             if case == Case::Culled {
-                cp.parts.push(PartPlan {
-                    part: pi,
-                    case,
-                    path: if multiplicity { "multiplicity" } else { "manifold" },
-                    silhouette_edges: 0,
-                    multiplicity_max: 0,
-                    sides: 0,
-                    dark_cap: 0,
-                    light_cap: 0,
-                    dark_cap_kind: DarkCap::None,
-                    formulation: Formulation::Front,
-                });
+                let path = if multiplicity { "multiplicity" } else { "manifold" };
+                cp.parts.push(PartPlan::undrawn(pi, case, path, DarkCap::None, Formulation::Front));
                 continue;
             }
             let (pp, draws) = plan_part(input, caster, pi, multiplicity, case, l_obj, &bits, &mut sil);
@@ -547,6 +505,59 @@ pub fn plan_light_with(input: &PlanInput, casters: &[Caster], opts: &PlanOptions
         (light_scissor(light, input.view_proj, input.width, input.height), light_depth_bounds(light, input.view_proj))
     };
     LightPlan { scissor, depth_bounds, casters: plans, silhouette_ms: sil_time, plan_ms: t0.elapsed().as_secs_f64() * 1e3 }
+}
+
+/// Each part's case: culled by its own bounds (a caster of several parts), or the case its
+/// bounds select; unless `case_per_part`, the parts drawn all take one case (the common one,
+/// or z-fail with light cap when they differ).
+fn part_cases(
+    caster: &Caster,
+    world_bounds: Aabb,
+    case_per_part: bool,
+    culls: &dyn Fn(&Aabb) -> bool,
+    select: impl Fn(&Aabb) -> Case,
+) -> Vec<Case> {
+    let single = caster.parts.len() == 1;
+    let mut cases: Vec<Case> = caster
+        .parts
+        .iter()
+        .map(|p| {
+            let pb = if single { world_bounds } else { p.object_bounds.transformed(&caster.transform) };
+            if !single && culls(&pb) {
+                Case::Culled
+            } else {
+                select(&pb)
+            }
+        })
+        .collect();
+    if !case_per_part {
+        let mut live = cases.iter().copied().filter(|&c| c != Case::Culled);
+        if let Some(first) = live.next() {
+            let uniform = if live.all(|c| c == first) { first } else { Case::ZFailLightCap };
+            for c in cases.iter_mut().filter(|c| **c != Case::Culled) {
+                *c = uniform;
+            }
+        }
+    }
+    cases
+}
+
+impl PartPlan {
+    /// A part with nothing drawn on the CPU path (culled, or left to the compute pass).
+    fn undrawn(part: usize, case: Case, path: &'static str, dark_cap_kind: DarkCap, formulation: Formulation) -> PartPlan {
+        PartPlan {
+            part,
+            case,
+            path,
+            silhouette_edges: 0,
+            multiplicity_max: 0,
+            sides: 0,
+            dark_cap: 0,
+            light_cap: 0,
+            dark_cap_kind,
+            formulation,
+        }
+    }
 }
 
 #[cfg(test)]

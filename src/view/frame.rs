@@ -14,6 +14,9 @@ use glam::{Mat4, Vec3};
 use gpu_allocator::MemoryLocation;
 use std::time::Instant;
 
+/// One frame's overlay: its primitives, pixels per point and texture changes.
+type OverlayFrame = (Vec<egui::ClippedPrimitive>, f32, egui::TexturesDelta);
+
 impl Live {
     /// Renders and presents one frame; `Ok(true)`: `--frames` reached.
     pub(super) fn frame(&mut self, args: &ViewArgs) -> Result<bool> {
@@ -22,25 +25,9 @@ impl Live {
             self.minimised = true;
             return Ok(false);
         }
-        if self.need_rebuild || (size.width, size.height) != (self.sc.extent.width, self.sc.extent.height) {
-            let old_format = self.sc.format.format;
-            if !self.sc.rebuild(self.renderer.context(), (size.width, size.height))? {
-                self.minimised = true;
-                return Ok(false);
-            }
-            self.settle()?;
-            self.renderer.resize(self.sc.extent.width, self.sc.extent.height)?;
-            if self.sc.format.format != old_format {
-                if let Some(r) = self.egui.renderer.as_mut() {
-                    let mode = egui_ash_renderer::RenderMode::DynamicRendering(egui_ash_renderer::DynamicRendering {
-                        color_attachment_format: self.sc.format.format,
-                        depth_attachment_format: None,
-                        stencil_attachment_format: None,
-                    });
-                    r.set_render_mode(mode).map_err(|e| Error::Other(format!("egui overlay: {e}")))?;
-                }
-            }
-            self.need_rebuild = false;
+        if !self.fit_window((size.width, size.height))? {
+            self.minimised = true;
+            return Ok(false);
         }
         self.minimised = false;
         let start = Instant::now();
@@ -67,57 +54,7 @@ impl Live {
         self.good = self.renderer.settings;
 
         // 2. The overlay.
-        let egui_live = self.overlay_visible || self.menu_at.is_some();
-        let mut draw = None;
-        if egui_live {
-            let raw = self.egui.state.take_egui_input(&self.window);
-            let stats = self.last.as_ref().map(|(f, _)| &f.stats);
-            let drawn = self.renderer.scene();
-            let caster_name = self.caster_index().map(|i| drawn.meshes[i].name.clone()).unwrap_or_else(|| "(no casters)".into());
-            let light = self.renderer.source_lights().get(self.light).map(|l| (self.light, l.position));
-            let settings = self.renderer.settings;
-            let present =
-                format!("{:?}, {:?}, {}x{}", self.sc.present_mode, self.sc.format.format, self.sc.extent.width, self.sc.extent.height);
-            let notes: Vec<String> = self.sc.notes.iter().chain(&self.notes).cloned().collect();
-            let shown = Shown {
-                fps: self.fps,
-                frame_ms: self.frame_ms,
-                stats,
-                techniques: &self.techniques,
-                technique: self.technique,
-                counter: settings.counter,
-                view: settings.view,
-                mode: self.mode,
-                caster: &caster_name,
-                light,
-                time,
-                paused: self.paused,
-                notes: &notes,
-                present,
-            };
-            let visible = self.overlay_visible;
-            let mut changes = overlay::Changes::default();
-            let menu_at = &mut self.menu_at;
-            let out = self.egui.ctx.run_ui(raw, |ui| {
-                if visible {
-                    changes = overlay::ui(ui.ctx(), &shown, menu_at);
-                } else {
-                    changes = overlay::menu_only(ui.ctx(), menu_at);
-                }
-            });
-            if visible {
-                self.shown = Some([
-                    self.techniques[self.technique].name().to_string(),
-                    settings.counter.name().to_string(),
-                    settings.view.name().to_string(),
-                    self.mode.name().to_string(),
-                ]);
-            }
-            self.egui.state.handle_platform_output(&self.window, out.platform_output);
-            let prims = self.egui.ctx.tessellate(out.shapes, out.pixels_per_point);
-            self.apply_changes(changes);
-            draw = Some((prims, out.pixels_per_point, out.textures_delta));
-        }
+        let mut draw = self.overlay(time);
 
         // 3. Present: this slot's previous presentation must be done first.
         let slot = self.slot;
@@ -194,6 +131,86 @@ impl Live {
             self.fps_since = Instant::now();
         }
         Ok(args.frames.map(|n| n > 0 && self.frames >= n).unwrap_or(false))
+    }
+
+    /// Rebuilds the swapchain (and resizes the renderer) when the window's `size` changed or
+    /// presentation asked for it; `Ok(false)`: the window is minimised.
+    fn fit_window(&mut self, size: (u32, u32)) -> Result<bool> {
+        if self.need_rebuild || size != (self.sc.extent.width, self.sc.extent.height) {
+            let old_format = self.sc.format.format;
+            if !self.sc.rebuild(self.renderer.context(), size)? {
+                return Ok(false);
+            }
+            self.settle()?;
+            self.renderer.resize(self.sc.extent.width, self.sc.extent.height)?;
+            if self.sc.format.format != old_format {
+                if let Some(r) = self.egui.renderer.as_mut() {
+                    let mode = egui_ash_renderer::RenderMode::DynamicRendering(egui_ash_renderer::DynamicRendering {
+                        color_attachment_format: self.sc.format.format,
+                        depth_attachment_format: None,
+                        stencil_attachment_format: None,
+                    });
+                    r.set_render_mode(mode).map_err(|e| Error::Other(format!("egui overlay: {e}")))?;
+                }
+            }
+            self.need_rebuild = false;
+        }
+        Ok(true)
+    }
+
+    /// The overlay's primitives, scale and texture changes when it (or the menu) is shown;
+    /// the user's changes in it are applied to the settings.
+    fn overlay(&mut self, time: f64) -> Option<OverlayFrame> {
+        if !(self.overlay_visible || self.menu_at.is_some()) {
+            return None;
+        }
+        let raw = self.egui.state.take_egui_input(&self.window);
+        let stats = self.last.as_ref().map(|(f, _)| &f.stats);
+        let drawn = self.renderer.scene();
+        let caster_name = self.caster_index().map(|i| drawn.meshes[i].name.clone()).unwrap_or_else(|| "(no casters)".into());
+        let light = self.renderer.source_lights().get(self.light).map(|l| (self.light, l.position));
+        let settings = self.renderer.settings;
+        let present =
+            format!("{:?}, {:?}, {}x{}", self.sc.present_mode, self.sc.format.format, self.sc.extent.width, self.sc.extent.height);
+        let notes: Vec<String> = self.sc.notes.iter().chain(&self.notes).cloned().collect();
+        let shown = Shown {
+            fps: self.fps,
+            frame_ms: self.frame_ms,
+            stats,
+            techniques: &self.techniques,
+            technique: self.technique,
+            counter: settings.counter,
+            view: settings.view,
+            mode: self.mode,
+            caster: &caster_name,
+            light,
+            time,
+            paused: self.paused,
+            notes: &notes,
+            present,
+        };
+        let visible = self.overlay_visible;
+        let mut changes = overlay::Changes::default();
+        let menu_at = &mut self.menu_at;
+        let out = self.egui.ctx.run_ui(raw, |ui| {
+            if visible {
+                changes = overlay::ui(ui.ctx(), &shown, menu_at);
+            } else {
+                changes = overlay::menu_only(ui.ctx(), menu_at);
+            }
+        });
+        if visible {
+            self.shown = Some([
+                self.techniques[self.technique].name().to_string(),
+                settings.counter.name().to_string(),
+                settings.view.name().to_string(),
+                self.mode.name().to_string(),
+            ]);
+        }
+        self.egui.state.handle_platform_output(&self.window, out.platform_output);
+        let prims = self.egui.ctx.tessellate(out.shapes, out.pixels_per_point);
+        self.apply_changes(changes);
+        Some((prims, out.pixels_per_point, out.textures_delta))
     }
 
     /// The scene at `time` (motion), with the user's edits, into the renderer.

@@ -150,28 +150,7 @@ fn run_inner(ctx: &Context, cfg: Config, cases: &[&Case], origins: &[(u32, u32)]
     let bpp = depth_bpp(kind) as usize;
 
     // Initial state: 1.0 / 0 outside the tiles, each case's own inside.
-    let mut depth_init = vec![0u8; n * bpp];
-    let mut stencil_init = vec![0u8; n];
-    let put_depth = |buf: &mut [u8], i: usize, v: f64| {
-        let raw = to_raw(kind, v);
-        buf[i * bpp..(i + 1) * bpp].copy_from_slice(&raw.to_le_bytes()[..bpp]);
-    };
-    if has_depth {
-        for i in 0..n {
-            put_depth(&mut depth_init, i, 1.0);
-        }
-    }
-    for (c, &(ox, oy)) in cases.iter().zip(origins) {
-        for ty in 0..c.size.1 {
-            for tx in 0..c.size.0 {
-                let (ti, ii) = ((ty * c.size.0 + tx) as usize, ((oy + ty) * width + ox + tx) as usize);
-                stencil_init[ii] = c.init_stencil[ti];
-                if has_depth {
-                    put_depth(&mut depth_init, ii, c.init_depth[ti]);
-                }
-            }
-        }
-    }
+    let (depth_init, stencil_init) = initial_state(kind, cases, origins, width, n);
     let extent = img.extent;
     let mut upload = depth_init.clone();
     let stencil_offset = upload.len() as u64;
@@ -197,50 +176,7 @@ fn run_inner(ctx: &Context, cfg: Config, cases: &[&Case], origins: &[(u32, u32)]
     }
 
     // Pipelines, vertices, queries.
-    let mut pipe_of: HashMap<String, vk::Pipeline> = HashMap::new();
-    let mut verts: Vec<[f32; 4]> = Vec::new();
-    struct Rec {
-        tile: (u32, u32, u32, u32),
-        pipeline: vk::Pipeline,
-        state: super::cases::DsState,
-        push: Vec<u8>,
-        first: u32,
-        count: u32,
-        query: Option<u32>,
-    }
-    let mut recs = Vec::new();
-    let mut queries = 0u32;
-    for (c, &(ox, oy)) in cases.iter().zip(origins) {
-        for d in &c.draws {
-            let key = d.state.pipeline_key(cfg.state);
-            let p = match pipe_of.get(&key) {
-                Some(&p) => p,
-                None => {
-                    let p = pipe::create(ctx, cfg, &d.state, o.layout, o.render_pass)?;
-                    o.pipelines.push(p);
-                    pipe_of.insert(key, p);
-                    p
-                }
-            };
-            let push = crate::pass::push::VolumePush::new(d.mvp, glam::Vec4::W, [0.0; 4]);
-            let query = if d.query {
-                queries += 1;
-                Some(queries - 1)
-            } else {
-                None
-            };
-            recs.push(Rec {
-                tile: (ox, oy, c.size.0, c.size.1),
-                pipeline: p,
-                state: d.state,
-                push: bytemuck::bytes_of(&push).to_vec(),
-                first: verts.len() as u32,
-                count: d.vertices.len() as u32,
-                query,
-            });
-            verts.extend_from_slice(&d.vertices);
-        }
-    }
+    let (recs, mut verts, queries) = batch_draws(ctx, cfg, cases, origins, o)?;
     if verts.is_empty() {
         verts.push([0.0; 4]);
     }
@@ -314,23 +250,7 @@ fn run_inner(ctx: &Context, cfg: Config, cases: &[&Case], origins: &[(u32, u32)]
                     bound = r.pipeline;
                 }
                 if dynamic {
-                    let st = &r.state;
-                    let (front, back) = st.stencil.unwrap_or_default();
-                    d.cmd_set_stencil_test_enable(cb, st.stencil.is_some());
-                    for (face, s) in [(vk::StencilFaceFlags::FRONT, front), (vk::StencilFaceFlags::BACK, back)] {
-                        d.cmd_set_stencil_op(cb, face, s.fail_op, s.pass_op, s.depth_fail_op, s.compare_op);
-                        d.cmd_set_stencil_compare_mask(cb, face, s.compare_mask);
-                        d.cmd_set_stencil_write_mask(cb, face, s.write_mask);
-                        d.cmd_set_stencil_reference(cb, face, s.reference);
-                    }
-                    d.cmd_set_depth_test_enable(cb, st.depth_test && has_depth);
-                    d.cmd_set_depth_write_enable(cb, st.depth_write && has_depth);
-                    d.cmd_set_depth_compare_op(cb, st.depth_compare);
-                    if bounds_feature {
-                        let (lo, hi) = st.depth_bounds.unwrap_or((0.0, 1.0));
-                        d.cmd_set_depth_bounds_test_enable(cb, st.depth_bounds.is_some());
-                        d.cmd_set_depth_bounds(cb, lo, hi);
-                    }
+                    set_dynamic_state(d, cb, &r.state, has_depth, bounds_feature);
                 }
                 d.cmd_push_constants(cb, layout, vk::ShaderStageFlags::VERTEX, 0, &r.push);
                 if let Some(q) = r.query {
@@ -365,6 +285,122 @@ fn run_inner(ctx: &Context, cfg: Config, cases: &[&Case], origins: &[(u32, u32)]
     }
     let data = o.buffers[read_idx].read()?;
     let (depth_bytes, stencil_bytes) = data.split_at(stencil_offset as usize);
+    let out = tiles(cases, origins, width, (depth_bytes, stencil_bytes), bpp, &counts);
+    Ok(out)
+}
+
+/// The batch image's initial depth (`depth_bpp` bytes a texel) and stencil: 1.0 / 0 outside
+/// the tiles, each case's own values inside its tile.
+fn initial_state(kind: DepthKind, cases: &[&Case], origins: &[(u32, u32)], width: u32, n: usize) -> (Vec<u8>, Vec<u8>) {
+    let has_depth = kind != DepthKind::None;
+    let bpp = depth_bpp(kind) as usize;
+    let mut depth_init = vec![0u8; n * bpp];
+    let mut stencil_init = vec![0u8; n];
+    let put_depth = |buf: &mut [u8], i: usize, v: f64| {
+        let raw = to_raw(kind, v);
+        buf[i * bpp..(i + 1) * bpp].copy_from_slice(&raw.to_le_bytes()[..bpp]);
+    };
+    if has_depth {
+        for i in 0..n {
+            put_depth(&mut depth_init, i, 1.0);
+        }
+    }
+    for (c, &(ox, oy)) in cases.iter().zip(origins) {
+        for ty in 0..c.size.1 {
+            for tx in 0..c.size.0 {
+                let (ti, ii) = ((ty * c.size.0 + tx) as usize, ((oy + ty) * width + ox + tx) as usize);
+                stencil_init[ii] = c.init_stencil[ti];
+                if has_depth {
+                    put_depth(&mut depth_init, ii, c.init_depth[ti]);
+                }
+            }
+        }
+    }
+    (depth_init, stencil_init)
+}
+
+/// One draw of the batch, ready to record.
+struct BatchDraw {
+    /// Its case's tile: x, y, width, height.
+    tile: (u32, u32, u32, u32),
+    pipeline: vk::Pipeline,
+    state: super::cases::DsState,
+    push: Vec<u8>,
+    first: u32,
+    count: u32,
+    query: Option<u32>,
+}
+
+/// Every case's draws in order, one pipeline per distinct state (kept in `o`), their vertices
+/// in one array, and the number of occlusion queries.
+fn batch_draws(ctx: &Context, cfg: Config, cases: &[&Case], origins: &[(u32, u32)], o: &mut Objects) -> Result<(Vec<BatchDraw>, Vec<[f32; 4]>, u32)> {
+    let mut pipe_of: HashMap<String, vk::Pipeline> = HashMap::new();
+    let mut verts: Vec<[f32; 4]> = Vec::new();
+    let mut recs = Vec::new();
+    let mut queries = 0u32;
+    for (c, &(ox, oy)) in cases.iter().zip(origins) {
+        for d in &c.draws {
+            let key = d.state.pipeline_key(cfg.state);
+            let p = match pipe_of.get(&key) {
+                Some(&p) => p,
+                None => {
+                    let p = pipe::create(ctx, cfg, &d.state, o.layout, o.render_pass)?;
+                    o.pipelines.push(p);
+                    pipe_of.insert(key, p);
+                    p
+                }
+            };
+            let push = crate::pass::push::VolumePush::new(d.mvp, glam::Vec4::W, [0.0; 4]);
+            let query = if d.query {
+                queries += 1;
+                Some(queries - 1)
+            } else {
+                None
+            };
+            recs.push(BatchDraw {
+                tile: (ox, oy, c.size.0, c.size.1),
+                pipeline: p,
+                state: d.state,
+                push: bytemuck::bytes_of(&push).to_vec(),
+                first: verts.len() as u32,
+                count: d.vertices.len() as u32,
+                query,
+            });
+            verts.extend_from_slice(&d.vertices);
+        }
+    }
+    Ok((recs, verts, queries))
+}
+
+/// Sets `st`'s stencil, depth and depth-bounds state (the dynamic-state model).
+///
+/// # Safety
+/// `cb` is recording inside a rendering instance with a pipeline that has these states dynamic.
+unsafe fn set_dynamic_state(d: &ash::Device, cb: vk::CommandBuffer, st: &super::cases::DsState, has_depth: bool, bounds_feature: bool) {
+    let (front, back) = st.stencil.unwrap_or_default();
+    // SAFETY: the caller's contract.
+    unsafe {
+        d.cmd_set_stencil_test_enable(cb, st.stencil.is_some());
+        for (face, s) in [(vk::StencilFaceFlags::FRONT, front), (vk::StencilFaceFlags::BACK, back)] {
+            d.cmd_set_stencil_op(cb, face, s.fail_op, s.pass_op, s.depth_fail_op, s.compare_op);
+            d.cmd_set_stencil_compare_mask(cb, face, s.compare_mask);
+            d.cmd_set_stencil_write_mask(cb, face, s.write_mask);
+            d.cmd_set_stencil_reference(cb, face, s.reference);
+        }
+        d.cmd_set_depth_test_enable(cb, st.depth_test && has_depth);
+        d.cmd_set_depth_write_enable(cb, st.depth_write && has_depth);
+        d.cmd_set_depth_compare_op(cb, st.depth_compare);
+        if bounds_feature {
+            let (lo, hi) = st.depth_bounds.unwrap_or((0.0, 1.0));
+            d.cmd_set_depth_bounds_test_enable(cb, st.depth_bounds.is_some());
+            d.cmd_set_depth_bounds(cb, lo, hi);
+        }
+    }
+}
+
+/// Each case's tile of the read-back depth (`bpp` bytes a texel; none when 0 or no depth) and
+/// stencil, with its share of the occlusion query `counts`.
+fn tiles(cases: &[&Case], origins: &[(u32, u32)], width: u32, (depth_bytes, stencil_bytes): (&[u8], &[u8]), bpp: usize, counts: &[u64]) -> Vec<TileResult> {
     let mut out = Vec::with_capacity(cases.len());
     let mut qi = 0usize;
     for (c, &(ox, oy)) in cases.iter().zip(origins) {
@@ -374,7 +410,7 @@ fn run_inner(ctx: &Context, cfg: Config, cases: &[&Case], origins: &[(u32, u32)]
             for tx in 0..tw {
                 let ii = ((oy + ty) * width + ox + tx) as usize;
                 t.stencil.push(stencil_bytes[ii]);
-                if has_depth {
+                if bpp > 0 {
                     let mut w = [0u8; 4];
                     w[..bpp].copy_from_slice(&depth_bytes[ii * bpp..(ii + 1) * bpp]);
                     t.depth.push(u32::from_le_bytes(w));
@@ -386,5 +422,5 @@ fn run_inner(ctx: &Context, cfg: Config, cases: &[&Case], origins: &[(u32, u32)]
         qi += nq;
         out.push(t);
     }
-    Ok(out)
+    out
 }

@@ -461,62 +461,10 @@ pub fn expect(case: &Case, subpixel_bits: u32, brk: Option<vk::StencilOp>) -> Ex
                         }
                         Frag::At(z) => z,
                     };
-                    // Depth bounds (on the stored depth).
-                    if let (Some((bmin, bmax)), true) = (st.depth_bounds, kind != DepthKind::None) {
-                        let Some(za) = d[i].interval() else {
-                            unknown(&mut s, &mut d);
-                            qhi += 1;
-                            continue;
-                        };
-                        let near = |b: f32| za.0 != za.1 || (za.0 != b as f64 && (za.0 - b as f64).abs() < 1e-6);
-                        if near(bmin) || near(bmax) {
-                            unknown(&mut s, &mut d);
-                            qhi += 1;
-                            continue;
-                        }
-                        if za.0 < bmin as f64 || za.0 > bmax as f64 {
-                            continue;
-                        }
-                    }
-                    // Stencil test.
-                    if let Some(fs) = face {
-                        let Some(sv) = s[i] else {
-                            unknown(&mut s, &mut d);
-                            qhi += 1;
-                            continue;
-                        };
-                        let (r, cm, wm) = (fs.reference as u8, fs.compare_mask as u8, fs.write_mask as u8);
-                        if !stencil_test(fs.compare_op, r, sv, cm) {
-                            s[i] = Some(apply_op(op_of(fs.fail_op), sv, r, wm));
-                            continue;
-                        }
-                    }
-                    // Depth test.
-                    let pass = if depth_test {
-                        match (zf.interval(), d[i].interval()) {
-                            (Some(a), Some(b)) => compare(st.depth_compare, a, b),
-                            _ => None,
-                        }
-                    } else {
-                        Some(true)
-                    };
-                    let Some(pass) = pass else {
-                        unknown(&mut s, &mut d);
-                        qhi += 1;
-                        continue;
-                    };
-                    if let Some(fs) = face {
-                        let sv = s[i].unwrap_or(0);
-                        let op = if pass { fs.pass_op } else { fs.depth_fail_op };
-                        s[i] = Some(apply_op(op_of(op), sv, fs.reference as u8, fs.write_mask as u8));
-                    }
-                    if pass {
-                        if depth_write {
-                            d[i] = zf;
-                        }
-                        qlo += 1;
-                        qhi += 1;
-                    }
+                    let f = Fragment { st, face, kind, depth_test, depth_write, op_of: &op_of };
+                    let (lo, hi) = f.test(&mut s[i], &mut d[i], zf);
+                    qlo += lo;
+                    qhi += hi;
                 }
             }
         }
@@ -531,6 +479,75 @@ pub fn expect(case: &Case, subpixel_bits: u32, brk: Option<vk::StencilOp>) -> Ex
         d = vec![DepthExp::Any; d.len()];
     }
     Expected { stencil: s, depth: d, queries }
+}
+
+/// One fragment's tests and writes, after coverage and its depth are known.
+struct Fragment<'a> {
+    st: &'a DsState,
+    /// The stencil state of the face drawn (None: no stencil test).
+    face: Option<vk::StencilOpState>,
+    kind: DepthKind,
+    depth_test: bool,
+    depth_write: bool,
+    /// The stencil op as the device applies it (the test seam's broken op).
+    op_of: &'a dyn Fn(vk::StencilOp) -> vk::StencilOp,
+}
+
+impl Fragment<'_> {
+    /// Depth bounds (on the stored depth), the stencil test, the depth test and the writes on
+    /// the pixel's expected stencil `s` and depth `d` for a fragment of depth `zf`. Returns
+    /// the occlusion query's (low, high) increments. What cannot be decided (a value near a
+    /// bound, an unknown stored value, an undecidable compare) makes the pixel unknown.
+    fn test(&self, s: &mut Option<u8>, d: &mut DepthExp, zf: DepthExp) -> (u64, u64) {
+        let unknown = |s: &mut Option<u8>, d: &mut DepthExp| {
+            if self.face.is_some() {
+                *s = None;
+            }
+            if self.depth_write {
+                *d = DepthExp::Any;
+            }
+            (0, 1)
+        };
+        if let (Some((bmin, bmax)), true) = (self.st.depth_bounds, self.kind != DepthKind::None) {
+            let Some(za) = d.interval() else { return unknown(s, d) };
+            let near = |b: f32| za.0 != za.1 || (za.0 != b as f64 && (za.0 - b as f64).abs() < 1e-6);
+            if near(bmin) || near(bmax) {
+                return unknown(s, d);
+            }
+            if za.0 < bmin as f64 || za.0 > bmax as f64 {
+                return (0, 0);
+            }
+        }
+        if let Some(fs) = self.face {
+            let Some(sv) = *s else { return unknown(s, d) };
+            let (r, cm, wm) = (fs.reference as u8, fs.compare_mask as u8, fs.write_mask as u8);
+            if !stencil_test(fs.compare_op, r, sv, cm) {
+                *s = Some(apply_op((self.op_of)(fs.fail_op), sv, r, wm));
+                return (0, 0);
+            }
+        }
+        let pass = if self.depth_test {
+            match (zf.interval(), d.interval()) {
+                (Some(a), Some(b)) => compare(self.st.depth_compare, a, b),
+                _ => None,
+            }
+        } else {
+            Some(true)
+        };
+        let Some(pass) = pass else { return unknown(s, d) };
+        if let Some(fs) = self.face {
+            let sv = s.unwrap_or(0);
+            let op = if pass { fs.pass_op } else { fs.depth_fail_op };
+            *s = Some(apply_op((self.op_of)(op), sv, fs.reference as u8, fs.write_mask as u8));
+        }
+        if !pass {
+            return (0, 0);
+        }
+        if self.depth_write {
+            *d = zf;
+        }
+        (1, 1)
+    }
 }
 
 #[cfg(test)]

@@ -317,7 +317,7 @@ impl SlotCompute {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::shadow::testmesh::{cube, uv_sphere};
+    use crate::geom::testmesh::{cube, uv_sphere};
     use glam::{Mat4, Vec3};
 
     #[test]

@@ -1,6 +1,9 @@
-//! Closed, CCW-outward test meshes (cube, UV sphere, torus) for tests and benchmarks.
+//! Closed, CCW-outward test meshes (cube, UV sphere, torus) for tests and benchmarks: compiled
+//! into the crate's own unit tests only (`#[cfg(test)]`), and included by path into the
+//! integration tests and benchmarks that need them (their parent module brings `Mesh` into
+//! scope), so they are not part of the library.
 
-use crate::geom::Mesh;
+use super::Mesh;
 use glam::Vec3;
 
 /// Axis-aligned cube of half-size `h` around `c`: 8 vertices, 12 triangles.
@@ -105,15 +108,4 @@ pub fn signed_volume(m: &Mesh) -> f64 {
             p(0).dot(p(1).cross(p(2))) / 6.0
         })
         .sum()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    #[test]
-    fn outward() {
-        assert!((signed_volume(&cube(Vec3::ONE, 1.0)) - 8.0).abs() < 1e-9);
-        assert!(signed_volume(&uv_sphere(1.0, 32, 16)) > 3.5);
-        assert!(signed_volume(&torus(1.0, 0.25, 32, 16)) > 0.5);
-    }
 }
