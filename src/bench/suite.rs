@@ -82,20 +82,19 @@ fn scene_of(p: &PointScene) -> Result<(Scene, String)> {
     }
 }
 
+/// Where a suite point sits: its sweep, its x on that sweep and its scene's name.
+#[derive(Clone, Copy)]
+struct Point<'a> {
+    sweep: &'a str,
+    x: f64,
+    name: &'a str,
+}
+
 impl Runner {
     /// Measures every variant on one scene and size. `errors`: render the reference too and
     /// fill in each technique's error.
-    #[allow(clippy::too_many_arguments)]
-    fn point(
-        &mut self,
-        sweep: &str,
-        x: f64,
-        scene: Scene,
-        name: &str,
-        size: (u32, u32),
-        variants: &[Variant],
-        errors: bool,
-    ) -> Result<Vec<SuiteRow>> {
+    fn point(&mut self, at: Point, scene: Scene, size: (u32, u32), variants: &[Variant], errors: bool) -> Result<Vec<SuiteRow>> {
+        let Point { sweep, name, .. } = at;
         let ctx = self.ctx.take().ok_or_else(|| Error::Other("context lost".into()))?;
         if self.log {
             eprintln!("[{:>6.1} s] {sweep} {name} {}x{} ({} variants)", self.start.elapsed().as_secs_f64(), size.0, size.1, variants.len());
@@ -110,22 +109,13 @@ impl Runner {
             scene.meshes.iter().filter(|m| m.casts_shadow).map(|m| (m.name.clone(), m.mesh.triangles.len() as u64)).collect();
         let mut r = Renderer::new(ctx, scene, opts)?;
         let shape = PointShape { casters, triangles, nlights, map_faces, mesh_triangles: &mesh_triangles };
-        let result = self.measure(&mut r, sweep, x, name, variants, errors, shape);
+        let result = self.measure(&mut r, at, variants, errors, shape);
         self.ctx = Some(r.into_context());
         result
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn measure(
-        &mut self,
-        r: &mut Renderer,
-        sweep: &str,
-        x: f64,
-        name: &str,
-        variants: &[Variant],
-        errors: bool,
-        shape: PointShape,
-    ) -> Result<Vec<SuiteRow>> {
+    fn measure(&mut self, r: &mut Renderer, at: Point, variants: &[Variant], errors: bool, shape: PointShape) -> Result<Vec<SuiteRow>> {
+        let Point { sweep, x, name } = at;
         let PointShape { casters, triangles, nlights, map_faces, mesh_triangles } = shape;
         let mut kept: Vec<&Variant> = Vec::with_capacity(variants.len());
         for v in variants {
@@ -336,26 +326,32 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
     for &n in named {
         run.bar.set_message(format!("scenes {n}"));
         let scene = crate::scene::load(n)?;
-        rows.extend(run.point("scenes", 0.0, scene, n, base, &all, true)?);
+        rows.extend(run.point(Point { sweep: "scenes", x: 0.0, name: n }, scene, base, &all, true)?);
     }
     for p in &points {
         let SweepPoint { sweep, x, scene, size } = p;
         let (scene, name) = scene_of(scene)?;
         run.bar.set_message(format!("{sweep} {name} {}x{}", size.0, size.1));
         let variants = if *sweep == "caps" { &caps } else { &all };
-        rows.extend(run.point(sweep, *x, scene, &name, *size, variants, false)?);
+        rows.extend(run.point(Point { sweep, x: *x, name: &name }, scene, *size, variants, false)?);
     }
     // Ablations: McGuire with each optimisation off; index formats on the vertex scene.
     for &n in ablation_scenes {
         run.bar.set_message(format!("ablation {n}"));
         let scene = crate::scene::load(n)?;
-        rows.extend(run.point("ablation", 0.0, scene, n, base, &toggle_variants, false)?);
+        rows.extend(run.point(Point { sweep: "ablation", x: 0.0, name: n }, scene, base, &toggle_variants, false)?);
     }
     // Lights with a range, casters beyond some of them: what scissor and culling are for.
     let ranged = super::scenes::SweepScene::ranged();
-    rows.extend(run.point("ablation", 0.0, ranged.build(), &ranged.name(), base, &toggle_variants, false)?);
+    rows.extend(run.point(Point { sweep: "ablation", x: 0.0, name: &ranged.name() }, ranged.build(), base, &toggle_variants, false)?);
     run.bar.set_message("ablation index formats");
-    rows.extend(run.point("ablation", 0.0, crate::scene::load(index_scene)?, index_scene, base, &index_variants, false)?);
+    rows.extend(run.point(
+        Point { sweep: "ablation", x: 0.0, name: index_scene },
+        crate::scene::load(index_scene)?,
+        base,
+        &index_variants,
+        false,
+    )?);
     run.bar.finish_and_clear();
     let ctx = run.ctx.take().ok_or_else(|| Error::Other("context lost".into()))?;
     ctx.check_validation()?;

@@ -308,8 +308,8 @@ static SPREAD: [u64; 256] = {
 mod tests {
     use super::*;
     use crate::geom::silhouette::{possible_silhouette_packed, FacePlanes};
-    use crate::geom::topology::Topology;
     use crate::geom::testmesh::{cube, shuffled, uv_sphere};
+    use crate::geom::topology::Topology;
     use glam::{Vec3, Vec4};
     use proptest::prelude::*;
 

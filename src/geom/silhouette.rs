@@ -163,8 +163,8 @@ pub fn possible_silhouette_packed_into(edges: &[ManifoldEdge], bits: &[u64], out
 mod tests {
     use super::*;
     use crate::geom::planes::exact_bit;
-    use crate::geom::topology::Topology;
     use crate::geom::testmesh::{cube, uv_sphere};
+    use crate::geom::topology::Topology;
     use glam::Vec3;
 
     #[test]

@@ -83,7 +83,8 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
             if let (Some(cf), Some(st)) = (compute.as_mut(), gpu.compute.as_ref()) {
                 if cp.parts.iter().any(|p| p.path == "compute" && p.case != Case::Culled) {
                     let buffers: Vec<vk::Buffer> = gpu.chunks.iter().map(|b| b.raw).collect();
-                    cf.add_caster(li, cstats.len(), cp.caster, caster, st, cp, &buffers, &mut draws);
+                    let at = crate::pass::compute::frame::CasterAt { light: li, stat: cstats.len(), caster: cp.caster };
+                    cf.add_caster(at, caster, st, cp, &buffers, &mut draws);
                     fmt_used = IndexFormat::U16.name();
                 }
             }

@@ -296,7 +296,8 @@ fn transmit_pipes(create: &mut Create, c: &PipelineDesc, format: vk::Format) -> 
     let mut tm = c.clone();
     tm.color_formats = &map_fmt;
     let mut t = [[vk::Pipeline::null(); 2]; 2];
-    for (li, (frag, blend)) in [(shaders::TRANSMIT_FRAG, Blend::Multiply), (shaders::TRANSMIT_LOG_FRAG, Blend::Additive)].into_iter().enumerate()
+    for (li, (frag, blend)) in
+        [(shaders::TRANSMIT_FRAG, Blend::Multiply), (shaders::TRANSMIT_LOG_FRAG, Blend::Additive)].into_iter().enumerate()
     {
         tm.fragment = Some(frag);
         tm.blend = blend;

@@ -355,7 +355,8 @@ fn build_parts(topo: &Topology, limit: usize, whole: bool) -> (Vec<Part>, Vec<Ch
             CasterKind::Multiplicity { reason: why.join(", ") }
         };
         let first = chunks.len();
-        build_chunks(mesh, &ptris, bounds.center(), limit, &mut chunks, &mut tri_chunk, &mut stamp, &mut local);
+        let out = Chunking { chunks: &mut chunks, tri_chunk: &mut tri_chunk, stamp: &mut stamp, local: &mut local };
+        build_chunks(mesh, &ptris, bounds.center(), limit, out);
         parts.push(Part {
             kind,
             triangles: ptris,
@@ -368,19 +369,21 @@ fn build_parts(topo: &Topology, limit: usize, whole: bool) -> (Vec<Part>, Vec<Ch
     (parts, chunks, tri_chunk)
 }
 
+/// Where [`build_chunks`] writes: the chunks, each triangle's (chunk, index in it), and the
+/// per-vertex scratch shared across calls (the chunk a vertex was last added to, its local
+/// index there).
+struct Chunking<'a> {
+    chunks: &'a mut Vec<Chunk>,
+    tri_chunk: &'a mut [(u32, u32)],
+    stamp: &'a mut [u32],
+    local: &'a mut [u16],
+}
+
 /// Greedy chunking of the triangles `tris` in their order (mesh order usually has good
-/// locality), appended to `chunks`; `stamp`/`local`: per-vertex scratch shared across calls.
-#[allow(clippy::too_many_arguments)]
-fn build_chunks(
-    mesh: &Mesh,
-    tris: &[u32],
-    apex: Vec3,
-    limit: usize,
-    chunks: &mut Vec<Chunk>,
-    tri_chunk: &mut [(u32, u32)],
-    stamp: &mut [u32],
-    local: &mut [u16],
-) {
+/// locality), appended to `out.chunks`, with the apex at `apex` and at most `limit` vertices
+/// a chunk.
+fn build_chunks(mesh: &Mesh, tris: &[u32], apex: Vec3, limit: usize, out: Chunking) {
+    let Chunking { chunks, tri_chunk, stamp, local } = out;
     let max_local = limit - 1; // room for the apex
     let new_chunk = || Chunk { vertices: Vec::new(), local_tris: Vec::new(), tri_ids: Vec::new(), global_ids: Vec::new() };
     let mut cur = new_chunk();

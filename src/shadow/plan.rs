@@ -278,7 +278,7 @@ fn select_case(method: Method, pyramid: &OcclusionPyramid, frustum: &Frustum, wb
 
 mod multiplicity;
 pub use multiplicity::{edge_multiplicities, emit_multiplicity, MultiplicityInput};
-use multiplicity::{edge_multiplicities_with, emit_multiplicity_with};
+use multiplicity::{edge_multiplicities_with, emit_multiplicity_with, VolumeShape};
 
 /// How expensive a case is to draw (the caster's case is its most expensive part's).
 fn case_rank(c: Case) -> u8 {
@@ -311,19 +311,27 @@ pub fn manifold_emit(method: Method, part: &super::caster::Part, case: Case, l_o
     Emit { formulation, directional, dark_cap, light_cap: case == Case::ZFailLightCap }
 }
 
+/// Which part of a caster [`plan_part`] plans, on which path and in which case.
+#[derive(Clone, Copy)]
+struct PartJob {
+    /// Index of the part in [`Caster::parts`].
+    part: usize,
+    /// The edge-multiplicity path (else the silhouette path).
+    multiplicity: bool,
+    case: Case,
+}
+
 /// Plans one part of a caster for which the facing `bits` are decided; returns the part plan
 /// and its draws.
-#[allow(clippy::too_many_arguments)]
 fn plan_part(
     input: &PlanInput,
     caster: &Caster,
-    pi: usize,
-    multiplicity: bool,
-    case: Case,
+    job: PartJob,
     l_obj: Vec4,
     bits: &[u64],
     sil: &mut Vec<SilhouetteEdge>,
 ) -> (PartPlan, Vec<ChunkDraw>) {
+    let PartJob { part: pi, multiplicity, case } = job;
     let part = &caster.parts[pi];
     let directional = l_obj.w == 0.0;
     let facing = Packed(bits);
@@ -343,8 +351,15 @@ fn plan_part(
         } else {
             DarkCap::AllFaces
         };
-        let (draws, sides, dark_cap, light_cap, edges, mmax) =
-            emit_multiplicity_with(caster, part.chunks.clone(), &part.edges, &facing, |_| opaque, &mult, case, directional, dark_cap_kind);
+        let (draws, sides, dark_cap, light_cap, edges, mmax) = emit_multiplicity_with(
+            caster,
+            part.chunks.clone(),
+            &part.edges,
+            &facing,
+            |_| opaque,
+            &mult,
+            VolumeShape { case, directional, dark_cap: dark_cap_kind },
+        );
         let pp = PartPlan {
             part: pi,
             case,
@@ -482,7 +497,7 @@ pub fn plan_light_with(input: &PlanInput, casters: &[Caster], opts: &PlanOptions
                 cp.parts.push(PartPlan::undrawn(pi, case, path, DarkCap::None, Formulation::Front));
                 continue;
             }
-            let (pp, draws) = plan_part(input, caster, pi, multiplicity, case, l_obj, &bits, &mut sil);
+            let (pp, draws) = plan_part(input, caster, PartJob { part: pi, multiplicity, case }, l_obj, &bits, &mut sil);
             cp.silhouette_edges += pp.silhouette_edges;
             cp.multiplicity_max = cp.multiplicity_max.max(pp.multiplicity_max);
             cp.sides += pp.sides;

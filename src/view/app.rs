@@ -453,7 +453,7 @@ impl Live {
                 None => return,
             },
         };
-        controls::drag(&mut self.edits, self.mode, kind, index, origin, from, to, size);
+        controls::drag(&mut self.edits, self.mode, kind, index, origin, controls::Stroke { from, to, size });
     }
 
     /// Waits for the device and destroys everything, the context last; validation's

@@ -154,11 +154,22 @@ pub fn zoom(camera: &Camera, steps: f32) -> Camera {
     c
 }
 
-/// The edit of one drag step from `a` to `b` (window pixels) in `mode`, on what `index`
-/// selects (a mesh or a light; ignored in scene mode). `origin`: the moved thing's world
-/// origin (the mesh's or the light's position as drawn; the target in scene mode).
-#[allow(clippy::too_many_arguments)]
-pub fn drag(edits: &mut Edits, mode: Mode, kind: DragKind, index: usize, origin: Vec3, a: Vec2, b: Vec2, size: Vec2) {
+/// One step of a drag, in window pixels.
+#[derive(Clone, Copy, Debug)]
+pub struct Stroke {
+    /// Where the cursor was.
+    pub from: Vec2,
+    /// Where it is.
+    pub to: Vec2,
+    /// The window's size.
+    pub size: Vec2,
+}
+
+/// The edit of one drag step (`stroke`) in `mode`, on what `index` selects (a mesh or a light; ignored in scene mode). `origin`: the moved
+/// thing's world origin (the mesh's or the light's position as drawn; the target in scene
+/// mode).
+pub fn drag(edits: &mut Edits, mode: Mode, kind: DragKind, index: usize, origin: Vec3, stroke: Stroke) {
+    let Stroke { from: a, to: b, size } = stroke;
     let camera = edits.camera.clone();
     match kind {
         DragKind::Rotate => {
@@ -235,7 +246,14 @@ mod tests {
     fn light_drag_rotates_about_the_origin_keeping_the_distance() {
         let mut e = Edits::new(cam(), 0, 1);
         let size = Vec2::new(400.0, 400.0);
-        drag(&mut e, Mode::Light, DragKind::Rotate, 0, Vec3::ZERO, Vec2::new(200.0, 200.0), Vec2::new(260.0, 170.0), size);
+        drag(
+            &mut e,
+            Mode::Light,
+            DragKind::Rotate,
+            0,
+            Vec3::ZERO,
+            Stroke { from: Vec2::new(200.0, 200.0), to: Vec2::new(260.0, 170.0), size },
+        );
         let l = Light {
             kind: LightKind::Point,
             position: Vec3::new(3.0, 4.0, 0.0),
@@ -265,7 +283,14 @@ mod tests {
     fn scene_rotation_turns_the_camera_the_other_way() {
         let mut e = Edits::new(cam(), 0, 0);
         let size = Vec2::new(400.0, 400.0);
-        drag(&mut e, Mode::Scene, DragKind::Rotate, 0, Vec3::ZERO, Vec2::new(200.0, 200.0), Vec2::new(300.0, 200.0), size);
+        drag(
+            &mut e,
+            Mode::Scene,
+            DragKind::Rotate,
+            0,
+            Vec3::ZERO,
+            Stroke { from: Vec2::new(200.0, 200.0), to: Vec2::new(300.0, 200.0), size },
+        );
         // The scene turns right (counter-clockwise from above): the eye goes left (-x).
         assert!(e.camera.eye.x < -0.5, "{}", e.camera.eye);
         assert!((e.camera.eye.length() - 10.0).abs() < 1e-4);
@@ -284,7 +309,7 @@ mod tests {
         let mut e = Edits::new(cam(), 1, 0);
         let o = Vec3::new(2.0, 0.0, 0.0);
         let size = Vec2::new(400.0, 400.0);
-        drag(&mut e, Mode::Model, DragKind::Rotate, 0, o, Vec2::new(200.0, 200.0), Vec2::new(200.0, 120.0), size);
+        drag(&mut e, Mode::Model, DragKind::Rotate, 0, o, Stroke { from: Vec2::new(200.0, 200.0), to: Vec2::new(200.0, 120.0), size });
         assert!(e.meshes[0].transform_point3(o).distance(o) < 1e-5);
         assert_ne!(e.meshes[0], Mat4::IDENTITY);
     }

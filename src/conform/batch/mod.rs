@@ -333,7 +333,13 @@ struct BatchDraw {
 
 /// Every case's draws in order, one pipeline per distinct state (kept in `o`), their vertices
 /// in one array, and the number of occlusion queries.
-fn batch_draws(ctx: &Context, cfg: Config, cases: &[&Case], origins: &[(u32, u32)], o: &mut Objects) -> Result<(Vec<BatchDraw>, Vec<[f32; 4]>, u32)> {
+fn batch_draws(
+    ctx: &Context,
+    cfg: Config,
+    cases: &[&Case],
+    origins: &[(u32, u32)],
+    o: &mut Objects,
+) -> Result<(Vec<BatchDraw>, Vec<[f32; 4]>, u32)> {
     let mut pipe_of: HashMap<String, vk::Pipeline> = HashMap::new();
     let mut verts: Vec<[f32; 4]> = Vec::new();
     let mut recs = Vec::new();
@@ -400,7 +406,14 @@ unsafe fn set_dynamic_state(d: &ash::Device, cb: vk::CommandBuffer, st: &super::
 
 /// Each case's tile of the read-back depth (`bpp` bytes a texel; none when 0 or no depth) and
 /// stencil, with its share of the occlusion query `counts`.
-fn tiles(cases: &[&Case], origins: &[(u32, u32)], width: u32, (depth_bytes, stencil_bytes): (&[u8], &[u8]), bpp: usize, counts: &[u64]) -> Vec<TileResult> {
+fn tiles(
+    cases: &[&Case],
+    origins: &[(u32, u32)],
+    width: u32,
+    (depth_bytes, stencil_bytes): (&[u8], &[u8]),
+    bpp: usize,
+    counts: &[u64],
+) -> Vec<TileResult> {
     let mut out = Vec::with_capacity(cases.len());
     let mut qi = 0usize;
     for (c, &(ox, oy)) in cases.iter().zip(origins) {

@@ -59,26 +59,36 @@ pub(crate) struct ComputeFrame {
     pub read_back: Cell<bool>,
 }
 
+/// Where a caster's compute work goes: its light, its index in that light's stats, and its
+/// index among the pass's casters.
+#[derive(Clone, Copy, Debug)]
+pub struct CasterAt {
+    /// The light.
+    pub light: usize,
+    /// The caster's index in the light's lists (its stats).
+    pub stat: usize,
+    /// The caster's index in the pass.
+    pub caster: usize,
+}
+
 impl ComputeFrame {
     pub fn set_of(&self, caster: usize) -> Option<vk::DescriptorSet> {
         self.sets.iter().find(|(c, _)| *c == caster).map(|&(_, s)| s)
     }
 
-    /// Lays out caster `ci`'s chunk records for light `li` from its plan `cp` (the parts the
-    /// planner left to the GPU: path `"compute"`), and appends the chunks' indirect draws to
-    /// `draws`. `stat` is the caster's index in the light's lists.
-    #[allow(clippy::too_many_arguments)]
+    /// Lays out caster `at.caster`'s chunk records for light `at.light` from its plan `cp` (the
+    /// parts the planner left to the GPU: path `"compute"`), and appends the chunks' indirect
+    /// draws to `draws`.
     pub fn add_caster(
         &mut self,
-        li: usize,
-        stat: usize,
-        ci: usize,
+        at: CasterAt,
         caster: &Caster,
         st: &ComputeStatic,
         cp: &CasterPlan,
         chunk_buffers: &[vk::Buffer],
         draws: &mut Vec<Draw>,
     ) {
+        let CasterAt { light: li, stat, caster: ci } = at;
         while self.jobs.len() <= li {
             self.jobs.push(Vec::new());
         }

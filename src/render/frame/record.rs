@@ -5,7 +5,7 @@ use crate::error::Result;
 use crate::pass::PreparedFrame;
 use crate::render::counters::CounterPools;
 use crate::render::options::*;
-use crate::render::passes::{self, debug, determine, gbuffer, illuminate, intensity, samples, tonemap, transparent, Rec};
+use crate::render::passes::{self, debug, determine, gbuffer, illuminate, intensity, samples, tonemap, transparent, Rec, SceneDraw};
 use crate::render::push::LightPush;
 use crate::render::readback::Layout;
 use crate::render::scene_gpu::Sidedness;
@@ -37,6 +37,7 @@ impl Renderer {
     pub(super) fn record_frame(&self, rec: &Rec, input: &FrameInputs) -> Result<FrameSpans> {
         let FrameInputs { frame, layout, instances, spheres, vp_rel, lights, float_counts, counters } = *input;
         let (t, p, pass) = (&self.own.parts.targets, &self.own.parts.pipes, &self.own.parts.pass);
+        let sd = SceneDraw { t, p, geo: &self.own.parts.geo, instances, vp_rel, ambient: self.own.parts.scene.ambient };
         let stamp = |stage| rec.timer.stamp(rec.ctx, rec.cb, stage);
         let all = vk::PipelineStageFlags2::ALL_COMMANDS;
         let mut spans = FrameSpans::default();
@@ -47,7 +48,7 @@ impl Renderer {
         // layouts each pass expects are those the previous pass leaves.
         unsafe {
             pass.cmd_upload(rec.cb, frame)?;
-            gbuffer::record(rec, t, p, &self.own.parts.geo, instances, vp_rel, self.own.parts.scene.ambient, spheres);
+            gbuffer::record(rec, &sd, spheres);
             spans.depth.end = stamp(all);
             let into = match (&self.own.parts.shadow_mapper, self.settings.counter) {
                 (Some(_), _) => determine::CountInto::External,
@@ -82,14 +83,15 @@ impl Renderer {
                     intensity::record(rec, pass, frame, li, t, self.settings.transmit_log, layout.transmit.get(li).copied())?;
                 }
                 let begin = stamp(all);
-                illuminate::record(rec, pass, frame, li, t, p, float_counts, self.own.parts.has_transparent, &lights[li])?;
+                let mode = illuminate::Lighting { float: float_counts, transmit: self.own.parts.has_transparent };
+                illuminate::record(rec, pass, frame, li, &sd, mode, &lights[li])?;
                 spans.illuminate.push(passes::timing_span(begin, stamp(all)));
             }
             if self.own.parts.geo.of(Sidedness::Transparent).next().is_some() {
                 let forward = if self.own.parts.self_shadow.is_some() { &[][..] } else { lights };
-                transparent::record(rec, t, p, &self.own.parts.geo, instances, vp_rel, self.own.parts.scene.ambient, forward);
+                transparent::record(rec, &sd, forward);
                 if let Some(ss) = &self.own.parts.self_shadow {
-                    ss.record(rec, t, p, pass, frame, &self.own.parts.geo, instances, vp_rel, lights, self.settings.transmit_log)?;
+                    ss.record(rec, &sd, pass, frame, lights, self.settings.transmit_log)?;
                 }
             }
             if self.settings.view == View::Volumes {

@@ -4,28 +4,16 @@
 //!    opaque mesh two-sided. Analytic spheres are ray-cast in their bounding cubes (exact
 //!    depth, normal and position).
 
-use super::{att, Rec, DS_CLEAR, SKY, ZERO};
-use crate::render::pipelines::FramePipelines;
+use super::{att, Rec, SceneDraw, DS_CLEAR, SKY, ZERO};
 use crate::render::push::{GBufferPush, SpherePush};
-use crate::render::scene_gpu::{SceneGeometry, Sidedness};
-use crate::render::targets::Targets;
+use crate::render::scene_gpu::Sidedness;
 use ash::vk;
-use glam::{Mat4, Vec3};
 
 /// # Safety
 /// `rec.cb` is recording outside a rendering instance; `instances` is this slot's instance
 /// buffer and `spheres` this slot's sphere cubes (buffer, vertex count), written for this frame.
-#[allow(clippy::too_many_arguments)]
-pub(crate) unsafe fn record(
-    rec: &Rec,
-    t: &Targets,
-    p: &FramePipelines,
-    geo: &SceneGeometry,
-    instances: vk::Buffer,
-    vp_rel: Mat4,
-    ambient: Vec3,
-    spheres: Option<(vk::Buffer, u32)>,
-) {
+pub(crate) unsafe fn record(rec: &Rec, sd: &SceneDraw, spheres: Option<(vk::Buffer, u32)>) {
+    let SceneDraw { t, p, geo, instances, vp_rel, ambient } = *sd;
     for img in t.gbuffer() {
         rec.transition(img, vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
     }

@@ -2,28 +2,33 @@
 //!     light's scissor, Blinn-Phong from the G-buffer, scaled by the light-intensity map,
 //!     added into the float target.
 
-use super::{att, Rec, COLOR_RW, DS_CLEAR, DS_RW, FRAG_TESTS, ZERO};
+use super::{att, Rec, SceneDraw, COLOR_RW, DS_CLEAR, DS_RW, FRAG_TESTS, ZERO};
 use crate::pass::{PreparedFrame, ShadowPass};
-use crate::render::pipelines::FramePipelines;
 use crate::render::push::LightPush;
-use crate::render::targets::Targets;
 use ash::vk;
+
+/// Which lighting pipeline: the count in the float target (or the stencil), the light scaled
+/// by the transparent casters' light-intensity map (or not).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Lighting {
+    pub float: bool,
+    pub transmit: bool,
+}
 
 /// # Safety
 /// `rec.cb` is recording outside a rendering instance; the G-buffer, the count target (float)
 /// and the intensity map (`transmit`) are in shader-read layout.
-#[allow(clippy::too_many_arguments)]
 pub(crate) unsafe fn record(
     rec: &Rec,
     pass: &ShadowPass,
     frame: &PreparedFrame,
     light: usize,
-    t: &Targets,
-    p: &FramePipelines,
-    float: bool,
-    transmit: bool,
+    sd: &SceneDraw,
+    mode: Lighting,
     push: &LightPush,
 ) -> crate::error::Result<()> {
+    let (t, p) = (sd.t, sd.p);
+    let Lighting { float, transmit } = mode;
     let load = vk::AttachmentLoadOp::LOAD;
     let accum = [att(&t.accum, load, ZERO)];
     let depth = att(&t.depth, load, DS_CLEAR);

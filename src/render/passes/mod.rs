@@ -18,7 +18,24 @@ use super::readback::Range;
 use super::timing::{Span, Timer};
 use crate::gpu::resources::{memory_barrier, transition};
 use crate::gpu::{Context, Image};
+use crate::render::pipelines::FramePipelines;
+use crate::render::scene_gpu::SceneGeometry;
+use crate::render::targets::Targets;
 use ash::vk;
+use glam::{Mat4, Vec3};
+
+/// What the passes that draw the scene (and the lighting) record with, besides [`Rec`]: the
+/// frame's targets and pipelines, the scene's geometry as this slot's instance buffer places it,
+/// the eye-relative view-projection and the ambient light.
+#[derive(Clone, Copy)]
+pub(crate) struct SceneDraw<'a> {
+    pub t: &'a Targets,
+    pub p: &'a FramePipelines,
+    pub geo: &'a SceneGeometry,
+    pub instances: vk::Buffer,
+    pub vp_rel: Mat4,
+    pub ambient: Vec3,
+}
 
 /// What every pass records with.
 pub(crate) struct Rec<'a> {

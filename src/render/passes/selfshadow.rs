@@ -30,7 +30,7 @@
 //! Everything here runs only when `RenderOptions::self_shadow` is set and the scene has
 //! transparent casters; otherwise the frame records exactly the passes it did before.
 
-use super::{att, transparent, Rec, COLOR_RW, DS_CLEAR, DS_RW, FRAG_TESTS, ZERO};
+use super::{att, transparent, Rec, SceneDraw, COLOR_RW, DS_CLEAR, DS_RW, FRAG_TESTS, ZERO};
 use crate::error::Result;
 use crate::gpu::descriptors::{pipeline_layout, Binding, DescriptorSet};
 use crate::gpu::pipeline::{self, Blend};
@@ -38,10 +38,8 @@ use crate::gpu::{shaders, Context, Image};
 use crate::pass::{PreparedFrame, ShadowPass, VolumeKind};
 use crate::render::pipelines::{scene_pipeline, FramePipelines};
 use crate::render::push::{ForwardPush, LightPush};
-use crate::render::scene_gpu::SceneGeometry;
 use crate::render::targets::*;
 use ash::vk;
-use glam::Mat4;
 
 /// The self-shadowing pass's own targets and pipelines.
 pub(crate) struct SelfShadow {
@@ -107,20 +105,16 @@ impl SelfShadow {
     /// # Safety
     /// `rec.cb` is recording outside a rendering instance; the accumulation target and the
     /// opaque depth are in attachment layout; `frame` was prepared by `pass` for this slot.
-    #[allow(clippy::too_many_arguments)]
     pub(crate) unsafe fn record(
         &self,
         rec: &Rec,
-        t: &Targets,
-        p: &FramePipelines,
+        sd: &SceneDraw,
         pass: &ShadowPass,
         frame: &PreparedFrame,
-        geo: &SceneGeometry,
-        instances: vk::Buffer,
-        vp_rel: Mat4,
         lights: &[LightPush],
         log: bool,
     ) -> crate::error::Result<()> {
+        let SceneDraw { t, p, geo, instances, vp_rel, .. } = *sd;
         let d = &rec.ctx.device;
         let cb = rec.cb;
         let load = vk::AttachmentLoadOp::LOAD;

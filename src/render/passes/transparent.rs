@@ -2,13 +2,10 @@
 //!    term, then each light added (unsorted: an order-independent approximation; without
 //!    `--self-shadow` transparent surfaces receive no shadows).
 
-use super::{att, Rec, DS_CLEAR, ZERO};
-use crate::render::pipelines::FramePipelines;
+use super::{att, Rec, SceneDraw, DS_CLEAR, ZERO};
 use crate::render::push::{ForwardPush, LightPush};
 use crate::render::scene_gpu::{SceneGeometry, Sidedness};
-use crate::render::targets::Targets;
 use ash::vk;
-use glam::{Mat4, Vec3};
 
 /// Draws every transparent mesh with `push` (the caller binds the pipeline).
 ///
@@ -29,17 +26,8 @@ pub(crate) unsafe fn draw_meshes(rec: &Rec, layout: vk::PipelineLayout, geo: &Sc
 ///
 /// # Safety
 /// `rec.cb` is recording outside a rendering instance; accumulation and depth in attachment layout.
-#[allow(clippy::too_many_arguments)]
-pub(crate) unsafe fn record(
-    rec: &Rec,
-    t: &Targets,
-    p: &FramePipelines,
-    geo: &SceneGeometry,
-    instances: vk::Buffer,
-    vp_rel: Mat4,
-    ambient: Vec3,
-    lights: &[LightPush],
-) {
+pub(crate) unsafe fn record(rec: &Rec, sd: &SceneDraw, lights: &[LightPush]) {
+    let SceneDraw { t, p, geo, instances, vp_rel, ambient } = *sd;
     let load = vk::AttachmentLoadOp::LOAD;
     let accum = [att(&t.accum, load, ZERO)];
     let depth = att(&t.depth, load, DS_CLEAR);

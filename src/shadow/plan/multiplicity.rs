@@ -44,12 +44,21 @@ pub fn emit_multiplicity(
 ) -> (Vec<ChunkDraw>, usize, usize, usize, usize, u32) {
     let edge_ids: Vec<u32> = (0..mult.len() as u32).collect();
     let shielded = |g: u32| mi.shielded.get(g as usize).copied().unwrap_or(true);
-    emit_multiplicity_with(caster, 0..caster.chunks.len(), &edge_ids, mi.facing, shielded, mult, case, directional, dark_cap)
+    let shape = VolumeShape { case, directional, dark_cap };
+    emit_multiplicity_with(caster, 0..caster.chunks.len(), &edge_ids, mi.facing, shielded, mult, shape)
+}
+
+/// What volume [`emit_multiplicity_with`] emits: the case, a directional light (no dark cap),
+/// and the dark cap's kind.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct VolumeShape {
+    pub case: Case,
+    pub directional: bool,
+    pub dark_cap: DarkCap,
 }
 
 /// [`emit_multiplicity`] for the part whose chunks are `range` and whose edges are `edge_ids`
 /// (`mult[i]` the multiplicity of edge `edge_ids[i]`).
-#[allow(clippy::too_many_arguments)]
 pub(super) fn emit_multiplicity_with<F: FacingSet + ?Sized, S: Fn(u32) -> bool>(
     caster: &Caster,
     range: std::ops::Range<usize>,
@@ -57,10 +66,9 @@ pub(super) fn emit_multiplicity_with<F: FacingSet + ?Sized, S: Fn(u32) -> bool>(
     facing: &F,
     shielded: S,
     mult: &[i32],
-    case: Case,
-    directional: bool,
-    dark_cap: DarkCap,
+    shape: VolumeShape,
 ) -> (Vec<ChunkDraw>, usize, usize, usize, usize, u32) {
+    let VolumeShape { case, directional, dark_cap } = shape;
     let nch = caster.chunks.len();
     let mut vol: Vec<Vec<u16>> = vec![Vec::new(); nch];
     let mut cap: Vec<Vec<u16>> = vec![Vec::new(); nch];
