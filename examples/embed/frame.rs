@@ -10,26 +10,6 @@ use ash::vk;
 use glam::{DMat4, DVec3, DVec4, Vec3};
 use umbrage::pass::{reverse_z, DepthStencilTarget, ShadowView};
 
-/// Vulkan's standard sample locations (`standardSampleLocations`) of `samples` samples, in
-/// pixel units from the pixel's top-left corner.
-pub(super) fn sample_locations(samples: u32) -> &'static [(f64, f64)] {
-    match samples {
-        2 => &[(0.75, 0.75), (0.25, 0.25)],
-        4 => &[(0.375, 0.125), (0.875, 0.375), (0.125, 0.625), (0.625, 0.875)],
-        8 => &[
-            (0.5625, 0.3125),
-            (0.4375, 0.6875),
-            (0.8125, 0.5625),
-            (0.3125, 0.1875),
-            (0.1875, 0.8125),
-            (0.0625, 0.4375),
-            (0.6875, 0.9375),
-            (0.9375, 0.0625),
-        ],
-        _ => &[(0.5, 0.5)],
-    }
-}
-
 impl Host {
     /// Records and submits frame `f` into ring slot `f % 2`, after retiring that slot's
     /// previous frame (its fence, its readback into `out`).
@@ -350,7 +330,7 @@ impl Host {
             })
             .collect();
         let mut sample_frames = Vec::with_capacity(samples as usize);
-        for (si, &(sx, sy)) in sample_locations(samples).iter().enumerate() {
+        for (si, &(sx, sy)) in umbrage::render::standard_sample_locations(samples).iter().enumerate() {
             let geometry = &words[layout.geometry(si as u32) as usize..][..4 * n];
             let mut positions = Vec::with_capacity(3 * n);
             let mut normals = Vec::with_capacity(3 * n);

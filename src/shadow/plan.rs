@@ -277,7 +277,7 @@ fn select_case(method: Method, pyramid: &OcclusionPyramid, frustum: &Frustum, wb
 }
 
 mod multiplicity;
-pub use multiplicity::{edge_multiplicities, emit_multiplicity, MultiplicityInput};
+pub use multiplicity::{edge_multiplicities, emit_multiplicity, MultiplicityInput, MultiplicityVolume};
 use multiplicity::{edge_multiplicities_with, emit_multiplicity_with, VolumeShape};
 
 /// How expensive a case is to draw (the caster's case is its most expensive part's).
@@ -351,7 +351,7 @@ fn plan_part(
         } else {
             DarkCap::AllFaces
         };
-        let (draws, sides, dark_cap, light_cap, edges, mmax) = emit_multiplicity_with(
+        let MultiplicityVolume { draws, sides, dark_cap, light_cap, edges, max_multiplicity: mmax } = emit_multiplicity_with(
             caster,
             part.chunks.clone(),
             &part.edges,

@@ -32,8 +32,25 @@ pub(super) fn edge_multiplicities_with<F: FacingSet + ?Sized>(caster: &Caster, e
         .collect()
 }
 
-/// Emits a multiplicity caster's index lists; returns (draws, sides, dark cap, light cap,
-/// edges with m != 0, largest |m|).
+/// What [`emit_multiplicity`] emits for one caster (or part) and light: its draws and the
+/// triangle counts the stats report.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MultiplicityVolume {
+    /// One draw per chunk that has triangles.
+    pub draws: Vec<ChunkDraw>,
+    /// Side triangles: per edge, |m| quads (two triangles; one towards a directional light).
+    pub sides: usize,
+    /// Dark-cap triangles.
+    pub dark_cap: usize,
+    /// Light-cap triangles.
+    pub light_cap: usize,
+    /// Edges with a non-zero multiplicity (the silhouette).
+    pub edges: usize,
+    /// The largest |m|.
+    pub max_multiplicity: u32,
+}
+
+/// Emits a multiplicity caster's index lists and counts.
 pub fn emit_multiplicity(
     caster: &Caster,
     mi: &MultiplicityInput,
@@ -41,7 +58,7 @@ pub fn emit_multiplicity(
     case: Case,
     directional: bool,
     dark_cap: DarkCap,
-) -> (Vec<ChunkDraw>, usize, usize, usize, usize, u32) {
+) -> MultiplicityVolume {
     let edge_ids: Vec<u32> = (0..mult.len() as u32).collect();
     let shielded = |g: u32| mi.shielded.get(g as usize).copied().unwrap_or(true);
     let shape = VolumeShape { case, directional, dark_cap };
@@ -67,7 +84,7 @@ pub(super) fn emit_multiplicity_with<F: FacingSet + ?Sized, S: Fn(u32) -> bool>(
     shielded: S,
     mult: &[i32],
     shape: VolumeShape,
-) -> (Vec<ChunkDraw>, usize, usize, usize, usize, u32) {
+) -> MultiplicityVolume {
     let VolumeShape { case, directional, dark_cap } = shape;
     let nch = caster.chunks.len();
     let mut vol: Vec<Vec<u16>> = vec![Vec::new(); nch];
@@ -151,5 +168,5 @@ pub(super) fn emit_multiplicity_with<F: FacingSet + ?Sized, S: Fn(u32) -> bool>(
         }
     }
     let draws = chunk_draws(vol, cap, case);
-    (draws, sides, dark, light, edges, mmax)
+    MultiplicityVolume { draws, sides, dark_cap: dark, light_cap: light, edges, max_multiplicity: mmax }
 }
