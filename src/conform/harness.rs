@@ -5,7 +5,7 @@
 
 use crate::error::{Error, Result};
 use crate::gpu::pipeline::{self, PipelineDesc};
-use crate::gpu::resources::{memory_barrier, transition};
+use crate::gpu::resources::{aspect_copy, memory_barrier, transition};
 use crate::gpu::{shaders, Buffer, Context, Image};
 use ash::vk;
 use glam::Mat4;
@@ -306,14 +306,7 @@ unsafe fn record_draws(
 /// `cb` is recording outside a rendering instance; `img` is in TRANSFER_SRC_OPTIMAL and the
 /// buffers hold 4 bytes (depth) and 1 byte (stencil) per texel.
 unsafe fn copy_aspects(ctx: &Context, cb: vk::CommandBuffer, img: &Image, (depth, stencil): (vk::Buffer, vk::Buffer)) {
-    let region = |aspect| vk::BufferImageCopy {
-        buffer_offset: 0,
-        buffer_row_length: 0,
-        buffer_image_height: 0,
-        image_subresource: vk::ImageSubresourceLayers { aspect_mask: aspect, mip_level: 0, base_array_layer: 0, layer_count: 1 },
-        image_offset: vk::Offset3D::default(),
-        image_extent: vk::Extent3D { width: img.extent.width, height: img.extent.height, depth: 1 },
-    };
+    let region = |aspect| aspect_copy(aspect, img.extent, 0);
     let src = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
     // SAFETY: the caller's contract.
     unsafe {

@@ -291,6 +291,19 @@ impl Image {
     }
 }
 
+/// A tightly packed copy between a buffer at `buffer_offset` and one whole `aspect` of a 2D
+/// image of `extent` (its single mip level and layer).
+pub fn aspect_copy(aspect: vk::ImageAspectFlags, extent: vk::Extent2D, buffer_offset: u64) -> vk::BufferImageCopy {
+    vk::BufferImageCopy {
+        buffer_offset,
+        buffer_row_length: 0,
+        buffer_image_height: 0,
+        image_subresource: vk::ImageSubresourceLayers { aspect_mask: aspect, mip_level: 0, base_array_layer: 0, layer_count: 1 },
+        image_offset: vk::Offset3D::default(),
+        image_extent: vk::Extent3D { width: extent.width, height: extent.height, depth: 1 },
+    }
+}
+
 /// Records a layout transition of the whole `image` from `from` to `to` into `cb` (which must
 /// be recording), as a synchronization2 barrier scoped by the two layouts: the writes of the
 /// stages that use an image in `from` are made visible to the stages that use it in `to` (see

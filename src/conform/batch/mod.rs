@@ -12,7 +12,7 @@ mod pipe;
 use super::cases::{Case, Config, DepthKind, RenderModel, StateModel};
 use super::model::to_raw;
 use crate::error::{Error, Result};
-use crate::gpu::resources::{memory_barrier, transition};
+use crate::gpu::resources::{aspect_copy, memory_barrier, transition};
 use crate::gpu::{Buffer, Context, Image};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -191,14 +191,7 @@ fn run_inner(ctx: &Context, cfg: Config, cases: &[&Case], origins: &[(u32, u32)]
     let dynamic = cfg.state == StateModel::Dynamic;
     let bounds_feature = ctx.features.depth_bounds;
 
-    let region = |aspect: vk::ImageAspectFlags, offset: u64| vk::BufferImageCopy {
-        buffer_offset: offset,
-        buffer_row_length: 0,
-        buffer_image_height: 0,
-        image_subresource: vk::ImageSubresourceLayers { aspect_mask: aspect, mip_level: 0, base_array_layer: 0, layer_count: 1 },
-        image_offset: vk::Offset3D::default(),
-        image_extent: vk::Extent3D { width, height, depth: 1 },
-    };
+    let region = |aspect: vk::ImageAspectFlags, offset: u64| aspect_copy(aspect, extent, offset);
     let mut regions = vec![region(vk::ImageAspectFlags::STENCIL, stencil_offset)];
     if has_depth {
         regions.push(region(vk::ImageAspectFlags::DEPTH, 0));

@@ -10,7 +10,7 @@
 
 use crate::conform::CheckResult;
 use crate::error::{Error, Result};
-use crate::gpu::resources::memory_barrier;
+use crate::gpu::resources::{aspect_copy, memory_barrier};
 use crate::gpu::{pipeline, shaders, Buffer, Context, Image};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -240,14 +240,7 @@ fn render(ctx: &Context, o: &mut Objects, vertices: &[[f32; 4]]) -> Result<Count
     let (render_pass, framebuffer, layout, pipe) = (o.render_pass, o.framebuffer, o.layout, o.pipeline);
     ctx.one_shot(|cb| {
         let d = &ctx.device;
-        let region = |aspect| vk::BufferImageCopy {
-            buffer_offset: 0,
-            buffer_row_length: 0,
-            buffer_image_height: 0,
-            image_subresource: vk::ImageSubresourceLayers { aspect_mask: aspect, mip_level: 0, base_array_layer: 0, layer_count: 1 },
-            image_offset: vk::Offset3D::default(),
-            image_extent: vk::Extent3D { width: W, height: H, depth: 1 },
-        };
+        let region = |aspect| aspect_copy(aspect, vk::Extent2D { width: W, height: H }, 0);
         // SAFETY: `cb` is recording (one_shot); every handle was created above on this device
         // and outlives the submission, which one_shot waits for. The render pass leaves both
         // images in TRANSFER_SRC_OPTIMAL, made visible to the copies by its external dependency.

@@ -16,7 +16,7 @@ pub(crate) mod transparent;
 
 use super::readback::Range;
 use super::timing::{Span, Timer};
-use crate::gpu::resources::{memory_barrier, transition};
+use crate::gpu::resources::{aspect_copy, memory_barrier, transition};
 use crate::gpu::{Context, Image};
 use crate::render::pipelines::FramePipelines;
 use crate::render::scene_gpu::SceneGeometry;
@@ -114,10 +114,7 @@ impl Rec<'_> {
     /// Copies one aspect of `img` (in `layout`) into `range` of the readback buffer, and
     /// returns it to `layout`.
     pub fn copy_out(&self, img: &Image, aspect: vk::ImageAspectFlags, layout: vk::ImageLayout, range: Range) {
-        let region = vk::BufferImageCopy::default()
-            .buffer_offset(range.offset)
-            .image_subresource(vk::ImageSubresourceLayers { aspect_mask: aspect, mip_level: 0, base_array_layer: 0, layer_count: 1 })
-            .image_extent(vk::Extent3D { width: img.extent.width, height: img.extent.height, depth: 1 });
+        let region = aspect_copy(aspect, img.extent, range.offset);
         self.transition(img, layout, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
         // SAFETY: `cb` is recording outside a rendering instance; the range was sized for
         // this image's aspect when the readback buffer was laid out.
