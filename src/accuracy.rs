@@ -102,7 +102,7 @@ pub fn evaluate(renderer: &mut Renderer, scene_name: &str, techniques: &[Techniq
         rows.push(Row {
             scene: scene_name.to_string(),
             // The technique that actually ran ("edgequad", "shadowmap" or the method).
-            method: frame.stats.method.clone(),
+            method: frame.stats.method.name().to_string(),
             mismatches,
             compared,
             ambiguous: metrics.iter().map(|m| m.ambiguous).max().unwrap_or(0),

@@ -437,14 +437,14 @@ fn info(json: bool, scene: Option<&str>) -> Result<ExitCode> {
                 if c.reason.is_empty() { String::new() } else { format!("  ({})", c.reason) }
             );
             if c.parts.len() > 1 {
-                let manifold = c.parts.iter().filter(|p| p.path == "manifold").count();
+                let manifold = c.parts.iter().filter(|p| p.path == umbrage::shadow::VolumePath::Manifold).count();
                 println!(
                     "    {} parts: {} manifold, {} multiplicity (each planned on its own)",
                     c.parts.len(),
                     manifold,
                     c.parts.len() - manifold
                 );
-                for (i, p) in c.parts.iter().enumerate().filter(|(_, p)| p.path != "manifold") {
+                for (i, p) in c.parts.iter().enumerate().filter(|(_, p)| p.path != umbrage::shadow::VolumePath::Manifold) {
                     println!("      part {i}: {} triangles, multiplicity ({})", p.triangles, p.reason);
                 }
             }

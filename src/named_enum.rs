@@ -1,5 +1,6 @@
 //! `named_enum!`: an enum of named options with `name()`, `ALL`, `FromStr` (an unknown name
-//! lists the valid ones) and `Display`, shared by the pass's and the renderer's settings.
+//! lists the valid ones), `Display` and (feature `serde`) `Serialize` as the name, shared by
+//! the pass's and the renderer's settings and the stats' typed fields.
 
 /// Declares a `Copy` enum whose variants have string names (see the module docs).
 macro_rules! named_enum {
@@ -7,6 +8,7 @@ macro_rules! named_enum {
         $(#[$m])*
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Default)]
         #[cfg_attr(feature = "cli", derive(clap::ValueEnum))]
+        #[non_exhaustive]
         pub enum $name {
             $($(#[$vm])* #[cfg_attr(feature = "cli", value(name = $s))] $variant),+
         }
@@ -30,6 +32,13 @@ macro_rules! named_enum {
                     name: s.into(),
                     expected: Self::ALL.iter().map(|v| v.name()).collect::<Vec<_>>().join(", "),
                 })
+            }
+        }
+
+        #[cfg(feature = "serde")]
+        impl serde::Serialize for $name {
+            fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+                s.serialize_str(self.name())
             }
         }
 

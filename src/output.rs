@@ -200,8 +200,8 @@ pub fn info_text(r: &InfoReport) -> String {
 pub struct CasterInfo {
     /// The mesh's name in the scene.
     pub name: String,
-    /// "manifold" (McGuire's three cases) or "multiplicity" (Kim et al.).
-    pub path: String,
+    /// `manifold` (McGuire's three cases), `multiplicity` (Kim et al.) or `sphere`.
+    pub path: crate::shadow::VolumePath,
     /// Why a caster takes the multiplicity path (empty for manifold casters).
     pub reason: String,
     /// Triangles after welding.
@@ -236,8 +236,8 @@ pub struct SphereInfo {
 /// One connected component of a caster.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct PartInfo {
-    /// "manifold" or "multiplicity".
-    pub path: String,
+    /// `manifold` or `multiplicity`.
+    pub path: crate::shadow::VolumePath,
     /// Why this part takes the multiplicity path (empty for manifold parts).
     pub reason: String,
     /// Its triangles.
@@ -262,7 +262,7 @@ pub fn caster_report(scene: &Scene) -> Result<Vec<CasterInfo>> {
         }
         out.push(CasterInfo {
             name: sp.name.clone(),
-            path: "sphere".into(),
+            path: crate::shadow::VolumePath::Sphere,
             reason: match sp.segments {
                 Some(n) => format!("analytic sphere, {n} segments"),
                 None => format!("analytic sphere, segments per light at 960x540: {segs:?}"),
@@ -292,7 +292,7 @@ fn mesh_caster_report(scene: &Scene) -> Result<Vec<CasterInfo>> {
             let c = m.caster()?;
             Ok(CasterInfo {
                 name: c.name.clone(),
-                path: c.kind.path().to_string(),
+                path: c.kind.path(),
                 reason: match &c.kind {
                     crate::shadow::CasterKind::Multiplicity { reason } => reason.clone(),
                     _ => String::new(),
@@ -304,7 +304,7 @@ fn mesh_caster_report(scene: &Scene) -> Result<Vec<CasterInfo>> {
                     .parts
                     .iter()
                     .map(|p| PartInfo {
-                        path: p.kind.path().to_string(),
+                        path: p.kind.path(),
                         reason: match &p.kind {
                             crate::shadow::CasterKind::Multiplicity { reason } => reason.clone(),
                             _ => String::new(),

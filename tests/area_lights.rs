@@ -374,6 +374,7 @@ fn describe(l: &Light) -> String {
     match l.area.map(|a| a.shape) {
         Some(umbrage::geom::AreaShape::Disc { radius }) => format!("a disc of radius {radius}"),
         Some(umbrage::geom::AreaShape::Rect { width, height }) => format!("a {width} x {height} rectangle"),
+        Some(other) => format!("{other:?}"),
         None => "a point light".into(),
     }
 }

@@ -4,7 +4,7 @@
 //! input. Validation (synchronisation included) on.
 mod common;
 use umbrage::render::{FrameOutput, RenderOptions, Renderer, Technique};
-use umbrage::shadow::Method;
+use umbrage::shadow::{Method, VolumePath};
 
 fn frame(r: &mut Renderer, t: Technique) -> FrameOutput {
     r.settings.technique = t;
@@ -29,7 +29,7 @@ fn compare(r: &mut Renderer, name: &str) -> FrameOutput {
         assert!(g == g2, "{name}: compute frames differ");
     }
     let (cs, gs) = (&cpu.stats, &gpu.stats);
-    assert_eq!(gs.method, "compute");
+    assert_eq!(gs.method, Technique::Compute);
     for (li, (cl, gl)) in cs.lights.iter().zip(&gs.lights).enumerate() {
         for (cc, gc) in cl.casters.iter().zip(&gl.casters) {
             let what = format!("{name} light {li} caster {}", cc.name);
@@ -48,8 +48,8 @@ fn compare(r: &mut Renderer, name: &str) -> FrameOutput {
                     "{what} part {}",
                     cp.part
                 );
-                if cp.path == "manifold" {
-                    assert_eq!(gp.path, "compute", "{what} part {}", cp.part);
+                if cp.path == VolumePath::Manifold {
+                    assert_eq!(gp.path, VolumePath::Compute, "{what} part {}", cp.part);
                 }
             }
         }
@@ -149,6 +149,6 @@ fn compute_multiplicity_parts_fall_back_to_the_cpu() {
     let mut r = renderer(ctx, umbrage::scene::load("hard/open_casters").unwrap());
     let g = compare(&mut r, "hard/open_casters");
     let parts: Vec<&str> =
-        g.stats.lights.iter().flat_map(|l| l.casters.iter().flat_map(|c| c.parts.iter().map(|p| p.path.as_str()))).collect();
+        g.stats.lights.iter().flat_map(|l| l.casters.iter().flat_map(|c| c.parts.iter().map(|p| p.path.name()))).collect();
     assert!(parts.contains(&"multiplicity"), "{parts:?}");
 }

@@ -2,9 +2,11 @@
 //! point light case 1 = 2s, case 2 = 3s, case 3 = 3s + light-facing faces; directional s sides.
 mod common;
 use umbrage::geom::silhouette::facing_bits;
+use umbrage::geom::LightKind;
+use umbrage::pass::stats::UsedIndexFormat;
 use umbrage::render::{IndexFormat, RenderOptions, Renderer, Stats};
 use umbrage::shadow::plan::object_light;
-use umbrage::shadow::Method;
+use umbrage::shadow::{Case, DarkCap, Method};
 
 /// Three casters that fall in the three cases for light 0 (behind and above the camera), and
 /// a second light in front of the camera that puts the cube on the view axis in case 3.
@@ -66,7 +68,7 @@ fn render(ctx: umbrage::gpu::Context, toml: &str, name: &str, method: Method, fm
 }
 
 /// Checks every caster of every light against the formulas; returns the cases seen.
-fn check_formulas(stats: &Stats, r: &Renderer) -> Vec<String> {
+fn check_formulas(stats: &Stats, r: &Renderer) -> Vec<Case> {
     let mut seen = Vec::new();
     for ls in &stats.lights {
         let light = &r.scene().lights[ls.index];
@@ -74,27 +76,26 @@ fn check_formulas(stats: &Stats, r: &Renderer) -> Vec<String> {
             let caster = r.casters().iter().find(|c| c.name == cs.name).unwrap();
             let s = cs.silhouette_edges;
             let t = &cs.triangles;
-            seen.push(cs.case.clone());
-            if cs.dark_cap_kind == "BackFaces" {
+            seen.push(cs.case);
+            if cs.dark_cap_kind == DarkCap::BackFaces {
                 continue; // light inside the caster's box: the back-face formulation (documented)
             }
             let l = object_light(caster, light.homogeneous());
             let lit = facing_bits(caster.mesh(), l, caster.mirrored).iter().filter(|&&b| b).count() as u64;
             let ctx = format!("light {} caster {} case {} s={s} {t:?}", ls.index, cs.name, cs.case);
-            if ls.kind == "directional" {
+            if ls.kind == LightKind::Directional {
                 assert_eq!(t.sides, s, "{ctx}");
                 assert_eq!(t.dark_cap, 0, "{ctx}");
-                if cs.case == "zfail_light_cap" {
+                if cs.case == Case::ZFailLightCap {
                     assert_eq!(t.light_cap, lit, "{ctx}");
                 }
                 continue;
             }
-            match cs.case.as_str() {
-                "culled" => assert_eq!(t.total(), 0, "{ctx}"),
-                "zpass" => assert_eq!((t.sides, t.dark_cap, t.light_cap), (2 * s, 0, 0), "{ctx}"),
-                "zfail" => assert_eq!((t.sides, t.dark_cap, t.light_cap), (2 * s, s, 0), "{ctx}"),
-                "zfail_light_cap" => assert_eq!((t.sides, t.dark_cap, t.light_cap), (2 * s, s, lit), "{ctx}"),
-                other => panic!("unknown case {other}"),
+            match cs.case {
+                Case::Culled => assert_eq!(t.total(), 0, "{ctx}"),
+                Case::ZPass => assert_eq!((t.sides, t.dark_cap, t.light_cap), (2 * s, 0, 0), "{ctx}"),
+                Case::ZFail => assert_eq!((t.sides, t.dark_cap, t.light_cap), (2 * s, s, 0), "{ctx}"),
+                Case::ZFailLightCap => assert_eq!((t.sides, t.dark_cap, t.light_cap), (2 * s, s, lit), "{ctx}"),
             }
         }
     }
@@ -110,8 +111,8 @@ fn mcguire_counts_follow_the_paper_in_every_case() {
         seen.extend(check_formulas(&stats, &r));
         ctx = r.into_context();
     }
-    for case in ["zpass", "zfail", "zfail_light_cap"] {
-        assert!(seen.iter().any(|c| c == case), "no caster fell in case {case}: {seen:?}");
+    for case in [Case::ZPass, Case::ZFail, Case::ZFailLightCap] {
+        assert!(seen.contains(&case), "no caster fell in case {case}: {seen:?}");
     }
 }
 
@@ -123,7 +124,7 @@ fn mcguire_draws_fewer_triangles_than_lengyel_when_a_caster_is_in_case_2() {
     let mut compared = 0;
     for (lm, ll) in mc.lights.iter().zip(&le.lights) {
         for (cm, cl) in lm.casters.iter().zip(&ll.casters) {
-            if cm.case == "zfail" {
+            if cm.case == Case::ZFail {
                 compared += 1;
                 assert!(
                     cm.triangles.total() < cl.triangles.total(),
@@ -154,7 +155,7 @@ fn bytes_per_triangle_by_index_format() {
     if ctx.features.index_type_uint8 {
         // A box has 9 vertices (8 + apex): 8-bit indices, 3 bytes a triangle.
         let (stats, _r) = render(ctx, CASES, "cases", Method::McGuire, IndexFormat::U8);
-        let small: Vec<_> = stats.lights.iter().flat_map(|l| &l.casters).filter(|c| c.index_format == "u8").collect();
+        let small: Vec<_> = stats.lights.iter().flat_map(|l| &l.casters).filter(|c| c.index_format == UsedIndexFormat::U8).collect();
         assert!(!small.is_empty(), "no caster used u8 indices");
         for c in small {
             assert_eq!(c.index_bytes, 3 * c.triangles.total(), "{}", c.name);

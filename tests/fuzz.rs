@@ -21,7 +21,7 @@ use umbrage::geom::silhouette::packed_bit;
 use umbrage::geom::topology::{Topology, Weld};
 use umbrage::geom::{Camera, Light, LightKind, Mesh};
 use umbrage::scene::{obj::load_obj_str, shapes};
-use umbrage::shadow::{plan_light_with, Case, Caster, CasterPlan, Method, PlanInput, PlanOptions};
+use umbrage::shadow::{plan_light_with, Case, Caster, CasterPlan, Method, PlanInput, PlanOptions, VolumePath};
 
 // ---------------------------------------------------------------------------------------------
 // harness
@@ -1057,7 +1057,7 @@ fn check_plan(casters: &[Caster], plans: &[CasterPlan], directional: bool) {
     assert_eq!(plans.len(), casters.len());
     let mut bits = Vec::new();
     for (caster, cp) in casters.iter().zip(plans) {
-        if cp.path == "edgequad" || cp.case == Case::Culled && cp.chunks.is_empty() {
+        if cp.path == VolumePath::EdgeQuad || cp.case == Case::Culled && cp.chunks.is_empty() {
             continue;
         }
         assert_eq!(cp.triangles(), cp.parts.iter().map(|p| p.sides + p.dark_cap + p.light_cap).sum::<usize>());
@@ -1098,7 +1098,7 @@ fn check_plan(casters: &[Caster], plans: &[CasterPlan], directional: bool) {
                 let open: Vec<_> = m.iter().filter(|(_, &c)| c != 0).collect();
                 assert!(open.is_empty(), "part {} ({}) not closed: {} open edges, e.g. {:?}", pp.part, pp.path, open.len(), open.first());
             }
-            if pp.path == "multiplicity" {
+            if pp.path == VolumePath::Multiplicity {
                 MULTIPLICITY_PARTS.fetch_add(1, Ordering::Relaxed);
                 // per undirected edge: the signed side count is the multiplicity
                 let topo = &caster.topology;

@@ -24,7 +24,7 @@ fn triangles(scene: &Scene, li: usize, w: u32, h: u32) -> (usize, usize) {
         .iter()
         .cloned()
         .map(|mut c| {
-            if c.parts.len() > 1 && c.parts.iter().any(|p| !p.kind.path().eq("manifold")) {
+            if c.parts.len() > 1 && c.parts.iter().any(|p| p.kind.path() != umbrage::shadow::VolumePath::Manifold) {
                 c.make_whole_multiplicity("whole caster (as before parts)".into());
             }
             c
@@ -99,7 +99,7 @@ fn check_city(ctx: umbrage::gpu::Context, name: &str, toml: &str, dir: &std::pat
     }
     let stats = r.render().unwrap().stats;
     let city = stats.lights[0].casters.iter().find(|c| c.name == "city").unwrap();
-    assert!(city.parts.len() > 1 || city.case == "culled", "per-part stats");
+    assert!(city.parts.len() > 1 || city.case == umbrage::shadow::Case::Culled, "per-part stats");
     r.context().check_validation().unwrap();
     r.into_context()
 }

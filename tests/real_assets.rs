@@ -45,7 +45,7 @@ fn real_open_and_non_manifold_assets_match_the_reference() {
             let mut r = Renderer::new(ctx, scene, RenderOptions { width: 256, height: 192, counter, ..Default::default() }).unwrap();
             let stats = r.render().unwrap().stats;
             let asset = stats.lights[0].casters.iter().find(|c| c.name == "asset").unwrap();
-            assert_eq!(asset.path, "multiplicity", "{file}: {}", asset.path_reason);
+            assert_eq!(asset.path, umbrage::shadow::VolumePath::Multiplicity, "{file}: {}", asset.path_reason);
             for row in evaluate(&mut r, file, &umbrage::render::Technique::all_volumes(), 1).unwrap() {
                 assert!(
                     row.passed,

@@ -139,7 +139,7 @@ fn deforming_and_removing_casters() {
         let stats = |f: &umbrage::pass::PreparedFrame| {
             f.lights
                 .iter()
-                .flat_map(|l| l.stats.casters.iter().map(|c| (c.case.clone(), c.silhouette_edges, c.triangles.total())))
+                .flat_map(|l| l.stats.casters.iter().map(|c| (c.case, c.silhouette_edges, c.triangles.total())))
                 .collect::<Vec<_>>()
         };
         assert_eq!(stats(&deformed), stats(&fresh));

@@ -42,7 +42,7 @@ fn sphere_scenes_match_the_reference_with_the_automatic_n() {
             let out = r.render().unwrap();
             let casting = r.scene().spheres.iter().filter(|s| s.casts_shadow).count();
             for l in &out.stats.lights {
-                let spheres: Vec<_> = l.casters.iter().filter(|c| c.path == "sphere").collect();
+                let spheres: Vec<_> = l.casters.iter().filter(|c| c.path == umbrage::shadow::VolumePath::Sphere).collect();
                 assert_eq!(spheres.len(), casting);
                 for c in spheres {
                     let s = c.sphere.unwrap();
@@ -209,7 +209,14 @@ fn write_docs_spheres_md() {
             let row = &evaluate(&mut r, "one", &[Technique::Volumes(Method::McGuire)], 1).unwrap()[0];
             if n.is_none() {
                 let out = r.render().unwrap();
-                auto_n = out.stats.lights[0].casters.iter().find(|c| c.path == "sphere").unwrap().sphere.unwrap().segments;
+                auto_n = out.stats.lights[0]
+                    .casters
+                    .iter()
+                    .find(|c| c.path == umbrage::shadow::VolumePath::Sphere)
+                    .unwrap()
+                    .sphere
+                    .unwrap()
+                    .segments;
                 cells.push(auto_n.to_string());
                 assert!(row.fraction <= THRESHOLD, "auto n on r={radius} D={distance}: {row:?}");
             }

@@ -315,10 +315,10 @@ impl Host {
         ];
         Stats {
             device: self.gpu.name.clone(),
-            method: settings.technique.name().to_string(),
-            depth_mode: self.pass().desc().depth_mode.name().to_string(),
-            index_format: settings.index_format.name().to_string(),
-            counter: settings.counter.name().to_string(),
+            method: settings.technique,
+            depth_mode: self.pass().desc().depth_mode,
+            index_format: settings.index_format,
+            counter: settings.counter,
             transmit: None,
             self_shadow: false,
             width: self.targets.width,

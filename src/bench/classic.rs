@@ -171,7 +171,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 scene: name.clone(),
                 method: technique_label(technique),
                 counter: counter.name().to_string(),
-                index_format: s.index_format.clone(),
+                index_format: s.index_format.name().to_string(),
                 frames: cfg.frames,
                 gpu_frame_ms: (!a.gpu.is_empty()).then(|| median(a.gpu)),
                 gpu_shadow_ms: (!a.shadow.is_empty()).then(|| median(a.shadow)),

@@ -200,7 +200,7 @@ impl Runner {
             let q = |x: &[f64], p: f64| (!x.is_empty()).then(|| super::model::quantile(x, p));
             let (p10, p90) = (q(&a.shadow, 0.1), q(&a.shadow, 0.9));
             // Per light, the casters it did not cull, and their meshes' triangles.
-            let drawn = s.lights.iter().flat_map(|l| l.casters.iter()).filter(|c| c.case != "culled");
+            let drawn = s.lights.iter().flat_map(|l| l.casters.iter()).filter(|c| c.case != crate::shadow::Case::Culled);
             let (caster_passes, bound_triangles) =
                 drawn.fold((0u64, 0u64), |(n, t), c| (n + 1, t + mesh_triangles.get(&c.name).copied().unwrap_or(0)));
             let lookup: Vec<f64> = a.shadow.iter().zip(&a.map).map(|(s, m)| s - m).collect();
@@ -215,7 +215,7 @@ impl Runner {
                 variant: v.label.clone(),
                 scene: name.into(),
                 method: technique_label(v.technique),
-                counter: if shadow_map { "float".into() } else { s.counter.clone() },
+                counter: if shadow_map { "float".into() } else { s.counter.name().to_string() },
                 index_format: v.index_format.name().into(),
                 width: w,
                 height: h,

@@ -80,6 +80,7 @@ impl Camera {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
+#[non_exhaustive]
 pub enum LightKind {
     /// A point light at `position`, shining in every direction (w = 1).
     Point,

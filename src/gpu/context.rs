@@ -322,7 +322,7 @@ impl Context {
         let gpdp2 = (has_gpdp2 && minimum == Minimum::Vulkan10)
             .then(|| ash::khr::get_physical_device_properties2::Instance::new(&entry, &instance));
         match super::probe::open_device(&instance, gpdp2.as_ref(), device_extensions, minimum) {
-            Ok((physical, device, queue_family, features, info, depth_format, limits)) => {
+            Ok(super::probe::OpenedDevice { physical, device, queue_family, features, info, depth_format, limits }) => {
                 // SAFETY: the queue family/index were requested at device creation.
                 let queue = unsafe { device.get_device_queue(queue_family, 0) };
                 let allocator = gpu_allocator::vulkan::Allocator::new(&gpu_allocator::vulkan::AllocatorCreateDesc {

@@ -20,16 +20,33 @@ pub(super) enum Minimum {
     Vulkan10,
 }
 
+/// The device [`open_device`] created, and what was learnt of it on the way.
+pub(super) struct OpenedDevice {
+    /// The physical device picked.
+    pub physical: vk::PhysicalDevice,
+    /// The logical device, with the probed optional features enabled.
+    pub device: ash::Device,
+    /// The graphics (and compute) queue family; queue 0 of it was created.
+    pub queue_family: u32,
+    /// The optional features probed and enabled.
+    pub features: Features,
+    /// Name, driver and version.
+    pub info: DeviceInfo,
+    /// The depth-stencil format the renderer uses.
+    pub depth_format: vk::Format,
+    /// The physical device's limits.
+    pub limits: vk::PhysicalDeviceLimits,
+}
+
 /// Picks the physical device (the best-ranked one with a graphics queue at `minimum` or newer,
 /// or the one `UMBRAGE_DEVICE` names), probes its optional features through the queries its
 /// version has, and creates the logical device with them enabled.
-#[allow(clippy::type_complexity)]
 pub(super) fn open_device(
     instance: &ash::Instance,
     gpdp2: Option<&ash::khr::get_physical_device_properties2::Instance>,
     extra_extensions: &[&CStr],
     minimum: Minimum,
-) -> Result<(vk::PhysicalDevice, ash::Device, u32, Features, DeviceInfo, vk::Format, vk::PhysicalDeviceLimits)> {
+) -> Result<OpenedDevice> {
     let Picked { physical, queue_family, props, name } = pick_physical(instance, minimum)?;
     let api = props.api_version;
     let v11 = api >= vk::API_VERSION_1_1;
@@ -149,7 +166,7 @@ pub(super) fn open_device(
 
     let has_driver_props = api >= vk::API_VERSION_1_2 || (has_ext(ash::khr::driver_properties::NAME) && can_query2);
     let info = device_info(instance, gpdp2, physical, &props, name, has_driver_props);
-    Ok((physical, device, queue_family, features, info, depth_format, props.limits))
+    Ok(OpenedDevice { physical, device, queue_family, features, info, depth_format, limits: props.limits })
 }
 
 /// What [`probe_features`] found.

@@ -184,9 +184,16 @@ named_enum!(
     }
 );
 
-/// How the shadow pass builds the volumes of closed opaque casters. Open, non-manifold and
-/// transparent casters take the multiplicity path (Kim et al. 2008) under every technique.
+/// How a frame's shadows are computed: one enum for every technique, shared by
+/// [`ShadowPass`](super::ShadowPass) and the [`Renderer`](crate::render::Renderer).
+///
+/// The first four build stencil shadow volumes and run in both. Open, non-manifold and
+/// transparent casters take the multiplicity path (Kim et al. 2008) under each of them.
+/// [`ShadowMap`](Technique::ShadowMap) and [`RayQuery`](Technique::RayQuery) are whole
+/// renderer paths: a `ShadowPass` refuses them with [`Error::InvalidDesc`]
+/// ([`PassSettings::check`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub enum Technique {
     /// CPU possible silhouettes and index streams, with one of the papers' case rules.
     Volumes(Method),
@@ -205,26 +212,84 @@ pub enum Technique {
     /// geometry sent per frame. Parts on the multiplicity path (open, non-manifold) and
     /// transparent casters keep the CPU path.
     Compute,
+    /// The shadow-map baseline (PCF 3x3) with maps of `size` texels a side (renderer only).
+    ShadowMap {
+        /// Texels per side of one map (16..=8192).
+        size: u32,
+    },
+    /// One shadow ray per pixel with `VK_KHR_ray_query` against acceleration structures of the
+    /// casters, writing the volumes' stencil (docs/raytrace.md; renderer only).
+    RayQuery,
 }
 
 impl Technique {
-    /// The name on the command line and in `--stats` (`mcguire`, ..., `edgequad`, `compute`).
+    /// The name on the command line and in `--stats` (`mcguire`, ..., `edgequad`, `compute`,
+    /// `shadowmap`, `rayquery`).
     pub fn name(self) -> &'static str {
         match self {
             Technique::Volumes(m) => m.name(),
             Technique::EdgeQuads => "edgequad",
             Technique::Planar => "planar",
             Technique::Compute => "compute",
+            Technique::ShadowMap { .. } => "shadowmap",
+            Technique::RayQuery => "rayquery",
         }
     }
-    /// The case rule the planner uses (edge quads cull with McGuire's rule).
+    /// The case rule the planner uses (edge quads, compute, and the renderer-only techniques'
+    /// culling use McGuire's rule).
     pub fn method(self) -> Method {
         match self {
             Technique::Volumes(m) => m,
-            Technique::EdgeQuads | Technique::Compute => Method::McGuire,
+            Technique::EdgeQuads | Technique::Compute | Technique::ShadowMap { .. } | Technique::RayQuery => Method::McGuire,
             // Culling only: the casters' draws are replaced by their flattened triangles.
             Technique::Planar => Method::ZPass,
         }
+    }
+    /// Whether a [`ShadowPass`](super::ShadowPass) runs it (the stencil-volume techniques).
+    pub fn is_volume_pass(self) -> bool {
+        self.pass_technique().is_some()
+    }
+    /// `Some(self)` for the techniques a [`ShadowPass`](super::ShadowPass) runs, `None` for
+    /// the renderer-only ones (shadow maps, ray query).
+    pub fn pass_technique(self) -> Option<Technique> {
+        match self {
+            Technique::Volumes(_) | Technique::EdgeQuads | Technique::Planar | Technique::Compute => Some(self),
+            Technique::ShadowMap { .. } | Technique::RayQuery => None,
+        }
+    }
+    /// The five volume methods (z-pass, z-fail, Everitt-Kilgard, Lengyel, McGuire).
+    pub fn all_volumes() -> Vec<Technique> {
+        Method::ALL.iter().map(|&m| Technique::Volumes(m)).collect()
+    }
+    /// Parses a `--method` value: `auto` (= mcguire), a volume method, `edgequad`, `planar`,
+    /// `compute`, `rayquery` or `shadowmap` (with maps of `shadow_map_size` texels).
+    pub fn parse(s: &str, shadow_map_size: u32) -> Result<Technique> {
+        match s {
+            "edgequad" => Ok(Technique::EdgeQuads),
+            "planar" => Ok(Technique::Planar),
+            "compute" => Ok(Technique::Compute),
+            "shadowmap" => Ok(Technique::ShadowMap { size: shadow_map_size }),
+            "rayquery" => Ok(Technique::RayQuery),
+            _ => s.parse::<Method>().map(Technique::Volumes).map_err(|_| Error::UnknownName {
+                what: "method",
+                name: s.into(),
+                expected: format!("auto, {}, edgequad, planar, compute, shadowmap, rayquery", Method::ALL.map(|m| m.name()).join(", ")),
+            }),
+        }
+    }
+}
+
+impl std::fmt::Display for Technique {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+#[cfg(feature = "serde")]
+impl serde::Serialize for Technique {
+    /// As its [`name`](Technique::name), the `method` of `--stats`.
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
     }
 }
 
@@ -362,6 +427,16 @@ pub(crate) fn check_depth_stencil_format(format: vk::Format) -> Result<()> {
 impl PassSettings {
     /// Whether the device can honour these settings (checked before every frame).
     pub fn check(&self, caps: &Capabilities) -> Result<()> {
+        if !self.technique.is_volume_pass() {
+            return Err(Error::InvalidDesc {
+                field: "PassSettings::technique",
+                msg: format!(
+                    "{} is a renderer technique (umbrage::render::Renderer), not one a ShadowPass records: \
+                     use Volumes, EdgeQuads, Planar or Compute",
+                    self.technique.name()
+                ),
+            });
+        }
         if self.index_format == IndexFormat::U8 && !caps.index_type_uint8 {
             return Err(Error::Unsupported(
                 "IndexFormat::U8 needs indexTypeUint8 (VK_EXT_index_type_uint8 / VK_KHR_index_type_uint8, enabled); use IndexFormat::Auto or U16".into(),

@@ -104,13 +104,3 @@ pub(crate) fn check_lights(lights: &[Light]) -> Result<()> {
     }
     Ok(())
 }
-
-/// The `--stats` name of a case.
-pub fn case_name(c: Case) -> &'static str {
-    match c {
-        Case::Culled => "culled",
-        Case::ZPass => "zpass",
-        Case::ZFail => "zfail",
-        Case::ZFailLightCap => "zfail_light_cap",
-    }
-}

@@ -92,7 +92,7 @@ pub use desc::{
     ShadowPassDesc, TargetModel, Technique,
 };
 pub use draw::LightFrame;
-pub use frame::{case_name, PreparedFrame};
+pub use frame::PreparedFrame;
 pub use pipelines::COUNT_FORMAT;
 pub use record::{lit_stencil_state, VolumeKind};
 pub use spheres::{SphereId, SphereInfo};

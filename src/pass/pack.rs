@@ -6,12 +6,11 @@ use super::casters::CasterTable;
 use super::compute::frame::ComputeFrame;
 use super::desc::{DepthDirection, IndexFormat, PassSettings, Technique};
 use super::draw::{CasterDraw, Draw, EdgeQuadDraw, LightFrame};
-use super::frame::case_name;
 use super::planar::flatten;
-use super::stats::{CasterStats, CpuMs, LightStats, PartStats, Totals, Triangles};
+use super::stats::{CasterStats, CpuMs, LightStats, PartStats, Totals, Triangles, UsedIndexFormat};
 use super::view::ShadowView;
-use crate::geom::{Camera, Light, LightKind};
-use crate::shadow::{self, Case, CasterKind, PlanInput, PlanOptions};
+use crate::geom::{Camera, Light};
+use crate::shadow::{self, Case, CasterKind, PlanInput, PlanOptions, VolumePath};
 use ash::vk;
 use glam::{DMat4, DVec3, Mat4, Vec4};
 
@@ -81,18 +80,18 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
             let gpu = &table.live[cp.caster];
             let ChunkDraws { mut draws, index_bytes, vertex_bytes, mut fmt_used } = write_chunks(&mut stream, input, caster, gpu, cp);
             if let (Some(cf), Some(st)) = (compute.as_mut(), gpu.compute.as_ref()) {
-                if cp.parts.iter().any(|p| p.path == "compute" && p.case != Case::Culled) {
+                if cp.parts.iter().any(|p| p.path == VolumePath::Compute && p.case != Case::Culled) {
                     let buffers: Vec<vk::Buffer> = gpu.chunks.iter().map(|b| b.raw).collect();
                     let at = crate::pass::compute::frame::CasterAt { light: li, stat: cstats.len(), caster: cp.caster };
                     cf.add_caster(at, caster, st, cp, &buffers, &mut draws);
-                    fmt_used = IndexFormat::U16.name();
+                    fmt_used = UsedIndexFormat::U16;
                 }
             }
             let tris = Triangles { sides: cp.sides as u64, dark_cap: cp.dark_cap as u64, light_cap: cp.light_cap as u64 };
             totals.triangles.add(&tris);
             totals.index_bytes += index_bytes;
             totals.vertex_bytes += vertex_bytes;
-            totals.draws += draws.len() as u64 + if cp.path == "edgequad" { 2 } else { 0 };
+            totals.draws += draws.len() as u64 + if cp.path == VolumePath::EdgeQuad { 2 } else { 0 };
             match cp.case {
                 Case::Culled => totals.cases.culled += 1,
                 Case::ZPass => totals.cases.zpass += 1,
@@ -100,7 +99,7 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
                 Case::ZFailLightCap => totals.cases.zfail_light_cap += 1,
             }
             cstats.push(caster_stats(caster, cp, tris, (index_bytes, vertex_bytes), fmt_used));
-            let edge_quad = match (&gpu.edge_quads, cp.path == "edgequad") {
+            let edge_quad = match (&gpu.edge_quads, cp.path == VolumePath::EdgeQuad) {
                 (Some(eq), true) => Some(EdgeQuadDraw {
                     vertices: eq.vertices.raw,
                     indices: eq.indices.raw,
@@ -157,7 +156,7 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
         };
         let stats = LightStats {
             index: li,
-            kind: light_kind_name(light.kind).to_string(),
+            kind: light.kind,
             scissor: plan.scissor.filter(|_| input.settings.toggles.scissor),
             depth_bounds: depth_bounds.map(|(a, b)| [a, b]),
             casters: cstats,
@@ -178,7 +177,7 @@ struct ChunkDraws {
     index_bytes: u64,
     vertex_bytes: u64,
     /// The index format used (`none` when nothing was drawn).
-    fmt_used: &'static str,
+    fmt_used: UsedIndexFormat,
 }
 
 /// Writes caster `cp`'s chunk draws (volume and light-cap lists) into `stream`, each aligned
@@ -193,7 +192,7 @@ fn write_chunks(
     let mut draws = Vec::new();
     let mut index_bytes = 0u64;
     let mut vertex_bytes = 0u64;
-    let mut fmt_used = "none";
+    let mut fmt_used = UsedIndexFormat::None;
     for cd in &cp.chunks {
         let chunk = &caster.chunks[cd.chunk];
         let n = chunk.vertices.len();
@@ -206,7 +205,7 @@ fn write_chunks(
                 IndexFormat::Auto | IndexFormat::U8 => IndexFormat::U16,
                 f => f,
             };
-            fmt_used = fmt.name();
+            fmt_used = fmt.into();
             align(stream, 16);
             let offset = stream.len() as u64;
             match fmt {
@@ -249,20 +248,20 @@ fn caster_stats(
     cp: &shadow::CasterPlan,
     tris: Triangles,
     (index_bytes, vertex_bytes): (u64, u64),
-    fmt_used: &str,
+    fmt_used: UsedIndexFormat,
 ) -> CasterStats {
     let ntris = tris.total();
     CasterStats {
         name: caster.name.clone(),
-        case: case_name(cp.case).to_string(),
+        case: cp.case,
         silhouette_edges: cp.silhouette_edges as u64,
         triangles: tris,
         index_bytes,
         vertex_bytes,
         bytes_per_triangle: if ntris > 0 { (index_bytes + vertex_bytes) as f64 / ntris as f64 } else { 0.0 },
-        index_format: fmt_used.to_string(),
-        dark_cap_kind: format!("{:?}", cp.dark_cap_kind),
-        path: cp.path.to_string(),
+        index_format: fmt_used,
+        dark_cap_kind: cp.dark_cap_kind,
+        path: cp.path,
         path_reason: match &caster.kind {
             CasterKind::Multiplicity { reason } => reason.clone(),
             _ => String::new(),
@@ -273,8 +272,8 @@ fn caster_stats(
             .iter()
             .map(|p| PartStats {
                 part: p.part,
-                case: case_name(p.case).to_string(),
-                path: p.path.to_string(),
+                case: p.case,
+                path: p.path,
                 silhouette_edges: p.silhouette_edges as u64,
                 triangles: Triangles { sides: p.sides as u64, dark_cap: p.dark_cap as u64, light_cap: p.light_cap as u64 },
             })
@@ -304,14 +303,6 @@ fn near_corners(view: &ShadowView) -> [DVec3; 4] {
         let h = inv * glam::DVec4::new(x, y, 0.0, 1.0);
         h.truncate() / h.w + view.eye
     })
-}
-
-fn light_kind_name(k: LightKind) -> &'static str {
-    match k {
-        LightKind::Point => "point",
-        LightKind::Spot => "spot",
-        LightKind::Directional => "directional",
-    }
 }
 
 fn align(v: &mut Vec<u8>, a: usize) {

@@ -3,7 +3,7 @@
 
 use super::casters::CasterTable;
 use crate::geom::Light;
-use crate::shadow::{self, Case, LightPlan};
+use crate::shadow::{self, Case, LightPlan, VolumePath};
 use glam::DMat4;
 
 /// Planar projected shadows: every drawn opaque caster's plan becomes all its triangles (w = 1
@@ -26,7 +26,7 @@ pub(crate) fn flatten(plan: &mut LightPlan, table: &CasterTable, light: &Light, 
             continue;
         }
         cp.case = Case::ZPass;
-        cp.path = "planar";
+        cp.path = VolumePath::Planar;
         cp.parts.clear();
         cp.silhouette_edges = 0;
         cp.dark_cap = 0;

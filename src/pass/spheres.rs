@@ -11,12 +11,12 @@
 
 use super::desc::{IndexFormat, Technique};
 use super::draw::{CasterDraw, Draw};
-use super::stats::{CasterStats, SphereStats, Totals, Triangles};
+use super::stats::{CasterStats, SphereStats, Totals, Triangles, UsedIndexFormat};
 use super::view::ShadowView;
 use crate::error::{Error, Result};
 use crate::geom::sphere::{auto_segments, shadow_error_px, volume_triangles, ViewScale};
 use crate::geom::{Light, LightKind, Sphere};
-use crate::shadow::Case;
+use crate::shadow::{Case, DarkCap, VolumePath};
 use ash::vk;
 use glam::{DMat4, DVec4};
 
@@ -180,15 +180,15 @@ pub(crate) fn pack_light(
         let ntris = tris.total();
         stats.push(CasterStats {
             name: s.name.clone(),
-            case: super::case_name(case).to_string(),
+            case,
             silhouette_edges: if case == Case::Culled { 0 } else { n as u64 },
             triangles: tris,
             index_bytes: 0,
             vertex_bytes,
             bytes_per_triangle: if ntris > 0 { vertex_bytes as f64 / ntris as f64 } else { 0.0 },
-            index_format: if case == Case::Culled { "none" } else { "naive" }.to_string(),
-            dark_cap_kind: if directional || input.technique == Technique::Planar { "None" } else { "Fan" }.to_string(),
-            path: "sphere".to_string(),
+            index_format: if case == Case::Culled { UsedIndexFormat::None } else { UsedIndexFormat::Naive },
+            dark_cap_kind: if directional || input.technique == Technique::Planar { DarkCap::None } else { DarkCap::Fan },
+            path: VolumePath::Sphere,
             path_reason: String::new(),
             multiplicity_max: 1,
             parts: Vec::new(),

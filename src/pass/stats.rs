@@ -1,5 +1,43 @@
 //! What one frame of the shadow pass did, per light and caster: the `--stats` JSON's
 //! `lights` and `totals` (a contract other tools read: keys as in issue #3, more keys welcome).
+//! The typed fields serialise to the names the JSON has always had.
+
+use crate::geom::LightKind;
+use crate::shadow::{Case, DarkCap, VolumePath};
+
+crate::named_enum::named_enum!(
+    /// The index format a caster's draws used this frame (`index_format` in `--stats`).
+    UsedIndexFormat, "used index format", {
+        /// Nothing was drawn.
+        #[default]
+        None => "none",
+        /// 8-bit indices.
+        U8 => "u8",
+        /// 16-bit indices (the paper's 6 bytes a triangle).
+        U16 => "u16",
+        /// 32-bit indices.
+        U32 => "u32",
+        /// No indices: vertices streamed as 4 x f32.
+        Naive => "naive",
+    }
+);
+
+impl From<super::IndexFormat> for UsedIndexFormat {
+    /// The format a draw used (`Auto` never reaches a draw: it is resolved per chunk first).
+    fn from(f: super::IndexFormat) -> Self {
+        match f {
+            super::IndexFormat::U8 => UsedIndexFormat::U8,
+            super::IndexFormat::U16 | super::IndexFormat::Auto => UsedIndexFormat::U16,
+            super::IndexFormat::U32 => UsedIndexFormat::U32,
+            super::IndexFormat::Naive => UsedIndexFormat::Naive,
+        }
+    }
+}
+
+#[cfg(feature = "serde")]
+fn dark_cap_name<S: serde::Serializer>(d: &DarkCap, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(d.name())
+}
 
 #[derive(Clone, Debug, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
@@ -33,7 +71,7 @@ pub struct CasterStats {
     /// The caster's name (the scene mesh's, or the one given to `add_caster`).
     pub name: String,
     /// `culled`, `zpass`, `zfail` or `zfail_light_cap` (McGuire et al.'s cases 1-3).
-    pub case: String,
+    pub case: Case,
     /// Possible silhouette edges found for this light.
     pub silhouette_edges: u64,
     /// Shadow triangles drawn.
@@ -45,11 +83,13 @@ pub struct CasterStats {
     /// Bytes per shadow triangle actually sent this frame (index + streamed vertex bytes).
     pub bytes_per_triangle: f64,
     /// `u8`, `u16`, `u32`, `naive` or `none`.
-    pub index_format: String,
-    /// Which dark cap was emitted (`Fan`, `BackFaces`, ...).
-    pub dark_cap_kind: String,
-    /// "manifold" (the three-case path) or "multiplicity" (open / non-manifold casters).
-    pub path: String,
+    pub index_format: UsedIndexFormat,
+    /// Which dark cap was emitted (`Fan`, `BackFaces`, ...: the variant's name).
+    #[cfg_attr(feature = "serde", serde(serialize_with = "dark_cap_name"))]
+    pub dark_cap_kind: DarkCap,
+    /// `manifold` (the three-case path), `multiplicity` (open / non-manifold casters),
+    /// `edgequad`, `planar`, `compute` or `sphere`.
+    pub path: VolumePath,
     /// Why the caster took the multiplicity path (empty for manifold casters).
     pub path_reason: String,
     /// Largest |edge multiplicity| drawn (1 for a manifold silhouette).
@@ -81,9 +121,9 @@ pub struct PartStats {
     /// Index of the part in the caster.
     pub part: usize,
     /// The part's case (`culled`, `zpass`, `zfail`, `zfail_light_cap`).
-    pub case: String,
-    /// `manifold` or `multiplicity`.
-    pub path: String,
+    pub case: Case,
+    /// `manifold`, `multiplicity` or `compute`.
+    pub path: VolumePath,
     /// Possible silhouette edges of the part.
     pub silhouette_edges: u64,
     /// Its shadow triangles.
@@ -97,7 +137,7 @@ pub struct LightStats {
     /// The light's index in the frame's light list.
     pub index: usize,
     /// `point`, `spot` or `directional`.
-    pub kind: String,
+    pub kind: LightKind,
     /// The light's scissor rectangle `[x, y, width, height]` in pixels (`None`: whole target).
     pub scissor: Option<[u32; 4]>,
     /// The light's depth bounds `[min, max]` when the device tests them.

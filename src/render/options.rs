@@ -2,8 +2,7 @@
 
 use crate::error::{Error, Result};
 use crate::named_enum::named_enum;
-pub use crate::pass::{Counter, DepthMode, IndexFormat, PassToggles};
-use crate::shadow::Method;
+pub use crate::pass::{Counter, DepthMode, IndexFormat, PassToggles, Technique};
 use ash::vk;
 
 named_enum!(
@@ -93,76 +92,6 @@ impl TransmitMode {
         } else {
             vk::Format::R16G16B16A16_SFLOAT
         }
-    }
-}
-
-/// How the frame's shadows are computed: one enum for every technique.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Technique {
-    /// Stencil shadow volumes from CPU possible silhouettes, with one of the papers' case rules.
-    Volumes(Method),
-    /// The Cg article's GPU-only edge quads for closed opaque casters.
-    EdgeQuads,
-    /// Flat projected shadows onto the plane y = 0 (the Cg article's first section): exact on
-    /// that plane, wrong everywhere else.
-    Planar,
-    /// Stencil shadow volumes from GPU possible silhouettes (compute pass, indirect draws):
-    /// McGuire's cases from CPU bounds, no CPU work per triangle.
-    Compute,
-    /// The shadow-map baseline (PCF 3x3) with maps of `size` texels a side.
-    ShadowMap {
-        /// Texels per side of one map (16..=8192).
-        size: u32,
-    },
-    /// One shadow ray per pixel with `VK_KHR_ray_query` against acceleration structures of the
-    /// casters, writing the volumes' stencil (docs/raytrace.md).
-    RayQuery,
-}
-
-impl Technique {
-    /// The name in `--stats` and the bench (`mcguire`, `edgequad`, `shadowmap`...).
-    pub fn name(self) -> &'static str {
-        match (self, self.pass_technique()) {
-            (_, Some(t)) => t.name(),
-            (Technique::RayQuery, None) => "rayquery",
-            _ => "shadowmap",
-        }
-    }
-    /// The five volume methods (z-pass, z-fail, Everitt-Kilgard, Lengyel, McGuire).
-    pub fn all_volumes() -> Vec<Technique> {
-        Method::ALL.iter().map(|&m| Technique::Volumes(m)).collect()
-    }
-    /// The technique the shadow pass runs (`None` for shadow maps).
-    pub fn pass_technique(self) -> Option<crate::pass::Technique> {
-        match self {
-            Technique::Volumes(m) => Some(crate::pass::Technique::Volumes(m)),
-            Technique::EdgeQuads => Some(crate::pass::Technique::EdgeQuads),
-            Technique::Planar => Some(crate::pass::Technique::Planar),
-            Technique::Compute => Some(crate::pass::Technique::Compute),
-            Technique::ShadowMap { .. } | Technique::RayQuery => None,
-        }
-    }
-    /// Parses a `--method` value: `auto` (= mcguire), a volume method, `edgequad`, or
-    /// `shadowmap` (with maps of `shadow_map_size` texels).
-    pub fn parse(s: &str, shadow_map_size: u32) -> Result<Technique> {
-        match s {
-            "edgequad" => Ok(Technique::EdgeQuads),
-            "planar" => Ok(Technique::Planar),
-            "compute" => Ok(Technique::Compute),
-            "shadowmap" => Ok(Technique::ShadowMap { size: shadow_map_size }),
-            "rayquery" => Ok(Technique::RayQuery),
-            _ => s.parse::<Method>().map(Technique::Volumes).map_err(|_| Error::UnknownName {
-                what: "method",
-                name: s.into(),
-                expected: format!("auto, {}, edgequad, planar, compute, shadowmap, rayquery", Method::ALL.map(|m| m.name()).join(", ")),
-            }),
-        }
-    }
-}
-
-impl Default for Technique {
-    fn default() -> Self {
-        Technique::Volumes(Method::McGuire)
     }
 }
 

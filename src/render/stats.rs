@@ -40,14 +40,14 @@ pub struct LightGpuMs {
 pub struct Stats {
     /// The device's name.
     pub device: String,
-    /// The technique that ran (`mcguire`, ..., `edgequad`, `shadowmap`).
-    pub method: String,
+    /// The technique that ran (`mcguire`, ..., `edgequad`, `shadowmap`: its name).
+    pub method: super::Technique,
     /// `infinite` or `clamp`.
-    pub depth_mode: String,
+    pub depth_mode: super::DepthMode,
     /// The requested index format (`auto`, `u16`, ...).
-    pub index_format: String,
-    /// "stencil" (8-bit, wraps at 256) or "float" (32-bit float target).
-    pub counter: String,
+    pub index_format: super::IndexFormat,
+    /// `stencil` (8-bit, wraps at 256) or `float` (32-bit float target).
+    pub counter: super::Counter,
     /// The transparent casters' light-intensity map mode (log16, mul16, log32, mul32), when
     /// the scene has transparent casters.
     pub transmit: Option<String>,

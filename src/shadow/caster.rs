@@ -10,6 +10,7 @@ use crate::error::{Error, Result};
 use crate::geom::silhouette::{EdgeScan, FacePlanes};
 use crate::geom::topology::Topology;
 use crate::geom::{Aabb, Mesh};
+use crate::shadow::VolumePath;
 use glam::{Mat4, Vec3};
 
 /// Most vertices a chunk may hold INCLUDING its apex, so that `2n - 1` fits in a u16.
@@ -50,6 +51,7 @@ impl Chunk {
 
 /// Which volume construction a caster takes.
 #[derive(Clone, Debug, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum CasterKind {
     /// Closed, consistently oriented 2-manifold: silhouette edges of the facing bits.
     Manifold,
@@ -61,11 +63,12 @@ pub enum CasterKind {
 }
 
 impl CasterKind {
-    /// `"manifold"` or `"multiplicity"`, as in the stats JSON and `umbrage info`.
-    pub fn path(&self) -> &'static str {
+    /// [`VolumePath::Manifold`] or [`VolumePath::Multiplicity`], as in the stats JSON and
+    /// `umbrage info`.
+    pub fn path(&self) -> VolumePath {
         match self {
-            CasterKind::Manifold => "manifold",
-            CasterKind::Multiplicity { .. } => "multiplicity",
+            CasterKind::Manifold => VolumePath::Manifold,
+            CasterKind::Multiplicity { .. } => VolumePath::Multiplicity,
         }
     }
 }
@@ -485,7 +488,7 @@ mod tests {
         m.triangles.pop();
         let c = Caster::new("boxy", &m, Mat4::IDENTITY).unwrap();
         assert_eq!(c.kind, CasterKind::Multiplicity { reason: "3 boundary edges (open mesh)".into() });
-        assert_eq!(c.kind.path(), "multiplicity");
+        assert_eq!(c.kind.path(), VolumePath::Multiplicity);
         assert!(c.coincident.iter().all(|&g| g == u32::MAX));
         check_chunks(&c);
         let closed = Caster::new("box", &cube(Vec3::ZERO, 1.0), Mat4::IDENTITY).unwrap();

@@ -8,5 +8,6 @@ pub mod plan;
 
 pub use caster::{Caster, CasterKind, Chunk, Part, TRANSMITTANCE_FLOOR};
 pub use plan::{
-    plan_light, plan_light_opts, plan_light_with, Case, CasterPlan, ChunkDraw, DarkCap, LightPlan, Method, PartPlan, PlanInput, PlanOptions,
+    plan_light, plan_light_opts, plan_light_with, Case, CasterPlan, ChunkDraw, DarkCap, LightPlan, Method, PartPlan, PlanInput,
+    PlanOptions, VolumePath,
 };

@@ -363,7 +363,7 @@ fn plan_part(
         let pp = PartPlan {
             part: pi,
             case,
-            path: "multiplicity",
+            path: VolumePath::Multiplicity,
             silhouette_edges: edges,
             multiplicity_max: mmax,
             sides,
@@ -382,7 +382,7 @@ fn plan_part(
     let pp = PartPlan {
         part: pi,
         case,
-        path: "manifold",
+        path: VolumePath::Manifold,
         silhouette_edges: sil.len(),
         multiplicity_max: u32::from(!sil.is_empty()),
         sides,
@@ -450,7 +450,7 @@ pub fn plan_light_with(input: &PlanInput, casters: &[Caster], opts: &PlanOptions
         if opts.edge_quads && caster.kind == CasterKind::Manifold && caster.transmittance.is_none() {
             plans.push(CasterPlan {
                 case: Case::ZFailLightCap,
-                path: "edgequad",
+                path: VolumePath::EdgeQuad,
                 sides: 2 * caster.topology.manifold_edges.len(),
                 light_cap: caster.triangle_count,
                 ..culled_plan(Case::ZFailLightCap)
@@ -475,7 +475,7 @@ pub fn plan_light_with(input: &PlanInput, casters: &[Caster], opts: &PlanOptions
             sil_time += ts.elapsed().as_secs_f64() * 1e3;
         }
         if gpu && caster.kind == CasterKind::Manifold {
-            cp.path = "compute";
+            cp.path = VolumePath::Compute;
         }
         let mut best = 0u8;
         for (pi, &case) in cases.iter().enumerate() {
@@ -483,7 +483,7 @@ pub fn plan_light_with(input: &PlanInput, casters: &[Caster], opts: &PlanOptions
             let multiplicity = whole_multiplicity || part.kind != CasterKind::Manifold;
             if case != Case::Culled && on_gpu(pi) {
                 let e = manifold_emit(input.method, part, case, l_obj);
-                cp.parts.push(PartPlan::undrawn(pi, case, "compute", e.dark_cap, e.formulation));
+                cp.parts.push(PartPlan::undrawn(pi, case, VolumePath::Compute, e.dark_cap, e.formulation));
                 if case_rank(case) > best {
                     best = case_rank(case);
                     cp.case = case;
@@ -493,7 +493,7 @@ pub fn plan_light_with(input: &PlanInput, casters: &[Caster], opts: &PlanOptions
                 continue;
             }
             if case == Case::Culled {
-                let path = if multiplicity { "multiplicity" } else { "manifold" };
+                let path = if multiplicity { VolumePath::Multiplicity } else { VolumePath::Manifold };
                 cp.parts.push(PartPlan::undrawn(pi, case, path, DarkCap::None, Formulation::Front));
                 continue;
             }
@@ -559,7 +559,7 @@ fn part_cases(
 
 impl PartPlan {
     /// A part with nothing drawn on the CPU path (culled, or left to the compute pass).
-    fn undrawn(part: usize, case: Case, path: &'static str, dark_cap_kind: DarkCap, formulation: Formulation) -> PartPlan {
+    fn undrawn(part: usize, case: Case, path: VolumePath, dark_cap_kind: DarkCap, formulation: Formulation) -> PartPlan {
         PartPlan {
             part,
             case,

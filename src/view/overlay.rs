@@ -60,7 +60,7 @@ pub fn triangles_by_case(stats: &Stats) -> Vec<(String, u64)> {
     let mut by: HashMap<String, u64> = HashMap::new();
     for l in &stats.lights {
         for c in &l.casters {
-            *by.entry(c.case.clone()).or_default() += c.triangles.total();
+            *by.entry(c.case.name().to_string()).or_default() += c.triangles.total();
         }
     }
     let mut v: Vec<_> = by.into_iter().collect();

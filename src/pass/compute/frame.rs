@@ -11,9 +11,9 @@
 use super::{rec, ComputeStatic, SilhouettePush, RECORD_WORDS};
 use crate::error::{Error, Result};
 use crate::pass::draw::{Draw, LightFrame};
-use crate::pass::stats::{CasterStats, Totals};
+use crate::pass::stats::{CasterStats, Totals, UsedIndexFormat};
 use crate::pass::IndexFormat;
-use crate::shadow::plan::{Case, CasterPlan, DarkCap, Formulation};
+use crate::shadow::plan::{Case, CasterPlan, DarkCap, Formulation, VolumePath};
 use crate::shadow::Caster;
 use ash::vk;
 use std::cell::Cell;
@@ -100,7 +100,7 @@ impl ComputeFrame {
         let mut caps = false;
         let directional = l_obj.w == 0.0;
         for (pp_index, pp) in cp.parts.iter().enumerate() {
-            if pp.path != "compute" || pp.case == Case::Culled {
+            if pp.path != VolumePath::Compute || pp.case == Case::Culled {
                 continue;
             }
             let part = &caster.parts[pp.part];
@@ -209,7 +209,7 @@ impl ComputeFrame {
             cs.triangles.light_cap += cap;
             cs.silhouette_edges += edges;
             cs.index_bytes += bytes;
-            cs.index_format = "u16".into();
+            cs.index_format = UsedIndexFormat::U16;
             cs.multiplicity_max = cs.multiplicity_max.max(u32::from(edges > 0));
             let n = cs.triangles.total();
             cs.bytes_per_triangle = if n > 0 { (cs.index_bytes + cs.vertex_bytes) as f64 / n as f64 } else { 0.0 };

@@ -58,10 +58,10 @@ impl Renderer {
         cpu.record += f.record_ms;
         Ok(Stats {
             device: ctx.info.name.clone(),
-            method: f.settings.technique.name().to_string(),
-            depth_mode: self.own.parts.config.depth_mode.name().into(),
-            index_format: f.settings.index_format.name().into(),
-            counter: f.settings.counter.name().into(),
+            method: f.settings.technique,
+            depth_mode: self.own.parts.config.depth_mode,
+            index_format: f.settings.index_format,
+            counter: f.settings.counter,
             transmit: self
                 .own
                 .parts

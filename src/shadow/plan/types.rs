@@ -7,6 +7,7 @@ use glam::Mat4;
 /// Which shadow-volume algorithm to plan for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
+#[non_exhaustive]
 pub enum Method {
     /// Heidmann's z-pass for every caster: sides only ([`Case::ZPass`]); wrong wherever a volume
     /// crosses the near plane.
@@ -94,6 +95,44 @@ pub enum Case {
     ZFailLightCap,
 }
 
+impl Case {
+    /// The name in `--stats` (`culled`, `zpass`, `zfail`, `zfail_light_cap`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Case::Culled => "culled",
+            Case::ZPass => "zpass",
+            Case::ZFail => "zfail",
+            Case::ZFailLightCap => "zfail_light_cap",
+        }
+    }
+}
+
+impl std::fmt::Display for Case {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+crate::named_enum::named_enum!(
+    /// Which code path built a caster's (or a part's) volume for one light: `path` in
+    /// `--stats` and `umbrage info`.
+    VolumePath, "volume path", {
+        /// McGuire et al.'s three cases on a closed, consistently oriented 2-manifold.
+        #[default]
+        Manifold => "manifold",
+        /// Kim et al.'s edge multiplicities (open, non-manifold, two-sided or transparent).
+        Multiplicity => "multiplicity",
+        /// The Cg article's GPU-only edge quads.
+        EdgeQuad => "edgequad",
+        /// Flattened onto the planar receiver.
+        Planar => "planar",
+        /// GPU possible silhouettes (left to the compute pass).
+        Compute => "compute",
+        /// An analytic sphere's circumscribed polygon.
+        Sphere => "sphere",
+    }
+);
+
 /// Which dark cap was emitted.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
@@ -110,6 +149,19 @@ pub enum DarkCap {
     None,
     /// Multiplicity casters: every triangle's w=0 copy, oriented away from the light.
     AllFaces,
+}
+
+impl DarkCap {
+    /// The name in `--stats`' `dark_cap_kind` (the variant's: `Fan`, `BackFaces`, ...).
+    pub fn name(self) -> &'static str {
+        match self {
+            DarkCap::Fan => "Fan",
+            DarkCap::BackFaces => "BackFaces",
+            DarkCap::FrontFaces => "FrontFaces",
+            DarkCap::None => "None",
+            DarkCap::AllFaces => "AllFaces",
+        }
+    }
 }
 
 /// Which closed volume the geometry describes.
@@ -166,8 +218,9 @@ pub struct CasterPlan {
     pub caster: usize,
     /// How the volume is drawn (culled, z-pass, z-fail with or without light cap).
     pub case: Case,
-    /// `"manifold"` or `"multiplicity"` ([`CasterKind::path`](crate::shadow::CasterKind::path)), `"edgequad"`, `"planar"` or `"compute"`.
-    pub path: &'static str,
+    /// Manifold or multiplicity ([`CasterKind::path`](crate::shadow::CasterKind::path)), edge
+    /// quads, planar or compute.
+    pub path: VolumePath,
     /// Silhouette edges (manifold) / edges of non-zero multiplicity.
     pub silhouette_edges: usize,
     /// Largest |multiplicity| of an emitted side (1 for a manifold silhouette, 0 when none).
@@ -202,8 +255,8 @@ pub struct PartPlan {
     pub part: usize,
     /// The part's own case (McGuire's rule on the part's bounds).
     pub case: Case,
-    /// `"manifold"`, `"multiplicity"` or `"compute"` (left to the GPU silhouettes).
-    pub path: &'static str,
+    /// Manifold, multiplicity or compute (left to the GPU silhouettes).
+    pub path: VolumePath,
     /// Possible silhouette edges of the part.
     pub silhouette_edges: usize,
     /// Largest |edge multiplicity| drawn (multiplicity parts).

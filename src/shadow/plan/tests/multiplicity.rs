@@ -223,7 +223,7 @@ fn multiplicity_counts_equal_occluders() {
             },
         ];
         for caster in &casters {
-            assert_eq!(caster.kind.path(), "multiplicity");
+            assert_eq!(caster.kind.path(), VolumePath::Multiplicity);
             let cs = std::slice::from_ref(caster);
             for i in 0..40 {
                 let dist = [0.3f32, 0.9, 2.0, 4.0, 25.0][i % 5];
@@ -237,7 +237,7 @@ fn multiplicity_counts_equal_occluders() {
                 let vp = cam.proj_infinite(1.0) * cam.view();
                 for method in Method::ALL {
                     let cp = &plan(&cam, &light, method, cs).casters[0];
-                    assert_eq!(cp.path, "multiplicity");
+                    assert_eq!(cp.path, VolumePath::Multiplicity);
                     if cp.case == Case::Culled {
                         continue;
                     }
@@ -312,7 +312,7 @@ fn multiplicity_rules() {
     };
     // a quad: the diagonal cancels (m = 0), the four boundary edges have |m| = 1
     let p = one("quad", &above, &cam3(), Method::McGuire);
-    assert_eq!((p.path, p.case, p.dark_cap_kind), ("multiplicity", Case::ZFailLightCap, DarkCap::Fan));
+    assert_eq!((p.path, p.case, p.dark_cap_kind), (VolumePath::Multiplicity, Case::ZFailLightCap, DarkCap::Fan));
     assert_eq!((p.silhouette_edges, p.multiplicity_max, p.sides, p.dark_cap, p.light_cap), (4, 1, 8, 4, 2));
     // seen from below (cam3 looks up the y axis): both triangles face the eye, caps are NEVER
     assert_eq!(p.chunks[0].light_cap.len(), 6);
@@ -360,7 +360,7 @@ fn multiplicity_rules() {
     assert_eq!(p.dark_cap_kind, DarkCap::AllFaces);
     // closed manifolds report the manifold path
     let p = &plan(&cam3(), &above, Method::McGuire, &box_caster()).casters[0];
-    assert_eq!((p.path, p.multiplicity_max, p.formulation), ("manifold", 1, Formulation::Front));
+    assert_eq!((p.path, p.multiplicity_max, p.formulation), (VolumePath::Manifold, 1, Formulation::Front));
 }
 
 /// A closed cube and an open quad apart in one mesh: two parts, the cube on the manifold
@@ -395,7 +395,7 @@ fn parts_planned_on_their_own() {
     let cp = &whole.casters[0];
     assert_eq!(cp.parts.len(), 2);
     let (cube_p, quad_p) = (&cp.parts[0], &cp.parts[1]);
-    assert_eq!((cube_p.path, quad_p.path), ("manifold", "multiplicity"));
+    assert_eq!((cube_p.path, quad_p.path), (VolumePath::Manifold, VolumePath::Multiplicity));
     assert_eq!(cube_p.formulation, Formulation::Front);
     assert_eq!(quad_p.formulation, Formulation::TwoSided);
     // the cube: 6 faces, the light sees 2 of them (+x and +y): a silhouette of 6 edges
