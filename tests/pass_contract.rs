@@ -11,7 +11,8 @@ use glam::{DMat4, DVec3, Mat4, Vec3};
 use umbrage::error::Misuse;
 use umbrage::geom::{Camera, Light};
 use umbrage::pass::{
-    DepthDirection, DepthMode, DepthStencilTarget, EnabledFeatures, RenderPassTarget, ShadowPass, ShadowPassDesc, ShadowView, TargetModel,
+    DepthDirection, DepthMode, DepthStencilTarget, EnabledFeatures, PassSettings, RenderPassTarget, ShadowPass, ShadowPassDesc, ShadowView,
+    TargetModel, Technique,
 };
 use umbrage::scene::shapes;
 use umbrage::Error;
@@ -92,6 +93,19 @@ fn creation_options_are_checked_against_the_device() {
             Err(Error::InvalidDesc { field, .. }) => assert_eq!(field, "ShadowPassDesc::samples"),
             other => panic!("{n} samples: {:?}", other.err()),
         }
+    }
+    // The renderer-only techniques (shadow maps, ray query) are refused by name, at creation
+    // and between frames; the pass keeps the settings it had.
+    for t in [Technique::ShadowMap { size: 512 }, Technique::RayQuery] {
+        let settings = PassSettings { technique: t, ..Default::default() };
+        match pass(&ctx, &ShadowPassDesc { settings, ..desc(&ctx) }) {
+            Err(Error::InvalidDesc { field, msg }) => assert!(field == "PassSettings::technique" && msg.contains(t.name()), "{msg}"),
+            other => panic!("{t:?} accepted at creation: {:?}", other.err()),
+        }
+        let mut p = pass(&ctx, &desc(&ctx)).expect("a default pass");
+        let before = p.settings();
+        assert!(matches!(p.set_settings(settings), Err(Error::InvalidDesc { .. })), "{t:?} accepted between frames");
+        assert_eq!(p.settings(), before);
     }
     // SAFETY: plain queries on the context's physical device.
     let (limits, image_counts) = unsafe {

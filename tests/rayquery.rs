@@ -22,6 +22,11 @@ fn rayquery_follows_a_moving_caster() {
         let rows = evaluate(&mut r, "default", &[Technique::RayQuery], 1).unwrap();
         assert!(rows[0].passed, "step {step}: {} mismatches of {}", rows[0].mismatches, rows[0].compared);
     }
+    // The float counter counts volumes; the rays write the stencil: refused, not a stale picture.
+    r.settings.technique = Technique::RayQuery;
+    r.settings.counter = umbrage::render::Counter::Float;
+    let e = r.render().err().expect("ray query with the float counter must fail");
+    assert!(matches!(e, umbrage::Error::InvalidDesc { field: "FrameSettings::counter", .. }), "{e:?}");
     r.context().check_validation().unwrap();
 }
 
@@ -35,6 +40,11 @@ fn missing_ray_query_is_a_clear_error() {
     let scene = umbrage::scene::load("default").unwrap();
     let mut r = Renderer::new(ctx, scene, RenderOptions { width: 64, height: 48, ..Default::default() }).unwrap();
     r.settings.technique = Technique::RayQuery;
+    // The float counter counts volumes: with rays it is refused first, whatever the device.
+    r.settings.counter = umbrage::render::Counter::Float;
+    let e = r.render().err().expect("ray query with the float counter must fail");
+    assert!(matches!(e, umbrage::Error::InvalidDesc { field: "FrameSettings::counter", .. }), "{e:?}");
+    r.settings.counter = umbrage::render::Counter::Stencil;
     let e = r.render().err().expect("ray query without the extension must fail").to_string();
     assert!(e.contains("VK_KHR_ray_query") && e.contains("scripts/drivers.sh install 25.0.7"), "{e}");
     // Nothing was left half-made: another technique still renders.

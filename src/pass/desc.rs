@@ -185,7 +185,7 @@ named_enum!(
 );
 
 /// How a frame's shadows are computed: one enum for every technique, shared by
-/// [`ShadowPass`](super::ShadowPass) and the [`Renderer`](crate::render::Renderer).
+/// [`ShadowPass`](super::ShadowPass) and the renderer (`umbrage::render::Renderer`).
 ///
 /// The first four build stencil shadow volumes and run in both. Open, non-manifold and
 /// transparent casters take the multiplicity path (Kim et al. 2008) under each of them.

@@ -402,8 +402,11 @@ impl Live {
                 "3" => self.mode = Mode::Light,
                 "m" => self.set_technique((self.technique + 1) % self.techniques.len()),
                 "c" => {
+                    // The counter counts volumes: the shadow-map and ray-query paths have none.
                     let s = &mut self.renderer.settings;
-                    s.counter = if s.counter == Counter::Stencil { Counter::Float } else { Counter::Stencil };
+                    if s.technique.is_volume_pass() {
+                        s.counter = if s.counter == Counter::Stencil { Counter::Float } else { Counter::Stencil };
+                    }
                 }
                 "v" => {
                     let s = &mut self.renderer.settings;
@@ -434,6 +437,10 @@ impl Live {
         if let Some(t) = self.techniques.get(i) {
             self.technique = i;
             self.renderer.settings.technique = *t;
+            if *t == Technique::RayQuery {
+                // The rays write the stencil; the float counter would be refused.
+                self.renderer.settings.counter = Counter::Stencil;
+            }
         }
     }
 

@@ -48,6 +48,14 @@ pub(super) fn check_options(ctx: &Context, config: &RenderConfig, s: &FrameSetti
     if s.index_format == IndexFormat::U8 && !f.index_type_uint8 {
         return Err(Error::Unsupported("--index-format u8 needs VK_EXT_index_type_uint8; use auto or u16".into()));
     }
+    if s.technique == Technique::RayQuery && s.counter == Counter::Float {
+        // The rays write the stencil; the float counter counts volumes (and would light from a
+        // count image nothing wrote this frame).
+        return Err(Error::InvalidDesc {
+            field: "FrameSettings::counter",
+            msg: "--method rayquery writes the stencil, not a volume count: use --counter stencil".into(),
+        });
+    }
     if s.technique == Technique::RayQuery && !f.ray_query {
         return Err(crate::gpu::accel::missing_ray_query(&ctx.info.name));
     }

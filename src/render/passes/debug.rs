@@ -1,5 +1,10 @@
 //! Debug views: `--view volumes` (the shadow pass's volumes translucent over the scene,
 //! coloured by case) and `--view stencil` (light 0's counts as a heat map, on the CPU).
+//!
+//! Inputs / outputs (`record_volumes`, `--view volumes` only, after the transparent passes, before `tonemap`):
+//! - Reads: `depth` as the depth-stencil attachment in `DEPTH_STENCIL_ATTACHMENT_OPTIMAL`, LOAD/STORE; nothing sampled.
+//! - Writes: `accum` in `COLOR_ATTACHMENT_OPTIMAL`, LOAD/STORE (the overlay over the lit scene).
+//! - Leaves both there (no transition), as `tonemap` expects. `stencil_heatmap` works on the read-back stencil on the CPU.
 
 use super::{att, Rec, DS_CLEAR, ZERO};
 use crate::pass::diagnostics::Diagnostics;

@@ -1,6 +1,23 @@
 //! 2a. Per light, the shadow determination, recorded by the [`ShadowPass`]: the count in the
 //!     stencil (cleared inside the light's scissor), or in the float target; with capture,
 //!     the count is copied out for the dumps and tests.
+//!
+//! Inputs / outputs, per light (`depth` is the `Targets` depth-stencil image, always in
+//! `DEPTH_STENCIL_ATTACHMENT_OPTIMAL` here, as `gbuffer` left it):
+//! - `CountInto::Stencil`: `ShadowPass::cmd_determine` with `DepthStencilTarget::new` (declared and left in
+//!   `DEPTH_STENCIL_ATTACHMENT_OPTIMAL`; the pass's own barriers keep that layout): depth aspect LOAD (read only),
+//!   stencil CLEAR to the light's `counter_clear` inside its scissor, STORE.
+//! - `CountInto::Float`: `begin_float` takes `count` `UNDEFINED -> COLOR_ATTACHMENT_OPTIMAL`; `cmd_count_float` clears it
+//!   (to `counter_clear`) inside the scissor and adds into it, the depth-stencil loaded and only read.
+//! - `CountInto::External` / `Written`: nothing recorded by `record`; the caller (`frame/record.rs`) already ran the
+//!   shadow-map lookup (`count` left in `COLOR_ATTACHMENT_OPTIMAL`, after `begin_float`) or the ray-query pass
+//!   (`RayTracer::cmd_determine`: stencil cleared and written, `depth` in `DEPTH_STENCIL_ATTACHMENT_OPTIMAL`, LOAD).
+//! - `finish`: with capture, `count` (`COLOR_ATTACHMENT_OPTIMAL`) or the stencil aspect (`DEPTH_STENCIL_ATTACHMENT_OPTIMAL`)
+//!   is copied out through `TRANSFER_SRC_OPTIMAL` and returned (`Rec::copy_out`), or with MSAA the stencil through
+//!   `samples`; then, float counts only, `count` goes `COLOR_ATTACHMENT_OPTIMAL -> SHADER_READ_ONLY_OPTIMAL`.
+//! - `record_count`: the occlusion-query variant, depth-stencil LOAD in `DEPTH_STENCIL_ATTACHMENT_OPTIMAL`, nothing written.
+//! - Leaves: `depth` in `DEPTH_STENCIL_ATTACHMENT_OPTIMAL` (stencil = the count with stencil counting), `count` in
+//!   `SHADER_READ_ONLY_OPTIMAL` (float counting, shadow map) for `illuminate`.
 
 use super::{Rec, DS_RW, FRAG_TESTS};
 use crate::error::Result;

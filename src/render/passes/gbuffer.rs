@@ -3,6 +3,15 @@
 //!    into the G-buffer. Closed outward meshes are drawn with back faces culled, every other
 //!    opaque mesh two-sided. Analytic spheres are ray-cast in their bounding cubes (exact
 //!    depth, normal and position).
+//!
+//! Inputs / outputs (the first pass of the frame; images are `Targets` fields):
+//! - Reads: nothing sampled (the instance buffer and the sphere cubes only).
+//! - Writes: `accum` (cleared to `SKY`), `albedo`, `normal`, `position` (cleared to `ZERO`), each
+//!   `UNDEFINED -> COLOR_ATTACHMENT_OPTIMAL`, CLEAR/STORE; `depth` `UNDEFINED -> DEPTH_STENCIL_ATTACHMENT_OPTIMAL`,
+//!   CLEAR/STORE (`DS_CLEAR`: depth 1, stencil 0), depth LESS with writes.
+//! - Leaves: `albedo`, `normal`, `position` in `SHADER_READ_ONLY_OPTIMAL` for the rest of the frame (lighting, shadow-map
+//!   lookup, ray query, readback); `accum` in `COLOR_ATTACHMENT_OPTIMAL` and `depth` in `DEPTH_STENCIL_ATTACHMENT_OPTIMAL`,
+//!   where every later pass loads them until `tonemap`.
 
 use super::{att, Rec, SceneDraw, DS_CLEAR, SKY, ZERO};
 use crate::render::push::{GBufferPush, SpherePush};

@@ -1,6 +1,15 @@
 //! 2c. Per light, illumination where the count is zero: a full-screen triangle over the
 //!     light's scissor, Blinn-Phong from the G-buffer, scaled by the light-intensity map,
 //!     added into the float target.
+//!
+//! Inputs / outputs, per light (after `determine::finish` and `intensity`):
+//! - Reads, sampled through `gbuffer_set` (written as `SHADER_READ_ONLY_OPTIMAL`): `albedo`, `normal`, `position` (left
+//!   there by `gbuffer`); `count` in the float variants (by `determine::finish`); `transmit` in the transmit variants
+//!   (by `intensity`).
+//! - Reads: `depth` as the depth-stencil attachment, `DEPTH_STENCIL_ATTACHMENT_OPTIMAL`, LOAD/STORE: the stencil variants
+//!   test stencil EQUAL 0 (nothing written), depth bounds where the pass uses them.
+//! - Writes: `accum` in `COLOR_ATTACHMENT_OPTIMAL`, LOAD/STORE, additive, inside the light's scissor.
+//! - Leaves every layout as it found it; a colour + depth-stencil memory barrier orders it before the next light's passes.
 
 use super::{att, Rec, SceneDraw, COLOR_RW, DS_CLEAR, DS_RW, FRAG_TESTS, ZERO};
 use crate::pass::{PreparedFrame, ShadowPass};

@@ -1,6 +1,13 @@
 //! 2b. Per light, the transparent casters' light-intensity map (Kim et al. 2008), recorded
 //!     by the [`ShadowPass`]: every counted volume face multiplies by `t` or `1/t` (or adds
 //!     `±log t`), depth-tested like the float counter.
+//!
+//! Inputs / outputs, per light (only when the scene has transparent casters):
+//! - Reads: `depth` (the `Targets` depth-stencil image) in `DEPTH_STENCIL_ATTACHMENT_OPTIMAL`, LOAD, declared and left there
+//!   (`DepthStencilTarget::new`; the pass's own barriers keep that layout).
+//! - Writes: `transmit`, `UNDEFINED -> COLOR_ATTACHMENT_OPTIMAL`, CLEAR to 1 (0 with the log map) inside the light's
+//!   scissor, STORE; with capture copied out through `TRANSFER_SRC_OPTIMAL` and returned.
+//! - Leaves: `transmit` in `SHADER_READ_ONLY_OPTIMAL` for `illuminate` (binding 5 of `gbuffer_set`); `depth` unchanged.
 
 use super::Rec;
 use crate::error::Result;

@@ -2,6 +2,33 @@
 //! them: G-buffer, per light determination (+ light-intensity map; the shadow-map baseline's
 //! maps and lookup, `shadowmap`) and illumination, the transparent casters (with
 //! `--self-shadow`, `selfshadow`), the debug views, the tone map.
+//!
+//! Inputs / outputs, in the order `frame/record.rs` records them (images are `Targets` fields unless named; `COLOR` =
+//! `COLOR_ATTACHMENT_OPTIMAL`, `DS` = `DEPTH_STENCIL_ATTACHMENT_OPTIMAL`, `READ` = `SHADER_READ_ONLY_OPTIMAL`, `SRC` =
+//! `TRANSFER_SRC_OPTIMAL`; `A -> B` is a transition the pass records, a single layout one it expects and keeps;
+//! attachments STORE; "in scissor": only inside the light's scissor):
+//!
+//! | Pass | Reads (layout, load op) | Writes (layout, load op) |
+//! |---|---|---|
+//! | `gbuffer` | nothing sampled | `accum`, `albedo`, `normal`, `position` `UNDEFINED -> COLOR`, `depth` `UNDEFINED -> DS`, CLEAR |
+//! | (after it) | | `albedo`, `normal`, `position` `COLOR -> READ`; `accum` stays `COLOR`, `depth` stays `DS` |
+//! | per light: `shadowmap` maps | nothing sampled | its atlas `UNDEFINED -> DS`, CLEAR, then `-> READ` |
+//! | `shadowmap` lookup | `normal`, `position`, atlas (`READ`) | `count` (`COLOR`, by `determine::begin_float`), CLEAR in scissor |
+//! | ray query (`raytrace.rs`) | `normal`, `position` (`READ`); `depth` (`DS`, LOAD) | stencil of `depth`, cleared in scissor |
+//! | `determine` | depth of `depth` (`DS`, LOAD) | stencil (`DS`, CLEAR in scissor) or `count` (`UNDEFINED -> COLOR`, CLEAR) |
+//! | `determine::finish` | with capture: `count` or the stencil via `SRC` and back | float counts: `count` `COLOR -> READ` |
+//! | `intensity` (transparent casters) | depth of `depth` (`DS`, LOAD) | `transmit` `UNDEFINED -> COLOR`, CLEAR in scissor, `-> READ` |
+//! | `illuminate` | G-buffer, `count`, `transmit` per variant (`READ`); `depth` (`DS`, LOAD) | `accum` (`COLOR`, LOAD), in scissor |
+//! | `transparent` | `depth` (`DS`, LOAD, tested, not written) | `accum` (`COLOR`, LOAD) |
+//! | `selfshadow` (`--self-shadow`) | `depth` (`DS`, LOAD); its own `count`, `map` (`READ`) | `accum` (`COLOR`, LOAD), in scissor |
+//! | (its own images) | | depth `UNDEFINED -> DS`, CLEAR; per light `count`, `map` `UNDEFINED -> COLOR`, CLEAR, `-> READ` |
+//! | `debug` (`--view volumes`) | `depth` (`DS`, LOAD) | `accum` (`COLOR`, LOAD) |
+//! | `tonemap` | `accum` `COLOR -> READ` | `output` `UNDEFINED -> COLOR`, DONT_CARE |
+//! | readback (`record.rs`) | `output` (`COLOR`); `position`, `normal` (`READ`) | the readback buffer, each image via `SRC` and back |
+//! | `samples` (MSAA; also in `finish`) | `depth` `DS -> READ -> DS`; `normal` (`READ`) | own images `UNDEFINED -> COLOR`, then `SRC` |
+//!
+//! Every image a frame writes starts the frame (or the light) from `UNDEFINED`, so nothing relies on the layout the
+//! previous frame left (`accum` and the G-buffer `READ`, `depth` `DS`, `output` `COLOR`).
 
 pub(crate) mod debug;
 pub(crate) mod determine;

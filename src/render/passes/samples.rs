@@ -3,6 +3,16 @@
 //! normal or stencil target into a single-sample image ([`SampleReadback`]) that is copied
 //! into sample `k`'s block of the readback range.
 //!
+//! Inputs / outputs (called by `determine::finish` for the stencil capture, and by `frame/record.rs` after the tone
+//! map for depth and normals):
+//! - Reads: `Source::Depth` / `Source::Stencil`: the `Targets` depth-stencil image, `DEPTH_STENCIL_ATTACHMENT_OPTIMAL ->
+//!   SHADER_READ_ONLY_OPTIMAL` for the pass and back afterwards (sampled through aspect views, `depth_set` /
+//!   `stencil_set`); `Source::Normal`: `normal` in `SHADER_READ_ONLY_OPTIMAL` (left there by `gbuffer`), not transitioned.
+//! - Writes, per sample: `per_sample.geometry` (depth, normal) or `per_sample.stencil`, `UNDEFINED ->
+//!   COLOR_ATTACHMENT_OPTIMAL`, DONT_CARE/STORE, then copied out through `TRANSFER_SRC_OPTIMAL` and returned to
+//!   `COLOR_ATTACHMENT_OPTIMAL`.
+//! - Leaves every `Targets` image in the layout it found it.
+//!
 //! [`SampleReadback`]: crate::render::targets::SampleReadback
 
 use super::{att, Rec, ZERO};

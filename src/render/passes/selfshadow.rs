@@ -29,6 +29,15 @@
 //!
 //! Everything here runs only when `RenderOptions::self_shadow` is set and the scene has
 //! transparent casters; otherwise the frame records exactly the passes it did before.
+//!
+//! Inputs / outputs (recorded by `frame/record.rs` right after `transparent::record`):
+//! - Reads: the opaque `depth` in `DEPTH_STENCIL_ATTACHMENT_OPTIMAL` and `accum` in `COLOR_ATTACHMENT_OPTIMAL`, as
+//!   `transparent` leaves them; its own `count` and `map` sampled in `SHADER_READ_ONLY_OPTIMAL` (its `set`, step 6).
+//! - Step 4: its own `depth` `UNDEFINED -> DEPTH_STENCIL_ATTACHMENT_OPTIMAL`, CLEAR (`DS_CLEAR`)/STORE; LOADed by step 5.
+//! - Step 5, per light, inside the scissor: `count` and `map` each `UNDEFINED -> COLOR_ATTACHMENT_OPTIMAL`, CLEAR (count 0;
+//!   map 1, or 0 in log space)/STORE, then `-> SHADER_READ_ONLY_OPTIMAL`.
+//! - Step 6, per light: `accum` (LOAD/STORE, additive) over the opaque `depth` (LOAD/STORE, tested LESS, not written).
+//! - Leaves: `accum` and both depth images in attachment layout; its `count` and `map` in `SHADER_READ_ONLY_OPTIMAL`.
 
 use super::{att, transparent, Rec, SceneDraw, COLOR_RW, DS_CLEAR, DS_RW, FRAG_TESTS, ZERO};
 use crate::error::Result;

@@ -18,6 +18,14 @@
 //! SHADER_READ_ONLY_OPTIMAL (lookup) per light; the G-buffer must be in
 //! SHADER_READ_ONLY_OPTIMAL and the float counter in COLOR_ATTACHMENT_OPTIMAL, where the
 //! lookup leaves it.
+//!
+//! Inputs / outputs per light (called by `frame/record.rs` after `determine::begin_float`, before `determine::record`):
+//! - `record_maps`: writes the atlas, `UNDEFINED -> DEPTH_STENCIL_ATTACHMENT_OPTIMAL`, CLEAR (depth 1)/STORE, the opaque
+//!   casters' depth; then `-> SHADER_READ_ONLY_OPTIMAL`.
+//! - `record_lookup`: reads `normal` and `position` (`SHADER_READ_ONLY_OPTIMAL`, left by `gbuffer`), the atlas
+//!   (`SHADER_READ_ONLY_OPTIMAL`, compare sampler) and the face table; writes `count` in `COLOR_ATTACHMENT_OPTIMAL`
+//!   (set from `UNDEFINED` by `determine::begin_float`), CLEAR to 0 inside the scissor, STORE, additive; no depth-stencil
+//!   attachment. `determine::finish` (`CountInto::External`) then takes `count` to `SHADER_READ_ONLY_OPTIMAL`.
 
 use crate::error::{Error, Result};
 use crate::gpu::descriptors::{pipeline_layout, Binding, DescriptorSet};

@@ -1,4 +1,12 @@
 //! 4. The final pass: tone map the float accumulation into the sRGB output.
+//!
+//! Inputs / outputs (the last pass):
+//! - Reads: `accum`, `COLOR_ATTACHMENT_OPTIMAL -> SHADER_READ_ONLY_OPTIMAL`, sampled through `accum_set` (resolved by
+//!   the multisampled variant).
+//! - Writes: `output`, `UNDEFINED -> COLOR_ATTACHMENT_OPTIMAL`, DONT_CARE/STORE, the full frame.
+//! - Leaves: `accum` in `SHADER_READ_ONLY_OPTIMAL` (the next frame's `gbuffer` takes it from `UNDEFINED`); `output` in
+//!   `COLOR_ATTACHMENT_OPTIMAL`, which `frame/record.rs` copies out through `TRANSFER_SRC_OPTIMAL` and returns there (the
+//!   layout `Renderer::output_image` documents). `host_barrier` then makes the frame's transfer writes visible to the host.
 
 use super::{att, Rec, ZERO};
 use crate::gpu::resources::memory_barrier;

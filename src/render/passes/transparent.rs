@@ -1,6 +1,12 @@
 //! 3. Transparent casters, forward over the lit scene: premultiplied "over" with the ambient
 //!    term, then each light added (unsorted: an order-independent approximation; without
 //!    `--self-shadow` transparent surfaces receive no shadows).
+//!
+//! Inputs / outputs (after the last light's `illuminate`; no transition recorded here):
+//! - Reads: `depth` (the opaque depth) in `DEPTH_STENCIL_ATTACHMENT_OPTIMAL`, LOAD/STORE, tested LESS, not written;
+//!   nothing sampled.
+//! - Writes: `accum` in `COLOR_ATTACHMENT_OPTIMAL`, LOAD/STORE ("over", then additive per forward light).
+//! - Leaves both in those layouts, where `selfshadow`, `debug` and `tonemap` expect them.
 
 use super::{att, Rec, SceneDraw, DS_CLEAR, ZERO};
 use crate::render::push::{ForwardPush, LightPush};
