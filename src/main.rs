@@ -46,6 +46,10 @@ struct FrameArgs {
     /// Texels per side of each shadow map (--method shadowmap).
     #[arg(long, default_value_t = 2048)]
     shadow_map_size: u32,
+    /// How the shadow map's 3x3 PCF lookup reads its taps (--method shadowmap): nine taps or
+    /// four gathers, the same comparisons and picture either way.
+    #[arg(long, value_enum, default_value = "taps")]
+    pcf: umbrage::render::Pcf,
     /// Partial self-shadowing of transparent casters (Kim et al. 2008): their forward light
     /// passes read a light-intensity map built on the nearest transparent surface.
     #[arg(long)]
@@ -117,7 +121,7 @@ enum MethodArg {
 }
 
 impl MethodArg {
-    fn technique(self, shadow_map_size: u32) -> Technique {
+    fn technique(self, shadow_map_size: u32, pcf: umbrage::render::Pcf) -> Technique {
         use umbrage::shadow::Method as M;
         match self {
             MethodArg::Auto | MethodArg::Mcguire => Technique::Volumes(M::McGuire),
@@ -129,7 +133,7 @@ impl MethodArg {
             MethodArg::Edgequad => Technique::EdgeQuads,
             MethodArg::Planar => Technique::Planar,
             MethodArg::Compute => Technique::Compute,
-            MethodArg::Shadowmap => Technique::ShadowMap { size: shadow_map_size },
+            MethodArg::Shadowmap => Technique::ShadowMap { size: shadow_map_size, pcf },
             MethodArg::Rayquery => Technique::RayQuery,
         }
     }
@@ -275,6 +279,7 @@ impl Default for FrameArgs {
             counter: Counter::Stencil,
             transmit: TransmitArg::Log16,
             shadow_map_size: 2048,
+            pcf: Default::default(),
             self_shadow: false,
             jitter: false,
             msaa: 1,
@@ -342,7 +347,7 @@ impl FrameArgs {
         Ok(RenderOptions {
             width: self.size.0,
             height: self.size.1,
-            technique: self.method.technique(self.shadow_map_size),
+            technique: self.method.technique(self.shadow_map_size, self.pcf),
             depth_mode: self.depth_mode,
             index_format: self.index_format,
             counter: self.counter,

@@ -2,7 +2,7 @@
 //! counts read back are the expected ones (one box = 1, two stacked boxes = 2), for every
 //! method that should handle the view, including the eye inside the volumes.
 mod common;
-use umbrage::render::{DepthMode, RenderOptions, Renderer, Technique};
+use umbrage::render::{DepthMode, Pcf, RenderOptions, Renderer, Technique};
 use umbrage::shadow::Method;
 
 /// Two boxes stacked above a floor, a point light straight above, camera looking down at the
@@ -110,18 +110,25 @@ fn eye_inside_two_volumes_counts_two_except_zpass() {
 
 /// The shadow-map baseline (PCF) renders under validation and lands close to the reference:
 /// not exact (that is the point of comparing), but within half a percent of the pixels on the
-/// built-in scenes with 1024-texel maps.
+/// built-in scenes with 1024-texel maps. The gathering lookup reads the same nine comparisons
+/// as the nine taps: the same shadow counts and the same picture, pixel for pixel.
 #[test]
 fn shadow_map_baseline_is_close_to_the_reference() {
     let Some(mut ctx) = common::context() else { return };
-    for name in ["default", "stairs", "spheres", "hard/light_inside_caster"] {
+    for name in ["default", "stairs", "spheres", "hard/light_inside_caster", "hard/light_inside_bounds"] {
         let scene = umbrage::scene::load(name).unwrap();
-        let sm = Technique::ShadowMap { size: 1024 };
-        let opts = RenderOptions { width: 256, height: 192, technique: sm, ..Default::default() };
+        let sm = Technique::ShadowMap { size: 1024, pcf: Pcf::Taps };
+        let opts = RenderOptions { width: 256, height: 192, technique: sm, capture: true, ..Default::default() };
         let mut r = Renderer::new(ctx, scene, opts).unwrap();
         let rows = umbrage::accuracy::evaluate(&mut r, name, &[sm], 1).unwrap();
-        assert!(matches!(r.render().unwrap().stats.method, umbrage::render::Technique::ShadowMap { .. }));
+        let taps = r.render().unwrap();
+        assert!(matches!(taps.stats.method, umbrage::render::Technique::ShadowMap { .. }));
         assert!(rows[0].fraction < 5e-3, "{name}: shadow map error {:.4}%", rows[0].fraction * 100.0);
+        r.settings.technique = Technique::ShadowMap { size: 1024, pcf: Pcf::Gather };
+        let gather = r.render().unwrap();
+        assert!(!taps.counts.is_empty() && taps.counts.iter().flatten().any(|&c| c != 0), "{name}: no shadow to compare");
+        assert!(taps.counts == gather.counts, "{name}: the gathers' shadow counts differ from the taps'");
+        assert!(taps.color == gather.color, "{name}: the gathers' picture differs from the taps'");
         r.context().check_validation().unwrap();
         ctx = r.into_context();
     }

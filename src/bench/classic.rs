@@ -91,10 +91,12 @@ pub struct BenchConfig {
     pub opts: RenderOptions,
 }
 
-/// The name of a bench row's technique.
+/// The name of a bench row's technique (`shadowmap-512`; `shadowmap-512-gather` for the
+/// gathering lookup).
 pub fn technique_label(t: Technique) -> String {
     match t {
-        Technique::ShadowMap { size } => format!("shadowmap-{size}"),
+        Technique::ShadowMap { size, pcf: crate::render::Pcf::Taps } => format!("shadowmap-{size}"),
+        Technique::ShadowMap { size, pcf } => format!("shadowmap-{size}-{pcf}"),
         t => t.name().to_string(),
     }
 }

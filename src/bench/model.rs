@@ -5,7 +5,7 @@
 //! gpu_shadow_ms ≈ 1e-6 · Σ c_k · count_k   (c_k in ns per unit, c_k ≥ 0)
 //! ```
 //!
-//! over [`TERMS`] (fragments, per-pixel light passes, shadow-map lookups and texels, rays,
+//! over [`TERMS`] (fragments, per-pixel light passes, shadow-map lookups (taps or gathers) and texels, rays,
 //! triangles submitted and set up, clipped triangles, vertices shaded, caster triangles bound, compute
 //! silhouette triangles, draws, caster passes, lights and a constant), fitted by non-negative least squares on the suite's own rows, in relative error
 //! (each row weighted by 1 / its time, so a 0.3 ms row counts as much as a 300 ms one). It is
@@ -37,7 +37,8 @@ pub enum Group {
 pub const TERMS: &[(&str, Group, &str)] = &[
     ("fragments", Group::Fill, "stencil fragments the volumes rasterise (precise occlusion query)"),
     ("pixel_passes", Group::Fill, "lights x frame pixels (per-light stencil clears and full-screen passes)"),
-    ("lookup_pixels", Group::Fill, "lights x frame pixels of the shadow-map PCF lookup (shadow maps only)"),
+    ("lookup_pixels", Group::Fill, "lights x frame pixels of the shadow-map PCF lookup, nine taps (shadow maps only)"),
+    ("gather_pixels", Group::Fill, "lights x frame pixels of the shadow-map PCF lookup, four gathers (shadow maps with --pcf gather)"),
     ("map_texels", Group::Fill, "shadow-map texels cleared and rendered (faces x size^2, per light)"),
     ("rays", Group::Fill, "ray-query rays (lights x frame pixels, ray query only)"),
     ("input_triangles", Group::Vertex, "input-assembly primitives (pipeline statistics): every triangle submitted, culled or not"),
@@ -51,7 +52,15 @@ pub const TERMS: &[(&str, Group, &str)] = &[
     ),
     ("silhouette_triangles", Group::Vertex, "lights x caster triangles the compute silhouette pass reads (compute only)"),
     ("draws", Group::Draw, "volume draw calls"),
-    ("caster_passes", Group::Draw, "(light, caster) pairs not culled (per pair: state, buffers, dispatches)"),
+    ("caster_passes", Group::Draw, "(light, caster) pairs not culled, CPU-planned volumes (per pair: state, index streams)"),
+    ("caster_passes_edgequad", Group::Draw, "(light, caster) pairs not culled, edge quads (per pair: state, two draws)"),
+    (
+        "caster_passes_compute",
+        Group::Draw,
+        "(light, caster) pairs not culled, compute silhouettes (per pair: dispatch, barrier, indirect draw)",
+    ),
+    ("caster_passes_planar", Group::Draw, "(light, caster) pairs not culled, planar projection (per pair: state, one draw)"),
+    ("caster_passes_other", Group::Draw, "(light, caster) pairs not culled, shadow maps and ray query"),
     ("lights", Group::Fixed, "lights (per-light passes, barriers, rendering instances)"),
     ("constant", Group::Fixed, "1 per frame"),
 ];
@@ -95,6 +104,7 @@ pub fn features(r: &SuiteRow) -> Option<Vec<f64>> {
     r.gpu_shadow_ms.filter(|t| *t > 0.0)?;
     let ray = r.method == "rayquery";
     let map = r.method.starts_with("shadowmap");
+    let gather = map && r.method.ends_with("-gather");
     // The CPU-planned volumes index each caster's dual-length vertex buffer.
     let planned = matches!(r.method.as_str(), "zpass" | "zfail" | "everitt-kilgard" | "lengyel" | "mcguire" | "zpass-clear");
     let lights = r.lights as f64;
@@ -103,7 +113,8 @@ pub fn features(r: &SuiteRow) -> Option<Vec<f64>> {
     Some(vec![
         r.stencil_fragments.unwrap_or(0) as f64,
         pixels,
-        only(map, pixels),
+        only(map && !gather, pixels),
+        only(gather, pixels),
         r.map_texels as f64,
         only(ray, pixels),
         r.primitives? as f64,
@@ -113,7 +124,11 @@ pub fn features(r: &SuiteRow) -> Option<Vec<f64>> {
         only(planned, r.bound_triangles as f64),
         only(r.method == "compute", r.triangles as f64 * lights),
         r.draws as f64,
-        r.caster_passes as f64,
+        only(planned, r.caster_passes as f64),
+        only(r.method == "edgequad", r.caster_passes as f64),
+        only(r.method == "compute", r.caster_passes as f64),
+        only(r.method == "planar", r.caster_passes as f64),
+        only(map || ray, r.caster_passes as f64),
         lights,
         1.0,
     ])

@@ -120,7 +120,7 @@ impl Runner {
         let mut kept: Vec<&Variant> = Vec::with_capacity(variants.len());
         for v in variants {
             match v.technique {
-                Technique::ShadowMap { size } if !sweeps::shadow_map_fits(size, nlights) => {
+                Technique::ShadowMap { size, .. } if !sweeps::shadow_map_fits(size, nlights) => {
                     self.skipped.push(format!("{sweep} {name}: shadowmap-{size} with {nlights} lights (over 2^26 map texels a frame)"));
                     self.bar.inc(1);
                 }
@@ -192,7 +192,7 @@ impl Runner {
         for ((v, s), a) in variants.iter().zip(counted).zip(acc) {
             let c = s.counters.clone().unwrap_or_default();
             let map_size = match v.technique {
-                Technique::ShadowMap { size } => Some(size as u64),
+                Technique::ShadowMap { size, .. } => Some(size as u64),
                 _ => None,
             };
             let shadow_map = map_size.is_some();
@@ -304,7 +304,15 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
         .map(|m| Variant::of(Technique::Volumes(m)))
         .collect();
     let caps_points = points.iter().filter(|p| p.sweep == "caps").count();
+    // The named scenes also read each shadow map with gathers (the same picture; the lookup's
+    // cost side by side with the nine taps').
+    let gathers: Vec<Variant> = scale
+        .shadow_map_sizes()
+        .into_iter()
+        .map(|size| Variant::of(Technique::ShadowMap { size, pcf: crate::render::Pcf::Gather }))
+        .collect();
     let units = (named.len() + points.len() - caps_points) * techniques.len()
+        + named.len() * gathers.len()
         + caps_points * caps.len()
         + (ablation_scenes.len() + 1) * toggle_variants.len()
         + index_variants.len();
@@ -322,11 +330,12 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
         Runner { ctx: Some(ctx), log, limits: row_limits, frames, frames_in_flight: cfg.frames_in_flight, bar, skipped: Vec::new(), start };
     let mut rows = Vec::new();
     let all: Vec<Variant> = techniques.iter().map(|&t| Variant::of(t)).collect();
+    let named_all: Vec<Variant> = all.iter().chain(&gathers).cloned().collect();
     // The named scenes, with their error (the Pareto chart).
     for &n in named {
         run.bar.set_message(format!("scenes {n}"));
         let scene = crate::scene::load(n)?;
-        rows.extend(run.point(Point { sweep: "scenes", x: 0.0, name: n }, scene, base, &all, true)?);
+        rows.extend(run.point(Point { sweep: "scenes", x: 0.0, name: n }, scene, base, &named_all, true)?);
     }
     for p in &points {
         let SweepPoint { sweep, x, scene, size } = p;

@@ -34,6 +34,10 @@ pub(crate) struct BenchArgs {
     /// default technique list).
     #[arg(long, default_value_t = 2048)]
     shadow_map_size: u32,
+    /// Comma-separated PCF lookups for the shadowmap technique (taps, gather): one row each,
+    /// side by side (`shadowmap-2048`, `shadowmap-2048-gather`).
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "taps")]
+    pcf: Vec<umbrage::render::Pcf>,
     /// Write the report as JSON.
     #[arg(long)]
     json: Option<PathBuf>,
@@ -81,7 +85,7 @@ pub(crate) fn bench_command(a: BenchArgs) -> Result<ExitCode> {
     if a.suite.is_some() {
         return suite(&a);
     }
-    let techniques = bench_techniques(&a.methods, a.shadow_map_size);
+    let techniques = bench_techniques(&a.methods, a.shadow_map_size, &a.pcf);
     let opts = RenderOptions {
         width: a.size.0,
         height: a.size.1,
@@ -153,7 +157,7 @@ fn soak_cmd(
     markdown: Option<&Path>,
 ) -> Result<ExitCode> {
     let frames = args.soak.unwrap_or(0);
-    let technique = methods.first().map(|m| m.technique(2048)).unwrap_or_default();
+    let technique = methods.first().map(|m| m.technique(2048, Default::default())).unwrap_or_default();
     let options = RenderOptions { width: size.0, height: size.1, technique, frames_in_flight, ..Default::default() };
     let cfg = umbrage::soak::SoakConfig {
         scene: scene.unwrap_or("default").to_string(),
@@ -176,22 +180,37 @@ fn soak_cmd(
     Ok(if report.passed { ExitCode::SUCCESS } else { ExitCode::FAILURE })
 }
 
-fn bench_techniques(methods: &[MethodArg], shadow_map_size: u32) -> Vec<Technique> {
+fn bench_techniques(methods: &[MethodArg], shadow_map_size: u32, pcfs: &[umbrage::render::Pcf]) -> Vec<Technique> {
     let size = if shadow_map_size > 0 { shadow_map_size } else { 2048 };
     let mut out: Vec<Technique> = Vec::new();
+    let mut push = |t: Technique| {
+        if !out.contains(&t) {
+            out.push(t);
+        }
+    };
     if methods.is_empty() {
         let sizes: &[u32] = if shadow_map_size > 0 { &[size] } else { &[] };
         // Ray query joins once the device is known (`bench`).
-        out = umbrage::bench::methods::all_techniques(sizes, false);
+        umbrage::bench::methods::all_techniques(sizes, false).into_iter().for_each(&mut push);
     } else {
-        for m in methods {
-            let t = m.technique(size);
-            if !out.contains(&t) {
-                out.push(t);
+        methods.iter().for_each(|m| push(m.technique(size, Default::default())));
+    }
+    // Each shadow map once per PCF lookup asked for, in place.
+    let mut expanded = Vec::new();
+    for t in out {
+        match t {
+            Technique::ShadowMap { size, .. } => {
+                for &pcf in pcfs.iter().chain(pcfs.is_empty().then_some(&umbrage::render::Pcf::Taps)) {
+                    let t = Technique::ShadowMap { size, pcf };
+                    if !expanded.contains(&t) {
+                        expanded.push(t);
+                    }
+                }
             }
+            t => expanded.push(t),
         }
     }
-    out
+    expanded
 }
 
 fn bench(

@@ -184,6 +184,19 @@ named_enum!(
     }
 );
 
+named_enum!(
+    /// How the shadow-map baseline reads its 3x3 percentage-closer-filtering taps: the
+    /// same nine comparisons either way, bit for bit; what differs is the fetch count.
+    Pcf, "pcf", {
+        /// Nine single taps of the compare sampler.
+        #[default]
+        Taps => "taps",
+        /// Four gathers of the compare sampler (each four comparisons), nine of whose sixteen
+        /// results are the taps (single taps within a texel of a map's edge).
+        Gather => "gather",
+    }
+);
+
 /// How a frame's shadows are computed: one enum for every technique, shared by
 /// [`ShadowPass`](super::ShadowPass) and the renderer (`umbrage::render::Renderer`).
 ///
@@ -216,6 +229,8 @@ pub enum Technique {
     ShadowMap {
         /// Texels per side of one map (16..=8192).
         size: u32,
+        /// How the lookup reads its taps.
+        pcf: Pcf,
     },
     /// One shadow ray per pixel with `VK_KHR_ray_query` against acceleration structures of the
     /// casters, writing the volumes' stencil (docs/raytrace.md; renderer only).
@@ -262,13 +277,14 @@ impl Technique {
         Method::ALL.iter().map(|&m| Technique::Volumes(m)).collect()
     }
     /// Parses a `--method` value: `auto` (= mcguire), a volume method, `edgequad`, `planar`,
-    /// `compute`, `rayquery` or `shadowmap` (with maps of `shadow_map_size` texels).
+    /// `compute`, `rayquery` or `shadowmap` (with maps of `shadow_map_size` texels, read with
+    /// [`Pcf::Taps`]).
     pub fn parse(s: &str, shadow_map_size: u32) -> Result<Technique> {
         match s {
             "edgequad" => Ok(Technique::EdgeQuads),
             "planar" => Ok(Technique::Planar),
             "compute" => Ok(Technique::Compute),
-            "shadowmap" => Ok(Technique::ShadowMap { size: shadow_map_size }),
+            "shadowmap" => Ok(Technique::ShadowMap { size: shadow_map_size, pcf: Pcf::Taps }),
             "rayquery" => Ok(Technique::RayQuery),
             _ => s.parse::<Method>().map(Technique::Volumes).map_err(|_| Error::UnknownName {
                 what: "method",

@@ -88,8 +88,8 @@ mod volumes;
 
 pub use casters::CasterId;
 pub use desc::{
-    reverse_z, Capabilities, Counter, DepthDirection, DepthMode, EnabledFeatures, IndexFormat, PassSettings, PassToggles, RenderPassTarget,
-    ShadowPassDesc, TargetModel, Technique,
+    reverse_z, Capabilities, Counter, DepthDirection, DepthMode, EnabledFeatures, IndexFormat, PassSettings, PassToggles, Pcf,
+    RenderPassTarget, ShadowPassDesc, TargetModel, Technique,
 };
 pub use draw::LightFrame;
 pub use frame::PreparedFrame;

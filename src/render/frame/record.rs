@@ -9,6 +9,7 @@ use crate::render::passes::{self, debug, determine, gbuffer, illuminate, intensi
 use crate::render::push::LightPush;
 use crate::render::readback::Layout;
 use crate::render::scene_gpu::Sidedness;
+use crate::render::shadowmap::Lookup;
 use ash::vk;
 use glam::Mat4;
 
@@ -65,7 +66,12 @@ impl Renderer {
                     determine::begin_float(rec, t);
                     let maps = sm.record_maps(rec.ctx, rec.cb, light, self.own.parts.scene.camera.eye.as_dvec3());
                     spans.shadow_map.push(passes::timing_span(begin, stamp(all)));
-                    sm.record_lookup(rec.ctx, rec.cb, t, &maps, lights[li].light_pos, frame.lights[li].scissor);
+                    let pcf = match self.settings.technique {
+                        Technique::ShadowMap { pcf, .. } => pcf,
+                        _ => Default::default(),
+                    };
+                    let lookup = Lookup { light_pos: lights[li].light_pos, scissor: frame.lights[li].scissor, pcf };
+                    sm.record_lookup(rec.ctx, rec.cb, t, &maps, lookup);
                 }
                 if let (Some(rt), Technique::RayQuery) = (&self.own.parts.ray_tracer, self.settings.technique) {
                     rt.cmd_determine(rec, t, frame.slot(), lights[li].light_pos, frame.lights[li].scissor);

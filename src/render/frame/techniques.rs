@@ -25,7 +25,7 @@ impl Renderer {
     /// technique runs; baselines built for an older placement are destroyed.
     pub(super) fn update_shadow_mapper(&mut self, technique: Technique) -> Result<()> {
         let wanted = match technique {
-            Technique::ShadowMap { size } => Some(size),
+            Technique::ShadowMap { size, .. } => Some(size),
             _ => None,
         };
         let version = self.own.parts.scene_version;

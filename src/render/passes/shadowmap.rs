@@ -33,6 +33,7 @@ use crate::gpu::pipeline::{self, Blend, PipelineDesc};
 use crate::gpu::resources::{memory_barrier, transition};
 use crate::gpu::{shaders, Buffer, Context, Image};
 use crate::render::targets::{Targets, COUNT_FORMAT};
+use crate::render::Pcf;
 use crate::scene::{Camera, LightKind, Scene};
 use ash::vk;
 use glam::{DVec3, Mat4, Vec3, Vec4};
@@ -66,7 +67,20 @@ pub struct ShadowMapper {
     set: DescriptorSet,
     layouts: [vk::PipelineLayout; 2],
     map_pipeline: vk::Pipeline,
-    lookup_pipeline: vk::Pipeline,
+    /// The lookup's pipelines: nine taps (`shadowmap_lookup.frag`), four gathers
+    /// (`shadowmap_gather.wgsl`).
+    lookup_pipelines: [vk::Pipeline; 2],
+}
+
+/// One light's lookup: where the light is, the pass's scissor, how the taps are read.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Lookup {
+    /// The frame's eye-relative light ([`LightPush::light_pos`](crate::render::push::LightPush)).
+    pub light_pos: [f32; 4],
+    /// The light's scissor: the pass's render area.
+    pub scissor: vk::Rect2D,
+    /// Nine taps or four gathers (the same result).
+    pub pcf: Pcf,
 }
 
 /// `shadowmap_lookup.frag`'s `Face` (std430).
@@ -270,8 +284,10 @@ impl ShadowMapper {
         l.color_formats = &count;
         l.blend = Blend::Additive;
         made.pipelines.push(pipeline::create(ctx, &l)?);
+        l.fragment = Some(shaders::SHADOWMAP_GATHER_WGSL);
+        made.pipelines.push(pipeline::create(ctx, &l)?);
         // Everything made: hand the objects over.
-        let (map_pipeline, lookup_pipeline) = (made.pipelines[0], made.pipelines[1]);
+        let (map_pipeline, lookup_pipelines) = (made.pipelines[0], [made.pipelines[1], made.pipelines[2]]);
         made.pipelines.clear();
         made.layouts.clear();
         made.sampler = None;
@@ -279,7 +295,7 @@ impl ShadowMapper {
         let atlas = made.images.pop().ok_or_else(|| Error::Other("shadow-map atlas".into()))?;
         let faces = made.buffers.pop().ok_or_else(|| Error::Other("shadow-map faces".into()))?;
         let casters = made.buffers.pop();
-        Ok(ShadowMapper { size, atlas, casters, meshes, bounds, faces, compare_sampler, set, layouts, map_pipeline, lookup_pipeline })
+        Ok(ShadowMapper { size, atlas, casters, meshes, bounds, faces, compare_sampler, set, layouts, map_pipeline, lookup_pipelines })
     }
 
     /// The maps one light needs, in eye-relative coordinates.
@@ -394,20 +410,15 @@ impl ShadowMapper {
         LightMaps { faces }
     }
 
-    /// Writes light `light`'s shadow fractions into `targets.count` (which must be in
+    /// Writes a light's shadow fractions into `targets.count` (which must be in
     /// COLOR_ATTACHMENT_OPTIMAL; it is left there) from the maps [`ShadowMapper::record_maps`]
-    /// rendered for that light (`light_pos`: the frame's eye-relative light,
-    /// [`LightPush::light_pos`](crate::render::push::LightPush)): one full-screen pass inside
-    /// `scissor`.
-    pub(crate) fn record_lookup(
-        &self,
-        ctx: &Context,
-        cb: vk::CommandBuffer,
-        targets: &Targets,
-        maps: &LightMaps,
-        light_pos: [f32; 4],
-        scissor: vk::Rect2D,
-    ) {
+    /// rendered for that light: one full-screen pass inside `lookup.scissor`.
+    pub(crate) fn record_lookup(&self, ctx: &Context, cb: vk::CommandBuffer, targets: &Targets, maps: &LightMaps, lookup: Lookup) {
+        let Lookup { light_pos, scissor, pcf } = lookup;
+        let pipeline = match pcf {
+            Pcf::Gather => self.lookup_pipelines[1],
+            _ => self.lookup_pipelines[0],
+        };
         let faces = &maps.faces;
         let d = &ctx.device;
         let mut rows = [FaceRow::default(); 6];
@@ -438,7 +449,7 @@ impl ShadowMapper {
             d.cmd_begin_rendering(cb, &vk::RenderingInfo::default().render_area(scissor).layer_count(1).color_attachments(&count_att));
             d.cmd_set_viewport(cb, 0, &[vk::Viewport { x: 0.0, y: 0.0, width: w, height: h, min_depth: 0.0, max_depth: 1.0 }]);
             d.cmd_set_scissor(cb, 0, &[scissor]);
-            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.lookup_pipeline);
+            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipeline);
             d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, self.layouts[1], 0, &[self.set.set], &[]);
             d.cmd_push_constants(cb, self.layouts[1], vk::ShaderStageFlags::FRAGMENT, 0, bytemuck::bytes_of(&push));
             d.cmd_draw(cb, 3, 1, 0, 0);
@@ -462,7 +473,9 @@ impl ShadowMapper {
         unsafe {
             let d = &ctx.device;
             d.destroy_pipeline(self.map_pipeline, None);
-            d.destroy_pipeline(self.lookup_pipeline, None);
+            for p in self.lookup_pipelines {
+                d.destroy_pipeline(p, None);
+            }
             for l in self.layouts {
                 d.destroy_pipeline_layout(l, None);
             }
