@@ -2,7 +2,7 @@
 # The measurements of docs/raytrace.md, on Mesa lavapipe 25.0.7 (ray query), in one run:
 # rayquery / mcguire / shadowmap side by side on the bench scenes (and the city asset when
 # scripts/fetch-assets.sh could get it), the resolution sweep, area lights at 1/4/16/64
-# samples, and the quick fill-vertex suite (whose technique list includes rayquery there).
+# samples, four spheres from 16k to 1M triangles, and the quick fill-vertex suite (whose technique list includes rayquery there).
 # Writes docs/raytrace/*.md and *.json. Usage: scripts/measure-raytrace.sh [--no-suite]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -50,6 +50,25 @@ for size in 480x270 960x540 1920x1080; do
   "$bin" bench --scene default --scene bench/fill --methods rayquery,mcguire --size "$size" --frames 8 \
     --json "$out/resolution-$size.json" --markdown /tmp/umbrage-res.md
   { echo "### $size"; echo; sed -n '/^| scene/,$p' /tmp/umbrage-res.md; echo; } >> "$out/resolution.md"
+done
+
+# Triangles, up to 1M: four tessellated spheres over a floor, one point light; each
+# technique's cost against the casters' triangle count (the BLAS build is once per scene).
+: > "$out/triangles.md"
+for spec in 64:33 256:126 500:251; do
+  seg=${spec%%:*}; rings=${spec##*:}
+  toml="target/tess-$seg.toml"
+  {
+    printf '[camera]\neye = [0.0, 9.0, 12.0]\ntarget = [0.0, 0.0, 0.0]\n'
+    printf '[[light]]\nkind = "point"\nposition = [2.0, 12.0, 3.0]\n'
+    printf '[[mesh]]\nshape = "plane"\nsize = [40.0, 40.0]\ncasts_shadow = false\n'
+    for x in -3 3; do for z in -3 3; do
+      printf '[[mesh]]\nshape = "sphere"\nradius = 1.2\nsegments = %d\nrings = %d\ntranslate = [%s.0, 1.5, %s.0]\n' "$seg" "$rings" "$x" "$z"
+    done; done
+  } > "$toml"
+  "$bin" bench --scene "$toml" --methods rayquery,mcguire,shadowmap --shadow-map-size 2048 --frames 6 \
+    --json "$out/triangles-$seg.json" --markdown /tmp/umbrage-tess.md
+  { echo "### 4 spheres of $seg x $rings"; echo; sed -n '/^| scene/,$p' /tmp/umbrage-tess.md; echo; } >> "$out/triangles.md"
 done
 
 # Area lights: N point-light samples, each one determination pass (volumes) or one ray a

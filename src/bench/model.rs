@@ -96,6 +96,47 @@ pub struct Model {
     pub limit_ns: BTreeMap<String, f64>,
     /// Per technique, the median held-out relative error (where the model fits worst).
     pub median_rel_error_by_method: BTreeMap<String, f64>,
+    /// The run's own repeatability, the floor any model is judged against: rows measured twice
+    /// in this run (the same scene, technique, size and variant in two sweeps).
+    pub repeat: Repeat,
+}
+
+/// How far apart two measurements of the same row in one run land ([`repeatability`]).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Repeat {
+    /// Pairs of rows measured twice.
+    pub pairs: usize,
+    /// Median of |a - b| / min(a, b) over the pairs: the first measured as a prediction of
+    /// the second, in the model's error measure.
+    pub median_rel_diff: f64,
+    /// Share of the pairs that differ by more than 30 %.
+    pub over_30_percent: f64,
+}
+
+/// Pairs of timed rows with the same scene, technique, size, lights and variant from
+/// different sweeps (a point two sweeps share, measured minutes apart), and how far apart
+/// their times are.
+pub fn repeatability(rows: &[SuiteRow]) -> Repeat {
+    let timed: Vec<&SuiteRow> = rows.iter().filter(|r| r.gpu_shadow_ms.is_some_and(|t| t > 0.0)).collect();
+    let mut diffs = Vec::new();
+    for (i, a) in timed.iter().enumerate() {
+        let twin = timed[i + 1..].iter().find(|b| {
+            b.sweep != a.sweep
+                && b.scene == a.scene
+                && b.method == a.method
+                && b.variant == a.variant
+                && (b.width, b.height, b.lights) == (a.width, a.height, a.lights)
+        });
+        if let (Some(b), Some(ta)) = (twin, a.gpu_shadow_ms) {
+            let tb = b.gpu_shadow_ms.unwrap_or(ta);
+            diffs.push((ta - tb).abs() / ta.min(tb));
+        }
+    }
+    Repeat {
+        pairs: diffs.len(),
+        median_rel_diff: quantile(&diffs, 0.5),
+        over_30_percent: diffs.iter().filter(|d| **d > 0.3).count() as f64 / diffs.len().max(1) as f64,
+    }
 }
 
 /// A row's counts, in [`TERMS`] order (`None`: the row cannot be modelled: untimed or without
@@ -268,6 +309,7 @@ pub fn fit(rows: &mut [SuiteRow], limit_ns: BTreeMap<String, f64>) -> Model {
         terms: TERMS.iter().map(|(n, _, what)| (n.to_string(), what.to_string())).collect(),
         limit_ns,
         median_rel_error_by_method: by_method.into_iter().map(|(m, e)| (m, quantile(&e, 0.5))).collect(),
+        repeat: repeatability(rows),
     }
 }
 
@@ -306,6 +348,22 @@ mod tests {
         };
         assert_eq!(features(&r).map(|f| f.len()), Some(TERMS.len()));
         assert_eq!(features(&SuiteRow::default()), None, "untimed rows are not modelled");
+    }
+
+    #[test]
+    fn repeatability_pairs_the_same_row_across_sweeps() {
+        let row = |sweep: &str, scene: &str, t: f64| SuiteRow {
+            sweep: sweep.into(),
+            scene: scene.into(),
+            method: "mcguire".into(),
+            gpu_shadow_ms: Some(t),
+            ..Default::default()
+        };
+        let rows = [row("lights", "a", 2.0), row("tessellation", "a", 3.0), row("lights", "b", 1.0), row("lights", "b", 9.0)];
+        let r = repeatability(&rows);
+        // Only the pair from two sweeps counts; the same sweep twice is not a repeat.
+        assert_eq!(r.pairs, 1);
+        assert!((r.median_rel_diff - 0.5).abs() < 1e-12 && r.over_30_percent == 1.0, "{r:?}");
     }
 
     #[test]

@@ -15,6 +15,7 @@ use super::report::{SuiteReport, SuiteRow};
 use crate::error::{Error, Result};
 use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 
 static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSansMono.ttf");
@@ -232,6 +233,17 @@ where
     Ok(())
 }
 
+/// One label for rows of one technique read two ways: `shadowmap-512 (taps, gather)` for
+/// `shadowmap-512` and `shadowmap-512-gather`; other names joined by commas.
+fn join_variants(names: &[String]) -> String {
+    let mut sorted: Vec<&String> = names.iter().collect();
+    sorted.sort_by_key(|n| n.len());
+    match sorted.as_slice() {
+        [a, b] if **b == format!("{a}-gather") => format!("{a} (taps, gather)"),
+        _ => names.join(", "),
+    }
+}
+
 fn pareto<DB: DrawingBackend>(r: &SuiteReport, root: DrawingArea<DB, Shift>) -> Result<()>
 where
     DB::ErrorType: 'static,
@@ -255,11 +267,16 @@ where
     }
     let (top, body) = root.split_vertically(30);
     top.titled(&title, ("sans-serif", 18)).map_err(err(&title))?;
-    let areas = body.split_evenly((1, scenes.len().max(1)));
+    // One panel per scene, stacked: each plot as wide as the image less its exact-method list.
+    let areas = body.split_evenly((scenes.len().max(1), 1));
     let all_methods = methods(rows.iter().copied());
-    for (area, scene) in areas.iter().zip(scenes) {
-        let mut chart = ChartBuilder::on(area)
-            .caption(scene, ("sans-serif", 16))
+    for (panel, scene) in areas.iter().zip(scenes) {
+        // The plot, and to its right a column listing the exact methods (which share the
+        // floor), so the list never covers a point or its label.
+        let (pw, _) = panel.dim_in_pixel();
+        let (area, list) = panel.split_horizontally(pw.saturating_sub(190));
+        let mut chart = ChartBuilder::on(&area)
+            .caption(format!("{scene} (green: the Pareto front)"), ("sans-serif", 16))
             .margin(10)
             .x_label_area_size(40)
             .y_label_area_size(65)
@@ -299,43 +316,43 @@ where
         if let Some(l) = front.last().copied() {
             front.push((x1, l.1));
         }
-        chart
-            .draw_series(LineSeries::new(front, RGBColor(40, 120, 40).stroke_width(2)))
-            .map_err(err(&title))?
-            .label("Pareto front")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], RGBColor(40, 120, 40).stroke_width(2)));
-        // Inexact points are labelled where they sit; the exact ones, which share the floor,
-        // are listed fastest first in the panel's middle right, each with its marker colour.
+        chart.draw_series(LineSeries::new(front, RGBColor(40, 120, 40).stroke_width(2))).map_err(err(&title))?;
+        // Inexact points are labelled where they sit, one label for the points of equal error
+        // (the shadow map read with taps and with gathers: the same comparisons), at the
+        // fastest; the exact ones are listed fastest first beside the plot, each with its
+        // marker colour.
         let mut exact = Vec::new();
+        let mut labelled: Vec<(f64, Vec<String>, f64)> = Vec::new();
         for (t, e, m, i) in &pts {
             let color = Palette99::pick(*i).to_rgba();
             let marker = EmptyElement::at((*t, *e)) + Circle::new((0, 0), 4, color.filled());
+            chart.draw_series(std::iter::once(marker)).map_err(err(&title))?;
             if *e <= floor {
-                chart.draw_series(std::iter::once(marker)).map_err(err(&title))?;
                 exact.push((format!("{m}  {t:.2} ms"), color));
+            } else if let Some(g) = labelled.iter_mut().find(|g| (g.0 - e).abs() <= 1e-9 * e) {
+                g.1.push(m.clone());
             } else {
-                let label = Text::new(m.clone(), (5, -14), ("sans-serif", 11).into_font());
-                chart.draw_series(std::iter::once(marker + label)).map_err(err(&title))?;
+                labelled.push((*e, vec![m.clone()], *t));
             }
+        }
+        for (e, names, t) in labelled {
+            // Right of the point, or left of it in the plot's right third (inside the plot).
+            let right_third = (t / x0).ln() > 0.67 * (x1 / x0).ln();
+            let font = TextStyle::from(("sans-serif", 11).into_font());
+            let (style, dx) = if right_third { (font.pos(Pos::new(HPos::Right, VPos::Top)), -5) } else { (font, 5) };
+            let label = Text::new(join_variants(&names), (dx, -14), style);
+            chart.draw_series(std::iter::once(EmptyElement::at((t, e)) + label)).map_err(err(&title))?;
         }
         if !exact.is_empty() {
-            let (w, h) = area.dim_in_pixel();
-            let (x, y0) = (w as i32 - 215, h as i32 / 2 - 10 * exact.len() as i32);
-            area.draw(&Text::new("exact, fastest first:", (x, y0 - 16), ("sans-serif", 12).into_font())).map_err(err(&title))?;
+            let (_, h) = list.dim_in_pixel();
+            let (x, y0) = (4, h as i32 / 2 - 10 * exact.len() as i32);
+            list.draw(&Text::new("exact, fastest first:", (x, y0 - 16), ("sans-serif", 12).into_font())).map_err(err(&title))?;
             for (k, (line, color)) in exact.iter().enumerate() {
                 let y = y0 + 15 * k as i32;
-                area.draw(&Circle::new((x + 4, y + 6), 4, color.filled())).map_err(err(&title))?;
-                area.draw(&Text::new(line.clone(), (x + 14, y), ("sans-serif", 11).into_font())).map_err(err(&title))?;
+                list.draw(&Circle::new((x + 4, y + 6), 4, color.filled())).map_err(err(&title))?;
+                list.draw(&Text::new(line.clone(), (x + 14, y), ("sans-serif", 11).into_font())).map_err(err(&title))?;
             }
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font(("sans-serif", 11))
-            .draw()
-            .map_err(err(&title))?;
     }
     root.present().map_err(err(&title))?;
     Ok(())
