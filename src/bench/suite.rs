@@ -18,7 +18,7 @@ use crate::gpu::Context;
 use crate::render::{IndexFormat, PassToggles, RenderOptions, Renderer, Technique};
 use crate::scene::Scene;
 use crate::shadow::Method;
-use std::collections::HashMap;
+use std::collections::{BTreeMap, HashMap};
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -364,36 +364,14 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
     run.bar.finish_and_clear();
     let ctx = run.ctx.take().ok_or_else(|| Error::Other("context lost".into()))?;
     ctx.check_validation()?;
-    let limit_ns = [
-        ("fragments", 1.0 / limits.stencil_fill_gfrag_s),
-        ("setup_triangles", 1e3 / limits.setup_tri_mtri_s),
-        ("clipped_triangles", 1e3 / limits.clip_tri_mtri_s),
-        ("draws", 1e9 / limits.draws_per_s),
-    ]
-    .iter()
-    .filter(|(_, v)| v.is_finite())
-    .map(|(k, v)| (k.to_string(), *v))
-    .collect();
-    let model = super::model::fit(&mut rows, limit_ns);
+    let model = super::model::fit(&mut rows, limit_costs(&limits));
     for r in &mut rows {
         sweeps::classify(r, row_limits);
     }
     let crossovers = sweeps::crossovers(&rows);
     let mut ablations = ablations(&rows);
     if !ctx.features.depth_bounds {
-        for &n in ablation_scenes {
-            ablations.push(Ablation {
-                what: "depth-bounds".into(),
-                scene: n.into(),
-                variant: "depth-bounds-off".into(),
-                baseline: "all-on".into(),
-                time_ratio: None,
-                fragment_ratio: None,
-                triangle_ratio: None,
-                byte_ratio: None,
-                skipped: "the device has no depthBounds feature (the pass never uses it here)".into(),
-            });
-        }
+        ablations.extend(ablation_scenes.iter().map(|n| no_depth_bounds(n)));
     }
     let mut report = SuiteReport {
         device,
@@ -419,6 +397,35 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
     report.cpu_seconds = process_cpu_seconds().map(|c| c - cpu0.unwrap_or(0.0));
     report.write(&cfg.out)?;
     Ok(report)
+}
+
+/// Each term's cost at the device's measured limit, ns per unit, where a limit measures it.
+fn limit_costs(limits: &Limits) -> BTreeMap<String, f64> {
+    [
+        ("fragments", 1.0 / limits.stencil_fill_gfrag_s),
+        ("setup_triangles", 1e3 / limits.setup_tri_mtri_s),
+        ("clipped_triangles", 1e3 / limits.clip_tri_mtri_s),
+        ("draws", 1e9 / limits.draws_per_s),
+    ]
+    .iter()
+    .filter(|(_, v)| v.is_finite())
+    .map(|(k, v)| (k.to_string(), *v))
+    .collect()
+}
+
+/// The depth-bounds ablation of `scene`, skipped: the device has no `depthBounds`.
+fn no_depth_bounds(scene: &str) -> Ablation {
+    Ablation {
+        what: "depth-bounds".into(),
+        scene: scene.into(),
+        variant: "depth-bounds-off".into(),
+        baseline: "all-on".into(),
+        time_ratio: None,
+        fragment_ratio: None,
+        triangle_ratio: None,
+        byte_ratio: None,
+        skipped: "the device has no depthBounds feature (the pass never uses it here)".into(),
+    }
 }
 
 fn toggle_variants(ctx: &Context) -> Vec<Variant> {
