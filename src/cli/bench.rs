@@ -182,35 +182,27 @@ fn soak_cmd(
 
 fn bench_techniques(methods: &[MethodArg], shadow_map_size: u32, pcfs: &[umbrage::render::Pcf]) -> Vec<Technique> {
     let size = if shadow_map_size > 0 { shadow_map_size } else { 2048 };
-    let mut out: Vec<Technique> = Vec::new();
-    let mut push = |t: Technique| {
-        if !out.contains(&t) {
-            out.push(t);
-        }
-    };
-    if methods.is_empty() {
+    let listed: Vec<Technique> = if methods.is_empty() {
         let sizes: &[u32] = if shadow_map_size > 0 { &[size] } else { &[] };
         // Ray query joins once the device is known (`bench`).
-        umbrage::bench::methods::all_techniques(sizes, false).into_iter().for_each(&mut push);
+        umbrage::bench::methods::all_techniques(sizes, false)
     } else {
-        methods.iter().for_each(|m| push(m.technique(size, Default::default())));
-    }
-    // Each shadow map once per PCF lookup asked for, in place.
-    let mut expanded = Vec::new();
-    for t in out {
-        match t {
-            Technique::ShadowMap { size, .. } => {
-                for &pcf in pcfs.iter().chain(pcfs.is_empty().then_some(&umbrage::render::Pcf::Taps)) {
-                    let t = Technique::ShadowMap { size, pcf };
-                    if !expanded.contains(&t) {
-                        expanded.push(t);
-                    }
-                }
+        methods.iter().map(|m| m.technique(size, Default::default())).collect()
+    };
+    // Each listed once, a shadow map once per PCF lookup asked for (`--pcf`, never empty).
+    let mut out: Vec<Technique> = Vec::new();
+    for t in listed {
+        let variants: Vec<Technique> = match t {
+            Technique::ShadowMap { size, .. } => pcfs.iter().map(|&pcf| Technique::ShadowMap { size, pcf }).collect(),
+            t => vec![t],
+        };
+        for v in variants {
+            if !out.contains(&v) {
+                out.push(v);
             }
-            t => expanded.push(t),
         }
     }
-    expanded
+    out
 }
 
 fn bench(
