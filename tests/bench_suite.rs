@@ -105,6 +105,13 @@ fn tiny_suite_writes_the_contract_and_the_plots() {
     keys(model, &["form", "coefficients", "median_rel_error", "p80_rel_error"], "model");
     assert!(model["coefficients"].as_object().unwrap().values().all(|c| c.as_f64().unwrap() >= 0.0));
     assert!(model["median_rel_error"].as_f64().unwrap().is_finite());
+    // The run's repeatability beside it: the rows two sweeps share, measured twice.
+    keys(&model["repeat"], &["pairs", "median_rel_diff", "over_30_percent"], "model.repeat");
+    assert!(model["repeat"]["pairs"].as_u64().unwrap() > 0, "no row measured twice");
+    // The named scenes read each shadow map with taps and with gathers: the same error.
+    let error_of = |m: &str| rows.iter().find(|r| r["sweep"] == "scenes" && r["method"] == m).map(|r| r["error_fraction"].clone());
+    assert!(error_of("shadowmap-512-gather").is_some(), "no gather row");
+    assert_eq!(error_of("shadowmap-512"), error_of("shadowmap-512-gather"), "taps and gathers disagree");
     keys(limits, &["setup_tri_mtri_s", "clip_tri_mtri_s", "sweeps"], "limits");
     for p in ["time_vs_triangles", "time_vs_resolution", "roofline", "pareto", "model_fit"] {
         for ext in ["svg", "png"] {
