@@ -96,9 +96,18 @@ pub struct BenchConfig {
 pub fn technique_label(t: Technique) -> String {
     match t {
         Technique::ShadowMap { size, pcf: crate::render::Pcf::Taps } => format!("shadowmap-{size}"),
-        Technique::ShadowMap { size, pcf } => format!("shadowmap-{size}-{pcf}"),
+        Technique::ShadowMap { size, pcf: crate::render::Pcf::Gather } => format!("shadowmap-{size}{GATHER_SUFFIX}"),
         t => t.name().to_string(),
     }
+}
+
+/// What [`technique_label`] appends for a shadow map read with gathers.
+const GATHER_SUFFIX: &str = "-gather";
+
+/// For a gathering shadow map's label (`shadowmap-512-gather`), the label of the same map read
+/// with taps (`shadowmap-512`); `None` for every other label.
+pub fn taps_label_of(label: &str) -> Option<&str> {
+    label.strip_suffix(GATHER_SUFFIX).filter(|l| l.starts_with("shadowmap"))
 }
 
 /// Runs the benchmark on `ctx`: per scene, first every variant's error against the reference,

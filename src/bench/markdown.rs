@@ -259,7 +259,7 @@ impl SuiteReport {
             let v: Vec<f64> = self.rows.iter().filter(|r| r.sweep != "ablation").filter_map(f).filter(|x| x.is_finite()).collect();
             (!v.is_empty()).then(|| super::model::quantile(&v, 0.5))
         };
-        let taps = |r: &SuiteRow| !r.method.ends_with("-gather");
+        let taps = |r: &SuiteRow| super::classic::taps_label_of(&r.method).is_none();
         let lookup_ns = per(&|r| Some(r.gpu_lookup_ms? * 1e6 / (r.width as f64 * r.height as f64 * r.lights as f64)).filter(|_| taps(r)));
         let map_ns = per(&|r| (r.map_texels > 0).then(|| r.gpu_map_ms.unwrap_or(0.0) * 1e6 / r.map_texels as f64));
         let frag_ns = self.model.coefficients.get("fragments").copied();
@@ -280,11 +280,10 @@ impl SuiteReport {
         let pairs: Vec<(&SuiteRow, &SuiteRow)> = self
             .rows
             .iter()
-            .filter(|g| g.method.ends_with("-gather"))
             .filter_map(|g| {
-                let t = self.rows.iter().find(|t| {
-                    t.sweep == g.sweep && t.scene == g.scene && t.variant == g.variant && g.method == format!("{}-gather", t.method)
-                })?;
+                let taps = super::classic::taps_label_of(&g.method)?;
+                let t =
+                    self.rows.iter().find(|t| t.sweep == g.sweep && t.scene == g.scene && t.variant == g.variant && t.method == taps)?;
                 Some((t, g))
             })
             .collect();

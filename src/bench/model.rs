@@ -145,7 +145,7 @@ pub fn features(r: &SuiteRow) -> Option<Vec<f64>> {
     r.gpu_shadow_ms.filter(|t| *t > 0.0)?;
     let ray = r.method == "rayquery";
     let map = r.method.starts_with("shadowmap");
-    let gather = map && r.method.ends_with("-gather");
+    let gather = super::classic::taps_label_of(&r.method).is_some();
     // The CPU-planned volumes index each caster's dual-length vertex buffer.
     let planned = matches!(r.method.as_str(), "zpass" | "zfail" | "everitt-kilgard" | "lengyel" | "mcguire" | "zpass-clear");
     let lights = r.lights as f64;

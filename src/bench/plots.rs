@@ -236,10 +236,8 @@ where
 /// One label for rows of one technique read two ways: `shadowmap-512 (taps, gather)` for
 /// `shadowmap-512` and `shadowmap-512-gather`; other names joined by commas.
 fn join_variants(names: &[String]) -> String {
-    let mut sorted: Vec<&String> = names.iter().collect();
-    sorted.sort_by_key(|n| n.len());
-    match sorted.as_slice() {
-        [a, b] if **b == format!("{a}-gather") => format!("{a} (taps, gather)"),
+    match names {
+        [a, b] | [b, a] if super::classic::taps_label_of(b) == Some(a.as_str()) => format!("{a} (taps, gather)"),
         _ => names.join(", "),
     }
 }

@@ -57,6 +57,10 @@ impl Renderer {
                 (None, Counter::Float) => determine::CountInto::Float,
                 (None, Counter::Stencil) => determine::CountInto::Stencil,
             };
+            let pcf = match self.settings.technique {
+                Technique::ShadowMap { pcf, .. } => pcf,
+                _ => Default::default(),
+            };
             for (li, light) in self.own.parts.scene.lights.iter().enumerate() {
                 let begin = stamp(all);
                 if let Some(c) = counters {
@@ -66,10 +70,6 @@ impl Renderer {
                     determine::begin_float(rec, t);
                     let maps = sm.record_maps(rec.ctx, rec.cb, light, self.own.parts.scene.camera.eye.as_dvec3());
                     spans.shadow_map.push(passes::timing_span(begin, stamp(all)));
-                    let pcf = match self.settings.technique {
-                        Technique::ShadowMap { pcf, .. } => pcf,
-                        _ => Default::default(),
-                    };
                     let lookup = Lookup { light_pos: lights[li].light_pos, scissor: frame.lights[li].scissor, pcf };
                     sm.record_lookup(rec.ctx, rec.cb, t, &maps, lookup);
                 }

@@ -14,11 +14,6 @@
 //! of about a texel, the usual trade between acne and peter-panning — so unlike shadow
 //! volumes, its error is not zero, and the bench says how large it is.
 //!
-//! Layouts: the atlas goes UNDEFINED -> DEPTH_STENCIL_ATTACHMENT_OPTIMAL (maps) ->
-//! SHADER_READ_ONLY_OPTIMAL (lookup) per light; the G-buffer must be in
-//! SHADER_READ_ONLY_OPTIMAL and the float counter in COLOR_ATTACHMENT_OPTIMAL, where the
-//! lookup leaves it.
-//!
 //! Inputs / outputs per light (called by `frame/record.rs` after `determine::begin_float`, before `determine::record`):
 //! - `record_maps`: writes the atlas, `UNDEFINED -> DEPTH_STENCIL_ATTACHMENT_OPTIMAL`, CLEAR (depth 1)/STORE, the opaque
 //!   casters' depth; then `-> SHADER_READ_ONLY_OPTIMAL`.
@@ -416,8 +411,8 @@ impl ShadowMapper {
     pub(crate) fn record_lookup(&self, ctx: &Context, cb: vk::CommandBuffer, targets: &Targets, maps: &LightMaps, lookup: Lookup) {
         let Lookup { light_pos, scissor, pcf } = lookup;
         let pipeline = match pcf {
+            Pcf::Taps => self.lookup_pipelines[0],
             Pcf::Gather => self.lookup_pipelines[1],
-            _ => self.lookup_pipelines[0],
         };
         let faces = &maps.faces;
         let d = &ctx.device;

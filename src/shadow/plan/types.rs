@@ -78,20 +78,15 @@ impl std::str::FromStr for Method {
 
 /// How one caster's volume is drawn for one light.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub enum Case {
     /// Nothing drawn (outside the light's radius or cone, or the volume is off screen).
-    #[cfg_attr(feature = "serde", serde(rename = "culled"))]
     #[default]
     Culled,
     /// Case 1: z-pass, sides only.
-    #[cfg_attr(feature = "serde", serde(rename = "zpass"))]
     ZPass,
     /// Case 2: z-fail, sides + dark cap, no light cap.
-    #[cfg_attr(feature = "serde", serde(rename = "zfail"))]
     ZFail,
     /// Case 3 (and Carmack / Everitt-Kilgard / Lengyel z-fail): sides + dark cap + light cap.
-    #[cfg_attr(feature = "serde", serde(rename = "zfail_light_cap"))]
     ZFailLightCap,
 }
 
@@ -104,6 +99,14 @@ impl Case {
             Case::ZFail => "zfail",
             Case::ZFailLightCap => "zfail_light_cap",
         }
+    }
+}
+
+#[cfg(feature = "serde")]
+impl serde::Serialize for Case {
+    /// As its [`name`](Case::name).
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
     }
 }
 
