@@ -50,6 +50,11 @@ struct FrameArgs {
     /// four gathers, the same comparisons and picture either way.
     #[arg(long, value_enum, default_value = "taps")]
     pcf: umbrage::render::Pcf,
+    /// How a point light's six shadow-map cube faces are rendered (--method shadowmap): tiles
+    /// of one atlas, a draw per face; or six views of one draw (needs the device's multiview).
+    /// The same maps and picture either way.
+    #[arg(long, value_enum, default_value = "atlas")]
+    cube: umbrage::render::CubeFaces,
     /// Partial self-shadowing of transparent casters (Kim et al. 2008): their forward light
     /// passes read a light-intensity map built on the nearest transparent surface.
     #[arg(long)]
@@ -121,7 +126,8 @@ enum MethodArg {
 }
 
 impl MethodArg {
-    fn technique(self, shadow_map_size: u32, pcf: umbrage::render::Pcf) -> Technique {
+    /// The technique; `shadow_map` is what `shadowmap` means (its size, lookup and cube faces).
+    fn technique(self, shadow_map: Technique) -> Technique {
         use umbrage::shadow::Method as M;
         match self {
             MethodArg::Auto | MethodArg::Mcguire => Technique::Volumes(M::McGuire),
@@ -133,7 +139,7 @@ impl MethodArg {
             MethodArg::Edgequad => Technique::EdgeQuads,
             MethodArg::Planar => Technique::Planar,
             MethodArg::Compute => Technique::Compute,
-            MethodArg::Shadowmap => Technique::ShadowMap { size: shadow_map_size, pcf },
+            MethodArg::Shadowmap => shadow_map,
             MethodArg::Rayquery => Technique::RayQuery,
         }
     }
@@ -280,6 +286,7 @@ impl Default for FrameArgs {
             transmit: TransmitArg::Log16,
             shadow_map_size: 2048,
             pcf: Default::default(),
+            cube: Default::default(),
             self_shadow: false,
             jitter: false,
             msaa: 1,
@@ -347,7 +354,7 @@ impl FrameArgs {
         Ok(RenderOptions {
             width: self.size.0,
             height: self.size.1,
-            technique: self.method.technique(self.shadow_map_size, self.pcf),
+            technique: self.method.technique(Technique::ShadowMap { size: self.shadow_map_size, pcf: self.pcf, cube: self.cube }),
             depth_mode: self.depth_mode,
             index_format: self.index_format,
             counter: self.counter,

@@ -173,6 +173,14 @@ pub fn info_report(ctx: &Context) -> InfoReport {
                 "missing: no --method rayquery (Mesa lavapipe 25.0.7 has it: scripts/drivers.sh install 25.0.7)",
             ),
         ),
+        (
+            "multiview".into(),
+            match (f.multiview, crate::gpu::quirks::multiview_defect(&ctx.info)) {
+                (false, _) => "missing: --cube atlas only (a draw per cube face)".into(),
+                (true, Some(_)) => "present, not used: this lavapipe loses clipped triangles in multiview; --cube atlas".into(),
+                (true, None) => "available: --cube multiview (a point light's six cube faces as views of one draw)".into(),
+            },
+        ),
         ("depth-stencil format".into(), format!("{} (8 stencil bits, wrap increments)", f.depth_stencil_format)),
     ];
     InfoReport { device: ctx.info.clone(), features: f.clone(), validation: ctx.validation, paths }

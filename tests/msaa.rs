@@ -121,7 +121,7 @@ fn what_renders_at_one_sample_is_refused() {
     let refused = [
         ("default", 3, Technique::default(), Counter::Stencil, View::Shaded, "1, 2, 4 or 8"),
         ("default", 0, Technique::default(), Counter::Stencil, View::Shaded, "1, 2, 4 or 8"),
-        ("default", SAMPLES, Technique::ShadowMap { size: 256, pcf: Default::default() }, Counter::Stencil, View::Shaded, "shadowmap"),
+        ("default", SAMPLES, Technique::shadow_map(256), Counter::Stencil, View::Shaded, "shadowmap"),
         ("default", SAMPLES, Technique::default(), Counter::Float, View::Shaded, "float counter"),
         ("default", SAMPLES, Technique::default(), Counter::Stencil, View::Volumes, "overlay"),
         ("transparent/depth_4", SAMPLES, Technique::default(), Counter::Stencil, View::Shaded, "transparent"),
@@ -142,7 +142,7 @@ fn what_renders_at_one_sample_is_refused() {
     // Switching a multisampled renderer to a one-sample method is refused at the frame.
     let scene = umbrage::scene::load("default").unwrap();
     let mut r = Renderer::new(ctx, scene, RenderOptions { width: 64, height: 48, samples: SAMPLES, ..Default::default() }).unwrap();
-    r.settings.technique = Technique::ShadowMap { size: 256, pcf: Default::default() };
+    r.settings.technique = Technique::shadow_map(256);
     let err = r.render().err().expect("a shadow-map frame at 4 samples");
     assert!(err.to_string().contains("one sample"), "{err}");
     r.settings.technique = Technique::default();

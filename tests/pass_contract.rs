@@ -96,7 +96,7 @@ fn creation_options_are_checked_against_the_device() {
     }
     // The renderer-only techniques (shadow maps, ray query) are refused by name, at creation
     // and between frames; the pass keeps the settings it had.
-    for t in [Technique::ShadowMap { size: 512, pcf: Default::default() }, Technique::RayQuery] {
+    for t in [Technique::shadow_map(512), Technique::RayQuery] {
         let settings = PassSettings { technique: t, ..Default::default() };
         match pass(&ctx, &ShadowPassDesc { settings, ..desc(&ctx) }) {
             Err(Error::InvalidDesc { field, msg }) => assert!(field == "PassSettings::technique" && msg.contains(t.name()), "{msg}"),

@@ -111,7 +111,7 @@ fn bad_sphere_frames_are_refused_not_drawn() {
     let opts = RenderOptions { width: 64, height: 48, ..Default::default() };
     let mut r = Renderer::new(ctx, scene.clone(), opts.clone()).unwrap();
     // Shadow maps do not draw spheres: a clear error, and the renderer keeps working after it.
-    r.settings.technique = Technique::ShadowMap { size: 512, pcf: Default::default() };
+    r.settings.technique = Technique::shadow_map(512);
     let e = r.render().err().expect("refused").to_string();
     assert!(e.contains("sphere"), "{e}");
     r.settings.technique = Technique::Volumes(Method::McGuire);

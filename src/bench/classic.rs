@@ -91,15 +91,28 @@ pub struct BenchConfig {
     pub opts: RenderOptions,
 }
 
-/// The name of a bench row's technique (`shadowmap-512`; `shadowmap-512-gather` for the
-/// gathering lookup).
+/// The name of a bench row's technique (`shadowmap-512`; `shadowmap-512-multiview` for cube
+/// faces rendered as views, then `-gather` for the gathering lookup:
+/// `shadowmap-512-multiview-gather`).
 pub fn technique_label(t: Technique) -> String {
     match t {
-        Technique::ShadowMap { size, pcf: crate::render::Pcf::Taps } => format!("shadowmap-{size}"),
-        Technique::ShadowMap { size, pcf: crate::render::Pcf::Gather } => format!("shadowmap-{size}{GATHER_SUFFIX}"),
+        Technique::ShadowMap { size, pcf, cube } => {
+            let views = match cube {
+                crate::render::CubeFaces::Atlas => "",
+                crate::render::CubeFaces::Multiview => MULTIVIEW_SUFFIX,
+            };
+            let lookup = match pcf {
+                crate::render::Pcf::Taps => "",
+                crate::render::Pcf::Gather => GATHER_SUFFIX,
+            };
+            format!("shadowmap-{size}{views}{lookup}")
+        }
         t => t.name().to_string(),
     }
 }
+
+/// What [`technique_label`] appends for a shadow map whose cube faces are multiview views.
+const MULTIVIEW_SUFFIX: &str = "-multiview";
 
 /// What [`technique_label`] appends for a shadow map read with gathers.
 const GATHER_SUFFIX: &str = "-gather";

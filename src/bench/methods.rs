@@ -35,7 +35,7 @@ pub fn all_techniques(shadow_map_sizes: &[u32], ray_query: bool) -> Vec<Techniqu
         listed(t);
         out.push(t);
     }
-    out.extend(shadow_map_sizes.iter().map(|&size| Technique::ShadowMap { size, pcf: crate::render::Pcf::Taps }));
+    out.extend(shadow_map_sizes.iter().map(|&size| Technique::shadow_map(size)));
     if ray_query {
         listed(Technique::RayQuery);
         out.push(Technique::RayQuery);

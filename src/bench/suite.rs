@@ -309,7 +309,7 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
     let gathers: Vec<Variant> = scale
         .shadow_map_sizes()
         .into_iter()
-        .map(|size| Variant::of(Technique::ShadowMap { size, pcf: crate::render::Pcf::Gather }))
+        .map(|size| Variant::of(Technique::ShadowMap { size, pcf: crate::render::Pcf::Gather, cube: Default::default() }))
         .collect();
     let units = (named.len() + points.len() - caps_points) * techniques.len()
         + named.len() * gathers.len()

@@ -38,6 +38,10 @@ pub(crate) struct BenchArgs {
     /// side by side (`shadowmap-2048`, `shadowmap-2048-gather`).
     #[arg(long, value_enum, value_delimiter = ',', default_value = "taps")]
     pcf: Vec<umbrage::render::Pcf>,
+    /// Comma-separated ways to render a point light's cube faces for the shadowmap technique
+    /// (atlas, multiview): one row each (`shadowmap-2048`, `shadowmap-2048-multiview`).
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "atlas")]
+    cube: Vec<umbrage::render::CubeFaces>,
     /// Write the report as JSON.
     #[arg(long)]
     json: Option<PathBuf>,
@@ -85,7 +89,7 @@ pub(crate) fn bench_command(a: BenchArgs) -> Result<ExitCode> {
     if a.suite.is_some() {
         return suite(&a);
     }
-    let techniques = bench_techniques(&a.methods, a.shadow_map_size, &a.pcf);
+    let techniques = bench_techniques(&a.methods, a.shadow_map_size, (&a.pcf, &a.cube));
     let opts = RenderOptions {
         width: a.size.0,
         height: a.size.1,
@@ -157,7 +161,7 @@ fn soak_cmd(
     markdown: Option<&Path>,
 ) -> Result<ExitCode> {
     let frames = args.soak.unwrap_or(0);
-    let technique = methods.first().map(|m| m.technique(2048, Default::default())).unwrap_or_default();
+    let technique = methods.first().map(|m| m.technique(Technique::shadow_map(2048))).unwrap_or_default();
     let options = RenderOptions { width: size.0, height: size.1, technique, frames_in_flight, ..Default::default() };
     let cfg = umbrage::soak::SoakConfig {
         scene: scene.unwrap_or("default").to_string(),
@@ -180,20 +184,27 @@ fn soak_cmd(
     Ok(if report.passed { ExitCode::SUCCESS } else { ExitCode::FAILURE })
 }
 
-fn bench_techniques(methods: &[MethodArg], shadow_map_size: u32, pcfs: &[umbrage::render::Pcf]) -> Vec<Technique> {
+fn bench_techniques(
+    methods: &[MethodArg],
+    shadow_map_size: u32,
+    (pcfs, cubes): (&[umbrage::render::Pcf], &[umbrage::render::CubeFaces]),
+) -> Vec<Technique> {
     let size = if shadow_map_size > 0 { shadow_map_size } else { 2048 };
     let listed: Vec<Technique> = if methods.is_empty() {
         let sizes: &[u32] = if shadow_map_size > 0 { &[size] } else { &[] };
         // Ray query joins once the device is known (`bench`).
         umbrage::bench::methods::all_techniques(sizes, false)
     } else {
-        methods.iter().map(|m| m.technique(size, Default::default())).collect()
+        methods.iter().map(|m| m.technique(Technique::shadow_map(size))).collect()
     };
-    // Each listed once, a shadow map once per PCF lookup asked for (`--pcf`, never empty).
+    // Each listed once, a shadow map once per way of rendering its cube faces and PCF lookup
+    // asked for (`--cube`, `--pcf`, never empty).
     let mut out: Vec<Technique> = Vec::new();
     for t in listed {
         let variants: Vec<Technique> = match t {
-            Technique::ShadowMap { size, .. } => pcfs.iter().map(|&pcf| Technique::ShadowMap { size, pcf }).collect(),
+            Technique::ShadowMap { size, .. } => {
+                cubes.iter().flat_map(|&cube| pcfs.iter().map(move |&pcf| Technique::ShadowMap { size, pcf, cube })).collect()
+            }
             t => vec![t],
         };
         for v in variants {

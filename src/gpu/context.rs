@@ -69,6 +69,9 @@ pub struct Features {
     /// `accelerationStructure` and `bufferDeviceAddress`) are present and enabled:
     /// `--method rayquery` can run (Mesa lavapipe 25 has them; 22.3 has not).
     pub ray_query: bool,
+    /// `multiview` (Vulkan 1.1 core) is supported and enabled: the shadow-map baseline can
+    /// render a point light's six cube faces as six views of one draw (`--cube multiview`).
+    pub multiview: bool,
     /// `sampleRateShading` is supported and enabled: the renderer's multisampled frame
     /// (`--msaa N`) shades its G-buffer and lighting per sample.
     pub sample_rate_shading: bool,

@@ -26,7 +26,8 @@ pub enum Binding {
 }
 
 /// A descriptor set layout with one set allocated from its own pool; binding `i` is the `i`-th
-/// [`Binding`] given to [`DescriptorSet::new`], one descriptor each, visible to the fragment stage.
+/// [`Binding`] given to [`DescriptorSet::new`], one descriptor each, visible to the fragment stage
+/// (or the stages given to [`DescriptorSet::with_stages`]).
 /// Not freed on drop: call [`DescriptorSet::destroy`].
 pub struct DescriptorSet {
     /// The set's layout, for [`pipeline_layout`].
@@ -41,6 +42,12 @@ impl DescriptorSet {
     /// `bindings` into it. The views and samplers are not owned: they must outlive every use
     /// of the set (and are not destroyed by [`DescriptorSet::destroy`]).
     pub fn new(ctx: &impl GpuDevice, bindings: &[Binding]) -> Result<DescriptorSet> {
+        DescriptorSet::with_stages(ctx, bindings, vk::ShaderStageFlags::FRAGMENT)
+    }
+
+    /// [`DescriptorSet::new`] with every binding visible to `stages` instead of the fragment
+    /// stage alone.
+    pub fn with_stages(ctx: &impl GpuDevice, bindings: &[Binding], stages: vk::ShaderStageFlags) -> Result<DescriptorSet> {
         let ty = |b: &Binding| match b {
             Binding::Image(_) => vk::DescriptorType::SAMPLED_IMAGE,
             Binding::Sampler(_) => vk::DescriptorType::SAMPLER,
@@ -51,11 +58,7 @@ impl DescriptorSet {
             .iter()
             .enumerate()
             .map(|(i, b)| {
-                vk::DescriptorSetLayoutBinding::default()
-                    .binding(i as u32)
-                    .descriptor_type(ty(b))
-                    .descriptor_count(1)
-                    .stage_flags(vk::ShaderStageFlags::FRAGMENT)
+                vk::DescriptorSetLayoutBinding::default().binding(i as u32).descriptor_type(ty(b)).descriptor_count(1).stage_flags(stages)
             })
             .collect();
         let count = |t: vk::DescriptorType| bindings.iter().filter(|b| ty(b) == t).count() as u32;

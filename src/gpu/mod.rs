@@ -10,6 +10,7 @@ pub mod descriptors;
 pub mod fault;
 pub mod pipeline;
 mod probe;
+pub mod quirks;
 pub mod resources;
 pub mod validation;
 pub mod shaders {

@@ -79,6 +79,10 @@ pub struct PipelineDesc<'a> {
     /// pipeline still has one blend state per colour attachment of the subpass, writing
     /// nothing.
     pub render_pass: Option<(vk::RenderPass, u32, u32)>,
+    /// The views (bit `i`: view `i`, rendered into layer `i`) of the rendering instances the
+    /// pipeline is used in; 0 (the default): no multiview. Non-zero needs the `multiview`
+    /// feature and dynamic rendering.
+    pub view_mask: u32,
 }
 
 impl<'a> PipelineDesc<'a> {
@@ -108,6 +112,7 @@ impl<'a> PipelineDesc<'a> {
             layout,
             samples: vk::SampleCountFlags::TYPE_1,
             render_pass: None,
+            view_mask: 0,
         }
     }
 }
@@ -243,7 +248,8 @@ pub fn create(ctx: &impl GpuDevice, d: &PipelineDesc) -> Result<vk::Pipeline> {
     let mut rendering = vk::PipelineRenderingCreateInfo::default()
         .color_attachment_formats(d.color_formats)
         .depth_attachment_format(d.depth_format)
-        .stencil_attachment_format(if has_stencil { d.depth_format } else { vk::Format::UNDEFINED });
+        .stencil_attachment_format(if has_stencil { d.depth_format } else { vk::Format::UNDEFINED })
+        .view_mask(d.view_mask);
     let mut info = vk::GraphicsPipelineCreateInfo::default()
         .stages(&stages)
         .vertex_input_state(&vertex_input)

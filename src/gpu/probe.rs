@@ -50,6 +50,7 @@ pub(super) fn open_device(
     let Picked { physical, queue_family, props, name } = pick_physical(instance, minimum)?;
     let api = props.api_version;
     let v11 = api >= vk::API_VERSION_1_1;
+    let v12 = api >= vk::API_VERSION_1_2;
     let v13 = api >= vk::API_VERSION_1_3;
 
     // Probe optional features: through the Vulkan 1.1 core query, or on a Vulkan 1.0 device
@@ -64,13 +65,12 @@ pub(super) fn open_device(
     let has_dru = has_ext(ash::ext::depth_range_unrestricted::NAME);
     // Ray query (`--method rayquery`): the two extensions, deferred host operations (which
     // acceleration structures require) and buffer device addresses (Vulkan 1.2 core).
-    let v12 = api >= vk::API_VERSION_1_2;
     let has_rq_exts = v12
         && [ash::khr::acceleration_structure::NAME, ash::khr::ray_query::NAME, ash::khr::deferred_host_operations::NAME]
             .into_iter()
             .all(has_ext);
-    let Probed { base, dyn_rendering, sync2, u8_supported, ray_query } =
-        probe_features(instance, gpdp2, physical, (v11, v13), has_u8_ext, has_rq_exts);
+    let Probed { base, dyn_rendering, sync2, u8_supported, ray_query, multiview } =
+        probe_features(instance, gpdp2, physical, (v11, v12, v13), has_u8_ext, has_rq_exts);
     if minimum == Minimum::Vulkan13 && (!dyn_rendering || !sync2) {
         return Err(Error::Unsupported(format!("{name}: umbrage needs dynamicRendering and synchronization2 (Vulkan 1.3)")));
     }
@@ -103,6 +103,7 @@ pub(super) fn open_device(
         r32f_blend: blendable(vk::Format::R32_SFLOAT),
         rgba32f_blend: blendable(vk::Format::R32G32B32A32_SFLOAT),
         ray_query,
+        multiview,
         sample_rate_shading: base.sample_rate_shading == vk::TRUE,
         standard_sample_locations: props.limits.standard_sample_locations == vk::TRUE,
         frame_sample_counts: {
@@ -130,6 +131,7 @@ pub(super) fn open_device(
     let mut e_as = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default().acceleration_structure(true);
     let mut e_rq = vk::PhysicalDeviceRayQueryFeaturesKHR::default().ray_query(true);
     let mut e12 = vk::PhysicalDeviceVulkan12Features::default().buffer_device_address(true);
+    let mut e11 = vk::PhysicalDeviceVulkan11Features::default().multiview(true);
     let mut dev_exts = Vec::new();
     if ray_query {
         for e in [ash::khr::acceleration_structure::NAME, ash::khr::ray_query::NAME, ash::khr::deferred_host_operations::NAME] {
@@ -158,6 +160,9 @@ pub(super) fn open_device(
     if u8_supported {
         dinfo = dinfo.push_next(&mut e_u8);
     }
+    if multiview {
+        dinfo = dinfo.push_next(&mut e11);
+    }
     if ray_query {
         dinfo = dinfo.push_next(&mut e_as).push_next(&mut e_rq).push_next(&mut e12);
     }
@@ -176,17 +181,19 @@ struct Probed {
     sync2: bool,
     u8_supported: bool,
     ray_query: bool,
+    multiview: bool,
 }
 
 /// The device's features: through the Vulkan 1.1 core query, or on a Vulkan 1.0 device through
 /// `VK_KHR_get_physical_device_properties2` (`gpdp2`, when the loader has it; otherwise only
 /// the 1.0 features). A structure is chained only where the device's version (`v11`, `v13`)
-/// or extensions (`has_u8_ext`, `has_rq_exts`) define it.
+/// or extensions (`has_u8_ext`, `has_rq_exts`) define it; `multiview` is read from the
+/// Vulkan 1.2 `Vulkan11Features` structure.
 fn probe_features(
     instance: &ash::Instance,
     gpdp2: Option<&ash::khr::get_physical_device_properties2::Instance>,
     physical: vk::PhysicalDevice,
-    (v11, v13): (bool, bool),
+    (v11, v12, v13): (bool, bool, bool),
     has_u8_ext: bool,
     has_rq_exts: bool,
 ) -> Probed {
@@ -195,9 +202,14 @@ fn probe_features(
     let mut f12 = vk::PhysicalDeviceVulkan12Features::default();
     let mut f_u8 = vk::PhysicalDeviceIndexTypeUint8FeaturesEXT::default();
     let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
+    let mut f11 = vk::PhysicalDeviceVulkan11Features::default();
     let mut f2 = vk::PhysicalDeviceFeatures2::default();
     if v13 {
         f2 = f2.push_next(&mut f13);
+    }
+    // The Vulkan11Features structure is defined from Vulkan 1.2 (1.1 has the per-feature ones).
+    if v12 {
+        f2 = f2.push_next(&mut f11);
     }
     if has_u8_ext {
         f2 = f2.push_next(&mut f_u8);
@@ -219,7 +231,8 @@ fn probe_features(
     let u8_supported = has_u8_ext && f_u8.index_type_uint8 == vk::TRUE;
     let ray_query =
         has_rq_exts && f_as.acceleration_structure == vk::TRUE && f_rq.ray_query == vk::TRUE && f12.buffer_device_address == vk::TRUE;
-    Probed { base, dyn_rendering, sync2, u8_supported, ray_query }
+    let multiview = v12 && f11.multiview == vk::TRUE;
+    Probed { base, dyn_rendering, sync2, u8_supported, ray_query, multiview }
 }
 
 /// The physical device [`open_device`] uses.

@@ -117,13 +117,14 @@ impl Buffer {
 /// What [`Image::new_all`] creates: name, format, usage and aspect of one image.
 pub type ImageSpec<'a> = (&'a str, vk::Format, vk::ImageUsageFlags, vk::ImageAspectFlags);
 
-/// A 2D image (one mip level, one layer, optimal tiling; one sample unless made by
-/// [`Image::new_2d_samples`]) in device-local memory, with a view of the whole image. Not freed
-/// on drop: call [`Image::destroy`].
+/// A 2D image (one mip level, one layer unless made by [`Image::new_array`], optimal tiling;
+/// one sample unless made by [`Image::new_2d_samples`]) in device-local memory, with a view of
+/// the whole image. Not freed on drop: call [`Image::destroy`].
 pub struct Image {
     /// The image handle.
     pub raw: vk::Image,
-    /// A 2D view of the whole image with [`Image::aspect`].
+    /// A view of the whole image with [`Image::aspect`]: 2D, or 2D array for an image made by
+    /// [`Image::new_array`].
     pub view: vk::ImageView,
     /// The image's (and the view's) format.
     pub format: vk::Format,
@@ -134,6 +135,8 @@ pub struct Image {
     pub aspect: vk::ImageAspectFlags,
     /// Samples per pixel.
     pub samples: vk::SampleCountFlags,
+    /// Array layers (1 unless made by [`Image::new_array`]).
+    pub layers: u32,
     allocation: Option<Allocation>,
 }
 
@@ -161,6 +164,7 @@ impl Image {
             extent: vk::Extent2D::default(),
             aspect: vk::ImageAspectFlags::COLOR,
             samples: vk::SampleCountFlags::TYPE_1,
+            layers: 1,
             allocation: None,
         }
     }
@@ -176,12 +180,42 @@ impl Image {
         aspect: vk::ImageAspectFlags,
         samples: vk::SampleCountFlags,
     ) -> Result<Image> {
+        Image::create(ctx, name, (format, aspect), extent, usage, samples, None)
+    }
+
+    /// A 2D array image of `layers` layers (one sample), with a `TYPE_2D_ARRAY` view of every
+    /// layer (also for one layer: a shader's `texture2DArray` reads it), as
+    /// [`Image::new_2d`] otherwise. [`Image::range`] and [`transition`] cover every layer.
+    pub fn new_array(
+        ctx: &impl GpuDevice,
+        name: &str,
+        format: vk::Format,
+        extent: vk::Extent2D,
+        layers: u32,
+        usage: vk::ImageUsageFlags,
+        aspect: vk::ImageAspectFlags,
+    ) -> Result<Image> {
+        Image::create(ctx, name, (format, aspect), extent, usage, vk::SampleCountFlags::TYPE_1, Some(layers.max(1)))
+    }
+
+    /// The image (`layers`: `None` for a single layer with a 2D view, `Some(n)` for a 2D array
+    /// view of `n` layers), its memory and its view.
+    fn create(
+        ctx: &impl GpuDevice,
+        name: &str,
+        (format, aspect): (vk::Format, vk::ImageAspectFlags),
+        extent: vk::Extent2D,
+        usage: vk::ImageUsageFlags,
+        samples: vk::SampleCountFlags,
+        array: Option<u32>,
+    ) -> Result<Image> {
+        let layers = array.unwrap_or(1);
         let info = vk::ImageCreateInfo::default()
             .image_type(vk::ImageType::TYPE_2D)
             .format(format)
             .extent(vk::Extent3D { width: extent.width, height: extent.height, depth: 1 })
             .mip_levels(1)
-            .array_layers(1)
+            .array_layers(layers)
             .samples(samples)
             .tiling(vk::ImageTiling::OPTIMAL)
             .usage(usage)
@@ -225,11 +259,11 @@ impl Image {
             release(Some(allocation));
             return Err(Error::Vulkan { call: "vkBindImageMemory", result: e });
         }
-        let view_info =
-            vk::ImageViewCreateInfo::default().image(raw).view_type(vk::ImageViewType::TYPE_2D).format(format).subresource_range(
-                vk::ImageSubresourceRange { aspect_mask: aspect, base_mip_level: 0, level_count: 1, base_array_layer: 0, layer_count: 1 },
-            );
-        // SAFETY: `raw` is bound to memory; the view covers its single subresource.
+        let view_type = if array.is_some() { vk::ImageViewType::TYPE_2D_ARRAY } else { vk::ImageViewType::TYPE_2D };
+        let view_info = vk::ImageViewCreateInfo::default().image(raw).view_type(view_type).format(format).subresource_range(
+            vk::ImageSubresourceRange { aspect_mask: aspect, base_mip_level: 0, level_count: 1, base_array_layer: 0, layer_count: layers },
+        );
+        // SAFETY: `raw` is bound to memory; the view covers its layers of its single mip level.
         let view = match unsafe { ctx.device().create_image_view(&view_info, None) } {
             Ok(v) => v,
             Err(e) => {
@@ -237,7 +271,7 @@ impl Image {
                 return Err(Error::Vulkan { call: "vkCreateImageView", result: e });
             }
         };
-        Ok(Image { raw, view, format, extent, aspect, samples, allocation: Some(allocation) })
+        Ok(Image { raw, view, format, extent, aspect, samples, layers, allocation: Some(allocation) })
     }
 
     /// Creates one image of `extent` per spec, all or nothing: when one fails, those already
@@ -268,9 +302,15 @@ impl Image {
         made.try_into().map_err(|_| Error::Internal("image count mismatch".into()))
     }
 
-    /// The subresource range of the whole image (its single mip level and layer, [`Image::aspect`]).
+    /// The subresource range of the whole image (its single mip level, every layer, [`Image::aspect`]).
     pub fn range(&self) -> vk::ImageSubresourceRange {
-        vk::ImageSubresourceRange { aspect_mask: self.aspect, base_mip_level: 0, level_count: 1, base_array_layer: 0, layer_count: 1 }
+        vk::ImageSubresourceRange {
+            aspect_mask: self.aspect,
+            base_mip_level: 0,
+            level_count: 1,
+            base_array_layer: 0,
+            layer_count: self.layers,
+        }
     }
 
     /// Destroys the view and the image and frees the memory. `ctx` must be the device and

@@ -197,6 +197,22 @@ named_enum!(
     }
 );
 
+named_enum!(
+    /// How the shadow-map baseline renders a point light's six cube faces: the same six
+    /// maps, the same per-face culling and the same picture either way; what differs is how
+    /// the work reaches the device.
+    CubeFaces, "cube", {
+        /// Six tiles of one 3 x 2 atlas in one rendering instance, each caster drawn once per
+        /// face its bounding sphere meets (a viewport and a draw per face).
+        #[default]
+        Atlas => "atlas",
+        /// Six layers of an array image rendered as six views of one draw (`multiview`,
+        /// Vulkan 1.1 core, where the device has it): each caster drawn once, its vertex
+        /// shader placing it outside the views whose frustum its bounding sphere misses.
+        Multiview => "multiview",
+    }
+);
+
 /// How a frame's shadows are computed: one enum for every technique, shared by
 /// [`ShadowPass`](super::ShadowPass) and the renderer (`umbrage::render::Renderer`).
 ///
@@ -231,6 +247,8 @@ pub enum Technique {
         size: u32,
         /// How the lookup reads its taps.
         pcf: Pcf,
+        /// How a point light's six cube faces are rendered.
+        cube: CubeFaces,
     },
     /// One shadow ray per pixel with `VK_KHR_ray_query` against acceleration structures of the
     /// casters, writing the volumes' stencil (docs/raytrace.md; renderer only).
@@ -272,19 +290,24 @@ impl Technique {
             Technique::ShadowMap { .. } | Technique::RayQuery => None,
         }
     }
+    /// The shadow-map baseline with maps of `size` texels, its default lookup ([`Pcf::Taps`])
+    /// and cube faces ([`CubeFaces::Atlas`]).
+    pub fn shadow_map(size: u32) -> Technique {
+        Technique::ShadowMap { size, pcf: Pcf::Taps, cube: CubeFaces::Atlas }
+    }
     /// The five volume methods (z-pass, z-fail, Everitt-Kilgard, Lengyel, McGuire).
     pub fn all_volumes() -> Vec<Technique> {
         Method::ALL.iter().map(|&m| Technique::Volumes(m)).collect()
     }
     /// Parses a `--method` value: `auto` (= mcguire), a volume method, `edgequad`, `planar`,
     /// `compute`, `rayquery` or `shadowmap` (with maps of `shadow_map_size` texels, read with
-    /// [`Pcf::Taps`]).
+    /// [`Pcf::Taps`], cube faces in an [`CubeFaces::Atlas`]).
     pub fn parse(s: &str, shadow_map_size: u32) -> Result<Technique> {
         match s {
             "edgequad" => Ok(Technique::EdgeQuads),
             "planar" => Ok(Technique::Planar),
             "compute" => Ok(Technique::Compute),
-            "shadowmap" => Ok(Technique::ShadowMap { size: shadow_map_size, pcf: Pcf::Taps }),
+            "shadowmap" => Ok(Technique::shadow_map(shadow_map_size)),
             "rayquery" => Ok(Technique::RayQuery),
             _ => s.parse::<Method>().map(Technique::Volumes).map_err(|_| Error::UnknownName {
                 what: "method",

@@ -88,7 +88,7 @@ mod volumes;
 
 pub use casters::CasterId;
 pub use desc::{
-    reverse_z, Capabilities, Counter, DepthDirection, DepthMode, EnabledFeatures, IndexFormat, PassSettings, PassToggles, Pcf,
+    reverse_z, Capabilities, Counter, CubeFaces, DepthDirection, DepthMode, EnabledFeatures, IndexFormat, PassSettings, PassToggles, Pcf,
     RenderPassTarget, ShadowPassDesc, TargetModel, Technique,
 };
 pub use draw::LightFrame;

@@ -177,13 +177,13 @@ pub(super) struct Live {
 }
 
 /// The techniques `M` cycles through, in the order of `render --method`.
-pub(super) fn technique_cycle(shadow_map_size: u32, pcf: crate::render::Pcf, ray_query: bool) -> Vec<Technique> {
+pub(super) fn technique_cycle(shadow_map: Technique, ray_query: bool) -> Vec<Technique> {
     let mut v: Vec<Technique> =
         [Method::McGuire, Method::Lengyel, Method::EverittKilgard, Method::ZFail, Method::ZPass, Method::ZPassClear]
             .into_iter()
             .map(Technique::Volumes)
             .collect();
-    v.extend([Technique::EdgeQuads, Technique::Planar, Technique::ShadowMap { size: shadow_map_size, pcf }]);
+    v.extend([Technique::EdgeQuads, Technique::Planar, shadow_map]);
     if ray_query {
         v.push(Technique::RayQuery);
     }
@@ -236,11 +236,12 @@ impl Live {
         let edits = Edits::new(scene.camera.clone(), scene.meshes.len(), scene.lights.len());
         let at0 = motion.scene_at(&scene, args.time);
         let good = opts.settings();
-        let (shadow_map_size, pcf) = match opts.technique {
-            Technique::ShadowMap { size, pcf } => (size, pcf),
-            _ => (2048, Default::default()),
+        // The shadow map the cycle offers: the one asked for, or the default's.
+        let shadow_map = match opts.technique {
+            t @ Technique::ShadowMap { .. } => t,
+            _ => Technique::shadow_map(2048),
         };
-        let mut techniques = technique_cycle(shadow_map_size, pcf, ctx.features.ray_query);
+        let mut techniques = technique_cycle(shadow_map, ctx.features.ray_query);
         let technique = match techniques.iter().position(|t| *t == opts.technique) {
             Some(i) => i,
             None => {

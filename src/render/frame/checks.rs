@@ -59,6 +59,11 @@ pub(super) fn check_options(ctx: &Context, config: &RenderConfig, s: &FrameSetti
     if s.technique == Technique::RayQuery && !f.ray_query {
         return Err(crate::gpu::accel::missing_ray_query(&ctx.info.name));
     }
+    if matches!(s.technique, Technique::ShadowMap { cube: CubeFaces::Multiview, .. }) {
+        if let Some(e) = crate::render::passes::shadowmap::multiview_refusal(ctx) {
+            return Err(e);
+        }
+    }
     let shadow_map = matches!(s.technique, Technique::ShadowMap { .. });
     if (s.counter == Counter::Float || shadow_map || config.self_shadow) && !f.r32f_blend {
         return Err(Error::Unsupported(

@@ -20,17 +20,17 @@ impl Renderer {
         Ok(())
     }
 
-    /// Makes the shadow-map baseline of the asked size current (built, or taken from the
+    /// Makes the shadow-map baseline of the asked size and cube layout current (built, or taken from the
     /// kept ones when built for the scene's placement now), and sets it aside when another
     /// technique runs; baselines built for an older placement are destroyed.
     pub(super) fn update_shadow_mapper(&mut self, technique: Technique) -> Result<()> {
         let wanted = match technique {
-            Technique::ShadowMap { size, .. } => Some(size),
+            Technique::ShadowMap { size, cube, .. } => Some((size, cube)),
             _ => None,
         };
         let version = self.own.parts.scene_version;
         let parts = &mut self.own.parts;
-        let current = parts.shadow_mapper.as_ref().map(|(m, v)| (m.size, *v));
+        let current = parts.shadow_mapper.as_ref().map(|(m, v)| ((m.size, m.cube), *v));
         if wanted.map(|s| (s, version)) == current {
             return Ok(());
         }
@@ -47,11 +47,11 @@ impl Renderer {
                 sm.destroy(&self.own.ctx);
             }
         }
-        if let Some(size) = wanted {
-            if let Some(i) = parts.spare_shadow_mappers.iter().position(|(m, _)| m.size == size) {
+        if let Some(key) = wanted {
+            if let Some(i) = parts.spare_shadow_mappers.iter().position(|(m, _)| (m.size, m.cube) == key) {
                 parts.shadow_mapper = Some(parts.spare_shadow_mappers.swap_remove(i));
             } else {
-                let sm = ShadowMapper::new(&self.own.ctx, &parts.scene, &parts.targets, size, parts.pipes.sampler)?;
+                let sm = ShadowMapper::new(&self.own.ctx, &parts.scene, &parts.targets, key, parts.pipes.sampler)?;
                 parts.shadow_mapper = Some((sm, version));
             }
         }

@@ -1,11 +1,13 @@
 //! The baseline users would otherwise pick: shadow mapping with 3x3 percentage-closer
 //! filtering (the textbook chapter), on the same frame, measured against the same reference.
 //!
-//! Per light, the opaque shadow casters' depth is rendered from the light into an atlas
-//! (directional: one orthographic map fitted to the casters' bounding sphere; spot: one
-//! perspective map over the cone; point: six 90-degree faces, 3 x 2 tiles, all in one
-//! rendering instance). Each caster mesh is drawn only into the faces whose frustum its
-//! bounding sphere meets, and a point or spot light's near and far planes hug its casters.
+//! Per light, the opaque shadow casters' depth is rendered from the light (directional: one
+//! orthographic map fitted to the casters' bounding sphere; spot: one perspective map over the
+//! cone; point: six 90-degree faces, all in one rendering instance: 3 x 2 tiles of an atlas,
+//! or with [`CubeFaces::Multiview`] six layers rendered as six views of each draw). Each caster
+//! mesh reaches only the faces whose frustum its bounding sphere meets (atlas: it is drawn once
+//! per such face; multiview: it is drawn once, and its vertex shader places it outside every
+//! other view), and a point or spot light's near and far planes hug its casters.
 //! One full-screen lookup pass per light then writes, for every visible point, the fraction
 //! of PCF taps that see a nearer occluder into the float counter target (each point picks
 //! its cube face in the shader; the comparison is a hardware compare sampler's), and the
@@ -15,10 +17,11 @@
 //! volumes, its error is not zero, and the bench says how large it is.
 //!
 //! Inputs / outputs per light (called by `frame/record.rs` after `determine::begin_float`, before `determine::record`):
-//! - `record_maps`: writes the atlas, `UNDEFINED -> DEPTH_STENCIL_ATTACHMENT_OPTIMAL`, CLEAR (depth 1)/STORE, the opaque
-//!   casters' depth; then `-> SHADER_READ_ONLY_OPTIMAL`.
-//! - `record_lookup`: reads `normal` and `position` (`SHADER_READ_ONLY_OPTIMAL`, left by `gbuffer`), the atlas
-//!   (`SHADER_READ_ONLY_OPTIMAL`, compare sampler) and the face table; writes `count` in `COLOR_ATTACHMENT_OPTIMAL`
+//! - `record_maps`: writes the face table (a transfer), then the maps (every layer),
+//!   `UNDEFINED -> DEPTH_STENCIL_ATTACHMENT_OPTIMAL`, CLEAR (depth 1)/STORE, the opaque casters' depth; then
+//!   `-> SHADER_READ_ONLY_OPTIMAL`.
+//! - `record_lookup`: reads `normal` and `position` (`SHADER_READ_ONLY_OPTIMAL`, left by `gbuffer`), the maps
+//!   (`SHADER_READ_ONLY_OPTIMAL`, a 2D array view, compare sampler) and the face table; writes `count` in `COLOR_ATTACHMENT_OPTIMAL`
 //!   (set from `UNDEFINED` by `determine::begin_float`), CLEAR to 0 inside the scissor, STORE, additive; no depth-stencil
 //!   attachment. `determine::finish` (`CountInto::External`) then takes `count` to `SHADER_READ_ONLY_OPTIMAL`.
 
@@ -28,28 +31,38 @@ use crate::gpu::pipeline::{self, Blend, PipelineDesc};
 use crate::gpu::resources::{memory_barrier, transition};
 use crate::gpu::{shaders, Buffer, Context, Image};
 use crate::render::targets::{Targets, COUNT_FORMAT};
-use crate::render::Pcf;
-use crate::scene::{Camera, LightKind, Scene};
+use crate::render::{CubeFaces, Pcf};
+use crate::scene::Scene;
 use ash::vk;
-use glam::{DVec3, Mat4, Vec3, Vec4};
+use faces::{sphere_in_frustum, Face, FaceRow, Layout, MeshRange, FACES_BYTES};
+use glam::DVec3;
+
+mod faces;
 
 /// The shadow maps' depth format.
 pub const MAP_FORMAT: vk::Format = vk::Format::D32_SFLOAT;
 
-/// One caster mesh's vertices in the casters' buffer and its eye-relative bounding sphere
-/// (per-face culling).
-#[derive(Clone, Copy, Debug)]
-struct MeshRange {
-    first: u32,
-    count: u32,
-    center: DVec3,
-    radius: f64,
+/// The view mask of a point light's six faces rendered as views (bit `i`: face `i`, layer `i`).
+const ALL_FACES: u32 = 0b11_1111;
+
+/// Why [`CubeFaces::Multiview`] cannot run on this device, if it cannot: no `multiview`
+/// feature, or a driver known to render it wrongly ([`crate::gpu::quirks::multiview_defect`]).
+pub(crate) fn multiview_refusal(ctx: &Context) -> Option<Error> {
+    let why = if !ctx.features.multiview {
+        format!("{} does not offer the multiview feature (Vulkan 1.1 core)", ctx.info.name)
+    } else {
+        crate::gpu::quirks::multiview_defect(&ctx.info)?
+    };
+    Some(Error::Unsupported(format!("--cube multiview: {why}; use --cube atlas (the same maps, a draw per face)")))
 }
 
 /// The shadow-map baseline's GPU objects.
 pub struct ShadowMapper {
-    /// Texels per side of one map (a point light uses 3 x 2 of them).
+    /// Texels per side of one map (a point light uses 3 x 2 of them in an atlas).
     pub size: u32,
+    /// Where a point light's six faces go.
+    pub cube: CubeFaces,
+    /// The maps: a 3 x 2 atlas in one layer, or six layers of one map each (multiview).
     atlas: Image,
     casters: Option<Buffer>,
     meshes: Vec<MeshRange>,
@@ -65,6 +78,16 @@ pub struct ShadowMapper {
     /// The lookup's pipelines: nine taps (`shadowmap_lookup.frag`), four gathers
     /// (`shadowmap_gather.wgsl`).
     lookup_pipelines: [vk::Pipeline; 2],
+    /// The six-view map pass ([`CubeFaces::Multiview`] only).
+    views: Option<Views>,
+}
+
+/// The multiview map pass's objects: the face table's set (vertex stage), its layout (push:
+/// the caster's view mask) and the pipeline (view mask 0b111111).
+struct Views {
+    set: DescriptorSet,
+    layout: vk::PipelineLayout,
+    pipeline: vk::Pipeline,
 }
 
 /// One light's lookup: where the light is, the pass's scissor, how the taps are read.
@@ -78,28 +101,13 @@ pub(crate) struct Lookup {
     pub pcf: Pcf,
 }
 
-/// `shadowmap_lookup.frag`'s `Face` (std430).
-#[repr(C)]
-#[derive(Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]
-struct FaceRow {
-    /// Eye-relative world -> this face's clip space.
-    view_proj: [f32; 16],
-    /// Atlas tile: x0, y0, width, height (texels).
-    tile: [f32; 4],
-    /// x: unused, y: compare bias, z: normal offset.
-    params: [f32; 4],
-}
-
-/// The face table's size: six faces.
-const FACES_BYTES: u64 = 6 * std::mem::size_of::<FaceRow>() as u64;
-
 /// `shadowmap_lookup.frag`'s push constants.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 struct LookupPush {
     /// Eye-relative light position (w = 1) or towards-light direction (w = 0).
     light: [f32; 4],
-    /// x: faces (1 or 6), y, z: 1 / atlas width, height.
+    /// x: faces (1 or 6), y, z: 1 / layer width, height.
     params: [f32; 4],
 }
 
@@ -108,21 +116,13 @@ pub(crate) struct LightMaps {
     faces: Vec<Face>,
 }
 
-/// One map to render and look up: the eye-relative light view-projection and its atlas tile.
-struct Face {
-    view_proj: Mat4,
-    tile: [u32; 2],
-    /// World size of one texel near the casters (for the normal offset).
-    texel_world: f32,
-}
-
 /// The objects `ShadowMapper::new` made so far, released if a later step fails.
 #[derive(Default)]
 struct Partial {
     buffers: Vec<Buffer>,
     images: Vec<Image>,
     sampler: Option<vk::Sampler>,
-    set: Option<DescriptorSet>,
+    sets: Vec<DescriptorSet>,
     layouts: Vec<vk::PipelineLayout>,
     pipelines: Vec<vk::Pipeline>,
 }
@@ -141,7 +141,7 @@ impl Partial {
                 ctx.device.destroy_sampler(s, None);
             }
         }
-        if let Some(mut s) = self.set.take() {
+        for mut s in self.sets.drain(..) {
             s.destroy(ctx);
         }
         for mut b in self.buffers.drain(..) {
@@ -155,13 +155,23 @@ impl Partial {
 
 impl ShadowMapper {
     /// Maps of `size` texels a side (16..=8192) for the scene's opaque casters, as placed now
-    /// relative to the camera (rebuilt by the renderer when either moves).
-    pub fn new(ctx: &Context, scene: &Scene, targets: &Targets, size: u32, sampler: vk::Sampler) -> Result<ShadowMapper> {
+    /// relative to the camera (rebuilt by the renderer when either moves), a point light's
+    /// faces laid out as `cube` says ([`CubeFaces::Multiview`] needs the device's `multiview`).
+    pub fn new(
+        ctx: &Context,
+        scene: &Scene,
+        targets: &Targets,
+        (size, cube): (u32, CubeFaces),
+        sampler: vk::Sampler,
+    ) -> Result<ShadowMapper> {
         if !(16..=8192).contains(&size) {
             return Err(Error::Other(format!("shadow map size {size} out of range (16..=8192)")));
         }
+        if let Some(e) = (cube == CubeFaces::Multiview).then(|| multiview_refusal(ctx)).flatten() {
+            return Err(e);
+        }
         let mut partial = Partial::default();
-        match Self::build(ctx, scene, targets, size, sampler, &mut partial) {
+        match Self::build(ctx, scene, targets, (size, cube), sampler, &mut partial) {
             Ok(m) => Ok(m),
             Err(e) => {
                 partial.release(ctx);
@@ -170,7 +180,14 @@ impl ShadowMapper {
         }
     }
 
-    fn build(ctx: &Context, scene: &Scene, targets: &Targets, size: u32, sampler: vk::Sampler, made: &mut Partial) -> Result<ShadowMapper> {
+    fn build(
+        ctx: &Context,
+        scene: &Scene,
+        targets: &Targets,
+        (size, cube): (u32, CubeFaces),
+        sampler: vk::Sampler,
+        made: &mut Partial,
+    ) -> Result<ShadowMapper> {
         let eye = scene.camera.eye.as_dvec3();
         let mut pos: Vec<[f32; 3]> = Vec::new();
         let mut meshes = Vec::new();
@@ -225,11 +242,16 @@ impl ShadowMapper {
         )?;
         let faces_raw = faces.raw;
         made.buffers.push(faces);
-        let atlas = Image::new_2d(
+        let (extent, layers) = match cube {
+            CubeFaces::Atlas => (vk::Extent2D { width: 3 * size, height: 2 * size }, 1),
+            CubeFaces::Multiview => (vk::Extent2D { width: size, height: size }, 6),
+        };
+        let atlas = Image::new_array(
             ctx,
-            "shadow-map atlas",
+            "shadow maps",
             MAP_FORMAT,
-            vk::Extent2D { width: 3 * size, height: 2 * size },
+            extent,
+            layers,
             vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::SAMPLED,
             vk::ImageAspectFlags::DEPTH,
         )?;
@@ -261,7 +283,7 @@ impl ShadowMapper {
             ],
         )?;
         let set_layout = set.layout;
-        made.set = Some(set);
+        made.sets.push(set);
         made.layouts.push(pipeline_layout(ctx, &[], 64, vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT)?);
         made.layouts.push(pipeline_layout(ctx, &[set_layout], std::mem::size_of::<LookupPush>() as u32, vk::ShaderStageFlags::FRAGMENT)?);
         let layouts = [made.layouts[0], made.layouts[1]];
@@ -281,79 +303,67 @@ impl ShadowMapper {
         made.pipelines.push(pipeline::create(ctx, &l)?);
         l.fragment = Some(shaders::SHADOWMAP_GATHER_WGSL);
         made.pipelines.push(pipeline::create(ctx, &l)?);
+        if cube == CubeFaces::Multiview {
+            // The six-view pass: the atlas pass's state, its matrices from the face table.
+            made.sets.push(DescriptorSet::with_stages(ctx, &[Binding::StorageBuffer(faces_raw)], vk::ShaderStageFlags::VERTEX)?);
+            made.layouts.push(pipeline_layout(ctx, &[made.sets[1].layout], 4, vk::ShaderStageFlags::VERTEX)?);
+            m.vertex = shaders::SHADOWMAP_MULTIVIEW_WGSL;
+            m.layout = made.layouts[2];
+            m.view_mask = ALL_FACES;
+            made.pipelines.push(pipeline::create(ctx, &m)?);
+        }
         // Everything made: hand the objects over.
         let (map_pipeline, lookup_pipelines) = (made.pipelines[0], [made.pipelines[1], made.pipelines[2]]);
+        let views = match cube {
+            CubeFaces::Atlas => None,
+            CubeFaces::Multiview => {
+                let set = made.sets.pop().ok_or_else(|| Error::Other("shadow-map views set".into()))?;
+                Some(Views { set, layout: made.layouts[2], pipeline: made.pipelines[3] })
+            }
+        };
         made.pipelines.clear();
         made.layouts.clear();
         made.sampler = None;
-        let set = made.set.take().ok_or_else(|| Error::Other("shadow-map set".into()))?;
+        let set = made.sets.pop().ok_or_else(|| Error::Other("shadow-map set".into()))?;
         let atlas = made.images.pop().ok_or_else(|| Error::Other("shadow-map atlas".into()))?;
         let faces = made.buffers.pop().ok_or_else(|| Error::Other("shadow-map faces".into()))?;
         let casters = made.buffers.pop();
-        Ok(ShadowMapper { size, atlas, casters, meshes, bounds, faces, compare_sampler, set, layouts, map_pipeline, lookup_pipelines })
+        Ok(ShadowMapper {
+            size,
+            cube,
+            atlas,
+            casters,
+            meshes,
+            bounds,
+            faces,
+            compare_sampler,
+            set,
+            layouts,
+            map_pipeline,
+            lookup_pipelines,
+            views,
+        })
     }
 
-    /// The maps one light needs, in eye-relative coordinates.
-    fn faces(&self, light: &crate::scene::Light, eye: DVec3) -> Vec<Face> {
-        let (c, r) = self.bounds;
-        let s = self.size as f64;
-        let rel = |p: Vec3| (p.as_dvec3() - eye).as_vec3();
-        match light.kind {
-            LightKind::Directional => {
-                let dir = light.direction.as_dvec3().normalize();
-                let from = c - dir * (2.0 * r);
-                let cam = Camera { eye: from.as_vec3(), target: c.as_vec3(), up: any_up(dir), fov_y_deg: 60.0, near: 0.1 };
-                let rr = r as f32;
-                // Vulkan orthographic: x, y in [-r, r] (y down), depth 0 at the eye .. 1 at 4r.
-                let ortho = Mat4::from_cols(
-                    Vec4::new(1.0 / rr, 0.0, 0.0, 0.0),
-                    Vec4::new(0.0, -1.0 / rr, 0.0, 0.0),
-                    Vec4::new(0.0, 0.0, -1.0 / (4.0 * rr), 0.0),
-                    Vec4::new(0.0, 0.0, 0.0, 1.0),
-                );
-                vec![Face { view_proj: ortho * cam.view(), tile: [0, 0], texel_world: (2.0 * r / s) as f32 }]
-            }
-            LightKind::Spot | LightKind::Point => {
-                let l = rel(light.position).as_dvec3();
-                // Near and far hug the casters: the nearest and farthest caster spheres.
-                let (mut near_c, mut far_c) = (f64::INFINITY, 0.0f64);
-                for m in &self.meshes {
-                    let d = (m.center - l).length();
-                    near_c = near_c.min(d - m.radius);
-                    far_c = far_c.max(d + m.radius);
-                }
-                let far = if far_c > 0.0 { far_c * 1.01 } else { ((l - c).length() + r) * 1.01 };
-                let near = (0.9 * near_c).max(far * 1e-4).max(1e-4);
-                let dist = (l - c).length().max(near);
-                let dirs: Vec<(DVec3, f64, f32)> = if light.kind == LightKind::Spot {
-                    vec![(light.direction.as_dvec3().normalize(), (light.cone_deg as f64 + 2.0).min(170.0), -1.0)]
-                } else {
-                    [DVec3::X, DVec3::NEG_X, DVec3::Y, DVec3::NEG_Y, DVec3::Z, DVec3::NEG_Z]
-                        .into_iter()
-                        .enumerate()
-                        .map(|(i, d)| (d, 90.0, i as f32))
-                        .collect()
-                };
-                dirs.into_iter()
-                    .map(|(d, fov, face)| {
-                        let cam =
-                            Camera { eye: l.as_vec3(), target: (l + d).as_vec3(), up: any_up(d), fov_y_deg: fov as f32, near: near as f32 };
-                        let tile = if face < 0.0 { [0, 0] } else { [(face as u32 % 3) * self.size, (face as u32 / 3) * self.size] };
-                        let texel_world = (2.0 * dist * (fov.to_radians() * 0.5).tan() / s) as f32;
-                        Face { view_proj: cam.proj_finite(1.0, far as f32) * cam.view(), tile, texel_world }
-                    })
-                    .collect()
-            }
-        }
-    }
-
-    /// Renders light `light`'s maps into the atlas (one rendering instance, each caster mesh
-    /// only into the faces it can be seen in) and returns the faces for
-    /// [`ShadowMapper::record_lookup`]. Leaves the atlas in SHADER_READ_ONLY_OPTIMAL.
+    /// Writes light `light`'s face table, renders its maps (one rendering instance; each
+    /// caster mesh only into the faces it can be seen in) and returns the faces for
+    /// [`ShadowMapper::record_lookup`]. Leaves the maps in SHADER_READ_ONLY_OPTIMAL.
     pub(crate) fn record_maps(&self, ctx: &Context, cb: vk::CommandBuffer, light: &crate::scene::Light, eye: DVec3) -> LightMaps {
-        let d = &ctx.device;
-        let faces = self.faces(light, eye);
-        let full = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: self.atlas.extent };
+        let layout = Layout { meshes: &self.meshes, bounds: self.bounds, size: self.size, cube: self.cube };
+        let faces = layout.faces(light, eye);
+        let mut rows = [FaceRow::default(); 6];
+        for (row, f) in rows.iter_mut().zip(&faces) {
+            *row = f.row(self.size);
+        }
+        // The previous light's map pass (multiview) and lookup read the table.
+        let readers = vk::PipelineStageFlags2::VERTEX_SHADER | vk::PipelineStageFlags2::FRAGMENT_SHADER;
+        let shader_read = (readers, vk::AccessFlags2::SHADER_STORAGE_READ);
+        let transfer_write = (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE);
+        memory_barrier(ctx, cb, shader_read, transfer_write);
+        // SAFETY: `cb` is recording outside any rendering instance; the table is this
+        // mapper's, and its readers finished (the barrier above).
+        unsafe { ctx.device.cmd_update_buffer(cb, self.faces.raw, 0, bytemuck::cast_slice(&rows)) };
+        memory_barrier(ctx, cb, transfer_write, shader_read);
         transition(ctx, cb, &self.atlas, vk::ImageLayout::UNDEFINED, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
         let map_att = vk::RenderingAttachmentInfo::default()
             .image_view(self.atlas.view)
@@ -361,48 +371,104 @@ impl ShadowMapper {
             .load_op(vk::AttachmentLoadOp::CLEAR)
             .store_op(vk::AttachmentStoreOp::STORE)
             .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } });
-        // The tiles in use only (a single map uses one of the six).
-        let area = match faces.len() {
-            1 => vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: vk::Extent2D { width: self.size, height: self.size } },
-            _ => full,
-        };
-        // SAFETY: `cb` is recording outside any rendering instance; every handle is alive.
-        unsafe {
-            d.cmd_begin_rendering(cb, &vk::RenderingInfo::default().render_area(area).layer_count(1).depth_attachment(&map_att));
-            if let Some(b) = &self.casters {
-                d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.map_pipeline);
-                d.cmd_bind_vertex_buffers(cb, 0, &[b.raw], &[0]);
-                for f in &faces {
-                    let visible: Vec<&MeshRange> =
-                        self.meshes.iter().filter(|m| sphere_in_frustum(&f.view_proj, m.center, m.radius)).collect();
-                    if visible.is_empty() {
-                        continue;
-                    }
-                    let sz = self.size as f32;
-                    let vp =
-                        vk::Viewport { x: f.tile[0] as f32, y: f.tile[1] as f32, width: sz, height: sz, min_depth: 0.0, max_depth: 1.0 };
-                    let sc = vk::Rect2D {
-                        offset: vk::Offset2D { x: f.tile[0] as i32, y: f.tile[1] as i32 },
-                        extent: vk::Extent2D { width: self.size, height: self.size },
-                    };
-                    d.cmd_set_viewport(cb, 0, &[vp]);
-                    d.cmd_set_scissor(cb, 0, &[sc]);
-                    d.cmd_push_constants(
-                        cb,
-                        self.layouts[0],
-                        vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                        0,
-                        bytemuck::bytes_of(&f.view_proj.to_cols_array()),
-                    );
-                    for m in visible {
-                        d.cmd_draw(cb, m.count, 1, m.first, 0);
-                    }
+        let one = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: vk::Extent2D { width: self.size, height: self.size } };
+        let info = vk::RenderingInfo::default().layer_count(1).depth_attachment(&map_att);
+        match (&self.views, faces.len()) {
+            // A point light's six faces as six views of each draw.
+            (Some(views), 6) => {
+                // SAFETY: as above; every handle is alive, and the views' pipeline was made
+                // for this view mask.
+                unsafe {
+                    ctx.device.cmd_begin_rendering(cb, &info.render_area(one).view_mask(ALL_FACES));
+                    self.record_views(ctx, cb, views, &faces);
+                    ctx.device.cmd_end_rendering(cb);
                 }
             }
-            d.cmd_end_rendering(cb);
+            // One map (layer 0, tile 0), or six tiles of the atlas.
+            _ => {
+                let area = if faces.len() == 1 { one } else { vk::Rect2D { offset: one.offset, extent: self.atlas.extent } };
+                // SAFETY: as above.
+                unsafe {
+                    ctx.device.cmd_begin_rendering(cb, &info.render_area(area));
+                    self.record_tiles(ctx, cb, &faces);
+                    ctx.device.cmd_end_rendering(cb);
+                }
+            }
         }
         transition(ctx, cb, &self.atlas, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
         LightMaps { faces }
+    }
+
+    /// Draws each caster mesh into each face (a tile of layer 0) whose frustum it meets: a
+    /// viewport, a scissor and the face's matrix per face.
+    ///
+    /// # Safety
+    /// `cb` is inside the rendering instance of the maps (no view mask).
+    unsafe fn record_tiles(&self, ctx: &Context, cb: vk::CommandBuffer, faces: &[Face]) {
+        let d = &ctx.device;
+        let Some(b) = &self.casters else { return };
+        // SAFETY: the caller's contract; every handle is alive.
+        unsafe {
+            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, self.map_pipeline);
+            d.cmd_bind_vertex_buffers(cb, 0, &[b.raw], &[0]);
+            for f in faces {
+                let visible: Vec<&MeshRange> = self.meshes.iter().filter(|m| sphere_in_frustum(&f.view_proj, m.center, m.radius)).collect();
+                if visible.is_empty() {
+                    continue;
+                }
+                let sz = self.size as f32;
+                let vp = vk::Viewport { x: f.tile[0] as f32, y: f.tile[1] as f32, width: sz, height: sz, min_depth: 0.0, max_depth: 1.0 };
+                let sc = vk::Rect2D {
+                    offset: vk::Offset2D { x: f.tile[0] as i32, y: f.tile[1] as i32 },
+                    extent: vk::Extent2D { width: self.size, height: self.size },
+                };
+                d.cmd_set_viewport(cb, 0, &[vp]);
+                d.cmd_set_scissor(cb, 0, &[sc]);
+                d.cmd_push_constants(
+                    cb,
+                    self.layouts[0],
+                    vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                    0,
+                    bytemuck::bytes_of(&f.view_proj.to_cols_array()),
+                );
+                for m in visible {
+                    d.cmd_draw(cb, m.count, 1, m.first, 0);
+                }
+            }
+        }
+    }
+
+    /// Draws each caster mesh once into the six views, with the mask of the faces whose
+    /// frustum it meets (the vertex shader places it outside the others).
+    ///
+    /// # Safety
+    /// `cb` is inside the rendering instance of the maps with view mask [`ALL_FACES`]; the
+    /// face table holds `faces`.
+    unsafe fn record_views(&self, ctx: &Context, cb: vk::CommandBuffer, views: &Views, faces: &[Face]) {
+        let d = &ctx.device;
+        let Some(b) = &self.casters else { return };
+        let full = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: self.atlas.extent };
+        let sz = self.size as f32;
+        // SAFETY: the caller's contract; every handle is alive.
+        unsafe {
+            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, views.pipeline);
+            d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, views.layout, 0, &[views.set.set], &[]);
+            d.cmd_bind_vertex_buffers(cb, 0, &[b.raw], &[0]);
+            d.cmd_set_viewport(cb, 0, &[vk::Viewport { x: 0.0, y: 0.0, width: sz, height: sz, min_depth: 0.0, max_depth: 1.0 }]);
+            d.cmd_set_scissor(cb, 0, &[full]);
+            for m in &self.meshes {
+                let mask = faces
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, f)| sphere_in_frustum(&f.view_proj, m.center, m.radius))
+                    .fold(0u32, |mask, (i, _)| mask | 1 << i);
+                if mask == 0 {
+                    continue;
+                }
+                d.cmd_push_constants(cb, views.layout, vk::ShaderStageFlags::VERTEX, 0, &mask.to_ne_bytes());
+                d.cmd_draw(cb, m.count, 1, m.first, 0);
+            }
+        }
     }
 
     /// Writes a light's shadow fractions into `targets.count` (which must be in
@@ -416,14 +482,6 @@ impl ShadowMapper {
         };
         let faces = &maps.faces;
         let d = &ctx.device;
-        let mut rows = [FaceRow::default(); 6];
-        for (row, f) in rows.iter_mut().zip(faces) {
-            *row = FaceRow {
-                view_proj: f.view_proj.to_cols_array(),
-                tile: [f.tile[0] as f32, f.tile[1] as f32, self.size as f32, self.size as f32],
-                params: [0.0, 2e-5, 1.5 * f.texel_world, 0.0],
-            };
-        }
         let count_att = [vk::RenderingAttachmentInfo::default()
             .image_view(targets.count.view)
             .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
@@ -433,14 +491,8 @@ impl ShadowMapper {
         let (aw, ah) = (self.atlas.extent.width as f32, self.atlas.extent.height as f32);
         let push = LookupPush { light: light_pos, params: [faces.len() as f32, 1.0 / aw, 1.0 / ah, 0.0] };
         let (w, h) = (targets.extent.width as f32, targets.extent.height as f32);
-        let shader_read = (vk::PipelineStageFlags2::FRAGMENT_SHADER, vk::AccessFlags2::SHADER_STORAGE_READ);
-        let transfer_write = (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE);
-        // SAFETY: as `record_maps`; the face table is written outside a rendering instance,
-        // after the previous light's lookup finished reading it, and read after the write.
+        // SAFETY: as `record_maps`; the face table `record_maps` wrote is visible (its barrier).
         unsafe {
-            memory_barrier(ctx, cb, shader_read, transfer_write);
-            d.cmd_update_buffer(cb, self.faces.raw, 0, bytemuck::cast_slice(&rows));
-            memory_barrier(ctx, cb, transfer_write, shader_read);
             d.cmd_begin_rendering(cb, &vk::RenderingInfo::default().render_area(scissor).layer_count(1).color_attachments(&count_att));
             d.cmd_set_viewport(cb, 0, &[vk::Viewport { x: 0.0, y: 0.0, width: w, height: h, min_depth: 0.0, max_depth: 1.0 }]);
             d.cmd_set_scissor(cb, 0, &[scissor]);
@@ -477,31 +529,18 @@ impl ShadowMapper {
             d.destroy_sampler(self.compare_sampler, None);
         }
         self.set.destroy(ctx);
+        if let Some(mut v) = self.views.take() {
+            // SAFETY: as above.
+            unsafe {
+                ctx.device.destroy_pipeline(v.pipeline, None);
+                ctx.device.destroy_pipeline_layout(v.layout, None);
+            }
+            v.set.destroy(ctx);
+        }
         self.atlas.destroy(ctx);
         self.faces.destroy(ctx);
         if let Some(mut b) = self.casters.take() {
             b.destroy(ctx);
         }
-    }
-}
-
-/// Whether a sphere (eye-relative centre, radius) meets the frustum of a Vulkan clip matrix
-/// (0 <= z <= w): its distance to each of the six planes.
-fn sphere_in_frustum(m: &Mat4, c: DVec3, r: f64) -> bool {
-    let rows = [m.row(0).as_dvec4(), m.row(1).as_dvec4(), m.row(2).as_dvec4(), m.row(3).as_dvec4()];
-    let planes = [rows[3] + rows[0], rows[3] - rows[0], rows[3] + rows[1], rows[3] - rows[1], rows[2], rows[3] - rows[2]];
-    planes.iter().all(|p| {
-        let n = p.truncate();
-        let len = n.length();
-        len == 0.0 || (n.dot(c) + p.w) / len >= -r
-    })
-}
-
-/// An up vector not parallel to `d`.
-fn any_up(d: DVec3) -> Vec3 {
-    if d.y.abs() > 0.9 {
-        Vec3::Z
-    } else {
-        Vec3::Y
     }
 }
