@@ -28,6 +28,12 @@ pub struct BenchRow {
     pub gpu_shadow_ms: Option<f64>,
     /// Median GPU time of the illumination passes (all lights), ms.
     pub gpu_illuminate_ms: Option<f64>,
+    /// Shadow maps: median GPU time of rendering the maps (all lights), ms, part of
+    /// `gpu_shadow_ms` (`None` for the other techniques).
+    pub gpu_map_ms: Option<f64>,
+    /// Shadow maps: median GPU time of the PCF lookups (all lights), ms: `gpu_shadow_ms` less
+    /// the maps, frame by frame (`None` for the other techniques).
+    pub gpu_lookup_ms: Option<f64>,
     /// Median wall-clock time of `Renderer::render` (plan, record, submit, wait, read back), ms.
     pub wall_ms: f64,
     /// Median CPU planning time (silhouettes included), ms.
@@ -159,6 +165,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
             gpu: Vec<f64>,
             shadow: Vec<f64>,
             illum: Vec<f64>,
+            map: Vec<f64>,
             accel: Vec<f64>,
             wall: Vec<f64>,
             plan: Vec<f64>,
@@ -178,6 +185,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                     a.gpu.push(g.frame);
                     a.shadow.push(g.shadow);
                     a.illum.push(g.illuminate);
+                    a.map.push(g.shadow_map);
                     a.accel.push(g.accel);
                 }
                 a.wall.push(f.stats.wall_ms);
@@ -191,6 +199,8 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
             let throughput = r.throughput(cfg.frames.max(2))?;
             let s = a.last.ok_or_else(|| Error::Other("no frame".into()))?;
             let c = &s.totals.cases;
+            let maps = matches!(technique, Technique::ShadowMap { .. }) && !a.map.is_empty();
+            let lookup: Vec<f64> = a.shadow.iter().zip(&a.map).map(|(s, m)| s - m).collect();
             let row = BenchRow {
                 scene: name.clone(),
                 method: technique_label(technique),
@@ -200,6 +210,8 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 gpu_frame_ms: (!a.gpu.is_empty()).then(|| median(a.gpu)),
                 gpu_shadow_ms: (!a.shadow.is_empty()).then(|| median(a.shadow)),
                 gpu_illuminate_ms: (!a.illum.is_empty()).then(|| median(a.illum)),
+                gpu_map_ms: maps.then(|| median(a.map)),
+                gpu_lookup_ms: maps.then(|| median(lookup)),
                 wall_ms: median(a.wall),
                 cpu_plan_ms: median(a.plan),
                 throughput_fps: throughput.fps,
@@ -227,17 +239,21 @@ impl BenchReport {
             "Device: {} ({}), {}x{}. Medians; wall ms = one frame at a time (latency), fps = throughput with frames in flight; error = mismatched pixels outside a 1-pixel band vs the CPU reference (worst light).\n\n",
             self.device, self.driver, self.width, self.height
         );
-        s += "| scene | method | counter | GPU frame ms | GPU shadow ms | wall ms | fps | plan ms | shadow tris | bytes | error | cases c/1/2/3 |\n";
-        s += "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        s += "| scene | method | counter | GPU frame ms | GPU shadow ms | map / lookup ms | wall ms | fps | plan ms | shadow tris | bytes | error | cases c/1/2/3 |\n";
+        s += "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
         let f = |v: Option<f64>| v.map(|x| format!("{x:.2}")).unwrap_or_else(|| "—".into());
         for r in &self.rows {
             s += &format!(
-                "| {} | {} | {} | {} | {} | {:.2} | {:.1} | {:.3} | {} | {} | {:.4}% | {}/{}/{}/{} |\n",
+                "| {} | {} | {} | {} | {} | {} | {:.2} | {:.1} | {:.3} | {} | {} | {:.4}% | {}/{}/{}/{} |\n",
                 r.scene,
                 r.method,
                 r.counter,
                 f(r.gpu_frame_ms),
                 f(r.gpu_shadow_ms),
+                match (r.gpu_map_ms, r.gpu_lookup_ms) {
+                    (Some(m), Some(l)) => format!("{m:.2} / {l:.2}"),
+                    _ => "—".into(),
+                },
                 r.wall_ms,
                 r.throughput_fps,
                 r.cpu_plan_ms,
