@@ -138,8 +138,24 @@ fn bench_accepts_every_render_method() {
     for r in rows {
         assert!(r["throughput_fps"].as_f64().unwrap() > 0.0, "{r}");
         assert!(r["wall_ms"].as_f64().unwrap() > 0.0, "{r}");
+        // The shadow map's time splits into its maps and its lookup; the volumes have neither.
+        let (map, lookup, shadow) = (r["gpu_map_ms"].as_f64(), r["gpu_lookup_ms"].as_f64(), r["gpu_shadow_ms"].as_f64().unwrap());
+        if r["method"] == "shadowmap-256" {
+            let (map, lookup) = (map.unwrap(), lookup.unwrap());
+            assert!(map > 0.0 && lookup > 0.0 && map < shadow, "{r}");
+        } else {
+            assert!(map.is_none() && lookup.is_none(), "{r}");
+        }
     }
     fails_with(&umbrage(&["bench", "--methods", "magic"]), "magic");
+    fails_with(&umbrage(&["render", "--cube", "sphere"]), "sphere");
+    // Multiview cube faces render where the device's multiview is trusted, and are otherwise
+    // a clear refusal that names the way out.
+    let png = d.join("multiview.png");
+    let out = umbrage(&["render", "--method", "shadowmap", "--cube", "multiview", "--size", "64x48", "--out", png.to_str().unwrap()]);
+    if !out.status.success() {
+        fails_with(&out, "--cube atlas");
+    }
     for m in ["zpass", "zfail", "everitt-kilgard", "lengyel", "mcguire", "auto", "edgequad", "shadowmap"] {
         let png = d.join(format!("{m}.png"));
         let stats = d.join(format!("{m}.json"));
