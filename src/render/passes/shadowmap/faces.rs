@@ -21,6 +21,51 @@ pub(super) struct MeshRange {
     pub radius: f64,
 }
 
+/// The opaque shadow casters as the map pass draws them: their triangles' vertices
+/// (eye-relative, three per triangle), each mesh's range and bounding sphere, and the bounding
+/// sphere of them all.
+pub(super) struct Casters {
+    /// Eye-relative vertices, three per triangle, mesh after mesh.
+    pub vertices: Vec<[f32; 3]>,
+    /// Each non-empty caster mesh's range of [`Casters::vertices`] and bounding sphere.
+    pub meshes: Vec<MeshRange>,
+    /// All casters' bounding sphere, eye-relative (the origin and 1 without casters).
+    pub bounds: (DVec3, f64),
+}
+
+impl Casters {
+    /// The casters of `scene`, relative to its camera's eye.
+    pub fn of(scene: &crate::scene::Scene) -> Casters {
+        let eye = scene.camera.eye.as_dvec3();
+        let mut pos: Vec<[f32; 3]> = Vec::new();
+        let mut meshes = Vec::new();
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        for m in scene.meshes.iter().filter(|m| m.casts_shadow && m.opacity >= 1.0) {
+            let xf = m.transform.as_dmat4();
+            let first = pos.len() as u32;
+            let (mut mlo, mut mhi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+            for t in 0..m.mesh.triangles.len() {
+                for v in m.mesh.triangle(t) {
+                    let r = xf.transform_point3(v.as_dvec3()) - eye;
+                    mlo = mlo.min(r);
+                    mhi = mhi.max(r);
+                    pos.push(r.as_vec3().to_array());
+                }
+            }
+            let count = pos.len() as u32 - first;
+            if count > 0 {
+                lo = lo.min(mlo);
+                hi = hi.max(mhi);
+                // A little slack: the vertices were rounded to f32.
+                let radius = ((mhi - mlo) * 0.5).length() * (1.0 + 1e-5) + 1e-6;
+                meshes.push(MeshRange { first, count, center: (mlo + mhi) * 0.5, radius });
+            }
+        }
+        let bounds = if pos.is_empty() { (DVec3::ZERO, 1.0) } else { ((lo + hi) * 0.5, ((hi - lo) * 0.5).length().max(1e-6)) };
+        Casters { vertices: pos, meshes, bounds }
+    }
+}
+
 /// `shadowmap_lookup.frag`'s (and `shadowmap_multiview.wgsl`'s) `Face` (std430).
 #[repr(C)]
 #[derive(Clone, Copy, Default, bytemuck::Pod, bytemuck::Zeroable)]

@@ -34,7 +34,7 @@ use crate::render::targets::{Targets, COUNT_FORMAT};
 use crate::render::{CubeFaces, Pcf};
 use crate::scene::Scene;
 use ash::vk;
-use faces::{sphere_in_frustum, Face, FaceRow, Layout, MeshRange, FACES_BYTES};
+use faces::{sphere_in_frustum, Casters, Face, FaceRow, Layout, MeshRange, FACES_BYTES};
 use glam::DVec3;
 
 mod faces;
@@ -188,32 +188,7 @@ impl ShadowMapper {
         sampler: vk::Sampler,
         made: &mut Partial,
     ) -> Result<ShadowMapper> {
-        let eye = scene.camera.eye.as_dvec3();
-        let mut pos: Vec<[f32; 3]> = Vec::new();
-        let mut meshes = Vec::new();
-        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-        for m in scene.meshes.iter().filter(|m| m.casts_shadow && m.opacity >= 1.0) {
-            let xf = m.transform.as_dmat4();
-            let first = pos.len() as u32;
-            let (mut mlo, mut mhi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
-            for t in 0..m.mesh.triangles.len() {
-                for v in m.mesh.triangle(t) {
-                    let r = xf.transform_point3(v.as_dvec3()) - eye;
-                    mlo = mlo.min(r);
-                    mhi = mhi.max(r);
-                    pos.push(r.as_vec3().to_array());
-                }
-            }
-            let count = pos.len() as u32 - first;
-            if count > 0 {
-                lo = lo.min(mlo);
-                hi = hi.max(mhi);
-                // A little slack: the vertices were rounded to f32.
-                let radius = ((mhi - mlo) * 0.5).length() * (1.0 + 1e-5) + 1e-6;
-                meshes.push(MeshRange { first, count, center: (mlo + mhi) * 0.5, radius });
-            }
-        }
-        let bounds = if pos.is_empty() { (DVec3::ZERO, 1.0) } else { ((lo + hi) * 0.5, ((hi - lo) * 0.5).length().max(1e-6)) };
+        let Casters { vertices: pos, meshes, bounds } = Casters::of(scene);
         let casters = if pos.is_empty() {
             None
         } else {
