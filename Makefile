@@ -67,7 +67,8 @@ conform: deps-tests
 # Regenerates this device's report in docs/conform/ (DEVICE_DOC names it: lavapipe, or a GPU's name).
 DEVICE_DOC ?= lavapipe
 conform-docs: deps-tests
-	UMBRAGE_VALIDATION=1 $(CARGO) run -- conform --out target/conform-docs --junit target/conform-docs/junit.xml
+	UMBRAGE_VALIDATION=1 $(CARGO) run -- conform --out target/conform-docs --junit target/conform-docs/junit.xml \
+	  || [ -f target/conform-docs/conform.md ]  # a driver's failures are part of its report
 	cp target/conform-docs/conform.md docs/conform/$(DEVICE_DOC).md
 
 # The driver matrix: the full suite on lavapipe 20.3.5 / 22.3.6 / 25.0.7 and llvmpipe's

@@ -2,18 +2,21 @@
 //!
 //! Grouped by family: depth (w = 0 vertices, depth clamp, depth bounds), coverage (watertight
 //! edges, index types), stencil (two-sided wrap, stencil formats), the float counter (a deep
-//! wrap counted in R32_SFLOAT next to the stencil) and the end-to-end pipeline check; every
+//! wrap counted in R32_SFLOAT next to the stencil), multiview (a point light's cube faces as
+//! views against atlas tiles) and the end-to-end pipeline check; every
 //! check is re-exported here.
 
 mod coverage;
 mod depth;
 mod float_count;
+mod multiview;
 mod pipeline;
 mod stencil;
 
 pub use coverage::{index_types, watertight_fan};
 pub use depth::{depth_bounds, depth_clamp, w0_vertices_and_infinity};
 pub use float_count::deep_wrap_float_count;
+pub use multiview::{multiview_cube_faces, NAME as MULTIVIEW_CUBE_FACES};
 pub use pipeline::{shadow_pipeline_hard_cases, PIPELINE_THRESHOLD};
 pub use stencil::{stencil_formats, two_sided_stencil_wrap};
 

@@ -95,7 +95,7 @@ pub fn run_unit(ctx: &Context, unit: Unit, new_context: &dyn Fn() -> Result<Cont
         }
         Unit::Legacy => {
             let mut cases = Vec::new();
-            let legacy = suite::run_legacy(ctx, opts, &mut cases);
+            let legacy = suite::run_legacy(ctx, new_context, opts, &mut cases);
             ChildResult { cases, config: None, legacy }
         }
         Unit::Pipeline { shard, shards } => {

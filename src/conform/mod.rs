@@ -30,6 +30,7 @@
 //! | `depth_bounds` | stored depth outside the bounds rejected (when depthBounds) |
 //! | `index_types` | u32 / u16 / u8 / non-indexed give identical stencil images |
 //! | `deep_wrap_float_count` | 1000 front / 700 back faces: exactly 300.0 in an R32F count, 44 in the wrapping stencil (a render pass: runs on Vulkan 1.0) |
+//! | `multiview_cube_faces` | a point light inside a box: its six shadow-map faces as multiview views give the atlas tiles' shadow, clipped triangles included (when multiview) |
 //! | `shadow_pipeline_hard_cases` | every hard scene x method vs the reference (z-pass expected failures recorded) |
 //!
 //! A check also fails when the validation layers reported an error during it.

@@ -187,7 +187,7 @@ impl Report {
     }
 }
 
-const LEGACY: [&str; 8] = [
+const LEGACY: [&str; 9] = [
     "w0_vertices_and_infinity",
     "depth_clamp",
     "watertight_fan",
@@ -196,6 +196,7 @@ const LEGACY: [&str; 8] = [
     "depth_bounds",
     "index_types",
     "deep_wrap_float_count",
+    super::checks::MULTIVIEW_CUBE_FACES,
 ];
 
 fn pipeline_name(scene: &str, m: crate::shadow::Method) -> String {
@@ -459,7 +460,7 @@ pub fn run_suite(ctx: &Context, new_context: &dyn Fn() -> Result<Context>, opts:
         outcomes.extend(o);
         configs.extend(run);
     }
-    let mut legacy = run_legacy(ctx, opts, &mut outcomes);
+    let mut legacy = run_legacy(ctx, new_context, opts, &mut outcomes);
     legacy.extend(run_pipeline(ctx, new_context, opts, (0, 1), &mut outcomes));
     Report {
         device: ctx.info.clone(),
@@ -476,17 +477,26 @@ pub fn run_suite(ctx: &Context, new_context: &dyn Fn() -> Result<Context>, opts:
 }
 
 /// The selected `legacy.*` checks (outcomes into `out`, full results returned).
-pub fn run_legacy(ctx: &Context, opts: &SuiteOptions, out: &mut Vec<CaseOutcome>) -> Vec<CheckResult> {
+pub fn run_legacy(
+    ctx: &Context,
+    new_context: &dyn Fn() -> Result<Context>,
+    opts: &SuiteOptions,
+    out: &mut Vec<CaseOutcome>,
+) -> Vec<CheckResult> {
     type Check = fn(&Context) -> Result<CheckResult>;
-    let unit: [(&str, Check); 8] = [
-        (LEGACY[0], super::checks::w0_vertices_and_infinity),
-        (LEGACY[1], super::checks::depth_clamp),
-        (LEGACY[2], super::checks::watertight_fan),
-        (LEGACY[3], super::checks::two_sided_stencil_wrap),
-        (LEGACY[4], super::checks::stencil_formats),
-        (LEGACY[5], super::checks::depth_bounds),
-        (LEGACY[6], super::checks::index_types),
-        (LEGACY[7], super::checks::deep_wrap_float_count),
+    type Run<'a> = Box<dyn Fn() -> Result<CheckResult> + 'a>;
+    let on_ctx = |f: Check| -> Run<'_> { Box::new(move || f(ctx)) };
+    let unit: [(&str, Run<'_>); 9] = [
+        (LEGACY[0], on_ctx(super::checks::w0_vertices_and_infinity)),
+        (LEGACY[1], on_ctx(super::checks::depth_clamp)),
+        (LEGACY[2], on_ctx(super::checks::watertight_fan)),
+        (LEGACY[3], on_ctx(super::checks::two_sided_stencil_wrap)),
+        (LEGACY[4], on_ctx(super::checks::stencil_formats)),
+        (LEGACY[5], on_ctx(super::checks::depth_bounds)),
+        (LEGACY[6], on_ctx(super::checks::index_types)),
+        (LEGACY[7], on_ctx(super::checks::deep_wrap_float_count)),
+        // The renderer on a context of its own (the one a frame needs).
+        (LEGACY[8], Box::new(|| super::checks::multiview_cube_faces(ctx, new_context))),
     ];
     let mut results = Vec::new();
     for (name, f) in unit {
@@ -507,7 +517,7 @@ pub fn run_legacy(ctx: &Context, opts: &SuiteOptions, out: &mut Vec<CaseOutcome>
             continue;
         }
         let t0 = Instant::now();
-        let mut r = f(ctx).unwrap_or_else(|e| CheckResult::error(name, &e));
+        let mut r = f().unwrap_or_else(|e| CheckResult::error(name, &e));
         super::with_validation(&mut r, ctx.take_validation_errors());
         let mut o = CaseOutcome::new(full, "legacy", None, format!("single-configuration check `{name}` (the renderer's depth format)"));
         o.status = r.status;
