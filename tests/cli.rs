@@ -162,6 +162,12 @@ fn bench_accepts_every_render_method() {
         let out =
             umbrage(&["render", "--method", m, "--size", "64x48", "--out", png.to_str().unwrap(), "--stats", stats.to_str().unwrap()]);
         assert!(out.status.success(), "{m}: {}", String::from_utf8_lossy(&out.stderr));
+        // The shadow map's settings are in its stats, and only in its stats.
+        let s: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+        match m {
+            "shadowmap" => assert_eq!(s["shadow_map"], serde_json::json!({ "size": 2048, "pcf": "taps", "cube": "atlas" })),
+            _ => assert!(s["shadow_map"].is_null(), "{m}: {}", s["shadow_map"]),
+        }
     }
 }
 

@@ -333,6 +333,7 @@ impl Host {
             counters: None,
             warnings: fl.warnings.clone(),
             ray_query: None,
+            shadow_map: None,
         }
     }
 }

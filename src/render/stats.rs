@@ -78,6 +78,19 @@ pub struct Stats {
     pub warnings: Vec<String>,
     /// The ray-query technique's acceleration structures (`None` for the other techniques).
     pub ray_query: Option<RayQueryStats>,
+    /// The shadow-map baseline's maps and lookup (`None` for the other techniques).
+    pub shadow_map: Option<ShadowMapStats>,
+}
+
+/// How `--method shadowmap` rendered and read its maps.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct ShadowMapStats {
+    /// Texels per side of one map.
+    pub size: u32,
+    /// How the lookup read its 3x3 taps (`taps` or `gather`).
+    pub pcf: super::Pcf,
+    /// How a point light's six cube faces were rendered (`atlas` or `multiview`).
+    pub cube: super::CubeFaces,
 }
 
 /// What `--method rayquery` traces against.

@@ -4,7 +4,7 @@
 use super::{FrameTicket, InFlight, Renderer};
 use crate::error::Result;
 use crate::render::options::{DepthMode, IndexFormat, TransmitMode};
-use crate::render::stats::{GpuMs, LightGpuMs, Stats};
+use crate::render::stats::{GpuMs, LightGpuMs, ShadowMapStats, Stats};
 
 impl Renderer {
     /// The frame's `--stats`.
@@ -84,6 +84,10 @@ impl Renderer {
             warnings: f.frame.warnings.clone(),
             ray_query: match (f.settings.technique, &self.own.parts.ray_tracer) {
                 (crate::render::Technique::RayQuery, Some(rt)) => Some(rt.stats()),
+                _ => None,
+            },
+            shadow_map: match f.settings.technique {
+                crate::render::Technique::ShadowMap { size, pcf, cube } => Some(ShadowMapStats { size, pcf, cube }),
                 _ => None,
             },
         })
