@@ -203,10 +203,6 @@ fn pipeline_name(scene: &str, m: crate::shadow::Method) -> String {
     format!("pipeline.hard_cases.{}.{}", scene.trim_start_matches("hard/"), m.name())
 }
 
-fn pipeline_names() -> Vec<String> {
-    pipeline_shard_names((0, 1))
-}
-
 /// The pipeline case names of the hard scenes whose index is `shard.0` modulo `shard.1`.
 fn pipeline_shard_names(shard: (usize, usize)) -> Vec<String> {
     let mut v = Vec::new();
@@ -233,7 +229,7 @@ pub fn unit_case_names(unit: super::isolate::Unit, filter: &[String]) -> Vec<Str
 pub fn all_names() -> Vec<String> {
     let mut v: Vec<String> = cases::all(&Config::all(&FORMATS)).into_iter().map(|c| c.name).collect();
     v.extend(LEGACY.iter().map(|n| format!("legacy.{n}")));
-    v.extend(pipeline_names());
+    v.extend(pipeline_shard_names((0, 1)));
     v
 }
 
@@ -504,22 +500,19 @@ pub fn run_legacy(
         if !selected(&opts.filter, &full) {
             continue;
         }
+        let mut o = CaseOutcome::new(full, "legacy", None, format!("single-configuration check `{name}` (the renderer's depth format)"));
         // Every check but the float count draws through the harness's dynamic rendering.
         if !ctx.features.dynamic_rendering && name != "deep_wrap_float_count" {
-            let mut o =
-                CaseOutcome::new(full, "legacy", None, format!("single-configuration check `{name}` (the renderer's depth format)"));
             o.status = Status::Skipped;
-            o.message = format!(
-                "the single-configuration checks draw with dynamic rendering (Vulkan 1.3); the device has Vulkan {}",
-                ctx.info.api_version
-            );
+            let version = &ctx.info.api_version;
+            o.message =
+                format!("the single-configuration checks draw with dynamic rendering (Vulkan 1.3); the device has Vulkan {version}");
             out.push(o);
             continue;
         }
         let t0 = Instant::now();
         let mut r = f().unwrap_or_else(|e| CheckResult::error(name, &e));
         super::with_validation(&mut r, ctx.take_validation_errors());
-        let mut o = CaseOutcome::new(full, "legacy", None, format!("single-configuration check `{name}` (the renderer's depth format)"));
         o.status = r.status;
         o.message = r.summary.clone();
         o.seconds = t0.elapsed().as_secs_f64();
