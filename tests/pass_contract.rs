@@ -94,19 +94,27 @@ fn creation_options_are_checked_against_the_device() {
             other => panic!("{n} samples: {:?}", other.err()),
         }
     }
-    // The renderer-only techniques (shadow maps, ray query) are refused by name, at creation
-    // and between frames; the pass keeps the settings it had.
-    for t in [Technique::shadow_map(512), Technique::RayQuery] {
-        let settings = PassSettings { technique: t, ..Default::default() };
-        match pass(&ctx, &ShadowPassDesc { settings, ..desc(&ctx) }) {
-            Err(Error::InvalidDesc { field, msg }) => assert!(field == "PassSettings::technique" && msg.contains(t.name()), "{msg}"),
-            other => panic!("{t:?} accepted at creation: {:?}", other.err()),
-        }
-        let mut p = pass(&ctx, &desc(&ctx)).expect("a default pass");
-        let before = p.settings();
-        assert!(matches!(p.set_settings(settings), Err(Error::InvalidDesc { .. })), "{t:?} accepted between frames");
-        assert_eq!(p.settings(), before);
+    // The renderer-only shadow-map baseline is refused by name, at creation and between
+    // frames; the pass keeps the settings it had.
+    let t = Technique::shadow_map(512);
+    let settings = PassSettings { technique: t, ..Default::default() };
+    match pass(&ctx, &ShadowPassDesc { settings, ..desc(&ctx) }) {
+        Err(Error::InvalidDesc { field, msg }) => assert!(field == "PassSettings::technique" && msg.contains(t.name()), "{msg}"),
+        other => panic!("{t:?} accepted at creation: {:?}", other.err()),
     }
+    let mut p = pass(&ctx, &desc(&ctx)).expect("a default pass");
+    let before = p.settings();
+    assert!(matches!(p.set_settings(settings), Err(Error::InvalidDesc { .. })), "{t:?} accepted between frames");
+    assert_eq!(p.settings(), before);
+    // Ray query without the host enabling it (EnabledFeatures::ray_query is off here): a clear
+    // error naming the extension, at creation and between frames.
+    let settings = PassSettings { technique: Technique::RayQuery, ..Default::default() };
+    match pass(&ctx, &ShadowPassDesc { settings, ..desc(&ctx) }) {
+        Err(Error::Unsupported(msg)) => assert!(msg.contains("VK_KHR_ray_query") && msg.contains("EnabledFeatures::ray_query"), "{msg}"),
+        other => panic!("ray query accepted at creation without the feature: {:?}", other.err()),
+    }
+    assert!(matches!(p.set_settings(settings), Err(Error::Unsupported(_))), "ray query accepted between frames");
+    assert_eq!(p.settings(), before);
     // SAFETY: plain queries on the context's physical device.
     let (limits, image_counts) = unsafe {
         let limits = ctx.instance.get_physical_device_properties(ctx.physical).limits;

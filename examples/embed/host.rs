@@ -407,6 +407,8 @@ impl Host {
             depth_clamp: picked.depth_clamp,
             depth_bounds: picked.depth_bounds,
             index_type_uint8: picked.index_type_uint8,
+            // This host's G-buffer is depth only: no positions and normals for rays.
+            ray_query: false,
         };
         let device = create_device(&host.instance, &picked, dynamic)?;
         host.device = Some(device.clone());

@@ -250,7 +250,12 @@ impl Host {
             depth_stencil_format: host.gpu.ds_format,
             frames_in_flight: FRAMES_IN_FLIGHT,
             // wgpu enables neither depthClamp (infinite far plane: not needed) nor depthBounds.
-            features: EnabledFeatures { depth_clamp: false, depth_bounds: false, index_type_uint8: host.gpu.index_type_uint8 },
+            features: EnabledFeatures {
+                depth_clamp: false,
+                depth_bounds: false,
+                index_type_uint8: host.gpu.index_type_uint8,
+                ray_query: false,
+            },
             ..Default::default()
         };
         let mut pass = ShadowPass::new(&host.gpu.raw_instance, host.gpu.physical, &host.gpu.raw_device, allocator, &desc)

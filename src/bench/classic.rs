@@ -53,7 +53,8 @@ pub struct BenchRow {
     pub cases: [u64; 4],
     /// Ray query: median GPU time of the frame's top-level build, ms (`None` otherwise).
     pub gpu_tlas_ms: Option<f64>,
-    /// Ray query: CPU wall time of the bottom-level builds (once, compaction included), ms.
+    /// Ray query: GPU time of the frame that built the bottom levels (its acceleration span:
+    /// the builds and that frame's top level), ms.
     pub blas_build_ms: Option<f64>,
     /// Ray query: bottom-level storage after compaction, bytes.
     pub blas_bytes: Option<u64>,

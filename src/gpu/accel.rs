@@ -1,9 +1,11 @@
-//! Acceleration structures for `VK_KHR_ray_query`: bottom levels built once from triangles
-//! or AABBs (one-shot, synchronous), and a top level whose instances are rewritten and rebuilt
-//! in a frame's command buffer. Needs [`super::Features::ray_query`] (the context enables
-//! buffer device addresses then).
+//! Acceleration structures for `VK_KHR_ray_query`, every build recorded into a command
+//! buffer the caller supplies (the shadow pass records into its host's): bottom levels from
+//! triangles or AABBs, built ([`prepare_blas`]), refitted in place ([`prepare_refit`]) or
+//! compacted ([`cmd_compact`] after [`cmd_write_compacted_size`]); a top level whose instances
+//! are rewritten and rebuilt every frame ([`Tlas`]). Needs ray query, acceleration structures
+//! and buffer device addresses enabled on the device.
 
-use super::context::Context;
+use super::context::GpuDevice;
 use super::resources::{memory_barrier, Buffer};
 use crate::error::{Error, Result};
 use ash::vk;
@@ -20,12 +22,10 @@ pub struct AccelLoader {
 }
 
 impl AccelLoader {
-    /// Loads the functions; `Error::Unsupported` when the context has no ray query.
-    pub fn new(ctx: &Context) -> Result<AccelLoader> {
-        if !ctx.features.ray_query {
-            return Err(missing_ray_query(&ctx.info.name));
-        }
-        Ok(AccelLoader { fns: ash::khr::acceleration_structure::Device::new(&ctx.instance, &ctx.device) })
+    /// Loads the functions of a device the caller created with `VK_KHR_acceleration_structure`
+    /// enabled (an embedding host's, checked by the caller).
+    pub fn from_device(instance: &ash::Instance, device: &ash::Device) -> AccelLoader {
+        AccelLoader { fns: ash::khr::acceleration_structure::Device::new(instance, device) }
     }
 }
 
@@ -40,10 +40,10 @@ pub fn missing_ray_query(device: &str) -> Error {
 }
 
 /// The device address of `buffer` (created with `SHADER_DEVICE_ADDRESS`).
-fn address(ctx: &Context, buffer: &Buffer) -> u64 {
+fn address(ctx: &impl GpuDevice, buffer: &Buffer) -> u64 {
     // SAFETY: the buffer is alive, bound, and was created with SHADER_DEVICE_ADDRESS usage on a
     // device with bufferDeviceAddress enabled.
-    unsafe { ctx.device.get_buffer_device_address(&vk::BufferDeviceAddressInfo::default().buffer(buffer.raw)) }
+    unsafe { ctx.device().get_buffer_device_address(&vk::BufferDeviceAddressInfo::default().buffer(buffer.raw)) }
 }
 
 const INPUT: vk::BufferUsageFlags = vk::BufferUsageFlags::from_raw(
@@ -63,7 +63,7 @@ pub struct Accel {
 }
 
 impl Accel {
-    fn new(ctx: &Context, l: &AccelLoader, name: &str, ty: vk::AccelerationStructureTypeKHR, size: u64) -> Result<Accel> {
+    fn new(ctx: &impl GpuDevice, l: &AccelLoader, name: &str, ty: vk::AccelerationStructureTypeKHR, size: u64) -> Result<Accel> {
         let usage = vk::BufferUsageFlags::ACCELERATION_STRUCTURE_STORAGE_KHR | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS;
         let mut buffer = Buffer::new(ctx, name, size, usage, MemoryLocation::GpuOnly)?;
         let info = vk::AccelerationStructureCreateInfoKHR::default().buffer(buffer.raw).size(size).ty(ty);
@@ -85,7 +85,7 @@ impl Accel {
     }
 
     /// Destroys the structure and frees its buffer; no pending GPU work may use it.
-    pub fn destroy(&mut self, ctx: &Context, l: &AccelLoader) {
+    pub fn destroy(&mut self, ctx: &impl GpuDevice, l: &AccelLoader) {
         // SAFETY: the owner guarantees the structure is no longer in use.
         unsafe { l.fns.destroy_acceleration_structure(self.raw, None) };
         self.raw = vk::AccelerationStructureKHR::null();
@@ -115,63 +115,94 @@ impl Geometry<'_> {
     }
 }
 
-fn scratch(ctx: &Context, name: &str, size: u64) -> Result<(Buffer, u64)> {
+fn scratch(ctx: &impl GpuDevice, name: &str, size: u64) -> Result<(Buffer, u64)> {
     let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::SHADER_DEVICE_ADDRESS;
     let b = Buffer::new(ctx, name, size + SCRATCH_SLACK, usage, MemoryLocation::GpuOnly)?;
     let a = address(ctx, &b).next_multiple_of(SCRATCH_SLACK);
     Ok((b, a))
 }
 
-/// Builds a bottom-level structure for `geometry` (opaque), preferring fast traces, and
-/// compacts it where the device allows. Blocks until the build is done.
-pub fn build_blas(ctx: &Context, l: &AccelLoader, name: &str, geometry: Geometry) -> Result<Accel> {
-    let count = geometry.primitives();
-    let mut inputs: Vec<Buffer> = Vec::new();
-    let result = build_blas_inner(ctx, l, name, &geometry, count, &mut inputs);
-    for mut b in inputs {
-        b.destroy(ctx);
-    }
-    result
+/// Where a bottom level's inputs are on the device.
+#[derive(Clone, Copy, Debug)]
+enum GeomAddr {
+    Triangles { vertices: u64, max_vertex: u32, indices: u64 },
+    Aabbs { boxes: u64 },
 }
 
-fn build_blas_inner(
-    ctx: &Context,
-    l: &AccelLoader,
-    name: &str,
-    geometry: &Geometry,
-    count: u32,
-    inputs: &mut Vec<Buffer>,
-) -> Result<Accel> {
-    let geom = match geometry {
+/// Uploads `geometry`'s inputs into host-visible buffers pushed onto `inputs` (they must
+/// outlive the build) and returns their addresses.
+fn describe(ctx: &impl GpuDevice, geometry: &Geometry, inputs: &mut Vec<Buffer>) -> Result<GeomAddr> {
+    Ok(match geometry {
         Geometry::Triangles { positions, indices } => {
-            inputs.push(Buffer::with_data(ctx, "blas vertices", bytemuck::cast_slice(positions), INPUT)?);
-            inputs.push(Buffer::with_data(ctx, "blas indices", bytemuck::cast_slice(indices), INPUT)?);
+            let v = Buffer::with_data(ctx, "blas vertices", bytemuck::cast_slice(positions), INPUT)?;
+            let vertices = address(ctx, &v);
+            inputs.push(v);
+            let i = Buffer::with_data(ctx, "blas indices", bytemuck::cast_slice(indices), INPUT)?;
+            let idx = address(ctx, &i);
+            inputs.push(i);
+            GeomAddr::Triangles { vertices, max_vertex: positions.len().saturating_sub(1) as u32, indices: idx }
+        }
+        Geometry::Aabbs(boxes) => {
+            let b = Buffer::with_data(ctx, "blas boxes", bytemuck::cast_slice(boxes), INPUT)?;
+            let boxes = address(ctx, &b);
+            inputs.push(b);
+            GeomAddr::Aabbs { boxes }
+        }
+    })
+}
+
+/// The Vulkan geometry of inputs at `addr` (opaque).
+fn geometry_of(addr: GeomAddr) -> vk::AccelerationStructureGeometryKHR<'static> {
+    match addr {
+        GeomAddr::Triangles { vertices, max_vertex, indices } => {
             let tri = vk::AccelerationStructureGeometryTrianglesDataKHR::default()
                 .vertex_format(vk::Format::R32G32B32_SFLOAT)
-                .vertex_data(vk::DeviceOrHostAddressConstKHR { device_address: address(ctx, &inputs[0]) })
+                .vertex_data(vk::DeviceOrHostAddressConstKHR { device_address: vertices })
                 .vertex_stride(12)
-                .max_vertex(positions.len().saturating_sub(1) as u32)
+                .max_vertex(max_vertex)
                 .index_type(vk::IndexType::UINT32)
-                .index_data(vk::DeviceOrHostAddressConstKHR { device_address: address(ctx, &inputs[1]) });
+                .index_data(vk::DeviceOrHostAddressConstKHR { device_address: indices });
             vk::AccelerationStructureGeometryKHR::default()
                 .geometry_type(vk::GeometryTypeKHR::TRIANGLES)
                 .geometry(vk::AccelerationStructureGeometryDataKHR { triangles: tri })
                 .flags(vk::GeometryFlagsKHR::OPAQUE)
         }
-        Geometry::Aabbs(boxes) => {
-            inputs.push(Buffer::with_data(ctx, "blas boxes", bytemuck::cast_slice(boxes), INPUT)?);
+        GeomAddr::Aabbs { boxes } => {
             let aabbs = vk::AccelerationStructureGeometryAabbsDataKHR::default()
-                .data(vk::DeviceOrHostAddressConstKHR { device_address: address(ctx, &inputs[0]) })
+                .data(vk::DeviceOrHostAddressConstKHR { device_address: boxes })
                 .stride(24);
             vk::AccelerationStructureGeometryKHR::default()
                 .geometry_type(vk::GeometryTypeKHR::AABBS)
                 .geometry(vk::AccelerationStructureGeometryDataKHR { aabbs })
                 .flags(vk::GeometryFlagsKHR::OPAQUE)
         }
-    };
-    let geoms = [geom];
-    let flags = vk::BuildAccelerationStructureFlagsKHR::PREFER_FAST_TRACE | vk::BuildAccelerationStructureFlagsKHR::ALLOW_COMPACTION;
-    let mut build = vk::AccelerationStructureBuildGeometryInfoKHR::default()
+    }
+}
+
+/// A bottom-level build or refit whose structure, inputs and scratch memory exist, recorded
+/// later into a command buffer the caller supplies ([`BlasJob::cmd_record`]). Plain handles
+/// and addresses: the caller keeps the buffers ([`prepare_blas`]'s `transient`) alive until
+/// the command buffer has completed.
+#[derive(Clone, Copy, Debug)]
+pub struct BlasJob {
+    geometry: GeomAddr,
+    flags: vk::BuildAccelerationStructureFlagsKHR,
+    /// An in-place refit of `dst` (mode UPDATE) rather than a build.
+    update: bool,
+    dst: vk::AccelerationStructureKHR,
+    count: u32,
+    scratch: u64,
+}
+
+/// The build sizes of `count` primitives of `addr` with `flags`.
+fn blas_sizes(
+    l: &AccelLoader,
+    addr: GeomAddr,
+    flags: vk::BuildAccelerationStructureFlagsKHR,
+    count: u32,
+) -> vk::AccelerationStructureBuildSizesInfoKHR<'static> {
+    let geoms = [geometry_of(addr)];
+    let build = vk::AccelerationStructureBuildGeometryInfoKHR::default()
         .ty(vk::AccelerationStructureTypeKHR::BOTTOM_LEVEL)
         .flags(flags)
         .mode(vk::BuildAccelerationStructureModeKHR::BUILD)
@@ -179,87 +210,139 @@ fn build_blas_inner(
     let mut sizes = vk::AccelerationStructureBuildSizesInfoKHR::default();
     // SAFETY: the build info points at locals alive for the call.
     unsafe { l.fns.get_acceleration_structure_build_sizes(vk::AccelerationStructureBuildTypeKHR::DEVICE, &build, &[count], &mut sizes) };
+    sizes
+}
+
+/// Creates a bottom level for `geometry` built with `flags`, its inputs and scratch memory
+/// (pushed onto `transient`), and returns it with the job that records its build.
+pub fn prepare_blas(
+    ctx: &impl GpuDevice,
+    l: &AccelLoader,
+    name: &str,
+    geometry: &Geometry,
+    flags: vk::BuildAccelerationStructureFlagsKHR,
+    transient: &mut Vec<Buffer>,
+) -> Result<(Accel, BlasJob)> {
+    let count = geometry.primitives();
+    let addr = describe(ctx, geometry, transient)?;
+    let sizes = blas_sizes(l, addr, flags, count);
     let mut accel = Accel::new(ctx, l, name, vk::AccelerationStructureTypeKHR::BOTTOM_LEVEL, sizes.acceleration_structure_size)?;
-    let (mut scratch_buf, scratch_addr) = match scratch(ctx, "blas scratch", sizes.build_scratch_size) {
-        Ok(s) => s,
+    match scratch(ctx, "blas scratch", sizes.build_scratch_size) {
+        Ok((b, scratch)) => {
+            transient.push(b);
+            let job = BlasJob { geometry: addr, flags, update: false, dst: accel.raw, count, scratch };
+            Ok((accel, job))
+        }
         Err(e) => {
             accel.destroy(ctx, l);
-            return Err(e);
-        }
-    };
-    build = build.dst_acceleration_structure(accel.raw).scratch_data(vk::DeviceOrHostAddressKHR { device_address: scratch_addr });
-    let range = [vk::AccelerationStructureBuildRangeInfoKHR::default().primitive_count(count)];
-    let query = compaction_query(ctx);
-    let built = ctx.one_shot(|cb| {
-        // SAFETY: `cb` is recording; every buffer the build reads or writes is alive until
-        // `one_shot` has waited for it.
-        unsafe {
-            l.fns.cmd_build_acceleration_structures(cb, std::slice::from_ref(&build), &[&range[..]]);
-            if let Some(q) = query {
-                let b = (vk::PipelineStageFlags2::ACCELERATION_STRUCTURE_BUILD_KHR, vk::AccessFlags2::ACCELERATION_STRUCTURE_WRITE_KHR);
-                memory_barrier(
-                    ctx,
-                    cb,
-                    b,
-                    (vk::PipelineStageFlags2::ACCELERATION_STRUCTURE_BUILD_KHR, vk::AccessFlags2::ACCELERATION_STRUCTURE_READ_KHR),
-                );
-                ctx.device.cmd_reset_query_pool(cb, q, 0, 1);
-                l.fns.cmd_write_acceleration_structures_properties(
-                    cb,
-                    &[accel.raw],
-                    vk::QueryType::ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR,
-                    q,
-                    0,
-                );
-            }
-        }
-    });
-    scratch_buf.destroy(ctx);
-    if let Err(e) = built {
-        if let Some(q) = query {
-            // SAFETY: the one-shot submission is over (or never happened).
-            unsafe { ctx.device.destroy_query_pool(q, None) };
-        }
-        accel.destroy(ctx, l);
-        return Err(e);
-    }
-    let Some(q) = query else { return Ok(accel) };
-    let mut compact = [0u64];
-    // SAFETY: the query was written by the finished submission.
-    let got = unsafe { ctx.device.get_query_pool_results(q, 0, &mut compact, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT) };
-    // SAFETY: no work uses the pool any more.
-    unsafe { ctx.device.destroy_query_pool(q, None) };
-    if got.is_err() || compact[0] == 0 || compact[0] >= accel.size {
-        return Ok(accel);
-    }
-    let mut small = match Accel::new(ctx, l, name, vk::AccelerationStructureTypeKHR::BOTTOM_LEVEL, compact[0]) {
-        Ok(a) => a,
-        Err(_) => return Ok(accel),
-    };
-    let copied = ctx.one_shot(|cb| {
-        let info = vk::CopyAccelerationStructureInfoKHR::default()
-            .src(accel.raw)
-            .dst(small.raw)
-            .mode(vk::CopyAccelerationStructureModeKHR::COMPACT);
-        // SAFETY: both structures are alive until `one_shot` has waited.
-        unsafe { l.fns.cmd_copy_acceleration_structure(cb, &info) };
-    });
-    match copied {
-        Ok(()) => {
-            accel.destroy(ctx, l);
-            Ok(small)
-        }
-        Err(_) => {
-            small.destroy(ctx, l);
-            Ok(accel)
+            Err(e)
         }
     }
 }
 
-fn compaction_query(ctx: &Context) -> Option<vk::QueryPool> {
+/// The job that refits `accel` (built with `flags`, which include `ALLOW_UPDATE`) in place to
+/// new positions of the same triangles; inputs and scratch are pushed onto `transient`.
+pub fn prepare_refit(
+    ctx: &impl GpuDevice,
+    l: &AccelLoader,
+    accel: &Accel,
+    geometry: &Geometry,
+    flags: vk::BuildAccelerationStructureFlagsKHR,
+    transient: &mut Vec<Buffer>,
+) -> Result<BlasJob> {
+    let count = geometry.primitives();
+    let addr = describe(ctx, geometry, transient)?;
+    let sizes = blas_sizes(l, addr, flags, count);
+    let (b, scratch) = scratch(ctx, "blas refit scratch", sizes.update_scratch_size)?;
+    transient.push(b);
+    Ok(BlasJob { geometry: addr, flags, update: true, dst: accel.raw, count, scratch })
+}
+
+impl BlasJob {
+    /// Records the build (or refit).
+    ///
+    /// # Safety
+    /// `cb` is recording outside any rendering instance or render pass; the structure and the
+    /// job's buffers live until it has completed; a refit's structure is read by no pending
+    /// work (an earlier barrier orders it after every earlier read).
+    pub unsafe fn cmd_record(&self, l: &AccelLoader, cb: vk::CommandBuffer) {
+        let geoms = [geometry_of(self.geometry)];
+        let mode = if self.update { vk::BuildAccelerationStructureModeKHR::UPDATE } else { vk::BuildAccelerationStructureModeKHR::BUILD };
+        let mut build = vk::AccelerationStructureBuildGeometryInfoKHR::default()
+            .ty(vk::AccelerationStructureTypeKHR::BOTTOM_LEVEL)
+            .flags(self.flags)
+            .mode(mode)
+            .geometries(&geoms)
+            .dst_acceleration_structure(self.dst)
+            .scratch_data(vk::DeviceOrHostAddressKHR { device_address: self.scratch });
+        if self.update {
+            build = build.src_acceleration_structure(self.dst);
+        }
+        let range = [vk::AccelerationStructureBuildRangeInfoKHR::default().primitive_count(self.count)];
+        // SAFETY: the caller's contract.
+        unsafe { l.fns.cmd_build_acceleration_structures(cb, std::slice::from_ref(&build), &[&range[..]]) };
+    }
+
+    /// Whether the job refits in place.
+    pub fn is_refit(&self) -> bool {
+        self.update
+    }
+}
+
+/// A one-query pool for a structure's compacted size.
+pub fn compaction_pool(ctx: &impl GpuDevice) -> Result<vk::QueryPool> {
+    compaction_query(ctx).ok_or_else(|| Error::Internal("no acceleration-structure compaction query pool".into()))
+}
+
+/// Records the reset of `pool` and the write of `accel`'s compacted size into it.
+///
+/// # Safety
+/// `cb` is recording outside any rendering instance; a barrier orders the structure's build
+/// before this read; `pool` is not in use by pending work.
+pub unsafe fn cmd_write_compacted_size(
+    ctx: &impl GpuDevice,
+    l: &AccelLoader,
+    cb: vk::CommandBuffer,
+    pool: vk::QueryPool,
+    accel: vk::AccelerationStructureKHR,
+) {
+    // SAFETY: the caller's contract.
+    unsafe {
+        ctx.device().cmd_reset_query_pool(cb, pool, 0, 1);
+        l.fns.cmd_write_acceleration_structures_properties(cb, &[accel], vk::QueryType::ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR, pool, 0);
+    }
+}
+
+/// The compacted size written into `pool`, if the GPU has written it yet (never waits).
+pub fn compacted_size(ctx: &impl GpuDevice, pool: vk::QueryPool) -> Option<u64> {
+    let mut size = [0u64];
+    // SAFETY: a non-blocking read of a query that was reset and written by recorded work
+    // (NOT_READY until then).
+    let got = unsafe { ctx.device().get_query_pool_results(pool, 0, &mut size, vk::QueryResultFlags::TYPE_64) };
+    got.ok().map(|()| size[0])
+}
+
+/// Records the compacting copy of `src` into `dst` (created with the compacted size).
+///
+/// # Safety
+/// `cb` is recording outside any rendering instance; `src`'s build completed before (an
+/// earlier submission on the same queue, after a barrier to build reads); both live until `cb`
+/// has completed.
+pub unsafe fn cmd_compact(l: &AccelLoader, cb: vk::CommandBuffer, src: vk::AccelerationStructureKHR, dst: vk::AccelerationStructureKHR) {
+    let info = vk::CopyAccelerationStructureInfoKHR::default().src(src).dst(dst).mode(vk::CopyAccelerationStructureModeKHR::COMPACT);
+    // SAFETY: the caller's contract.
+    unsafe { l.fns.cmd_copy_acceleration_structure(cb, &info) };
+}
+
+/// Creates an empty bottom level of `size` bytes (the destination of [`cmd_compact`]).
+pub fn new_blas(ctx: &impl GpuDevice, l: &AccelLoader, name: &str, size: u64) -> Result<Accel> {
+    Accel::new(ctx, l, name, vk::AccelerationStructureTypeKHR::BOTTOM_LEVEL, size)
+}
+
+fn compaction_query(ctx: &impl GpuDevice) -> Option<vk::QueryPool> {
     let info = vk::QueryPoolCreateInfo::default().query_type(vk::QueryType::ACCELERATION_STRUCTURE_COMPACTED_SIZE_KHR).query_count(1);
     // SAFETY: valid device with the acceleration-structure extension enabled.
-    unsafe { ctx.device.create_query_pool(&info, None) }.ok()
+    unsafe { ctx.device().create_query_pool(&info, None) }.ok()
 }
 
 /// One top-level instance.
@@ -290,7 +373,7 @@ pub struct Tlas {
 
 impl Tlas {
     /// Allocates the structure, its instance buffer (host-visible) and scratch memory.
-    pub fn new(ctx: &Context, l: &AccelLoader, capacity: u32) -> Result<Tlas> {
+    pub fn new(ctx: &impl GpuDevice, l: &AccelLoader, capacity: u32) -> Result<Tlas> {
         let capacity = capacity.max(1);
         let geoms = [top_geometry(0)];
         let build = vk::AccelerationStructureBuildGeometryInfoKHR::default()
@@ -323,13 +406,9 @@ impl Tlas {
         }
     }
 
-    /// Writes `instances` and records their build into `cb`, then a barrier making the
-    /// structure visible to fragment-shader ray queries.
-    ///
-    /// # Safety
-    /// `cb` is recording outside a rendering instance, and no pending GPU work still reads this
-    /// structure or its instance buffer (the frame slot that owns it has retired).
-    pub unsafe fn cmd_build(&mut self, ctx: &Context, l: &AccelLoader, cb: vk::CommandBuffer, instances: &[Instance]) -> Result<()> {
+    /// Writes `instances` into the host-visible instance buffer (no pending GPU work may
+    /// still read it: the frame slot that owns it has retired).
+    pub fn write(&mut self, instances: &[Instance]) -> Result<()> {
         if instances.len() as u32 > self.capacity {
             return Err(Error::Internal(format!("{} instances for a top level of {}", instances.len(), self.capacity)));
         }
@@ -345,7 +424,22 @@ impl Tlas {
         // SAFETY: `AccelerationStructureInstanceKHR` is a plain 64-byte record (f32s, packed
         // u32s and a u64), written as bytes into the host-visible instance buffer.
         let data = unsafe { std::slice::from_raw_parts(raw.as_ptr() as *const u8, std::mem::size_of_val(&raw[..])) };
-        self.instances.write(0, data)?;
+        self.instances.write(0, data)
+    }
+
+    /// The most instances the structure holds.
+    pub fn capacity(&self) -> u32 {
+        self.capacity
+    }
+
+    /// Records the build of the first `count` instances [`write`](Self::write) wrote, between
+    /// a barrier from the host's write and one to fragment-shader ray queries.
+    ///
+    /// # Safety
+    /// `cb` is recording outside a rendering instance, after [`write`](Self::write) of at least
+    /// `count` instances; no pending GPU work still reads this structure or its instance buffer
+    /// (the frame slot that owns it has retired).
+    pub unsafe fn cmd_record(&self, ctx: &impl GpuDevice, l: &AccelLoader, cb: vk::CommandBuffer, count: u32) {
         let geoms = [top_geometry(address(ctx, &self.instances))];
         let build = vk::AccelerationStructureBuildGeometryInfoKHR::default()
             .ty(vk::AccelerationStructureTypeKHR::TOP_LEVEL)
@@ -354,7 +448,7 @@ impl Tlas {
             .geometries(&geoms)
             .dst_acceleration_structure(self.accel.raw)
             .scratch_data(vk::DeviceOrHostAddressKHR { device_address: self.scratch_address });
-        let range = [vk::AccelerationStructureBuildRangeInfoKHR::default().primitive_count(instances.len() as u32)];
+        let range = [vk::AccelerationStructureBuildRangeInfoKHR::default().primitive_count(count.min(self.capacity))];
         let host = (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_WRITE);
         let input = (vk::PipelineStageFlags2::ACCELERATION_STRUCTURE_BUILD_KHR, vk::AccessFlags2::SHADER_READ);
         memory_barrier(ctx, cb, host, input);
@@ -364,11 +458,10 @@ impl Tlas {
         let built = (vk::PipelineStageFlags2::ACCELERATION_STRUCTURE_BUILD_KHR, vk::AccessFlags2::ACCELERATION_STRUCTURE_WRITE_KHR);
         let read = (vk::PipelineStageFlags2::FRAGMENT_SHADER, vk::AccessFlags2::ACCELERATION_STRUCTURE_READ_KHR);
         memory_barrier(ctx, cb, built, read);
-        Ok(())
     }
 
     /// Destroys everything; no pending GPU work may use it.
-    pub fn destroy(&mut self, ctx: &Context, l: &AccelLoader) {
+    pub fn destroy(&mut self, ctx: &impl GpuDevice, l: &AccelLoader) {
         self.accel.destroy(ctx, l);
         self.instances.destroy(ctx);
         self.scratch.destroy(ctx);

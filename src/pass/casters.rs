@@ -50,6 +50,8 @@ pub(crate) struct GpuCaster {
     /// The compute pass's static tables, built the first time a frame asks for them
     /// (opaque casters with a closed manifold part).
     pub compute: Option<ComputeStatic>,
+    /// Bumped by every `update_positions` (the ray-query bottom levels follow it).
+    pub version: u64,
 }
 
 /// Buffers waiting for the frames in flight that may use them to retire: bit `s` of `mask`
@@ -133,7 +135,7 @@ impl CasterTable {
         self.slots.push((0, Some(self.live.len())));
         let shells = shell_count(caster.mesh());
         self.cpu.push(caster);
-        self.live.push(GpuCaster { id, transform, shells, chunks, edge_quads: None, compute: None });
+        self.live.push(GpuCaster { id, transform, shells, chunks, edge_quads: None, compute: None, version: 0 });
         Ok(id)
     }
 
@@ -201,6 +203,7 @@ impl CasterTable {
         caster.refresh_after_positions_changed();
         let chunks = self.upload_chunks(dev, &caster)?;
         let entry = &mut self.live[i];
+        entry.version += 1;
         let mut old: Vec<Buffer> = std::mem::replace(&mut entry.chunks, chunks);
         if let Some(eq) = entry.edge_quads.take() {
             old.push(eq.vertices);

@@ -218,9 +218,10 @@ named_enum!(
 ///
 /// The first four build stencil shadow volumes and run in both. Open, non-manifold and
 /// transparent casters take the multiplicity path (Kim et al. 2008) under each of them.
-/// [`ShadowMap`](Technique::ShadowMap) and [`RayQuery`](Technique::RayQuery) are whole
-/// renderer paths: a `ShadowPass` refuses them with [`Error::InvalidDesc`]
-/// ([`PassSettings::check`]).
+/// [`RayQuery`](Technique::RayQuery) runs in both too, writing the same stencil from the
+/// host's G-buffer ([`ShadowPass::set_ray_query_inputs`](super::ShadowPass::set_ray_query_inputs)).
+/// [`ShadowMap`](Technique::ShadowMap) is a whole renderer path: a `ShadowPass` refuses it
+/// with [`Error::InvalidDesc`] ([`PassSettings::check`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[non_exhaustive]
 pub enum Technique {
@@ -251,7 +252,9 @@ pub enum Technique {
         cube: CubeFaces,
     },
     /// One shadow ray per pixel with `VK_KHR_ray_query` against acceleration structures of the
-    /// casters, writing the volumes' stencil (docs/raytrace.md; renderer only).
+    /// casters, writing the volumes' stencil: 1 where the ray towards the light is blocked
+    /// (docs/raytrace.md). Needs [`Capabilities::ray_query`], one sample and the stencil
+    /// counter; transparent casters are refused.
     RayQuery,
 }
 
@@ -278,16 +281,17 @@ impl Technique {
             Technique::Planar => Method::ZPass,
         }
     }
-    /// Whether a [`ShadowPass`](super::ShadowPass) runs it (the stencil-volume techniques).
+    /// Whether it counts shadow volumes (or planar projections) in the stencil: every
+    /// technique a [`ShadowPass`](super::ShadowPass) runs except [`RayQuery`](Technique::RayQuery).
     pub fn is_volume_pass(self) -> bool {
-        self.pass_technique().is_some()
+        self.pass_technique().is_some() && self != Technique::RayQuery
     }
     /// `Some(self)` for the techniques a [`ShadowPass`](super::ShadowPass) runs, `None` for
-    /// the renderer-only ones (shadow maps, ray query).
+    /// the renderer-only shadow-map baseline.
     pub fn pass_technique(self) -> Option<Technique> {
         match self {
-            Technique::Volumes(_) | Technique::EdgeQuads | Technique::Planar | Technique::Compute => Some(self),
-            Technique::ShadowMap { .. } | Technique::RayQuery => None,
+            Technique::Volumes(_) | Technique::EdgeQuads | Technique::Planar | Technique::Compute | Technique::RayQuery => Some(self),
+            Technique::ShadowMap { .. } => None,
         }
     }
     /// The shadow-map baseline with maps of `size` texels, its default lookup ([`Pcf::Taps`])
@@ -350,6 +354,10 @@ pub struct EnabledFeatures {
     /// `VK_EXT_index_type_uint8` / `VK_KHR_index_type_uint8` with `indexTypeUint8`: 3-byte
     /// shadow triangles for chunks of at most 128 vertices.
     pub index_type_uint8: bool,
+    /// `VK_KHR_ray_query` (`rayQuery`) and `VK_KHR_acceleration_structure`
+    /// (`accelerationStructure`) with Vulkan 1.2's `bufferDeviceAddress`, and the host's
+    /// gpu-allocator created with `buffer_device_address`: [`Technique::RayQuery`].
+    pub ray_query: bool,
 }
 
 /// What a [`ShadowPass`](super::ShadowPass) is created for. Everything here is fixed for the
@@ -442,6 +450,8 @@ impl Default for PassToggles {
 /// device reports, plus the format capabilities it probed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Capabilities {
+    /// Ray query enabled and present ([`EnabledFeatures::ray_query`]).
+    pub ray_query: bool,
     /// depthClamp enabled and present.
     pub depth_clamp: bool,
     /// depthBounds enabled and present.
@@ -466,15 +476,26 @@ pub(crate) fn check_depth_stencil_format(format: vk::Format) -> Result<()> {
 impl PassSettings {
     /// Whether the device can honour these settings (checked before every frame).
     pub fn check(&self, caps: &Capabilities) -> Result<()> {
-        if !self.technique.is_volume_pass() {
+        if self.technique.pass_technique().is_none() {
             return Err(Error::InvalidDesc {
                 field: "PassSettings::technique",
                 msg: format!(
                     "{} is a renderer technique (umbrage::render::Renderer), not one a ShadowPass records: \
-                     use Volumes, EdgeQuads, Planar or Compute",
+                     use Volumes, EdgeQuads, Planar, Compute or RayQuery",
                     self.technique.name()
                 ),
             });
+        }
+        if self.technique == Technique::RayQuery {
+            if !caps.ray_query {
+                return Err(super::rays::rays_missing());
+            }
+            if self.counter == Counter::Float {
+                return Err(Error::InvalidDesc {
+                    field: "PassSettings::counter",
+                    msg: "Technique::RayQuery writes the stencil (non-zero = shadowed), not a volume count: use Counter::Stencil".into(),
+                });
+            }
         }
         if self.index_format == IndexFormat::U8 && !caps.index_type_uint8 {
             return Err(Error::Unsupported(

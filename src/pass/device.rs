@@ -89,3 +89,24 @@ pub(super) fn index_type_uint8_supported(instance: &ash::Instance, pd: vk::Physi
     unsafe { instance.get_physical_device_features2(pd, &mut f2) };
     u8f.index_type_uint8 == vk::TRUE
 }
+
+/// Whether the device can trace ray queries: Vulkan 1.2 (`bufferDeviceAddress`),
+/// `VK_KHR_acceleration_structure` and `VK_KHR_ray_query` with their features.
+pub(super) fn ray_query_supported(instance: &ash::Instance, pd: vk::PhysicalDevice, api: u32) -> bool {
+    if api < vk::API_VERSION_1_2 {
+        return false;
+    }
+    // SAFETY: a plain query on a valid physical device.
+    let Ok(exts) = (unsafe { instance.enumerate_device_extension_properties(pd) }) else { return false };
+    let has = |name: &std::ffi::CStr| exts.iter().any(|e| e.extension_name_as_c_str() == Ok(name));
+    if !has(ash::khr::acceleration_structure::NAME) || !has(ash::khr::ray_query::NAME) || !has(ash::khr::deferred_host_operations::NAME) {
+        return false;
+    }
+    let mut rq = vk::PhysicalDeviceRayQueryFeaturesKHR::default();
+    let mut acc = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default();
+    let mut v12 = vk::PhysicalDeviceVulkan12Features::default();
+    let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut rq).push_next(&mut acc).push_next(&mut v12);
+    // SAFETY: a feature query on a valid Vulkan 1.2 physical device with a well-formed pNext chain.
+    unsafe { instance.get_physical_device_features2(pd, &mut f2) };
+    rq.ray_query == vk::TRUE && acc.acceleration_structure == vk::TRUE && v12.buffer_device_address == vk::TRUE
+}

@@ -39,9 +39,15 @@ pub struct PreparedFrame {
     /// The GPU silhouettes of [`Technique::Compute`] (counts read back by
     /// [`ShadowPass::read_back_counts`](super::ShadowPass::read_back_counts)).
     pub(crate) compute: Option<ComputeFrame>,
+    /// [`Technique::RayQuery`](super::Technique::RayQuery)'s structures and bindings.
+    pub(crate) rays: Option<super::rays::RayFrame>,
 }
 
 impl PreparedFrame {
+    /// What a ray-query frame traces against (`None` for the other techniques).
+    pub fn ray_query(&self) -> Option<super::rays::RayQueryFrame> {
+        self.rays.as_ref().map(|r| r.info())
+    }
     /// The ring slot this frame uses.
     pub fn slot(&self) -> usize {
         self.slot

@@ -79,6 +79,7 @@ mod pack;
 mod pipelines;
 mod planar;
 pub mod push;
+mod rays;
 mod record;
 mod spheres;
 pub mod stats;
@@ -94,6 +95,7 @@ pub use desc::{
 pub use draw::LightFrame;
 pub use frame::PreparedFrame;
 pub use pipelines::COUNT_FORMAT;
+pub use rays::{RayCounts, RayQueryFrame, RayQueryInputs};
 pub use record::{lit_stencil_state, VolumeKind};
 pub use spheres::{SphereId, SphereInfo};
 pub use target::DepthStencilTarget;
@@ -146,6 +148,12 @@ pub struct ShadowPass {
     next_sphere: u64,
     /// Unique among the process's passes: a frame carries it, so another pass's frame is refused.
     id: u64,
+    /// The host's instance (for the ray-query extension's functions).
+    instance: ash::Instance,
+    /// [`Technique::RayQuery`]'s structures, made by the first frame that asks for it.
+    rays: Option<rays::Rays>,
+    /// The G-buffer the rays read ([`ShadowPass::set_ray_query_inputs`]).
+    ray_inputs: Option<RayQueryInputs>,
 }
 
 /// The id of the next pass created.
@@ -255,6 +263,7 @@ impl ShadowPass {
         }
         device::check_samples(instance, physical_device, &props.limits, desc)?;
         let caps = Capabilities {
+            ray_query: desc.features.ray_query && device::ray_query_supported(instance, physical_device, api),
             depth_clamp: desc.features.depth_clamp && features.depth_clamp == vk::TRUE,
             depth_bounds: desc.features.depth_bounds && features.depth_bounds == vk::TRUE,
             index_type_uint8: desc.features.index_type_uint8 && device::index_type_uint8_supported(instance, physical_device),
@@ -269,6 +278,7 @@ impl ShadowPass {
             )));
         }
         desc.settings.check(&caps)?;
+        rays::check_host(&desc.settings, desc)?;
         let dev = PassDevice { device: device.clone(), allocator };
         let mut pipes = Pipelines::new(&dev, desc, caps.depth_clamp, caps.depth_bounds, caps.r32f_blend)?;
         let compute_pipes = match compute::ComputePipes::new(&dev) {
@@ -296,6 +306,9 @@ impl ShadowPass {
             spheres: Vec::new(),
             next_sphere: 0,
             id: NEXT_PASS_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
+            instance: instance.clone(),
+            rays: None,
+            ray_inputs: None,
         })
     }
 
@@ -328,6 +341,7 @@ impl ShadowPass {
     /// refused when the device cannot honour them.
     pub fn set_settings(&mut self, settings: PassSettings) -> Result<()> {
         settings.check(&self.caps)?;
+        rays::check_host(&settings, &self.desc)?;
         self.settings = settings;
         Ok(())
     }
@@ -478,6 +492,11 @@ impl ShadowPass {
             spheres::check(&self.spheres, lights)?;
         }
         self.settings.check(&self.caps)?;
+        let rays = self.settings.technique == Technique::RayQuery;
+        let casters = casters && !rays;
+        if rays {
+            self.check_rays()?;
+        }
         if self.casters.cpu.iter().any(|c| c.transmittance.is_some()) && self.pipes.transmit.is_none() {
             return Err(
                 Misuse::NotConfigured { call: "prepare (with transparent casters)", needs: "ShadowPassDesc::transmit_format" }.into()
@@ -488,6 +507,9 @@ impl ShadowPass {
             b.destroy(&self.dev);
         }
         self.casters.slot_retired(&self.dev, slot);
+        if let Some(r) = &mut self.rays {
+            r.slot_retired(&self.dev, slot);
+        }
         if self.settings.technique == Technique::EdgeQuads {
             self.casters.ensure_edge_quads(&self.dev)?;
         }
@@ -523,6 +545,10 @@ impl ShadowPass {
             Some(cf) => Some(self.prepare_compute(slot, cf)?),
             None => None,
         };
+        let ray_frame = match rays {
+            true => Some(self.prepare_rays(slot, view, lights)?),
+            false => None,
+        };
         let mut cpu = packed.cpu;
         cpu.record = record_start.elapsed().as_secs_f64() * 1e3;
         let mut totals = packed.totals;
@@ -545,6 +571,7 @@ impl ShadowPass {
             warnings,
             extent: vk::Extent2D { width: view.width, height: view.height },
             compute,
+            rays: ray_frame,
         })
     }
 
@@ -580,6 +607,9 @@ impl Drop for ShadowPass {
             unsafe { c.destroy(&self.dev.device) };
         }
         self.casters.destroy(&self.dev);
+        if let Some(mut r) = self.rays.take() {
+            r.destroy(&self.dev);
+        }
         for s in &mut self.slots {
             if let Some(mut b) = s.stream.take() {
                 b.destroy(&self.dev);

@@ -202,6 +202,7 @@ impl ShadowPass {
         // SAFETY: the caller's contract.
         unsafe {
             self.cmd_upload(cb, frame)?;
+            self.cmd_build_rays(cb, frame)?;
             self.cmd_compute_silhouettes(cb, frame)
         }
     }
@@ -262,6 +263,10 @@ impl ShadowPass {
     ) -> Result<()> {
         let lf = self.light(frame, light)?;
         target.check(frame, &self.desc.target)?;
+        if frame.rays.is_some() {
+            // SAFETY: forwarded contract.
+            return unsafe { self.cmd_trace(cb, frame, light, target) };
+        }
         let d = &self.dev.device;
         if let TargetModel::RenderPass(_) = self.desc.target {
             self.check_recorded_before_rendering(frame)?;
@@ -366,11 +371,12 @@ impl ShadowPass {
 
     /// Refuses a frame whose uploads or GPU silhouettes would have to be recorded inside the
     /// host's render pass.
-    fn check_recorded_before_rendering(&self, frame: &PreparedFrame) -> Result<()> {
+    pub(super) fn check_recorded_before_rendering(&self, frame: &PreparedFrame) -> Result<()> {
         let compute_pending = frame.compute.as_ref().is_some_and(|cf| !cf.recorded.get() && !cf.jobs.iter().all(|j| j.is_empty()));
-        if frame.pending_uploads() > 0 || compute_pending {
+        let rays_pending = frame.rays.as_ref().is_some_and(|r| !r.recorded.get());
+        if frame.pending_uploads() > 0 || compute_pending || rays_pending {
             return Err(Misuse::Order(
-                "the frame's uploads or GPU silhouettes are not recorded: call cmd_before_rendering before beginning the render pass"
+                "the frame's uploads, GPU silhouettes or acceleration structures are not recorded: call cmd_before_rendering before beginning the render pass"
                     .into(),
             )
             .into());

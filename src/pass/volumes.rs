@@ -30,6 +30,13 @@ impl ShadowPass {
     /// `frame`'s slot is not prepared again before `cb` completes.
     pub unsafe fn cmd_draw_volumes(&self, cb: vk::CommandBuffer, frame: &PreparedFrame, light: usize, kind: VolumeKind) -> Result<()> {
         let lf = self.light(frame, light)?;
+        if frame.rays.is_some() {
+            return Err(Misuse::NotConfigured {
+                call: "cmd_draw_volumes",
+                needs: "a volume technique: the frame was prepared for Technique::RayQuery, which draws no volumes",
+            }
+            .into());
+        }
         let p = &self.pipes;
         let count = p.count.as_ref();
         match kind {

@@ -24,7 +24,6 @@ pub mod options;
 pub(crate) mod passes;
 mod pipelines;
 pub mod push;
-pub(crate) mod raytrace;
 mod readback;
 mod scene_gpu;
 /// The shadow-map baseline (a pass of the frame, in `passes/`).

@@ -98,12 +98,20 @@ pub struct ShadowMapStats {
 pub struct RayQueryStats {
     /// Bottom levels: one per shadow-casting mesh, one for the analytic spheres.
     pub bottom_levels: usize,
-    /// Their storage after compaction, bytes.
+    /// Their storage, bytes (compacted once the frame that built them has retired).
     pub bottom_level_bytes: u64,
-    /// CPU wall time the bottom levels took to build and compact, once (ms).
+    /// GPU time of the last frame that built bottom levels (its acceleration-structure span:
+    /// the builds and that frame's top level), ms; 0 when the timestamps are off.
     pub bottom_level_build_ms: f64,
     /// Top-level instances rebuilt every frame.
     pub instances: usize,
     /// The offset the shadow rays start off the surface (world units).
     pub offset: f32,
+    /// Bottom levels this frame built (new casters, a caster's first deformation, a changed
+    /// sphere set).
+    pub builds: usize,
+    /// Bottom levels this frame refitted in place (deformed casters, `ALLOW_UPDATE`).
+    pub refits: usize,
+    /// Bottom levels this frame compacted (built `frames_in_flight` frames earlier).
+    pub compactions: usize,
 }

@@ -16,7 +16,7 @@ pub(super) fn check_spheres(scene: &Scene, s: &FrameSettings) -> Result<()> {
         }
     }
     if s.technique == Technique::RayQuery {
-        if let Some(why) = crate::render::raytrace::unsupported(scene) {
+        if let Some(why) = super::techniques::ray_query_unsupported(scene) {
             return Err(Error::Unsupported(why));
         }
     }
@@ -113,7 +113,7 @@ fn check_samples(ctx: &Context, config: &RenderConfig, s: &FrameSettings) -> Res
         )));
     }
     let why = match (s.technique.pass_technique(), s.counter, s.view) {
-        (None, _, _) => Some(format!("the {} baseline", s.technique.name())),
+        _ if !s.technique.is_volume_pass() => Some(format!("the {} baseline", s.technique.name())),
         (_, Counter::Float, _) => Some("the float counter".to_string()),
         (_, _, View::Volumes) => Some("the volume overlay view".to_string()),
         _ => None,

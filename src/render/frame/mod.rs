@@ -11,7 +11,6 @@ use super::passes::shadowmap::ShadowMapper;
 use super::passes::{debug, Rec};
 use super::pipelines::FramePipelines;
 use super::push::LightPush;
-use super::raytrace::RayTracer;
 use super::readback::Layout;
 use super::scene_gpu::{SceneGeometry, Sidedness};
 use super::sphere_gpu::SphereGeometry;
@@ -128,8 +127,11 @@ struct Parts {
     /// Baselines of other map sizes built earlier and kept (a bench alternating techniques
     /// neither rebuilds them nor times a freshly allocated atlas); dropped when stale.
     spare_shadow_mappers: Vec<(ShadowMapper, u64)>,
-    /// The ray-query technique's acceleration structures.
-    ray_tracer: Option<RayTracer>,
+    /// The ray-query surface offset (2e-5 of the scene's diagonal, the CPU reference's) and the
+    /// scene version it was computed for.
+    ray_offset: Option<(u64, f32)>,
+    /// GPU ms of the last frame that built ray-query bottom levels (its acceleration span).
+    blas_build_ms: std::cell::Cell<f64>,
     slots: Vec<FrameSlot>,
     next_slot: usize,
     serial: u64,
@@ -146,9 +148,6 @@ impl Destroy for Parts {
             self.pipes.destroy(ctx);
             for (sm, _) in self.shadow_mapper.iter_mut().chain(self.spare_shadow_mappers.iter_mut()) {
                 sm.destroy(ctx);
-            }
-            if let Some(rt) = &mut self.ray_tracer {
-                rt.destroy(ctx);
             }
             self.self_shadow.destroy(ctx);
             self.targets.destroy(ctx);
@@ -298,7 +297,7 @@ impl Renderer {
         let vp_rel = (proj.as_dmat4() * view_rel.as_dmat4()).as_mat4();
         let view = ShadowView { eye, view: view_rel, proj, width: w, height: h };
         self.update_shadow_mapper(settings.technique)?;
-        self.update_ray_tracer(settings.technique)?;
+        self.update_ray_inputs(settings.technique)?;
 
         // 1. The CPU work: plans and streams (the shadow-map baseline plans scissors only).
         let frame = match settings.technique.pass_technique() {
@@ -342,11 +341,12 @@ impl Renderer {
             s.counters.begin(&self.own.ctx, cb, nlights as u32)?;
         }
         let mut accel = Span::default();
-        if let (Some(rt), Technique::RayQuery) = (&mut self.own.parts.ray_tracer, settings.technique) {
+        if frame.ray_query().is_some() {
             let timer = &self.own.parts.slots[slot].timer;
             accel.begin = timer.stamp(&self.own.ctx, cb, vk::PipelineStageFlags2::ALL_COMMANDS);
-            // SAFETY: `cb` is recording outside a rendering instance; the slot retired.
-            unsafe { rt.cmd_build(&self.own.ctx, cb, slot, &self.own.parts.scene, eye)? };
+            // SAFETY: `cb` is recording outside a rendering instance; the slot retired; the
+            // frames before it were submitted earlier on the same queue.
+            unsafe { self.own.parts.pass.cmd_before_rendering(cb, &frame)? };
             accel.end = timer.stamp(&self.own.ctx, cb, vk::PipelineStageFlags2::ALL_COMMANDS);
         }
         let s = &self.own.parts.slots[slot];
@@ -476,6 +476,7 @@ impl Parts {
                 depth_clamp: f.depth_clamp,
                 depth_bounds: f.depth_bounds,
                 index_type_uint8: f.index_type_uint8,
+                ray_query: f.ray_query,
             },
             settings: pass_settings(&settings),
             transmit_format: Some(transmit_format),
@@ -529,7 +530,8 @@ impl Parts {
             self_shadow: self_shadow.into_inner(),
             shadow_mapper: None,
             spare_shadow_mappers: Vec::new(),
-            ray_tracer: None,
+            ray_offset: None,
+            blas_build_ms: std::cell::Cell::new(0.0),
             slots,
             next_slot: 0,
             serial: 0,

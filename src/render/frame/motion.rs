@@ -4,7 +4,7 @@
 use super::Renderer;
 use crate::error::{Error, Result};
 use crate::scene::{Camera, Light};
-use glam::Mat4;
+use glam::{Mat4, Vec3};
 
 impl Renderer {
     /// Moves the camera (from the next frame).
@@ -43,6 +43,51 @@ impl Renderer {
         }
         self.own.parts.scene.meshes[index].transform = transform;
         self.own.parts.scene_version += 1;
+        Ok(())
+    }
+
+    /// New object-space positions for mesh `index` (a skinned or cloth mesh: the same vertices,
+    /// in the order it was loaded with, and the same triangles), from the next frame.
+    ///
+    /// The shadow pass rebuilds its caster ([`ShadowPass::update_positions`](crate::pass::ShadowPass::update_positions):
+    /// new silhouette tables for the volumes; with ray query its bottom level is rebuilt once with
+    /// `ALLOW_UPDATE`, then refitted in place). The drawn geometry is baked again, after waiting
+    /// for the device: frames in flight are dropped (their tickets fail in
+    /// [`finish`](Renderer::finish)). On error nothing changes.
+    pub fn set_mesh_positions(&mut self, index: usize, positions: &[Vec3]) -> Result<()> {
+        let parts = &mut self.own.parts;
+        let m = parts.scene.meshes.get(index).ok_or_else(|| Error::Other(format!("no mesh {index}")))?;
+        if positions.len() != m.mesh.positions.len() {
+            return Err(Error::mesh(&m.name, format!("{} positions for a mesh of {} vertices", positions.len(), m.mesh.positions.len())));
+        }
+        if let Some(k) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(Error::mesh(&m.name, format!("vertex {k} is not finite ({:?})", positions[k])));
+        }
+        let ctx = &self.own.ctx;
+        // SAFETY: waiting for every submission before the old geometry is destroyed.
+        unsafe { ctx.device.device_wait_idle() }.map_err(Error::vk("vkDeviceWaitIdle"))?;
+        for s in &mut parts.slots {
+            s.in_flight = None;
+        }
+        let old = std::mem::replace(&mut parts.scene.meshes[index].mesh.positions, positions.to_vec());
+        let restore = |parts: &mut super::Parts, old: Vec<Vec3>| parts.scene.meshes[index].mesh.positions = old;
+        let mut geo = match crate::render::scene_gpu::SceneGeometry::new(ctx, &parts.scene, parts.slots.len()) {
+            Ok(g) => g,
+            Err(e) => {
+                restore(parts, old);
+                return Err(e);
+            }
+        };
+        if let Some(id) = parts.caster_ids[index] {
+            if let Err(e) = parts.pass.update_positions(id, positions) {
+                geo.destroy(ctx);
+                restore(parts, old);
+                return Err(e);
+            }
+        }
+        std::mem::swap(&mut parts.geo, &mut geo);
+        geo.destroy(ctx);
+        parts.scene_version += 1;
         Ok(())
     }
 }

@@ -53,7 +53,6 @@ impl Renderer {
             spans.depth.end = stamp(all);
             let into = match (&self.own.parts.shadow_mapper, self.settings.counter) {
                 (Some(_), _) => determine::CountInto::External,
-                _ if self.settings.technique == Technique::RayQuery => determine::CountInto::Written,
                 (None, Counter::Float) => determine::CountInto::Float,
                 (None, Counter::Stencil) => determine::CountInto::Stencil,
             };
@@ -72,9 +71,6 @@ impl Renderer {
                     spans.shadow_map.push(passes::timing_span(begin, stamp(all)));
                     let lookup = Lookup { light_pos: lights[li].light_pos, scissor: frame.lights[li].scissor, pcf };
                     sm.record_lookup(rec.ctx, rec.cb, t, &maps, lookup);
-                }
-                if let (Some(rt), Technique::RayQuery) = (&self.own.parts.ray_tracer, self.settings.technique) {
-                    rt.cmd_determine(rec, t, frame.slot(), lights[li].light_pos, frame.lights[li].scissor);
                 }
                 determine::record(rec, pass, frame, li, t, into)?;
                 determine::finish(rec, t, p, into, layout.counts.get(li).copied())?;
@@ -100,7 +96,7 @@ impl Renderer {
                     ss.record(rec, &sd, pass, frame, lights, self.settings.transmit_log)?;
                 }
             }
-            if self.settings.view == View::Volumes {
+            if self.settings.view == View::Volumes && frame.ray_query().is_none() {
                 debug::record_volumes(rec, pass, frame, t)?;
             }
             tonemap::record(rec, t, p);

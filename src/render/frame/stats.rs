@@ -4,7 +4,7 @@
 use super::{FrameTicket, InFlight, Renderer};
 use crate::error::Result;
 use crate::render::options::{DepthMode, IndexFormat, TransmitMode};
-use crate::render::stats::{GpuMs, LightGpuMs, ShadowMapStats, Stats};
+use crate::render::stats::{GpuMs, LightGpuMs, RayQueryStats, ShadowMapStats, Stats};
 
 impl Renderer {
     /// The frame's `--stats`.
@@ -39,6 +39,7 @@ impl Renderer {
             }
             false => None,
         };
+        let accel_ms = gpu_ms.as_ref().map(|g| g.accel);
         let (mut features_used, mut features_missing) = (Vec::new(), Vec::new());
         let fe = &ctx.features;
         let u8_used = caps.index_type_uint8 && matches!(f.settings.index_format, IndexFormat::U8 | IndexFormat::Auto);
@@ -82,10 +83,21 @@ impl Renderer {
                 false => None,
             },
             warnings: f.frame.warnings.clone(),
-            ray_query: match (f.settings.technique, &self.own.parts.ray_tracer) {
-                (crate::render::Technique::RayQuery, Some(rt)) => Some(rt.stats()),
-                _ => None,
-            },
+            ray_query: f.frame.ray_query().map(|r| {
+                if let (true, Some(accel)) = (r.builds > 0, accel_ms) {
+                    self.own.parts.blas_build_ms.set(accel);
+                }
+                RayQueryStats {
+                    bottom_levels: r.instances,
+                    bottom_level_bytes: r.bottom_level_bytes,
+                    bottom_level_build_ms: self.own.parts.blas_build_ms.get(),
+                    instances: r.instances,
+                    offset: r.offset,
+                    builds: r.builds,
+                    refits: r.refits,
+                    compactions: r.compactions,
+                }
+            }),
             shadow_map: match f.settings.technique {
                 crate::render::Technique::ShadowMap { size, pcf, cube } => Some(ShadowMapStats { size, pcf, cube }),
                 _ => None,

@@ -1,23 +1,37 @@
-//! The techniques that keep GPU objects of their own beside the shadow pass: the shadow-map
-//! baseline's maps and the ray tracer's acceleration structures, made when a frame first asks
-//! for them and dropped when another technique runs.
+//! The techniques that need more than the shadow pass's volumes: the shadow-map baseline's
+//! maps (GPU objects of its own, made when a frame first asks for them and set aside when
+//! another technique runs), and the inputs of the pass's ray query (the G-buffer and the CPU
+//! reference's surface offset).
 
 use super::Renderer;
 use crate::error::{Error, Result};
 use crate::render::options::Technique;
-use crate::render::raytrace::RayTracer;
 use crate::render::shadowmap::ShadowMapper;
+use crate::scene::Scene;
+use glam::DVec3;
 
 impl Renderer {
-    /// Builds the ray tracer's bottom levels when ray query is first asked for, and keeps them
-    /// (the renderer's meshes never change shape; their transforms reach the top level every
-    /// frame), so a bench alternating techniques does not rebuild them.
-    pub(super) fn update_ray_tracer(&mut self, technique: Technique) -> Result<()> {
-        if technique == Technique::RayQuery && self.own.parts.ray_tracer.is_none() {
-            let p = &self.own.parts;
-            self.own.parts.ray_tracer = Some(RayTracer::new(&self.own.ctx, &p.scene, &p.targets, p.slots.len())?);
+    /// Points the pass's ray query at this frame's G-buffer, with the CPU reference's surface
+    /// offset (2e-5 of the scene's diagonal, recomputed when the scene moved). The pass keeps
+    /// its acceleration structures across frames and techniques, so a bench alternating
+    /// techniques does not rebuild them.
+    pub(super) fn update_ray_inputs(&mut self, technique: Technique) -> Result<()> {
+        if technique != Technique::RayQuery {
+            return Ok(());
         }
-        Ok(())
+        let p = &mut self.own.parts;
+        let version = p.scene_version;
+        let offset = match p.ray_offset {
+            Some((v, o)) if v == version => o,
+            _ => {
+                let o = (2e-5 * scene_size(&p.scene)) as f32;
+                p.ray_offset = Some((version, o));
+                o
+            }
+        };
+        let inputs =
+            crate::pass::RayQueryInputs { position: p.targets.position.view, normal: p.targets.normal.view, surface_offset: offset };
+        p.pass.set_ray_query_inputs(inputs)
     }
 
     /// Makes the shadow-map baseline of the asked size and cube layout current (built, or taken from the
@@ -56,5 +70,36 @@ impl Renderer {
             }
         }
         Ok(())
+    }
+}
+
+/// Why `scene` cannot be traced yet, if it cannot.
+pub(super) fn ray_query_unsupported(scene: &Scene) -> Option<String> {
+    if scene.meshes.iter().any(|m| m.casts_shadow && m.opacity < 1.0) {
+        return Some("--method rayquery does not trace transparent casters yet (their coloured shadows need the light-intensity map); use a shadow-volume method".into());
+    }
+    None
+}
+
+/// The diagonal of the bounds of every scene triangle and sphere (the CPU reference's
+/// `scene_size`).
+fn scene_size(scene: &Scene) -> f64 {
+    let mut lo = DVec3::splat(f64::INFINITY);
+    let mut hi = DVec3::splat(f64::NEG_INFINITY);
+    for m in &scene.meshes {
+        let b = m.world_bounds();
+        if b.min.x <= b.max.x {
+            lo = lo.min(b.min.as_dvec3());
+            hi = hi.max(b.max.as_dvec3());
+        }
+    }
+    for s in &scene.spheres {
+        lo = lo.min(s.sphere.center - s.sphere.radius);
+        hi = hi.max(s.sphere.center + s.sphere.radius);
+    }
+    if lo.x <= hi.x {
+        (hi - lo).length()
+    } else {
+        1.0
     }
 }

@@ -6,12 +6,12 @@
 //! `DEPTH_STENCIL_ATTACHMENT_OPTIMAL` here, as `gbuffer` left it):
 //! - `CountInto::Stencil`: `ShadowPass::cmd_determine` with `DepthStencilTarget::new` (declared and left in
 //!   `DEPTH_STENCIL_ATTACHMENT_OPTIMAL`; the pass's own barriers keep that layout): depth aspect LOAD (read only),
-//!   stencil CLEAR to the light's `counter_clear` inside its scissor, STORE.
+//!   stencil CLEAR to the light's `counter_clear` inside its scissor, STORE. With ray query the pass's rays also read
+//!   `position` and `normal` (`SHADER_READ_ONLY_OPTIMAL`, as `gbuffer` left them) and write 1 where blocked.
 //! - `CountInto::Float`: `begin_float` takes `count` `UNDEFINED -> COLOR_ATTACHMENT_OPTIMAL`; `cmd_count_float` clears it
 //!   (to `counter_clear`) inside the scissor and adds into it, the depth-stencil loaded and only read.
-//! - `CountInto::External` / `Written`: nothing recorded by `record`; the caller (`frame/record.rs`) already ran the
-//!   shadow-map lookup (`count` left in `COLOR_ATTACHMENT_OPTIMAL`, after `begin_float`) or the ray-query pass
-//!   (`RayTracer::cmd_determine`: stencil cleared and written, `depth` in `DEPTH_STENCIL_ATTACHMENT_OPTIMAL`, LOAD).
+//! - `CountInto::External`: nothing recorded by `record`; the caller (`frame/record.rs`) already ran the
+//!   shadow-map lookup (`count` left in `COLOR_ATTACHMENT_OPTIMAL`, after `begin_float`).
 //! - `finish`: with capture, `count` (`COLOR_ATTACHMENT_OPTIMAL`) or the stencil aspect (`DEPTH_STENCIL_ATTACHMENT_OPTIMAL`)
 //!   is copied out through `TRANSFER_SRC_OPTIMAL` and returned (`Rec::copy_out`), or with MSAA the stencil through
 //!   `samples`; then, float counts only, `count` goes `COLOR_ATTACHMENT_OPTIMAL -> SHADER_READ_ONLY_OPTIMAL`.
@@ -39,8 +39,6 @@ pub(crate) enum CountInto {
     /// The R32F count target, written by the caller (the shadow-map lookup): only the layout
     /// transitions and the capture happen here.
     External,
-    /// The stencil, written by the caller (the ray-query pass): only the capture happens here.
-    Written,
 }
 
 /// Makes the count target writable (float counting).
@@ -63,7 +61,7 @@ pub(crate) unsafe fn record(rec: &Rec, pass: &ShadowPass, frame: &PreparedFrame,
                 begin_float(rec, t);
                 pass.cmd_count_float(rec.cb, frame, light, &target, t.count.view)?;
             }
-            CountInto::External | CountInto::Written => {}
+            CountInto::External => {}
         }
     }
     rec.barrier((FRAG_TESTS, DS_RW), (FRAG_TESTS, DS_RW));
@@ -108,8 +106,12 @@ pub(crate) unsafe fn record_count(
 ) -> Result<()> {
     let target = DepthStencilTarget::new(t.depth.raw, t.depth.view, t.extent);
     c.occlusion(rec.ctx, rec.cb, light as u32, true);
-    // SAFETY: the caller's contract, which is `ShadowPass`'s.
-    let r = unsafe { pass.cmd_count_rasterised(rec.cb, frame, light, &target) };
+    // A ray-query frame has no volumes: its query counts nothing.
+    let r = match frame.ray_query() {
+        Some(_) => Ok(()),
+        // SAFETY: the caller's contract, which is `ShadowPass`'s.
+        None => unsafe { pass.cmd_count_rasterised(rec.cb, frame, light, &target) },
+    };
     c.occlusion(rec.ctx, rec.cb, light as u32, false);
     rec.barrier((FRAG_TESTS, DS_RW), (FRAG_TESTS, DS_RW));
     r

@@ -14,8 +14,7 @@
 //! | (after it) | | `albedo`, `normal`, `position` `COLOR -> READ`; `accum` stays `COLOR`, `depth` stays `DS` |
 //! | per light: `shadowmap` maps | nothing sampled | its atlas `UNDEFINED -> DS`, CLEAR, then `-> READ` |
 //! | `shadowmap` lookup | `normal`, `position`, atlas (`READ`) | `count` (`COLOR`, by `determine::begin_float`), CLEAR in scissor |
-//! | ray query (`raytrace.rs`) | `normal`, `position` (`READ`); `depth` (`DS`, LOAD) | stencil of `depth`, cleared in scissor |
-//! | `determine` | depth of `depth` (`DS`, LOAD) | stencil (`DS`, CLEAR in scissor) or `count` (`UNDEFINED -> COLOR`, CLEAR) |
+//! | `determine` | depth of `depth` (`DS`, LOAD); ray query: `normal`, `position` (`READ`) | stencil (`DS`, CLEAR in scissor) or `count` (`UNDEFINED -> COLOR`, CLEAR) |
 //! | `determine::finish` | with capture: `count` or the stencil via `SRC` and back | float counts: `count` `COLOR -> READ` |
 //! | `intensity` (transparent casters) | depth of `depth` (`DS`, LOAD) | `transmit` `UNDEFINED -> COLOR`, CLEAR in scissor, `-> READ` |
 //! | `illuminate` | G-buffer, `count`, `transmit` per variant (`READ`); `depth` (`DS`, LOAD) | `accum` (`COLOR`, LOAD), in scissor |

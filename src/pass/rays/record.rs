@@ -1,0 +1,262 @@
+//! Ray query's share of the pass's API and recording: the inputs, the per-frame structures'
+//! recording ([`ShadowPass::cmd_before_rendering`]) and the traced determination
+//! ([`ShadowPass::cmd_determine`]).
+
+use super::{RayCounts, RayPush, RayQueryInputs, Rays};
+use crate::error::{Error, Misuse, Result};
+use crate::geom::Light;
+use crate::gpu::accel::{self, BlasJob};
+use crate::pass::desc::{PassSettings, ShadowPassDesc, TargetModel, Technique};
+use crate::pass::device::PassDevice;
+use crate::pass::{DepthStencilTarget, PreparedFrame, ShadowPass, ShadowView};
+use ash::vk;
+use std::cell::Cell;
+
+/// What a ray-query frame traces against ([`PreparedFrame::ray_query`](crate::pass::PreparedFrame::ray_query)).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RayQueryFrame {
+    /// World units the rays start off the surface (and stop short of a point light).
+    pub offset: f32,
+    /// Instances in the top level (one per caster, one for all sphere casters).
+    pub instances: usize,
+    /// Bytes of bottom-level storage (compacted where done).
+    pub bottom_level_bytes: u64,
+    /// Bottom levels this frame builds (new or first-deformed casters, a changed sphere set).
+    pub builds: usize,
+    /// Bottom levels this frame refits in place (deformed casters).
+    pub refits: usize,
+    /// Bottom levels this frame compacts.
+    pub compactions: usize,
+}
+
+/// One frame's ray-query work: the jobs [`cmd_before_rendering`](super::ShadowPass::cmd_before_rendering)
+/// records, and what `cmd_determine` binds.
+#[derive(Debug)]
+pub(crate) struct RayFrame {
+    pub(super) compactions: Vec<(vk::AccelerationStructureKHR, vk::AccelerationStructureKHR)>,
+    pub(super) jobs: Vec<BlasJob>,
+    pub(super) queries: Vec<(vk::QueryPool, vk::AccelerationStructureKHR)>,
+    pub(super) instances: u32,
+    pub(super) tlas_slot: usize,
+    pub set: vk::DescriptorSet,
+    pub layout: vk::PipelineLayout,
+    pub pipeline: vk::Pipeline,
+    /// Per light, the push constants.
+    pub push: Vec<RayPush>,
+    /// Bottom levels built in this frame.
+    pub builds: usize,
+    pub recorded: Cell<bool>,
+    /// The offset the rays use (world units).
+    pub offset: f32,
+    /// Bytes of bottom-level storage.
+    pub blas_bytes: u64,
+}
+
+impl RayFrame {
+    pub fn info(&self) -> RayQueryFrame {
+        let refits = self.jobs.iter().filter(|j| j.is_refit()).count();
+        RayQueryFrame {
+            offset: self.offset,
+            instances: self.instances as usize,
+            bottom_level_bytes: self.blas_bytes,
+            builds: self.builds,
+            refits,
+            compactions: self.compactions.len(),
+        }
+    }
+
+    /// Records the frame's acceleration-structure work: compactions, builds and refits, the
+    /// compacted-size queries of new bottom levels, and the top level.
+    ///
+    /// # Safety
+    /// `cb` is recording outside any rendering instance or render pass; the frame's slot is not
+    /// prepared again before `cb` has completed; every frame recorded before it is submitted
+    /// earlier on the same queue.
+    pub unsafe fn cmd_record(&self, dev: &PassDevice, rays: &Rays, cb: vk::CommandBuffer) -> Result<()> {
+        use vk::AccessFlags2 as A;
+        use vk::PipelineStageFlags2 as S;
+        let build = S::ACCELERATION_STRUCTURE_BUILD_KHR;
+        let l = rays.loader();
+        // Earlier frames' rays and builds finish before a structure is rewritten (refits) or
+        // read (compaction sources).
+        crate::gpu::resources::memory_barrier(
+            dev,
+            cb,
+            (S::FRAGMENT_SHADER | build, A::ACCELERATION_STRUCTURE_READ_KHR | A::ACCELERATION_STRUCTURE_WRITE_KHR),
+            (build, A::ACCELERATION_STRUCTURE_READ_KHR | A::ACCELERATION_STRUCTURE_WRITE_KHR),
+        );
+        // SAFETY: the caller's contract; every structure and buffer lives until the slot retires.
+        unsafe {
+            for &(src, dst) in &self.compactions {
+                accel::cmd_compact(l, cb, src, dst);
+            }
+            for job in &self.jobs {
+                job.cmd_record(l, cb);
+            }
+        }
+        crate::gpu::resources::memory_barrier(
+            dev,
+            cb,
+            (build, A::ACCELERATION_STRUCTURE_WRITE_KHR),
+            (build, A::ACCELERATION_STRUCTURE_READ_KHR),
+        );
+        // SAFETY: as above; the pools are reset before they are written.
+        unsafe {
+            for &(pool, blas) in &self.queries {
+                accel::cmd_write_compacted_size(dev, l, cb, pool, blas);
+            }
+            let tlas = rays.tlas(self.tlas_slot).ok_or_else(|| Error::Internal("no top level".into()))?;
+            tlas.cmd_record(dev, l, cb, self.instances);
+        }
+        Ok(())
+    }
+}
+
+impl ShadowPass {
+    /// Records a ray-query frame's acceleration structures once (part of
+    /// [`cmd_before_rendering`](Self::cmd_before_rendering)); nothing for other frames.
+    ///
+    /// # Safety
+    /// As [`cmd_upload`](Self::cmd_upload); every earlier frame is submitted earlier on the
+    /// same queue (a refit rewrites a structure they read).
+    pub(crate) unsafe fn cmd_build_rays(&self, cb: vk::CommandBuffer, frame: &PreparedFrame) -> Result<()> {
+        self.check_frame(frame)?;
+        let (Some(rf), Some(rays)) = (&frame.rays, &self.rays) else { return Ok(()) };
+        if rf.recorded.replace(true) {
+            return Ok(());
+        }
+        // SAFETY: forwarded contract.
+        unsafe { rf.cmd_record(&self.dev, rays, cb) }
+    }
+
+    /// Light `light`'s ray-query determination: the stencil cleared to 0 inside the light's
+    /// scissor, then set to 1 where the pixel's shadow ray is blocked.
+    ///
+    /// # Safety
+    /// As [`cmd_determine`](Self::cmd_determine); `frame`, `light` and `target` checked; the
+    /// inputs in `SHADER_READ_ONLY_OPTIMAL`.
+    pub(crate) unsafe fn cmd_trace(
+        &self,
+        cb: vk::CommandBuffer,
+        frame: &PreparedFrame,
+        light: usize,
+        target: &DepthStencilTarget,
+    ) -> Result<()> {
+        let lf = self.light(frame, light)?;
+        let rf = frame.rays.as_ref().ok_or_else(|| Error::Internal("not a ray-query frame".into()))?;
+        let push = rf.push.get(light).ok_or_else(|| Error::Internal("no ray push for the light".into()))?;
+        let d = &self.dev.device;
+        // SAFETY: the caller's contract; the set, pipeline and top level live until the slot
+        // is prepared again.
+        unsafe {
+            let draw = || -> Result<()> {
+                self.cmd_light_state(cb, frame, light, target.extent)?;
+                d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, rf.pipeline);
+                d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, rf.layout, 0, &[rf.set], &[]);
+                d.cmd_push_constants(cb, rf.layout, vk::ShaderStageFlags::FRAGMENT, 0, bytemuck::bytes_of(push));
+                d.cmd_draw(cb, 3, 1, 0, 0);
+                Ok(())
+            };
+            self.cmd_before_rendering(cb, frame)?;
+            let depth = crate::pass::record::depth_attachment(target, vk::AttachmentLoadOp::LOAD, 0);
+            let stencil = crate::pass::record::depth_attachment(target, vk::AttachmentLoadOp::CLEAR, 0);
+            let info =
+                vk::RenderingInfo::default().render_area(lf.scissor).layer_count(1).depth_attachment(&depth).stencil_attachment(&stencil);
+            self.enter(cb, target);
+            d.cmd_begin_rendering(cb, &info);
+            let drawn = draw();
+            d.cmd_end_rendering(cb);
+            self.leave(cb, target);
+            drawn
+        }
+    }
+
+    /// The G-buffer [`Technique::RayQuery`] reads, from the next `prepare` on (again after a
+    /// resize: the views are bound when a slot is prepared). See [`RayQueryInputs`] for what
+    /// the images hold; the pass does not own them.
+    ///
+    /// Errors: [`Error::Unsupported`] when the device or the host lacks ray query
+    /// ([`Capabilities::ray_query`](crate::pass::Capabilities::ray_query)), [`Error::Argument`](crate::Error) for a negative or
+    /// non-finite offset.
+    pub fn set_ray_query_inputs(&mut self, inputs: RayQueryInputs) -> Result<()> {
+        if !self.caps.ray_query {
+            return Err(rays_missing());
+        }
+        if !(inputs.surface_offset.is_finite() && inputs.surface_offset >= 0.0) {
+            return Err(Error::argument(
+                "RayQueryInputs::surface_offset",
+                format!("{} is not a finite offset >= 0", inputs.surface_offset),
+            ));
+        }
+        self.ray_inputs = Some(inputs);
+        Ok(())
+    }
+
+    /// What the ray-query structures have cost since the pass was created (bottom-level builds,
+    /// refits, compactions); `None` before the first ray-query frame.
+    pub fn ray_counts(&self) -> Option<RayCounts> {
+        self.rays.as_ref().map(|r| r.counts)
+    }
+
+    /// Refuses a ray-query frame the pass cannot trace.
+    pub(crate) fn check_rays(&self) -> Result<()> {
+        if self.ray_inputs.is_none() {
+            return Err(Misuse::NotConfigured {
+                call: "prepare (Technique::RayQuery)",
+                needs: "set_ray_query_inputs (the G-buffer the rays start from)",
+            }
+            .into());
+        }
+        if let Some(c) = self.casters.cpu.iter().find(|c| c.transmittance.is_some()) {
+            return Err(Error::Unsupported(format!(
+                "Technique::RayQuery does not trace transparent casters yet ('{}': its coloured shadow needs the light-intensity map); use a volume technique",
+                c.name
+            )));
+        }
+        Ok(())
+    }
+
+    pub(crate) fn prepare_rays(&mut self, slot: usize, view: &ShadowView, lights: &[Light]) -> Result<RayFrame> {
+        let inputs = self.ray_inputs.ok_or_else(|| Error::Internal("no ray-query inputs".into()))?;
+        if self.rays.is_none() {
+            self.rays = Some(Rays::new(&self.dev, &self.instance, self.slots.len())?);
+        }
+        let all = self.all_slots();
+        let r = self.rays.as_mut().ok_or_else(|| Error::Internal("no ray-query state".into()))?;
+        let mut transient = Vec::new();
+        let out = r.prepare(&self.dev, slot, &self.casters, &self.spheres, view, lights, &inputs, &self.desc, all, &mut transient);
+        // Inputs and scratch memory go when the slot's frame has retired (as staging copies do).
+        self.slots[slot].staging.extend(transient);
+        out
+    }
+}
+
+/// The clear error for a pass without ray query.
+pub(crate) fn rays_missing() -> Error {
+    Error::Unsupported(
+        "Technique::RayQuery needs VK_KHR_ray_query and VK_KHR_acceleration_structure with bufferDeviceAddress (Vulkan 1.2), \
+         enabled by the host (EnabledFeatures::ray_query, and the allocator created with buffer_device_address); \
+         Mesa lavapipe 25.0.7 has them: `scripts/drivers.sh install 25.0.7`"
+            .into(),
+    )
+}
+
+/// Refuses settings the host's configuration cannot take: ray query traces one ray per pixel
+/// of a single-sample G-buffer, in the pass's own rendering instance.
+pub(crate) fn check_host(settings: &PassSettings, desc: &ShadowPassDesc) -> Result<()> {
+    if settings.technique != Technique::RayQuery {
+        return Ok(());
+    }
+    if desc.samples > 1 {
+        return Err(Error::Unsupported(format!(
+            "Technique::RayQuery traces one ray per pixel from a single-sample G-buffer; the pass has {} samples (per-sample rays are not built)",
+            desc.samples
+        )));
+    }
+    if desc.target != TargetModel::DynamicRendering {
+        return Err(Error::Unsupported(
+            "Technique::RayQuery records in the pass's own rendering instance: TargetModel::DynamicRendering only (inside a host's render pass it is not built)".into(),
+        ));
+    }
+    Ok(())
+}
