@@ -96,8 +96,8 @@ fn filter_runs_only_the_subset() {
 /// The expected-failure list of this driver when the repository has one
 /// (`docs/conform/expectations/lavapipe-X.Y.Z.txt` for Mesa lavapipe X.Y.Z).
 fn expectations_for(ctx: &Context) -> Option<PathBuf> {
-    let version = ctx.info.driver_info.strip_prefix("Mesa ")?.split(|c: char| !(c.is_ascii_digit() || c == '.')).next()?;
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("docs/conform/expectations/lavapipe-{version}.txt"));
+    let (major, minor, patch) = umbrage::gpu::quirks::mesa_version(&ctx.info.driver_info)?;
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("docs/conform/expectations/lavapipe-{major}.{minor}.{patch}.txt"));
     (ctx.info.driver == "llvmpipe" && path.exists()).then_some(path)
 }
 

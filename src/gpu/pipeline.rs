@@ -26,7 +26,7 @@ pub enum Blend {
 
 /// Everything that varies between the renderer's pipelines.
 ///
-/// Fixed for all of them: triangle lists, fill mode, counter-clockwise front faces, line width 1, entry point `main`, and viewport and scissor as dynamic state (one each), so
+/// Fixed for all of them: triangle lists, fill mode, counter-clockwise front faces, line width 1, the vertex entry point `main`, and viewport and scissor as dynamic state (one each), so
 /// the caller sets both before drawing.
 #[derive(Clone)]
 pub struct PipelineDesc<'a> {
@@ -34,6 +34,8 @@ pub struct PipelineDesc<'a> {
     pub vertex: &'a [u8],
     /// SPIR-V of the fragment shader; `None` = no fragment stage (depth/stencil-only passes).
     pub fragment: Option<&'a [u8]>,
+    /// The fragment shader's entry point (`main` unless a WGSL module holds several).
+    pub fragment_entry: &'a std::ffi::CStr,
     /// Byte stride of vertex binding 0 (per-vertex); 0 = no vertex input at all, in which case
     /// the instance binding below is ignored too.
     pub vertex_stride: u32,
@@ -93,6 +95,7 @@ impl<'a> PipelineDesc<'a> {
         PipelineDesc {
             vertex,
             fragment: None,
+            fragment_entry: c"main",
             vertex_stride: 0,
             attributes: &[],
             instance_stride: 0,
@@ -140,7 +143,7 @@ pub fn create(ctx: &impl GpuDevice, d: &PipelineDesc) -> Result<vk::Pipeline> {
     };
     let mut stages = vec![vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vs).name(c"main")];
     if let Some(fs) = fs {
-        stages.push(vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::FRAGMENT).module(fs).name(c"main"));
+        stages.push(vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::FRAGMENT).module(fs).name(d.fragment_entry));
     }
     let mut bindings =
         vec![vk::VertexInputBindingDescription { binding: 0, stride: d.vertex_stride, input_rate: vk::VertexInputRate::VERTEX }];

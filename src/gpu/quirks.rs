@@ -9,8 +9,15 @@
 use super::context::DeviceInfo;
 
 /// The Mesa version in a driver's `driverInfo` (`Mesa 22.3.6 (LLVM 15.0.6)`,
-/// `Mesa 25.0.7-2~bpo12+1 (LLVM 15.0.6)`): `(major, minor, patch)`.
-fn mesa_version(driver_info: &str) -> Option<(u32, u32, u32)> {
+/// `Mesa 25.0.7-2~bpo12+1 (LLVM 15.0.6)`): `(major, minor, patch)`; `None` for another
+/// vendor's driver.
+///
+/// ```
+/// use umbrage::gpu::quirks::mesa_version;
+/// assert_eq!(mesa_version("Mesa 25.0.7-2~bpo12+1 (LLVM 15.0.6)"), Some((25, 0, 7)));
+/// assert_eq!(mesa_version("550.54"), None);
+/// ```
+pub fn mesa_version(driver_info: &str) -> Option<(u32, u32, u32)> {
     let v = driver_info.strip_prefix("Mesa ")?.split(|c: char| !(c.is_ascii_digit() || c == '.')).next()?;
     let mut parts = v.split('.').map(|p| p.parse::<u32>().ok());
     Some((parts.next()??, parts.next().flatten().unwrap_or(0), parts.next().flatten().unwrap_or(0)))

@@ -350,6 +350,18 @@ pub fn aspect_copy(aspect: vk::ImageAspectFlags, extent: vk::Extent2D, buffer_of
 /// `layout_scope`; layouts without a known use get the full scope). `from` may be `UNDEFINED`
 /// (contents discarded; earlier commands are still waited for).
 pub fn transition(ctx: &impl GpuDevice, cb: vk::CommandBuffer, image: &Image, from: vk::ImageLayout, to: vk::ImageLayout) {
+    transition_range(ctx, cb, image.raw, image.range(), from, to);
+}
+
+/// [`transition`] of `range` of a raw image handle (an image held as handles, not an [`Image`]).
+pub fn transition_range(
+    ctx: &impl GpuDevice,
+    cb: vk::CommandBuffer,
+    image: vk::Image,
+    range: vk::ImageSubresourceRange,
+    from: vk::ImageLayout,
+    to: vk::ImageLayout,
+) {
     let (src_stage, src_access) = layout_scope(from, true);
     let (dst_stage, dst_access) = layout_scope(to, false);
     let barrier = vk::ImageMemoryBarrier2::default()
@@ -359,8 +371,8 @@ pub fn transition(ctx: &impl GpuDevice, cb: vk::CommandBuffer, image: &Image, fr
         .dst_access_mask(dst_access)
         .old_layout(from)
         .new_layout(to)
-        .image(image.raw)
-        .subresource_range(image.range());
+        .image(image)
+        .subresource_range(range);
     if !ctx.synchronization2() {
         let b = [vk::ImageMemoryBarrier::default()
             .src_access_mask(access_v1(src_access))
@@ -369,8 +381,8 @@ pub fn transition(ctx: &impl GpuDevice, cb: vk::CommandBuffer, image: &Image, fr
             .new_layout(to)
             .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
             .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-            .image(image.raw)
-            .subresource_range(image.range())];
+            .image(image)
+            .subresource_range(range)];
         // SAFETY: `cb` is recording; the image belongs to this device.
         unsafe {
             ctx.device().cmd_pipeline_barrier(

@@ -438,11 +438,18 @@ pub struct PassToggles {
     /// Cull casters whose shadow volume cannot reach the view frustum, or that lie beyond the
     /// light's range or cone (off: every caster's volume is drawn, its case still chosen).
     pub culling: bool,
+    /// [`Technique::RayQuery`] with two lights or more: every light's rays in one pass per 32
+    /// lights, reading the G-buffer once per pixel into a bit mask that each light's
+    /// determination turns into its stencil (off, the default: one ray pass per light). The
+    /// same rays, so the same stencil, either way. Off by default because it measured slower
+    /// on lavapipe (1.1-1.3x, docs/raytrace.md): the rays cost the same, and the per-light
+    /// resolve passes cost more than the G-buffer reads they save.
+    pub ray_batch: bool,
 }
 
 impl Default for PassToggles {
     fn default() -> Self {
-        PassToggles { scissor: true, depth_bounds: true, culling: true }
+        PassToggles { scissor: true, depth_bounds: true, culling: true, ray_batch: false }
     }
 }
 

@@ -40,6 +40,15 @@
 //!    (with [`Technique::Compute`], [`ShadowPass::read_back_counts`] after the fence puts the
 //!    GPU's triangle counts into the frame's stats).
 //!
+//! **Ray query** ([`Technique::RayQuery`], where the host enabled it:
+//! [`EnabledFeatures::ray_query`]): the same calls and the same stencil out (1 where the
+//! pixel's ray to the light is blocked), traced from the host's G-buffer
+//! ([`ShadowPass::set_ray_query_inputs`]); `cmd_before_rendering` records the acceleration
+//! structures' builds, refits and compactions into the host's command buffer; with
+//! [`PassToggles::ray_batch`] and two lights or more, the first `cmd_determine` of each 32
+//! lights traces them all in one pass. Every frame's pass commands go to one queue (a refit rewrites
+//! a structure earlier frames read).
+//!
 //! **Frames in flight:** the ring has [`ShadowPassDesc::frames_in_flight`] slots; the host
 //! passes the slot of the frame it records. Removing a caster or changing its positions
 //! releases its old buffers only once every slot has been prepared again (so no frame in
@@ -546,7 +555,10 @@ impl ShadowPass {
             None => None,
         };
         let ray_frame = match rays {
-            true => Some(self.prepare_rays(slot, view, lights)?),
+            true => {
+                let scissors: Vec<vk::Rect2D> = packed.lights.iter().map(|l| l.scissor).collect();
+                Some(self.prepare_rays(slot, view, lights, &scissors)?)
+            }
             false => None,
         };
         let mut cpu = packed.cpu;

@@ -114,4 +114,7 @@ pub struct RayQueryStats {
     pub refits: usize,
     /// Bottom levels this frame compacted (built `frames_in_flight` frames earlier).
     pub compactions: usize,
+    /// Every light's rays in one pass per 32 lights (`PassToggles::ray_batch`, two lights or
+    /// more), rather than one pass per light.
+    pub batched: bool,
 }

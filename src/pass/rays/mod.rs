@@ -36,6 +36,7 @@ use ash::vk;
 use glam::{DMat4, DVec3};
 use std::cell::Cell;
 
+mod batch;
 mod record;
 pub use record::RayQueryFrame;
 pub(crate) use record::{check_host, rays_missing, RayFrame};
@@ -93,7 +94,9 @@ struct Balls {
 /// A ring slot's top level and descriptor set (with the handles it was written with).
 struct RaySlot {
     tlas: Option<Tlas>,
-    set: Option<(DescriptorSet, [u64; 4])>,
+    set: Option<(DescriptorSet, [u64; 5])>,
+    /// The batched lights and mask ([`PassToggles::ray_batch`](crate::pass::PassToggles::ray_batch)).
+    batch: batch::SlotBatch,
 }
 
 /// What waits for the frames in flight to retire.
@@ -113,6 +116,8 @@ pub(crate) struct Rays {
     slots: Vec<RaySlot>,
     /// The pipeline and its layout, made with the first descriptor set.
     pipeline: Option<(vk::PipelineLayout, vk::Pipeline)>,
+    /// The batched frames' pipelines, made by the first batched frame.
+    batch_pipes: Option<batch::BatchPipes>,
     graves: Vec<(Garbage, u64)>,
     /// Bottom-level builds, refits and compactions recorded so far (for the stats).
     pub counts: RayCounts,
@@ -159,8 +164,9 @@ impl Rays {
             entries: Vec::new(),
             balls: None,
             no_balls,
-            slots: (0..slots).map(|_| RaySlot { tlas: None, set: None }).collect(),
+            slots: (0..slots).map(|_| RaySlot { tlas: None, set: None, batch: Default::default() }).collect(),
             pipeline: None,
+            batch_pipes: None,
             graves: Vec::new(),
             counts: RayCounts::default(),
         })
@@ -199,12 +205,13 @@ impl Rays {
         casters: &CasterTable,
         spheres: &[SphereCaster],
         view: &ShadowView,
-        lights: &[Light],
+        lights: (&[Light], &[vk::Rect2D], bool),
         inputs: &RayQueryInputs,
         desc: &ShadowPassDesc,
         all_slots: u64,
         transient: &mut Vec<Buffer>,
     ) -> Result<RayFrame> {
+        let (lights, scissors, settings_batch) = lights;
         let mut w = Work { dev, transient, all_slots };
         let compactions = self.compact(&mut w, slot)?;
         let mut jobs = Vec::new();
@@ -245,10 +252,20 @@ impl Rays {
             }
         }
         let offset = inputs.surface_offset.max((extent * 2f64.powi(-16)) as f32);
-        let (set, layout, pipeline) = self.slot_objects(dev, slot, instances.len() as u32, inputs, desc)?;
+        let push: Vec<RayPush> = lights.iter().map(|l| RayPush { light: light_rel(l, eye), params: [offset, 0.0, 0.0, 0.0] }).collect();
+        let batched = lights.len() > 1 && settings_batch;
+        let data: Vec<batch::BatchLight> = match batched {
+            true => push.iter().zip(scissors).map(|(p, r)| batch::BatchLight { light: p.light, scissor: batch::scissor_f32(r) }).collect(),
+            false => Vec::new(),
+        };
+        let lights_buffer = self.slots[slot].batch.write_lights(dev, lights.len(), &data)?;
+        let (set, layout, pipeline) = self.slot_objects(dev, slot, instances.len() as u32, (inputs, lights_buffer), desc)?;
         let tlas = self.slots[slot].tlas.as_mut().ok_or_else(|| Error::Internal("no top level".into()))?;
         tlas.write(&instances)?;
-        let push = lights.iter().map(|l| RayPush { light: light_rel(l, eye), params: [offset, 0.0, 0.0, 0.0] }).collect();
+        let batch = match batched {
+            true => Some(self.batch_frame(dev, slot, view, scissors, desc)?),
+            false => None,
+        };
         Ok(RayFrame {
             compactions,
             jobs,
@@ -263,6 +280,7 @@ impl Rays {
             recorded: Cell::new(false),
             offset,
             blas_bytes: self.entries.iter().map(|e| e.blas.size).sum::<u64>() + self.balls.as_ref().map_or(0, |b| b.blas.size),
+            batch,
         })
     }
 
@@ -406,7 +424,7 @@ impl Rays {
         dev: &PassDevice,
         slot: usize,
         instances: u32,
-        inputs: &RayQueryInputs,
+        (inputs, lights): (&RayQueryInputs, vk::Buffer),
         desc: &ShadowPassDesc,
     ) -> Result<(vk::DescriptorSet, vk::PipelineLayout, vk::Pipeline)> {
         let s = &mut self.slots[slot];
@@ -420,7 +438,7 @@ impl Rays {
         let tlas = s.tlas.as_ref().map(|t| t.accel.raw).unwrap_or_default();
         let balls = self.balls.as_ref().map_or(self.no_balls.raw, |b| b.buffer.raw);
         use vk::Handle;
-        let key = [tlas.as_raw(), inputs.position.as_raw(), inputs.normal.as_raw(), balls.as_raw()];
+        let key = [tlas.as_raw(), inputs.position.as_raw(), inputs.normal.as_raw(), balls.as_raw(), lights.as_raw()];
         if s.set.as_ref().map(|(_, k)| *k) != Some(key) {
             if let Some((mut old, _)) = s.set.take() {
                 old.destroy(dev);
@@ -432,6 +450,7 @@ impl Rays {
                     Binding::Image(inputs.position),
                     Binding::Image(inputs.normal),
                     Binding::StorageBuffer(balls),
+                    Binding::StorageBuffer(lights),
                 ],
             )?;
             s.set = Some((set, key));
@@ -445,6 +464,41 @@ impl Rays {
         }
         let (layout, pipeline) = self.pipeline.ok_or_else(|| Error::Internal("no ray-query pipeline".into()))?;
         Ok((set, layout, pipeline))
+    }
+
+    /// A batched frame's mask (of the view's extent), its set, the pipelines (made by the first
+    /// batched frame) and the union of each batch's scissors.
+    fn batch_frame(
+        &mut self,
+        dev: &PassDevice,
+        slot: usize,
+        view: &ShadowView,
+        scissors: &[vk::Rect2D],
+        desc: &ShadowPassDesc,
+    ) -> Result<batch::BatchFrame> {
+        let extent = vk::Extent2D { width: view.width, height: view.height };
+        let (image, mask_set) = self.slots[slot].batch.mask(dev, extent)?;
+        let (mask, mask_view) = (image.raw, image.view);
+        if self.batch_pipes.is_none() {
+            let ray_layout = self.pipeline.map(|(l, _)| l).ok_or_else(|| Error::Internal("no ray-query pipeline".into()))?;
+            let mask_set_layout = match &self.slots[slot].batch.mask {
+                Some((_, set)) => set.layout,
+                None => return Err(Error::Internal("no ray-query mask".into())),
+            };
+            self.batch_pipes = Some(batch::BatchPipes::new(dev, desc, ray_layout, mask_set_layout)?);
+        }
+        let p = self.batch_pipes.as_ref().ok_or_else(|| Error::Internal("no batch pipelines".into()))?;
+        Ok(batch::BatchFrame {
+            mask,
+            mask_view,
+            extent,
+            mask_set,
+            batch: p.batch,
+            mask_layout: p.mask_layout,
+            resolve: p.resolve,
+            unions: scissors.chunks(batch::BATCH).map(batch::union).collect(),
+            traced: Cell::new(None),
+        })
     }
 
     /// The slot's top level.
@@ -479,6 +533,10 @@ impl Rays {
             if let Some((mut set, _)) = s.set.take() {
                 set.destroy(dev);
             }
+            s.batch.destroy(dev);
+        }
+        if let Some(mut p) = self.batch_pipes.take() {
+            p.destroy(dev);
         }
         self.no_balls.destroy(dev);
         if let Some((layout, pipeline)) = self.pipeline.take() {
@@ -491,6 +549,17 @@ impl Rays {
     }
 }
 
+/// The stencil of a shadowed pixel: 1, written where the fragment survives.
+pub(crate) const MARK: vk::StencilOpState = vk::StencilOpState {
+    fail_op: vk::StencilOp::KEEP,
+    pass_op: vk::StencilOp::REPLACE,
+    depth_fail_op: vk::StencilOp::KEEP,
+    compare_op: vk::CompareOp::ALWAYS,
+    compare_mask: 0xff,
+    write_mask: 0xff,
+    reference: 1,
+};
+
 /// The full-screen ray pipeline: stencil REPLACE 1 where the fragment survives (its ray is
 /// blocked), no depth test, one sample, dynamic rendering (the only model ray query takes).
 fn make_pipeline(
@@ -499,18 +568,9 @@ fn make_pipeline(
     set_layout: vk::DescriptorSetLayout,
 ) -> Result<(vk::PipelineLayout, vk::Pipeline)> {
     let layout = pipeline_layout(dev, &[set_layout], std::mem::size_of::<RayPush>() as u32, vk::ShaderStageFlags::FRAGMENT)?;
-    let mark = vk::StencilOpState {
-        fail_op: vk::StencilOp::KEEP,
-        pass_op: vk::StencilOp::REPLACE,
-        depth_fail_op: vk::StencilOp::KEEP,
-        compare_op: vk::CompareOp::ALWAYS,
-        compare_mask: 0xff,
-        write_mask: 0xff,
-        reference: 1,
-    };
     let mut d = PipelineDesc::new(shaders::FULLSCREEN_VERT, layout, desc.depth_stencil_format);
     d.fragment = Some(shaders::RAYQUERY_WGSL);
-    d.stencil = Some((mark, mark));
+    d.stencil = Some((MARK, MARK));
     d.color_write = false;
     match pipeline::create(dev, &d) {
         Ok(p) => Ok((layout, p)),

@@ -2,6 +2,7 @@
 //! recording ([`ShadowPass::cmd_before_rendering`]) and the traced determination
 //! ([`ShadowPass::cmd_determine`]).
 
+use super::batch::BATCH;
 use super::{RayCounts, RayPush, RayQueryInputs, Rays};
 use crate::error::{Error, Misuse, Result};
 use crate::geom::Light;
@@ -27,6 +28,8 @@ pub struct RayQueryFrame {
     pub refits: usize,
     /// Bottom levels this frame compacts.
     pub compactions: usize,
+    /// Every light traced in one pass per 32 ([`PassToggles::ray_batch`](crate::pass::PassToggles::ray_batch)).
+    pub batched: bool,
 }
 
 /// One frame's ray-query work: the jobs [`cmd_before_rendering`](super::ShadowPass::cmd_before_rendering)
@@ -50,6 +53,8 @@ pub(crate) struct RayFrame {
     pub offset: f32,
     /// Bytes of bottom-level storage.
     pub blas_bytes: u64,
+    /// Every light in one pass per 32 ([`PassToggles::ray_batch`](crate::pass::PassToggles::ray_batch), two lights or more).
+    pub batch: Option<super::batch::BatchFrame>,
 }
 
 impl RayFrame {
@@ -62,6 +67,7 @@ impl RayFrame {
             builds: self.builds,
             refits,
             compactions: self.compactions.len(),
+            batched: self.batch.is_some(),
         }
     }
 
@@ -149,15 +155,27 @@ impl ShadowPass {
         // SAFETY: the caller's contract; the set, pipeline and top level live until the slot
         // is prepared again.
         unsafe {
+            self.cmd_before_rendering(cb, frame)?;
+            // Batched: the light's batch traced into the mask (once), then its bit resolved.
+            let bit = (light % BATCH) as u32;
+            let (pipeline, layout, set, constants) = match &rf.batch {
+                Some(b) => {
+                    let first = light - light % BATCH;
+                    let count = BATCH.min(rf.push.len() - first);
+                    let batch_push = RayPush { light: [0.0; 4], params: [rf.offset, first as f32, count as f32, 0.0] };
+                    b.cmd_trace_batch(&self.dev, cb, light / BATCH, (rf.set, rf.layout), batch_push)?;
+                    (b.resolve, b.mask_layout, b.mask_set, bytemuck::bytes_of(&bit))
+                }
+                None => (rf.pipeline, rf.layout, rf.set, bytemuck::bytes_of(push)),
+            };
             let draw = || -> Result<()> {
                 self.cmd_light_state(cb, frame, light, target.extent)?;
-                d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, rf.pipeline);
-                d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, rf.layout, 0, &[rf.set], &[]);
-                d.cmd_push_constants(cb, rf.layout, vk::ShaderStageFlags::FRAGMENT, 0, bytemuck::bytes_of(push));
+                d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipeline);
+                d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, layout, 0, &[set], &[]);
+                d.cmd_push_constants(cb, layout, vk::ShaderStageFlags::FRAGMENT, 0, constants);
                 d.cmd_draw(cb, 3, 1, 0, 0);
                 Ok(())
             };
-            self.cmd_before_rendering(cb, frame)?;
             let depth = crate::pass::record::depth_attachment(target, vk::AttachmentLoadOp::LOAD, 0);
             let stencil = crate::pass::record::depth_attachment(target, vk::AttachmentLoadOp::CLEAR, 0);
             let info =
@@ -216,7 +234,7 @@ impl ShadowPass {
         Ok(())
     }
 
-    pub(crate) fn prepare_rays(&mut self, slot: usize, view: &ShadowView, lights: &[Light]) -> Result<RayFrame> {
+    pub(crate) fn prepare_rays(&mut self, slot: usize, view: &ShadowView, lights: &[Light], scissors: &[vk::Rect2D]) -> Result<RayFrame> {
         let inputs = self.ray_inputs.ok_or_else(|| Error::Internal("no ray-query inputs".into()))?;
         if self.rays.is_none() {
             self.rays = Some(Rays::new(&self.dev, &self.instance, self.slots.len())?);
@@ -224,7 +242,8 @@ impl ShadowPass {
         let all = self.all_slots();
         let r = self.rays.as_mut().ok_or_else(|| Error::Internal("no ray-query state".into()))?;
         let mut transient = Vec::new();
-        let out = r.prepare(&self.dev, slot, &self.casters, &self.spheres, view, lights, &inputs, &self.desc, all, &mut transient);
+        let frame_lights = (lights, scissors, self.settings.toggles.ray_batch);
+        let out = r.prepare(&self.dev, slot, &self.casters, &self.spheres, view, frame_lights, &inputs, &self.desc, all, &mut transient);
         // Inputs and scratch memory go when the slot's frame has retired (as staging copies do).
         self.slots[slot].staging.extend(transient);
         out

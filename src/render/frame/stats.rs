@@ -96,6 +96,7 @@ impl Renderer {
                     builds: r.builds,
                     refits: r.refits,
                     compactions: r.compactions,
+                    batched: r.batched,
                 }
             }),
             shadow_map: match f.settings.technique {
