@@ -282,3 +282,88 @@ fn write_docs_raytrace_batch_md() {
     }
     std::fs::write(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/raytrace/batch.md"), doc).unwrap();
 }
+
+/// `ShadowPass` with `Technique::RayQuery`, as an embedding host meets it on a device with ray
+/// query: every misuse is a typed error before anything is recorded (MSAA, a render pass, the
+/// float counter, no G-buffer, a bad offset, transparent casters, volume calls on a ray frame),
+/// and a host that did not enable the feature is told so.
+#[test]
+fn the_pass_refuses_ray_query_misuse() {
+    use umbrage::error::Misuse;
+    use umbrage::pass::diagnostics::Diagnostics;
+    use umbrage::pass::*;
+    use umbrage::Error;
+    let Some(ctx) = common::ray_query_context("the_pass_refuses_ray_query_misuse") else { return };
+    let new = |d: &ShadowPassDesc| ShadowPass::new(&ctx.instance, ctx.physical, &ctx.device, (*ctx.allocator).clone(), d);
+    let rq = PassSettings { technique: Technique::RayQuery, ..Default::default() };
+    let features = EnabledFeatures { ray_query: true, ..Default::default() };
+    let base = ShadowPassDesc { depth_stencil_format: ctx.depth_format, features, ..Default::default() };
+    // The host did not enable it: refused, whatever the device has.
+    let mut off = new(&ShadowPassDesc { features: EnabledFeatures::default(), ..base.clone() }).unwrap();
+    assert!(!off.capabilities().ray_query);
+    assert!(matches!(off.set_settings(rq), Err(Error::Unsupported(m)) if m.contains("EnabledFeatures::ray_query")));
+    let inputs = RayQueryInputs { position: ash::vk::ImageView::null(), normal: ash::vk::ImageView::null(), surface_offset: 1e-4 };
+    assert!(matches!(off.set_ray_query_inputs(inputs), Err(Error::Unsupported(_))));
+    // One sample and dynamic rendering only.
+    match new(&ShadowPassDesc { samples: 4, settings: rq, ..base.clone() }) {
+        Err(Error::Unsupported(m)) => assert!(m.contains("4 samples"), "{m}"),
+        other => panic!("ray query with 4 samples: {:?}", other.err()),
+    }
+    let mut p = new(&base).unwrap();
+    assert!(p.capabilities().ray_query);
+    assert!(matches!(p.set_settings(PassSettings { counter: Counter::Float, ..rq }), Err(Error::InvalidDesc { .. })));
+    p.set_settings(rq).unwrap();
+    let cube = umbrage::scene::shapes::cuboid(glam::Vec3::ONE);
+    p.add_caster("cube", &cube, glam::DMat4::from_translation(glam::DVec3::Y)).unwrap();
+    let cam = umbrage::geom::Camera { eye: glam::Vec3::new(0.0, 3.0, 6.0), target: glam::Vec3::ZERO, ..Default::default() };
+    let view_m = glam::camera::rh::view::look_at_mat4(cam.eye, cam.target, cam.up);
+    let view = ShadowView::from_view_matrix(cam.eye.as_dvec3(), view_m, cam.proj_infinite(4.0 / 3.0), (64, 48)).unwrap();
+    let lights =
+        [umbrage::geom::Light::point(glam::Vec3::new(1.0, 5.0, 2.0)), umbrage::geom::Light::point(glam::Vec3::new(-1.0, 5.0, 2.0))];
+    // No G-buffer yet.
+    match p.prepare(0, &view, &lights) {
+        Err(Error::Misuse(Misuse::NotConfigured { needs, .. })) => assert!(needs.contains("set_ray_query_inputs")),
+        other => panic!("a ray frame without inputs: {:?}", other.err()),
+    }
+    for bad in [-1.0, f32::NAN, f32::INFINITY] {
+        assert!(p.set_ray_query_inputs(RayQueryInputs { surface_offset: bad, ..inputs }).is_err(), "offset {bad} accepted");
+    }
+    // A real G-buffer (never written: nothing is drawn from it here).
+    let extent = ash::vk::Extent2D { width: 64, height: 48 };
+    let usage = ash::vk::ImageUsageFlags::SAMPLED | ash::vk::ImageUsageFlags::COLOR_ATTACHMENT;
+    let color = ash::vk::ImageAspectFlags::COLOR;
+    let mut pos = umbrage::gpu::Image::new_2d(&ctx, "positions", ash::vk::Format::R32G32B32A32_SFLOAT, extent, usage, color).unwrap();
+    let mut nrm = umbrage::gpu::Image::new_2d(&ctx, "normals", ash::vk::Format::R32G32B32A32_SFLOAT, extent, usage, color).unwrap();
+    p.set_ray_query_inputs(RayQueryInputs { position: pos.view, normal: nrm.view, ..inputs }).unwrap();
+    for batch in [false, true] {
+        p.set_settings(PassSettings { toggles: PassToggles { ray_batch: batch, ..Default::default() }, ..rq }).unwrap();
+        let frame = p.prepare(0, &view, &lights).unwrap();
+        let info = frame.ray_query().expect("a ray-query frame says so");
+        assert_eq!((info.instances, info.batched), (1, batch));
+        assert_eq!(frame.totals.triangles.total(), 0, "a ray frame plans no volumes");
+        let target = DepthStencilTarget::new(ash::vk::Image::null(), ash::vk::ImageView::null(), extent);
+        let mut refused = Vec::new();
+        ctx.one_shot(|cb| {
+            // SAFETY: every call below is refused before it records anything (asserted).
+            unsafe {
+                refused.push(p.cmd_draw_volumes(cb, &frame, 0, VolumeKind::Stencil).err());
+                refused.push(p.cmd_count_rasterised(cb, &frame, 0, &target).err());
+                refused.push(p.cmd_count_float(cb, &frame, 0, &target, ash::vk::ImageView::null()).err());
+                refused.push(p.cmd_draw_volume_overlay(cb, &frame).err());
+            }
+        })
+        .unwrap();
+        for e in refused {
+            assert!(matches!(e, Some(Error::Misuse(Misuse::NotConfigured { .. }))), "{e:?}");
+        }
+    }
+    // Transparent casters are not traced yet.
+    let mut t = new(&ShadowPassDesc { transmit_format: Some(ash::vk::Format::R16G16B16A16_SFLOAT), settings: rq, ..base.clone() }).unwrap();
+    t.add_transparent_caster("glass", &cube, glam::DMat4::IDENTITY, glam::Vec3::splat(0.5)).unwrap();
+    t.set_ray_query_inputs(RayQueryInputs { position: pos.view, normal: nrm.view, ..inputs }).unwrap();
+    assert!(matches!(t.prepare(0, &view, &lights), Err(Error::Unsupported(m)) if m.contains("glass")));
+    drop((p, t, off));
+    pos.destroy(&ctx);
+    nrm.destroy(&ctx);
+    ctx.check_validation().unwrap();
+}

@@ -70,6 +70,7 @@ impl Diagnostics for ShadowPass {
         target: &DepthStencilTarget,
     ) -> Result<()> {
         self.light(frame, light)?;
+        Self::volume_frame(frame, "cmd_count_rasterised")?;
         self.dynamic_only("cmd_count_rasterised")?;
         target.check(frame, &self.desc.target)?;
         // SAFETY: the caller's contract (outside a rendering instance).
@@ -105,6 +106,7 @@ impl Diagnostics for ShadowPass {
 
     unsafe fn cmd_draw_volume_overlay(&self, cb: vk::CommandBuffer, frame: &PreparedFrame) -> Result<()> {
         self.check_frame(frame)?;
+        Self::volume_frame(frame, "cmd_draw_volume_overlay")?;
         let Some(pipe) = self.pipes.overlay else {
             return Err(Misuse::NotConfigured { call: "cmd_draw_volume_overlay", needs: "ShadowPassDesc::debug_color_format" }.into());
         };

@@ -422,6 +422,7 @@ impl ShadowPass {
         kind: VolumeKind,
     ) -> Result<()> {
         self.light(frame, light)?;
+        Self::volume_frame(frame, "the float counter and the light-intensity map")?;
         self.dynamic_only("the float counter and the light-intensity map")?;
         target.check(frame, &self.desc.target)?;
         // SAFETY: the caller's contract (outside a rendering instance).

@@ -12,6 +12,19 @@ use crate::shadow::Case;
 use ash::vk;
 
 impl ShadowPass {
+    /// Refuses a ray-query frame where volumes are drawn or counted (it has none: the count
+    /// would be a silent zero).
+    pub(super) fn volume_frame(frame: &PreparedFrame, call: &'static str) -> Result<()> {
+        match frame.rays {
+            Some(_) => Err(Misuse::NotConfigured {
+                call,
+                needs: "a volume technique: the frame was prepared for Technique::RayQuery, which draws no volumes",
+            }
+            .into()),
+            None => Ok(()),
+        }
+    }
+
     /// Records the volumes of `light` for `kind` inside a rendering instance the caller
     /// began (attachments: the pass's depth-stencil format, plus an R32F colour attachment
     /// for the float kinds or the transmit format for `Transmit`), with the viewport and
@@ -30,13 +43,7 @@ impl ShadowPass {
     /// `frame`'s slot is not prepared again before `cb` completes.
     pub unsafe fn cmd_draw_volumes(&self, cb: vk::CommandBuffer, frame: &PreparedFrame, light: usize, kind: VolumeKind) -> Result<()> {
         let lf = self.light(frame, light)?;
-        if frame.rays.is_some() {
-            return Err(Misuse::NotConfigured {
-                call: "cmd_draw_volumes",
-                needs: "a volume technique: the frame was prepared for Technique::RayQuery, which draws no volumes",
-            }
-            .into());
-        }
+        Self::volume_frame(frame, "cmd_draw_volumes")?;
         let p = &self.pipes;
         let count = p.count.as_ref();
         match kind {
