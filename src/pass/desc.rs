@@ -392,6 +392,47 @@ pub struct ShadowPassDesc {
     pub debug_color_format: Option<vk::Format>,
 }
 
+impl ShadowPassDesc {
+    /// The checks that need no device: the format has depth and 8 stencil bits, 1..=64 frames
+    /// in flight, 1, 2, 4 or 8 samples, and a render-pass target that agrees with the rest.
+    pub(crate) fn check_shape(&self) -> Result<()> {
+        check_depth_stencil_format(self.depth_stencil_format)?;
+        if self.frames_in_flight == 0 || self.frames_in_flight > 64 {
+            return Err(Error::desc("ShadowPassDesc::frames_in_flight", format!("must be 1..=64, got {}", self.frames_in_flight)));
+        }
+        if ![1, 2, 4, 8].contains(&self.samples) {
+            return Err(Error::desc("ShadowPassDesc::samples", format!("must be 1, 2, 4 or 8, got {}", self.samples)));
+        }
+        let samples = super::pipelines::sample_flags(self.samples);
+        if let TargetModel::RenderPass(rp) = self.target {
+            let field = "ShadowPassDesc::target";
+            if rp.depth_stencil_format != self.depth_stencil_format {
+                return Err(Error::desc(
+                    field,
+                    format!(
+                        "the subpass's depth-stencil attachment is {:?}, the desc says {:?}",
+                        rp.depth_stencil_format, self.depth_stencil_format
+                    ),
+                ));
+            }
+            if rp.samples != samples {
+                return Err(Error::desc(
+                    field,
+                    format!("the subpass's depth-stencil attachment has {:?} samples, the desc says {}", rp.samples, self.samples),
+                ));
+            }
+            if self.transmit_format.is_some() || self.debug_color_format.is_some() {
+                return Err(Error::desc(
+                    field,
+                    "transmit_format and debug_color_format draw into colour targets of the pass's own rendering instances: \
+                     dynamic rendering only",
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
 impl Default for ShadowPassDesc {
     fn default() -> Self {
         ShadowPassDesc {

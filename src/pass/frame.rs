@@ -110,3 +110,27 @@ pub(crate) fn check_lights(lights: &[Light]) -> Result<()> {
     }
     Ok(())
 }
+
+impl super::ShadowPass {
+    /// Writes the stream into the slot's buffer (grown to the next power of two when short).
+    pub(super) fn write_stream(&mut self, slot: usize, data: &[u8]) -> crate::error::Result<vk::Buffer> {
+        let dev = &self.dev;
+        let s = &mut self.slots[slot];
+        if s.stream.as_ref().map(|b| b.size < data.len() as u64).unwrap_or(true) {
+            if let Some(mut old) = s.stream.take() {
+                old.destroy(dev);
+            }
+            let size = (data.len() as u64).max(1 << 16).next_power_of_two();
+            s.stream = Some(crate::gpu::Buffer::new(
+                dev,
+                &format!("shadow stream {slot}"),
+                size,
+                vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::VERTEX_BUFFER,
+                gpu_allocator::MemoryLocation::CpuToGpu,
+            )?);
+        }
+        let buf = s.stream.as_mut().ok_or_else(|| crate::error::Error::Internal("no stream buffer".into()))?;
+        buf.write(0, data)?;
+        Ok(buf.raw)
+    }
+}

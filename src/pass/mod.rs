@@ -121,7 +121,6 @@ use device::PassDevice;
 use frame::{check_lights, overflow_warnings};
 use glam::{DMat4, Vec3};
 use gpu_allocator::vulkan::Allocator;
-use gpu_allocator::MemoryLocation;
 use pack::{pack, PackInput};
 use pipelines::Pipelines;
 use std::cell::Cell;
@@ -210,39 +209,7 @@ impl ShadowPass {
         allocator: Arc<Mutex<Allocator>>,
         desc: &ShadowPassDesc,
     ) -> Result<ShadowPass> {
-        desc::check_depth_stencil_format(desc.depth_stencil_format)?;
-        if desc.frames_in_flight == 0 || desc.frames_in_flight > 64 {
-            return Err(Error::desc("ShadowPassDesc::frames_in_flight", format!("must be 1..=64, got {}", desc.frames_in_flight)));
-        }
-        if ![1, 2, 4, 8].contains(&desc.samples) {
-            return Err(Error::desc("ShadowPassDesc::samples", format!("must be 1, 2, 4 or 8, got {}", desc.samples)));
-        }
-        let samples = pipelines::sample_flags(desc.samples);
-        if let TargetModel::RenderPass(rp) = desc.target {
-            let field = "ShadowPassDesc::target";
-            if rp.depth_stencil_format != desc.depth_stencil_format {
-                return Err(Error::desc(
-                    field,
-                    format!(
-                        "the subpass's depth-stencil attachment is {:?}, the desc says {:?}",
-                        rp.depth_stencil_format, desc.depth_stencil_format
-                    ),
-                ));
-            }
-            if rp.samples != samples {
-                return Err(Error::desc(
-                    field,
-                    format!("the subpass's depth-stencil attachment has {:?} samples, the desc says {}", rp.samples, desc.samples),
-                ));
-            }
-            if desc.transmit_format.is_some() || desc.debug_color_format.is_some() {
-                return Err(Error::desc(
-                    field,
-                    "transmit_format and debug_color_format draw into colour targets of the pass's own rendering instances: \
-                     dynamic rendering only",
-                ));
-            }
-        }
+        desc.check_shape()?;
         // SAFETY: plain queries on a valid physical device of `instance`.
         let (features, props, ds_props, r32f) = unsafe {
             (
@@ -585,27 +552,6 @@ impl ShadowPass {
             compute,
             rays: ray_frame,
         })
-    }
-
-    /// Writes the stream into the slot's buffer (grown to the next power of two when short).
-    fn write_stream(&mut self, slot: usize, data: &[u8]) -> Result<vk::Buffer> {
-        let s = &mut self.slots[slot];
-        if s.stream.as_ref().map(|b| b.size < data.len() as u64).unwrap_or(true) {
-            if let Some(mut old) = s.stream.take() {
-                old.destroy(&self.dev);
-            }
-            let size = (data.len() as u64).max(1 << 16).next_power_of_two();
-            s.stream = Some(Buffer::new(
-                &self.dev,
-                &format!("shadow stream {slot}"),
-                size,
-                vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::VERTEX_BUFFER,
-                MemoryLocation::CpuToGpu,
-            )?);
-        }
-        let buf = s.stream.as_mut().ok_or_else(|| Error::Internal("no stream buffer".into()))?;
-        buf.write(0, data)?;
-        Ok(buf.raw)
     }
 }
 
