@@ -18,9 +18,11 @@ pub fn volume_methods() -> Vec<Method> {
     all.to_vec()
 }
 
-/// Every technique, shadow maps once per size in `shadow_map_sizes` (none when empty), and
-/// ray query when the device has it (`ray_query`: [`crate::gpu::Features::ray_query`]).
-pub fn all_techniques(shadow_map_sizes: &[u32], ray_query: bool) -> Vec<Technique> {
+/// Every technique, shadow maps once per size in `shadow_map_sizes` (none when empty; each
+/// size twice, atlas and multiview cube faces, with `multiview`: a device whose multiview the
+/// renderer trusts), and ray query when the device has it (`ray_query`:
+/// [`crate::gpu::Features::ray_query`]).
+pub fn all_techniques(shadow_map_sizes: &[u32], ray_query: bool, multiview: bool) -> Vec<Technique> {
     let mut out: Vec<Technique> = volume_methods().into_iter().map(Technique::Volumes).collect();
     // Exhaustive on purpose: a new Technique variant is a compile error until listed below.
     let listed = |t: Technique| match t {
@@ -35,7 +37,12 @@ pub fn all_techniques(shadow_map_sizes: &[u32], ray_query: bool) -> Vec<Techniqu
         listed(t);
         out.push(t);
     }
-    out.extend(shadow_map_sizes.iter().map(|&size| Technique::shadow_map(size)));
+    for &size in shadow_map_sizes {
+        out.push(Technique::shadow_map(size));
+        if multiview {
+            out.push(Technique::ShadowMap { size, pcf: crate::render::Pcf::Taps, cube: crate::render::CubeFaces::Multiview });
+        }
+    }
     if ray_query {
         listed(Technique::RayQuery);
         out.push(Technique::RayQuery);
@@ -58,8 +65,9 @@ mod tests {
     use super::*;
     #[test]
     fn every_method_once() {
-        let all = all_techniques(&[512, 4096], true);
+        let all = all_techniques(&[512, 4096], true, false);
         assert_eq!(all.len(), volume_methods().len() + 6);
+        assert_eq!(all_techniques(&[512, 4096], true, true).len(), volume_methods().len() + 8);
         for (i, a) in all.iter().enumerate() {
             assert!(!all[i + 1..].contains(a), "{a:?} listed twice");
         }

@@ -290,7 +290,9 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
         setup_tri_mtri_s: limits.setup_tri_mtri_s,
         clip_tri_mtri_s: limits.clip_tri_mtri_s,
     };
-    let techniques = all_techniques(&scale.shadow_map_sizes(), ctx.features.ray_query);
+    // Multiview cube faces where the renderer trusts the device's multiview (gpu::quirks).
+    let multiview = ctx.features.multiview && crate::gpu::quirks::multiview_defect(&ctx.info).is_none();
+    let techniques = all_techniques(&scale.shadow_map_sizes(), ctx.features.ray_query, multiview);
     let points = sweeps::points(scale);
     // The tiny suite (tests) leaves the 435k-triangle vertex scene out.
     let named: &[&str] = if scale == Scale::Tiny { &["bench/fill", "default"] } else { &["bench/fill", "bench/vertex"] };

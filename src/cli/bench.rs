@@ -193,7 +193,7 @@ fn bench_techniques(
     let listed: Vec<Technique> = if methods.is_empty() {
         let sizes: &[u32] = if shadow_map_size > 0 { &[size] } else { &[] };
         // Ray query joins once the device is known (`bench`).
-        umbrage::bench::methods::all_techniques(sizes, false)
+        umbrage::bench::methods::all_techniques(sizes, false, false)
     } else {
         methods.iter().map(|m| m.technique(Technique::shadow_map(size))).collect()
     };
