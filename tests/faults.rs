@@ -5,11 +5,27 @@
 //! `vkDestroyDevice`, which these tests see on stderr. And the soak: memory held flat over
 //! many frames in one process.
 
+mod common;
+
 use std::process::{Command, Output};
 
 fn umbrage(args: &[&str], env: &[(&str, &str)]) -> Output {
+    umbrage_on(args, env, &[])
+}
+
+/// A driver's environment: each variable set (`Some`) or removed (`None`).
+type DriverEnv = Vec<(String, Option<String>)>;
+
+/// [`umbrage`] with a driver's environment (`common::lavapipe_25_env`) applied first.
+fn umbrage_on(args: &[&str], env: &[(&str, &str)], driver: &[(String, Option<String>)]) -> Output {
     let mut c = Command::new(env!("CARGO_BIN_EXE_umbrage"));
     c.args(args).env("UMBRAGE_VALIDATION", "1").env_remove("UMBRAGE_FAULT").env_remove("UMBRAGE_MEMORY_BUDGET");
+    for (k, v) in driver {
+        match v {
+            Some(v) => c.env(k, v),
+            None => c.env_remove(k),
+        };
+    }
     for (k, v) in env {
         c.env(k, v);
     }
@@ -81,14 +97,24 @@ fn memory_budget_failures_are_clean_at_every_point() {
 /// before it released again. Also through a frame dump (captures) and the shadow-map baseline.
 #[test]
 fn every_allocation_failure_is_clean() {
-    for (tag, extra) in [("render", &[][..]), ("shadowmap", &["--method", "shadowmap", "--shadow-map-size", "128"][..])] {
+    // Ray query (its acceleration structures, inputs, scratch and batched masks) on lavapipe
+    // 25.0.7, where the system's driver has none.
+    let lavapipe_25 = common::lavapipe_25_env();
+    assert!(lavapipe_25.is_some() || std::env::var_os("CI").is_none(), "CI needs lavapipe 25.0.7 (scripts/drivers.sh install 25.0.7)");
+    let rays = ["--method", "rayquery", "--scene", "analytic/sphere_and_meshes"];
+    let mut runs: Vec<(&str, &[&str], DriverEnv)> =
+        vec![("render", &[][..], Vec::new()), ("shadowmap", &["--method", "shadowmap", "--shadow-map-size", "128"][..], Vec::new())];
+    if let Some(env) = lavapipe_25 {
+        runs.push(("rayquery", &rays[..], env));
+    }
+    for (tag, extra, driver) in runs {
         let png = out_png(tag);
         let mut args = vec!["render", "--size", "96x72", "--out", &png];
         args.extend_from_slice(extra);
         let mut n = 1;
         loop {
             let spec = format!("alloc=out_of_device_memory@{n}");
-            let o = umbrage(&args, &[("UMBRAGE_FAULT", &spec)]);
+            let o = umbrage_on(&args, &[("UMBRAGE_FAULT", &spec)], &driver);
             let what = format!("{tag} {spec}");
             clean(&o, &what);
             if o.status.success() {

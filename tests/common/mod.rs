@@ -47,17 +47,11 @@ pub fn rerun_on_lavapipe_25(test: &str, ignored: bool, env: &[(&str, &str)]) -> 
         !child,
         "this child already runs on lavapipe 25.0.7, and it lacks what the test needs (ray query, or a multiview it can trust)"
     );
-    let root = env!("CARGO_MANIFEST_DIR");
-    let exports = std::process::Command::new(format!("{root}/scripts/drivers.sh")).args(["env", "25.0.7"]).output();
-    let exports = match exports {
-        Ok(o) if o.status.success() => String::from_utf8_lossy(&o.stdout).into_owned(),
-        other => {
-            let why =
-                format!("no ray-query device, and Mesa lavapipe 25.0.7 is not installed (scripts/drivers.sh install 25.0.7): {other:?}");
-            assert!(std::env::var_os("CI").is_none(), "{why}");
-            eprintln!("SKIPPED: {why}");
-            return false;
-        }
+    let Some(vars) = lavapipe_25_env() else {
+        let why = "no ray-query device, and Mesa lavapipe 25.0.7 is not installed (scripts/drivers.sh install 25.0.7)";
+        assert!(std::env::var_os("CI").is_none(), "{why}");
+        eprintln!("SKIPPED: {why}");
+        return false;
     };
     let mut cmd = std::process::Command::new(std::env::current_exe().expect("test binary"));
     cmd.args(["--exact", test, "--nocapture", "--test-threads", "1"]).env("UMBRAGE_RAY_QUERY_CHILD", "1");
@@ -67,7 +61,31 @@ pub fn rerun_on_lavapipe_25(test: &str, ignored: bool, env: &[(&str, &str)]) -> 
     for (k, v) in env {
         cmd.env(k, v);
     }
-    for line in exports.lines() {
+    for (k, v) in vars {
+        match v {
+            Some(v) => cmd.env(k, v),
+            None => cmd.env_remove(k),
+        };
+    }
+    let out = cmd.output().expect("run the test on lavapipe 25.0.7");
+    print!("{}", String::from_utf8_lossy(&out.stdout));
+    eprint!("{}", String::from_utf8_lossy(&out.stderr));
+    assert!(out.status.success(), "{test} failed on Mesa lavapipe 25.0.7 (output above)");
+    assert!(String::from_utf8_lossy(&out.stdout).contains("1 passed"), "{test} did not run in the child");
+    true
+}
+
+/// The environment that makes Mesa lavapipe 25.0.7 from `.drivers/` the only Vulkan device
+/// (`scripts/drivers.sh env 25.0.7`): each variable to set (`Some`) or remove (`None`); `None`
+/// when that driver is not installed.
+pub fn lavapipe_25_env() -> Option<Vec<(String, Option<String>)>> {
+    let root = env!("CARGO_MANIFEST_DIR");
+    let o = std::process::Command::new(format!("{root}/scripts/drivers.sh")).args(["env", "25.0.7"]).output().ok()?;
+    if !o.status.success() {
+        return None;
+    }
+    let mut vars = Vec::new();
+    for line in String::from_utf8_lossy(&o.stdout).lines() {
         let line = line.trim();
         if let Some(rest) = line.strip_prefix("export ") {
             if let Some((k, v)) = rest.split_once('=') {
@@ -80,18 +98,11 @@ pub fn rerun_on_lavapipe_25(test: &str, ignored: bool, env: &[(&str, &str)]) -> 
                     },
                     None => v.to_string(),
                 };
-                cmd.env(k, v);
+                vars.push((k.to_string(), Some(v)));
             }
         } else if let Some(rest) = line.strip_prefix("unset ") {
-            for k in rest.split_whitespace() {
-                cmd.env_remove(k);
-            }
+            vars.extend(rest.split_whitespace().map(|k| (k.to_string(), None)));
         }
     }
-    let out = cmd.output().expect("run the test on lavapipe 25.0.7");
-    print!("{}", String::from_utf8_lossy(&out.stdout));
-    eprint!("{}", String::from_utf8_lossy(&out.stderr));
-    assert!(out.status.success(), "{test} failed on Mesa lavapipe 25.0.7 (output above)");
-    assert!(String::from_utf8_lossy(&out.stdout).contains("1 passed"), "{test} did not run in the child");
-    true
+    Some(vars)
 }

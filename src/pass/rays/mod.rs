@@ -36,8 +36,10 @@ use ash::vk;
 use glam::{DMat4, DVec3};
 use std::cell::Cell;
 
+mod balls;
 mod batch;
 mod record;
+use balls::Balls;
 pub use record::RayQueryFrame;
 pub(crate) use record::{check_host, rays_missing, RayFrame};
 
@@ -80,15 +82,6 @@ struct Entry {
     /// The compacted-size query written by the frame of slot `.1`, read when that slot is
     /// prepared again.
     compaction: Option<(vk::QueryPool, usize)>,
-}
-
-/// The sphere casters' boxes, the balls the shader tests (f32, relative to `origin`), and what
-/// they were built from.
-struct Balls {
-    blas: Accel,
-    buffer: Buffer,
-    origin: DVec3,
-    built_from: Vec<[f64; 4]>,
 }
 
 /// A ring slot's top level and descriptor set (with the handles it was written with).
@@ -197,8 +190,41 @@ impl Rays {
     /// Plans slot `slot`'s frame (the slot's previous frame retired): bottom levels built,
     /// refitted or compacted as the casters need, the top level's instances written, the
     /// slot's descriptor set made for `inputs`.
+    ///
+    /// On error every bottom level is retired (some may have been made or swapped for builds
+    /// and copies this frame will never record), so the next frame builds them all again.
     #[allow(clippy::too_many_arguments)]
     pub fn prepare(
+        &mut self,
+        dev: &PassDevice,
+        slot: usize,
+        casters: &CasterTable,
+        spheres: &[SphereCaster],
+        view: &ShadowView,
+        lights: (&[Light], &[vk::Rect2D], bool),
+        inputs: &RayQueryInputs,
+        desc: &ShadowPassDesc,
+        all_slots: u64,
+        transient: &mut Vec<Buffer>,
+    ) -> Result<RayFrame> {
+        let r = self.prepare_inner(dev, slot, casters, spheres, view, lights, inputs, desc, all_slots, transient);
+        if r.is_err() {
+            for e in std::mem::take(&mut self.entries) {
+                self.graves.push((Garbage::Accel(e.blas), all_slots));
+                if let Some((p, _)) = e.compaction {
+                    self.graves.push((Garbage::Pool(p), all_slots));
+                }
+            }
+            if let Some(b) = self.balls.take() {
+                self.graves.push((Garbage::Accel(b.blas), all_slots));
+                self.graves.push((Garbage::Buffer(b.buffer), all_slots));
+            }
+        }
+        r
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn prepare_inner(
         &mut self,
         dev: &PassDevice,
         slot: usize,
@@ -372,49 +398,6 @@ impl Rays {
         if let Some((p, _)) = e.compaction {
             self.graves.push((Garbage::Pool(p), w.all_slots));
         }
-    }
-
-    /// Rebuilds the spheres' bottom level when the sphere casters changed.
-    fn sync_balls(&mut self, w: &mut Work, spheres: &[SphereCaster]) -> Result<Option<BlasJob>> {
-        let now: Vec<[f64; 4]> = spheres.iter().map(|s| s.sphere.center.extend(s.sphere.radius).to_array()).collect();
-        if self.balls.as_ref().map(|b| &b.built_from) == Some(&now) || (self.balls.is_none() && now.is_empty()) {
-            return Ok(None);
-        }
-        if let Some(old) = self.balls.take() {
-            self.graves.push((Garbage::Accel(old.blas), w.all_slots));
-            self.graves.push((Garbage::Buffer(old.buffer), w.all_slots));
-        }
-        let Some(first) = spheres.first() else { return Ok(None) };
-        let origin = first.sphere.center;
-        let balls: Vec<[f32; 4]> = spheres
-            .iter()
-            .map(|s| {
-                let c = (s.sphere.center - origin).as_vec3();
-                [c.x, c.y, c.z, s.sphere.radius as f32]
-            })
-            .collect();
-        // Each box holds its f32 ball with a margin of a few ulps (the test is exact on the
-        // f32 ball; the box only has to contain it).
-        let boxes: Vec<[[f32; 3]; 2]> = balls
-            .iter()
-            .map(|b| {
-                let r = b[3] * (1.0 + 1e-5) + 1e-30;
-                [[b[0] - r, b[1] - r, b[2] - r], [b[0] + r, b[1] + r, b[2] + r]]
-            })
-            .collect();
-        let data: Vec<u8> = balls.iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
-        let buffer = Buffer::with_data(w.dev, "ray-query balls", &data, vk::BufferUsageFlags::STORAGE_BUFFER)?;
-        let (blas, job) = match accel::prepare_blas(w.dev, &self.loader, "spheres blas", &Geometry::Aabbs(&boxes), STATIC, w.transient) {
-            Ok(r) => r,
-            Err(e) => {
-                let mut buffer = buffer;
-                buffer.destroy(w.dev);
-                return Err(e);
-            }
-        };
-        self.counts.builds += 1;
-        self.balls = Some(Balls { blas, buffer, origin, built_from: now });
-        Ok(Some(job))
     }
 
     /// The slot's top level (grown to `instances`) and its descriptor set for `inputs`,
