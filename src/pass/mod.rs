@@ -104,6 +104,8 @@ pub use desc::{
 pub use draw::LightFrame;
 pub use frame::PreparedFrame;
 pub use pipelines::COUNT_FORMAT;
+#[cfg(feature = "cli")]
+pub(crate) use rays::light_rel;
 pub use rays::{RayCounts, RayQueryFrame, RayQueryInputs};
 pub use record::{lit_stencil_state, VolumeKind};
 pub use spheres::{SphereId, SphereInfo};

@@ -373,10 +373,9 @@ impl ShadowPass {
     /// host's render pass.
     pub(super) fn check_recorded_before_rendering(&self, frame: &PreparedFrame) -> Result<()> {
         let compute_pending = frame.compute.as_ref().is_some_and(|cf| !cf.recorded.get() && !cf.jobs.iter().all(|j| j.is_empty()));
-        let rays_pending = frame.rays.as_ref().is_some_and(|r| !r.recorded.get());
-        if frame.pending_uploads() > 0 || compute_pending || rays_pending {
+        if frame.pending_uploads() > 0 || compute_pending {
             return Err(Misuse::Order(
-                "the frame's uploads, GPU silhouettes or acceleration structures are not recorded: call cmd_before_rendering before beginning the render pass"
+                "the frame's uploads or GPU silhouettes are not recorded: call cmd_before_rendering before beginning the render pass"
                     .into(),
             )
             .into());

@@ -75,10 +75,7 @@ impl LightPush {
 
     /// A light's block for a frame whose eye is `eye`.
     pub fn new(l: &Light, eye: DVec3, log: bool) -> LightPush {
-        let pos = match l.kind {
-            LightKind::Directional => (-l.direction.normalize()).extend(0.0),
-            _ => (l.position.as_dvec3() - eye).as_vec3().extend(1.0),
-        };
+        let pos = Vec4::from_array(crate::pass::light_rel(l, eye));
         let spot = match l.kind {
             LightKind::Spot => l.direction.normalize().extend((l.cone_deg.to_radians() * 0.5).cos()),
             _ => Vec4::new(0.0, 0.0, -1.0, -2.0),

@@ -127,8 +127,9 @@ pub struct RayCounts {
     pub compactions: u64,
 }
 
-/// The eye-relative homogeneous light the shader takes (as the renderer's lighting pass).
-fn light_rel(l: &Light, eye: DVec3) -> [f32; 4] {
+/// The eye-relative homogeneous light, f32: (position - eye, 1) or (direction towards the
+/// light, 0). The rays and the renderer's lighting pass take the same one.
+pub(crate) fn light_rel(l: &Light, eye: DVec3) -> [f32; 4] {
     match l.kind {
         LightKind::Directional => (-l.direction.normalize()).extend(0.0).to_array(),
         _ => (l.position.as_dvec3() - eye).as_vec3().extend(1.0).to_array(),
@@ -141,6 +142,24 @@ const STATIC: vk::BuildAccelerationStructureFlagsKHR = vk::BuildAccelerationStru
 const DEFORMABLE: vk::BuildAccelerationStructureFlagsKHR = vk::BuildAccelerationStructureFlagsKHR::from_raw(
     vk::BuildAccelerationStructureFlagsKHR::PREFER_FAST_TRACE.as_raw() | vk::BuildAccelerationStructureFlagsKHR::ALLOW_UPDATE.as_raw(),
 );
+
+/// What a ray-query frame is prepared from.
+#[derive(Clone, Copy)]
+pub(crate) struct FrameInput<'a> {
+    pub dev: &'a PassDevice,
+    /// The ring slot (its previous frame retired).
+    pub slot: usize,
+    pub casters: &'a CasterTable,
+    pub spheres: &'a [SphereCaster],
+    pub view: &'a ShadowView,
+    /// The frame's lights and their scissors.
+    pub lights: &'a [Light],
+    pub scissors: &'a [vk::Rect2D],
+    /// [`PassToggles::ray_batch`](crate::pass::PassToggles::ray_batch).
+    pub batch: bool,
+    pub inputs: &'a RayQueryInputs,
+    pub desc: &'a ShadowPassDesc,
+}
 
 /// What one prepare allocates or retires on the way.
 struct Work<'a> {
@@ -193,21 +212,8 @@ impl Rays {
     ///
     /// On error every bottom level is retired (some may have been made or swapped for builds
     /// and copies this frame will never record), so the next frame builds them all again.
-    #[allow(clippy::too_many_arguments)]
-    pub fn prepare(
-        &mut self,
-        dev: &PassDevice,
-        slot: usize,
-        casters: &CasterTable,
-        spheres: &[SphereCaster],
-        view: &ShadowView,
-        lights: (&[Light], &[vk::Rect2D], bool),
-        inputs: &RayQueryInputs,
-        desc: &ShadowPassDesc,
-        all_slots: u64,
-        transient: &mut Vec<Buffer>,
-    ) -> Result<RayFrame> {
-        let r = self.prepare_inner(dev, slot, casters, spheres, view, lights, inputs, desc, all_slots, transient);
+    pub fn prepare(&mut self, f: &FrameInput, all_slots: u64, transient: &mut Vec<Buffer>) -> Result<RayFrame> {
+        let r = self.prepare_inner(f, &mut Work { dev: f.dev, transient, all_slots });
         if r.is_err() {
             for e in std::mem::take(&mut self.entries) {
                 self.graves.push((Garbage::Accel(e.blas), all_slots));
@@ -223,28 +229,14 @@ impl Rays {
         r
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn prepare_inner(
-        &mut self,
-        dev: &PassDevice,
-        slot: usize,
-        casters: &CasterTable,
-        spheres: &[SphereCaster],
-        view: &ShadowView,
-        lights: (&[Light], &[vk::Rect2D], bool),
-        inputs: &RayQueryInputs,
-        desc: &ShadowPassDesc,
-        all_slots: u64,
-        transient: &mut Vec<Buffer>,
-    ) -> Result<RayFrame> {
-        let (lights, scissors, settings_batch) = lights;
-        let mut w = Work { dev, transient, all_slots };
-        let compactions = self.compact(&mut w, slot)?;
+    fn prepare_inner(&mut self, f: &FrameInput, w: &mut Work) -> Result<RayFrame> {
+        let FrameInput { dev, slot, casters, spheres, view, lights, scissors, batch: settings_batch, inputs, desc } = *f;
+        let compactions = self.compact(w, slot)?;
         let mut jobs = Vec::new();
         let mut queries = Vec::new();
-        self.sync_casters(&mut w, slot, casters, &mut jobs, &mut queries)?;
+        self.sync_casters(w, slot, casters, &mut jobs, &mut queries)?;
         let mut builds = jobs.iter().filter(|j| !j.is_refit()).count();
-        if let Some(job) = self.sync_balls(&mut w, spheres)? {
+        if let Some(job) = self.sync_balls(w, spheres)? {
             jobs.push(job);
             builds += 1;
         }
@@ -348,12 +340,19 @@ impl Rays {
     ) -> Result<()> {
         let mut old: Vec<Entry> = std::mem::take(&mut self.entries);
         for (c, live) in casters.cpu.iter().zip(&casters.live) {
+            let found = old.iter().position(|e| e.id == live.id).map(|i| old.swap_remove(i));
+            let found = match found {
+                Some(e) if e.version == live.version => {
+                    self.entries.push(e);
+                    continue;
+                }
+                other => other,
+            };
+            // Built or refitted this frame: only then are the positions copied.
             let mesh = &c.topology.mesh;
             let positions: Vec<[f32; 3]> = mesh.positions.iter().map(|p| p.to_array()).collect();
             let geometry = Geometry::Triangles { positions: &positions, indices: &mesh.triangles };
-            let found = old.iter().position(|e| e.id == live.id).map(|i| old.swap_remove(i));
             let entry = match found {
-                Some(e) if e.version == live.version => e,
                 Some(e) if e.deformable => {
                     jobs.push(accel::prepare_refit(w.dev, &self.loader, &e.blas, &geometry, DEFORMABLE, w.transient)?);
                     self.counts.refits += 1;

@@ -242,8 +242,19 @@ impl ShadowPass {
         let all = self.all_slots();
         let r = self.rays.as_mut().ok_or_else(|| Error::Internal("no ray-query state".into()))?;
         let mut transient = Vec::new();
-        let frame_lights = (lights, scissors, self.settings.toggles.ray_batch);
-        let out = r.prepare(&self.dev, slot, &self.casters, &self.spheres, view, frame_lights, &inputs, &self.desc, all, &mut transient);
+        let input = super::FrameInput {
+            dev: &self.dev,
+            slot,
+            casters: &self.casters,
+            spheres: &self.spheres,
+            view,
+            lights,
+            scissors,
+            batch: self.settings.toggles.ray_batch,
+            inputs: &inputs,
+            desc: &self.desc,
+        };
+        let out = r.prepare(&input, all, &mut transient);
         // Inputs and scratch memory go when the slot's frame has retired (as staging copies do).
         self.slots[slot].staging.extend(transient);
         out
