@@ -73,6 +73,20 @@ struct Runner {
     bar: indicatif::ProgressBar,
     skipped: Vec<String>,
     start: Instant,
+    /// Wall seconds a point's timed rounds may take: past it, fewer frames (at least
+    /// [`MIN_FRAMES`]).
+    point_budget_s: f64,
+}
+
+/// Fewest timed frames a point is cut to by its budget.
+pub const MIN_FRAMES: usize = 5;
+
+/// Timed rounds for a point whose warm-up round took `round_s` wall seconds: `frames`, or
+/// as many as fit `budget_s` where fewer do, never below [`MIN_FRAMES`] (nor above `frames`).
+pub fn frames_within(frames: usize, round_s: f64, budget_s: f64) -> usize {
+    let fit = budget_s / round_s.max(1e-6);
+    let fit = if fit.is_finite() && fit < frames as f64 { fit as usize } else { frames };
+    fit.max(MIN_FRAMES).min(frames)
 }
 
 fn scene_of(p: &PointScene) -> Result<(Scene, String)> {
@@ -168,7 +182,10 @@ impl Runner {
             plan: Vec<f64>,
         }
         let mut acc: Vec<Acc> = variants.iter().map(|_| Acc::default()).collect();
-        for frame in 0..=self.frames {
+        let mut frames = self.frames;
+        let mut frame = 0;
+        while frame <= frames {
+            let round = Instant::now();
             for (k, v) in variants.iter().enumerate() {
                 apply(r, v);
                 let f = r.render()?;
@@ -185,6 +202,11 @@ impl Runner {
                 }
                 a.plan.push(f.stats.cpu_ms.plan + f.stats.cpu_ms.silhouettes);
             }
+            if frame == 0 {
+                // The warm-up round's wall time sets how many timed rounds fit the budget.
+                frames = frames_within(frames, round.elapsed().as_secs_f64(), self.point_budget_s);
+            }
+            frame += 1;
         }
         r.settings = base;
         let (w, h) = (r.config().width, r.config().height);
@@ -222,7 +244,7 @@ impl Runner {
                 triangles,
                 casters,
                 lights: nlights as u64,
-                frames: self.frames,
+                frames,
                 gpu_shadow_ms: med(a.shadow),
                 gpu_shadow_ms_p10: p10,
                 gpu_shadow_ms_p90: p90,
@@ -328,8 +350,17 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
         indicatif::ProgressBar::hidden()
     };
     let log = cfg.progress && bar.is_hidden();
-    let mut run =
-        Runner { ctx: Some(ctx), log, limits: row_limits, frames, frames_in_flight: cfg.frames_in_flight, bar, skipped: Vec::new(), start };
+    let mut run = Runner {
+        ctx: Some(ctx),
+        log,
+        limits: row_limits,
+        frames,
+        frames_in_flight: cfg.frames_in_flight,
+        bar,
+        skipped: Vec::new(),
+        start,
+        point_budget_s: if cfg.frames.is_some() { f64::INFINITY } else { scale.point_budget_s() },
+    };
     let mut rows = Vec::new();
     let all: Vec<Variant> = techniques.iter().map(|&t| Variant::of(t)).collect();
     let named_all: Vec<Variant> = all.iter().chain(&gathers).cloned().collect();
@@ -506,4 +537,24 @@ fn process_cpu_seconds() -> Option<f64> {
 /// CPU slows lavapipe); Linux only.
 fn load_average() -> Option<f64> {
     std::fs::read_to_string("/proc/loadavg").ok()?.split_whitespace().next()?.parse().ok()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{frames_within, MIN_FRAMES};
+
+    #[test]
+    fn the_point_budget_cuts_only_heavy_points_and_never_below_the_floor() {
+        // A light point keeps every frame.
+        assert_eq!(frames_within(9, 0.5, 30.0), 9);
+        // A heavy one is cut to what fits the budget...
+        assert_eq!(frames_within(9, 4.0, 30.0), 7);
+        // ...but keeps at least MIN_FRAMES, whatever a round takes.
+        assert_eq!(frames_within(9, 20.0, 30.0), MIN_FRAMES);
+        assert_eq!(frames_within(9, f64::INFINITY, 30.0), MIN_FRAMES);
+        // No budget (tiny suites, explicit --frames): every frame; fewer asked than the floor: those.
+        assert_eq!(frames_within(9, 100.0, f64::INFINITY), 9);
+        assert_eq!(frames_within(1, 100.0, 30.0), 1);
+        assert_eq!(frames_within(9, 0.0, 30.0), 9);
+    }
 }

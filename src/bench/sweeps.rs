@@ -55,6 +55,15 @@ impl Scale {
             Scale::Tiny => 1,
         }
     }
+    /// Wall seconds a point's timed rounds may take before its frames are cut (to no fewer
+    /// than [`super::suite::MIN_FRAMES`]): only the heaviest points (32 lights) reach it.
+    pub fn point_budget_s(self) -> f64 {
+        match self {
+            Scale::Full => 120.0,
+            Scale::Quick => 30.0,
+            Scale::Tiny => f64::INFINITY,
+        }
+    }
     /// Shadow-map sizes every point runs.
     pub fn shadow_map_sizes(self) -> Vec<u32> {
         match self {
