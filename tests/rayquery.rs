@@ -134,6 +134,31 @@ fn rayquery_follows_a_deforming_caster() {
     r.context().check_validation().unwrap();
 }
 
+/// `umbrage bench` gives ray query's acceleration work its own columns: the bottom levels'
+/// build, a deforming caster's refit and the top level, as GPU times, beside the row's shadow
+/// time (issue 20); other techniques leave them empty, and the refit leaves the scene as it was.
+#[test]
+fn the_classic_bench_times_builds_refits_and_top_levels() {
+    let Some(ctx) = common::ray_query_context("the_classic_bench_times_builds_refits_and_top_levels") else { return };
+    let cfg = umbrage::bench::BenchConfig {
+        scenes: vec!["default".into()],
+        techniques: vec![Technique::RayQuery, Technique::default()],
+        counters: vec![umbrage::render::Counter::Stencil],
+        frames: 2,
+        opts: RenderOptions { width: 160, height: 120, ..Default::default() },
+    };
+    let report = umbrage::bench::run(ctx, &cfg, |_| {}).unwrap();
+    let rays = report.rows.iter().find(|r| r.method == "rayquery").expect("a rayquery row");
+    for (what, v) in [("build", rays.blas_build_ms), ("refit", rays.blas_refit_ms), ("top level", rays.gpu_tlas_ms)] {
+        assert!(v.is_some_and(|ms| ms > 0.0 && ms.is_finite()), "{what}: {v:?}");
+    }
+    assert_eq!(rays.error_fraction, 0.0, "rayquery is exact on the default scene");
+    let volumes = report.rows.iter().find(|r| r.method != "rayquery").unwrap();
+    assert_eq!((volumes.blas_build_ms, volumes.blas_refit_ms, volumes.gpu_tlas_ms), (None, None, None));
+    let md = report.markdown();
+    assert!(md.contains("BLAS build / refit / TLAS ms"), "{md}");
+}
+
 /// The GPU cost of the acceleration structures, from each frame's acceleration span
 /// (`gpu_ms.accel`: everything `cmd_before_rendering` records): the first frame's bottom-level
 /// builds, the frame that compacts them, the top level alone, and a deforming caster's first

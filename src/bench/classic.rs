@@ -58,6 +58,48 @@ pub struct BenchRow {
     pub blas_build_ms: Option<f64>,
     /// Ray query: bottom-level storage after compaction, bytes.
     pub blas_bytes: Option<u64>,
+    /// Ray query: median GPU time of a frame that refits the largest caster's bottom level in
+    /// place after a deformation ([`Renderer::set_mesh_positions`]: rebuilt once with
+    /// `ALLOW_UPDATE`, then refitted; the caster is put back afterwards), its acceleration
+    /// span, ms (`None` otherwise, or with no mesh caster).
+    pub blas_refit_ms: Option<f64>,
+}
+
+/// Frames [`refit_ms`] times.
+const REFIT_FRAMES: usize = 5;
+
+/// Ray query's refit cost on `r`'s scene: the largest mesh caster deformed (a 1 % stretch,
+/// growing each frame) `REFIT_FRAMES` times after the deformation that rebuilds it with
+/// `ALLOW_UPDATE`; the median acceleration span of the refitting frames. The caster's
+/// positions are restored before returning (on error too), so the scene is unchanged.
+fn refit_ms(r: &mut Renderer) -> Result<Option<f64>> {
+    let meshes = &r.scene().meshes;
+    let Some(big) = (0..meshes.len()).filter(|&i| meshes[i].casts_shadow).max_by_key(|&i| meshes[i].mesh.triangles.len()) else {
+        return Ok(None);
+    };
+    let rest = meshes[big].mesh.positions.clone();
+    let mut spans = Vec::with_capacity(REFIT_FRAMES);
+    let mut measure = |r: &mut Renderer| -> Result<()> {
+        for k in 0..=REFIT_FRAMES {
+            let s = 1.0 + 0.01 * (k + 1) as f32;
+            let moved: Vec<glam::Vec3> = rest.iter().map(|p| *p * glam::Vec3::new(s, 1.0 / s, 1.0)).collect();
+            r.set_mesh_positions(big, &moved)?;
+            let f = r.render()?;
+            let refits = f.stats.ray_query.as_ref().map_or(0, |q| q.refits);
+            match (k, f.stats.gpu_ms) {
+                // The first deformation rebuilds the bottom level with ALLOW_UPDATE.
+                (0, _) => {}
+                (_, Some(g)) if refits > 0 => spans.push(g.accel),
+                _ => return Err(Error::Other(format!("ray query: frame {k} after a deformation refitted nothing"))),
+            }
+        }
+        Ok(())
+    };
+    let measured = measure(r);
+    let restored = r.set_mesh_positions(big, &rest);
+    measured?;
+    restored?;
+    Ok((!spans.is_empty()).then(|| median(spans)))
 }
 
 /// A whole `umbrage bench` run: the device and every row (the JSON `--out` writes).
@@ -132,7 +174,9 @@ pub fn taps_label_of(label: &str) -> Option<&str> {
 
 /// Runs the benchmark on `ctx`: per scene, first every variant's error against the reference,
 /// then `cfg.frames` frames of each variant interleaved (latency), then each variant's
-/// throughput with frames in flight; `progress` sees each row as it is done.
+/// throughput with frames in flight (and, for ray query, a deforming caster's refit);
+/// `progress` sees each row as it is done. Anything the validation layers reported (when
+/// they are on) fails the run with [`Error::Validation`].
 pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow)) -> Result<BenchReport> {
     if cfg.frames == 0 {
         return Err(Error::Other("--frames must be at least 1".into()));
@@ -224,11 +268,19 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 gpu_tlas_ms: (technique == Technique::RayQuery && !a.accel.is_empty()).then(|| median(a.accel)),
                 blas_build_ms: s.ray_query.as_ref().map(|q| q.bottom_level_build_ms),
                 blas_bytes: s.ray_query.as_ref().map(|q| q.bottom_level_bytes),
+                blas_refit_ms: match technique {
+                    Technique::RayQuery => refit_ms(&mut r)?,
+                    _ => None,
+                },
             };
             progress(&row);
             rows.push(row);
         }
         ctx = Some(r.into_context());
+    }
+    // Under validation (UMBRAGE_VALIDATION), anything the layers reported fails the run.
+    if let Some(c) = &ctx {
+        c.check_validation()?;
     }
     Ok(BenchReport { device, driver, width: cfg.opts.width, height: cfg.opts.height, rows })
 }
@@ -240,12 +292,12 @@ impl BenchReport {
             "Device: {} ({}), {}x{}. Medians; wall ms = one frame at a time (latency), fps = throughput with frames in flight; error = mismatched pixels outside a 1-pixel band vs the CPU reference (worst light).\n\n",
             self.device, self.driver, self.width, self.height
         );
-        s += "| scene | method | counter | GPU frame ms | GPU shadow ms | map / lookup ms | wall ms | fps | plan ms | shadow tris | bytes | error | cases c/1/2/3 |\n";
-        s += "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        s += "| scene | method | counter | GPU frame ms | GPU shadow ms | map / lookup ms | BLAS build / refit / TLAS ms | wall ms | fps | plan ms | shadow tris | bytes | error | cases c/1/2/3 |\n";
+        s += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
         let f = |v: Option<f64>| v.map(|x| format!("{x:.2}")).unwrap_or_else(|| "—".into());
         for r in &self.rows {
             s += &format!(
-                "| {} | {} | {} | {} | {} | {} | {:.2} | {:.1} | {:.3} | {} | {} | {:.4}% | {}/{}/{}/{} |\n",
+                "| {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.1} | {:.3} | {} | {} | {:.4}% | {}/{}/{}/{} |\n",
                 r.scene,
                 r.method,
                 r.counter,
@@ -253,6 +305,10 @@ impl BenchReport {
                 f(r.gpu_shadow_ms),
                 match (r.gpu_map_ms, r.gpu_lookup_ms) {
                     (Some(m), Some(l)) => format!("{m:.2} / {l:.2}"),
+                    _ => "—".into(),
+                },
+                match (r.blas_build_ms, r.gpu_tlas_ms) {
+                    (Some(b), Some(t)) => format!("{b:.2} / {} / {t:.3}", f(r.blas_refit_ms)),
                     _ => "—".into(),
                 },
                 r.wall_ms,
