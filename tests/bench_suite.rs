@@ -2,6 +2,7 @@
 //! 160x90; the hidden `--tiny`): the bench.json contract (issue #10's keys), the CSV, the
 //! Markdown and the SVG + PNG plots, under validation.
 
+mod common;
 use std::process::Command;
 
 fn keys(v: &serde_json::Value, want: &[&str], what: &str) {
@@ -13,17 +14,45 @@ fn keys(v: &serde_json::Value, want: &[&str], what: &str) {
 
 #[test]
 fn tiny_suite_writes_the_contract_and_the_plots() {
-    let dir = std::env::temp_dir().join(format!("umbrage-suite-{}", std::process::id()));
+    tiny_suite("system", &[]);
+}
+
+/// The same on lavapipe 25.0.7, where ray query joins the technique list: its rows carry the
+/// acceleration structures' times, and the model fits them with the others.
+#[test]
+fn tiny_suite_on_lavapipe_25_has_ray_query_rows() {
+    let Some(driver) = common::lavapipe_25_env() else {
+        assert!(std::env::var_os("CI").is_none(), "CI needs lavapipe 25.0.7 (scripts/drivers.sh install 25.0.7)");
+        eprintln!("SKIPPED: lavapipe 25.0.7 is not installed (scripts/drivers.sh install 25.0.7)");
+        return;
+    };
+    let v = tiny_suite("lavapipe-25", &driver);
+    assert!(!v.is_null(), "lavapipe 25.0.7 is installed but gave no Vulkan device");
+    let rows = v["rows"].as_array().unwrap();
+    let rays: Vec<_> = rows.iter().filter(|r| r["method"] == "rayquery").collect();
+    assert!(rays.len() >= 10, "{} rayquery rows", rays.len());
+    assert!(rays.iter().all(|r| r["model_rel_error"].is_number()), "rayquery rows outside the model");
+    assert!(v["model"]["coefficients"]["rays"].as_f64().unwrap() > 0.0, "no cost per ray");
+}
+
+/// Runs the tiny suite with `driver`'s environment (each variable set, or removed where
+/// `None`) under validation, checks its contract and outputs, and returns its bench.json.
+fn tiny_suite(tag: &str, driver: &[(String, Option<String>)]) -> serde_json::Value {
+    let dir = std::env::temp_dir().join(format!("umbrage-suite-{tag}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    let out = Command::new(env!("CARGO_BIN_EXE_umbrage"))
-        .args(["bench", "--suite", "fill-vertex", "--quick", "--tiny", "--out", dir.to_str().unwrap()])
-        .env("UMBRAGE_VALIDATION", "1")
-        .output()
-        .unwrap();
+    let mut c = Command::new(env!("CARGO_BIN_EXE_umbrage"));
+    c.args(["bench", "--suite", "fill-vertex", "--quick", "--tiny", "--out", dir.to_str().unwrap()]).env("UMBRAGE_VALIDATION", "1");
+    for (k, v) in driver {
+        match v {
+            Some(v) => c.env(k, v),
+            None => c.env_remove(k),
+        };
+    }
+    let out = c.output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     if !out.status.success() && std::env::var_os("CI").is_none() && err.contains("Vulkan") {
         eprintln!("SKIPPED (no Vulkan device, CI not set): {err}");
-        return;
+        return serde_json::Value::Null;
     }
     assert!(out.status.success(), "suite failed: {err}");
     assert!(!err.contains("panicked"), "{err}");
@@ -68,6 +97,11 @@ fn tiny_suite_writes_the_contract_and_the_plots() {
         let bound = r["bound"].as_str().unwrap();
         assert!(["fill", "vertex", "draw", "cpu"].contains(&bound), "bound {bound}");
         keys(r, &["gpu_shadow_ms_p10", "gpu_shadow_ms_p90", "predicted_shadow_ms", "bound_clear", "fixed_fraction"], "row");
+        // Acceleration-structure times belong to ray-query rows only (and are timed there).
+        let rays = r["method"] == "rayquery";
+        for k in ["gpu_tlas_ms", "blas_build_ms"] {
+            assert_eq!(r[k].as_f64().is_some_and(|ms| ms > 0.0), rays, "{k} on a {} row: {}", r["method"], r[k]);
+        }
         let (lo, mid, hi) =
             (r["gpu_shadow_ms_p10"].as_f64().unwrap(), r["gpu_shadow_ms"].as_f64().unwrap(), r["gpu_shadow_ms_p90"].as_f64().unwrap());
         assert!(lo <= mid && mid <= hi, "spread {lo} {mid} {hi}");
@@ -128,6 +162,7 @@ fn tiny_suite_writes_the_contract_and_the_plots() {
     assert!(md.contains("## Limits") && md.contains("## Crossovers") && md.contains("## Ablations"));
     assert!(md.contains("## Cost model") && md.contains("## Shadow maps: map against lookup") && md.contains("## The paper's claim"));
     let _ = std::fs::remove_dir_all(&dir);
+    v
 }
 
 #[test]

@@ -129,6 +129,10 @@ fn rayquery_follows_a_deforming_caster() {
         }
     }
     assert_eq!(refits, 2);
+    // A shadow-map frame after the ray-query ones prepares no rays (no top level, no stats).
+    r.settings.technique = Technique::ShadowMap { size: 256, pcf: Default::default(), cube: Default::default() };
+    let s = r.render().unwrap().stats;
+    assert!(s.ray_query.is_none(), "a shadow-map frame prepared ray query: {:?}", s.ray_query);
     // A wrong vertex count is refused and changes nothing.
     assert!(r.set_mesh_positions(i, &rest[..rest.len() - 1]).is_err());
     r.context().check_validation().unwrap();

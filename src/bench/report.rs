@@ -69,6 +69,11 @@ pub struct SuiteRow {
     pub gpu_map_ms: Option<f64>,
     /// Shadow maps: median GPU time of the PCF lookup (shadow time less map time), ms.
     pub gpu_lookup_ms: Option<f64>,
+    /// Ray query: median GPU time of the timed frames' acceleration span (the top level
+    /// rebuilt each frame; not part of `gpu_shadow_ms`), ms (`None` for other techniques).
+    pub gpu_tlas_ms: Option<f64>,
+    /// Ray query: GPU time of the frame that built the bottom levels, ms.
+    pub blas_build_ms: Option<f64>,
     /// The cost model's prediction of `gpu_shadow_ms` (fitted on every row; see
     /// [`super::model`]), ms.
     pub predicted_shadow_ms: Option<f64>,
@@ -266,6 +271,8 @@ pub const CSV_COLUMNS: &[&str] = &[
     "bound_triangles",
     "fixed_fraction",
     "bound_clear",
+    "gpu_tlas_ms",
+    "blas_build_ms",
 ];
 
 fn opt<T: ToString>(v: Option<T>) -> String {
@@ -321,6 +328,8 @@ impl SuiteRow {
             r.bound_triangles.to_string(),
             opt(r.fixed_fraction),
             r.bound_clear.to_string(),
+            opt(r.gpu_tlas_ms),
+            opt(r.blas_build_ms),
         ]
         .iter()
         .map(|f| if f.contains(',') { format!("\"{f}\"") } else { f.clone() })

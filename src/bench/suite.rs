@@ -179,6 +179,7 @@ impl Runner {
             frame: Vec<f64>,
             depth: Vec<f64>,
             illum: Vec<f64>,
+            accel: Vec<f64>,
             plan: Vec<f64>,
         }
         let mut acc: Vec<Acc> = variants.iter().map(|_| Acc::default()).collect();
@@ -199,6 +200,7 @@ impl Runner {
                     a.frame.push(g.frame);
                     a.depth.push(g.depth);
                     a.illum.push(g.illuminate);
+                    a.accel.push(g.accel);
                 }
                 a.plan.push(f.stats.cpu_ms.plan + f.stats.cpu_ms.silhouettes);
             }
@@ -250,6 +252,8 @@ impl Runner {
                 gpu_shadow_ms_p90: p90,
                 gpu_map_ms: map_ms,
                 gpu_lookup_ms: lookup_ms,
+                gpu_tlas_ms: if v.technique == Technique::RayQuery { med(a.accel) } else { None },
+                blas_build_ms: s.ray_query.as_ref().filter(|_| v.technique == Technique::RayQuery).map(|q| q.bottom_level_build_ms),
                 gpu_frame_ms: med(a.frame),
                 gpu_depth_ms: med(a.depth),
                 gpu_illuminate_ms: med(a.illum),

@@ -454,7 +454,7 @@ impl ShadowPass {
     }
 
     /// As [`prepare`](Self::prepare), with every caster culled: only the lights' scissors and
-    /// depth bounds (and pending uploads). For hosts that determine this frame's shadows
+    /// depth bounds (and pending uploads; no ray-query structures, whatever the technique). For hosts that determine this frame's shadows
     /// another way (umbrage's shadow-map baseline) but keep the pass's per-light state.
     pub fn prepare_culled(&mut self, slot: usize, view: &ShadowView, lights: &[Light]) -> Result<PreparedFrame> {
         self.prepare_with(slot, view, lights, false)
@@ -470,7 +470,9 @@ impl ShadowPass {
             spheres::check(&self.spheres, lights)?;
         }
         self.settings.check(&self.caps)?;
-        let rays = self.settings.technique == Technique::RayQuery;
+        // A culled frame prepares no rays either, whatever the technique (a shadow-map frame
+        // after a ray-query one must not build a top level nobody traces).
+        let rays = casters && self.settings.technique == Technique::RayQuery;
         let casters = casters && !rays;
         if rays {
             self.check_rays()?;
