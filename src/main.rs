@@ -236,8 +236,8 @@ enum Command {
         /// Run on the device whose name contains NAME (case-insensitive).
         #[arg(long, value_name = "NAME")]
         device: Option<String>,
-        /// Run every unit (a configuration's submission, the legacy checks, the pipeline
-        /// checks) in this process instead of a child process each: faster to debug, but a
+        /// Run every unit (a configuration's submission, the legacy checks, the multiview
+        /// check, the pipeline checks) in this process instead of a child process each: faster to debug, but a
         /// driver crash ends the run.
         #[arg(long)]
         no_isolate: bool,

@@ -284,6 +284,36 @@ fn a_crashing_driver_costs_only_its_configuration() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// The multiview check runs in a unit of its own: a driver crashing there costs that one
+/// check, and the other single-configuration checks still report.
+#[test]
+fn a_multiview_crash_costs_only_the_multiview_check() {
+    let Some(_ctx) = common::context() else { return };
+    let dir = tmp("crash-multiview");
+    let out = umbrage()
+        .args(["conform", "--filter", "legacy.", "--out"])
+        .arg(&dir)
+        .env("UMBRAGE_CONFORM_CRASH", "multiview:abort")
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{stdout}");
+    let j = json(&dir);
+    let cases = j["cases"].as_array().unwrap();
+    assert_eq!(cases.len(), 9, "{cases:?}");
+    for c in cases {
+        if c["name"] == "legacy.multiview_cube_faces" {
+            assert_eq!(c["status"], "crash");
+            let m = c["message"].as_str().unwrap();
+            assert!(m.contains("SIGABRT") && m.contains("unit multiview"), "{m}");
+        } else {
+            assert!(c["status"] == "pass" || c["status"] == "skipped", "{}: {} {}", c["name"], c["status"], c["message"]);
+        }
+    }
+    assert!(cases.iter().filter(|c| c["status"] == "pass").count() >= 6, "{stdout}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// A hung driver: the child is killed at `--timeout` and its cases say so; the rest passes.
 #[test]
 fn a_hanging_driver_is_killed_at_the_timeout() {

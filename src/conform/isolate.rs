@@ -1,5 +1,5 @@
 //! Crash isolation, as deqp-runner does for the CTS: every unit of the suite (one
-//! configuration's submission, the legacy checks, the pipeline checks) runs in a child
+//! configuration's submission, the legacy checks, the multiview check, the pipeline checks) runs in a child
 //! process (`umbrage conform --child UNIT`) with a timeout. A driver that crashes or hangs
 //! costs exactly that unit's cases, each reported as [`Status::Crash`] (JUnit `<error>`) with
 //! the signal or the timeout named, and the run goes on.
@@ -36,8 +36,10 @@ pub struct Isolation {
 pub enum Unit {
     /// One configuration's submission (`d24s8.render_pass.static_state`).
     Config(Config),
-    /// The `legacy.*` single-configuration checks.
+    /// The `legacy.*` single-configuration checks, but multiview.
     Legacy,
+    /// `legacy.multiview_cube_faces` on its own (a multiview crash costs no other check).
+    Multiview,
     /// The `pipeline.hard_cases.*` renders against the CPU reference, of the hard scenes whose
     /// index is `shard` modulo `shards` (split so that `--jobs` children share them).
     Pipeline {
@@ -49,11 +51,12 @@ pub enum Unit {
 }
 
 impl Unit {
-    /// The name a child is given: the configuration's name, `legacy` or `pipeline`.
+    /// The name a child is given: the configuration's name, `legacy`, `multiview` or `pipeline`.
     pub fn name(&self) -> String {
         match self {
             Unit::Config(c) => c.name(),
             Unit::Legacy => "legacy".into(),
+            Unit::Multiview => "multiview".into(),
             Unit::Pipeline { shards: 1, .. } => "pipeline".into(),
             Unit::Pipeline { shard, shards } => format!("pipeline.{shard}of{shards}"),
         }
@@ -63,6 +66,7 @@ impl Unit {
     pub fn parse(s: &str) -> Option<Unit> {
         match s {
             "legacy" => Some(Unit::Legacy),
+            "multiview" => Some(Unit::Multiview),
             "pipeline" => Some(Unit::Pipeline { shard: 0, shards: 1 }),
             _ if s.starts_with("pipeline.") => {
                 let (k, n) = s["pipeline.".len()..].split_once("of")?;
@@ -93,9 +97,10 @@ pub fn run_unit(ctx: &Context, unit: Unit, new_context: &dyn Fn() -> Result<Cont
             let (cases, config) = suite::run_config(ctx, cfg, format_ok, opts);
             ChildResult { cases, config, legacy: Vec::new() }
         }
-        Unit::Legacy => {
+        Unit::Legacy | Unit::Multiview => {
+            let names = if unit == Unit::Legacy { suite::SINGLE } else { suite::MULTIVIEW };
             let mut cases = Vec::new();
-            let legacy = suite::run_legacy(ctx, new_context, opts, &mut cases);
+            let legacy = suite::run_legacy(ctx, new_context, opts, names, &mut cases);
             ChildResult { cases, config: None, legacy }
         }
         Unit::Pipeline { shard, shards } => {
@@ -159,7 +164,7 @@ pub fn run_suite_isolated(ctx: &Context, opts: &SuiteOptions, iso: &Isolation, a
         }
     }
     let shards = iso.jobs.max(1);
-    let units = std::iter::once(Unit::Legacy).chain((0..shards).map(|shard| Unit::Pipeline { shard, shards }));
+    let units = [Unit::Legacy, Unit::Multiview].into_iter().chain((0..shards).map(|shard| Unit::Pipeline { shard, shards }));
     for unit in units {
         let names = suite::unit_case_names(unit, &opts.filter);
         if names.is_empty() {

@@ -36,7 +36,7 @@
 //! A check also fails when the validation layers reported an error during it.
 //!
 //! The command line runs every unit (a configuration's submission, the legacy checks, the
-//! pipeline checks) in a child process ([`isolate`]), judges a run against a driver's
+//! multiview check, the pipeline checks) in a child process ([`isolate`]), judges a run against a driver's
 //! expected failures ([`expect`]), and puts several runs side by side ([`matrix`]). Any
 //! Vulkan 1.0 device runs the classic render pass with static state; what needs 1.3 is skipped
 //! with the reason.

@@ -199,6 +199,12 @@ const LEGACY: [&str; 9] = [
     super::checks::MULTIVIEW_CUBE_FACES,
 ];
 
+/// The legacy checks the `legacy` unit runs: everything but multiview.
+pub(crate) const SINGLE: &[&str] = LEGACY.split_at(8).0;
+/// The legacy check the `multiview` unit runs on its own: the renderer's multiview cube faces,
+/// the feature most likely to take a driver down (a crash there costs no other check).
+pub(crate) const MULTIVIEW: &[&str] = LEGACY.split_at(8).1;
+
 fn pipeline_name(scene: &str, m: crate::shadow::Method) -> String {
     format!("pipeline.hard_cases.{}.{}", scene.trim_start_matches("hard/"), m.name())
 }
@@ -218,7 +224,8 @@ fn pipeline_shard_names(shard: (usize, usize)) -> Vec<String> {
 /// The selected case names of the legacy or pipeline unit (empty for a configuration unit).
 pub fn unit_case_names(unit: super::isolate::Unit, filter: &[String]) -> Vec<String> {
     let all = match unit {
-        super::isolate::Unit::Legacy => LEGACY.iter().map(|n| format!("legacy.{n}")).collect(),
+        super::isolate::Unit::Legacy => SINGLE.iter().map(|n| format!("legacy.{n}")).collect(),
+        super::isolate::Unit::Multiview => MULTIVIEW.iter().map(|n| format!("legacy.{n}")).collect(),
         super::isolate::Unit::Pipeline { shard, shards } => pipeline_shard_names((shard, shards)),
         super::isolate::Unit::Config(_) => Vec::new(),
     };
@@ -456,7 +463,7 @@ pub fn run_suite(ctx: &Context, new_context: &dyn Fn() -> Result<Context>, opts:
         outcomes.extend(o);
         configs.extend(run);
     }
-    let mut legacy = run_legacy(ctx, new_context, opts, &mut outcomes);
+    let mut legacy = run_legacy(ctx, new_context, opts, &LEGACY, &mut outcomes);
     legacy.extend(run_pipeline(ctx, new_context, opts, (0, 1), &mut outcomes));
     Report {
         device: ctx.info.clone(),
@@ -472,11 +479,12 @@ pub fn run_suite(ctx: &Context, new_context: &dyn Fn() -> Result<Context>, opts:
     }
 }
 
-/// The selected `legacy.*` checks (outcomes into `out`, full results returned).
+/// The selected `legacy.*` checks among `names` (outcomes into `out`, full results returned).
 pub fn run_legacy(
     ctx: &Context,
     new_context: &dyn Fn() -> Result<Context>,
     opts: &SuiteOptions,
+    names: &[&str],
     out: &mut Vec<CaseOutcome>,
 ) -> Vec<CheckResult> {
     type Check = fn(&Context) -> Result<CheckResult>;
@@ -497,7 +505,7 @@ pub fn run_legacy(
     let mut results = Vec::new();
     for (name, f) in unit {
         let full = format!("legacy.{name}");
-        if !selected(&opts.filter, &full) {
+        if !names.contains(&name) || !selected(&opts.filter, &full) {
             continue;
         }
         let mut o = CaseOutcome::new(full, "legacy", None, format!("single-configuration check `{name}` (the renderer's depth format)"));
