@@ -148,6 +148,9 @@ impl SuiteReport {
         for (k, e) in &m.median_rel_error_by_method {
             let _ = writeln!(s, "| {k} | {:.1}% |", e * 100.0);
         }
+        for (k, e) in m.median_rel_error_by_method.iter().filter(|(_, e)| **e > 0.3) {
+            let _ = writeln!(s, "\n{}", self.misfit(k, *e));
+        }
         let mut worst: Vec<&SuiteRow> = self.rows.iter().filter(|r| r.model_rel_error.is_some()).collect();
         worst.sort_by(|a, b| b.model_rel_error.unwrap_or(0.0).total_cmp(&a.model_rel_error.unwrap_or(0.0)));
         let _ = writeln!(s, "\nWorst-predicted rows (held out):\n\n| sweep | scene | variant | method | size | measured ms | predicted ms | error |\n|---|---|---|---|---|---|---|---|");
@@ -168,6 +171,38 @@ impl SuiteReport {
         }
         s.push('\n');
         s
+    }
+
+    /// Where the model fails for `method` (median held-out error `e` over 30 %): why, and the
+    /// spread of its rows at one frame size and one light that no counted work explains.
+    fn misfit(&self, method: &str, e: f64) -> String {
+        let mut same: Vec<&SuiteRow> = self
+            .rows
+            .iter()
+            .filter(|r| r.method == method && r.lights == 1 && r.gpu_shadow_ms.is_some() && r.sweep != "ablation")
+            .collect();
+        // The most common frame size among them.
+        let size = |r: &SuiteRow| (r.width, r.height);
+        let common = same.iter().map(|r| size(r)).max_by_key(|z| same.iter().filter(|r| size(r) == *z).count());
+        same.retain(|r| Some(size(r)) == common);
+        same.sort_by(|a, b| a.gpu_shadow_ms.unwrap_or(0.0).total_cmp(&b.gpu_shadow_ms.unwrap_or(0.0)));
+        let why = match method {
+            "rayquery" => "the model counts one ray per pixel and light, but what a ray costs is its traversal — the top level's instances, each bottom level's depth, how far the ray goes before it hits — which no counter here sees",
+            _ => "its cost depends on work no counter here sees",
+        };
+        let mut line = format!("**The model fails for {method}** (median held-out error {:.0}%): {why}.", e * 100.0);
+        if let (Some(lo), Some(hi), Some((w, h))) = (same.first(), same.last(), common) {
+            line += &format!(
+                " At {w}x{h} with one light its rows run from {:.1} ms (`{}`) to {:.1} ms (`{}`), {:.1}x apart{}.",
+                lo.gpu_shadow_ms.unwrap_or(0.0),
+                lo.scene,
+                hi.gpu_shadow_ms.unwrap_or(0.0),
+                hi.scene,
+                hi.gpu_shadow_ms.unwrap_or(0.0) / lo.gpu_shadow_ms.unwrap_or(1.0).max(1e-9),
+                if method == "rayquery" { ", for the same count of rays" } else { "" }
+            );
+        }
+        line
     }
 
     /// McGuire et al.'s claim ("the simplification method trades vertex rate for fill rate
@@ -359,4 +394,31 @@ fn table<'a>(rows: impl Iterator<Item = &'a SuiteRow>, error: bool) -> String {
         s.push('\n');
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::report::{SuiteReport, SuiteRow};
+
+    #[test]
+    fn the_model_section_says_where_the_model_fails() {
+        let row = |scene: &str, ms: f64, width: u32| SuiteRow {
+            sweep: "casters".into(),
+            scene: scene.into(),
+            method: "rayquery".into(),
+            width,
+            height: 540,
+            lights: 1,
+            gpu_shadow_ms: Some(ms),
+            model_rel_error: Some(0.4),
+            ..Default::default()
+        };
+        let mut report =
+            SuiteReport { rows: vec![row("one", 10.0, 960), row("many", 40.0, 960), row("big", 90.0, 1920)], ..Default::default() };
+        report.model.median_rel_error_by_method = [("rayquery".to_string(), 0.4), ("mcguire".to_string(), 0.05)].into_iter().collect();
+        let md = report.model_markdown();
+        assert!(md.contains("**The model fails for rayquery** (median held-out error 40%)"), "{md}");
+        assert!(md.contains("from 10.0 ms (`one`) to 40.0 ms (`many`), 4.0x apart, for the same count of rays"), "{md}");
+        assert!(!md.contains("fails for mcguire"), "{md}");
+    }
 }

@@ -186,7 +186,7 @@ pub struct Ablation {
 }
 
 /// The whole suite run (`bench.json`).
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Default, Serialize)]
 pub struct SuiteReport {
     /// Vulkan device name.
     pub device: String,
