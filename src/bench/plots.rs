@@ -18,6 +18,37 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 use std::path::Path;
 
+/// Series colours, saturated enough to read as markers and text on white (plotters'
+/// `Palette99` has pale yellows and greens from its tenth colour on).
+const SERIES: [(u8, u8, u8); 20] = [
+    (31, 119, 180),
+    (255, 127, 14),
+    (44, 160, 44),
+    (214, 39, 40),
+    (148, 103, 189),
+    (140, 86, 75),
+    (227, 119, 194),
+    (90, 90, 90),
+    (160, 160, 20),
+    (23, 160, 180),
+    (0, 0, 128),
+    (128, 0, 0),
+    (0, 110, 110),
+    (255, 0, 255),
+    (0, 0, 0),
+    (210, 105, 30),
+    (85, 107, 47),
+    (199, 21, 133),
+    (70, 130, 180),
+    (120, 60, 160),
+];
+
+/// The colour of series `i` (cycling through [`SERIES`]).
+fn series_colour(i: usize) -> RGBAColor {
+    let (r, g, b) = SERIES[i % SERIES.len()];
+    RGBColor(r, g, b).to_rgba()
+}
+
 static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSansMono.ttf");
 const W: u32 = 960;
 const H: u32 = 600;
@@ -106,7 +137,7 @@ where
         .map_err(err(title))?;
     chart.configure_mesh().x_desc(x_label).y_desc("GPU shadow ms").draw().map_err(err(title))?;
     for (i, m) in methods(rows.iter().copied()).iter().enumerate() {
-        let color = Palette99::pick(i).to_rgba();
+        let color = series_colour(i);
         let mut pts: Vec<(f64, f64)> = rows.iter().filter(|r| &r.method == m).filter_map(|r| Some((r.x, r.gpu_shadow_ms?))).collect();
         pts.sort_by(|a, b| a.0.total_cmp(&b.0));
         chart
@@ -209,7 +240,7 @@ where
     chart.draw_series(LineSeries::new(vec![(a0, 1.0), (a1, 1.0)], RED.mix(0.6).stroke_width(2))).map_err(err(&title))?;
     for (i, sweep) in ["scenes", "resolution", "tessellation", "lights", "light_distance", "casters", "caps", "ablation"].iter().enumerate()
     {
-        let color = Palette99::pick(i).to_rgba();
+        let color = series_colour(i);
         let pts: Vec<(f64, f64)> =
             rows.iter().filter(|x| x.sweep == *sweep).filter_map(|x| Some((x.fill_fraction?, x.vertex_fraction?))).collect();
         if pts.is_empty() {
@@ -322,7 +353,7 @@ where
         let mut exact = Vec::new();
         let mut labelled: Vec<(f64, Vec<String>, f64)> = Vec::new();
         for (t, e, m, i) in &pts {
-            let color = Palette99::pick(*i).to_rgba();
+            let color = series_colour(*i);
             let marker = EmptyElement::at((*t, *e)) + Circle::new((0, 0), 4, color.filled());
             chart.draw_series(std::iter::once(marker)).map_err(err(&title))?;
             if *e <= floor {
@@ -387,7 +418,7 @@ where
         chart.draw_series(LineSeries::new(line, BLACK.mix(0.3).stroke_width(1))).map_err(err(&title))?;
     }
     for (i, m) in methods(rows.iter().copied()).iter().enumerate() {
-        let color = Palette99::pick(i).to_rgba();
+        let color = series_colour(i);
         let pts: Vec<(f64, f64)> =
             rows.iter().filter(|x| &x.method == m).filter_map(|x| Some((x.predicted_shadow_ms?, x.gpu_shadow_ms?))).collect();
         chart
