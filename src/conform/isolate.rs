@@ -98,7 +98,7 @@ pub fn run_unit(ctx: &Context, unit: Unit, new_context: &dyn Fn() -> Result<Cont
             ChildResult { cases, config, legacy: Vec::new() }
         }
         Unit::Legacy | Unit::Multiview => {
-            let names = if unit == Unit::Legacy { suite::SINGLE } else { suite::MULTIVIEW };
+            let names = if unit == Unit::Legacy { super::units::SINGLE } else { super::units::MULTIVIEW };
             let mut cases = Vec::new();
             let legacy = suite::run_legacy(ctx, new_context, opts, names, &mut cases);
             ChildResult { cases, config: None, legacy }

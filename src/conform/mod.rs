@@ -57,6 +57,7 @@ pub mod model;
 pub mod raster;
 pub mod report;
 pub mod suite;
+mod units;
 
 pub use suite::{run_suite, Report, SuiteOptions};
 

@@ -12,6 +12,9 @@ use ash::vk;
 use std::path::PathBuf;
 use std::time::Instant;
 
+use super::units::{pipeline_shard_names, LEGACY};
+pub use super::units::{run_legacy, run_pipeline};
+
 /// Options of a suite run.
 #[derive(Clone, Debug)]
 pub struct SuiteOptions {
@@ -52,7 +55,7 @@ pub fn matches(pattern: &str, name: &str) -> bool {
     glob(pattern.as_bytes(), name.as_bytes())
 }
 
-fn selected(filter: &[String], name: &str) -> bool {
+pub(crate) fn selected(filter: &[String], name: &str) -> bool {
     filter.is_empty() || filter.iter().any(|p| matches(p, name))
 }
 
@@ -187,45 +190,11 @@ impl Report {
     }
 }
 
-const LEGACY: [&str; 9] = [
-    "w0_vertices_and_infinity",
-    "depth_clamp",
-    "watertight_fan",
-    "two_sided_stencil_wrap",
-    "stencil_formats",
-    "depth_bounds",
-    "index_types",
-    "deep_wrap_float_count",
-    super::checks::MULTIVIEW_CUBE_FACES,
-];
-
-/// The legacy checks the `legacy` unit runs: everything but multiview.
-pub(crate) const SINGLE: &[&str] = LEGACY.split_at(8).0;
-/// The legacy check the `multiview` unit runs on its own: the renderer's multiview cube faces,
-/// the feature most likely to take a driver down (a crash there costs no other check).
-pub(crate) const MULTIVIEW: &[&str] = LEGACY.split_at(8).1;
-
-fn pipeline_name(scene: &str, m: crate::shadow::Method) -> String {
-    format!("pipeline.hard_cases.{}.{}", scene.trim_start_matches("hard/"), m.name())
-}
-
-/// The pipeline case names of the hard scenes whose index is `shard.0` modulo `shard.1`.
-fn pipeline_shard_names(shard: (usize, usize)) -> Vec<String> {
-    let mut v = Vec::new();
-    let scenes = crate::scene::builtin_names().into_iter().filter(|n| n.starts_with("hard/"));
-    for (_, scene) in scenes.enumerate().filter(|(i, _)| i % shard.1.max(1) == shard.0) {
-        for m in crate::shadow::Method::ALL {
-            v.push(pipeline_name(scene, m));
-        }
-    }
-    v
-}
-
 /// The selected case names of the legacy or pipeline unit (empty for a configuration unit).
 pub fn unit_case_names(unit: super::isolate::Unit, filter: &[String]) -> Vec<String> {
     let all = match unit {
-        super::isolate::Unit::Legacy => SINGLE.iter().map(|n| format!("legacy.{n}")).collect(),
-        super::isolate::Unit::Multiview => MULTIVIEW.iter().map(|n| format!("legacy.{n}")).collect(),
+        super::isolate::Unit::Legacy => super::units::SINGLE.iter().map(|n| format!("legacy.{n}")).collect(),
+        super::isolate::Unit::Multiview => super::units::MULTIVIEW.iter().map(|n| format!("legacy.{n}")).collect(),
         super::isolate::Unit::Pipeline { shard, shards } => pipeline_shard_names((shard, shards)),
         super::isolate::Unit::Config(_) => Vec::new(),
     };
@@ -477,122 +446,6 @@ pub fn run_suite(ctx: &Context, new_context: &dyn Fn() -> Result<Context>, opts:
         legacy,
         seconds: start.elapsed().as_secs_f64(),
     }
-}
-
-/// The selected `legacy.*` checks among `names` (outcomes into `out`, full results returned).
-pub fn run_legacy(
-    ctx: &Context,
-    new_context: &dyn Fn() -> Result<Context>,
-    opts: &SuiteOptions,
-    names: &[&str],
-    out: &mut Vec<CaseOutcome>,
-) -> Vec<CheckResult> {
-    type Check = fn(&Context) -> Result<CheckResult>;
-    type Run<'a> = Box<dyn Fn() -> Result<CheckResult> + 'a>;
-    let on_ctx = |f: Check| -> Run<'_> { Box::new(move || f(ctx)) };
-    let unit: [(&str, Run<'_>); 9] = [
-        (LEGACY[0], on_ctx(super::checks::w0_vertices_and_infinity)),
-        (LEGACY[1], on_ctx(super::checks::depth_clamp)),
-        (LEGACY[2], on_ctx(super::checks::watertight_fan)),
-        (LEGACY[3], on_ctx(super::checks::two_sided_stencil_wrap)),
-        (LEGACY[4], on_ctx(super::checks::stencil_formats)),
-        (LEGACY[5], on_ctx(super::checks::depth_bounds)),
-        (LEGACY[6], on_ctx(super::checks::index_types)),
-        (LEGACY[7], on_ctx(super::checks::deep_wrap_float_count)),
-        // The renderer on a context of its own (the one a frame needs).
-        (LEGACY[8], Box::new(|| super::checks::multiview_cube_faces(ctx, new_context))),
-    ];
-    let mut results = Vec::new();
-    for (name, f) in unit {
-        let full = format!("legacy.{name}");
-        if !names.contains(&name) || !selected(&opts.filter, &full) {
-            continue;
-        }
-        let mut o = CaseOutcome::new(full, "legacy", None, format!("single-configuration check `{name}` (the renderer's depth format)"));
-        // Every check but the float count draws through the harness's dynamic rendering.
-        if !ctx.features.dynamic_rendering && name != "deep_wrap_float_count" {
-            o.status = Status::Skipped;
-            let version = &ctx.info.api_version;
-            o.message =
-                format!("the single-configuration checks draw with dynamic rendering (Vulkan 1.3); the device has Vulkan {version}");
-            out.push(o);
-            continue;
-        }
-        let t0 = Instant::now();
-        let mut r = f().unwrap_or_else(|e| CheckResult::error(name, &e));
-        super::with_validation(&mut r, ctx.take_validation_errors());
-        o.status = r.status;
-        o.message = r.summary.clone();
-        o.seconds = t0.elapsed().as_secs_f64();
-        out.push(o);
-        results.push(r);
-    }
-    results
-}
-
-/// The selected `pipeline.hard_cases.*` cases of the hard scenes in `shard` (`(k, n)`: those
-/// whose index is k modulo n; `(0, 1)`: all), outcomes into `out`, the check's full result
-/// returned.
-pub fn run_pipeline(
-    ctx: &Context,
-    new_context: &dyn Fn() -> Result<Context>,
-    opts: &SuiteOptions,
-    shard: (usize, usize),
-    out: &mut Vec<CaseOutcome>,
-) -> Vec<CheckResult> {
-    let mut results = Vec::new();
-    let names: Vec<String> = pipeline_shard_names(shard).into_iter().filter(|n| selected(&opts.filter, n)).collect();
-    if !names.is_empty() && !ctx.features.dynamic_rendering {
-        for n in names {
-            let mut o = CaseOutcome::new(n, "pipeline", None, "the whole shadow pipeline against the exact CPU reference".into());
-            o.status = Status::Skipped;
-            o.message = format!(
-                "the renderer needs Vulkan 1.3 (dynamicRendering, synchronization2); the device has Vulkan {}",
-                ctx.info.api_version
-            );
-            out.push(o);
-        }
-    } else if !names.is_empty() {
-        let t0 = Instant::now();
-        let (w, h) = opts.pipeline_size;
-        let chosen = |scene: &str, m: crate::shadow::Method| names.contains(&pipeline_name(scene, m));
-        match super::checks::shadow_pipeline_hard_cases(new_context, w, h, &chosen) {
-            Ok(r) => {
-                let per = t0.elapsed().as_secs_f64() / r.cases.len().max(1) as f64;
-                for k in &r.cases {
-                    let full = format!("pipeline.hard_cases.{}.{}", k.scene.trim_start_matches("hard/"), k.method);
-                    if !names.contains(&full) {
-                        continue;
-                    }
-                    let mut o =
-                        CaseOutcome::new(full, "pipeline", None, "the whole shadow pipeline against the exact CPU reference".into());
-                    o.seconds = per;
-                    o.status = if k.status == "fail" { Status::Fail } else { Status::Pass };
-                    o.message = format!(
-                        "{}: {} of {} compared pixels mismatched outside the 1-pixel band ({:.4}%)",
-                        k.status,
-                        k.mismatches_outside_band,
-                        k.compared,
-                        k.worst_fraction_outside_band * 100.0
-                    );
-                    if k.expected_failure {
-                        o.message.push_str(" — a known limitation of this method (accuracy::expected_failure), reproduced");
-                    }
-                    out.push(o);
-                }
-                results.push(r);
-            }
-            Err(e) => {
-                for n in names {
-                    let mut o = CaseOutcome::new(n, "pipeline", None, "the whole shadow pipeline against the exact CPU reference".into());
-                    o.status = Status::Fail;
-                    o.message = format!("error: {e}");
-                    out.push(o);
-                }
-            }
-        }
-    }
-    results
 }
 
 /// The cases whose expectation `brk` changes (the seam test's prediction), among `filter`.
