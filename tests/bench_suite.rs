@@ -42,12 +42,7 @@ fn tiny_suite(tag: &str, driver: &[(String, Option<String>)]) -> serde_json::Val
     let _ = std::fs::remove_dir_all(&dir);
     let mut c = Command::new(env!("CARGO_BIN_EXE_umbrage"));
     c.args(["bench", "--suite", "fill-vertex", "--quick", "--tiny", "--out", dir.to_str().unwrap()]).env("UMBRAGE_VALIDATION", "1");
-    for (k, v) in driver {
-        match v {
-            Some(v) => c.env(k, v),
-            None => c.env_remove(k),
-        };
-    }
+    common::apply_driver_env(&mut c, driver);
     let out = c.output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     if !out.status.success() && std::env::var_os("CI").is_none() && err.contains("Vulkan") {

@@ -20,12 +20,7 @@ type DriverEnv = Vec<(String, Option<String>)>;
 fn umbrage_on(args: &[&str], env: &[(&str, &str)], driver: &[(String, Option<String>)]) -> Output {
     let mut c = Command::new(env!("CARGO_BIN_EXE_umbrage"));
     c.args(args).env("UMBRAGE_VALIDATION", "1").env_remove("UMBRAGE_FAULT").env_remove("UMBRAGE_MEMORY_BUDGET");
-    for (k, v) in driver {
-        match v {
-            Some(v) => c.env(k, v),
-            None => c.env_remove(k),
-        };
-    }
+    common::apply_driver_env(&mut c, driver);
     for (k, v) in env {
         c.env(k, v);
     }

@@ -246,8 +246,9 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
             let c = &s.totals.cases;
             let maps = matches!(technique, Technique::ShadowMap { .. }) && !a.map.is_empty();
             let lookup: Vec<f64> = a.shadow.iter().zip(&a.map).map(|(s, m)| s - m).collect();
-            // The acceleration structures' stats are the ray-query rows' only.
-            let rays = s.ray_query.as_ref().filter(|_| technique == Technique::RayQuery);
+            // The acceleration structures' stats and times are the ray-query rows' only.
+            let ray = technique == Technique::RayQuery;
+            let rays = s.ray_query.as_ref().filter(|_| ray);
             let row = BenchRow {
                 scene: name.clone(),
                 method: technique_label(technique),
@@ -267,13 +268,10 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 shadow_bytes: s.totals.index_bytes + s.totals.vertex_bytes,
                 error_fraction: err.fraction,
                 cases: [c.culled, c.zpass, c.zfail, c.zfail_light_cap],
-                gpu_tlas_ms: (technique == Technique::RayQuery && !a.accel.is_empty()).then(|| median(a.accel)),
+                gpu_tlas_ms: (ray && !a.accel.is_empty()).then(|| median(a.accel)),
                 blas_build_ms: rays.map(|q| q.bottom_level_build_ms),
                 blas_bytes: rays.map(|q| q.bottom_level_bytes),
-                blas_refit_ms: match technique {
-                    Technique::RayQuery => refit_ms(&mut r)?,
-                    _ => None,
-                },
+                blas_refit_ms: if ray { refit_ms(&mut r)? } else { None },
             };
             progress(&row);
             rows.push(row);

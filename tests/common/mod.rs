@@ -61,12 +61,7 @@ pub fn rerun_on_lavapipe_25(test: &str, ignored: bool, env: &[(&str, &str)]) -> 
     for (k, v) in env {
         cmd.env(k, v);
     }
-    for (k, v) in vars {
-        match v {
-            Some(v) => cmd.env(k, v),
-            None => cmd.env_remove(k),
-        };
-    }
+    apply_driver_env(&mut cmd, &vars);
     let out = cmd.output().expect("run the test on lavapipe 25.0.7");
     print!("{}", String::from_utf8_lossy(&out.stdout));
     eprint!("{}", String::from_utf8_lossy(&out.stderr));
@@ -105,4 +100,15 @@ pub fn lavapipe_25_env() -> Option<Vec<(String, Option<String>)>> {
         }
     }
     Some(vars)
+}
+
+/// Applies a driver's environment ([`lavapipe_25_env`]) to `c`: each variable set (`Some`) or
+/// removed (`None`).
+pub fn apply_driver_env(c: &mut std::process::Command, driver: &[(String, Option<String>)]) {
+    for (k, v) in driver {
+        match v {
+            Some(v) => c.env(k, v),
+            None => c.env_remove(k),
+        };
+    }
 }
