@@ -1,13 +1,16 @@
 #!/usr/bin/env bash
-# Extra Mesa lavapipe (CPU Vulkan) versions beside the system's, in a project-local cache
-# (the recipe measured in the design notes, "Three lavapipes on one machine").
+# Extra CPU Vulkan drivers beside the system's, in a project-local cache: Mesa lavapipe versions
+# and Google's SwiftShader (the recipe measured in the design notes, "Three lavapipes on one
+# machine" and "SwiftShader, the fourth driver").
 #
 #   scripts/drivers.sh install VERSION...|all   fetch + extract into $UMBRAGE_DRIVERS_DIR/VERSION
 #   scripts/drivers.sh env VERSION              export lines: eval "$(scripts/drivers.sh env 25.0.7)"
 #   scripts/drivers.sh list | path VERSION | check VERSION | --help
 #
-# VERSION is 20.3.5 (Debian 11 bullseye, Vulkan 1.0), 22.3.6 (Debian 12 bookworm, Vulkan 1.3) or
-# 25.0.7 (bookworm-backports, Vulkan 1.4). The packages come from the Debian mirror the machine's
+# VERSION is 20.3.5 (Debian 11 bullseye, Vulkan 1.0), 22.3.6 (Debian 12 bookworm, Vulkan 1.3),
+# 25.0.7 (bookworm-backports, Vulkan 1.4) or swiftshader (SwiftShader from bookworm's
+# chromium-common, Vulkan 1.3; its package version moves with security updates and is recorded
+# in packages.txt, which `list` prints). The packages come from the Debian mirror the machine's
 # own apt sources name, through a private, throw-away apt state (its own sources list, lists and
 # cache): nothing is installed system-wide and the machine's apt setup is never touched. Each
 # version is staged in a temp dir and renamed into place with a stamp, so an interrupted run
@@ -17,7 +20,7 @@ set -euo pipefail
 REPO="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 DRIVERS_DIR="${UMBRAGE_DRIVERS_DIR:-$REPO/.drivers}"
 case "$DRIVERS_DIR" in /*) ;; *) DRIVERS_DIR="$PWD/$DRIVERS_DIR" ;; esac # ICD JSONs need it absolute
-VERSIONS=(20.3.5 22.3.6 25.0.7)
+VERSIONS=(20.3.5 22.3.6 25.0.7 swiftshader)
 STAMP=.installed # written last, inside the staging dir, before the atomic rename
 
 usage() {
@@ -37,11 +40,15 @@ spec() {
     # libllvm15 is the system's own on bookworm; cached too so the version works without it.
     22.3.6) SUITES="bookworm bookworm-updates bookworm-security"; EXTRA="libllvm15"; API=1.3 ;;
     25.0.7) SUITES="bookworm bookworm-backports"; EXTRA="libdrm2 libdrm-amdgpu1 libllvm15"; API=1.4 ;;
+    # Only libvk_swiftshader.so and its ICD JSON are kept from chromium-common (the rest of
+    # Chromium is deleted after extraction); the library needs only libc, libm and libgcc_s.
+    swiftshader) SUITES="bookworm bookworm-updates bookworm-security"; EXTRA=""; API=1.3 ;;
     *) usage_error "unknown version '$1' (known: ${VERSIONS[*]})" ;;
   esac
 }
 installed() { [ -f "$DRIVERS_DIR/$1/$STAMP" ]; }
-need_installed() { spec "$1"; installed "$1" || die "lavapipe $1 is not installed; run: scripts/drivers.sh install $1"; }
+need_installed() { spec "$1"; installed "$1" || die "$(label "$1") is not installed; run: scripts/drivers.sh install $1"; }
+label() { if [ "$1" = swiftshader ]; then echo SwiftShader; else echo "lavapipe $1"; fi; }
 
 # The Debian archive and security URIs the machine's apt sources already use (one-line .list
 # and deb822 .sources files); deb.debian.org only when none can be read. UMBRAGE_DEBIAN_MIRROR /
@@ -112,12 +119,13 @@ best_version() {
 }
 
 install_one() {
-  local v="$1" stage pkg ver pkgs=() icd lib d
+  local v="$1" stage pkg ver pkgs=() icd lib d main=mesa-vulkan-drivers glob="$1-*"
   spec "$v"
-  for pkg in mesa-vulkan-drivers $EXTRA; do
-    if [ "$pkg" = mesa-vulkan-drivers ]; then ver="$(best_version "$pkg" "$SUITES" "$v-*")"
+  if [ "$v" = swiftshader ]; then main=chromium-common; glob="*"; fi
+  for pkg in $main $EXTRA; do
+    if [ "$pkg" = "$main" ]; then ver="$(best_version "$pkg" "$SUITES" "$glob")"
     else ver="$(best_version "$pkg" "$SUITES" "*")"; fi
-    [ -n "$ver" ] || die "$pkg for Mesa $v not found in $SUITES at $MIRROR" \
+    [ -n "$ver" ] || die "$pkg for $(label "$v") not found in $SUITES at $MIRROR" \
       "(set UMBRAGE_DEBIAN_MIRROR, e.g. to an archive mirror, if the suite has moved)"
     pkgs+=("$pkg=$ver")
   done
@@ -127,19 +135,13 @@ install_one() {
   stage="$(mktemp -d "$DRIVERS_DIR/.stage-$v.XXXXXX")"
   STAGES+=("$stage")
   for pkg in "$APTDIR"/debs/*.deb; do dpkg -x "$pkg" "$stage"; done
+  if [ "$v" = swiftshader ]; then
+    keep_swiftshader "$stage"
+  else
+    keep_lavapipe "$stage" "$v"
+  fi
 
-  # The ICD JSON names the library by a system path or a bare name: point it at our copy. Mesa
-  # 25's is lvp_icd.json (no arch); it is renamed so every version has lvp_icd.<cpu>.json.
-  icd="$(find "$stage/usr/share/vulkan/icd.d" -name 'lvp_icd*.json' | head -n 1)"
-  lib="$(find "$stage/usr/lib" -name libvulkan_lvp.so | head -n 1)"
-  if [ -z "$icd" ] || [ -z "$lib" ]; then die "$v: no lvp ICD JSON or libvulkan_lvp.so in the packages"; fi
-  icd="${icd#"$stage"/}"; lib="${lib#"$stage"/}"
-  d="usr/share/vulkan/icd.d/lvp_icd.$(basename "$(dirname "$lib")" | cut -d- -f1).json"
-  [ "$icd" = "$d" ] || { mv "$stage/$icd" "$stage/$d"; icd="$d"; }
-  sed -i -E "s#(\"library_path\"[[:space:]]*:[[:space:]]*)\"[^\"]*\"#\\1\"$DRIVERS_DIR/$v/$lib\"#" "$stage/$icd"
-  grep -q "\"$DRIVERS_DIR/$v/$lib\"" "$stage/$icd" || die "$v: could not rewrite library_path in $icd"
-
-  write_env "$v" "$stage" "$icd" "$(dirname "$lib")" >"$stage/env.sh"
+  write_env "$v" "$stage" "$ICD" "$(dirname "$LIB")" >"$stage/env.sh"
   printf '%s\n' "${pkgs[@]}" >"$stage/packages.txt"
   date -u +%Y-%m-%dT%H:%M:%SZ >"$stage/$STAMP"
   chmod 755 "$stage"
@@ -149,13 +151,51 @@ install_one() {
   echo "drivers: $v installed in $DRIVERS_DIR/$v ($(du -sh "$DRIVERS_DIR/$v" | cut -f1))"
 }
 
+# Points the ICD JSON's library_path at the extracted library (an absolute path: the JSON names
+# it by a system path, a bare name or a relative path). Sets ICD and LIB, relative to the stage.
+rewrite_icd() { # STAGE VERSION ICD LIB
+  local stage="$1" v="$2"
+  ICD="$3"; LIB="$4"
+  sed -i -E "s#(\"library_path\"[[:space:]]*:[[:space:]]*)\"[^\"]*\"#\\1\"$DRIVERS_DIR/$v/$LIB\"#" "$stage/$ICD"
+  grep -q "\"$DRIVERS_DIR/$v/$LIB\"" "$stage/$ICD" || die "$v: could not rewrite library_path in $ICD"
+}
+
+# SwiftShader: keep the driver and its ICD JSON, drop the rest of Chromium's data.
+keep_swiftshader() { # STAGE
+  local stage="$1" keep
+  keep="$(mktemp -d "$stage/.keep.XXXXXX")"
+  [ -f "$stage/usr/lib/chromium/libvk_swiftshader.so" ] && [ -f "$stage/usr/lib/chromium/vk_swiftshader_icd.json" ] ||
+    die "swiftshader: no usr/lib/chromium/libvk_swiftshader.so or vk_swiftshader_icd.json in chromium-common"
+  mv "$stage/usr/lib/chromium/libvk_swiftshader.so" "$stage/usr/lib/chromium/vk_swiftshader_icd.json" "$keep/"
+  rm -rf "${stage:?}/usr" "${stage:?}/etc"
+  mkdir -p "$stage/usr/lib/swiftshader" "$stage/usr/share/vulkan/icd.d"
+  mv "$keep/libvk_swiftshader.so" "$stage/usr/lib/swiftshader/"
+  mv "$keep/vk_swiftshader_icd.json" "$stage/usr/share/vulkan/icd.d/"
+  rmdir "$keep"
+  rewrite_icd "$stage" swiftshader usr/share/vulkan/icd.d/vk_swiftshader_icd.json usr/lib/swiftshader/libvk_swiftshader.so
+}
+
+keep_lavapipe() { # STAGE VERSION
+  local stage="$1" v="$2" icd lib d
+
+  # The ICD JSON names the library by a system path or a bare name: point it at our copy. Mesa
+  # 25's is lvp_icd.json (no arch); it is renamed so every version has lvp_icd.<cpu>.json.
+  icd="$(find "$stage/usr/share/vulkan/icd.d" -name 'lvp_icd*.json' | head -n 1)"
+  lib="$(find "$stage/usr/lib" -name libvulkan_lvp.so | head -n 1)"
+  if [ -z "$icd" ] || [ -z "$lib" ]; then die "$v: no lvp ICD JSON or libvulkan_lvp.so in the packages"; fi
+  icd="${icd#"$stage"/}"; lib="${lib#"$stage"/}"
+  d="usr/share/vulkan/icd.d/lvp_icd.$(basename "$(dirname "$lib")" | cut -d- -f1).json"
+  [ "$icd" = "$d" ] || { mv "$stage/$icd" "$stage/$d"; icd="$d"; }
+  rewrite_icd "$stage" "$v" "$icd" "$lib"
+}
+
 # env.sh: select this lavapipe alone (VK_ICD_FILENAMES for old loaders, VK_DRIVER_FILES for new),
 # drop loader variables that add or filter drivers, and put its libraries (and any llvm-*/lib)
 # first on LD_LIBRARY_PATH, keeping what was there after.
 write_env() { # VERSION STAGE ICD LIBDIR (the last two relative to the cache root)
   local v="$1" stage="$2" root="$DRIVERS_DIR/$1" icd="$DRIVERS_DIR/$1/$3" libs="$DRIVERS_DIR/$1/$4" d
   for d in "$stage"/usr/lib/llvm-*/lib; do [ -d "$d" ] && libs="$libs:$root/${d#"$stage"/}"; done
-  echo "# lavapipe $v from $root: eval or source this"
+  echo "# $(label "$v") from $root: eval or source this"
   echo "export VK_ICD_FILENAMES=$(printf '%q' "$icd")"
   echo "export VK_DRIVER_FILES=$(printf '%q' "$icd")"
   echo "unset VK_ADD_DRIVER_FILES VK_LOADER_DRIVERS_SELECT VK_LOADER_DRIVERS_DISABLE"
@@ -199,7 +239,10 @@ cmd_check() {
   echo "devices: $n"
   [ "$n" = 1 ] || die "$1: expected exactly one device, saw $n"
   grep -qE "apiVersion\s*= ${API//./\\.}\." <<<"$out" || die "$1: expected Vulkan $API.x"
-  if grep -qE 'driverInfo\s*=' <<<"$out"; then
+  if [ "$1" = swiftshader ]; then
+    grep -qE 'driverName\s*= SwiftShader' <<<"$out" || grep -qE 'deviceName\s*= SwiftShader' <<<"$out" ||
+      die "swiftshader: the device is not SwiftShader"
+  elif grep -qE 'driverInfo\s*=' <<<"$out"; then
     grep -qE "driverInfo\s*= Mesa ${1//./\\.}\b" <<<"$out" || die "$1: driverInfo names another Mesa"
   fi
   echo "drivers: $1 ok"

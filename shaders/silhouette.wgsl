@@ -105,58 +105,69 @@ fn acc_clear() {
     }
 }
 
-// Adds s * x * y * z exactly (s = +1 or -1).
+// An f32's significand (with its hidden bit) and the exponent of its last bit.
+fn significand(b: u32) -> u32 {
+    let f = b & 0x7fffffu;
+    return select(f | 0x800000u, f, ((b >> 23u) & 0xffu) == 0u);
+}
+fn exponent(b: u32) -> i32 {
+    let ef = (b >> 23u) & 0xffu;
+    return select(i32(ef) - 150, -149, ef == 0u);
+}
+
+// Adds s * x * y * z exactly (s = +1 or -1). Written without loops over private arrays
+// or early returns: SwiftShader's compiler (it inlines every call, and `exact` has one
+// call site per term) never finished the looped form (docs/drivers/swiftshader.md).
 fn add3(x: f32, y: f32, z: f32, s: i32) {
     let bx = bitcast<u32>(x);
     let by = bitcast<u32>(y);
     let bz = bitcast<u32>(z);
-    if ((bx & 0x7fffffffu) == 0u || (by & 0x7fffffffu) == 0u || (bz & 0x7fffffffu) == 0u) {
-        return;
-    }
-    var sign = s;
-    if (((bx ^ by ^ bz) >> 31u) != 0u) {
-        sign = -s;
-    }
-    var e = 0i;
-    var m = array<u32, 3>(0u, 0u, 0u);
-    let bs = array<u32, 3>(bx, by, bz);
-    for (var k = 0u; k < 3u; k = k + 1u) {
-        let b = bs[k];
-        let ef = (b >> 23u) & 0xffu;
-        let f = b & 0x7fffffu;
-        if (ef == 0u) {
-            m[k] = f;
-            e = e - 149;
-        } else {
-            m[k] = f | 0x800000u;
-            e = e + i32(ef) - 150;
+    if ((bx & 0x7fffffffu) != 0u && (by & 0x7fffffffu) != 0u && (bz & 0x7fffffffu) != 0u) {
+        let sign = select(s, -s, ((bx ^ by ^ bz) >> 31u) != 0u);
+        let e = exponent(bx) + exponent(by) + exponent(bz);
+        let mx = significand(bx);
+        let my = significand(by);
+        let mz = significand(bz);
+        // mx * my in 12-bit limbs
+        let a0 = mx & 0xfffu;
+        let a1 = mx >> 12u;
+        let b0 = my & 0xfffu;
+        let b1 = my >> 12u;
+        var r0 = a0 * b0;
+        var r1 = a0 * b1 + a1 * b0;
+        var r2 = a1 * b1;
+        r1 = r1 + (r0 >> 12u);
+        r0 = r0 & 0xfffu;
+        r2 = r2 + (r1 >> 12u);
+        r1 = r1 & 0xfffu;
+        let r3 = r2 >> 12u;
+        r2 = r2 & 0xfffu;
+        // times mz
+        let c0 = mz & 0xfffu;
+        let c1 = mz >> 12u;
+        var t0 = r0 * c0;
+        var t1 = r0 * c1 + r1 * c0;
+        var t2 = r1 * c1 + r2 * c0;
+        var t3 = r2 * c1 + r3 * c0;
+        var t4 = r3 * c1;
+        t1 = t1 + (t0 >> 12u);
+        t0 = t0 & 0xfffu;
+        t2 = t2 + (t1 >> 12u);
+        t1 = t1 & 0xfffu;
+        t3 = t3 + (t2 >> 12u);
+        t2 = t2 & 0xfffu;
+        t4 = t4 + (t3 >> 12u);
+        t3 = t3 & 0xfffu;
+        let t5 = t4 >> 12u;
+        t4 = t4 & 0xfffu;
+        let p = u32(e + BIAS);
+        let q = p / 12u;
+        let sh = p % 12u;
+        let t = array<u32, 6>(t0 << sh, t1 << sh, t2 << sh, t3 << sh, t4 << sh, t5 << sh);
+        for (var i = 0u; i < 6u; i = i + 1u) {
+            acc[q + i] = acc[q + i] + sign * i32(t[i] & 0xfffu);
+            acc[q + i + 1u] = acc[q + i + 1u] + sign * i32(t[i] >> 12u);
         }
-    }
-    // m0 * m1 in 12-bit limbs
-    let a0 = m[0] & 0xfffu;
-    let a1 = m[0] >> 12u;
-    let b0 = m[1] & 0xfffu;
-    let b1 = m[1] >> 12u;
-    var r = array<u32, 4>(a0 * b0, a0 * b1 + a1 * b0, a1 * b1, 0u);
-    for (var i = 0u; i < 3u; i = i + 1u) {
-        r[i + 1u] = r[i + 1u] + (r[i] >> 12u);
-        r[i] = r[i] & 0xfffu;
-    }
-    // times m2
-    let c0 = m[2] & 0xfffu;
-    let c1 = m[2] >> 12u;
-    var t = array<u32, 6>(r[0] * c0, r[0] * c1 + r[1] * c0, r[1] * c1 + r[2] * c0, r[2] * c1 + r[3] * c0, r[3] * c1, 0u);
-    for (var i = 0u; i < 5u; i = i + 1u) {
-        t[i + 1u] = t[i + 1u] + (t[i] >> 12u);
-        t[i] = t[i] & 0xfffu;
-    }
-    let p = u32(e + BIAS);
-    let q = p / 12u;
-    let sh = p % 12u;
-    for (var i = 0u; i < 6u; i = i + 1u) {
-        let v = t[i] << sh;
-        acc[q + i] = acc[q + i] + sign * i32(v & 0xfffu);
-        acc[q + i + 1u] = acc[q + i + 1u] + sign * i32(v >> 12u);
     }
 }
 
@@ -181,21 +192,12 @@ fn acc_sign() -> i32 {
     return 0;
 }
 
-// Adds s * (x0 - x1) * (y0 - y1) * (z0 - z1) (each factor a difference of two f32 values,
-// expanded: no rounding).
-fn add_diff3(x0: f32, x1: f32, y0: f32, y1: f32, z0: f32, z1: f32, s: i32) {
-    add3(x0, y0, z0, s);
-    add3(x0, y0, z1, -s);
-    add3(x0, y1, z0, -s);
-    add3(x0, y1, z1, s);
-    add3(x1, y0, z0, -s);
-    add3(x1, y0, z1, s);
-    add3(x1, y1, z0, s);
-    add3(x1, y1, z1, -s);
-}
-
 // Exact facing: point light: det[p0 - L, p1 - L, p2 - L] < 0; directional:
-// det[p1 - p0, p2 - p0, d] > 0 (`geom::predicates::facing_exact`).
+// det[p1 - p0, p2 - p0, d] > 0 (`geom::predicates::facing_exact`). The determinant is the
+// sum over the six permutations (i, j, k) of its rows' components, each a product of three
+// differences expanded into its terms: point light, rows (x0 - x1) (y0 - y1) (z0 - z1) with
+// x = (p0, L), y = (p1, L), z = (p2, L): 8 terms; directional, x = (p1, p0), y = (p2, p0),
+// z = d: 4 terms. One loop over the 48 (or 24) terms, so `add3` is inlined once.
 fn facing_exact(t: u32) -> bool {
     let tri = tris[t];
     var i1 = tri.g.y;
@@ -208,35 +210,30 @@ fn facing_exact(t: u32) -> bool {
     let p1 = positions[i1].xyz;
     let p2 = positions[i2].xyz;
     let l = pc.light.xyz;
-    acc_clear();
-    if (pc.light.w != 0.0) {
-        // rows a = p0 - L, b = p1 - L, c = p2 - L; det = sum over permutations
-        add_diff3(p0.x, l.x, p1.y, l.y, p2.z, l.z, 1);
-        add_diff3(p0.x, l.x, p1.z, l.z, p2.y, l.y, -1);
-        add_diff3(p0.y, l.y, p1.z, l.z, p2.x, l.x, 1);
-        add_diff3(p0.y, l.y, p1.x, l.x, p2.z, l.z, -1);
-        add_diff3(p0.z, l.z, p1.x, l.x, p2.y, l.y, 1);
-        add_diff3(p0.z, l.z, p1.y, l.y, p2.x, l.x, -1);
-        return acc_sign() < 0;
-    }
-    // rows u = p1 - p0, v = p2 - p0, d: det = sum over permutations u_i v_j d_k
-    let d = l;
+    let point = pc.light.w != 0.0;
+    let x0 = select(p1, p0, point);
+    let x1 = select(p0, l, point);
+    let y0 = select(p2, p1, point);
+    let y1 = select(p0, l, point);
+    let z0 = select(l, p2, point);
+    let z1 = l;
+    let terms = select(4u, 8u, point);
     let perms = array<vec4<i32>, 6>(
         vec4<i32>(0, 1, 2, 1), vec4<i32>(0, 2, 1, -1), vec4<i32>(1, 2, 0, 1),
         vec4<i32>(1, 0, 2, -1), vec4<i32>(2, 0, 1, 1), vec4<i32>(2, 1, 0, -1));
-    for (var k = 0u; k < 6u; k = k + 1u) {
-        let pm = perms[k];
-        let ui = p1[pm.x];
-        let uo = p0[pm.x];
-        let vi = p2[pm.y];
-        let vo = p0[pm.y];
-        let dk = d[pm.z];
-        add3(ui, vi, dk, pm.w);
-        add3(ui, vo, dk, -pm.w);
-        add3(uo, vi, dk, -pm.w);
-        add3(uo, vo, dk, pm.w);
+    acc_clear();
+    for (var n = 0u; n < 6u * terms; n = n + 1u) {
+        let pm = perms[n / terms];
+        let b = n % terms;
+        let x = select(x0[pm.x], x1[pm.x], (b & 1u) != 0u);
+        let y = select(y0[pm.y], y1[pm.y], (b & 2u) != 0u);
+        let z = select(z0[pm.z], z1[pm.z], (b & 4u) != 0u);
+        // each term taken from the subtrahend flips the sign
+        let flips = countOneBits(b);
+        add3(x, y, z, select(pm.w, -pm.w, (flips & 1u) != 0u));
     }
-    return acc_sign() > 0;
+    let sign = acc_sign();
+    return select(sign > 0, sign < 0, point);
 }
 
 // The filter's verdict: 1 light-facing, 0 not, 2 undecided (the exact test decides).

@@ -157,6 +157,19 @@ pub enum Misuse {
         /// The id as printed.
         id: String,
     },
+    /// A caster, transparent-caster or sphere id made by another `ShadowPass`: ids carry
+    /// the pass that made them, so one pass never moves, reshapes or removes another's caster.
+    #[error("{what} {id} belongs to ShadowPass #{owner}, not to this one (#{this})")]
+    ForeignId {
+        /// `"caster"` or `"sphere caster"`.
+        what: &'static str,
+        /// The id as printed.
+        id: String,
+        /// The id of the pass that made it.
+        owner: u64,
+        /// The id of the pass it was given to.
+        this: u64,
+    },
     /// A call that needs an option the pass was not created with, or the other target model.
     #[error("{call} needs {needs}")]
     NotConfigured {

@@ -9,6 +9,8 @@ use umbrage::{Error, Result};
 // `umbrage bench`: its arguments and the classic, suite and soak modes.
 #[path = "cli/bench.rs"]
 mod bench_cli;
+#[path = "cli/pipelines.rs"]
+mod pipelines_cli;
 
 #[derive(Parser)]
 #[command(name = "umbrage", version, about = "Exact hard shadows with stencil shadow volumes on Vulkan, measured against a CPU reference")]
@@ -205,6 +207,11 @@ enum Command {
         /// multiplicity) and why, with their triangles and chunks.
         #[arg(long)]
         scene: Option<String>,
+        /// Create every pipeline the renderer and the shadow pass can create on this device
+        /// (recording nothing) and print each one's creation time; non-zero exit when any
+        /// creation fails.
+        #[arg(long)]
+        pipelines: bool,
     },
     /// Speed against error: every method on each scene, side by side on this device; with
     /// `--suite fill-vertex`, the fill-rate vs vertex-rate suite against the device's limits.
@@ -318,7 +325,8 @@ fn main() -> ExitCode {
         Command::Render { frame, out, stats, view, dump, time } => render(&frame, &out, stats.as_deref(), view, dump.as_deref(), time),
         #[cfg(feature = "view")]
         Command::View { frame, view } => frame.options().and_then(|o| umbrage::view::run(&frame.scene, o, &view)),
-        Command::Info { json, scene } => info(json, scene.as_deref()),
+        Command::Info { pipelines: true, .. } => info_pipelines(),
+        Command::Info { json, scene, .. } => info(json, scene.as_deref()),
         Command::Check { dir, band, threshold } => check(&dir, band, threshold),
         Command::Bench(args) => bench_cli::bench_command(args),
         Command::Conform { out, filter, list, junit, device, no_isolate, timeout, jobs, expect, child, child_result } => {
@@ -410,6 +418,17 @@ fn render(frame: &FrameArgs, out: &Path, stats: Option<&Path>, view: View, dump:
     );
     renderer.context().check_validation()?;
     Ok(ExitCode::SUCCESS)
+}
+
+fn info_pipelines() -> Result<ExitCode> {
+    let ctx = umbrage::gpu::Context::any_version(umbrage::gpu::context::validation_requested())?;
+    let device = format!("{} ({} {})", ctx.info.name, ctx.info.driver, ctx.info.driver_info);
+    let (groups, ctx) = pipelines_cli::create_all(ctx);
+    let ok = pipelines_cli::print(&device, &groups);
+    if let Some(ctx) = ctx {
+        ctx.check_validation()?;
+    }
+    Ok(if ok { ExitCode::SUCCESS } else { ExitCode::FAILURE })
 }
 
 fn info(json: bool, scene: Option<&str>) -> Result<ExitCode> {

@@ -11,7 +11,7 @@ mod common;
 #[path = "../examples/embed/host.rs"]
 mod host;
 
-use host::{Config, FrameResult};
+use host::{Config, FrameResult, Skip};
 use umbrage::render::{RenderOptions, Renderer};
 
 /// At most this many pixels (per light, of 320 x 200) may hold another stencil count than
@@ -198,5 +198,44 @@ fn dumps_hold_every_sample() {
             }
         }
         let _ = std::fs::remove_dir_all(&dir);
+    }
+}
+
+/// A host that gives up prepared frames (dropped unrecorded, or recorded and reset without
+/// submitting, then `abandon_frame`) loses nothing: the casters added before the first frame,
+/// and every upload since, reach the GPU with a later frame on either slot, and every frame
+/// that is submitted matches the reference. Without it, the first recorded frame would draw
+/// from vertex buffers nothing ever wrote (no shadow at all).
+#[test]
+fn skipped_frames_lose_no_uploads() {
+    let plans: [&[(usize, Skip)]; 5] = [
+        &[(0, Skip::Unrecorded)],
+        &[(0, Skip::RecordedNotSubmitted)],
+        &[(0, Skip::Unrecorded), (1, Skip::Unrecorded)],
+        &[(0, Skip::RecordedNotSubmitted), (1, Skip::Unrecorded), (2, Skip::RecordedNotSubmitted)],
+        &[(1, Skip::Unrecorded), (2, Skip::RecordedNotSubmitted)],
+    ];
+    for render_pass in [false, true] {
+        for plan in plans {
+            let config = Config { render_pass, skip: plan.to_vec(), ..Config::default() };
+            let frames = match host::run(&config, 5) {
+                Ok(f) => f,
+                Err(e) if e.starts_with("no Vulkan loader") || e.contains("no Vulkan driver") => {
+                    assert!(std::env::var_os("CI").is_none(), "no Vulkan device under CI: {e}");
+                    eprintln!("SKIPPED (no Vulkan device, CI not set): {e}");
+                    return;
+                }
+                Err(e) => panic!("{} skipping {plan:?}: {e}", config.name()),
+            };
+            let submitted: Vec<usize> = (0..5).filter(|f| !plan.iter().any(|(k, _)| k == f)).collect();
+            assert_eq!(frames.iter().map(|r| r.frame).collect::<Vec<_>>(), submitted, "{plan:?}");
+            for r in &frames {
+                for (li, l) in r.lights.iter().enumerate() {
+                    let what = format!("{} skipping {plan:?}, frame {} light {li}", config.name(), r.frame);
+                    assert!(l.shadowed[0] > 100, "{what}: no shadow (an upload was lost)");
+                    assert_eq!(l.mismatches[0], 0, "{what}: mismatches outside the band");
+                }
+            }
+        }
     }
 }

@@ -101,6 +101,50 @@ fn misuse_is_a_clear_error() {
     ctx.check_validation().unwrap();
 }
 
+/// Ids carry the pass that made them: another pass's caster, transparent-caster or sphere id
+/// is refused by every call that takes one (a typed `ForeignId` naming both passes), and
+/// nothing of either pass changes.
+#[test]
+fn another_passes_ids_are_refused() {
+    use umbrage::error::{Error, Misuse};
+    let Some(ctx) = common::context() else { return };
+    {
+        let mut a = pass(&ctx, &desc(&ctx)).unwrap();
+        let mut b = pass(&ctx, &desc(&ctx)).unwrap();
+        let cube = shapes::cuboid(Vec3::ONE);
+        // Both passes' first caster has the same index and generation: only the pass differs.
+        let ida = a.add_caster("a", &cube, DMat4::IDENTITY).unwrap();
+        let idb = b.add_caster("b", &cube, DMat4::from_translation(DVec3::new(0.0, 1.0, 0.0))).unwrap();
+        let sa = a.add_sphere_caster("ball", umbrage::geom::Sphere { center: DVec3::new(2.0, 1.0, 0.0), radius: 0.5 }, None).unwrap();
+        let foreign = |r: umbrage::Result<()>, what: &str| match r {
+            Err(Error::Misuse(Misuse::ForeignId { what: w, owner, this, .. })) => {
+                assert_eq!(w, what);
+                assert_ne!(owner, this);
+            }
+            other => panic!("{what}: expected ForeignId, got {other:?}"),
+        };
+        let bounds = b.casters()[0].object_bounds;
+        foreign(b.set_transform(ida, DMat4::from_scale(DVec3::splat(3.0))), "caster");
+        foreign(b.update_positions(ida, &cube.positions), "caster");
+        foreign(b.remove_caster(ida), "caster");
+        foreign(b.caster_kind(ida).map(|_| ()), "caster");
+        foreign(b.set_sphere(sa, umbrage::geom::Sphere { center: DVec3::ZERO, radius: 1.0 }), "sphere caster");
+        foreign(b.remove_sphere(sa), "sphere caster");
+        foreign(a.set_transform(idb, DMat4::IDENTITY), "caster");
+        foreign(a.remove_caster(idb), "caster");
+        // Nothing changed: B still has its caster where it was, A its caster and sphere.
+        assert_eq!(b.casters().len(), 1);
+        assert_eq!(b.casters()[0].object_bounds, bounds);
+        assert_eq!(b.caster_id(0), Some(idb));
+        assert_eq!(a.casters().len(), 1);
+        assert_eq!(a.spheres().count(), 1);
+        b.set_transform(idb, DMat4::IDENTITY).unwrap();
+        a.remove_caster(ida).unwrap();
+        a.remove_sphere(sa).unwrap();
+    }
+    ctx.check_validation().unwrap();
+}
+
 /// A caster too big for 16-bit indices is split into chunks, never refused.
 #[test]
 fn big_casters_are_split_into_16_bit_chunks() {
@@ -148,6 +192,8 @@ fn deforming_and_removing_casters() {
         // Deferred release: the removed caster's chunk buffer lives until slots 1 and 0 have
         // both been prepared again (frames in flight may still read it). First a steady state:
         // both slots have their streams, the upload's staging copy is gone.
+        // No frame here is recorded, so the upload stays pending (every frame carries it) and
+        // its staging copy lives on with it: once the caster is removed, both go together.
         let qid = q.caster_id(0).unwrap();
         q.prepare(1, &view(), &[light()]).unwrap();
         q.prepare(0, &view(), &[light()]).unwrap();
@@ -157,7 +203,7 @@ fn deforming_and_removing_casters() {
         q.prepare(1, &view(), &[light()]).unwrap();
         assert_eq!(allocations(&ctx), before, "slot 0's frame may still use it");
         q.prepare(0, &view(), &[light()]).unwrap();
-        assert_eq!(allocations(&ctx), before - 1, "released once every slot retired");
+        assert_eq!(allocations(&ctx), before - 2, "the chunk and its pending upload's staging, released once every slot retired");
     }
     ctx.check_validation().unwrap();
 }

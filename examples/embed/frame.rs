@@ -61,6 +61,19 @@ impl Host {
         }
         write_buffer(&mut self.slots[slot].lit, bytemuck::cast_slice(&lit_data))?;
 
+        match self.config.skip.iter().find(|(k, _)| *k == f).map(|&(_, how)| how) {
+            Some(super::Skip::Unrecorded) => return Ok(()), // `frame` dropped unrecorded
+            Some(super::Skip::RecordedNotSubmitted) => {
+                // SAFETY: as below; the command buffer is reset, never submitted.
+                unsafe { self.record(slot, &frame, &push, &lit_draws)? };
+                // SAFETY: the command buffer was recorded above and is not pending execution.
+                unsafe { self.dev().reset_command_buffer(self.slots[slot].cmd, vk::CommandBufferResetFlags::empty()) }
+                    .map_err(vkerr("vkResetCommandBuffer"))?;
+                return self.pass().abandon_frame(slot).map_err(|e| format!("abandon_frame: {e}"));
+            }
+            None => {}
+        }
+
         let started = std::time::Instant::now();
         // SAFETY: the slot's previous submission retired (`retire` waited its fence), so its
         // command buffer may be re-recorded; `frame` was prepared for this slot, which is not

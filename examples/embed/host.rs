@@ -80,11 +80,24 @@ pub struct Config {
     /// (`umbrage::scene::load`'s file or built-in name) whose last shadow-casting mesh slides
     /// 0.25 a frame along +x (frame 0 is the scene as loaded).
     pub scene: Option<String>,
+    /// Frames the host skips after `prepare`, and how (what a host does when its swapchain
+    /// goes out of date): they produce no [`FrameResult`], and the pass must lose nothing.
+    pub skip: Vec<(usize, Skip)>,
+}
+
+/// How a host gives up a prepared frame.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Skip {
+    /// The frame is dropped without recording anything.
+    Unrecorded,
+    /// The frame is recorded, then the command buffer is reset instead of submitted, and the
+    /// pass is told (`ShadowPass::abandon_frame`).
+    RecordedNotSubmitted,
 }
 
 impl Default for Config {
     fn default() -> Config {
-        Config { samples: 1, reverse_z: false, render_pass: false, width: WIDTH, height: HEIGHT, scene: None }
+        Config { samples: 1, reverse_z: false, render_pass: false, width: WIDTH, height: HEIGHT, scene: None, skip: Vec::new() }
     }
 }
 

@@ -81,6 +81,7 @@ fn run(args: &Args) -> Result<bool, String> {
         width: args.size.0,
         height: args.size.1,
         scene: args.scene.clone(),
+        skip: Vec::new(),
     };
     let results = host::run(&config, args.frames as usize)?;
     let mut bad = 0u64;

@@ -343,7 +343,7 @@ impl Context {
                     .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
                 // SAFETY: valid device and create info.
                 let pool = unsafe { device.create_command_pool(&pool_info, None) }.map_err(vkerr("vkCreateCommandPool"))?;
-                Ok(Context {
+                let ctx = Context {
                     entry,
                     instance,
                     debug,
@@ -359,7 +359,16 @@ impl Context {
                     depth_format,
                     limits,
                     validation,
-                })
+                };
+                if minimum == Minimum::Vulkan13 && ctx.null_hardware() {
+                    return Err(Error::Unsupported(format!(
+                        "{} is a driver without a GPU (Mesa's RADV with NODEVICE_SELECT=1 and RADV_FORCE_FAMILY): it creates devices \
+                         and compiles pipelines but executes nothing, so nothing can be rendered; `umbrage info --pipelines` \
+                         creates every pipeline there",
+                        ctx.info.name
+                    )));
+                }
+                Ok(ctx)
             }
             Err(e) => {
                 // SAFETY: nothing else was created from the instance except the messenger.
@@ -372,6 +381,13 @@ impl Context {
                 Err(e)
             }
         }
+    }
+
+    /// Whether the device is a driver's "null hardware" (Mesa RADV's `Null hardware (RADV
+    /// NAVI21)` with `NODEVICE_SELECT=1 RADV_FORCE_FAMILY=...`): real device creation and
+    /// shader compilation, but no GPU behind it.
+    pub fn null_hardware(&self) -> bool {
+        self.info.name.starts_with("Null hardware")
     }
 
     /// The shared validation log: keep a clone to read what validation said during teardown
@@ -476,7 +492,11 @@ impl Drop for Context {
         // SAFETY: wait for all work, then destroy children before parents. The allocator must be
         // dropped (freeing its device memory blocks) before the device.
         unsafe {
-            let _ = self.device.device_wait_idle();
+            // Null hardware runs nothing, and RADV's null winsys has no queue wait (a call
+            // through a null pointer).
+            if !self.null_hardware() {
+                let _ = self.device.device_wait_idle();
+            }
             std::mem::ManuallyDrop::drop(&mut self.allocator);
             self.device.destroy_command_pool(self.pool, None);
             self.device.destroy_device(None);

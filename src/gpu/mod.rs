@@ -6,6 +6,7 @@
 #![warn(missing_docs)]
 pub mod accel;
 pub mod context;
+pub mod creation;
 pub mod descriptors;
 pub mod fault;
 pub mod pipeline;

@@ -268,9 +268,15 @@ pub fn create(ctx: &impl GpuDevice, d: &PipelineDesc) -> Result<vk::Pipeline> {
         Some((render_pass, subpass, _)) => info.render_pass(render_pass).subpass(subpass),
         None => info.push_next(&mut rendering),
     };
-    // SAFETY: every pointer in `info` refers to locals alive for this call; the modules are
-    // destroyed right after, which Vulkan allows once the pipeline exists.
-    let result = unsafe { ctx.device().create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) };
+    let result = super::creation::timed(
+        || label(d),
+        || {
+            // SAFETY: every pointer in `info` refers to locals alive for this call; the modules
+            // are destroyed right after, which Vulkan allows once the pipeline exists.
+            unsafe { ctx.device().create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) }
+                .map_err(|(_, e)| Error::Vulkan { call: "vkCreateGraphicsPipelines", result: e })
+        },
+    );
     // SAFETY: modules are no longer needed after pipeline creation.
     unsafe {
         ctx.device().destroy_shader_module(vs, None);
@@ -278,7 +284,45 @@ pub fn create(ctx: &impl GpuDevice, d: &PipelineDesc) -> Result<vk::Pipeline> {
             ctx.device().destroy_shader_module(fs, None);
         }
     }
-    result.map(|p| p[0]).map_err(|(_, e)| Error::Vulkan { call: "vkCreateGraphicsPipelines", result: e })
+    result.map(|p| p[0])
+}
+
+/// A graphics pipeline's name in [`super::creation`]'s log: its shaders and the state that
+/// tells the renderer's pipelines apart.
+fn label(d: &PipelineDesc) -> String {
+    let mut s = super::creation::shader_name(d.vertex);
+    if let Some(f) = d.fragment {
+        s += &format!(" + {}", super::creation::shader_name(f));
+        if d.fragment_entry != c"main" {
+            s += &format!(":{}", d.fragment_entry.to_string_lossy());
+        }
+    }
+    if d.depth_test {
+        s += &format!(" depth {:?}{}", d.depth_compare, if d.depth_write { " write" } else { "" });
+    }
+    if let Some((f, b)) = d.stencil {
+        s += &format!(" stencil {:?}/{:?} back {:?}/{:?}", f.pass_op, f.depth_fail_op, b.pass_op, b.depth_fail_op);
+    }
+    if d.blend != Blend::None {
+        s += &format!(" blend {:?}", d.blend);
+    }
+    for (on, what) in [
+        (d.depth_clamp, " clamp"),
+        (d.depth_bounds, " bounds"),
+        (d.depth_bias.is_some(), " bias"),
+        (d.render_pass.is_some(), " render-pass"),
+    ] {
+        if on {
+            s += what;
+        }
+    }
+    if d.samples != vk::SampleCountFlags::TYPE_1 {
+        s += &format!(" {}x", d.samples.as_raw());
+    }
+    if d.view_mask != 0 {
+        s += &format!(" views {:#x}", d.view_mask);
+    }
+    s
 }
 
 /// A stencil op state for the shadow-volume passes: the test always passes, `pass` is applied

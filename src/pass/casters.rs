@@ -16,6 +16,8 @@ use gpu_allocator::MemoryLocation;
 /// removed caster is refused with an error, never confused with a newer caster.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct CasterId {
+    /// The pass that made it (`ShadowPass`'s process-unique id).
+    pub(crate) pass: u64,
     pub(crate) index: u32,
     pub(crate) generation: u32,
 }
@@ -26,6 +28,18 @@ pub(crate) struct Upload {
     pub src: vk::Buffer,
     pub dst: vk::Buffer,
     pub size: u64,
+}
+
+/// A copy not yet known to have reached the GPU. It belongs to the pass, not to a frame: every
+/// frame carries every pending upload until a frame that recorded it has retired (its slot
+/// prepared again, the host not having abandoned it), so a frame dropped unrecorded, or recorded
+/// and never submitted, loses nothing. Copying again is harmless: the bytes are the same.
+pub(crate) struct PendingUpload {
+    pub staging: Buffer,
+    pub up: Upload,
+    /// Bit `s`: the frame last prepared on ring slot `s` carries it (and may copy from
+    /// `staging` until that slot is prepared again).
+    pub carried: u64,
 }
 
 /// A caster's static edge-quad geometry (u32 indices: faces first, then quads).
@@ -63,14 +77,16 @@ struct Grave {
 
 /// All casters, in insertion order (the order their volumes are drawn in).
 pub(crate) struct CasterTable {
+    /// The id of the pass that owns the table (every id it hands out carries it).
+    pass: u64,
     /// The planner's view of the live casters (a slice, as `shadow::plan_light` takes it).
     pub cpu: Vec<Caster>,
     /// Their GPU side, index for index.
     pub live: Vec<GpuCaster>,
     /// Per id index: its current generation and dense position in `live` (None: removed).
     slots: Vec<(u32, Option<usize>)>,
-    /// Staging copies not yet handed to a frame.
-    pub pending: Vec<(Buffer, Upload)>,
+    /// Staging copies not yet known to have reached the GPU.
+    pub pending: Vec<PendingUpload>,
     graves: Vec<Grave>,
 }
 
@@ -83,12 +99,21 @@ fn dual_length(vertices: &[Vec3]) -> Vec<[f32; 4]> {
 }
 
 impl CasterTable {
-    pub fn new() -> CasterTable {
-        CasterTable { cpu: Vec::new(), live: Vec::new(), slots: Vec::new(), pending: Vec::new(), graves: Vec::new() }
+    pub fn new(pass: u64) -> CasterTable {
+        CasterTable { pass, cpu: Vec::new(), live: Vec::new(), slots: Vec::new(), pending: Vec::new(), graves: Vec::new() }
     }
 
-    /// Dense index of a live id.
+    /// Dense index of a live id of this pass.
     pub fn find(&self, id: CasterId) -> Result<usize> {
+        if id.pass != self.pass {
+            return Err(crate::error::Misuse::ForeignId {
+                what: "caster",
+                id: format!("{}:{}", id.index, id.generation),
+                owner: id.pass,
+                this: self.pass,
+            }
+            .into());
+        }
         match self.slots.get(id.index as usize) {
             Some(&(generation, Some(i))) if generation == id.generation => Ok(i),
             _ => Err(crate::error::Misuse::UnknownId { what: "caster", id: format!("{}:{}", id.index, id.generation) }.into()),
@@ -107,7 +132,7 @@ impl CasterTable {
             }
         };
         let up = Upload { src: staging.raw, dst: dst.raw, size: data.len() as u64 };
-        self.pending.push((staging, up));
+        self.pending.push(PendingUpload { staging, up, carried: 0 });
         Ok(dst)
     }
 
@@ -131,7 +156,7 @@ impl CasterTable {
     pub fn add(&mut self, dev: &PassDevice, caster: Caster, transform: DMat4) -> Result<CasterId> {
         let chunks = self.upload_chunks(dev, &caster)?;
         let index = self.slots.len() as u32;
-        let id = CasterId { index, generation: 0 };
+        let id = CasterId { pass: self.pass, index, generation: 0 };
         self.slots.push((0, Some(self.live.len())));
         let shells = shell_count(caster.mesh());
         self.cpu.push(caster);
@@ -160,7 +185,7 @@ impl CasterTable {
         if let Some(cs) = c.compute.take() {
             buffers.extend(cs.buffers());
         }
-        self.graves.push(Grave { buffers, mask: all_slots });
+        self.retire(buffers, all_slots);
         Ok(())
     }
 
@@ -214,7 +239,7 @@ impl CasterTable {
             old.extend(cs.buffers());
         }
         self.cpu[i] = caster;
-        self.graves.push(Grave { buffers: old, mask: all_slots });
+        self.retire(old, all_slots);
         Ok(())
     }
 
@@ -261,7 +286,7 @@ impl CasterTable {
                     Err(e) => {
                         // the staged copies already queued still refer to `made`: leave them
                         // to the graves of the next frames (freed once no frame can use them)
-                        self.graves.push(Grave { buffers: made, mask: u64::MAX });
+                        self.retire(made, u64::MAX);
                         return Err(e);
                     }
                 }
@@ -282,6 +307,42 @@ impl CasterTable {
             });
         }
         Ok(())
+    }
+
+    /// Buffers no new frame may use: freed once the slots in `mask` have been prepared again.
+    /// Pending uploads into them are dropped (no later frame copies into a retired buffer);
+    /// their staging copies wait for the frames that carry them.
+    fn retire(&mut self, buffers: Vec<Buffer>, mask: u64) {
+        let (dead, live): (Vec<PendingUpload>, Vec<PendingUpload>) =
+            std::mem::take(&mut self.pending).into_iter().partition(|p| buffers.iter().any(|b| b.raw == p.up.dst));
+        self.pending = live;
+        for p in dead {
+            self.graves.push(Grave { buffers: vec![p.staging], mask: p.carried });
+        }
+        self.graves.push(Grave { buffers, mask });
+    }
+
+    /// Ring slot `slot` is being prepared: settles the uploads its previous frame carried,
+    /// then hands every upload still pending to the new frame. `delivered` says whether that
+    /// previous frame recorded its uploads and was not abandoned by the host; then what it
+    /// carried has reached the GPU (the slot's work has completed) and is no longer pending.
+    /// Returns the new frame's copies and their bytes.
+    pub fn carry_uploads(&mut self, slot: usize, delivered: bool) -> (Vec<Upload>, u64) {
+        let bit = 1u64 << slot;
+        let mut keep = Vec::with_capacity(self.pending.len());
+        for mut p in std::mem::take(&mut self.pending) {
+            if delivered && p.carried & bit != 0 {
+                // Other slots' frames in flight may still copy from the staging buffer.
+                self.graves.push(Grave { buffers: vec![p.staging], mask: p.carried & !bit });
+            } else {
+                p.carried = (p.carried & !bit) | bit;
+                keep.push(p);
+            }
+        }
+        self.pending = keep;
+        let ups: Vec<Upload> = self.pending.iter().map(|p| p.up).collect();
+        let bytes = ups.iter().map(|u| u.size).sum();
+        (ups, bytes)
     }
 
     /// Ring slot `slot` is being prepared, so its previous frame has retired: frees what
@@ -318,8 +379,8 @@ impl CasterTable {
         }
         self.live.clear();
         self.cpu.clear();
-        for (mut b, _) in self.pending.drain(..) {
-            b.destroy(dev);
+        for mut p in self.pending.drain(..) {
+            p.staging.destroy(dev);
         }
         for g in self.graves.drain(..) {
             for mut b in g.buffers {

@@ -403,7 +403,7 @@ impl ShadowPassDesc {
         if ![1, 2, 4, 8].contains(&self.samples) {
             return Err(Error::desc("ShadowPassDesc::samples", format!("must be 1, 2, 4 or 8, got {}", self.samples)));
         }
-        let samples = super::pipelines::sample_flags(self.samples);
+        let samples = sample_flags(self.samples);
         if let TargetModel::RenderPass(rp) = self.target {
             let field = "ShadowPassDesc::target";
             if rp.depth_stencil_format != self.depth_stencil_format {
@@ -536,7 +536,7 @@ impl PassSettings {
         }
         if self.technique == Technique::RayQuery {
             if !caps.ray_query {
-                return Err(super::rays::rays_missing());
+                return Err(rays_missing());
             }
             if self.counter == Counter::Float {
                 return Err(Error::InvalidDesc {
@@ -557,4 +557,24 @@ impl PassSettings {
         }
         Ok(())
     }
+}
+
+/// The sample count flag of `n` samples (1, 2, 4 or 8; checked at creation).
+pub(crate) fn sample_flags(n: u32) -> vk::SampleCountFlags {
+    match n {
+        2 => vk::SampleCountFlags::TYPE_2,
+        4 => vk::SampleCountFlags::TYPE_4,
+        8 => vk::SampleCountFlags::TYPE_8,
+        _ => vk::SampleCountFlags::TYPE_1,
+    }
+}
+
+/// The clear error for a pass without ray query.
+pub(crate) fn rays_missing() -> Error {
+    Error::Unsupported(
+        "Technique::RayQuery needs VK_KHR_ray_query and VK_KHR_acceleration_structure with bufferDeviceAddress (Vulkan 1.2), \
+         enabled by the host (EnabledFeatures::ray_query, and the allocator created with buffer_device_address); \
+         Mesa lavapipe 25.0.7 has them: `scripts/drivers.sh install 25.0.7`"
+            .into(),
+    )
 }

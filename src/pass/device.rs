@@ -1,7 +1,6 @@
 //! The host's device and allocator, as the GPU helpers see them.
 
 use super::desc::ShadowPassDesc;
-use super::pipelines;
 use crate::error::{Error, Result};
 use crate::gpu::context::{lock_allocator, GpuDevice};
 use ash::vk;
@@ -47,7 +46,7 @@ pub(super) fn check_samples(
     limits: &vk::PhysicalDeviceLimits,
     desc: &ShadowPassDesc,
 ) -> Result<()> {
-    let flag = pipelines::sample_flags(desc.samples);
+    let flag = super::desc::sample_flags(desc.samples);
     let framebuffer = limits.framebuffer_depth_sample_counts & limits.framebuffer_stencil_sample_counts;
     // SAFETY: a format query on a valid physical device.
     let image = unsafe {

@@ -11,7 +11,8 @@ use crate::error::{Error, Result};
 use crate::geom::{Light, LightKind};
 use crate::shadow::Case;
 use ash::vk;
-use std::cell::Cell;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 /// The CPU work of one frame ([`ShadowPass::prepare`](super::ShadowPass::prepare)): what the
 /// recording calls draw. It refers to buffers of ring slot [`slot`](Self::slot), valid until
@@ -24,7 +25,9 @@ pub struct PreparedFrame {
     pub(crate) serial: u64,
     pub(crate) stream: vk::Buffer,
     pub(crate) uploads: Vec<Upload>,
-    pub(crate) uploads_recorded: Cell<bool>,
+    /// Shared with the pass's slot: set once the copies are recorded (the pass then counts
+    /// them delivered when the slot is prepared again), cleared by `abandon_frame`.
+    pub(crate) uploads_recorded: Arc<AtomicBool>,
     /// Per light, in the order given to `prepare`.
     pub lights: Vec<LightFrame>,
     /// Totals over all lights (triangles, bytes, cases).
@@ -63,7 +66,7 @@ impl PreparedFrame {
     /// Caster buffers this frame must copy before any volume is drawn (recorded by
     /// [`ShadowPass::cmd_upload`](super::ShadowPass::cmd_upload)).
     pub fn pending_uploads(&self) -> usize {
-        if self.uploads_recorded.get() {
+        if self.uploads_recorded.load(Ordering::Acquire) {
             0
         } else {
             self.uploads.len()
@@ -112,6 +115,35 @@ pub(crate) fn check_lights(lights: &[Light]) -> Result<()> {
 }
 
 impl super::ShadowPass {
+    /// Tells the pass that the frame last prepared on `slot` was recorded but will never be
+    /// submitted: the host reset or freed its command buffer (a swapchain that went out of
+    /// date between recording and submission, a frame skipped late). Its uploads stay pending
+    /// and ride with the next frame on any slot, and recording the same frame again records
+    /// its copies again. A frame dropped without being recorded needs no call: the pass sees
+    /// that `cmd_upload` never ran. Without this call, a recorded frame is taken to have been
+    /// submitted and to have completed by the time its slot is prepared again.
+    ///
+    /// Errors: [`Misuse::SlotOutOfRange`](crate::error::Misuse::SlotOutOfRange).
+    ///
+    /// ```no_run
+    /// # use umbrage::pass::*; use ash::vk;
+    /// # fn f(pass: &mut ShadowPass, frame: &PreparedFrame, device: &ash::Device, cb: vk::CommandBuffer) -> umbrage::Result<()> {
+    /// // The swapchain went out of date after recording: the host resets instead of submitting.
+    /// // SAFETY: `cb` is not pending execution.
+    /// unsafe { device.reset_command_buffer(cb, vk::CommandBufferResetFlags::empty()) }.ok();
+    /// pass.abandon_frame(frame.slot())?; // its caster uploads ride with the next frame
+    /// # Ok(()) }
+    /// ```
+    pub fn abandon_frame(&mut self, slot: usize) -> Result<()> {
+        match self.slots.get(slot) {
+            Some(s) => {
+                s.recorded.store(false, Ordering::Release);
+                Ok(())
+            }
+            None => Err(crate::error::Misuse::SlotOutOfRange { slot, slots: self.slots.len() }.into()),
+        }
+    }
+
     /// Writes the stream into the slot's buffer (grown to the next power of two when short).
     pub(super) fn write_stream(&mut self, slot: usize, data: &[u8]) -> crate::error::Result<vk::Buffer> {
         let dev = &self.dev;

@@ -54,13 +54,22 @@
 //! releases its old buffers only once every slot has been prepared again (so no frame in
 //! flight can still read them).
 //!
+//! **Skipped frames lose nothing:** an upload (a new caster's buffers, new positions, the
+//! compute tables) stays the pass's until a frame that recorded it has retired, and every
+//! frame carries every upload still pending, on any slot. A frame dropped without being
+//! recorded needs nothing from the host; one recorded into a command buffer the host then
+//! resets without submitting is reported with [`ShadowPass::abandon_frame`]. Ids carry their
+//! pass: another pass's caster or sphere id is refused ([`Misuse::ForeignId`]).
+//!
 //! **Layouts and synchronisation:** the host declares the layout its image is in and the one it
 //! wants after ([`DepthStencilTarget::with_layouts`]). With dynamic rendering the pass records
 //! both transitions around its rendering instance, waiting for every earlier command and making
 //! its stencil writes visible to every later one, so the host needs no barrier of its own. In
 //! the render-pass model `cmd_determine` records inside the host's subpass, where no barrier
 //! can go: the declared layouts are the subpass's and the host's subpass dependencies order
-//! the rest. `cmd_upload` records transfer writes followed by a barrier to vertex-attribute,
+//! the rest. `cmd_upload` records transfer writes (after an execution barrier behind earlier
+//! vertex and compute reads: a copy carried by two frames in flight rewrites the same bytes)
+//! followed by a barrier to vertex-attribute,
 //! index and compute reads; `cmd_compute_silhouettes` compute writes followed by a barrier to
 //! indirect-command and index reads.
 //!
@@ -125,7 +134,7 @@ use glam::{DMat4, Vec3};
 use gpu_allocator::vulkan::Allocator;
 use pack::{pack, PackInput};
 use pipelines::Pipelines;
-use std::cell::Cell;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
@@ -138,6 +147,9 @@ struct Slot {
     compute: compute::SlotCompute,
     /// Serial of the frame last prepared in this slot.
     serial: Option<u64>,
+    /// Set by `cmd_upload` of the frame last prepared in this slot (shared with that frame),
+    /// cleared by [`ShadowPass::abandon_frame`]: whether its copies will reach the GPU.
+    recorded: Arc<AtomicBool>,
 }
 
 /// The shadow determination as an embeddable component (see the [module docs](self) for the
@@ -258,17 +270,10 @@ impl ShadowPass {
         desc.settings.check(&caps)?;
         rays::check_host(&desc.settings, desc)?;
         let dev = PassDevice { device: device.clone(), allocator };
-        let mut pipes = Pipelines::new(&dev, desc, caps.depth_clamp, caps.depth_bounds, caps.r32f_blend)?;
-        let compute_pipes = match compute::ComputePipes::new(&dev) {
-            Ok(c) => c,
-            Err(e) => {
-                // SAFETY: the pipelines were just created and never used.
-                unsafe { pipes.destroy(&dev.device) };
-                return Err(e);
-            }
-        };
+        let pipes = Pipelines::new(&dev, desc, caps.depth_clamp, caps.depth_bounds, caps.r32f_blend)?;
+        let id = NEXT_PASS_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let slots = (0..desc.frames_in_flight)
-            .map(|_| Slot { stream: None, staging: Vec::new(), compute: Default::default(), serial: None })
+            .map(|_| Slot { stream: None, staging: Vec::new(), compute: Default::default(), serial: None, recorded: Default::default() })
             .collect();
         Ok(ShadowPass {
             dev,
@@ -276,14 +281,14 @@ impl ShadowPass {
             desc: desc.clone(),
             settings: desc.settings,
             pipes,
-            casters: CasterTable::new(),
+            casters: CasterTable::new(id),
             slots,
             serial: 0,
             planar_receiver: glam::DVec4::Y,
-            compute_pipes: Some(compute_pipes),
+            compute_pipes: None,
             spheres: Vec::new(),
             next_sphere: 0,
-            id: NEXT_PASS_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
+            id,
             instance: instance.clone(),
             rays: None,
             ray_inputs: None,
@@ -423,6 +428,17 @@ impl ShadowPass {
         self.casters.remove(id, all)
     }
 
+    /// Creates now the pipelines that the first frame of `technique` would otherwise create
+    /// (the GPU silhouettes' compute pipelines of [`Technique::Compute`]; the other
+    /// techniques' are made with the pass), so that frame does not wait for the driver's
+    /// shader compiler. Idempotent.
+    pub fn create_pipelines(&mut self, technique: Technique) -> Result<()> {
+        if technique == Technique::Compute && self.compute_pipes.is_none() {
+            self.compute_pipes = Some(compute::ComputePipes::new(&self.dev)?);
+        }
+        Ok(())
+    }
+
     fn all_slots(&self) -> u64 {
         if self.slots.len() == 64 {
             u64::MAX
@@ -494,15 +510,14 @@ impl ShadowPass {
             self.casters.ensure_edge_quads(&self.dev)?;
         }
         if self.settings.technique == Technique::Compute {
+            self.create_pipelines(Technique::Compute)?;
             self.casters.ensure_compute(&self.dev)?;
         }
-        let mut uploads = Vec::new();
-        let mut upload_bytes = 0;
-        for (b, up) in self.casters.pending.drain(..) {
-            upload_bytes += up.size;
-            uploads.push(up);
-            self.slots[slot].staging.push(b);
-        }
+        // What the slot's previous frame recorded has reached the GPU; everything else still
+        // pending rides with this frame (a dropped or abandoned frame loses nothing).
+        let recorded = std::mem::take(&mut self.slots[slot].recorded);
+        let (uploads, upload_bytes) = self.casters.carry_uploads(slot, recorded.load(Ordering::Acquire));
+        let uploads_recorded = self.slots[slot].recorded.clone();
 
         let packed = pack(
             &self.casters,
@@ -546,7 +561,7 @@ impl ShadowPass {
             serial,
             stream,
             uploads,
-            uploads_recorded: Cell::new(false),
+            uploads_recorded,
             lights: packed.lights,
             totals,
             cpu_ms: cpu,

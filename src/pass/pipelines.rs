@@ -1,7 +1,7 @@
 //! The shadow pass's pipelines: every way a volume face is counted, as a table of
 //! fixed-function state (stencil ops, depth compare). Destroyed exactly as created.
 
-use super::desc::{DepthDirection, DepthMode, ShadowPassDesc, TargetModel};
+use super::desc::{sample_flags, DepthDirection, DepthMode, ShadowPassDesc, TargetModel};
 use super::push::VolumePush;
 use crate::error::Result;
 use crate::gpu::descriptors::pipeline_layout;
@@ -63,16 +63,6 @@ pub(crate) struct Pipelines {
     pub planar: vk::Pipeline,
     /// The same into the float counter (+1, additive; any non-zero count is shadow).
     pub planar_count: Option<vk::Pipeline>,
-}
-
-/// The sample count flag of `n` samples (1, 2, 4 or 8; checked at creation).
-pub(crate) fn sample_flags(n: u32) -> vk::SampleCountFlags {
-    match n {
-        2 => vk::SampleCountFlags::TYPE_2,
-        4 => vk::SampleCountFlags::TYPE_4,
-        8 => vk::SampleCountFlags::TYPE_8,
-        _ => vk::SampleCountFlags::TYPE_1,
-    }
 }
 
 /// A depth compare for forward depth, mirrored for reverse-Z (closer is GREATER).

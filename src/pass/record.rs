@@ -159,10 +159,21 @@ impl ShadowPass {
     /// the frame's slot is prepared again.
     pub unsafe fn cmd_upload(&self, cb: vk::CommandBuffer, frame: &PreparedFrame) -> Result<()> {
         self.check_frame(frame)?;
-        if frame.uploads_recorded.replace(true) || frame.uploads.is_empty() {
+        if frame.uploads_recorded.swap(true, std::sync::atomic::Ordering::AcqRel) || frame.uploads.is_empty() {
             return Ok(());
         }
         let d = &self.dev.device;
+        use vk::AccessFlags2 as A;
+        use vk::PipelineStageFlags2 as S;
+        // An upload not yet known to have landed rides with every frame until one that
+        // carried it retires, so an earlier frame still in flight may be reading the buffer
+        // this copy rewrites (with the same bytes): order the copies after those reads.
+        crate::gpu::resources::memory_barrier(
+            &self.dev,
+            cb,
+            (S::VERTEX_INPUT | S::COMPUTE_SHADER, A::NONE),
+            (S::TRANSFER, A::TRANSFER_WRITE),
+        );
         // SAFETY: the caller's contract; the staging and destination buffers live until the
         // frame's slot is prepared again.
         unsafe {
@@ -170,8 +181,6 @@ impl ShadowPass {
                 d.cmd_copy_buffer(cb, up.src, up.dst, &[vk::BufferCopy { src_offset: 0, dst_offset: 0, size: up.size }]);
             }
         }
-        use vk::AccessFlags2 as A;
-        use vk::PipelineStageFlags2 as S;
         crate::gpu::resources::memory_barrier(
             &self.dev,
             cb,

@@ -22,7 +22,11 @@ use glam::{DMat4, DVec4};
 
 /// A sphere caster added to a [`ShadowPass`](super::ShadowPass) (ids are never reused).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct SphereId(pub(crate) u64);
+pub struct SphereId {
+    /// The pass that made it (`ShadowPass`'s process-unique id).
+    pub(crate) pass: u64,
+    pub(crate) n: u64,
+}
 
 /// A sphere caster as [`ShadowPass::spheres`](super::ShadowPass::spheres) lists it.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -206,11 +210,14 @@ pub(crate) fn pack_light(
 }
 
 /// The index of sphere `id`.
-pub(crate) fn find(spheres: &[SphereCaster], id: SphereId) -> Result<usize> {
+pub(crate) fn find(spheres: &[SphereCaster], pass: u64, id: SphereId) -> Result<usize> {
+    if id.pass != pass {
+        return Err(crate::error::Misuse::ForeignId { what: "sphere caster", id: format!("{}", id.n), owner: id.pass, this: pass }.into());
+    }
     spheres
         .iter()
         .position(|s| s.id == id)
-        .ok_or_else(|| crate::error::Misuse::UnknownId { what: "sphere caster", id: format!("{id:?}") }.into())
+        .ok_or_else(|| crate::error::Misuse::UnknownId { what: "sphere caster", id: format!("{}", id.n) }.into())
 }
 
 /// Rejects a sphere the pass cannot draw.
@@ -238,7 +245,7 @@ impl super::ShadowPass {
     /// light is inside or on a sphere caster is refused by `prepare`.
     pub fn add_sphere_caster(&mut self, name: &str, sphere: crate::geom::Sphere, segments: Option<u32>) -> Result<SphereId> {
         check_sphere(name, &sphere, segments)?;
-        let id = SphereId(self.next_sphere);
+        let id = SphereId { pass: self.id, n: self.next_sphere };
         self.next_sphere += 1;
         self.spheres.push(SphereCaster { id, name: name.to_string(), sphere, segments });
         Ok(id)
@@ -246,7 +253,7 @@ impl super::ShadowPass {
 
     /// Moves or resizes a sphere caster (from the next `prepare`).
     pub fn set_sphere(&mut self, id: SphereId, sphere: crate::geom::Sphere) -> Result<()> {
-        let i = find(&self.spheres, id)?;
+        let i = find(&self.spheres, self.id, id)?;
         check_sphere(&self.spheres[i].name, &sphere, self.spheres[i].segments)?;
         self.spheres[i].sphere = sphere;
         Ok(())
@@ -254,7 +261,7 @@ impl super::ShadowPass {
 
     /// Removes a sphere caster (its volumes live in the per-frame stream: nothing to release).
     pub fn remove_sphere(&mut self, id: SphereId) -> Result<()> {
-        let i = find(&self.spheres, id)?;
+        let i = find(&self.spheres, self.id, id)?;
         self.spheres.remove(i);
         Ok(())
     }

@@ -209,10 +209,15 @@ impl ComputePipes {
         let make = |entry: &std::ffi::CStr| -> Result<vk::Pipeline> {
             let stage = vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::COMPUTE).module(module).name(entry);
             let info = [vk::ComputePipelineCreateInfo::default().stage(stage).layout(self.layout)];
-            // SAFETY: valid device, module and layout; the create info points at locals.
-            unsafe { d.create_compute_pipelines(vk::PipelineCache::null(), &info, None) }
-                .map(|p| p[0])
-                .map_err(|(_, e)| Error::vk("vkCreateComputePipelines")(e))
+            crate::gpu::creation::timed(
+                || format!("silhouette.wgsl:{}", entry.to_string_lossy()),
+                || {
+                    // SAFETY: valid device, module and layout; the create info points at locals.
+                    unsafe { d.create_compute_pipelines(vk::PipelineCache::null(), &info, None) }
+                        .map(|p| p[0])
+                        .map_err(|(_, e)| Error::vk("vkCreateComputePipelines")(e))
+                },
+            )
         };
         let r = make(c"facing").and_then(|f| {
             self.facing = f;

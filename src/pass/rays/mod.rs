@@ -41,7 +41,7 @@ mod batch;
 mod record;
 use balls::Balls;
 pub use record::RayQueryFrame;
-pub(crate) use record::{check_host, rays_missing, RayFrame};
+pub(crate) use record::{check_host, RayFrame};
 
 /// The host's G-buffer as the rays read it ([`ShadowPass::set_ray_query_inputs`](super::ShadowPass::set_ray_query_inputs)).
 ///

@@ -198,7 +198,7 @@ impl ShadowPass {
     /// non-finite offset.
     pub fn set_ray_query_inputs(&mut self, inputs: RayQueryInputs) -> Result<()> {
         if !self.caps.ray_query {
-            return Err(rays_missing());
+            return Err(crate::pass::desc::rays_missing());
         }
         if !(inputs.surface_offset.is_finite() && inputs.surface_offset >= 0.0) {
             return Err(Error::argument(
@@ -259,16 +259,6 @@ impl ShadowPass {
         self.slots[slot].staging.extend(transient);
         out
     }
-}
-
-/// The clear error for a pass without ray query.
-pub(crate) fn rays_missing() -> Error {
-    Error::Unsupported(
-        "Technique::RayQuery needs VK_KHR_ray_query and VK_KHR_acceleration_structure with bufferDeviceAddress (Vulkan 1.2), \
-         enabled by the host (EnabledFeatures::ray_query, and the allocator created with buffer_device_address); \
-         Mesa lavapipe 25.0.7 has them: `scripts/drivers.sh install 25.0.7`"
-            .into(),
-    )
 }
 
 /// Refuses settings the host's configuration cannot take: ray query traces one ray per pixel
