@@ -12,15 +12,16 @@ deps:
 	@./scripts/drivers.sh install 25.0.7 >/dev/null || echo "warning: Mesa lavapipe 25.0.7 not installed (scripts/drivers.sh install 25.0.7): no --method rayquery here" >&2
 
 # What the tests and the conformance runs need as well (off Debian: the validation layer too),
-# and lavapipe 25.0.7, which tests/rayquery.rs runs on when the system's driver has no ray query.
+# lavapipe 25.0.7, which tests/rayquery.rs runs on when the system's driver has no ray query,
+# and SwiftShader, which tests/hard_cases.rs, the quick matrix and the minimal example run on.
 deps-tests:
 	@./scripts/deps.sh --tests
-	./scripts/drivers.sh install 25.0.7
+	./scripts/drivers.sh install 25.0.7 swiftshader
 
-# Three Mesa lavapipe versions (Vulkan 1.0, 1.3, 1.4) in .drivers/, beside the system's; select
-# one with eval "$$(scripts/drivers.sh env 25.0.7)" (scripts/drivers.sh --help).
+# Three Mesa lavapipe versions (Vulkan 1.0, 1.3, 1.4) and SwiftShader in .drivers/, beside the
+# system's; select one with eval "$$(scripts/drivers.sh env 25.0.7)" (scripts/drivers.sh --help).
 drivers:
-	./scripts/drivers.sh install 20.3.5 22.3.6 25.0.7
+	./scripts/drivers.sh install 20.3.5 22.3.6 25.0.7 swiftshader
 
 run: deps
 	$(CARGO) run -- render
@@ -39,6 +40,7 @@ test: deps-tests lint
 	$(CARGO) test --doc
 	$(CARGO) build --lib --no-default-features
 	UMBRAGE_VALIDATION=1 $(CARGO) run --example minimal --no-default-features
+	eval "$$(./scripts/drivers.sh env swiftshader)" && UMBRAGE_VALIDATION=1 $(CARGO) run --example minimal --no-default-features
 	$(MAKE) doc
 
 # Formatting and lints (Cargo.toml's [lints]: every unsafe block and unsafe fn documented),

@@ -4,8 +4,9 @@
 # switches that change its code paths, then `umbrage conform-matrix` side by side.
 #
 #   scripts/conform-matrix.sh            the full suite per column -> docs/conform/drivers.md
-#   scripts/conform-matrix.sh --quick    one configuration per family on the three drivers, each
+#   scripts/conform-matrix.sh --quick    one configuration per family on the four drivers, each
 #                                        judged against docs/conform/expectations/lavapipe-V.txt
+#                                        (SwiftShader: expectations/swiftshader.txt)
 #                                        (Mesa CI style: a new failure or an unexpected pass fails)
 #
 # Reports go to target/conform-matrix/<column>/ (conform.json, conform.md, junit.xml).
@@ -17,7 +18,7 @@ quick=0
 [ "${1:-}" = "--quick" ] && quick=1
 out=target/conform-matrix
 exp=docs/conform/expectations
-./scripts/drivers.sh install 20.3.5 22.3.6 25.0.7
+./scripts/drivers.sh install 20.3.5 22.3.6 25.0.7 swiftshader
 cargo build --quiet --bin umbrage
 bin="${CARGO_TARGET_DIR:-target}/debug/umbrage"
 export UMBRAGE_VALIDATION=1
@@ -35,11 +36,13 @@ run() {
   dir="${dir//=/-}" # conform-matrix reads NAME=DIR: no '=' in DIR
   rm -rf "$dir"
   local args=(conform --out "$dir" --junit "$dir/junit.xml")
-  if [ $quick = 1 ]; then args+=(--filter "$QUICK" --expect "$exp/lavapipe-$version.txt"); fi
+  local expect="$exp/lavapipe-$version.txt"
+  [ "$version" != swiftshader ] || expect="$exp/swiftshader.txt"
+  if [ $quick = 1 ]; then args+=(--filter "$QUICK" --expect "$expect"); fi
   echo "== $name"
   local rc=0
   (eval "$(./scripts/drivers.sh env "$version")" && env "$@" "$bin" "${args[@]}") 2>&1 |
-    grep -v '^WARNING: lavapipe is not a conformant' | grep -E '^(PASS|FAIL|NEW|UNEXPECTED|expectations|llvmpipe)' || true
+    grep -v '^WARNING: lavapipe is not a conformant' | grep -E '^(PASS|FAIL|NEW|UNEXPECTED|expectations|llvmpipe|SwiftShader)' || true
   # The pipeline above hides the exit status; the report says what happened.
   if [ $quick = 1 ]; then
     if ! grep -q '"new_failures": \[\]' "$dir/expectations.json" 2>/dev/null ||
@@ -78,6 +81,7 @@ status=0
 run 20.3.5 20.3.5 || status=1
 run 22.3.6 22.3.6 || status=1
 run 25.0.7 25.0.7 || status=1
+run swiftshader swiftshader || status=1
 if [ $quick = 0 ]; then
   # llvmpipe's own switches (docs/conform/mesa-ci-notes.md): the JIT's SIMD width, the
   # rasteriser's debug path (read by release builds since Mesa 24), and draw's C clipper.

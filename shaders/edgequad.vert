@@ -16,5 +16,11 @@ void main() {
     if (dot(in_plane.xyz, pc.light.xyz) + in_plane.w * pc.light.w <= 0.0) {
         p = vec4(in_pos * pc.light.w - pc.light.xyz, 0.0);
     }
-    gl_Position = pc.mvp * p;
+    vec4 c = pc.mvp * p;
+    // Clip w exactly 0 (a direction perpendicular to the view axis) as +tiny: the same
+    // primitive in the limit, and what SwiftShader needs (shadow.vert says why).
+    if (p.w == 0.0 && c.w == 0.0) {
+        c.w = max(max(abs(c.x), abs(c.y)), abs(c.z)) * 8.6736174e-19;
+    }
+    gl_Position = c;
 }

@@ -116,8 +116,8 @@ fn exponent(b: u32) -> i32 {
 }
 
 // Adds s * x * y * z exactly (s = +1 or -1). Written without loops over private arrays
-// or early returns: SwiftShader's compiler (it inlines every call, and `exact` has one
-// call site per term) never finished the looped form (docs/drivers/swiftshader.md).
+// or early returns: SwiftShader's compiler (it inlines every call) never finished the form
+// with a call site per term (docs/drivers/pipelines.md).
 fn add3(x: f32, y: f32, z: f32, s: i32) {
     let bx = bitcast<u32>(x);
     let by = bitcast<u32>(y);

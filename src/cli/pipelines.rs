@@ -46,7 +46,8 @@ fn render_pass(ctx: &Context, samples: u32) -> Result<(vk::RenderPass, sp::Rende
     let info = vk::RenderPassCreateInfo::default().attachments(&att).subpasses(&sub);
     // SAFETY: creation on a valid device from locals; destroyed by the caller.
     let rp = unsafe { ctx.device.create_render_pass(&info, None) }.map_err(umbrage::Error::vk("vkCreateRenderPass"))?;
-    let target = sp::RenderPassTarget { render_pass: rp, subpass: 0, depth_stencil_format: ctx.depth_format, samples: flags, color_attachments: 0 };
+    let target =
+        sp::RenderPassTarget { render_pass: rp, subpass: 0, depth_stencil_format: ctx.depth_format, samples: flags, color_attachments: 0 };
     Ok((rp, target))
 }
 
@@ -138,7 +139,12 @@ pub fn create_all(ctx: Context) -> (Vec<Group>, Option<Context>) {
         let scene = match umbrage::scene::load("default") {
             Ok(s) => s,
             Err(e) => {
-                out.push(Group { name: "Renderer (default scene)".into(), creations: Vec::new(), error: Some(e.to_string()), not_attempted: None });
+                out.push(Group {
+                    name: "Renderer (default scene)".into(),
+                    creations: Vec::new(),
+                    error: Some(e.to_string()),
+                    not_attempted: None,
+                });
                 ctx = Some(c);
                 break;
             }
@@ -146,7 +152,12 @@ pub fn create_all(ctx: Context) -> (Vec<Group>, Option<Context>) {
         match Renderer::new(c, scene, opts) {
             Ok(r) => {
                 ctx = Some(r.into_context());
-                out.push(Group { name: format!("Renderer {samples}x (default scene)"), creations: creation::take(), error: None, not_attempted: None });
+                out.push(Group {
+                    name: format!("Renderer {samples}x (default scene)"),
+                    creations: creation::take(),
+                    error: None,
+                    not_attempted: None,
+                });
             }
             Err(e) => out.push(Group {
                 name: format!("Renderer {samples}x (default scene)"),

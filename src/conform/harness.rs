@@ -220,7 +220,7 @@ fn prepare_draw(
     pipelines: &mut Vec<vk::Pipeline>,
     buffers: &mut Vec<Buffer>,
 ) -> Result<RecordedDraw> {
-    let mut desc = PipelineDesc::new(shaders::SHADOW_VERT, layout, format);
+    let mut desc = PipelineDesc::new(shaders::SHADOW_RAW_VERT, layout, format);
     desc.vertex_stride = 16;
     desc.attributes = &[(0, vk::Format::R32G32B32A32_SFLOAT, 0)];
     desc.depth_test = d.spec.depth_test;

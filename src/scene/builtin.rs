@@ -21,6 +21,7 @@ pub const SCENES: &[(&str, &str)] = &[
     ("hard/near_plane_cut", include_str!("../../scenes/hard/near_plane_cut.toml")),
     ("hard/light_inside_bounds", include_str!("../../scenes/hard/light_inside_bounds.toml")),
     ("hard/light_in_face_plane", include_str!("../../scenes/hard/light_in_face_plane.toml")),
+    ("hard/bounded_lights", include_str!("../../scenes/hard/bounded_lights.toml")),
     ("hard/grazing_directional", include_str!("../../scenes/hard/grazing_directional.toml")),
     ("hard/light_very_close", include_str!("../../scenes/hard/light_very_close.toml")),
     ("hard/near_coplanar", include_str!("../../scenes/hard/near_coplanar.toml")),

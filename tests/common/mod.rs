@@ -74,8 +74,14 @@ pub fn rerun_on_lavapipe_25(test: &str, ignored: bool, env: &[(&str, &str)]) -> 
 /// (`scripts/drivers.sh env 25.0.7`): each variable to set (`Some`) or remove (`None`); `None`
 /// when that driver is not installed.
 pub fn lavapipe_25_env() -> Option<Vec<(String, Option<String>)>> {
+    driver_env("25.0.7")
+}
+
+/// The environment of `scripts/drivers.sh env VERSION` (`25.0.7`, `swiftshader`, ...), as
+/// [`lavapipe_25_env`] reads it; `None` when that driver is not installed.
+pub fn driver_env(version: &str) -> Option<Vec<(String, Option<String>)>> {
     let root = env!("CARGO_MANIFEST_DIR");
-    let o = std::process::Command::new(format!("{root}/scripts/drivers.sh")).args(["env", "25.0.7"]).output().ok()?;
+    let o = std::process::Command::new(format!("{root}/scripts/drivers.sh")).args(["env", version]).output().ok()?;
     if !o.status.success() {
         return None;
     }
@@ -111,4 +117,29 @@ pub fn apply_driver_env(c: &mut std::process::Command, driver: &[(String, Option
             None => c.env_remove(k),
         };
     }
+}
+
+/// Runs the `#[ignore]`d helper test `test` of this binary in a child process whose only
+/// Vulkan device is SwiftShader from `.drivers/` (`scripts/drivers.sh env swiftshader`), with
+/// `env` added, and asserts that it passed. Returns false when SwiftShader is not installed
+/// and `CI` is not set (a loud skip); under `CI` that is a failure.
+pub fn rerun_on_swiftshader(test: &str, env: &[(&str, &str)]) -> bool {
+    let Some(vars) = driver_env("swiftshader") else {
+        let why = "SwiftShader is not installed (scripts/drivers.sh install swiftshader)";
+        assert!(std::env::var_os("CI").is_none(), "{why}");
+        eprintln!("SKIPPED: {why}");
+        return false;
+    };
+    let mut cmd = std::process::Command::new(std::env::current_exe().expect("test binary"));
+    cmd.args(["--exact", test, "--nocapture", "--test-threads", "1", "--ignored"]);
+    for (k, v) in env {
+        cmd.env(k, v);
+    }
+    apply_driver_env(&mut cmd, &vars);
+    let out = cmd.output().expect("run the test on SwiftShader");
+    print!("{}", String::from_utf8_lossy(&out.stdout));
+    eprint!("{}", String::from_utf8_lossy(&out.stderr));
+    assert!(out.status.success(), "{test} failed on SwiftShader (output above)");
+    assert!(String::from_utf8_lossy(&out.stdout).contains("1 passed"), "{test} did not run in the child");
+    true
 }

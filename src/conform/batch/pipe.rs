@@ -45,7 +45,7 @@ pub fn dynamic_states(model: StateModel, depth_bounds: bool) -> Vec<vk::DynamicS
 
 /// Creates the pipeline for `st` in `cfg` (`render_pass`: the pass for [`RenderModel::RenderPass`]).
 pub fn create(ctx: &Context, cfg: Config, st: &DsState, layout: vk::PipelineLayout, render_pass: vk::RenderPass) -> Result<vk::Pipeline> {
-    let vs = pipeline::shader_module(ctx, shaders::SHADOW_VERT)?;
+    let vs = pipeline::shader_module(ctx, shaders::SHADOW_RAW_VERT)?;
     let stages = [vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vs).name(c"main")];
     let bindings = [vk::VertexInputBindingDescription { binding: 0, stride: 16, input_rate: vk::VertexInputRate::VERTEX }];
     let attrs = [vk::VertexInputAttributeDescription { location: 0, binding: 0, format: vk::Format::R32G32B32A32_SFLOAT, offset: 0 }];

@@ -129,7 +129,7 @@ fn render_pass(ctx: &Context, ds_format: vk::Format) -> Result<vk::RenderPass> {
 /// The counting pipeline: `shadow.vert` + `count.frag`, additive R32F blending, two-sided
 /// stencil INCR_WRAP / DECR_WRAP, no depth test, no culling.
 fn counting_pipeline(ctx: &Context, layout: vk::PipelineLayout, render_pass: vk::RenderPass) -> Result<vk::Pipeline> {
-    let vs = pipeline::shader_module(ctx, shaders::SHADOW_VERT)?;
+    let vs = pipeline::shader_module(ctx, shaders::SHADOW_RAW_VERT)?;
     let fs = match pipeline::shader_module(ctx, shaders::COUNT_FRAG) {
         Ok(f) => f,
         Err(e) => {
