@@ -236,3 +236,37 @@ fn render_msaa_dumps_every_sample() {
         "one sample",
     );
 }
+
+/// `umbrage info --pipelines` creates every pipeline the renderer and the shadow pass can
+/// create (validation on), one line each with its time, the compute silhouettes' included,
+/// and says all were created; with `UMBRAGE_PIPELINE_TRACE=1` each is named before creation.
+#[test]
+fn info_pipelines_creates_and_times_every_pipeline() {
+    let out = Command::new(env!("CARGO_BIN_EXE_umbrage"))
+        .args(["info", "--pipelines"])
+        .env("UMBRAGE_VALIDATION", "1")
+        .env("UMBRAGE_PIPELINE_TRACE", "1")
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    let err = String::from_utf8_lossy(&out.stderr);
+    if err.contains("no Vulkan") && std::env::var_os("CI").is_none() {
+        eprintln!("SKIPPED (no Vulkan device, CI not set): {err}");
+        return;
+    }
+    assert!(out.status.success(), "info --pipelines failed: {text}\n{err}");
+    assert!(text.contains("all created"), "{text}");
+    for what in [
+        "silhouette.wgsl:exact",
+        "silhouette.wgsl:edges",
+        "shadow.vert depth LESS stencil",
+        "fullscreen.vert + illuminate.frag",
+        "render-pass",
+    ] {
+        assert!(text.contains(what), "no {what} in: {text}");
+    }
+    let lines = text.lines().filter(|l| l.trim_start().split("  ").next().is_some_and(|t| t.ends_with(" ms"))).count();
+    let created = err.matches("umbrage: created pipeline").count();
+    assert!(created >= 100, "only {created} pipelines traced");
+    assert!(lines >= created, "{lines} timed lines for {created} creations");
+}

@@ -53,21 +53,29 @@ pub fn rerun_on_lavapipe_25(test: &str, ignored: bool, env: &[(&str, &str)]) -> 
         eprintln!("SKIPPED: {why}");
         return false;
     };
+    let mut env = env.to_vec();
+    env.push(("UMBRAGE_RAY_QUERY_CHILD", "1"));
+    run_child(test, ignored, &env, &vars, "Mesa lavapipe 25.0.7");
+    true
+}
+
+/// Runs test `test` of this binary in a child process with the driver environment `vars` and
+/// `env` added, and asserts that it passed (and ran).
+fn run_child(test: &str, ignored: bool, env: &[(&str, &str)], vars: &[(String, Option<String>)], driver: &str) {
     let mut cmd = std::process::Command::new(std::env::current_exe().expect("test binary"));
-    cmd.args(["--exact", test, "--nocapture", "--test-threads", "1"]).env("UMBRAGE_RAY_QUERY_CHILD", "1");
+    cmd.args(["--exact", test, "--nocapture", "--test-threads", "1"]);
     if ignored {
         cmd.arg("--ignored");
     }
     for (k, v) in env {
         cmd.env(k, v);
     }
-    apply_driver_env(&mut cmd, &vars);
-    let out = cmd.output().expect("run the test on lavapipe 25.0.7");
+    apply_driver_env(&mut cmd, vars);
+    let out = cmd.output().unwrap_or_else(|e| panic!("run the test on {driver}: {e}"));
     print!("{}", String::from_utf8_lossy(&out.stdout));
     eprint!("{}", String::from_utf8_lossy(&out.stderr));
-    assert!(out.status.success(), "{test} failed on Mesa lavapipe 25.0.7 (output above)");
+    assert!(out.status.success(), "{test} failed on {driver} (output above)");
     assert!(String::from_utf8_lossy(&out.stdout).contains("1 passed"), "{test} did not run in the child");
-    true
 }
 
 /// The environment that makes Mesa lavapipe 25.0.7 from `.drivers/` the only Vulkan device
@@ -130,16 +138,6 @@ pub fn rerun_on_swiftshader(test: &str, env: &[(&str, &str)]) -> bool {
         eprintln!("SKIPPED: {why}");
         return false;
     };
-    let mut cmd = std::process::Command::new(std::env::current_exe().expect("test binary"));
-    cmd.args(["--exact", test, "--nocapture", "--test-threads", "1", "--ignored"]);
-    for (k, v) in env {
-        cmd.env(k, v);
-    }
-    apply_driver_env(&mut cmd, &vars);
-    let out = cmd.output().expect("run the test on SwiftShader");
-    print!("{}", String::from_utf8_lossy(&out.stdout));
-    eprint!("{}", String::from_utf8_lossy(&out.stderr));
-    assert!(out.status.success(), "{test} failed on SwiftShader (output above)");
-    assert!(String::from_utf8_lossy(&out.stdout).contains("1 passed"), "{test} did not run in the child");
+    run_child(test, true, env, &vars, "SwiftShader");
     true
 }
