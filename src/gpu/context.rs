@@ -231,8 +231,9 @@ impl Context {
     }
 
     /// [`with_validation`](Self::with_validation), with extra instance and device extensions
-    /// (a windowed host's surface and swapchain extensions). A device extension the chosen
-    /// device lacks is [`Error::Unsupported`]; the pointers must be NUL-terminated names.
+    /// (a windowed host's surface and swapchain extensions). An instance extension the driver
+    /// lacks, or a device extension the chosen device lacks, is [`Error::Unsupported`] naming
+    /// it; the pointers must be NUL-terminated names.
     pub fn with_extensions(
         validation: bool,
         instance_extensions: &[*const std::ffi::c_char],
@@ -283,6 +284,23 @@ impl Context {
         // SAFETY: plain enumeration call on a loaded entry.
         let instance_exts =
             unsafe { entry.enumerate_instance_extension_properties(None) }.map_err(vkerr("vkEnumerateInstanceExtensionProperties"))?;
+        // A window's surface extensions the driver lacks (SwiftShader as Debian's Chromium
+        // ships it has no Xlib surface): say which, rather than "no driver".
+        let missing: Vec<String> = instance_extensions
+            .iter()
+            // SAFETY: the caller passes NUL-terminated extension names (documented).
+            .map(|&p| unsafe { CStr::from_ptr(p) })
+            .filter(|want| !instance_exts.iter().any(|e| e.extension_name_as_c_str().is_ok_and(|n| n == *want)))
+            .map(|n| n.to_string_lossy().into_owned())
+            .collect();
+        if !missing.is_empty() {
+            return Err(Error::Unsupported(format!(
+                "the Vulkan driver has no instance extension {}, which this window's surface needs (SwiftShader as \
+                 Debian's chromium-common ships it has the XCB and Wayland surfaces but not Xlib, which winit's X11 \
+                 windows use): render offscreen with `umbrage render`",
+                missing.join(", ")
+            )));
+        }
         let gpdp2 = ash::khr::get_physical_device_properties2::NAME;
         let has_gpdp2 = instance_exts.iter().any(|e| e.extension_name_as_c_str().map(|n| n == gpdp2).unwrap_or(false));
         if has_gpdp2 && minimum == Minimum::Vulkan10 {
