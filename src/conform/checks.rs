@@ -6,6 +6,7 @@
 //! views against atlas tiles) and the end-to-end pipeline check; every
 //! check is re-exported here.
 
+pub mod commands;
 mod coverage;
 mod depth;
 mod float_count;

@@ -28,6 +28,8 @@ pub struct PipeSpec {
     pub front: vk::StencilOpState,
     /// Stencil state of back-facing triangles.
     pub back: vk::StencilOpState,
+    /// The scissor set (`vkCmdSetScissor`) before this draw; `None`: the whole image.
+    pub scissor: Option<vk::Rect2D>,
 }
 
 impl PipeSpec {
@@ -41,6 +43,7 @@ impl PipeSpec {
             depth_bounds: None,
             front: pipeline::stencil_ops(front, vk::StencilOp::KEEP),
             back: pipeline::stencil_ops(back, vk::StencilOp::KEEP),
+            scissor: None,
         }
     }
     /// Stencil REPLACE with `reference` on both faces.
@@ -62,6 +65,17 @@ pub enum Indices {
     U16(Vec<u16>),
     /// `VK_INDEX_TYPE_UINT32`.
     U32(Vec<u32>),
+    /// `VK_INDEX_TYPE_UINT16` drawn through `vkCmdDrawIndexedIndirect`, one call per record
+    /// (draw count 1, stride 20, as `ShadowPass`'s compute path draws): the records sit in one
+    /// indirect buffer after `lead_in` unused records, so every call has a non-zero offset.
+    Indirect16 {
+        /// The index buffer.
+        indices: Vec<u16>,
+        /// The draws' parameters.
+        records: Vec<vk::DrawIndexedIndirectCommand>,
+        /// Records (filled with garbage that must never be drawn) before the first one.
+        lead_in: u32,
+    },
 }
 
 /// One draw of a [`render`]: triangles through their own pipeline.
@@ -115,6 +129,91 @@ fn bytes<T: Copy>(v: &[T]) -> Vec<u8> {
     unsafe { std::slice::from_raw_parts(v.as_ptr() as *const u8, std::mem::size_of_val(v)) }.to_vec()
 }
 
+/// Draws ready to record: their pipeline layout (shadow.vert's push block), pipelines, vertex,
+/// index and indirect buffers. [`Draws::destroy`] frees them once the device is done.
+pub(crate) struct Draws {
+    layout: vk::PipelineLayout,
+    pipelines: Vec<vk::Pipeline>,
+    buffers: Vec<Buffer>,
+    draws: Vec<RecordedDraw>,
+}
+
+impl Draws {
+    /// Creates every draw's pipeline (for `format`) and buffers; on an error, what was made
+    /// is destroyed.
+    pub(crate) fn new(ctx: &Context, format: vk::Format, draws: &[DrawCall]) -> Result<Draws> {
+        let push_range = [vk::PushConstantRange { stage_flags: vk::ShaderStageFlags::VERTEX, offset: 0, size: 96 }];
+        let layout_info = vk::PipelineLayoutCreateInfo::default().push_constant_ranges(&push_range);
+        // SAFETY: valid device and create info; destroyed by `destroy`.
+        let layout = unsafe { ctx.device.create_pipeline_layout(&layout_info, None) }.map_err(vkerr("vkCreatePipelineLayout"))?;
+        let mut out = Draws { layout, pipelines: Vec::new(), buffers: Vec::new(), draws: Vec::with_capacity(draws.len()) };
+        for d in draws {
+            match prepare_draw(ctx, layout, format, d, &mut out.pipelines, &mut out.buffers) {
+                Ok(r) => out.draws.push(r),
+                Err(e) => {
+                    out.destroy(ctx);
+                    return Err(e);
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// How many draws there are.
+    pub(crate) fn len(&self) -> usize {
+        self.draws.len()
+    }
+
+    /// Records draw `i` (pipeline, push block, depth bounds, scissor — `area` when the draw
+    /// names none — vertex and index buffers, the draw command).
+    ///
+    /// # Safety
+    /// `cb` is recording inside a rendering instance (or subpass) compatible with the draws'
+    /// format, with the viewport set; the draws outlive the submission.
+    pub(crate) unsafe fn record(&self, ctx: &Context, cb: vk::CommandBuffer, i: usize, area: vk::Rect2D) {
+        let d = &ctx.device;
+        let r = &self.draws[i];
+        // SAFETY: the caller's contract; every handle was created on this device by `new`.
+        unsafe {
+            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, r.pipeline);
+            d.cmd_push_constants(cb, self.layout, vk::ShaderStageFlags::VERTEX, 0, &r.push);
+            if let Some((lo, hi)) = r.depth_bounds {
+                d.cmd_set_depth_bounds(cb, lo, hi);
+            }
+            d.cmd_set_scissor(cb, 0, &[r.scissor.unwrap_or(area)]);
+            d.cmd_bind_vertex_buffers(cb, 0, &[r.vertices], &[0]);
+            match (r.indices, &r.indirect) {
+                (Some((ib, ty, _)), Some((buf, offsets))) => {
+                    d.cmd_bind_index_buffer(cb, ib, 0, ty);
+                    for &o in offsets {
+                        d.cmd_draw_indexed_indirect(cb, *buf, o, 1, std::mem::size_of::<vk::DrawIndexedIndirectCommand>() as u32);
+                    }
+                }
+                (Some((ib, ty, count)), None) => {
+                    d.cmd_bind_index_buffer(cb, ib, 0, ty);
+                    d.cmd_draw_indexed(cb, count, 1, 0, 0, 0);
+                }
+                (None, _) => d.cmd_draw(cb, r.vertex_count, 1, 0, 0),
+            }
+        }
+    }
+
+    /// Waits for the device and destroys everything.
+    pub(crate) fn destroy(mut self, ctx: &Context) {
+        // SAFETY: after the wait nothing is in use.
+        unsafe {
+            let _ = ctx.device.device_wait_idle();
+            for p in self.pipelines.drain(..) {
+                ctx.device.destroy_pipeline(p, None);
+            }
+            ctx.device.destroy_pipeline_layout(self.layout, None);
+        }
+        for b in &mut self.buffers {
+            b.destroy(ctx);
+        }
+    }
+}
+
 /// Clears a `width` x `height` depth-stencil image of `format` to (`clear_depth`,
 /// `clear_stencil`), records `draws` in order, and reads both aspects back.
 pub fn render(
@@ -126,11 +225,7 @@ pub fn render(
     clear_stencil: u32,
     draws: &[DrawCall],
 ) -> Result<Readback> {
-    let push_range = [vk::PushConstantRange { stage_flags: vk::ShaderStageFlags::VERTEX, offset: 0, size: 96 }];
-    let layout_info = vk::PipelineLayoutCreateInfo::default().push_constant_ranges(&push_range);
-    // SAFETY: valid device and create info; destroyed at the end of this function.
-    let layout = unsafe { ctx.device.create_pipeline_layout(&layout_info, None) }.map_err(vkerr("vkCreatePipelineLayout"))?;
-    let mut pipelines = Vec::new();
+    let prepared = Draws::new(ctx, format, draws)?;
     let mut buffers: Vec<Buffer> = Vec::new();
     let mut image: Option<Image> = None;
     let result = (|| -> Result<Readback> {
@@ -144,15 +239,10 @@ pub fn render(
             vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL,
         )?);
         let img = image.as_ref().expect("just created");
-        // Pipelines and geometry.
-        let mut recorded = Vec::with_capacity(draws.len());
-        for d in draws {
-            recorded.push(prepare_draw(ctx, layout, format, d, &mut pipelines, &mut buffers)?);
-        }
         let n = (width * height) as u64;
         buffers.push(Buffer::new(ctx, "conform-depth-readback", n * 4, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?);
         buffers.push(Buffer::new(ctx, "conform-stencil-readback", n, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu)?);
-        let (depth_buf, stencil_buf) = (buffers[buffers.len() - 2].raw, buffers[buffers.len() - 1].raw);
+        let (depth_buf, stencil_buf) = (buffers[0].raw, buffers[1].raw);
         ctx.one_shot(|cb| {
             transition(ctx, cb, img, vk::ImageLayout::UNDEFINED, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
             let att = vk::RenderingAttachmentInfo::default()
@@ -166,7 +256,14 @@ pub fn render(
             let viewport = vk::Viewport { x: 0.0, y: 0.0, width: width as f32, height: height as f32, min_depth: 0.0, max_depth: 1.0 };
             // SAFETY: `cb` is recording (one_shot); every handle used was created above on this
             // device and outlives the submission, which one_shot waits for.
-            unsafe { record_draws(ctx, cb, layout, &info, viewport, area, &recorded) };
+            unsafe {
+                ctx.device.cmd_begin_rendering(cb, &info);
+                ctx.device.cmd_set_viewport(cb, 0, &[viewport]);
+                for i in 0..prepared.len() {
+                    prepared.record(ctx, cb, i, area);
+                }
+                ctx.device.cmd_end_rendering(cb);
+            }
             transition(ctx, cb, img, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
             // SAFETY: recording; the image is in TRANSFER_SRC_OPTIMAL and the buffers are large
             // enough for one aspect each (4 bytes per depth texel, 1 per stencil texel).
@@ -178,19 +275,12 @@ pub fn render(
                 (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
             );
         })?;
-        let depth_bytes = buffers[buffers.len() - 2].read()?;
+        let depth_bytes = buffers[0].read()?;
         let depth = depth_bytes.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
-        let stencil = buffers[buffers.len() - 1].read()?.to_vec();
+        let stencil = buffers[1].read()?.to_vec();
         Ok(Readback { width, height, depth, stencil })
     })();
-    // SAFETY: one_shot waited for the submission (or nothing was submitted): nothing in use.
-    unsafe {
-        let _ = ctx.device.device_wait_idle();
-        for p in pipelines {
-            ctx.device.destroy_pipeline(p, None);
-        }
-        ctx.device.destroy_pipeline_layout(layout, None);
-    }
+    prepared.destroy(ctx);
     for b in &mut buffers {
         b.destroy(ctx);
     }
@@ -205,9 +295,12 @@ struct RecordedDraw {
     pipeline: vk::Pipeline,
     vertices: vk::Buffer,
     indices: Option<(vk::Buffer, vk::IndexType, u32)>,
+    /// The indirect buffer and the offsets of its records (`Indices::Indirect16`).
+    indirect: Option<(vk::Buffer, Vec<u64>)>,
     vertex_count: u32,
     push: Vec<u8>,
     depth_bounds: Option<(f32, f32)>,
+    scissor: Option<vk::Rect2D>,
 }
 
 /// Creates `d`'s pipeline and buffers, handing them to `pipelines` and `buffers` (which the
@@ -239,6 +332,32 @@ fn prepare_draw(
         Indices::U8(i) => Some((bytes(i), vk::IndexType::UINT8_EXT, i.len())),
         Indices::U16(i) => Some((bytes(i), vk::IndexType::UINT16, i.len())),
         Indices::U32(i) => Some((bytes(i), vk::IndexType::UINT32, i.len())),
+        Indices::Indirect16 { indices, .. } => Some((bytes(indices), vk::IndexType::UINT16, indices.len())),
+    };
+    let indirect = match &d.indices {
+        Indices::Indirect16 { records, lead_in, .. } => {
+            // The lead-in records would draw every index 1000 times over: drawn by mistake,
+            // they show.
+            let garbage = vk::DrawIndexedIndirectCommand {
+                index_count: 3,
+                instance_count: 1000,
+                first_index: 0,
+                vertex_offset: 0,
+                first_instance: 0,
+            };
+            let all: Vec<vk::DrawIndexedIndirectCommand> =
+                std::iter::repeat_n(garbage, *lead_in as usize).chain(records.iter().copied()).collect();
+            let words: Vec<u32> = all
+                .iter()
+                .flat_map(|r| [r.index_count, r.instance_count, r.first_index, r.vertex_offset as u32, r.first_instance])
+                .collect();
+            let ib = Buffer::with_data(ctx, "conform-indirect", &bytes(&words), vk::BufferUsageFlags::INDIRECT_BUFFER)?;
+            let raw = ib.raw;
+            buffers.push(ib);
+            let stride = std::mem::size_of::<vk::DrawIndexedIndirectCommand>() as u64;
+            Some((raw, (0..records.len() as u64).map(|i| (*lead_in as u64 + i) * stride).collect()))
+        }
+        _ => None,
     };
     let indices = match index {
         Some((data, ty, n)) => {
@@ -255,49 +374,12 @@ fn prepare_draw(
         pipeline,
         vertices,
         indices,
+        indirect,
         vertex_count: d.vertices.len() as u32,
         push: bytemuck::bytes_of(&push).to_vec(),
         depth_bounds: d.spec.depth_bounds,
+        scissor: d.spec.scissor,
     })
-}
-
-/// Records the rendering instance `info` with `draws`, in order.
-///
-/// # Safety
-/// `cb` is recording outside a rendering instance; `info`'s attachment is in its layout and
-/// every handle in `draws` belongs to `ctx`'s device and outlives the submission.
-unsafe fn record_draws(
-    ctx: &Context,
-    cb: vk::CommandBuffer,
-    layout: vk::PipelineLayout,
-    info: &vk::RenderingInfo,
-    viewport: vk::Viewport,
-    area: vk::Rect2D,
-    draws: &[RecordedDraw],
-) {
-    let d = &ctx.device;
-    // SAFETY: the caller's contract.
-    unsafe {
-        d.cmd_begin_rendering(cb, info);
-        d.cmd_set_viewport(cb, 0, &[viewport]);
-        d.cmd_set_scissor(cb, 0, &[area]);
-        for r in draws {
-            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, r.pipeline);
-            d.cmd_push_constants(cb, layout, vk::ShaderStageFlags::VERTEX, 0, &r.push);
-            if let Some((lo, hi)) = r.depth_bounds {
-                d.cmd_set_depth_bounds(cb, lo, hi);
-            }
-            d.cmd_bind_vertex_buffers(cb, 0, &[r.vertices], &[0]);
-            match r.indices {
-                Some((ib, ty, count)) => {
-                    d.cmd_bind_index_buffer(cb, ib, 0, ty);
-                    d.cmd_draw_indexed(cb, count, 1, 0, 0, 0);
-                }
-                None => d.cmd_draw(cb, r.vertex_count, 1, 0, 0),
-            }
-        }
-        d.cmd_end_rendering(cb);
-    }
 }
 
 /// Copies `img`'s depth and stencil aspects into `buffers` (depth, stencil).

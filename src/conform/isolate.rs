@@ -98,9 +98,9 @@ pub fn run_unit(ctx: &Context, unit: Unit, new_context: &dyn Fn() -> Result<Cont
             ChildResult { cases, config, legacy: Vec::new() }
         }
         Unit::Legacy | Unit::Multiview => {
-            let names = if unit == Unit::Legacy { super::units::SINGLE } else { super::units::MULTIVIEW };
+            let names = if unit == Unit::Legacy { super::units::legacy_unit() } else { super::units::MULTIVIEW.to_vec() };
             let mut cases = Vec::new();
-            let legacy = suite::run_legacy(ctx, new_context, opts, names, &mut cases);
+            let legacy = suite::run_legacy(ctx, new_context, opts, &names, &mut cases);
             ChildResult { cases, config: None, legacy }
         }
         Unit::Pipeline { shard, shards } => {

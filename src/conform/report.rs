@@ -109,7 +109,7 @@ pub fn markdown(r: &Report) -> String {
         let _ = writeln!(s, "| `{}` | {} | {bug} |", c.name, c.status.name());
     }
 
-    let legacy: Vec<_> = r.cases.iter().filter(|c| c.group == "legacy" || c.group == "pipeline").collect();
+    let legacy: Vec<_> = r.cases.iter().filter(|c| ["legacy", "commands", "pipeline"].contains(&c.group.as_str())).collect();
     if !legacy.is_empty() {
         s.push_str("\n## Single-configuration checks\n\n| case | result | details |\n|---|---|---|\n");
         for c in legacy {

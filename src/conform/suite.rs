@@ -12,7 +12,7 @@ use ash::vk;
 use std::path::PathBuf;
 use std::time::Instant;
 
-use super::units::{pipeline_shard_names, LEGACY};
+use super::units::{pipeline_shard_names, COMMANDS, LEGACY};
 pub use super::units::{run_legacy, run_pipeline};
 
 /// Options of a suite run.
@@ -193,7 +193,7 @@ impl Report {
 /// The selected case names of the legacy or pipeline unit (empty for a configuration unit).
 pub fn unit_case_names(unit: super::isolate::Unit, filter: &[String]) -> Vec<String> {
     let all = match unit {
-        super::isolate::Unit::Legacy => super::units::SINGLE.iter().map(|n| format!("legacy.{n}")).collect(),
+        super::isolate::Unit::Legacy => super::units::legacy_unit().into_iter().map(super::units::full_name).collect(),
         super::isolate::Unit::Multiview => super::units::MULTIVIEW.iter().map(|n| format!("legacy.{n}")).collect(),
         super::isolate::Unit::Pipeline { shard, shards } => pipeline_shard_names((shard, shards)),
         super::isolate::Unit::Config(_) => Vec::new(),
@@ -205,6 +205,7 @@ pub fn unit_case_names(unit: super::isolate::Unit, filter: &[String]) -> Vec<Str
 pub fn all_names() -> Vec<String> {
     let mut v: Vec<String> = cases::all(&Config::all(&FORMATS)).into_iter().map(|c| c.name).collect();
     v.extend(LEGACY.iter().map(|n| format!("legacy.{n}")));
+    v.extend(COMMANDS.iter().map(|n| format!("commands.{n}")));
     v.extend(pipeline_shard_names((0, 1)));
     v
 }
@@ -432,7 +433,8 @@ pub fn run_suite(ctx: &Context, new_context: &dyn Fn() -> Result<Context>, opts:
         outcomes.extend(o);
         configs.extend(run);
     }
-    let mut legacy = run_legacy(ctx, new_context, opts, &LEGACY, &mut outcomes);
+    let every: Vec<&str> = LEGACY.iter().chain(COMMANDS.iter()).copied().collect();
+    let mut legacy = run_legacy(ctx, new_context, opts, &every, &mut outcomes);
     legacy.extend(run_pipeline(ctx, new_context, opts, (0, 1), &mut outcomes));
     Report {
         device: ctx.info.clone(),

@@ -20,6 +20,22 @@ pub(crate) const LEGACY: [&str; 9] = [
     super::checks::MULTIVIEW_CUBE_FACES,
 ];
 
+/// The `commands.*` checks (run in the `legacy` unit): what umbrage records besides draws.
+pub(crate) const COMMANDS: [&str; 8] = super::checks::commands::NAMES;
+
+/// A single-configuration check's case name: `commands.<name>` or `legacy.<name>`.
+pub(crate) fn full_name(name: &str) -> String {
+    match COMMANDS.contains(&name) {
+        true => format!("commands.{name}"),
+        false => format!("legacy.{name}"),
+    }
+}
+
+/// What the `legacy` unit runs: the legacy checks but multiview, and the commands.
+pub(crate) fn legacy_unit() -> Vec<&'static str> {
+    SINGLE.iter().chain(COMMANDS.iter()).copied().collect()
+}
+
 /// The legacy checks the `legacy` unit runs: everything but multiview.
 pub(crate) const SINGLE: &[&str] = LEGACY.split_at(8).0;
 /// The legacy check the `multiview` unit runs on its own: the renderer's multiview cube faces,
@@ -53,7 +69,8 @@ pub fn run_legacy(
     type Check = fn(&Context) -> Result<CheckResult>;
     type Run<'a> = Box<dyn Fn() -> Result<CheckResult> + 'a>;
     let on_ctx = |f: Check| -> Run<'_> { Box::new(move || f(ctx)) };
-    let unit: [(&str, Run<'_>); 9] = [
+    use super::checks::commands;
+    let unit: [(&str, Run<'_>); 17] = [
         (LEGACY[0], on_ctx(super::checks::w0_vertices_and_infinity)),
         (LEGACY[1], on_ctx(super::checks::depth_clamp)),
         (LEGACY[2], on_ctx(super::checks::watertight_fan)),
@@ -64,16 +81,30 @@ pub fn run_legacy(
         (LEGACY[7], on_ctx(super::checks::deep_wrap_float_count)),
         // The renderer on a context of its own (the one a frame needs).
         (LEGACY[8], Box::new(|| super::checks::multiview_cube_faces(ctx, new_context))),
+        (COMMANDS[0], on_ctx(commands::clears)),
+        (COMMANDS[1], on_ctx(commands::copy_aspects)),
+        (COMMANDS[2], on_ctx(commands::layouts)),
+        (COMMANDS[3], on_ctx(commands::blit_copy_color)),
+        (COMMANDS[4], on_ctx(commands::buffers)),
+        (COMMANDS[5], on_ctx(commands::queries)),
+        (COMMANDS[6], on_ctx(commands::scissor)),
+        (COMMANDS[7], on_ctx(commands::indirect)),
     ];
     let mut results = Vec::new();
     for (name, f) in unit {
-        let full = format!("legacy.{name}");
+        let full = full_name(name);
         if !names.contains(&name) || !selected(&opts.filter, &full) {
             continue;
         }
-        let mut o = CaseOutcome::new(full, "legacy", None, format!("single-configuration check `{name}` (the renderer's depth format)"));
-        // Every check but the float count draws through the harness's dynamic rendering.
-        if !ctx.features.dynamic_rendering && name != "deep_wrap_float_count" {
+        let command = COMMANDS.contains(&name);
+        let (group, what) = match command {
+            true => ("commands", format!("recorded command `{name}` against its spec semantics")),
+            false => ("legacy", format!("single-configuration check `{name}` (the renderer's depth format)")),
+        };
+        let mut o = CaseOutcome::new(full, group, None, what);
+        // Every legacy check but the float count draws through the harness's dynamic rendering
+        // (the commands checks say themselves what they need).
+        if !ctx.features.dynamic_rendering && name != "deep_wrap_float_count" && !command {
             o.status = Status::Skipped;
             let version = &ctx.info.api_version;
             o.message =

@@ -1,0 +1,1022 @@
+//! The `commands.*` checks: the Vulkan commands umbrage records outside its draws, each held
+//! to the exact semantics the spec gives it, against a CPU model of the result — not only
+//! through the draws they serve. `docs/conform/coverage.md` maps every command and state the
+//! renderer, `ShadowPass` and the hosts record to the family that checks it.
+//!
+//! - `clears`: `vkCmdClearAttachments` inside a rendering instance and inside a classic
+//!   subpass, per aspect mask, with several rects, a stencil clear value wider than 8 bits (only
+//!   its low bits count), a scissor that must not apply; load ops per aspect (depth `LOAD`,
+//!   stencil `CLEAR` and the reverse) limited to a partial render area.
+//! - `copy_aspects`: `vkCmdCopyImageToBuffer` of the depth and the stencil aspect of every
+//!   depth-stencil format, with a buffer offset, a row length and image height larger than
+//!   the region and an image offset: each texel at its address, 2 bytes (D16) or 4 (D24 as X8D24,
+//!   D32) of depth, 1 of stencil, every byte outside the region untouched.
+//! - `layouts`: contents kept through every layout transition umbrage and its hosts use.
+//! - `blit_copy_color`: `vkCmdCopyImage` and `vkCmdBlitImage` (`NEAREST`, scaling up by
+//!   non-integer ratios, RGBA to BGRA) as the viewer presents; the copy kept through the colour
+//!   layouts.
+//! - `buffers`: `vkCmdUpdateBuffer` and `vkCmdCopyBuffer` with offsets: every byte.
+//! - `queries`: query resets of a sub-range, precise occlusion counts, results read from a
+//!   first query with 32- and 64-bit strides and availability, an unavailable query reported
+//!   as such, pipeline statistics in flag-bit order, timestamps in order.
+//! - `scissor`: `vkCmdSetScissor` per draw, including a scissor past the image and an empty one.
+//! - `indirect`: `vkCmdDrawIndexedIndirect` one record at a time at non-zero offsets, with
+//!   `firstIndex`, `vertexOffset` and an `instanceCount` of 0, as `ShadowPass`'s compute path
+//!   draws its volumes.
+
+use super::rect;
+use crate::conform::harness::{self, DrawCall, Draws, Indices, PipeSpec};
+use crate::conform::CheckResult;
+use crate::error::{Error, Result};
+use crate::gpu::resources::{aspect_copy, memory_barrier, transition};
+use crate::gpu::{Buffer, Context, Image};
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+use serde_json::json;
+
+/// The checks' names (cases `commands.<name>`), in run order.
+pub const NAMES: [&str; 8] = ["clears", "copy_aspects", "layouts", "blit_copy_color", "buffers", "queries", "scissor", "indirect"];
+
+fn vkerr(call: &'static str) -> impl Fn(vk::Result) -> Error {
+    Error::vk(call)
+}
+
+const DS: vk::ImageAspectFlags =
+    vk::ImageAspectFlags::from_raw(vk::ImageAspectFlags::DEPTH.as_raw() | vk::ImageAspectFlags::STENCIL.as_raw());
+const W: u32 = 64;
+const H: u32 = 32;
+/// The byte every read-back buffer starts with: a byte the device did not write keeps it.
+const UNTOUCHED: u8 = 0xee;
+
+/// The depth-stencil formats with 8 bits of stencil the device can attach and copy from.
+fn ds_formats(ctx: &Context) -> Vec<vk::Format> {
+    [vk::Format::D16_UNORM_S8_UINT, vk::Format::D24_UNORM_S8_UINT, vk::Format::D32_SFLOAT_S8_UINT]
+        .into_iter()
+        .filter(|&f| harness::format_supported(ctx, f))
+        .collect()
+}
+
+fn short(format: vk::Format) -> &'static str {
+    match format {
+        vk::Format::D16_UNORM_S8_UINT => "d16s8",
+        vk::Format::D24_UNORM_S8_UINT => "d24s8",
+        _ => "d32s8",
+    }
+}
+
+/// Bytes per texel of a copied depth aspect: 2 for D16, 4 for D24 (X8_D24, top byte
+/// undefined) and D32.
+fn depth_texel_bytes(format: vk::Format) -> usize {
+    if format == vk::Format::D16_UNORM_S8_UINT {
+        2
+    } else {
+        4
+    }
+}
+
+/// Whether the copied depth texel `bytes` holds `value`: D32 bit for bit; UNORM formats within
+/// one step of `value * (2^b - 1)` (the spec's float-to-unorm conversion picks either
+/// neighbour), D24's undefined top byte ignored.
+fn depth_matches(format: vk::Format, bytes: &[u8], value: f32) -> bool {
+    match format {
+        vk::Format::D16_UNORM_S8_UINT => {
+            let word = u16::from_le_bytes([bytes[0], bytes[1]]) as f64;
+            (word - value as f64 * 65_535.0).abs() < 1.0
+        }
+        vk::Format::D24_UNORM_S8_UINT => {
+            let word = (u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]) & 0x00ff_ffff) as f64;
+            (word - value as f64 * 16_777_215.0).abs() < 1.0
+        }
+        _ => f32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]) == value,
+    }
+}
+
+/// The CPU model of a depth-stencil image.
+#[derive(Clone)]
+struct Grid {
+    depth: Vec<f32>,
+    stencil: Vec<u8>,
+}
+
+impl Grid {
+    fn new(depth: f32, stencil: u8) -> Grid {
+        Grid { depth: vec![depth; (W * H) as usize], stencil: vec![stencil; (W * H) as usize] }
+    }
+    /// Writes `depth` and/or `stencil` over `r` clipped to the image.
+    fn fill(&mut self, r: vk::Rect2D, depth: Option<f32>, stencil: Option<u8>) {
+        let x1 = (r.offset.x as i64 + r.extent.width as i64).min(W as i64);
+        let y1 = (r.offset.y as i64 + r.extent.height as i64).min(H as i64);
+        for y in r.offset.y.max(0) as i64..y1 {
+            for x in r.offset.x.max(0) as i64..x1 {
+                let i = (y * W as i64 + x) as usize;
+                if let Some(d) = depth {
+                    self.depth[i] = d;
+                }
+                if let Some(s) = stencil {
+                    self.stencil[i] = s;
+                }
+            }
+        }
+    }
+}
+
+fn rect2d(x: i32, y: i32, w: u32, h: u32) -> vk::Rect2D {
+    vk::Rect2D { offset: vk::Offset2D { x, y }, extent: vk::Extent2D { width: w, height: h } }
+}
+
+fn full() -> vk::Rect2D {
+    rect2d(0, 0, W, H)
+}
+
+/// Objects a check made, destroyed (after the device is idle) whatever the check returns.
+struct Scratch<'a> {
+    ctx: &'a Context,
+    images: Vec<Image>,
+    buffers: Vec<Buffer>,
+    passes: Vec<vk::RenderPass>,
+    framebuffers: Vec<vk::Framebuffer>,
+    pools: Vec<vk::QueryPool>,
+}
+
+impl<'a> Scratch<'a> {
+    fn new(ctx: &'a Context) -> Scratch<'a> {
+        Scratch { ctx, images: Vec::new(), buffers: Vec::new(), passes: Vec::new(), framebuffers: Vec::new(), pools: Vec::new() }
+    }
+    fn image(
+        &mut self,
+        format: vk::Format,
+        extent: vk::Extent2D,
+        usage: vk::ImageUsageFlags,
+        aspect: vk::ImageAspectFlags,
+    ) -> Result<usize> {
+        self.images.push(Image::new_2d(self.ctx, "conform-commands", format, extent, usage, aspect)?);
+        Ok(self.images.len() - 1)
+    }
+    /// A host-visible transfer buffer of `size` bytes, every byte [`UNTOUCHED`].
+    fn readback(&mut self, size: u64) -> Result<usize> {
+        let usage = vk::BufferUsageFlags::TRANSFER_DST | vk::BufferUsageFlags::TRANSFER_SRC;
+        let mut b = Buffer::new(self.ctx, "conform-commands-readback", size, usage, MemoryLocation::GpuToCpu)?;
+        let filled = b.write(0, &vec![UNTOUCHED; size as usize]);
+        self.buffers.push(b);
+        filled?;
+        Ok(self.buffers.len() - 1)
+    }
+    fn query_pool(&mut self, ty: vk::QueryType, count: u32, stats: vk::QueryPipelineStatisticFlags) -> Result<vk::QueryPool> {
+        let info = vk::QueryPoolCreateInfo::default().query_type(ty).query_count(count).pipeline_statistics(stats);
+        // SAFETY: valid device and create info; destroyed in Drop.
+        let pool = unsafe { self.ctx.device.create_query_pool(&info, None) }.map_err(vkerr("vkCreateQueryPool"))?;
+        self.pools.push(pool);
+        Ok(pool)
+    }
+    /// A one-subpass render pass over one depth-stencil attachment of `format` (in and out of
+    /// DEPTH_STENCIL_ATTACHMENT_OPTIMAL) with these load ops, both aspects stored, and its
+    /// framebuffer over `view`.
+    fn render_pass(
+        &mut self,
+        format: vk::Format,
+        view: vk::ImageView,
+        (depth_load, stencil_load): (vk::AttachmentLoadOp, vk::AttachmentLoadOp),
+    ) -> Result<(vk::RenderPass, vk::Framebuffer)> {
+        let layout = vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+        let att = [vk::AttachmentDescription::default()
+            .format(format)
+            .samples(vk::SampleCountFlags::TYPE_1)
+            .load_op(depth_load)
+            .store_op(vk::AttachmentStoreOp::STORE)
+            .stencil_load_op(stencil_load)
+            .stencil_store_op(vk::AttachmentStoreOp::STORE)
+            .initial_layout(layout)
+            .final_layout(layout)];
+        let ds_ref = vk::AttachmentReference { attachment: 0, layout };
+        let subpass =
+            [vk::SubpassDescription::default().pipeline_bind_point(vk::PipelineBindPoint::GRAPHICS).depth_stencil_attachment(&ds_ref)];
+        let info = vk::RenderPassCreateInfo::default().attachments(&att).subpasses(&subpass);
+        // SAFETY: valid device and create info; destroyed in Drop.
+        let pass = unsafe { self.ctx.device.create_render_pass(&info, None) }.map_err(vkerr("vkCreateRenderPass"))?;
+        self.passes.push(pass);
+        let views = [view];
+        let fb_info = vk::FramebufferCreateInfo::default().render_pass(pass).attachments(&views).width(W).height(H).layers(1);
+        // SAFETY: as above; the view outlives the framebuffer (both freed in Drop, framebuffers first).
+        let fb = unsafe { self.ctx.device.create_framebuffer(&fb_info, None) }.map_err(vkerr("vkCreateFramebuffer"))?;
+        self.framebuffers.push(fb);
+        Ok((pass, fb))
+    }
+}
+
+impl Drop for Scratch<'_> {
+    fn drop(&mut self) {
+        let d = &self.ctx.device;
+        // SAFETY: after the wait nothing is in use; every handle was created on this device.
+        unsafe {
+            let _ = d.device_wait_idle();
+            for fb in self.framebuffers.drain(..) {
+                d.destroy_framebuffer(fb, None);
+            }
+            for p in self.passes.drain(..) {
+                d.destroy_render_pass(p, None);
+            }
+            for p in self.pools.drain(..) {
+                d.destroy_query_pool(p, None);
+            }
+        }
+        for i in &mut self.images {
+            i.destroy(self.ctx);
+        }
+        for b in &mut self.buffers {
+            b.destroy(self.ctx);
+        }
+    }
+}
+
+/// How a rendering instance is begun.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Model {
+    DynamicRendering,
+    RenderPass,
+}
+
+impl Model {
+    fn name(self) -> &'static str {
+        match self {
+            Model::DynamicRendering => "dynamic_rendering",
+            Model::RenderPass => "render_pass",
+        }
+    }
+}
+
+/// One rendering instance of the pattern: its load ops and clear value, its render area, and
+/// the `vkCmdClearAttachments` calls inside it.
+struct Instance {
+    load: (vk::AttachmentLoadOp, vk::AttachmentLoadOp),
+    clear: (f32, u32),
+    area: vk::Rect2D,
+    clears: Vec<(vk::ImageAspectFlags, f32, u32, Vec<vk::Rect2D>)>,
+}
+
+/// The pattern `clears` checks and the other checks start from: instances with every load-op
+/// pair and clears of each aspect mask, and what the spec says the image then holds.
+fn pattern() -> (Vec<Instance>, Grid) {
+    use vk::AttachmentLoadOp as L;
+    use vk::ImageAspectFlags as A;
+    let instances = vec![
+        Instance {
+            load: (L::CLEAR, L::CLEAR),
+            clear: (0.25, 0x5a),
+            area: full(),
+            clears: vec![
+                // The depth value of a stencil-only clear (and the stencil of a depth-only one)
+                // must be ignored; of the stencil value only the low 8 bits count.
+                (A::STENCIL, 0.875, 0x1c3, vec![rect2d(2, 3, 10, 7), rect2d(20, 1, 5, 5)]),
+                (A::DEPTH, 0.75, 0x11, vec![rect2d(8, 5, 12, 6)]),
+                (DS, 1.0, 0xff, vec![rect2d(30, 10, 4, 4), rect2d(40, 20, 24, 12)]),
+                (DS, 0.0, 0x00, vec![rect2d(0, 31, 64, 1)]),
+            ],
+        },
+        // Depth kept, stencil cleared, only inside the render area.
+        Instance { load: (L::LOAD, L::CLEAR), clear: (0.5, 0x33), area: rect2d(16, 8, 32, 16), clears: vec![] },
+        // Depth cleared, stencil kept; a clear inside the partial area.
+        Instance {
+            load: (L::CLEAR, L::LOAD),
+            clear: (0.125, 0x77),
+            area: rect2d(0, 24, 48, 8),
+            clears: vec![(A::STENCIL, 0.0, 0x0f, vec![rect2d(44, 26, 4, 2)])],
+        },
+    ];
+    let mut g = Grid::new(0.0, 0);
+    for inst in &instances {
+        let (d, s) = inst.clear;
+        g.fill(inst.area, (inst.load.0 == L::CLEAR).then_some(d), (inst.load.1 == L::CLEAR).then_some(s as u8));
+        for (aspect, d, s, rects) in &inst.clears {
+            for r in rects {
+                g.fill(*r, aspect.contains(A::DEPTH).then_some(*d), aspect.contains(A::STENCIL).then_some((*s & 0xff) as u8));
+            }
+        }
+    }
+    (instances, g)
+}
+
+/// Makes a `W` x `H` depth-stencil image of `format` (with `usage` besides attachment and
+/// transfer source) holding [`pattern`], drawn through `model`; returns its index in `s` and
+/// the model of its contents, the image left in DEPTH_STENCIL_ATTACHMENT_OPTIMAL.
+fn patterned(s: &mut Scratch<'_>, format: vk::Format, model: Model, usage: vk::ImageUsageFlags) -> Result<(usize, Grid)> {
+    let ctx = s.ctx;
+    let usage = usage | vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
+    let i = s.image(format, vk::Extent2D { width: W, height: H }, usage, DS)?;
+    let (instances, grid) = pattern();
+    let mut passes = Vec::new();
+    if model == Model::RenderPass {
+        let view = s.images[i].view;
+        for inst in &instances {
+            passes.push(s.render_pass(format, view, inst.load)?);
+        }
+    }
+    let img = &s.images[i];
+    let layout = vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+    ctx.one_shot(|cb| {
+        let d = &ctx.device;
+        transition(ctx, cb, img, vk::ImageLayout::UNDEFINED, layout);
+        for (k, inst) in instances.iter().enumerate() {
+            if k > 0 {
+                // The next instance's load ops read and write what this one stored.
+                let tests = vk::PipelineStageFlags2::EARLY_FRAGMENT_TESTS | vk::PipelineStageFlags2::LATE_FRAGMENT_TESTS;
+                memory_barrier(
+                    ctx,
+                    cb,
+                    (tests, vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE),
+                    (tests, vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_READ | vk::AccessFlags2::DEPTH_STENCIL_ATTACHMENT_WRITE),
+                );
+            }
+            let value = vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: inst.clear.0, stencil: inst.clear.1 } };
+            let depth_att = vk::RenderingAttachmentInfo::default()
+                .image_view(img.view)
+                .image_layout(layout)
+                .load_op(inst.load.0)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(value);
+            let stencil_att = depth_att.load_op(inst.load.1);
+            let values = [value];
+            // SAFETY: `cb` is recording outside a rendering instance; the image, its view and
+            // the render passes belong to this device and outlive the submission (one_shot waits).
+            unsafe {
+                match model {
+                    Model::DynamicRendering => {
+                        let info = vk::RenderingInfo::default()
+                            .render_area(inst.area)
+                            .layer_count(1)
+                            .depth_attachment(&depth_att)
+                            .stencil_attachment(&stencil_att);
+                        d.cmd_begin_rendering(cb, &info);
+                    }
+                    Model::RenderPass => {
+                        let (pass, fb) = passes[k];
+                        let info = vk::RenderPassBeginInfo::default()
+                            .render_pass(pass)
+                            .framebuffer(fb)
+                            .render_area(inst.area)
+                            .clear_values(&values);
+                        d.cmd_begin_render_pass(cb, &info, vk::SubpassContents::INLINE);
+                    }
+                }
+                // Clears ignore the scissor (and every other piece of pipeline state).
+                d.cmd_set_scissor(cb, 0, &[rect2d(W as i32 - 1, 0, 1, 1)]);
+                for (aspect, depth, stencil, rects) in &inst.clears {
+                    let clear = [vk::ClearAttachment {
+                        aspect_mask: *aspect,
+                        color_attachment: 0,
+                        clear_value: vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: *depth, stencil: *stencil } },
+                    }];
+                    let rects: Vec<vk::ClearRect> =
+                        rects.iter().map(|&rect| vk::ClearRect { rect, base_array_layer: 0, layer_count: 1 }).collect();
+                    d.cmd_clear_attachments(cb, &clear, &rects);
+                }
+                match model {
+                    Model::DynamicRendering => d.cmd_end_rendering(cb),
+                    Model::RenderPass => d.cmd_end_render_pass(cb),
+                }
+            }
+        }
+    })?;
+    Ok((i, grid))
+}
+
+/// Copies both aspects of image `i` (in `layout`, returned to it) tightly into a new buffer:
+/// (depth bytes, stencil bytes).
+fn read_aspects(s: &mut Scratch<'_>, i: usize, format: vk::Format, layout: vk::ImageLayout) -> Result<(Vec<u8>, Vec<u8>)> {
+    let ctx = s.ctx;
+    let n = (W * H) as u64;
+    let db = depth_texel_bytes(format) as u64;
+    let b = s.readback(n * db + n)?;
+    let (img, buf) = (&s.images[i], s.buffers[b].raw);
+    let extent = vk::Extent2D { width: W, height: H };
+    ctx.one_shot(|cb| {
+        transition(ctx, cb, img, layout, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+        let regions = [aspect_copy(vk::ImageAspectFlags::DEPTH, extent, 0), aspect_copy(vk::ImageAspectFlags::STENCIL, extent, n * db)];
+        // SAFETY: recording outside rendering; the image is in TRANSFER_SRC_OPTIMAL and the
+        // buffer holds both aspects at these offsets (a multiple of 4: n is).
+        unsafe { ctx.device.cmd_copy_image_to_buffer(cb, img.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, buf, &regions) };
+        transition(ctx, cb, img, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, layout);
+        memory_barrier(
+            ctx,
+            cb,
+            (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE),
+            (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
+        );
+    })?;
+    let bytes = s.buffers[b].read()?;
+    let split = (n * db) as usize;
+    Ok((bytes[..split].to_vec(), bytes[split..].to_vec()))
+}
+
+/// Mismatched (depth, stencil) texels of tightly packed aspects against `g`.
+fn compare_grid(format: vk::Format, g: &Grid, depth: &[u8], stencil: &[u8]) -> (usize, usize) {
+    let db = depth_texel_bytes(format);
+    let dm = (0..g.depth.len()).filter(|&i| !depth_matches(format, &depth[i * db..(i + 1) * db], g.depth[i])).count();
+    let sm = (0..g.stencil.len()).filter(|&i| stencil[i] != g.stencil[i]).count();
+    (dm, sm)
+}
+
+fn models(ctx: &Context) -> Vec<Model> {
+    let mut v = vec![Model::RenderPass];
+    if ctx.features.dynamic_rendering {
+        v.insert(0, Model::DynamicRendering);
+    }
+    v
+}
+
+/// `commands.clears`: load ops per aspect within a partial render area and
+/// `vkCmdClearAttachments` per aspect mask, in a rendering instance and in a subpass, in every
+/// depth-stencil format.
+pub fn clears(ctx: &Context) -> Result<CheckResult> {
+    let mut numbers = serde_json::Map::new();
+    let mut fails = Vec::new();
+    for format in ds_formats(ctx) {
+        for model in models(ctx) {
+            let label = format!("{}.{}", short(format), model.name());
+            let mut s = Scratch::new(ctx);
+            let (i, grid) = patterned(&mut s, format, model, vk::ImageUsageFlags::empty())?;
+            let (depth, stencil) = read_aspects(&mut s, i, format, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)?;
+            let (dm, sm) = compare_grid(format, &grid, &depth, &stencil);
+            numbers.insert(label.clone(), json!({ "depth_mismatches": dm, "stencil_mismatches": sm }));
+            if dm + sm > 0 {
+                fails.push(format!("{label}: {dm} depth and {sm} stencil texels differ from the load ops' and clears' result"));
+            }
+        }
+    }
+    let what =
+        "load ops per aspect within the render area and vkCmdClearAttachments per aspect mask (low 8 stencil bits, scissor ignored), \
+                rendering instance and subpass, every format";
+    Ok(CheckResult::from_fails("clears", fails, numbers, what))
+}
+
+/// `commands.copy_aspects`: each aspect copied at a buffer offset with a row length and image
+/// height beyond the region, from an image offset.
+pub fn copy_aspects(ctx: &Context) -> Result<CheckResult> {
+    let mut numbers = serde_json::Map::new();
+    let mut fails = Vec::new();
+    let (ox, oy, cw, ch) = (3u32, 2u32, 40u32, 20u32);
+    let (row, image_height) = (47u32, 23u32);
+    for format in ds_formats(ctx) {
+        let mut s = Scratch::new(ctx);
+        let model = models(ctx)[0];
+        let (i, _) = patterned(&mut s, format, model, vk::ImageUsageFlags::empty())?;
+        // The reference: the same aspects copied whole and tightly packed (what
+        // `commands.clears` holds to the model), so this check judges the region's addressing.
+        let (ref_depth, ref_stencil) = read_aspects(&mut s, i, format, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)?;
+        let db = depth_texel_bytes(format);
+        // D24's top byte is undefined in both copies.
+        let depth_bytes = if format == vk::Format::D24_UNORM_S8_UINT { 3 } else { db };
+        let span = (image_height as usize * row as usize) * db;
+        let (depth_at, stencil_at) = (256usize, 256 + span + 4 * 5);
+        let size = stencil_at + image_height as usize * row as usize + 64;
+        let b = s.readback(size as u64)?;
+        let (img, buf) = (&s.images[i], s.buffers[b].raw);
+        let region = |aspect, offset: usize| vk::BufferImageCopy {
+            buffer_offset: offset as u64,
+            buffer_row_length: row,
+            buffer_image_height: image_height,
+            image_subresource: vk::ImageSubresourceLayers { aspect_mask: aspect, mip_level: 0, base_array_layer: 0, layer_count: 1 },
+            image_offset: vk::Offset3D { x: ox as i32, y: oy as i32, z: 0 },
+            image_extent: vk::Extent3D { width: cw, height: ch, depth: 1 },
+        };
+        ctx.one_shot(|cb| {
+            let att = vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+            transition(ctx, cb, img, att, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
+            let regions = [region(vk::ImageAspectFlags::DEPTH, depth_at), region(vk::ImageAspectFlags::STENCIL, stencil_at)];
+            // SAFETY: recording outside rendering; the image is in TRANSFER_SRC_OPTIMAL; the
+            // buffer holds both regions (offsets multiples of 4, as depth-stencil copies need).
+            unsafe { ctx.device.cmd_copy_image_to_buffer(cb, img.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, buf, &regions) };
+            memory_barrier(
+                ctx,
+                cb,
+                (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE),
+                (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
+            );
+        })?;
+        let got = s.buffers[b].read()?;
+        // Every byte: a region texel where the spec puts it, untouched everywhere else (but
+        // D24's undefined top byte).
+        let mut expected: Vec<Option<u8>> = vec![Some(UNTOUCHED); size];
+        let (mut dm, mut sm) = (0usize, 0usize);
+        for y in 0..ch as usize {
+            for x in 0..cw as usize {
+                let src = (oy as usize + y) * W as usize + ox as usize + x;
+                let at = depth_at + (y * row as usize + x) * db;
+                if got[at..at + depth_bytes] != ref_depth[src * db..src * db + depth_bytes] {
+                    dm += 1;
+                }
+                for e in &mut expected[at..at + db] {
+                    *e = None;
+                }
+                let at = stencil_at + y * row as usize + x;
+                expected[at] = Some(ref_stencil[src]);
+            }
+        }
+        for (k, e) in expected.iter().enumerate() {
+            if let Some(v) = e {
+                if got[k] != *v {
+                    sm += 1;
+                }
+            }
+        }
+        numbers.insert(short(format).into(), json!({ "depth_mismatches": dm, "other_byte_mismatches": sm, "bytes": size }));
+        if dm + sm > 0 {
+            fails.push(format!(
+                "{}: {dm} depth texels wrong, {sm} stencil or untouched bytes wrong (row length {row}, image height {image_height}, offsets {depth_at}/{stencil_at})",
+                short(format)
+            ));
+        }
+    }
+    let what = "depth (2 bytes D16, 4 bytes X8D24/D32) and stencil (1 byte) aspects copied with buffer offsets, row length and image \
+                height beyond the region and an image offset; nothing else written";
+    Ok(CheckResult::from_fails("copy_aspects", fails, numbers, what))
+}
+
+/// `commands.layouts`: the pattern read back after a chain through every layout umbrage and
+/// its hosts put a depth-stencil image in.
+pub fn layouts(ctx: &Context) -> Result<CheckResult> {
+    use vk::ImageLayout as L;
+    let mut numbers = serde_json::Map::new();
+    let mut fails = Vec::new();
+    for format in ds_formats(ctx) {
+        // SAFETY: a format query on the context's valid physical device.
+        let props = unsafe { ctx.instance.get_physical_device_format_properties(ctx.physical, format) };
+        let sampled = props.optimal_tiling_features.contains(vk::FormatFeatureFlags::SAMPLED_IMAGE);
+        let mut chain = vec![L::DEPTH_STENCIL_READ_ONLY_OPTIMAL];
+        if sampled {
+            chain.push(L::SHADER_READ_ONLY_OPTIMAL);
+        }
+        if ctx.features.api_version >= vk::API_VERSION_1_1 {
+            chain.push(L::DEPTH_ATTACHMENT_STENCIL_READ_ONLY_OPTIMAL);
+        }
+        chain.extend([L::TRANSFER_SRC_OPTIMAL, L::TRANSFER_DST_OPTIMAL, L::DEPTH_STENCIL_ATTACHMENT_OPTIMAL]);
+        let usage = vk::ImageUsageFlags::TRANSFER_DST | if sampled { vk::ImageUsageFlags::SAMPLED } else { vk::ImageUsageFlags::empty() };
+        let mut s = Scratch::new(ctx);
+        let (i, _) = patterned(&mut s, format, models(ctx)[0], usage)?;
+        // The reference: the contents read before the chain (`commands.clears` holds them to
+        // the model), so this check judges the transitions alone.
+        let before = read_aspects(&mut s, i, format, L::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)?;
+        let img = &s.images[i];
+        ctx.one_shot(|cb| {
+            let mut from = L::DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+            for &to in &chain {
+                transition(ctx, cb, img, from, to);
+                from = to;
+            }
+        })?;
+        let (depth, stencil) = read_aspects(&mut s, i, format, L::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)?;
+        let db = depth_texel_bytes(format);
+        let kept = if format == vk::Format::D24_UNORM_S8_UINT { 3 } else { db };
+        let dm = (0..(W * H) as usize).filter(|&t| depth[t * db..t * db + kept] != before.0[t * db..t * db + kept]).count();
+        let sm = (0..(W * H) as usize).filter(|&t| stencil[t] != before.1[t]).count();
+        let names: Vec<String> = chain.iter().map(|l| format!("{l:?}")).collect();
+        numbers.insert(short(format).into(), json!({ "chain": names, "depth_mismatches": dm, "stencil_mismatches": sm }));
+        if dm + sm > 0 {
+            fails.push(format!("{}: {dm} depth and {sm} stencil texels changed through {}", short(format), names.join(" -> ")));
+        }
+    }
+    let what = "depth and stencil kept through DEPTH_STENCIL_READ_ONLY, SHADER_READ_ONLY (where sampled), \
+                DEPTH_ATTACHMENT_STENCIL_READ_ONLY (Vulkan 1.1), TRANSFER_SRC, TRANSFER_DST and back";
+    Ok(CheckResult::from_fails("layouts", fails, numbers, what))
+}
+
+/// `commands.blit_copy_color`: a 7 x 5 RGBA8 image of distinct texels copied to its like and
+/// blitted (NEAREST) to 16 x 9 in RGBA8 and BGRA8 — ratios with no texel-centre ties, so the
+/// spec fixes every destination texel.
+pub fn blit_copy_color(ctx: &Context) -> Result<CheckResult> {
+    let (sw, sh, dw, dh) = (7u32, 5u32, 16u32, 9u32);
+    let rgba = vk::Format::R8G8B8A8_UNORM;
+    let bgra = vk::Format::B8G8R8A8_UNORM;
+    let feats = |f: vk::Format| {
+        // SAFETY: a format query on the context's valid physical device.
+        unsafe { ctx.instance.get_physical_device_format_properties(ctx.physical, f) }.optimal_tiling_features
+    };
+    use vk::FormatFeatureFlags as F;
+    let base = F::COLOR_ATTACHMENT | F::SAMPLED_IMAGE | F::TRANSFER_SRC | F::TRANSFER_DST;
+    if !feats(rgba).contains(base | F::BLIT_SRC | F::BLIT_DST) {
+        return Ok(CheckResult::skipped("blit_copy_color", "skipped: R8G8B8A8_UNORM cannot be blitted (BLIT_SRC/BLIT_DST)"));
+    }
+    let with_bgra = feats(bgra).contains(base | F::BLIT_DST);
+    let texel = |x: u32, y: u32| [(x * 31 + 7) as u8, (y * 47 + 3) as u8, (x * 5 + y * 11) as u8, (200 + x + y) as u8];
+    let src_bytes: Vec<u8> = (0..sh).flat_map(|y| (0..sw).flat_map(move |x| texel(x, y))).collect();
+    let mut s = Scratch::new(ctx);
+    let usage = vk::ImageUsageFlags::COLOR_ATTACHMENT
+        | vk::ImageUsageFlags::SAMPLED
+        | vk::ImageUsageFlags::TRANSFER_SRC
+        | vk::ImageUsageFlags::TRANSFER_DST;
+    let color = vk::ImageAspectFlags::COLOR;
+    let src = s.image(rgba, vk::Extent2D { width: sw, height: sh }, usage, color)?;
+    let copy = s.image(rgba, vk::Extent2D { width: sw, height: sh }, usage, color)?;
+    let mut blits = vec![(rgba, s.image(rgba, vk::Extent2D { width: dw, height: dh }, usage, color)?)];
+    if with_bgra {
+        blits.push((bgra, s.image(bgra, vk::Extent2D { width: dw, height: dh }, usage, color)?));
+    }
+    let upload = s.readback(src_bytes.len() as u64)?;
+    s.buffers[upload].write(0, &src_bytes)?;
+    let copy_bytes = (sw * sh * 4) as usize;
+    let blit_bytes = (dw * dh * 4) as usize;
+    let out = s.readback((copy_bytes + blits.len() * blit_bytes) as u64)?;
+    let layers = vk::ImageSubresourceLayers { aspect_mask: color, mip_level: 0, base_array_layer: 0, layer_count: 1 };
+    let (src_img, copy_img) = (&s.images[src], &s.images[copy]);
+    let (up, down) = (s.buffers[upload].raw, s.buffers[out].raw);
+    let blit_imgs: Vec<&Image> = blits.iter().map(|&(_, k)| &s.images[k]).collect();
+    ctx.one_shot(|cb| {
+        use vk::ImageLayout as L;
+        let d = &ctx.device;
+        let corner = |w: u32, h: u32| [vk::Offset3D::default(), vk::Offset3D { x: w as i32, y: h as i32, z: 1 }];
+        transition(ctx, cb, src_img, L::UNDEFINED, L::TRANSFER_DST_OPTIMAL);
+        transition(ctx, cb, copy_img, L::UNDEFINED, L::TRANSFER_DST_OPTIMAL);
+        for img in &blit_imgs {
+            transition(ctx, cb, img, L::UNDEFINED, L::TRANSFER_DST_OPTIMAL);
+        }
+        let whole = |w: u32, h: u32, offset: u64| vk::BufferImageCopy {
+            buffer_offset: offset,
+            buffer_row_length: 0,
+            buffer_image_height: 0,
+            image_subresource: layers,
+            image_offset: vk::Offset3D::default(),
+            image_extent: vk::Extent3D { width: w, height: h, depth: 1 },
+        };
+        // SAFETY: recording outside rendering; every image is in the layout named, the
+        // buffers hold what is copied, all handles outlive the submission.
+        unsafe {
+            d.cmd_copy_buffer_to_image(cb, up, src_img.raw, L::TRANSFER_DST_OPTIMAL, &[whole(sw, sh, 0)]);
+            transition(ctx, cb, src_img, L::TRANSFER_DST_OPTIMAL, L::TRANSFER_SRC_OPTIMAL);
+            let region = vk::ImageCopy::default().src_subresource(layers).dst_subresource(layers).extent(vk::Extent3D {
+                width: sw,
+                height: sh,
+                depth: 1,
+            });
+            d.cmd_copy_image(cb, src_img.raw, L::TRANSFER_SRC_OPTIMAL, copy_img.raw, L::TRANSFER_DST_OPTIMAL, &[region]);
+            for img in &blit_imgs {
+                let blit = vk::ImageBlit::default()
+                    .src_subresource(layers)
+                    .src_offsets(corner(sw, sh))
+                    .dst_subresource(layers)
+                    .dst_offsets(corner(dw, dh));
+                d.cmd_blit_image(cb, src_img.raw, L::TRANSFER_SRC_OPTIMAL, img.raw, L::TRANSFER_DST_OPTIMAL, &[blit], vk::Filter::NEAREST);
+            }
+            // The copy then goes through the colour layouts the renderer and the viewer use.
+            transition(ctx, cb, copy_img, L::TRANSFER_DST_OPTIMAL, L::COLOR_ATTACHMENT_OPTIMAL);
+            transition(ctx, cb, copy_img, L::COLOR_ATTACHMENT_OPTIMAL, L::SHADER_READ_ONLY_OPTIMAL);
+            transition(ctx, cb, copy_img, L::SHADER_READ_ONLY_OPTIMAL, L::TRANSFER_SRC_OPTIMAL);
+            d.cmd_copy_image_to_buffer(cb, copy_img.raw, L::TRANSFER_SRC_OPTIMAL, down, &[whole(sw, sh, 0)]);
+            for (k, img) in blit_imgs.iter().enumerate() {
+                transition(ctx, cb, img, L::TRANSFER_DST_OPTIMAL, L::TRANSFER_SRC_OPTIMAL);
+                let offset = (copy_bytes + k * blit_bytes) as u64;
+                d.cmd_copy_image_to_buffer(cb, img.raw, L::TRANSFER_SRC_OPTIMAL, down, &[whole(dw, dh, offset)]);
+            }
+        }
+        memory_barrier(
+            ctx,
+            cb,
+            (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE),
+            (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
+        );
+    })?;
+    let got = s.buffers[out].read()?;
+    let mut numbers = serde_json::Map::new();
+    let mut fails = Vec::new();
+    let copy_bad = (0..copy_bytes).filter(|&k| got[k] != src_bytes[k]).count();
+    numbers.insert("copy_image_byte_mismatches".into(), json!(copy_bad));
+    if copy_bad > 0 {
+        fails.push(format!("vkCmdCopyImage: {copy_bad} bytes differ"));
+    }
+    for (k, &(format, _)) in blits.iter().enumerate() {
+        let base = copy_bytes + k * blit_bytes;
+        let mut bad = 0;
+        for y in 0..dh {
+            for x in 0..dw {
+                // NEAREST: the source texel containing the destination centre mapped back,
+                // u = (x + 0.5) * sw / dw (never an integer for these sizes).
+                let (u, v) = ((2 * x + 1) * sw / (2 * dw), (2 * y + 1) * sh / (2 * dh));
+                let [r, g, b, a] = texel(u, v);
+                let want = if format == bgra { [b, g, r, a] } else { [r, g, b, a] };
+                let at = base + ((y * dw + x) * 4) as usize;
+                bad += usize::from(got[at..at + 4] != want);
+            }
+        }
+        numbers.insert(format!("blit_{format:?}_texel_mismatches"), json!(bad));
+        if bad > 0 {
+            fails.push(format!("vkCmdBlitImage to {format:?}: {bad} of {} texels differ", dw * dh));
+        }
+    }
+    numbers.insert("bgra_blit".into(), json!(with_bgra));
+    let what = "vkCmdCopyImage exact (kept through COLOR_ATTACHMENT and SHADER_READ_ONLY); vkCmdBlitImage NEAREST 7x5 -> 16x9 (RGBA8, and to BGRA8 where it can be a blit destination) exact";
+    Ok(CheckResult::from_fails("blit_copy_color", fails, numbers, what))
+}
+
+/// `commands.buffers`: `vkCmdUpdateBuffer` at an offset, then `vkCmdCopyBuffer` of two regions
+/// at offsets within the buffer: every byte as the spec puts it.
+pub fn buffers(ctx: &Context) -> Result<CheckResult> {
+    let size = 512usize;
+    let mut s = Scratch::new(ctx);
+    let b = s.readback(size as u64)?;
+    let buf = s.buffers[b].raw;
+    let data: Vec<u8> = (0..64u32).map(|k| (k * 37 + 5) as u8).collect();
+    let (at, regions) = (16usize, [(16usize, 128usize, 40usize), (48, 300, 8)]);
+    ctx.one_shot(|cb| {
+        // SAFETY: recording outside rendering; offsets and sizes are multiples of 4 within the buffer.
+        unsafe { ctx.device.cmd_update_buffer(cb, buf, at as u64, &data) };
+        memory_barrier(
+            ctx,
+            cb,
+            (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE),
+            (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_READ | vk::AccessFlags2::TRANSFER_WRITE),
+        );
+        let copies: Vec<vk::BufferCopy> = regions
+            .iter()
+            .map(|&(src, dst, n)| vk::BufferCopy { src_offset: src as u64, dst_offset: dst as u64, size: n as u64 })
+            .collect();
+        // SAFETY: as above; the regions do not overlap each other or their sources.
+        unsafe { ctx.device.cmd_copy_buffer(cb, buf, buf, &copies) };
+        memory_barrier(
+            ctx,
+            cb,
+            (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE),
+            (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
+        );
+    })?;
+    let mut want = vec![UNTOUCHED; size];
+    want[at..at + data.len()].copy_from_slice(&data);
+    for (src, dst, n) in regions {
+        let chunk = want[src..src + n].to_vec();
+        want[dst..dst + n].copy_from_slice(&chunk);
+    }
+    let got = s.buffers[b].read()?;
+    let bad = (0..size).filter(|&k| got[k] != want[k]).count();
+    let mut numbers = serde_json::Map::new();
+    numbers.insert("byte_mismatches".into(), json!(bad));
+    let fails = if bad > 0 { vec![format!("{bad} of {size} bytes differ")] } else { vec![] };
+    Ok(CheckResult::from_fails("buffers", fails, numbers, "vkCmdUpdateBuffer at an offset and vkCmdCopyBuffer of two regions: every byte"))
+}
+
+/// Two triangles covering the integer rectangle `[x0, y0, x1, y1]` at depth `z`.
+fn quad(r: [f32; 4], z: f32) -> Vec<[f32; 4]> {
+    let mut q = Vec::new();
+    rect(&mut q, r, true);
+    q.into_iter().map(|p| [p[0], p[1], z, 1.0]).collect()
+}
+
+fn needs_dynamic_rendering(ctx: &Context, name: &str) -> Option<CheckResult> {
+    (!ctx.features.dynamic_rendering).then(|| {
+        let v = &ctx.info.api_version;
+        CheckResult::skipped(name, &format!("skipped: draws through dynamic rendering (Vulkan 1.3); the device has Vulkan {v}"))
+    })
+}
+
+/// `commands.queries`: occlusion, pipeline-statistics and timestamp queries recorded and read
+/// as the renderer's counters do, and read back with other offsets, strides and flags.
+pub fn queries(ctx: &Context) -> Result<CheckResult> {
+    if let Some(r) = needs_dynamic_rendering(ctx, "queries") {
+        return Ok(r);
+    }
+    let f = &ctx.features;
+    let format = ctx.depth_format;
+    let mvp = harness::pixel_ortho(W, H);
+    let incr = PipeSpec::stencil(vk::StencilOp::INCREMENT_AND_WRAP, vk::StencilOp::INCREMENT_AND_WRAP);
+    // 0: 10 x 6 pixels; 1: 7 x 3; 2: five triangles, two entirely left of the image.
+    let mut five = quad([0.0, 0.0, 8.0, 8.0], 0.5);
+    five.extend(&quad([-40.0, 0.0, -30.0, 8.0], 0.5));
+    let again = five[0..3].to_vec();
+    five.extend(again);
+    let draws = [
+        DrawCall { spec: incr, mvp, vertices: quad([2.0, 3.0, 12.0, 9.0], 0.5), indices: Indices::None },
+        DrawCall { spec: incr, mvp, vertices: quad([30.0, 10.0, 37.0, 13.0], 0.5), indices: Indices::None },
+        DrawCall { spec: incr, mvp, vertices: five, indices: Indices::None },
+    ];
+    let prepared = Draws::new(ctx, format, &draws)?;
+    let result = (|| -> Result<CheckResult> {
+        let mut s = Scratch::new(ctx);
+        let i = s.image(format, vk::Extent2D { width: W, height: H }, vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT, DS)?;
+        let occ = s.query_pool(vk::QueryType::OCCLUSION, 8, vk::QueryPipelineStatisticFlags::empty())?;
+        use vk::QueryPipelineStatisticFlags as P;
+        let stat_flags = P::INPUT_ASSEMBLY_PRIMITIVES | P::VERTEX_SHADER_INVOCATIONS | P::CLIPPING_PRIMITIVES;
+        let stats = match f.pipeline_statistics_query {
+            true => Some(s.query_pool(vk::QueryType::PIPELINE_STATISTICS, 2, stat_flags)?),
+            false => None,
+        };
+        let stamps = match f.timestamps {
+            true => Some(s.query_pool(vk::QueryType::TIMESTAMP, 2, P::empty())?),
+            false => None,
+        };
+        let control = if f.occlusion_query_precise { vk::QueryControlFlags::PRECISE } else { vk::QueryControlFlags::empty() };
+        let img = &s.images[i];
+        ctx.one_shot(|cb| {
+            let d = &ctx.device;
+            let area = full();
+            // SAFETY: recording; the pools, image and draws outlive the submission; every query
+            // is reset before it is begun, begun and ended once, inside one rendering instance.
+            unsafe {
+                d.cmd_reset_query_pool(cb, occ, 0, 8);
+                d.cmd_reset_query_pool(cb, occ, 2, 4);
+                if let Some(p) = stats {
+                    d.cmd_reset_query_pool(cb, p, 0, 2);
+                }
+                if let Some(p) = stamps {
+                    d.cmd_reset_query_pool(cb, p, 0, 2);
+                    write_timestamp(ctx, cb, p, 0);
+                }
+            }
+            transition(ctx, cb, img, vk::ImageLayout::UNDEFINED, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
+            let att = vk::RenderingAttachmentInfo::default()
+                .image_view(img.view)
+                .image_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
+                .load_op(vk::AttachmentLoadOp::CLEAR)
+                .store_op(vk::AttachmentStoreOp::STORE)
+                .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } });
+            let info = vk::RenderingInfo::default().render_area(area).layer_count(1).depth_attachment(&att).stencil_attachment(&att);
+            let viewport = vk::Viewport { x: 0.0, y: 0.0, width: W as f32, height: H as f32, min_depth: 0.0, max_depth: 1.0 };
+            // SAFETY: as above.
+            unsafe {
+                d.cmd_begin_rendering(cb, &info);
+                d.cmd_set_viewport(cb, 0, &[viewport]);
+                d.cmd_begin_query(cb, occ, 2, control);
+                prepared.record(ctx, cb, 0, area);
+                d.cmd_end_query(cb, occ, 2);
+                d.cmd_begin_query(cb, occ, 3, control);
+                d.cmd_end_query(cb, occ, 3);
+                d.cmd_begin_query(cb, occ, 5, control);
+                prepared.record(ctx, cb, 1, area);
+                d.cmd_end_query(cb, occ, 5);
+                if let Some(p) = stats {
+                    d.cmd_begin_query(cb, p, 1, vk::QueryControlFlags::empty());
+                    prepared.record(ctx, cb, 2, area);
+                    d.cmd_end_query(cb, p, 1);
+                }
+                d.cmd_end_rendering(cb);
+                if let Some(p) = stamps {
+                    write_timestamp(ctx, cb, p, 1);
+                }
+            }
+        })?;
+        let mut numbers = serde_json::Map::new();
+        let mut fails = Vec::new();
+        let d = &ctx.device;
+        let exact = f.occlusion_query_precise;
+        let count_ok = |got: u64, want: u64| if exact { got == want } else { (got > 0) == (want > 0) };
+        let mut q64 = [0u64; 2];
+        // SAFETY: one_shot waited for the submission (here and below); each slice
+        // holds `len` results of the flags' size and layout.
+        unsafe { d.get_query_pool_results(occ, 2, &mut q64, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT) }
+            .map_err(vkerr("vkGetQueryPoolResults"))?;
+        let mut q32 = [0u32; 2];
+        // SAFETY: as above.
+        unsafe { d.get_query_pool_results(occ, 2, &mut q32, vk::QueryResultFlags::WAIT) }.map_err(vkerr("vkGetQueryPoolResults"))?;
+        // Queries 5 (ended) and 6 (reset, never begun) with availability, without waiting: the
+        // call must say VK_NOT_READY, write 5's count and a non-zero availability ("non-zero if
+        // the query's status was available": SwiftShader writes 2, lavapipe 1), and 6's 0.
+        let mut avail = [[0u64, 7], [0, 7]];
+        // SAFETY: as above; two u64 per query (count, availability).
+        let r = unsafe {
+            d.get_query_pool_results(occ, 5, &mut avail, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WITH_AVAILABILITY)
+        };
+        numbers.insert("occlusion_64".into(), json!(q64));
+        numbers.insert("occlusion_32".into(), json!(q32));
+        numbers.insert("occlusion_with_availability".into(), json!(avail));
+        numbers.insert("precise".into(), json!(exact));
+        if !(count_ok(q64[0], 60) && q64[1] == 0) {
+            fails.push(format!("occlusion queries 2..4 (64-bit): {q64:?}, want [60, 0]"));
+        }
+        if q32[0] as u64 != q64[0] || q32[1] != 0 {
+            fails.push(format!("occlusion queries 2..4 (32-bit): {q32:?}, the 64-bit read gave {q64:?}"));
+        }
+        if !count_ok(avail[0][0], 21) || avail[0][1] == 0 || avail[1][1] != 0 {
+            fails.push(format!("queries 5..7 with availability: {avail:?}, want [[21, non-zero], [_, 0]]"));
+        }
+        match r {
+            Err(vk::Result::NOT_READY) => {}
+            other => fails.push(format!("reading an unavailable query without WAIT returned {other:?}, not VK_NOT_READY")),
+        }
+        if let Some(p) = stats {
+            let mut raw = [[0u64; 3]; 1];
+            // SAFETY: as above; three u64 per query, in flag-bit order.
+            unsafe { d.get_query_pool_results(p, 1, &mut raw, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT) }
+                .map_err(vkerr("vkGetQueryPoolResults"))?;
+            let [ia, vs, clip] = raw[0];
+            numbers.insert(
+                "statistics".into(),
+                json!({ "input_assembly_primitives": ia, "vertex_shader_invocations": vs, "clipping_primitives": clip }),
+            );
+            // Five triangles (15 vertices, not indexed), two of them outside the view: exactly
+            // 5 assembled; at least the visible three's 9 vertices shaded; 3 to 5 out of clipping.
+            if ia != 5 || !(9..=45).contains(&vs) || !(3..=5).contains(&clip) {
+                fails.push(format!(
+                    "pipeline statistics [input assembly primitives, vertex invocations, clipping primitives] = {:?}, want [5, 9..=45, 3..=5]",
+                    raw[0]
+                ));
+            }
+        }
+        if let Some(p) = stamps {
+            let mut t = [0u64; 2];
+            // SAFETY: as above.
+            unsafe { d.get_query_pool_results(p, 0, &mut t, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT) }
+                .map_err(vkerr("vkGetQueryPoolResults"))?;
+            numbers.insert("timestamps".into(), json!(t));
+            if t[1] < t[0] {
+                fails.push(format!("the later timestamp {} is before the earlier {}", t[1], t[0]));
+            }
+        }
+        let what = "occlusion queries reset by sub-range, counted (precise where the device can), read from a first query in 64 and \
+                    32 bits and with availability (unavailable: 0, VK_NOT_READY); pipeline statistics in flag-bit order; timestamps in order";
+        Ok(CheckResult::from_fails("queries", fails, numbers, what))
+    })();
+    prepared.destroy(ctx);
+    result
+}
+
+/// Records a timestamp after every earlier command (synchronization2 where the device has it).
+///
+/// # Safety
+/// `cb` is recording; `query` of `pool` (a timestamp pool) was reset and is written once.
+unsafe fn write_timestamp(ctx: &Context, cb: vk::CommandBuffer, pool: vk::QueryPool, query: u32) {
+    // SAFETY: the caller's contract.
+    unsafe {
+        if ctx.features.synchronization2 {
+            ctx.device.cmd_write_timestamp2(cb, vk::PipelineStageFlags2::ALL_COMMANDS, pool, query);
+        } else {
+            ctx.device.cmd_write_timestamp(cb, vk::PipelineStageFlags::BOTTOM_OF_PIPE, pool, query);
+        }
+    }
+}
+
+/// `commands.scissor`: full-image quads through per-draw scissors — inside, straddling the
+/// image's edge and past it, and empty: only the scissored pixels change.
+pub fn scissor(ctx: &Context) -> Result<CheckResult> {
+    if let Some(r) = needs_dynamic_rendering(ctx, "scissor") {
+        return Ok(r);
+    }
+    let mvp = harness::pixel_ortho(W, H);
+    let scissors = [rect2d(5, 3, 20, 10), rect2d(50, 20, 30, 30), rect2d(0, 0, 0, 9), rect2d(10, 0, 3, 32)];
+    let mut g = Grid::new(1.0, 0);
+    let draws: Vec<DrawCall> = scissors
+        .iter()
+        .enumerate()
+        .map(|(k, &sc)| {
+            let mut spec = PipeSpec::replace(k as u32 + 1);
+            spec.scissor = Some(sc);
+            g.fill(sc, None, Some(k as u8 + 1));
+            DrawCall { spec, mvp, vertices: quad([0.0, 0.0, W as f32, H as f32], 0.5), indices: Indices::None }
+        })
+        .collect();
+    let rb = harness::render(ctx, ctx.depth_format, W, H, 1.0, 0, &draws)?;
+    let bad = (0..g.stencil.len()).filter(|&i| rb.stencil[i] != g.stencil[i]).count();
+    let mut numbers = serde_json::Map::new();
+    numbers.insert("mismatched_pixels".into(), json!(bad));
+    let fails = if bad > 0 { vec![format!("{bad} pixels differ from the scissors' coverage")] } else { vec![] };
+    Ok(CheckResult::from_fails(
+        "scissor",
+        fails,
+        numbers,
+        "per-draw scissors (inside, past the image's edge, empty) bound coverage exactly",
+    ))
+}
+
+/// `commands.indirect`: indexed indirect draws, one record per call at non-zero offsets, with
+/// `firstIndex`, `vertexOffset` and an empty record, against the same coverage computed directly.
+pub fn indirect(ctx: &Context) -> Result<CheckResult> {
+    if let Some(r) = needs_dynamic_rendering(ctx, "indirect") {
+        return Ok(r);
+    }
+    let mvp = harness::pixel_ortho(W, H);
+    let rects = [[2.0, 2.0, 20.0, 12.0], [10.0, 8.0, 40.0, 30.0], [44.0, 1.0, 60.0, 20.0]];
+    // A decoy triangle at vertex 0: drawn only by a record read from the wrong place.
+    let mut vertices = quad([0.0, 0.0, W as f32, H as f32], 0.5)[0..3].to_vec();
+    for r in rects {
+        vertices.extend(quad(r, 0.5));
+    }
+    let indices: Vec<u16> = (0..vertices.len() as u16).collect();
+    let rec = |index_count, instance_count, first_index, vertex_offset| vk::DrawIndexedIndirectCommand {
+        index_count,
+        instance_count,
+        first_index,
+        vertex_offset,
+        first_instance: 0,
+    };
+    // Rect 0 through first_index 3; rect 1 through first_index 0 and vertex_offset 9; an empty
+    // record (instance count 0) over rect 2; rect 2 twice (two instances).
+    let records = vec![rec(6, 1, 3, 0), rec(6, 1, 0, 9), rec(6, 0, 15, 0), rec(6, 2, 15, 0)];
+    let spec = PipeSpec::stencil(vk::StencilOp::INCREMENT_AND_WRAP, vk::StencilOp::INCREMENT_AND_WRAP);
+    let rb = harness::render(
+        ctx,
+        ctx.depth_format,
+        W,
+        H,
+        1.0,
+        0,
+        &[DrawCall { spec, mvp, vertices, indices: Indices::Indirect16 { indices, records, lead_in: 3 } }],
+    )?;
+    let mut want = vec![0u8; (W * H) as usize];
+    for (r, times) in rects.iter().zip([1u8, 1, 2]) {
+        for y in r[1] as u32..r[3] as u32 {
+            for x in r[0] as u32..r[2] as u32 {
+                want[(y * W + x) as usize] += times;
+            }
+        }
+    }
+    let bad = (0..want.len()).filter(|&i| rb.stencil[i] != want[i]).count();
+    let mut numbers = serde_json::Map::new();
+    numbers.insert("mismatched_pixels".into(), json!(bad));
+    let fails = if bad > 0 { vec![format!("{bad} pixels differ from the records' coverage")] } else { vec![] };
+    let what = "vkCmdDrawIndexedIndirect per record at offsets 60..120 (firstIndex, vertexOffset, instanceCount 0 and 2) exact";
+    Ok(CheckResult::from_fails("indirect", fails, numbers, what))
+}
