@@ -82,6 +82,8 @@ mod named_enum;
 pub mod output;
 pub mod pass;
 #[cfg(feature = "cli")]
+pub mod profiles;
+#[cfg(feature = "cli")]
 pub mod reference;
 #[cfg(feature = "cli")]
 pub mod render;

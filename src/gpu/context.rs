@@ -9,101 +9,13 @@
 //!   (which always run with `UMBRAGE_VALIDATION=1`) fail when any was reported.
 //! - Teardown order: device idle -> allocator -> pool -> device -> messenger -> instance.
 
-use super::probe::Minimum;
+use super::caps::Minimum;
+pub use super::caps::{version_string, DeviceInfo, Features};
 pub use super::validation::ValidationMode;
 use crate::error::{Error, Result};
 use ash::vk;
 use std::ffi::{c_void, CStr};
 use std::sync::{Arc, Mutex};
-
-/// Optional device capabilities, as probed.
-#[derive(Clone, Debug, Default)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
-pub struct Features {
-    /// The device's Vulkan version as `VK_MAKE_API_VERSION` packs it (`DeviceInfo::api_version`
-    /// spells it out). Below 1.3 only what Vulkan 1.0 core offers is used, and the context is
-    /// made only through [`Context::any_version`].
-    #[cfg_attr(feature = "serde", serde(skip))]
-    pub api_version: u32,
-    /// `dynamicRendering` (Vulkan 1.3 core) is enabled: `vkCmdBeginRendering` may be used.
-    pub dynamic_rendering: bool,
-    /// `synchronization2` (Vulkan 1.3 core) is enabled: barriers are recorded with
-    /// `vkCmdPipelineBarrier2`; without it [`super::resources::transition`] and
-    /// [`super::resources::memory_barrier`] record Vulkan 1.0 barriers.
-    pub synchronization2: bool,
-    /// The Vulkan 1.3 core dynamic depth/stencil state (`vkCmdSetStencilOp`,
-    /// `vkCmdSetDepthCompareOp`, ..., formerly `VK_EXT_extended_dynamic_state`) can be used.
-    pub extended_dynamic_state: bool,
-    /// `depthClamp` is supported (and enabled on the device): `--depth-mode clamp` (finite far
-    /// plane, geometry beyond it clamped to depth 1.0 instead of clipped).
-    pub depth_clamp: bool,
-    /// `depthBounds` is supported (and enabled): pipelines may use the depth-bounds test.
-    pub depth_bounds: bool,
-    /// `VK_EXT_depth_range_unrestricted` is available (and enabled).
-    pub depth_range_unrestricted: bool,
-    /// `VK_EXT_index_type_uint8` with its `indexTypeUint8` feature (both enabled when present):
-    /// 8-bit index buffers can be bound.
-    pub index_type_uint8: bool,
-    /// `pipelineStatisticsQuery` is supported (and enabled).
-    pub pipeline_statistics_query: bool,
-    /// `occlusionQueryPrecise` is supported (and enabled): occlusion queries with
-    /// `VK_QUERY_CONTROL_PRECISE_BIT` count samples exactly (the bench's rasterised-fragment
-    /// counter; the conformance suite checks them).
-    pub occlusion_query_precise: bool,
-    /// The graphics queue writes timestamps (`timestampValidBits > 0`) and the device reports a
-    /// non-zero `timestampPeriod`.
-    pub timestamps: bool,
-    /// Nanoseconds per timestamp tick (`VkPhysicalDeviceLimits::timestampPeriod`).
-    pub timestamp_period_ns: f32,
-    /// The chosen depth-stencil format, as its `Debug` name (`D32_SFLOAT_S8_UINT` or
-    /// `D24_UNORM_S8_UINT`); the format itself is [`Context::depth_format`].
-    pub depth_stencil_format: String,
-    /// `geometryShader` is supported (probed and reported only; never enabled).
-    pub geometry_shader: bool,
-    /// R32_SFLOAT can be blended as a colour attachment (optional in Vulkan): `--counter float`
-    /// and the shadow-map baseline need it.
-    pub r32f_blend: bool,
-    /// R32G32B32A32_SFLOAT can be blended (optional): the fp32 light-intensity map needs it.
-    pub rgba32f_blend: bool,
-    /// `VK_KHR_ray_query` and `VK_KHR_acceleration_structure` (with `rayQuery`,
-    /// `accelerationStructure` and `bufferDeviceAddress`) are present and enabled:
-    /// `--method rayquery` can run (Mesa lavapipe 25 has them; 22.3 has not).
-    pub ray_query: bool,
-    /// `multiview` (Vulkan 1.1 core) is supported and enabled: the shadow-map baseline can
-    /// render a point light's six cube faces as six views of one draw (`--cube multiview`).
-    pub multiview: bool,
-    /// `sampleRateShading` is supported and enabled: the renderer's multisampled frame
-    /// (`--msaa N`) shades its G-buffer and lighting per sample.
-    pub sample_rate_shading: bool,
-    /// Sample counts (bit `N` for N samples) that every target of the renderer's multisampled
-    /// frame supports: the colour and depth-stencil framebuffer counts and the sampled-image
-    /// counts (colour, integer for the stencil, depth) together.
-    pub frame_sample_counts: u32,
-    /// `standardSampleLocations`: multisampled images use Vulkan's standard sample locations
-    /// (a multisampled capture is unprojected at them).
-    pub standard_sample_locations: bool,
-}
-
-/// Identification of the chosen physical device, for `umbrage info`, logs and the stats JSON.
-#[derive(Clone, Debug)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize))]
-pub struct DeviceInfo {
-    /// `deviceName`, e.g. `llvmpipe (LLVM 15.0.7, 256 bits)`.
-    pub name: String,
-    /// The device type as its `Debug` name: `DISCRETE_GPU`, `INTEGRATED_GPU`, `VIRTUAL_GPU`, `CPU`, ...
-    pub kind: String,
-    /// `driverName` from `VkPhysicalDeviceDriverProperties` (empty if the driver leaves it empty).
-    pub driver: String,
-    /// `driverInfo` from `VkPhysicalDeviceDriverProperties`, typically the driver's version string.
-    pub driver_info: String,
-    /// The device's Vulkan version, `major.minor.patch` (at least 1.3.0, except for a context
-    /// made with [`Context::any_version`]).
-    pub api_version: String,
-    /// PCI vendor id (`vendorID`).
-    pub vendor_id: u32,
-    /// Vendor-specific device id (`deviceID`).
-    pub device_id: u32,
-}
 
 /// Shared sink for validation messages, filled by the debug messenger (only when validation is on).
 #[derive(Default)]
@@ -157,11 +69,6 @@ pub struct Context {
     pub limits: vk::PhysicalDeviceLimits,
     /// Whether the validation layer and debug messenger are active.
     pub validation: bool,
-}
-
-/// `major.minor.patch` of a packed Vulkan version.
-pub fn version_string(v: u32) -> String {
-    format!("{}.{}.{}", vk::api_version_major(v), vk::api_version_minor(v), vk::api_version_patch(v))
 }
 
 /// Whether validation is requested through `UMBRAGE_VALIDATION`: `1`, `true`, `sync`,

@@ -5,6 +5,7 @@
 //! `// SAFETY:` line and every `unsafe fn` a `# Safety` section (`Cargo.toml`'s `[lints]`).
 #![warn(missing_docs)]
 pub mod accel;
+pub mod caps;
 pub mod context;
 pub mod creation;
 pub mod descriptors;
@@ -18,5 +19,6 @@ pub mod shaders {
     //! The naga-compiled SPIR-V of every shader in `shaders/` (see build.rs).
     include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
 }
+pub use caps::{DeviceCaps, FeatureSet};
 pub use context::{Context, DeviceInfo, Features, GpuDevice, ValidationMode};
 pub use resources::{Buffer, Image};

@@ -2,22 +2,13 @@
 //! has (through the Vulkan 1.0 queries, `VK_KHR_get_physical_device_properties2` or the 1.1
 //! ones, whichever the device's version allows), and the logical device with it enabled.
 
-use super::context::{version_string, DeviceInfo, Features};
+use super::caps::{choose, version_string, Choice, DeviceCaps, DeviceInfo, Features, Minimum};
 use crate::error::{Error, Result};
 use ash::vk;
 use std::ffi::CStr;
 
 fn vkerr(call: &'static str) -> impl Fn(vk::Result) -> Error {
     Error::vk(call)
-}
-
-/// The oldest device a context accepts.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum Minimum {
-    /// Vulkan 1.3 with `dynamicRendering` and `synchronization2`: the renderer and the viewer.
-    Vulkan13,
-    /// Any Vulkan device: the conformance suite and `umbrage info`.
-    Vulkan10,
 }
 
 /// The device [`open_device`] created, and what was learnt of it on the way.
@@ -49,75 +40,12 @@ pub(super) fn open_device(
 ) -> Result<OpenedDevice> {
     let Picked { physical, queue_family, props, name } = pick_physical(instance, minimum)?;
     let api = props.api_version;
-    let v11 = api >= vk::API_VERSION_1_1;
-    let v12 = api >= vk::API_VERSION_1_2;
     let v13 = api >= vk::API_VERSION_1_3;
-
-    // Probe optional features: through the Vulkan 1.1 core query, or on a Vulkan 1.0 device
-    // through VK_KHR_get_physical_device_properties2 (when the loader has it; otherwise
-    // only the 1.0 features are known).
-    // SAFETY: enumeration of extensions on a valid physical device.
-    let exts =
-        unsafe { instance.enumerate_device_extension_properties(physical) }.map_err(vkerr("vkEnumerateDeviceExtensionProperties"))?;
-    let has_ext = |n: &CStr| exts.iter().any(|e| e.extension_name_as_c_str().map(|x| x == n).unwrap_or(false));
-    let can_query2 = v11 || gpdp2.is_some();
-    let has_u8_ext = has_ext(ash::ext::index_type_uint8::NAME) && can_query2;
-    let has_dru = has_ext(ash::ext::depth_range_unrestricted::NAME);
-    // Ray query (`--method rayquery`): the two extensions, deferred host operations (which
-    // acceleration structures require) and buffer device addresses (Vulkan 1.2 core).
-    let has_rq_exts = v12
-        && [ash::khr::acceleration_structure::NAME, ash::khr::ray_query::NAME, ash::khr::deferred_host_operations::NAME]
-            .into_iter()
-            .all(has_ext);
-    let Probed { base, dyn_rendering, sync2, u8_supported, ray_query, multiview } =
-        probe_features(instance, gpdp2, physical, (v11, v12, v13), has_u8_ext, has_rq_exts);
-    if minimum == Minimum::Vulkan13 && (!dyn_rendering || !sync2) {
-        return Err(Error::Unsupported(format!("{name}: umbrage needs dynamicRendering and synchronization2 (Vulkan 1.3)")));
-    }
-    // SAFETY: as above.
-    let families = unsafe { instance.get_physical_device_queue_family_properties(physical) };
-    let timestamps = families[queue_family as usize].timestamp_valid_bits > 0 && props.limits.timestamp_period > 0.0;
-
-    let depth_format = depth_stencil_format(instance, physical, v11, &name)?;
-
-    let blendable = |f: vk::Format| {
-        // SAFETY: format query on a valid physical device.
-        let p = unsafe { instance.get_physical_device_format_properties(physical, f) };
-        p.optimal_tiling_features.contains(vk::FormatFeatureFlags::COLOR_ATTACHMENT_BLEND)
-    };
-    let features = Features {
-        api_version: api,
-        dynamic_rendering: v13 && dyn_rendering,
-        synchronization2: v13 && sync2,
-        extended_dynamic_state: v13,
-        depth_clamp: base.depth_clamp == vk::TRUE,
-        depth_bounds: base.depth_bounds == vk::TRUE,
-        depth_range_unrestricted: has_dru,
-        index_type_uint8: u8_supported,
-        pipeline_statistics_query: base.pipeline_statistics_query == vk::TRUE,
-        occlusion_query_precise: base.occlusion_query_precise == vk::TRUE,
-        timestamps,
-        timestamp_period_ns: props.limits.timestamp_period,
-        depth_stencil_format: format!("{depth_format:?}"),
-        geometry_shader: base.geometry_shader == vk::TRUE,
-        r32f_blend: blendable(vk::Format::R32_SFLOAT),
-        rgba32f_blend: blendable(vk::Format::R32G32B32A32_SFLOAT),
-        ray_query,
-        multiview,
-        sample_rate_shading: base.sample_rate_shading == vk::TRUE,
-        standard_sample_locations: props.limits.standard_sample_locations == vk::TRUE,
-        frame_sample_counts: {
-            let l = &props.limits;
-            (l.framebuffer_color_sample_counts
-                & l.framebuffer_depth_sample_counts
-                & l.framebuffer_stencil_sample_counts
-                & l.sampled_image_color_sample_counts
-                & l.sampled_image_integer_sample_counts
-                & l.sampled_image_stencil_sample_counts)
-                .as_raw()
-        },
-    };
-
+    let caps = DeviceCaps::query(instance, gpdp2, physical)?;
+    let Choice { features, depth_format, extensions } = choose(&caps, minimum)?;
+    let ray_query = features.ray_query;
+    let u8_supported = features.index_type_uint8;
+    let multiview = features.multiview;
     let enabled = vk::PhysicalDeviceFeatures::default()
         .depth_clamp(features.depth_clamp)
         .depth_bounds(features.depth_bounds)
@@ -132,20 +60,9 @@ pub(super) fn open_device(
     let mut e_rq = vk::PhysicalDeviceRayQueryFeaturesKHR::default().ray_query(true);
     let mut e12 = vk::PhysicalDeviceVulkan12Features::default().buffer_device_address(true);
     let mut e11 = vk::PhysicalDeviceVulkan11Features::default().multiview(true);
-    let mut dev_exts = Vec::new();
-    if ray_query {
-        for e in [ash::khr::acceleration_structure::NAME, ash::khr::ray_query::NAME, ash::khr::deferred_host_operations::NAME] {
-            dev_exts.push(e.as_ptr());
-        }
-    }
-    if u8_supported {
-        dev_exts.push(ash::ext::index_type_uint8::NAME.as_ptr());
-    }
-    if has_dru {
-        dev_exts.push(ash::ext::depth_range_unrestricted::NAME.as_ptr());
-    }
+    let mut dev_exts: Vec<_> = extensions.iter().map(|e| e.as_ptr()).collect();
     for &e in extra_extensions {
-        if !has_ext(e) {
+        if !caps.has_extension(e) {
             return Err(Error::Unsupported(format!("{name}: the device lacks {}", e.to_string_lossy())));
         }
         dev_exts.push(e.as_ptr());
@@ -169,70 +86,10 @@ pub(super) fn open_device(
     // SAFETY: all pointers refer to locals alive for the call.
     let device = unsafe { instance.create_device(physical, &dinfo, None) }.map_err(vkerr("vkCreateDevice"))?;
 
-    let has_driver_props = api >= vk::API_VERSION_1_2 || (has_ext(ash::khr::driver_properties::NAME) && can_query2);
+    let can_query2 = api >= vk::API_VERSION_1_1 || gpdp2.is_some();
+    let has_driver_props = api >= vk::API_VERSION_1_2 || (caps.has_extension(ash::khr::driver_properties::NAME) && can_query2);
     let info = device_info(instance, gpdp2, physical, &props, name, has_driver_props);
     Ok(OpenedDevice { physical, device, queue_family, features, info, depth_format, limits: props.limits })
-}
-
-/// What [`probe_features`] found.
-struct Probed {
-    base: vk::PhysicalDeviceFeatures,
-    dyn_rendering: bool,
-    sync2: bool,
-    u8_supported: bool,
-    ray_query: bool,
-    multiview: bool,
-}
-
-/// The device's features: through the Vulkan 1.1 core query, or on a Vulkan 1.0 device through
-/// `VK_KHR_get_physical_device_properties2` (`gpdp2`, when the loader has it; otherwise only
-/// the 1.0 features). A structure is chained only where the device's version (`v11`, `v13`)
-/// or extensions (`has_u8_ext`, `has_rq_exts`) define it; `multiview` is read from the
-/// Vulkan 1.2 `Vulkan11Features` structure.
-fn probe_features(
-    instance: &ash::Instance,
-    gpdp2: Option<&ash::khr::get_physical_device_properties2::Instance>,
-    physical: vk::PhysicalDevice,
-    (v11, v12, v13): (bool, bool, bool),
-    has_u8_ext: bool,
-    has_rq_exts: bool,
-) -> Probed {
-    let mut f_as = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default();
-    let mut f_rq = vk::PhysicalDeviceRayQueryFeaturesKHR::default();
-    let mut f12 = vk::PhysicalDeviceVulkan12Features::default();
-    let mut f_u8 = vk::PhysicalDeviceIndexTypeUint8FeaturesEXT::default();
-    let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
-    let mut f11 = vk::PhysicalDeviceVulkan11Features::default();
-    let mut f2 = vk::PhysicalDeviceFeatures2::default();
-    if v13 {
-        f2 = f2.push_next(&mut f13);
-    }
-    // The Vulkan11Features structure is defined from Vulkan 1.2 (1.1 has the per-feature ones).
-    if v12 {
-        f2 = f2.push_next(&mut f11);
-    }
-    if has_u8_ext {
-        f2 = f2.push_next(&mut f_u8);
-    }
-    if has_rq_exts {
-        f2 = f2.push_next(&mut f_as).push_next(&mut f_rq).push_next(&mut f12);
-    }
-    // SAFETY: the chain points at locals alive for this call; a struct is chained only when
-    // the device's version or extensions define it.
-    unsafe {
-        match (v11, gpdp2) {
-            (true, _) => instance.get_physical_device_features2(physical, &mut f2),
-            (false, Some(g)) => g.get_physical_device_features2(physical, &mut f2),
-            (false, None) => f2.features = instance.get_physical_device_features(physical),
-        }
-    }
-    let base = f2.features;
-    let (dyn_rendering, sync2) = (f13.dynamic_rendering == vk::TRUE, f13.synchronization2 == vk::TRUE);
-    let u8_supported = has_u8_ext && f_u8.index_type_uint8 == vk::TRUE;
-    let ray_query =
-        has_rq_exts && f_as.acceleration_structure == vk::TRUE && f_rq.ray_query == vk::TRUE && f12.buffer_device_address == vk::TRUE;
-    let multiview = v12 && f11.multiview == vk::TRUE;
-    Probed { base, dyn_rendering, sync2, u8_supported, ray_query, multiview }
 }
 
 /// The physical device [`open_device`] uses.
@@ -306,21 +163,6 @@ fn pick_physical(instance: &ash::Instance, minimum: Minimum) -> Result<Picked> {
         }));
     };
     Ok(Picked { physical, queue_family, props, name })
-}
-
-/// A depth-stencil format with 8 stencil bits, usable as attachment and transfer source.
-fn depth_stencil_format(instance: &ash::Instance, physical: vk::PhysicalDevice, v11: bool, name: &str) -> Result<vk::Format> {
-    let needed = vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT | vk::FormatFeatureFlags::TRANSFER_SRC;
-    [vk::Format::D32_SFLOAT_S8_UINT, vk::Format::D24_UNORM_S8_UINT]
-        .into_iter()
-        .find(|&f| {
-            // SAFETY: format query on a valid physical device.
-            let p = unsafe { instance.get_physical_device_format_properties(physical, f) };
-            // Vulkan 1.0 has no TRANSFER_SRC format feature (VK_KHR_maintenance1): every
-            // attachment format may be copied there.
-            p.optimal_tiling_features.contains(if v11 { needed } else { vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT })
-        })
-        .ok_or_else(|| Error::Unsupported(format!("{name}: no depth-stencil format with 8 stencil bits (D32S8 or D24S8)")))
 }
 
 /// The device's identification; the driver's name and version string where the device has

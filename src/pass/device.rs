@@ -1,7 +1,9 @@
 //! The host's device and allocator, as the GPU helpers see them.
 
-use super::desc::ShadowPassDesc;
+use super::desc::{Capabilities, ShadowPassDesc, TargetModel};
+use super::pipelines::COUNT_FORMAT;
 use crate::error::{Error, Result};
+use crate::gpu::caps::DeviceCaps;
 use crate::gpu::context::{lock_allocator, GpuDevice};
 use ash::vk;
 use gpu_allocator::vulkan::Allocator;
@@ -27,40 +29,56 @@ impl GpuDevice for PassDevice {
     }
 }
 
-/// Whether the device can do dynamic rendering: Vulkan 1.3 with `dynamicRendering`.
-pub(super) fn dynamic_rendering_supported(instance: &ash::Instance, pd: vk::PhysicalDevice, api: u32) -> bool {
-    if api < vk::API_VERSION_1_3 {
-        return false;
+/// What a pass made with `desc` can use on the device `caps` describes, or why
+/// [`ShadowPass::new`](super::ShadowPass::new) would refuse it: the Vulkan version, the target
+/// model, the depth-stencil format and sample count, and the host's enabled features
+/// intersected with the device's. A pure function of `caps`, so a report of a device decides
+/// the same as the device itself.
+pub(super) fn capabilities(caps: &DeviceCaps, desc: &ShadowPassDesc) -> Result<Capabilities> {
+    let api = caps.api_version;
+    let version = |v: u32| format!("{}.{}", vk::api_version_major(v), vk::api_version_minor(v));
+    if api < vk::API_VERSION_1_1 {
+        return Err(Error::Unsupported(format!("the shadow pass needs Vulkan 1.1; the device has {}", version(api))));
     }
-    let mut f13 = vk::PhysicalDeviceVulkan13Features::default();
-    let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut f13);
-    // SAFETY: a feature query on a valid Vulkan 1.3 physical device with a well-formed pNext chain.
-    unsafe { instance.get_physical_device_features2(pd, &mut f2) };
-    f13.dynamic_rendering == vk::TRUE
+    let f = &caps.features;
+    if desc.target == TargetModel::DynamicRendering && !(api >= vk::API_VERSION_1_3 && f.dynamic_rendering) {
+        return Err(Error::Unsupported(format!(
+            "TargetModel::DynamicRendering needs Vulkan 1.3 with dynamicRendering; the device has {} without it: \
+             use TargetModel::RenderPass",
+            version(api)
+        )));
+    }
+    if !caps.format_features(desc.depth_stencil_format).contains(vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT) {
+        return Err(Error::Unsupported(format!("{:?} is not a depth-stencil attachment format on this device", desc.depth_stencil_format)));
+    }
+    check_samples(caps, desc)?;
+    let has = |n: &std::ffi::CStr| caps.has_extension(n);
+    let ray_query = api >= vk::API_VERSION_1_2
+        && has(ash::khr::acceleration_structure::NAME)
+        && has(ash::khr::ray_query::NAME)
+        && has(ash::khr::deferred_host_operations::NAME)
+        && f.ray_query
+        && f.acceleration_structure
+        && f.buffer_device_address;
+    let u8_ext = has(ash::ext::index_type_uint8::NAME) || has(ash::khr::index_type_uint8::NAME);
+    Ok(Capabilities {
+        ray_query: desc.features.ray_query && ray_query,
+        depth_clamp: desc.features.depth_clamp && f.depth_clamp,
+        depth_bounds: desc.features.depth_bounds && f.depth_bounds,
+        index_type_uint8: desc.features.index_type_uint8 && u8_ext && f.index_type_uint8,
+        r32f_blend: caps.format_features(COUNT_FORMAT).contains(vk::FormatFeatureFlags::COLOR_ATTACHMENT_BLEND)
+            && desc.target == TargetModel::DynamicRendering,
+    })
 }
 
-/// Refuses a sample count the device's framebuffer limits or the depth-stencil format lack.
-pub(super) fn check_samples(
-    instance: &ash::Instance,
-    pd: vk::PhysicalDevice,
-    limits: &vk::PhysicalDeviceLimits,
-    desc: &ShadowPassDesc,
-) -> Result<()> {
+/// Refuses a sample count the device's framebuffer limits or the depth-stencil format lack
+/// (the format's image sample counts where `caps` knows them).
+fn check_samples(caps: &DeviceCaps, desc: &ShadowPassDesc) -> Result<()> {
     let flag = super::desc::sample_flags(desc.samples);
+    let limits = &caps.limits;
     let framebuffer = limits.framebuffer_depth_sample_counts & limits.framebuffer_stencil_sample_counts;
-    // SAFETY: a format query on a valid physical device.
-    let image = unsafe {
-        instance.get_physical_device_image_format_properties(
-            pd,
-            desc.depth_stencil_format,
-            vk::ImageType::TYPE_2D,
-            vk::ImageTiling::OPTIMAL,
-            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
-            vk::ImageCreateFlags::empty(),
-        )
-    }
-    .map(|p| p.sample_counts)
-    .unwrap_or(vk::SampleCountFlags::empty());
+    let image =
+        caps.depth_stencil_image_samples.iter().find(|(f, _)| *f == desc.depth_stencil_format).map_or(framebuffer, |&(_, counts)| counts);
     if !framebuffer.contains(flag) || !image.contains(flag) {
         let counts = |f: vk::SampleCountFlags| {
             [1u32, 2, 4, 8, 16, 32, 64].into_iter().filter(|&n| f.as_raw() & n != 0).map(|n| n.to_string()).collect::<Vec<_>>().join(", ")
@@ -73,39 +91,4 @@ pub(super) fn check_samples(
         )));
     }
     Ok(())
-}
-
-pub(super) fn index_type_uint8_supported(instance: &ash::Instance, pd: vk::PhysicalDevice) -> bool {
-    // SAFETY: enumeration on a valid physical device.
-    let exts = unsafe { instance.enumerate_device_extension_properties(pd) }.unwrap_or_default();
-    let named = |n: &std::ffi::CStr| exts.iter().any(|e| e.extension_name_as_c_str().map(|x| x == n).unwrap_or(false));
-    if !named(ash::ext::index_type_uint8::NAME) && !named(ash::khr::index_type_uint8::NAME) {
-        return false;
-    }
-    let mut u8f = vk::PhysicalDeviceIndexTypeUint8FeaturesEXT::default();
-    let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut u8f);
-    // SAFETY: a feature query on a valid physical device with a well-formed pNext chain.
-    unsafe { instance.get_physical_device_features2(pd, &mut f2) };
-    u8f.index_type_uint8 == vk::TRUE
-}
-
-/// Whether the device can trace ray queries: Vulkan 1.2 (`bufferDeviceAddress`),
-/// `VK_KHR_acceleration_structure` and `VK_KHR_ray_query` with their features.
-pub(super) fn ray_query_supported(instance: &ash::Instance, pd: vk::PhysicalDevice, api: u32) -> bool {
-    if api < vk::API_VERSION_1_2 {
-        return false;
-    }
-    // SAFETY: a plain query on a valid physical device.
-    let Ok(exts) = (unsafe { instance.enumerate_device_extension_properties(pd) }) else { return false };
-    let has = |name: &std::ffi::CStr| exts.iter().any(|e| e.extension_name_as_c_str() == Ok(name));
-    if !has(ash::khr::acceleration_structure::NAME) || !has(ash::khr::ray_query::NAME) || !has(ash::khr::deferred_host_operations::NAME) {
-        return false;
-    }
-    let mut rq = vk::PhysicalDeviceRayQueryFeaturesKHR::default();
-    let mut acc = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default();
-    let mut v12 = vk::PhysicalDeviceVulkan12Features::default();
-    let mut f2 = vk::PhysicalDeviceFeatures2::default().push_next(&mut rq).push_next(&mut acc).push_next(&mut v12);
-    // SAFETY: a feature query on a valid Vulkan 1.2 physical device with a well-formed pNext chain.
-    unsafe { instance.get_physical_device_features2(pd, &mut f2) };
-    rq.ray_query == vk::TRUE && acc.acceleration_structure == vk::TRUE && v12.buffer_device_address == vk::TRUE
 }

@@ -124,7 +124,7 @@ pub use view::ShadowView;
 use crate::error::{Error, Misuse, Result};
 use crate::geom::Light;
 use crate::geom::Mesh;
-use crate::gpu::Buffer;
+use crate::gpu::{Buffer, DeviceCaps};
 use crate::shadow::Caster;
 use ash::vk;
 use casters::CasterTable;
@@ -223,52 +223,9 @@ impl ShadowPass {
         allocator: Arc<Mutex<Allocator>>,
         desc: &ShadowPassDesc,
     ) -> Result<ShadowPass> {
-        desc.check_shape()?;
-        // SAFETY: plain queries on a valid physical device of `instance`.
-        let (features, props, ds_props, r32f) = unsafe {
-            (
-                instance.get_physical_device_features(physical_device),
-                instance.get_physical_device_properties(physical_device),
-                instance.get_physical_device_format_properties(physical_device, desc.depth_stencil_format),
-                instance.get_physical_device_format_properties(physical_device, COUNT_FORMAT),
-            )
-        };
-        let api = props.api_version;
-        let version = |v: u32| format!("{}.{}", vk::api_version_major(v), vk::api_version_minor(v));
-        if api < vk::API_VERSION_1_1 {
-            return Err(Error::Unsupported(format!("the shadow pass needs Vulkan 1.1; the device has {}", version(api))));
-        }
-        if desc.target == TargetModel::DynamicRendering && !device::dynamic_rendering_supported(instance, physical_device, api) {
-            return Err(Error::Unsupported(format!(
-                "TargetModel::DynamicRendering needs Vulkan 1.3 with dynamicRendering; the device has {} without it: \
-                 use TargetModel::RenderPass",
-                version(api)
-            )));
-        }
-        if !ds_props.optimal_tiling_features.contains(vk::FormatFeatureFlags::DEPTH_STENCIL_ATTACHMENT) {
-            return Err(Error::Unsupported(format!(
-                "{:?} is not a depth-stencil attachment format on this device",
-                desc.depth_stencil_format
-            )));
-        }
-        device::check_samples(instance, physical_device, &props.limits, desc)?;
-        let caps = Capabilities {
-            ray_query: desc.features.ray_query && device::ray_query_supported(instance, physical_device, api),
-            depth_clamp: desc.features.depth_clamp && features.depth_clamp == vk::TRUE,
-            depth_bounds: desc.features.depth_bounds && features.depth_bounds == vk::TRUE,
-            index_type_uint8: desc.features.index_type_uint8 && device::index_type_uint8_supported(instance, physical_device),
-            r32f_blend: r32f.optimal_tiling_features.contains(vk::FormatFeatureFlags::COLOR_ATTACHMENT_BLEND)
-                && desc.target == TargetModel::DynamicRendering,
-        };
-        if desc.depth_mode == DepthMode::Clamp && !caps.depth_clamp {
-            return Err(Error::Unsupported(format!(
-                "DepthMode::Clamp (a finite far plane, {} depth) needs the depthClamp feature, present and enabled on the device \
-                 (EnabledFeatures::depth_clamp); use DepthMode::Infinite",
-                desc.depth_direction.name()
-            )));
-        }
-        desc.settings.check(&caps)?;
-        rays::check_host(&desc.settings, desc)?;
+        // The Vulkan 1.1 feature query (the pass refuses older devices below).
+        let device_caps = DeviceCaps::query(instance, None, physical_device)?;
+        let caps = Self::capabilities_for(&device_caps, desc)?;
         let dev = PassDevice { device: device.clone(), allocator };
         let pipes = Pipelines::new(&dev, desc, caps.depth_clamp, caps.depth_bounds, caps.r32f_blend)?;
         let id = NEXT_PASS_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -293,6 +250,33 @@ impl ShadowPass {
             rays: None,
             ray_inputs: None,
         })
+    }
+
+    /// What a pass made with `desc` would use on the device `device` describes, or the error
+    /// [`ShadowPass::new`] would return there, without a device: the same checks and the same
+    /// intersection of the host's enabled features with the device's (`ShadowPass::new` calls
+    /// it on [`DeviceCaps::query`]'s answer). `device` may come from the device itself or from
+    /// a report of it (umbrage's `docs/devices.md` runs it over 68 gpuinfo.org reports).
+    ///
+    /// # Errors
+    /// As [`ShadowPass::new`], for everything but the GPU objects' creation:
+    /// [`Error::InvalidDesc`] for a malformed description, [`Error::Unsupported`] for what the
+    /// device lacks (Vulkan 1.1; dynamic rendering for [`TargetModel::DynamicRendering`]; the
+    /// depth-stencil format as an attachment; the sample count; `depthClamp` for
+    /// [`DepthMode::Clamp`]; what the settings' technique needs).
+    pub fn capabilities_for(device: &DeviceCaps, desc: &ShadowPassDesc) -> Result<Capabilities> {
+        desc.check_shape()?;
+        let caps = device::capabilities(device, desc)?;
+        if desc.depth_mode == DepthMode::Clamp && !caps.depth_clamp {
+            return Err(Error::Unsupported(format!(
+                "DepthMode::Clamp (a finite far plane, {} depth) needs the depthClamp feature, present and enabled on the device \
+                 (EnabledFeatures::depth_clamp); use DepthMode::Infinite",
+                desc.depth_direction.name()
+            )));
+        }
+        desc.settings.check(&caps)?;
+        rays::check_host(&desc.settings, desc)?;
+        Ok(caps)
     }
 
     /// The receiver plane of [`Technique::Planar`] in world space, `n·x + d = 0` as
