@@ -114,7 +114,7 @@ else
   need=()
   have_pkg() { dpkg-query -W -f='${Status}' "$1" 2>/dev/null | grep -q "install ok installed"; }
   for p in libvulkan1 mesa-vulkan-drivers vulkan-validationlayers spirv-tools \
-    xvfb xauth xdotool libxkbcommon-x11-0 libxcursor1 libxrandr2 libxi6; do
+    xvfb xauth xdotool libxkbcommon-x11-0 libxcursor1 libxrandr2 libxi6 libx11-xcb1; do
     have_pkg "$p" || need+=("$p")
   done
   if ! command -v cc >/dev/null 2>&1; then need+=(build-essential); fi

@@ -7,6 +7,8 @@
 //! xvfb-run and xdotool come from scripts/deps.sh; without them the tests fail when `CI` is
 //! set and are skipped loudly otherwise. They run one at a time (each starts its own X server).
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::Mutex;
@@ -42,21 +44,30 @@ fn x_tools(need_xdotool: bool) -> bool {
 
 /// Runs `script` (bash, with $UMBRAGE the binary) inside a fresh Xvfb, in `dir`.
 fn in_xvfb(dir: &Path, script: &str) -> Output {
+    in_xvfb_on(dir, script, &[])
+}
+
+/// [`in_xvfb`] with a driver's environment (`common::driver_env`) applied.
+fn in_xvfb_on(dir: &Path, script: &str, driver: &[(String, Option<String>)]) -> Output {
     let path = dir.join("script.sh");
     std::fs::write(&path, format!("set -u\nUMBRAGE={BIN}\n{script}")).unwrap();
-    let out = Command::new("timeout")
-        .args(["300", "xvfb-run", "-a", "-s", SCREEN, "bash"])
-        .arg(&path)
-        .current_dir(dir)
-        .env("UMBRAGE_VALIDATION", "1")
-        .output()
-        .unwrap();
+    let mut c = Command::new("timeout");
+    c.args(["300", "xvfb-run", "-a", "-s", SCREEN, "bash"]).arg(&path).current_dir(dir).env("UMBRAGE_VALIDATION", "1");
+    common::apply_driver_env(&mut c, driver);
+    let out = c.output().unwrap();
     eprintln!("--- stdout\n{}--- stderr\n{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
     out
 }
 
 fn render(dir: &Path, out: &str, args: &[&str]) {
-    let o = Command::new(BIN).arg("render").args(args).arg("--out").arg(dir.join(out)).env("UMBRAGE_VALIDATION", "1").output().unwrap();
+    render_on(dir, out, args, &[])
+}
+
+fn render_on(dir: &Path, out: &str, args: &[&str], driver: &[(String, Option<String>)]) {
+    let mut c = Command::new(BIN);
+    c.arg("render").args(args).arg("--out").arg(dir.join(out)).env("UMBRAGE_VALIDATION", "1");
+    common::apply_driver_env(&mut c, driver);
+    let o = c.output().unwrap();
     assert!(o.status.success(), "render failed: {}", String::from_utf8_lossy(&o.stderr));
 }
 
@@ -110,6 +121,36 @@ fn thirty_frames_equal_render() {
     assert_eq!((s["width"].as_u64(), s["height"].as_u64()), (Some(320), Some(240)));
     assert_eq!(s["stats"]["method"], "mcguire");
     render(&d, "b.png", &["--scene", "default", "--size", "320x240"]);
+    assert_same(&d.join("a.png"), &d.join("b.png"));
+}
+
+/// The viewer on SwiftShader, whose Linux build has the XCB surface but not the Xlib one
+/// winit's windows come with: the window goes through its XCB connection
+/// (`view/surface.rs`), and the presented frame equals `umbrage render`'s on the same driver.
+#[test]
+fn thirty_frames_equal_render_on_swiftshader() {
+    let _g = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    if !x_tools(false) {
+        return;
+    }
+    let Some(driver) = common::driver_env("swiftshader") else {
+        let why = "SwiftShader is not installed (scripts/drivers.sh install swiftshader)";
+        assert!(std::env::var_os("CI").is_none(), "{why}");
+        eprintln!("SKIPPED: {why}");
+        return;
+    };
+    let d = tmp("swiftshader");
+    let out = in_xvfb_on(
+        &d,
+        "$UMBRAGE view --scene default --size 320x240 --frames 30 --screenshot a.png --stats s.json --vsync off\necho rc=$?\n",
+        &driver,
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(exit_code(&stdout), 0, "view failed on SwiftShader");
+    assert!(stdout.contains("SwiftShader"), "not SwiftShader: {stdout}");
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("validation"), "validation complained");
+    assert_eq!(json(&d.join("s.json"))["frames"], 30);
+    render_on(&d, "b.png", &["--scene", "default", "--size", "320x240"], &driver);
     assert_same(&d.join("a.png"), &d.join("b.png"));
 }
 

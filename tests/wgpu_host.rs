@@ -7,6 +7,8 @@
 //! Without a Vulkan device the test is skipped loudly, except under CI (`CI` set), where that is
 //! a failure.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -43,17 +45,30 @@ fn no_device(out: &Output) -> bool {
 /// against the reference. Returns the dump's shadow masks, or None when there is no Vulkan
 /// device (and `CI` is not set).
 fn run_and_check(bin: &Path, scene: &str, size: &str, frames: usize) -> Option<Vec<Vec<u8>>> {
-    let dir = tmp(&format!("{scene}-{frames}"));
+    run_and_check_on(bin, scene, size, frames, &[], None)
+}
+
+/// [`run_and_check`] with a driver's environment (`common::driver_env`) applied, and the
+/// device's name expected to contain `device`.
+fn run_and_check_on(
+    bin: &Path,
+    scene: &str,
+    size: &str,
+    frames: usize,
+    driver: &[(String, Option<String>)],
+    device: Option<&str>,
+) -> Option<Vec<Vec<u8>>> {
+    let dir = tmp(&format!("{scene}-{frames}-{}", driver.len()));
     let png = dir.join("out.png");
     let dump = dir.join("dump");
-    let out = Command::new(bin)
-        .args(["--scene", scene, "--size", size, "--frames", &frames.to_string(), "--out"])
+    let mut c = Command::new(bin);
+    c.args(["--scene", scene, "--size", size, "--frames", &frames.to_string(), "--out"])
         .arg(&png)
         .arg("--dump")
         .arg(&dump)
-        .env("UMBRAGE_VALIDATION", "1")
-        .output()
-        .expect("the example runs");
+        .env("UMBRAGE_VALIDATION", "1");
+    common::apply_driver_env(&mut c, driver);
+    let out = c.output().expect("the example runs");
     let stdout = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);
     eprintln!("--- {scene}: stdout\n{stdout}--- stderr\n{stderr}");
@@ -65,6 +80,9 @@ fn run_and_check(bin: &Path, scene: &str, size: &str, frames: usize) -> Option<V
         return None;
     }
     assert!(out.status.success(), "{scene}: the example failed ({}):\n{stderr}", out.status);
+    if let Some(device) = device {
+        assert!(stderr.contains(device) || stdout.contains(device), "{scene}: not on {device}");
+    }
     assert!(!stderr.contains("[ERROR"), "{scene}: errors were logged:\n{stderr}");
     assert!(png.is_file(), "{scene}: no PNG");
     // Every frame reported, two in flight.
@@ -100,4 +118,20 @@ fn wgpu_host_matches_reference_with_validation() {
     let moved = moved.expect("the default scene ran");
     let differ: usize = still.iter().zip(&moved).map(|(a, b)| a.iter().zip(b).filter(|(x, y)| x != y).count()).sum();
     assert!(differ > 100, "the moving caster changed only {differ} mask pixels");
+}
+
+/// The same host on SwiftShader (wgpu picks its only adapter; its `Depth24PlusStencil8` is
+/// D32S8 there): exact on the default scene and with the eye inside a volume.
+#[test]
+fn wgpu_host_matches_reference_on_swiftshader() {
+    let Some(driver) = common::driver_env("swiftshader") else {
+        let why = "SwiftShader is not installed (scripts/drivers.sh install swiftshader)";
+        assert!(std::env::var_os("CI").is_none(), "{why}");
+        eprintln!("SKIPPED: {why}");
+        return;
+    };
+    let bin = example();
+    for scene in ["default", "hard/eye_in_volume"] {
+        run_and_check_on(&bin, scene, "320x200", 3, &driver, Some("SwiftShader")).expect("SwiftShader is a Vulkan device");
+    }
 }

@@ -191,8 +191,8 @@ impl Context {
         // SAFETY: plain enumeration call on a loaded entry.
         let instance_exts =
             unsafe { entry.enumerate_instance_extension_properties(None) }.map_err(vkerr("vkEnumerateInstanceExtensionProperties"))?;
-        // A window's surface extensions the driver lacks (SwiftShader as Debian's Chromium
-        // ships it has no Xlib surface): say which, rather than "no driver".
+        // A window's surface extensions the driver lacks: say which, rather than "no driver"
+        // (the viewer takes an X11 window through XCB where a driver has no Xlib surface).
         let missing: Vec<String> = instance_extensions
             .iter()
             // SAFETY: the caller passes NUL-terminated extension names (documented).
@@ -202,9 +202,8 @@ impl Context {
             .collect();
         if !missing.is_empty() {
             return Err(Error::Unsupported(format!(
-                "the Vulkan driver has no instance extension {}, which this window's surface needs (SwiftShader as \
-                 Debian's chromium-common ships it has the XCB and Wayland surfaces but not Xlib, which winit's X11 \
-                 windows use): render offscreen with `umbrage render`",
+                "the Vulkan driver has no instance extension {}, which this window's surface needs: render offscreen \
+                 with `umbrage render`",
                 missing.join(", ")
             )));
         }

@@ -198,6 +198,7 @@ impl Live {
         let window = el.create_window(attrs).map_err(|e| Error::Other(format!("cannot create a window: {e}")))?;
         let display = window.display_handle().map_err(|e| Error::Other(format!("no display handle: {e}")))?.as_raw();
         let handle = window.window_handle().map_err(|e| Error::Other(format!("no window handle: {e}")))?.as_raw();
+        let (display, handle) = super::surface::surface_handles(display, handle)?;
         let exts = ash_window::enumerate_required_extensions(display)
             .map_err(|e| Error::Unsupported(format!("no Vulkan surface for this display: {e:?}")))?;
         let ctx = Context::with_extensions(crate::gpu::context::validation_requested(), exts, &[ash::khr::swapchain::NAME])?;

@@ -24,6 +24,7 @@ pub mod controls;
 mod frame;
 mod overlay;
 mod present;
+mod surface;
 pub mod swapchain;
 
 use crate::error::{Error, Result};
