@@ -27,7 +27,7 @@ fn names_are_unique_and_every_config_has_every_family() {
     assert_eq!(names.len(), all.len(), "duplicate names");
     for config in Config::all(&FORMATS) {
         let v = cases(config);
-        assert_eq!(v.len(), 68, "{}", config.name());
+        assert_eq!(v.len(), 69, "{}", config.name());
         for g in GROUPS {
             let n = v.iter().filter(|c| c.group == g).count();
             assert!(n >= 13, "{g}: {n}");

@@ -342,6 +342,40 @@ fn grid_case(config: Config, seed: u64) -> Case {
     c
 }
 
+/// A strip of `n` quads from a near edge inside the tile (y about 1.5) to a far edge 60 pixels
+/// down (outside it, so the bottom plane clips every triangle), 20 pixels wide at the top and
+/// 3 at the bottom: each quad's diagonal leaves a sliver narrower than 1/16 pixel across the
+/// tile, the shape of a shadow volume's sides running to their vanishing points (drivers notes
+/// §1e: SwiftShader walks the clipped polygon's edges in the winding of the unclipped,
+/// separately snapped triangle, and drops it where the two disagree). One draw, front
+/// INCR_WRAP / back DECR_WRAP: every centre inside the strip exactly 1, however the slivers
+/// snap, as long as each polygon's coverage and facing come from the same polygon.
+fn sliver_strip_case(config: Config, n: usize, seed: u64) -> Case {
+    let mut c = Case::new(config, "watertight", &format!("clipped_sliver_strip_{n}.incr_decr"), SIZE, 1.0, 0);
+    let mut rng = Rng::new(seed);
+    let near: Vec<[f32; 4]> = (0..=n)
+        .map(|i| [(6.0 + 20.0 * (i as f64 + 0.5 * rng.range(0.0, 1.0)) / n as f64) as f32, rng.range(1.3, 1.7) as f32, 0.5, 1.0])
+        .collect();
+    let far: Vec<[f32; 4]> = (0..=n)
+        .map(|i| [(-3.0 + 3.0 * (i as f64 + 0.5 * rng.range(0.0, 1.0)) / n as f64) as f32, rng.range(60.0, 60.3) as f32, 0.5, 1.0])
+        .collect();
+    let mut verts = Vec::with_capacity(6 * n);
+    for i in 0..n {
+        verts.extend([near[i], far[i + 1], near[i + 1], near[i], far[i], far[i + 1]]);
+    }
+    let mvp = pixel_ortho(SIZE.0, SIZE.1);
+    c.draws = vec![Draw { state: stencil_only(two_sided()), mvp, vertices: verts, query: false }];
+    let mut outline: Vec<DVec2> = near.iter().map(|&p| window(mvp, p)).collect();
+    outline.extend(far.iter().rev().map(|&p| window(mvp, p)));
+    c.stencil_override = Some(outline_override(&outline, &outline, 1, 0));
+    c.check_depth = false;
+    c.what = format!(
+        "a strip of {n} quads (two triangles each) from inside the tile to 60 pixels below it, every triangle clipped by the bottom plane, \
+         the diagonals leaving slivers under 1/16 pixel wide across the tile; one draw, front INCR_WRAP / back DECR_WRAP: every centre inside exactly 1"
+    );
+    c
+}
+
 /// The watertightness cases of `config`. The geometry and its expectation do not depend on the
 /// configuration, so they are built once (the first call) and stamped with each configuration.
 pub fn cases(config: Config) -> Vec<Case> {
@@ -393,5 +427,6 @@ fn build(config: Config) -> Vec<Case> {
     v.push(fan_case(config, 500, false, 22));
     v.push(fan_case(config, 500, true, 23));
     v.push(grid_case(config, 24));
+    v.push(sliver_strip_case(config, 128, 25));
     v
 }
