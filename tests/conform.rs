@@ -300,7 +300,7 @@ fn a_multiview_crash_costs_only_the_multiview_check() {
     assert_eq!(out.status.code(), Some(1), "{stdout}");
     let j = json(&dir);
     let cases = j["cases"].as_array().unwrap();
-    assert_eq!(cases.len(), 9, "{cases:?}");
+    assert_eq!(cases.len(), 10, "{cases:?}");
     for c in cases {
         if c["name"] == "legacy.multiview_cube_faces" {
             assert_eq!(c["status"], "crash");

@@ -2,7 +2,8 @@
 //!
 //! Grouped by family: depth (w = 0 vertices, depth clamp, depth bounds), coverage (watertight
 //! edges, index types), stencil (two-sided wrap, stencil formats), the float counter (a deep
-//! wrap counted in R32_SFLOAT next to the stencil), multiview (a point light's cube faces as
+//! wrap counted in R32_SFLOAT next to the stencil), multisampling (each sample's coverage and
+//! depth at its standard location), multiview (a point light's cube faces as
 //! views against atlas tiles) and the end-to-end pipeline check; every
 //! check is re-exported here.
 
@@ -12,6 +13,7 @@ mod depth;
 mod float_count;
 mod multiview;
 mod pipeline;
+mod sample_locations;
 mod stencil;
 
 pub use coverage::{index_types, watertight_fan};
@@ -19,6 +21,7 @@ pub use depth::{depth_bounds, depth_clamp, w0_vertices_and_infinity};
 pub use float_count::deep_wrap_float_count;
 pub use multiview::{multiview_cube_faces, NAME as MULTIVIEW_CUBE_FACES};
 pub use pipeline::{shadow_pipeline_hard_cases, PIPELINE_THRESHOLD};
+pub use sample_locations::{msaa_depth_locations, NAME as MSAA_DEPTH_LOCATIONS};
 pub use stencil::{stencil_formats, two_sided_stencil_wrap};
 
 use super::harness::{PipeSpec, Readback};

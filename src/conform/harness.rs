@@ -142,13 +142,18 @@ impl Draws {
     /// Creates every draw's pipeline (for `format`) and buffers; on an error, what was made
     /// is destroyed.
     pub(crate) fn new(ctx: &Context, format: vk::Format, draws: &[DrawCall]) -> Result<Draws> {
+        Draws::with_samples(ctx, format, vk::SampleCountFlags::TYPE_1, draws)
+    }
+
+    /// [`Draws::new`] for attachments of `samples` samples per pixel.
+    pub(crate) fn with_samples(ctx: &Context, format: vk::Format, samples: vk::SampleCountFlags, draws: &[DrawCall]) -> Result<Draws> {
         let push_range = [vk::PushConstantRange { stage_flags: vk::ShaderStageFlags::VERTEX, offset: 0, size: 96 }];
         let layout_info = vk::PipelineLayoutCreateInfo::default().push_constant_ranges(&push_range);
         // SAFETY: valid device and create info; destroyed by `destroy`.
         let layout = unsafe { ctx.device.create_pipeline_layout(&layout_info, None) }.map_err(vkerr("vkCreatePipelineLayout"))?;
         let mut out = Draws { layout, pipelines: Vec::new(), buffers: Vec::new(), draws: Vec::with_capacity(draws.len()) };
         for d in draws {
-            match prepare_draw(ctx, layout, format, d, &mut out.pipelines, &mut out.buffers) {
+            match prepare_draw(ctx, layout, (format, samples), d, &mut out.pipelines, &mut out.buffers) {
                 Ok(r) => out.draws.push(r),
                 Err(e) => {
                     out.destroy(ctx);
@@ -308,7 +313,7 @@ struct RecordedDraw {
 fn prepare_draw(
     ctx: &Context,
     layout: vk::PipelineLayout,
-    format: vk::Format,
+    (format, samples): (vk::Format, vk::SampleCountFlags),
     d: &DrawCall,
     pipelines: &mut Vec<vk::Pipeline>,
     buffers: &mut Vec<Buffer>,
@@ -322,6 +327,7 @@ fn prepare_draw(
     desc.depth_clamp = d.spec.depth_clamp;
     desc.depth_bounds = d.spec.depth_bounds.is_some();
     desc.stencil = Some((d.spec.front, d.spec.back));
+    desc.samples = samples;
     let pipeline = pipeline::create(ctx, &desc)?;
     pipelines.push(pipeline);
     let vb = Buffer::with_data(ctx, "conform-vertices", &bytes(&d.vertices), vk::BufferUsageFlags::VERTEX_BUFFER)?;

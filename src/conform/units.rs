@@ -8,7 +8,7 @@ use crate::error::Result;
 use crate::gpu::Context;
 use std::time::Instant;
 
-pub(crate) const LEGACY: [&str; 9] = [
+pub(crate) const LEGACY: [&str; 10] = [
     "w0_vertices_and_infinity",
     "depth_clamp",
     "watertight_fan",
@@ -17,6 +17,7 @@ pub(crate) const LEGACY: [&str; 9] = [
     "depth_bounds",
     "index_types",
     "deep_wrap_float_count",
+    super::checks::MSAA_DEPTH_LOCATIONS,
     super::checks::MULTIVIEW_CUBE_FACES,
 ];
 
@@ -37,10 +38,10 @@ pub(crate) fn legacy_unit() -> Vec<&'static str> {
 }
 
 /// The legacy checks the `legacy` unit runs: everything but multiview.
-pub(crate) const SINGLE: &[&str] = LEGACY.split_at(8).0;
+pub(crate) const SINGLE: &[&str] = LEGACY.split_at(9).0;
 /// The legacy check the `multiview` unit runs on its own: the renderer's multiview cube faces,
 /// the feature most likely to take a driver down (a crash there costs no other check).
-pub(crate) const MULTIVIEW: &[&str] = LEGACY.split_at(8).1;
+pub(crate) const MULTIVIEW: &[&str] = LEGACY.split_at(9).1;
 
 fn pipeline_name(scene: &str, m: crate::shadow::Method) -> String {
     format!("pipeline.hard_cases.{}.{}", scene.trim_start_matches("hard/"), m.name())
@@ -70,7 +71,7 @@ pub fn run_legacy(
     type Run<'a> = Box<dyn Fn() -> Result<CheckResult> + 'a>;
     let on_ctx = |f: Check| -> Run<'_> { Box::new(move || f(ctx)) };
     use super::checks::commands;
-    let unit: [(&str, Run<'_>); 17] = [
+    let unit: [(&str, Run<'_>); 18] = [
         (LEGACY[0], on_ctx(super::checks::w0_vertices_and_infinity)),
         (LEGACY[1], on_ctx(super::checks::depth_clamp)),
         (LEGACY[2], on_ctx(super::checks::watertight_fan)),
@@ -79,8 +80,9 @@ pub fn run_legacy(
         (LEGACY[5], on_ctx(super::checks::depth_bounds)),
         (LEGACY[6], on_ctx(super::checks::index_types)),
         (LEGACY[7], on_ctx(super::checks::deep_wrap_float_count)),
+        (LEGACY[8], on_ctx(super::checks::msaa_depth_locations)),
         // The renderer on a context of its own (the one a frame needs).
-        (LEGACY[8], Box::new(|| super::checks::multiview_cube_faces(ctx, new_context))),
+        (LEGACY[9], Box::new(|| super::checks::multiview_cube_faces(ctx, new_context))),
         (COMMANDS[0], on_ctx(commands::clears)),
         (COMMANDS[1], on_ctx(commands::copy_aspects)),
         (COMMANDS[2], on_ctx(commands::layouts)),
