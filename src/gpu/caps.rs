@@ -132,6 +132,16 @@ impl DeviceCaps {
         self.has_extension(c"VK_KHR_portability_subset")
     }
 
+    /// Adds `format`'s optimal-tiling features, read from `physical`, when they are not known
+    /// yet (a host's colour format beyond [`QUERIED_FORMATS`]).
+    pub fn query_format(&mut self, instance: &ash::Instance, physical: vk::PhysicalDevice, format: vk::Format) {
+        if !self.formats.iter().any(|(f, _)| *f == format) {
+            // SAFETY: a format query on a valid physical device.
+            let p = unsafe { instance.get_physical_device_format_properties(physical, format) };
+            self.formats.push((format, p.optimal_tiling_features));
+        }
+    }
+
     /// Reads what umbrage asks of `physical`: its properties, the extensions and features of
     /// [`FeatureSet`] (through `vkGetPhysicalDeviceFeatures2` on Vulkan 1.1 devices, or
     /// `gpdp2`'s on a Vulkan 1.0 device where the instance has

@@ -391,6 +391,15 @@ impl CasterTable {
 }
 
 /// Validates a caster transform: finite and invertible.
+/// A transparent caster's transmittance: each channel in [0, 1] (a surface lets through at
+/// most all of the light).
+pub(crate) fn check_transmittance(name: &str, t: glam::Vec3) -> Result<()> {
+    if !(t.is_finite() && t.min_element() >= 0.0 && t.max_element() <= 1.0) {
+        return Err(Error::mesh(name, format!("transmittance {t} is not in [0, 1] per channel")));
+    }
+    Ok(())
+}
+
 pub(crate) fn check_transform(name: &str, m: &DMat4) -> Result<()> {
     let det = m.determinant();
     if !(m.is_finite() && det.is_finite() && det != 0.0) {

@@ -52,6 +52,16 @@ pub(super) fn capabilities(caps: &DeviceCaps, desc: &ShadowPassDesc) -> Result<C
         return Err(Error::Unsupported(format!("{:?} is not a depth-stencil attachment format on this device", desc.depth_stencil_format)));
     }
     check_samples(caps, desc)?;
+    let blend = vk::FormatFeatureFlags::COLOR_ATTACHMENT | vk::FormatFeatureFlags::COLOR_ATTACHMENT_BLEND;
+    for (field, format) in
+        [("ShadowPassDesc::transmit_format", desc.transmit_format), ("ShadowPassDesc::debug_color_format", desc.debug_color_format)]
+    {
+        if let Some(f) = format {
+            if !caps.format_features(f).contains(blend) {
+                return Err(Error::desc(field, format!("{f:?} is not a blendable colour attachment format on this device")));
+            }
+        }
+    }
     let has = |n: &std::ffi::CStr| caps.has_extension(n);
     let ray_query = api >= vk::API_VERSION_1_2
         && has(ash::khr::acceleration_structure::NAME)

@@ -95,21 +95,50 @@ pub(crate) fn overflow_warnings(table: &CasterTable, lights: &[LightFrame], coun
 
 /// Rejects lights the planner cannot use (NaN or infinite values, a zero direction).
 pub(crate) fn check_lights(lights: &[Light]) -> Result<()> {
-    for (i, l) in lights.iter().enumerate() {
-        let finite = l.position.is_finite() && l.direction.is_finite() && l.color.is_finite() && l.intensity.is_finite();
-        let dir_ok = l.kind == LightKind::Point || l.direction.length_squared() > 0.0;
-        if !finite || !dir_ok || l.radius.is_some_and(|r| !(r > 0.0)) {
-            return Err(Error::argument("light", format!("light {i}: not finite, zero direction or non-positive radius ({l:?})")));
+    lights.iter().enumerate().try_for_each(|(i, l)| check_light(i, l))
+}
+
+/// The largest full cone angle of a spot light, degrees (every direction).
+pub const MAX_CONE_DEG: f32 = 360.0;
+
+/// One light against the ranges `docs/contract.md` lists: every error is
+/// [`Misuse::Argument`](crate::error::Misuse::Argument) naming the field (`Light::radius`) and
+/// the light's index.
+fn check_light(i: usize, l: &Light) -> Result<()> {
+    let bad = |field: &'static str, msg: String| Err(Error::argument(field, format!("light {i}: {msg}")));
+    if l.area.is_some() {
+        return bad(
+            "Light::area",
+            "an area light: the pass determines point, spot and directional lights; expand it into its point-light \
+             samples first (geom::area::expand_lights), one determination and lighting pass each"
+                .into(),
+        );
+    }
+    if !l.position.is_finite() {
+        return bad("Light::position", format!("{} is not finite", l.position));
+    }
+    if !l.direction.is_finite() {
+        return bad("Light::direction", format!("{} is not finite", l.direction));
+    }
+    if l.kind != LightKind::Point && !(l.direction.length_squared() > 0.0) {
+        return bad("Light::direction", format!("a {:?} light needs a non-zero direction, got {}", l.kind, l.direction));
+    }
+    if !(l.color.is_finite() && l.color.min_element() >= 0.0) {
+        return bad("Light::color", format!("{} is not finite and non-negative", l.color));
+    }
+    if !(l.intensity.is_finite() && l.intensity >= 0.0) {
+        return bad("Light::intensity", format!("{} is not finite and non-negative", l.intensity));
+    }
+    if let Some(r) = l.radius {
+        if !(r.is_finite() && r > 0.0) {
+            return bad("Light::radius", format!("{r} is not finite and positive (None: the light reaches everything)"));
         }
-        if l.area.is_some() {
-            return Err(Error::argument(
-                "light",
-                format!(
-                    "light {i} is an area light: the pass determines point, spot and directional lights; expand it into its \
-                     point-light samples first (geom::area::expand_lights), one determination and lighting pass each"
-                ),
-            ));
-        }
+    }
+    if l.kind == LightKind::Spot && !(l.cone_deg > 0.0 && l.cone_deg <= MAX_CONE_DEG) {
+        return bad(
+            "Light::cone_deg",
+            format!("a spot light's full cone angle must be in (0, {MAX_CONE_DEG}] degrees, got {}", l.cone_deg),
+        );
     }
     Ok(())
 }

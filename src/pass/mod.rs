@@ -111,7 +111,7 @@ pub use desc::{
     RenderPassTarget, ShadowPassDesc, TargetModel, Technique,
 };
 pub use draw::LightFrame;
-pub use frame::PreparedFrame;
+pub use frame::{PreparedFrame, MAX_CONE_DEG};
 pub use pipelines::COUNT_FORMAT;
 #[cfg(feature = "cli")]
 pub(crate) use rays::light_rel;
@@ -119,7 +119,7 @@ pub use rays::{RayCounts, RayQueryFrame, RayQueryInputs};
 pub use record::{lit_stencil_state, VolumeKind};
 pub use spheres::{SphereId, SphereInfo};
 pub use target::DepthStencilTarget;
-pub use view::ShadowView;
+pub use view::{ShadowView, MAX_TARGET_SIZE};
 
 use crate::error::{Error, Misuse, Result};
 use crate::geom::Light;
@@ -224,7 +224,10 @@ impl ShadowPass {
         desc: &ShadowPassDesc,
     ) -> Result<ShadowPass> {
         // The Vulkan 1.1 feature query (the pass refuses older devices below).
-        let device_caps = DeviceCaps::query(instance, None, physical_device)?;
+        let mut device_caps = DeviceCaps::query(instance, None, physical_device)?;
+        for f in [desc.transmit_format, desc.debug_color_format].into_iter().flatten() {
+            device_caps.query_format(instance, physical_device, f);
+        }
         let caps = Self::capabilities_for(&device_caps, desc)?;
         let dev = PassDevice { device: device.clone(), allocator };
         let pipes = Pipelines::new(&dev, desc, caps.depth_clamp, caps.depth_bounds, caps.r32f_blend)?;
@@ -342,9 +345,7 @@ impl ShadowPass {
         if self.pipes.transmit.is_none() {
             return Err(Misuse::NotConfigured { call: "add_transparent_caster", needs: "ShadowPassDesc::transmit_format" }.into());
         }
-        if !transmittance.is_finite() {
-            return Err(Error::mesh(name, format!("transmittance {transmittance} is not finite")));
-        }
+        casters::check_transmittance(name, transmittance)?;
         casters::check_transform(name, &transform)?;
         let caster = Caster::new(name, mesh, transform.as_mat4())?.into_transparent(transmittance);
         self.casters.add(&self.dev, caster, transform)
@@ -353,6 +354,9 @@ impl ShadowPass {
     /// Adds a caster prepared by the caller (e.g. `SceneMesh::caster` with the `cli` feature, or [`Caster::new`] then [`Caster::into_transparent`]).
     pub fn add_prepared_caster(&mut self, caster: Caster, transform: DMat4) -> Result<CasterId> {
         casters::check_transform(&caster.name, &transform)?;
+        if let Some(t) = caster.transmittance {
+            casters::check_transmittance(&caster.name, t)?;
+        }
         if caster.transmittance.is_some() && self.pipes.transmit.is_none() {
             return Err(Misuse::NotConfigured {
                 call: "add_prepared_caster (a transparent caster)",

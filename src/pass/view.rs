@@ -5,6 +5,10 @@ use super::desc::DepthDirection;
 use crate::error::{Error, Result};
 use glam::{DMat4, DVec3, Mat4};
 
+/// The largest target width or height a [`ShadowView`] may name, in pixels (beyond every
+/// device's `maxFramebufferWidth`).
+pub const MAX_TARGET_SIZE: u32 = 65536;
+
 /// The host's camera for one frame, as the pass needs it to land its volumes exactly on the
 /// host's depth values: the eye in f64 and the host's eye-relative view and projection (the
 /// host draws its scene with `proj * view * (world - eye)`).
@@ -77,12 +81,33 @@ impl ShadowView {
     pub fn world_view_proj(&self) -> Mat4 {
         (self.proj.as_dmat4() * self.view.as_dmat4() * DMat4::from_translation(-self.eye)).as_mat4()
     }
+    /// The ranges `docs/contract.md` lists: every error is
+    /// [`Misuse::Argument`](crate::error::Misuse::Argument) naming the field.
     pub(crate) fn check(&self) -> Result<()> {
-        if !(self.eye.is_finite() && self.view.is_finite() && self.proj.is_finite()) {
-            return Err(Error::argument("ShadowView", "eye, view or projection is not finite"));
+        if !self.eye.is_finite() {
+            return Err(Error::argument("ShadowView::eye", format!("{} is not finite", self.eye)));
         }
-        if self.width == 0 || self.height == 0 {
-            return Err(Error::argument("ShadowView", format!("empty target {}x{}", self.width, self.height)));
+        if !self.view.is_finite() {
+            return Err(Error::argument("ShadowView::view", "not finite"));
+        }
+        let v = self.view.as_dmat4();
+        let r = glam::DMat3::from_mat4(v);
+        let rigid = (r * r.transpose()).abs_diff_eq(glam::DMat3::IDENTITY, 1e-4) && r.determinant() > 0.0;
+        if !rigid || v.w_axis != glam::DVec4::W || (v.row(3) - glam::DVec4::W).length() != 0.0 {
+            return Err(Error::argument(
+                "ShadowView::view",
+                "not a rotation without translation (the eye-relative view: ShadowView::from_view_matrix makes it from a \
+                 camera's view matrix)",
+            ));
+        }
+        let det = self.proj.as_dmat4().determinant();
+        if !(self.proj.is_finite() && det.is_finite() && det != 0.0) {
+            return Err(Error::argument("ShadowView::proj", format!("not finite or singular (determinant {det})")));
+        }
+        for (field, n) in [("ShadowView::width", self.width), ("ShadowView::height", self.height)] {
+            if !(1..=MAX_TARGET_SIZE).contains(&n) {
+                return Err(Error::argument(field, format!("{n} is outside 1..={MAX_TARGET_SIZE}")));
+            }
         }
         Ok(())
     }
