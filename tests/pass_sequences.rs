@@ -1,0 +1,495 @@
+//! Every call sequence of `ShadowPass`'s public API against a reference model
+//! (proptest-state-machine). The model is the live casters (mesh, transform, deformation),
+//! sphere casters and transparent casters, and the settings; the transitions are the host's
+//! calls: add, remove and update casters, sphere casters and transparent casters,
+//! `set_transform`, `update_positions`, `set_settings`, `prepare` on any slot (including
+//! invalid ones) with the frame then dropped, recorded and submitted, or recorded and never
+//! submitted (`abandon_frame`), interleaved with invalid arguments and another pass's ids.
+//!
+//! After every submitted frame the stencil must equal, byte for byte, the stencil of a pass
+//! holding exactly the model's casters, prepared from scratch (one per configuration, its
+//! casters replaced before each comparison: a fresh pass per frame would compile its
+//! pipelines hundreds of times). Every refused call must leave the model's picture unchanged
+//! (the next comparison checks it), and validation must stay clean. Configurations:
+//! `frames_in_flight` 1 to 3, dynamic rendering (the classic render-pass target model is
+//! covered by tests/embed.rs and tests/pass_contract.rs, not here). Each frame is waited for
+//! before the next is prepared.
+//!
+//! CI runs `PASS_SEQUENCES_CASES` (default 200) sequences of 30 steps (shrunk on failure) per configuration;
+//! before a release run more: `PASS_SEQUENCES_CASES=5000 cargo test --release --test
+//! pass_sequences`. Failing seeds are kept in `proptest-regressions/`.
+
+mod common;
+
+use ash::vk;
+use glam::{DMat4, DVec3, Vec3};
+use gpu_allocator::MemoryLocation;
+use proptest::prelude::*;
+use proptest::test_runner::Config;
+use proptest_state_machine::{ReferenceStateMachine, StateMachineTest};
+use std::cell::RefCell;
+use umbrage::geom::{Light, Mesh, Sphere};
+use umbrage::gpu::resources::transition;
+use umbrage::gpu::{Buffer, Context, Image};
+use umbrage::pass::{
+    CasterId, DepthStencilTarget, PassSettings, PreparedFrame, ShadowPass, ShadowPassDesc, ShadowView, SphereId, Technique,
+};
+use umbrage::scene::shapes;
+use umbrage::shadow::Method;
+
+const W: u32 = 48;
+const H: u32 = 36;
+/// The receiver: the depth buffer cleared to a plane 12.5 units in front of the eye
+/// (`1 - near / z` with near 0.1), behind every caster.
+const RECEIVER_DEPTH: f32 = 0.992;
+
+fn meshes() -> [Mesh; 3] {
+    [shapes::cuboid(Vec3::splat(0.8)), shapes::sphere(0.5, 10, 6), shapes::torus(0.5, 0.2, 10, 6)]
+}
+
+fn transform(pos: [i8; 3], turn: u8) -> DMat4 {
+    let p = DVec3::new(pos[0] as f64 * 0.5, pos[1] as f64 * 0.25 + 0.5, pos[2] as f64 * 0.5);
+    DMat4::from_translation(p) * DMat4::from_rotation_y(turn as f64 * 0.4)
+}
+
+fn view() -> ShadowView {
+    let eye = Vec3::new(0.0, 4.0, 8.0);
+    ShadowView {
+        eye: eye.as_dvec3(),
+        view: glam::camera::rh::view::look_at_mat4(Vec3::ZERO, -eye, Vec3::Y),
+        proj: glam::camera::rh::proj::vulkan::perspective_infinite(1.0, W as f32 / H as f32, 0.1),
+        width: W,
+        height: H,
+    }
+}
+
+fn light() -> Light {
+    Light::point(Vec3::new(1.0, 8.0, 2.0))
+}
+
+// ---- The reference model -------------------------------------------------------------------
+
+#[derive(Clone, Debug, PartialEq)]
+struct ModelCaster {
+    shape: usize,
+    pos: [i8; 3],
+    turn: u8,
+    /// `update_positions` with the mesh scaled by `1 + k / 8` about its origin.
+    deform: u8,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+struct ModelSphere {
+    pos: [i8; 3],
+    radius: u8,
+}
+
+#[derive(Clone, Debug)]
+struct Model {
+    frames_in_flight: usize,
+    casters: Vec<ModelCaster>,
+    spheres: Vec<ModelSphere>,
+    transparent: Vec<ModelCaster>,
+    method: Method,
+}
+
+#[derive(Clone, Copy, Debug)]
+enum FrameFate {
+    Dropped,
+    Submitted,
+    /// Recorded, then the command buffer reset instead of submitted (`abandon_frame`).
+    Abandoned,
+}
+
+#[derive(Clone, Debug)]
+enum Step {
+    AddCaster(ModelCaster),
+    RemoveCaster(usize),
+    SetTransform(usize, [i8; 3], u8),
+    UpdatePositions(usize, u8),
+    AddSphere(ModelSphere),
+    RemoveSphere(usize),
+    SetSphere(usize, ModelSphere),
+    AddTransparent(ModelCaster),
+    RemoveTransparent(usize),
+    SetMethod(Method),
+    Prepare(usize, FrameFate),
+    /// A call with an invalid argument, or another pass's id: refused, nothing changes.
+    Invalid(u8),
+}
+
+fn pos() -> impl Strategy<Value = [i8; 3]> {
+    [-4i8..=4, 0i8..=4, -4i8..=4]
+}
+
+fn caster() -> impl Strategy<Value = ModelCaster> {
+    (0usize..3, pos(), 0u8..8).prop_map(|(shape, pos, turn)| ModelCaster { shape, pos, turn, deform: 0 })
+}
+
+fn sphere() -> impl Strategy<Value = ModelSphere> {
+    (pos(), 1u8..=3).prop_map(|(pos, radius)| ModelSphere { pos, radius })
+}
+
+const METHODS: [Method; 4] = [Method::McGuire, Method::ZPass, Method::ZFail, Method::Lengyel];
+
+struct Reference;
+
+// The configuration of the current run: frames in flight.
+thread_local! {
+    static FRAMES_IN_FLIGHT: std::cell::Cell<usize> = const { std::cell::Cell::new(2) };
+}
+
+impl ReferenceStateMachine for Reference {
+    type State = Model;
+    type Transition = Step;
+
+    fn init_state() -> BoxedStrategy<Model> {
+        let fif = FRAMES_IN_FLIGHT.with(|f| f.get());
+        Just(Model { frames_in_flight: fif, casters: vec![], spheres: vec![], transparent: vec![], method: Method::McGuire }).boxed()
+    }
+
+    fn transitions(state: &Model) -> BoxedStrategy<Step> {
+        let (nc, ns, nt, slots) = (state.casters.len(), state.spheres.len(), state.transparent.len(), state.frames_in_flight);
+        let any = |n: usize| if n == 0 { Just(0usize).boxed() } else { (0..n).boxed() };
+        prop_oneof![
+            3 => caster().prop_map(Step::AddCaster),
+            1 => any(nc).prop_map(Step::RemoveCaster),
+            2 => (any(nc), pos(), 0u8..8).prop_map(|(i, p, t)| Step::SetTransform(i, p, t)),
+            1 => (any(nc), 0u8..4).prop_map(|(i, k)| Step::UpdatePositions(i, k)),
+            1 => sphere().prop_map(Step::AddSphere),
+            1 => any(ns).prop_map(Step::RemoveSphere),
+            1 => (any(ns), sphere()).prop_map(|(i, s)| Step::SetSphere(i, s)),
+            1 => caster().prop_map(Step::AddTransparent),
+            1 => any(nt).prop_map(Step::RemoveTransparent),
+            1 => (0usize..METHODS.len()).prop_map(|m| Step::SetMethod(METHODS[m])),
+            6 => (0..slots + 1, prop_oneof![1 => Just(FrameFate::Dropped), 3 => Just(FrameFate::Submitted), 1 => Just(FrameFate::Abandoned)])
+                .prop_map(|(s, f)| Step::Prepare(s, f)),
+            2 => (0u8..8).prop_map(Step::Invalid),
+        ]
+        .boxed()
+    }
+
+    fn preconditions(state: &Model, step: &Step) -> bool {
+        match step {
+            Step::RemoveCaster(i) | Step::SetTransform(i, ..) | Step::UpdatePositions(i, _) => *i < state.casters.len(),
+            Step::RemoveSphere(i) | Step::SetSphere(i, _) => *i < state.spheres.len(),
+            Step::RemoveTransparent(i) => *i < state.transparent.len(),
+            _ => true,
+        }
+    }
+
+    fn apply(mut state: Model, step: &Step) -> Model {
+        match step {
+            Step::AddCaster(c) => state.casters.push(c.clone()),
+            Step::RemoveCaster(i) => {
+                state.casters.remove(*i);
+            }
+            Step::SetTransform(i, p, t) => {
+                state.casters[*i].pos = *p;
+                state.casters[*i].turn = *t;
+            }
+            Step::UpdatePositions(i, k) => state.casters[*i].deform = *k,
+            Step::AddSphere(s) => state.spheres.push(s.clone()),
+            Step::RemoveSphere(i) => {
+                state.spheres.remove(*i);
+            }
+            Step::SetSphere(i, s) => state.spheres[*i] = s.clone(),
+            Step::AddTransparent(c) => state.transparent.push(c.clone()),
+            Step::RemoveTransparent(i) => {
+                state.transparent.remove(*i);
+            }
+            Step::SetMethod(m) => state.method = *m,
+            Step::Prepare(..) | Step::Invalid(_) => {}
+        }
+        state
+    }
+}
+
+// ---- The system under test ------------------------------------------------------------------
+
+/// The device and the target every pass draws into (one per test thread).
+struct Harness {
+    ctx: Context,
+    image: Image,
+    readback: Buffer,
+    /// The comparison pass of each `frames_in_flight`.
+    reference: Vec<(usize, ShadowPass)>,
+    /// A second pass whose ids the SUT must refuse.
+    other: ShadowPass,
+    other_caster: CasterId,
+    other_sphere: SphereId,
+}
+
+thread_local! {
+    static HARNESS: RefCell<Option<Harness>> = const { RefCell::new(None) };
+    /// Frames compared, those with a shadow, refused calls, abandoned frames.
+    static COUNTS: std::cell::Cell<[usize; 4]> = const { std::cell::Cell::new([0; 4]) };
+}
+
+fn count(k: usize) {
+    COUNTS.with(|c| {
+        let mut v = c.get();
+        v[k] += 1;
+        c.set(v);
+    });
+}
+
+fn desc(ctx: &Context, frames_in_flight: usize) -> ShadowPassDesc {
+    ShadowPassDesc {
+        depth_stencil_format: ctx.depth_format,
+        frames_in_flight,
+        transmit_format: Some(vk::Format::R16G16B16A16_SFLOAT),
+        ..Default::default()
+    }
+}
+
+fn new_pass(ctx: &Context, frames_in_flight: usize) -> ShadowPass {
+    ShadowPass::new(&ctx.instance, ctx.physical, &ctx.device, (*ctx.allocator).clone(), &desc(ctx, frames_in_flight)).unwrap()
+}
+
+fn with_harness<R>(f: impl FnOnce(&mut Harness) -> R) -> R {
+    HARNESS.with(|h| {
+        let mut h = h.borrow_mut();
+        let h = h.as_mut().expect("the harness is set up by the test");
+        f(h)
+    })
+}
+
+fn deformed(shape: usize, k: u8) -> Vec<Vec3> {
+    let s = 1.0 + k as f32 / 8.0;
+    meshes()[shape].positions.iter().map(|p| *p * s).collect()
+}
+
+/// Records `frame`'s determination of light 0 into the harness's target (cleared to the
+/// receiver plane) and, when `submit`, runs it and returns the stencil; otherwise resets the
+/// command buffer unsubmitted.
+fn record(h: &Harness, pass: &ShadowPass, frame: &PreparedFrame, submit: bool) -> Option<Vec<u8>> {
+    let ctx = &h.ctx;
+    let rec = |cb: vk::CommandBuffer| {
+        let ds = vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+        transition(ctx, cb, &h.image, vk::ImageLayout::UNDEFINED, ds);
+        let att = vk::RenderingAttachmentInfo::default()
+            .image_view(h.image.view)
+            .image_layout(ds)
+            .load_op(vk::AttachmentLoadOp::CLEAR)
+            .store_op(vk::AttachmentStoreOp::STORE)
+            .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: RECEIVER_DEPTH, stencil: 0 } });
+        let extent = vk::Extent2D { width: W, height: H };
+        let info = vk::RenderingInfo::default().render_area(extent.into()).layer_count(1).depth_attachment(&att).stencil_attachment(&att);
+        // SAFETY: `cb` is recording outside rendering; the image is in `ds`; the frame is live
+        // and its slot's previous frame has completed (every frame is waited for).
+        unsafe {
+            pass.cmd_before_rendering(cb, frame).unwrap();
+            ctx.device.cmd_begin_rendering(cb, &info);
+            ctx.device.cmd_end_rendering(cb);
+            transition(ctx, cb, &h.image, ds, ds);
+            pass.cmd_determine(cb, frame, 0, &DepthStencilTarget::new(h.image.raw, h.image.view, extent)).unwrap();
+        }
+        let src = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
+        transition(ctx, cb, &h.image, ds, src);
+        let copy = vk::BufferImageCopy::default()
+            .image_subresource(vk::ImageSubresourceLayers::default().aspect_mask(vk::ImageAspectFlags::STENCIL).layer_count(1))
+            .image_extent(vk::Extent3D { width: W, height: H, depth: 1 });
+        // SAFETY: the image is in TRANSFER_SRC_OPTIMAL; the buffer holds W x H bytes.
+        unsafe { ctx.device.cmd_copy_image_to_buffer(cb, h.image.raw, src, h.readback.raw, &[copy]) };
+    };
+    if submit {
+        ctx.one_shot(rec).unwrap();
+        return Some(h.readback.read().unwrap()[..(W * H) as usize].to_vec());
+    }
+    let info = vk::CommandBufferAllocateInfo::default().command_pool(ctx.pool).command_buffer_count(1);
+    // SAFETY: a new primary buffer, recorded, ended and freed without being submitted.
+    unsafe {
+        let cb = ctx.device.allocate_command_buffers(&info).unwrap()[0];
+        ctx.device.begin_command_buffer(cb, &vk::CommandBufferBeginInfo::default()).unwrap();
+        rec(cb);
+        ctx.device.end_command_buffer(cb).unwrap();
+        ctx.device.free_command_buffers(ctx.pool, &[cb]);
+    }
+    None
+}
+
+/// The stencil of a pass holding exactly the model's casters, prepared from scratch.
+fn reference_stencil(h: &mut Harness, model: &Model) -> Vec<u8> {
+    let fif = model.frames_in_flight;
+    if !h.reference.iter().any(|(f, _)| *f == fif) {
+        let p = new_pass(&h.ctx, fif);
+        h.reference.push((fif, p));
+    }
+    let i = h.reference.iter().position(|(f, _)| *f == fif).unwrap();
+    let (_, mut pass) = h.reference.swap_remove(i);
+    let fresh = new_pass_state(&mut pass, model);
+    let frame = pass.prepare(0, &view(), &[light()]).unwrap();
+    let stencil = record(h, &pass, &frame, true).unwrap();
+    drop(frame);
+    for id in fresh.0 {
+        pass.remove_caster(id).unwrap();
+    }
+    for id in fresh.1 {
+        pass.remove_sphere(id).unwrap();
+    }
+    h.reference.push((fif, pass));
+    stencil
+}
+
+/// Adds the model's casters and spheres to `pass` (whose own are removed after use).
+fn new_pass_state(pass: &mut ShadowPass, model: &Model) -> (Vec<CasterId>, Vec<SphereId>) {
+    let meshes = meshes();
+    pass.set_settings(PassSettings { technique: Technique::Volumes(model.method), ..Default::default() }).unwrap();
+    let casters = model
+        .casters
+        .iter()
+        .map(|c| {
+            let mesh = Mesh::new(deformed(c.shape, c.deform), meshes[c.shape].triangles.clone());
+            pass.add_caster("ref", &mesh, transform(c.pos, c.turn)).unwrap()
+        })
+        .collect();
+    let spheres = model.spheres.iter().map(|s| pass.add_sphere_caster("ref", sphere_of(s), None).unwrap()).collect();
+    (casters, spheres)
+}
+
+fn sphere_of(s: &ModelSphere) -> Sphere {
+    Sphere { center: transform(s.pos, 0).w_axis.truncate(), radius: s.radius as f64 * 0.25 }
+}
+
+struct Sut {
+    pass: ShadowPass,
+    casters: Vec<CasterId>,
+    spheres: Vec<SphereId>,
+    transparent: Vec<CasterId>,
+    frames: usize,
+}
+
+struct Sequences;
+
+impl StateMachineTest for Sequences {
+    type SystemUnderTest = Sut;
+    type Reference = Reference;
+
+    fn init_test(model: &Model) -> Sut {
+        let pass = with_harness(|h| new_pass(&h.ctx, model.frames_in_flight));
+        Sut { pass, casters: vec![], spheres: vec![], transparent: vec![], frames: 0 }
+    }
+
+    fn apply(mut sut: Sut, model: &Model, step: Step) -> Sut {
+        let meshes = meshes();
+        match step {
+            Step::AddCaster(c) => {
+                let id = sut.pass.add_caster("c", &meshes[c.shape], transform(c.pos, c.turn)).unwrap();
+                sut.casters.push(id);
+            }
+            Step::RemoveCaster(i) => sut.pass.remove_caster(sut.casters.remove(i)).unwrap(),
+            Step::SetTransform(i, p, t) => sut.pass.set_transform(sut.casters[i], transform(p, t)).unwrap(),
+            Step::UpdatePositions(i, k) => {
+                // The model has applied the step: its caster i has this shape.
+                let shape = model.casters[i].shape;
+                sut.pass.update_positions(sut.casters[i], &deformed(shape, k)).unwrap()
+            }
+            Step::AddSphere(s) => sut.spheres.push(sut.pass.add_sphere_caster("s", sphere_of(&s), None).unwrap()),
+            Step::RemoveSphere(i) => sut.pass.remove_sphere(sut.spheres.remove(i)).unwrap(),
+            Step::SetSphere(i, s) => sut.pass.set_sphere(sut.spheres[i], sphere_of(&s)).unwrap(),
+            Step::AddTransparent(c) => {
+                let id = sut.pass.add_transparent_caster("t", &meshes[c.shape], transform(c.pos, c.turn), Vec3::splat(0.5)).unwrap();
+                sut.transparent.push(id);
+            }
+            Step::RemoveTransparent(i) => sut.pass.remove_caster(sut.transparent.remove(i)).unwrap(),
+            Step::SetMethod(m) => sut.pass.set_settings(PassSettings { technique: Technique::Volumes(m), ..Default::default() }).unwrap(),
+            Step::Prepare(slot, fate) => {
+                let r = sut.pass.prepare(slot, &view(), &[light()]);
+                if slot >= model.frames_in_flight {
+                    assert!(r.is_err(), "slot {slot} of {} was accepted", model.frames_in_flight);
+                    return sut;
+                }
+                let frame = r.unwrap();
+                match fate {
+                    FrameFate::Dropped => drop(frame),
+                    FrameFate::Abandoned => {
+                        with_harness(|h| record(h, &sut.pass, &frame, false));
+                        sut.pass.abandon_frame(slot).unwrap();
+                        count(3);
+                    }
+                    FrameFate::Submitted => {
+                        let (got, want) = with_harness(|h| {
+                            let got = record(h, &sut.pass, &frame, true).unwrap();
+                            (got, reference_stencil(h, model))
+                        });
+                        let differ = got.iter().zip(&want).filter(|(a, b)| a != b).count();
+                        let shadowed = want.iter().filter(|&&v| v != 0).count();
+                        assert_eq!(differ, 0, "{differ} stencil bytes differ from a fresh pass's ({shadowed} shadowed there)");
+                        sut.frames += 1;
+                        count(0);
+                        if shadowed > 0 {
+                            count(1);
+                        }
+                    }
+                }
+            }
+            Step::Invalid(k) => {
+                let err = match k {
+                    0 => sut.pass.add_caster("nan", &Mesh::new(vec![Vec3::NAN; 3], vec![[0, 1, 2]]), DMat4::IDENTITY).err(),
+                    1 => sut.pass.add_caster("singular", &meshes[0], DMat4::from_scale(DVec3::ZERO)).err(),
+                    2 => with_harness(|h| sut.pass.remove_caster(h.other_caster).err()),
+                    3 => with_harness(|h| sut.pass.set_transform(h.other_caster, DMat4::IDENTITY).err()),
+                    4 => with_harness(|h| sut.pass.remove_sphere(h.other_sphere).err()),
+                    5 => sut.pass.prepare(0, &view(), &[Light { radius: Some(-1.0), ..light() }]).err(),
+                    6 => sut.casters.first().and_then(|&id| sut.pass.update_positions(id, &[Vec3::ZERO]).err()),
+                    _ => sut.pass.set_settings(PassSettings { technique: Technique::shadow_map(256), ..Default::default() }).err(),
+                };
+                // Case 6 needs a caster; every other refusal must happen.
+                assert!(err.is_some() || (k == 6 && sut.casters.is_empty()), "invalid call {k} was accepted");
+                if err.is_some() {
+                    count(2);
+                }
+            }
+        }
+        sut
+    }
+
+    fn check_invariants(_sut: &Sut, _model: &Model) {
+        with_harness(|h| {
+            let errors = h.ctx.take_validation_errors();
+            assert!(errors.is_empty(), "validation: {errors:#?}");
+        });
+    }
+}
+
+fn cases() -> u32 {
+    std::env::var("PASS_SEQUENCES_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(200)
+}
+
+#[test]
+fn every_call_sequence_matches_a_fresh_pass() {
+    let Some(ctx) = common::context() else { return };
+    let extent = vk::Extent2D { width: W, height: H };
+    let usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
+    let image = Image::new_2d(&ctx, "target", ctx.depth_format, extent, usage, vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL)
+        .unwrap();
+    let readback =
+        Buffer::new(&ctx, "readback", (W * H) as u64 + 256, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu).unwrap();
+    let mut other = new_pass(&ctx, 1);
+    let other_caster = other.add_caster("other", &meshes()[0], DMat4::IDENTITY).unwrap();
+    let other_sphere = other.add_sphere_caster("other", Sphere { center: DVec3::Y, radius: 0.5 }, None).unwrap();
+    HARNESS.with(|h| *h.borrow_mut() = Some(Harness { ctx, image, readback, reference: vec![], other, other_caster, other_sphere }));
+    let config = Config { cases: cases(), max_shrink_iters: 2000, source_file: Some(file!()), ..Config::default() };
+    for fif in 1..=3 {
+        FRAMES_IN_FLIGHT.with(|f| f.set(fif));
+        let mut runner = proptest::test_runner::TestRunner::new(config.clone());
+        let result = runner.run(&Reference::sequential_strategy(30..31), |(initial, transitions, seen)| {
+            Sequences::test_sequential(config.clone(), initial, transitions, seen);
+            Ok(())
+        });
+        if let Err(e) = result {
+            panic!("frames_in_flight {fif}: {e}");
+        }
+    }
+    let [compared, shadowed, refused, abandoned] = COUNTS.with(|c| c.get());
+    eprintln!("{compared} frames compared ({shadowed} with a shadow), {refused} calls refused, {abandoned} frames abandoned");
+    // The comparisons must have had something to compare.
+    assert!(shadowed * 3 >= compared && compared >= cases() as usize, "{shadowed} of {compared} frames had a shadow");
+    let mut h = HARNESS.with(|h| h.borrow_mut().take()).unwrap();
+    h.reference.clear();
+    drop(h.other);
+    h.image.destroy(&h.ctx);
+    h.readback.destroy(&h.ctx);
+    h.ctx.check_validation().unwrap();
+}
