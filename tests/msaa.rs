@@ -91,7 +91,7 @@ fn samples_are_at_their_own_locations_and_the_resolve_antialiases() {
     assert!(one.samples.is_empty(), "a single-sampled frame has no per-sample captures");
     let (four, r) = render(r.into_context(), "default", t, SAMPLES);
     // Each sample's points lie on the floor plane (y = 0) and move between samples by about a
-    // quarter pixel: the depth was unprojected at each sample's own location.
+    // quarter pixel: each was found at the sample's own location.
     let floor = |p: &[f32; 3], n: &[f32; 3]| p[0].is_finite() && n[1] > 0.999 && p[1].abs() < 0.05;
     for (k, s) in four.samples.iter().enumerate() {
         let on_floor: Vec<f32> = s.positions.iter().zip(&s.normals).filter(|(p, n)| floor(p, n)).map(|(p, _)| p[1].abs()).collect();

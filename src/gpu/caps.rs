@@ -460,7 +460,7 @@ pub struct Features {
     /// counts (colour, integer for the stencil, depth) together.
     pub frame_sample_counts: u32,
     /// `standardSampleLocations`: multisampled images use Vulkan's standard sample locations
-    /// (a multisampled capture is unprojected at them).
+    /// (a multisampled capture's positions are found at them).
     pub standard_sample_locations: bool,
 }
 

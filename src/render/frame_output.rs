@@ -147,7 +147,9 @@ pub(crate) fn parse(
     let (Some(pos_r), Some(nrm_r)) = (layout.positions, layout.normals) else { return Ok(c) };
     let n = layout.samples.max(1);
     if n > 1 {
-        for (k, &location) in (0..n).zip(standard_sample_locations(n)) {
+        let standard = standard_sample_locations(n);
+        for k in 0..n {
+            let location = view.locations.get(k as usize).or(standard.get(k as usize)).copied().unwrap_or((0.5, 0.5));
             let mut s = SampleOutput::default();
             (s.positions, s.normals) = sample_geometry(rb.bytes(pos_r.sample(k, n))?, rb.bytes(nrm_r.sample(k, n))?, view, location);
             for &range in &layout.counts {
@@ -212,14 +214,18 @@ fn geometry(pos: &[u8], nrm: &[u8], eye: DVec3) -> (Vec<[f32; 3]>, Vec<[f32; 3]>
 }
 
 /// What a captured frame's positions are recovered with: the eye, and for a multisampled frame
-/// the frame's size and the inverse of its eye-relative view-projection.
-pub(crate) struct CaptureView {
+/// the frame's size, the inverse of its eye-relative view-projection and where each sample's
+/// depth is evaluated.
+pub(crate) struct CaptureView<'a> {
     pub eye: DVec3,
     /// Clip space to eye-relative space: the inverse, in f64, of the matrix the G-buffer pass
     /// projected with.
     pub clip_to_rel: DMat4,
     pub width: u32,
     pub height: u32,
+    /// Per sample, where the device evaluates its depth (measured; the standard locations on
+    /// a conformant device). Empty: the standard locations.
+    pub locations: &'a [(f64, f64)],
 }
 
 /// Vulkan's standard sample locations (`standardSampleLocations`) of `samples` samples, in
@@ -242,26 +248,40 @@ pub fn standard_sample_locations(samples: u32) -> &'static [(f64, f64)] {
     }
 }
 
-/// One sample's world positions and normals (NaN for background) from its read-back depth
-/// (`r` of RGBA32F; 1, the clear value, where nothing was drawn) and normal: each position is
-/// the depth unprojected in f64 at the sample's own location, which is exactly the point the
-/// sample's depth and stencil tests saw (the G-buffer's shading position is the pixel's).
-fn sample_geometry(depth: &[u8], nrm: &[u8], view: &CaptureView, (sx, sy): (f64, f64)) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
+/// One sample's world positions and normals (NaN for background) from its read-back G-buffer
+/// position (eye-relative, `w` = 0 where nothing was drawn) and face normal, at the sample's
+/// location `(sx, sy)` (where the device evaluates the sample's depth, so where its depth and
+/// stencil tests saw the surface): the ray from the eye through that location meets the
+/// plane through the G-buffer's point with the face normal. The G-buffer shades once per
+/// pixel (its point is the pixel's, on the sample's triangle; the analytic spheres' is the
+/// sample's own ray's hit), and its f32 position is exact to about 1e-7 of the distance,
+/// where the depth unprojected (1 - depth is about 5e-3 on the default scene's back wall: one
+/// ulp there is 1.2e-5 of the distance) is not: SwiftShader's depth plane is off by up to
+/// 2.6 ulps across the default scene's back wall, beyond the reference's surface offset
+/// (2e-5 of the scene, about 2 ulps), which then called the wall's points behind it shadowed.
+/// A ray within 1e-6 of the plane's direction (grazing) keeps the G-buffer's point.
+fn sample_geometry(pos: &[u8], nrm: &[u8], view: &CaptureView, (sx, sy): (f64, f64)) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
     let floats = |bytes: &[u8]| -> Vec<[f32; 4]> { bytemuck::pod_collect_to_vec::<u8, [f32; 4]>(bytes) };
     let (w, h) = (view.width as usize, view.height.max(1) as usize);
-    floats(depth)
+    floats(pos)
         .iter()
         .zip(&floats(nrm))
         .enumerate()
-        .map(|(i, (d, n))| {
-            if d[0] >= 1.0 {
+        .map(|(i, (p, n))| {
+            if p[3] == 0.0 {
                 return ([f32::NAN; 3], [f32::NAN; 3]);
             }
             let x = (i % w.max(1)) as f64 + sx;
             let y = (i / w.max(1)) as f64 + sy;
-            let clip = DVec4::new(2.0 * x / w as f64 - 1.0, 2.0 * y / h as f64 - 1.0, d[0] as f64, 1.0);
+            // Any point of the sample's ray: the eye is the origin of eye-relative space.
+            let clip = DVec4::new(2.0 * x / w as f64 - 1.0, 2.0 * y / h as f64 - 1.0, 0.5, 1.0);
             let r = view.clip_to_rel * clip;
-            ((r.truncate() / r.w + view.eye).as_vec3().to_array(), [n[0], n[1], n[2]])
+            let dir = (r.truncate() / r.w).normalize_or_zero();
+            let g = DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64);
+            let normal = DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64).normalize_or_zero();
+            let facing = normal.dot(dir);
+            let rel = if facing.abs() > 1e-6 { dir * (normal.dot(g) / facing) } else { g };
+            ((rel + view.eye).as_vec3().to_array(), [n[0], n[1], n[2]])
         })
         .unzip()
 }

@@ -26,7 +26,7 @@ pub(crate) struct Layouts {
 }
 
 /// The per-sample readback of a multisampled frame ([`SampleReadback`]): a full-screen pass
-/// copies one sample of the depth, normal or stencil target into a single-sample image.
+/// copies one sample of the position, normal or stencil target into a single-sample image.
 pub(crate) struct SampleReadbackPipes {
     /// One source image and the sampler; push: the sample index (an `i32`).
     pub layout: vk::PipelineLayout,
@@ -34,8 +34,8 @@ pub(crate) struct SampleReadbackPipes {
     pub geometry: vk::Pipeline,
     /// Into the R8_UINT readback image.
     pub stencil: vk::Pipeline,
-    /// The depth, normal and stencil sources.
-    pub depth_set: DescriptorSet,
+    /// The position, normal and stencil sources.
+    pub position_set: DescriptorSet,
     pub normal_set: DescriptorSet,
     pub stencil_set: DescriptorSet,
 }
@@ -181,7 +181,7 @@ impl FramePipelines {
         tm.color_formats = &out;
         let tonemap = create(&tm)?;
         let sample_readback = match &t.per_sample {
-            Some(rb) => Some(SampleReadbackPipes::new(ctx, t, (rb.depth_view, rb.stencil_view), sampler, &mut create)?),
+            Some(rb) => Some(SampleReadbackPipes::new(ctx, t, rb.stencil_view, sampler, &mut create)?),
             None => None,
         };
         Ok(FramePipelines {
@@ -224,7 +224,7 @@ impl FramePipelines {
         if let Some(mut r) = self.sample_readback.take() {
             // SAFETY: as above (its pipelines are in `made`).
             unsafe { d.destroy_pipeline_layout(r.layout, None) };
-            r.depth_set.destroy(ctx);
+            r.position_set.destroy(ctx);
             r.normal_set.destroy(ctx);
             r.stencil_set.destroy(ctx);
         }
@@ -236,14 +236,14 @@ impl SampleReadbackPipes {
     fn new(
         ctx: &Context,
         t: &Targets,
-        (depth_view, stencil_view): (vk::ImageView, vk::ImageView),
+        stencil_view: vk::ImageView,
         sampler: vk::Sampler,
         create: &mut impl FnMut(&PipelineDesc) -> Result<vk::Pipeline>,
     ) -> Result<SampleReadbackPipes> {
         let set = |view| DescriptorSet::new(ctx, &[Binding::Image(view), Binding::Sampler(sampler)]);
         let mut sets = Vec::with_capacity(3);
         let made = (|| -> Result<(vk::PipelineLayout, vk::Pipeline, vk::Pipeline)> {
-            for view in [depth_view, t.normal.view, stencil_view] {
+            for view in [t.position.view, t.normal.view, stencil_view] {
                 sets.push(set(view)?);
             }
             let layout = pipeline_layout(ctx, &[sets[0].layout], 4, vk::ShaderStageFlags::FRAGMENT)?;
@@ -270,10 +270,10 @@ impl SampleReadbackPipes {
         match made {
             Ok((layout, geometry, stencil)) => {
                 let mut it = sets.into_iter();
-                let (Some(depth_set), Some(normal_set), Some(stencil_set)) = (it.next(), it.next(), it.next()) else {
+                let (Some(position_set), Some(normal_set), Some(stencil_set)) = (it.next(), it.next(), it.next()) else {
                     return Err(crate::Error::Internal("sample readback sets".into()));
                 };
-                Ok(SampleReadbackPipes { layout, geometry, stencil, depth_set, normal_set, stencil_set })
+                Ok(SampleReadbackPipes { layout, geometry, stencil, position_set, normal_set, stencil_set })
             }
             Err(e) => {
                 for mut s in sets {

@@ -30,14 +30,12 @@ pub use crate::pass::COUNT_FORMAT;
 /// copied to a buffer): one sample at a time is drawn into these single-sample images and
 /// copied out.
 pub struct SampleReadback {
-    /// One sample of the depth (in `r`) or of the normal target (RGBA32F).
+    /// One sample of the position or of the normal target (RGBA32F).
     pub geometry: Image,
     /// One sample of the stencil (R8_UINT).
     pub stencil: Image,
     /// The depth-stencil target's stencil aspect, sampled.
     pub stencil_view: vk::ImageView,
-    /// The depth-stencil target's depth aspect, sampled.
-    pub depth_view: vk::ImageView,
 }
 
 /// The renderer's offscreen targets, all of one size.
@@ -152,7 +150,7 @@ impl Targets {
                 self.extent,
                 [("sample readback", SAMPLE_GEOMETRY_FORMAT, readback, c), ("sample stencil readback", SAMPLE_STENCIL_FORMAT, readback, c)],
             )?;
-            let mut rb = SampleReadback { geometry, stencil, stencil_view: vk::ImageView::null(), depth_view: vk::ImageView::null() };
+            let mut rb = SampleReadback { geometry, stencil, stencil_view: vk::ImageView::null() };
             let view = |aspect_mask| {
                 let info = vk::ImageViewCreateInfo::default()
                     .image(self.depth.raw)
@@ -169,16 +167,8 @@ impl Targets {
                 // destroyed in `destroy`, before the image.
                 unsafe { ctx.device.create_image_view(&info, None) }.map_err(crate::Error::vk("vkCreateImageView"))
             };
-            let views = view(vk::ImageAspectFlags::STENCIL).and_then(|s| match view(vk::ImageAspectFlags::DEPTH) {
-                Ok(d) => Ok((s, d)),
-                Err(e) => {
-                    // SAFETY: made just above, used by nothing.
-                    unsafe { ctx.device.destroy_image_view(s, None) };
-                    Err(e)
-                }
-            });
-            match views {
-                Ok((s, d)) => (rb.stencil_view, rb.depth_view) = (s, d),
+            match view(vk::ImageAspectFlags::STENCIL) {
+                Ok(s) => rb.stencil_view = s,
                 Err(e) => {
                     rb.geometry.destroy(ctx);
                     rb.stencil.destroy(ctx);
@@ -198,11 +188,8 @@ impl Targets {
     /// Destroys every target (the owner waited for the device).
     pub fn destroy(&mut self, ctx: &Context) {
         if let Some(mut rb) = self.per_sample.take() {
-            // SAFETY: the owner waited for the device; the views are destroyed once.
-            unsafe {
-                ctx.device.destroy_image_view(rb.stencil_view, None);
-                ctx.device.destroy_image_view(rb.depth_view, None);
-            }
+            // SAFETY: the owner waited for the device; the view is destroyed once.
+            unsafe { ctx.device.destroy_image_view(rb.stencil_view, None) };
             rb.geometry.destroy(ctx);
             rb.stencil.destroy(ctx);
         }

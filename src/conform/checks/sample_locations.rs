@@ -266,6 +266,27 @@ fn judge(n: u32, x_render: &[Vec<f32>], y_render: &[Vec<f32>]) -> Tally {
     t
 }
 
+/// Where the device evaluates a multisampled draw's depth, per sample of `n` (in Vulkan's
+/// standard sample order, pixel units from the pixel's top-left corner): the check's two
+/// sloped-plane renders at `n` samples (the renderer's depth format, sampled), each sample's
+/// median location over the covered pixels. The standard locations on a conformant device;
+/// SwiftShader's are mirrored in x (docs/conform/drivers-notes.md §1f). `None` where the
+/// depth format cannot be a sampled attachment of `n` samples, or `n` is not 2, 4 or 8.
+pub fn measure_depth_locations(ctx: &Context, n: u32) -> Result<Option<Vec<(f64, f64)>>> {
+    if !sample_counts(ctx).contains(&n) {
+        return Ok(None);
+    }
+    let t = judge(n, &render_samples(ctx, n, true)?, &render_samples(ctx, n, false)?);
+    // A location that is not a number (no covered sample read back) is the standard one.
+    let at = t
+        .depth_at
+        .iter()
+        .zip(standard_sample_locations(n))
+        .map(|(&(x, y), &(sx, sy))| (if x.is_finite() { x } else { sx }, if y.is_finite() { y } else { sy }))
+        .collect();
+    Ok(Some(at))
+}
+
 /// Every sample's coverage and depth at its standard location, at each supported count of 2, 4
 /// and 8 (the renderer's depth format, sampled). Skipped without `standardSampleLocations` or
 /// without a multisampled, sampled depth format.

@@ -67,7 +67,7 @@ struct InFlight {
     float_counts: bool,
     eye: glam::DVec3,
     /// The inverse of the G-buffer's eye-relative view-projection (a multisampled capture's
-    /// positions are unprojected from each sample's depth).
+    /// sample rays).
     clip_to_rel: glam::DMat4,
     spans: FrameSpans,
     wall: Instant,
@@ -137,6 +137,56 @@ struct Parts {
     serial: u64,
     /// Bumped when the camera or a mesh moves (the shadow maps are rebuilt then).
     scene_version: u64,
+    /// Per sample, where the device evaluates a multisampled draw's depth (pixel units from
+    /// the pixel's top-left corner), measured once ([`DepthLocations::measure`]): a
+    /// multisampled capture's positions are found there.
+    depth_locations: DepthLocations,
+}
+
+/// Where a multisampled frame's depth is evaluated, per sample.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct DepthLocations {
+    /// Per sample, in Vulkan's standard order (empty for one sample).
+    pub at: Vec<(f64, f64)>,
+    /// The driver defect, when they are not the standard locations (a frame's warning).
+    pub defect: Option<String>,
+}
+
+impl DepthLocations {
+    /// Off the standard location by more than this (pixels), a sample's depth is reported.
+    const TOLERANCE: f64 = 1e-3;
+
+    /// Measures where `n` samples' depth is evaluated: a tiny sloped-plane render, the
+    /// conformance case `legacy.msaa_depth_locations`'s
+    /// ([`crate::conform::checks::measure_depth_locations`]). The standard locations
+    /// (`standardSampleLocations`) on a conformant device; where they differ, the measured ones
+    /// are used and the difference is the frame's warning (SwiftShader evaluates depth at the
+    /// standard locations mirrored in x: docs/conform/drivers-notes.md §1f).
+    fn measure(ctx: &Context, n: u32) -> Result<DepthLocations> {
+        let standard = crate::render::standard_sample_locations(n);
+        if n < 2 {
+            return Ok(DepthLocations::default());
+        }
+        let Some(at) = crate::conform::checks::measure_depth_locations(ctx, n)? else {
+            return Ok(DepthLocations { at: standard.to_vec(), defect: None });
+        };
+        let off: Vec<String> = at
+            .iter()
+            .zip(standard)
+            .enumerate()
+            .filter(|(_, (&(x, y), &(sx, sy)))| (x - sx).abs() > Self::TOLERANCE || (y - sy).abs() > Self::TOLERANCE)
+            .map(|(k, (&(x, y), &(sx, sy)))| format!("sample {k} at ({x:.4}, {y:.4}), not ({sx}, {sy})"))
+            .collect();
+        let defect = (!off.is_empty()).then(|| {
+            format!(
+                "driver defect (docs/conform/drivers-notes.md §1f): {} evaluates multisampled depth away from the standard sample locations \
+                 ({}); a capture's positions are found at the measured locations",
+                ctx.info.name,
+                off.join(", ")
+            )
+        });
+        Ok(DepthLocations { at, defect })
+    }
 }
 
 impl Destroy for Parts {
@@ -400,7 +450,8 @@ impl Renderer {
             .has_transparent
             .then_some(TransmitMode { fp32: self.own.parts.config.transmit_fp32, log: f.settings.transmit_log });
         let (width, height) = (self.own.parts.config.width, self.own.parts.config.height);
-        let view = CaptureView { eye: f.eye, clip_to_rel: f.clip_to_rel, width, height };
+        let locations = &self.own.parts.depth_locations.at;
+        let view = CaptureView { eye: f.eye, clip_to_rel: f.clip_to_rel, width, height, locations };
         let c = parse(&s.readback, &f.layout, f.float_counts, transmit, &view)?;
         let stats = self.stats(&ticket, &f)?;
         let mut out = FrameOutput {
@@ -462,6 +513,7 @@ impl Parts {
         }
         check_options(ctx, &config, &settings)?;
         memory::check_fits(ctx, &scene, &config)?;
+        let depth_locations = DepthLocations::measure(ctx, config.samples)?;
         let transmit_format = opts.transmit.format();
         let f = &ctx.features;
         let accum_format = area::accum_format(&source_lights, f.rgba32f_blend);
@@ -536,6 +588,7 @@ impl Parts {
             next_slot: 0,
             serial: 0,
             scene_version: 0,
+            depth_locations,
         })
     }
 }

@@ -108,7 +108,7 @@ impl Renderer {
                 // SAFETY: recording outside a rendering instance; the G-buffer is in shader-read
                 // layout since its pass.
                 unsafe {
-                    samples::record(rec, t, p, samples::Source::Depth, pos)?;
+                    samples::record(rec, t, p, samples::Source::Position, pos)?;
                     samples::record(rec, t, p, samples::Source::Normal, nrm)?;
                 }
             }

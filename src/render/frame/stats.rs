@@ -82,7 +82,14 @@ impl Renderer {
                 true => Some(self.own.parts.slots[ticket.slot].counters.read(ctx)?),
                 false => None,
             },
-            warnings: f.frame.warnings.clone(),
+            warnings: {
+                let mut w = f.frame.warnings.clone();
+                // A multisampled capture's positions rely on where depth is evaluated.
+                if let (true, Some(defect)) = (f.settings.capture, &self.own.parts.depth_locations.defect) {
+                    w.push(defect.clone());
+                }
+                w
+            },
             ray_query: f.frame.ray_query().map(|r| {
                 if let (true, Some(accel)) = (r.builds > 0, accel_ms) {
                     self.own.parts.blas_build_ms.set(accel);

@@ -1,14 +1,15 @@
 //! The readback of a multisampled frame, one sample at a time: images of more than one sample
-//! cannot be copied to a buffer, so a full-screen pass copies sample `k` of the depth,
+//! cannot be copied to a buffer, so a full-screen pass copies sample `k` of the position,
 //! normal or stencil target into a single-sample image ([`SampleReadback`]) that is copied
 //! into sample `k`'s block of the readback range.
 //!
 //! Inputs / outputs (called by `determine::finish` for the stencil capture, and by `frame/record.rs` after the tone
-//! map for depth and normals):
-//! - Reads: `Source::Depth` / `Source::Stencil`: the `Targets` depth-stencil image, `DEPTH_STENCIL_ATTACHMENT_OPTIMAL ->
-//!   SHADER_READ_ONLY_OPTIMAL` for the pass and back afterwards (sampled through aspect views, `depth_set` /
-//!   `stencil_set`); `Source::Normal`: `normal` in `SHADER_READ_ONLY_OPTIMAL` (left there by `gbuffer`), not transitioned.
-//! - Writes, per sample: `per_sample.geometry` (depth, normal) or `per_sample.stencil`, `UNDEFINED ->
+//! map for positions and normals):
+//! - Reads: `Source::Stencil`: the `Targets` depth-stencil image, `DEPTH_STENCIL_ATTACHMENT_OPTIMAL ->
+//!   SHADER_READ_ONLY_OPTIMAL` for the pass and back afterwards (sampled through its stencil aspect view,
+//!   `stencil_set`); `Source::Position` / `Source::Normal`: `position` / `normal` in `SHADER_READ_ONLY_OPTIMAL` (left
+//!   there by `gbuffer`), not transitioned.
+//! - Writes, per sample: `per_sample.geometry` (position, normal) or `per_sample.stencil`, `UNDEFINED ->
 //!   COLOR_ATTACHMENT_OPTIMAL`, DONT_CARE/STORE, then copied out through `TRANSFER_SRC_OPTIMAL` and returned to
 //!   `COLOR_ATTACHMENT_OPTIMAL`.
 //! - Leaves every `Targets` image in the layout it found it.
@@ -25,9 +26,9 @@ use ash::vk;
 /// What is read back.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum Source {
-    /// The depth, into the readback's `r` (the depth-stencil target in attachment layout; it is
-    /// returned there).
-    Depth,
+    /// The G-buffer's eye-relative positions (in shader-read layout): a capture's positions
+    /// are found on their planes (`frame_output::sample_geometry`), not unprojected from depth.
+    Position,
     /// The G-buffer's normals (in shader-read layout).
     Normal,
     /// The stencil (the depth-stencil target in attachment layout; it is returned there).
@@ -44,13 +45,13 @@ pub(crate) unsafe fn record(rec: &Rec, t: &Targets, p: &FramePipelines, source: 
         return Err(Error::Internal("per-sample readback of a single-sampled frame".into()));
     };
     let (img, pipe, set) = match source {
-        Source::Depth => (&rb.geometry, pipes.geometry, &pipes.depth_set),
+        Source::Position => (&rb.geometry, pipes.geometry, &pipes.position_set),
         Source::Normal => (&rb.geometry, pipes.geometry, &pipes.normal_set),
         Source::Stencil => (&rb.stencil, pipes.stencil, &pipes.stencil_set),
     };
     let ds = vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
     let read = vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL;
-    if matches!(source, Source::Stencil | Source::Depth) {
+    if source == Source::Stencil {
         rec.transition(&t.depth, ds, read);
     }
     let d = &rec.ctx.device;
@@ -69,7 +70,7 @@ pub(crate) unsafe fn record(rec: &Rec, t: &Targets, p: &FramePipelines, source: 
         }
         rec.copy_out(img, vk::ImageAspectFlags::COLOR, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL, range.sample(k, t.samples));
     }
-    if matches!(source, Source::Stencil | Source::Depth) {
+    if source == Source::Stencil {
         rec.transition(&t.depth, read, ds);
     }
     Ok(())
