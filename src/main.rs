@@ -387,6 +387,11 @@ fn render(frame: &FrameArgs, out: &Path, stats: Option<&Path>, view: View, dump:
     let scene = motion.scene_at(&scene, time);
     let ctx = umbrage::gpu::Context::new()?;
     let mut renderer = Renderer::new(ctx, scene, opts)?;
+    if dump.is_some() {
+        // A multisampled capture finds each sample's position where the device evaluated its
+        // depth (measured: SwiftShader's are not the standard locations).
+        umbrage::conform::checks::calibrate_sample_locations(&mut renderer)?;
+    }
     let frame_out = renderer.render()?;
     umbrage::output::write_png(out, frame_out.width, frame_out.height, &frame_out.color)?;
     if let Some(path) = stats {

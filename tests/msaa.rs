@@ -50,6 +50,7 @@ fn render(ctx: umbrage::gpu::Context, name: &str, technique: Technique, samples:
     let scene = umbrage::scene::load(name).unwrap();
     let opts = RenderOptions { width: 160, height: 120, technique, capture: true, samples, ..Default::default() };
     let mut r = Renderer::new(ctx, scene, opts).unwrap_or_else(|e| panic!("{name} at {samples} samples: {e}"));
+    umbrage::conform::checks::calibrate_sample_locations(&mut r).unwrap();
     let out = r.render().unwrap();
     r.context().check_validation().unwrap();
     (out, r)

@@ -287,6 +287,23 @@ pub fn measure_depth_locations(ctx: &Context, n: u32) -> Result<Option<Vec<(f64,
     Ok(Some(at))
 }
 
+/// Measures where `renderer`'s device evaluates a multisampled draw's depth
+/// ([`measure_depth_locations`]) and hands the locations to it
+/// ([`Renderer::use_sample_depth_locations`](crate::render::Renderer::use_sample_depth_locations)),
+/// so a multisampled capture's positions are found where its depth tests looked. Nothing for a
+/// one-sample renderer, or where the depth format cannot be sampled at its count (the
+/// standard locations stay).
+pub fn calibrate_sample_locations(renderer: &mut crate::render::Renderer) -> Result<()> {
+    let n = renderer.config().samples;
+    if n < 2 {
+        return Ok(());
+    }
+    match measure_depth_locations(renderer.context(), n)? {
+        Some(at) => renderer.use_sample_depth_locations(&at),
+        None => Ok(()),
+    }
+}
+
 /// Every sample's coverage and depth at its standard location, at each supported count of 2, 4
 /// and 8 (the renderer's depth format, sampled). Skipped without `standardSampleLocations` or
 /// without a multisampled, sampled depth format.

@@ -138,8 +138,9 @@ struct Parts {
     /// Bumped when the camera or a mesh moves (the shadow maps are rebuilt then).
     scene_version: u64,
     /// Per sample, where the device evaluates a multisampled draw's depth (pixel units from
-    /// the pixel's top-left corner), measured once ([`DepthLocations::measure`]): a
-    /// multisampled capture's positions are found there.
+    /// the pixel's top-left corner): the standard ones, or as measured
+    /// ([`Renderer::use_sample_depth_locations`]); a multisampled capture's positions are found
+    /// there.
     depth_locations: DepthLocations,
 }
 
@@ -156,20 +157,18 @@ impl DepthLocations {
     /// Off the standard location by more than this (pixels), a sample's depth is reported.
     const TOLERANCE: f64 = 1e-3;
 
-    /// Measures where `n` samples' depth is evaluated: a tiny sloped-plane render, the
-    /// conformance case `legacy.msaa_depth_locations`'s
-    /// ([`crate::conform::checks::measure_depth_locations`]). The standard locations
-    /// (`standardSampleLocations`) on a conformant device; where they differ, the measured ones
-    /// are used and the difference is the frame's warning (SwiftShader evaluates depth at the
-    /// standard locations mirrored in x: docs/conform/drivers-notes.md §1f).
-    fn measure(ctx: &Context, n: u32) -> Result<DepthLocations> {
-        let standard = crate::render::standard_sample_locations(n);
-        if n < 2 {
-            return Ok(DepthLocations::default());
-        }
-        let Some(at) = crate::conform::checks::measure_depth_locations(ctx, n)? else {
-            return Ok(DepthLocations { at: standard.to_vec(), defect: None });
-        };
+    /// The standard locations of `n` samples (`standardSampleLocations`), none for one sample:
+    /// a renderer's until [`Renderer::use_sample_depth_locations`] says otherwise.
+    fn standard(n: u32) -> DepthLocations {
+        let at = if n < 2 { Vec::new() } else { crate::render::standard_sample_locations(n).to_vec() };
+        DepthLocations { at, defect: None }
+    }
+
+    /// The locations `at` measured on `device`: where they differ from the standard ones, the
+    /// difference is the frame's warning (SwiftShader evaluates depth at the standard locations
+    /// mirrored in x: docs/conform/drivers-notes.md §1f).
+    fn measured(device: &str, at: &[(f64, f64)]) -> DepthLocations {
+        let standard = crate::render::standard_sample_locations(at.len() as u32);
         let off: Vec<String> = at
             .iter()
             .zip(standard)
@@ -179,13 +178,37 @@ impl DepthLocations {
             .collect();
         let defect = (!off.is_empty()).then(|| {
             format!(
-                "driver defect (docs/conform/drivers-notes.md §1f): {} evaluates multisampled depth away from the standard sample locations \
-                 ({}); a capture's positions are found at the measured locations",
-                ctx.info.name,
+                "driver defect (docs/conform/drivers-notes.md §1f): {device} evaluates multisampled depth away from the standard \
+                 sample locations ({}); a capture's positions are found at the measured locations",
                 off.join(", ")
             )
         });
-        Ok(DepthLocations { at, defect })
+        DepthLocations { at: at.to_vec(), defect }
+    }
+}
+
+impl Renderer {
+    /// Where this device evaluates a multisampled draw's depth, per sample (Vulkan's standard
+    /// order, pixels from the pixel's top-left corner), as measured by the caller (umbrage's
+    /// `conform::checks::calibrate_sample_locations` measures it with the conformance case
+    /// `legacy.msaa_depth_locations`): a multisampled capture's positions are then found there
+    /// instead of at the standard locations, and a frame whose locations are not the standard
+    /// ones carries a warning naming the defect.
+    ///
+    /// # Errors
+    /// [`Error::InvalidDesc`] when `at` does not hold one finite location in [0, 1)² per
+    /// sample of the frame.
+    pub fn use_sample_depth_locations(&mut self, at: &[(f64, f64)]) -> Result<()> {
+        let n = self.own.parts.config.samples as usize;
+        let inside = |v: f64| (0.0..1.0).contains(&v);
+        if n < 2 || at.len() != n || !at.iter().all(|&(x, y)| inside(x) && inside(y)) {
+            return Err(crate::Error::desc(
+                "Renderer::use_sample_depth_locations",
+                format!("{} locations for a frame of {n} samples (one per sample, each in [0, 1)^2)", at.len()),
+            ));
+        }
+        self.own.parts.depth_locations = DepthLocations::measured(&self.own.ctx.info.name, at);
+        Ok(())
     }
 }
 
@@ -513,7 +536,7 @@ impl Parts {
         }
         check_options(ctx, &config, &settings)?;
         memory::check_fits(ctx, &scene, &config)?;
-        let depth_locations = DepthLocations::measure(ctx, config.samples)?;
+        let depth_locations = DepthLocations::standard(config.samples);
         let transmit_format = opts.transmit.format();
         let f = &ctx.features;
         let accum_format = area::accum_format(&source_lights, f.rgba32f_blend);
