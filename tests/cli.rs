@@ -270,3 +270,47 @@ fn info_pipelines_creates_and_times_every_pipeline() {
     assert!(created >= 100, "only {created} pipelines traced");
     assert!(lines >= created, "{lines} timed lines for {created} creations");
 }
+
+/// `UMBRAGE_PIPELINE_CACHE=FILE`: the context's pipeline cache is saved there and loaded on the
+/// next run; a torn file, or another device's (its header names another
+/// `pipelineCacheUUID`), is ignored, never handed to the driver; `off` makes no cache.
+#[test]
+fn the_pipeline_cache_file_round_trips_and_ignores_foreign_data() {
+    let d = tmp("pipeline-cache");
+    let file = d.join("pipelines.bin");
+    let render = |cache: &str| {
+        Command::new(env!("CARGO_BIN_EXE_umbrage"))
+            .args(["render", "--size", "64x48", "--out"])
+            .arg(d.join("out.png"))
+            .env("UMBRAGE_VALIDATION", "1")
+            .env("UMBRAGE_PIPELINE_CACHE", cache)
+            .output()
+            .unwrap()
+    };
+    let first = render(file.to_str().unwrap());
+    let err = String::from_utf8_lossy(&first.stderr);
+    if err.contains("no Vulkan") && std::env::var_os("CI").is_none() {
+        eprintln!("SKIPPED (no Vulkan device, CI not set): {err}");
+        return;
+    }
+    assert!(first.status.success(), "{err}");
+    let saved = std::fs::read(&file).expect("the cache file is written");
+    assert!(saved.len() >= 32 && saved[..4] == 32u32.to_le_bytes() && saved[4..8] == 1u32.to_le_bytes(), "{} bytes", saved.len());
+    // Loaded again: the same picture.
+    let png = std::fs::read(d.join("out.png")).unwrap();
+    assert!(render(file.to_str().unwrap()).status.success());
+    assert_eq!(std::fs::read(d.join("out.png")).unwrap(), png);
+    // Another device's cache (its UUID changed) and a torn file: ignored, the same picture.
+    let mut foreign = saved.clone();
+    foreign[16] ^= 0xff;
+    for (what, bytes) in [("foreign", foreign), ("torn", saved[..20].to_vec()), ("garbage", vec![0xa5; 4096])] {
+        std::fs::write(&file, &bytes).unwrap();
+        let out = render(file.to_str().unwrap());
+        assert!(out.status.success(), "{what}: {}", String::from_utf8_lossy(&out.stderr));
+        assert_eq!(std::fs::read(d.join("out.png")).unwrap(), png, "{what}");
+        let rewritten = std::fs::read(&file).unwrap();
+        assert!(rewritten.len() >= 32 && rewritten[16..32] == saved[16..32], "{what}: this device's cache replaces it");
+    }
+    assert!(render("off").status.success());
+    let _ = std::fs::remove_dir_all(&d);
+}

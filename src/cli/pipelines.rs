@@ -89,6 +89,7 @@ fn pass_groups(ctx: &Context, out: &mut Vec<Group>) {
                         let dynamic = !render_pass_model;
                         let desc = ShadowPassDesc {
                             depth_stencil_format: ctx.depth_format,
+                            pipeline_cache: ctx.pipeline_cache,
                             samples,
                             depth_direction: direction,
                             depth_mode: mode,

@@ -58,6 +58,11 @@ pub struct Context {
     /// Command pool of [`Context::queue_family`], created with `RESET_COMMAND_BUFFER`. Like any
     /// Vulkan pool it is externally synchronised: use it from one thread at a time.
     pub pool: vk::CommandPool,
+    /// The pipeline cache of every pipeline umbrage makes on this context (its renderer's
+    /// `ShadowPass` included): pipelines made twice in one process (a renderer per scene, the
+    /// accuracy tables) are compiled once where the driver caches. Loaded from and saved to the
+    /// file `UMBRAGE_PIPELINE_CACHE` names, when set (`gpu::cache`).
+    pub pipeline_cache: vk::PipelineCache,
     /// The optional capabilities that were probed (and enabled where present).
     pub features: Features,
     /// Names and versions of the chosen device.
@@ -267,6 +272,9 @@ impl Context {
                     .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
                 // SAFETY: valid device and create info.
                 let pool = unsafe { device.create_command_pool(&pool_info, None) }.map_err(vkerr("vkCreateCommandPool"))?;
+                // SAFETY: a plain query on the physical device the device was made from.
+                let uuid = unsafe { instance.get_physical_device_properties(physical) }.pipeline_cache_uuid;
+                let pipeline_cache = super::cache::create(&device, &uuid);
                 let ctx = Context {
                     entry,
                     instance,
@@ -278,6 +286,7 @@ impl Context {
                     queue_family,
                     allocator: std::mem::ManuallyDrop::new(Arc::new(Mutex::new(allocator))),
                     pool,
+                    pipeline_cache,
                     features,
                     info,
                     depth_format,
@@ -397,6 +406,11 @@ pub trait GpuDevice {
     fn synchronization2(&self) -> bool {
         true
     }
+    /// The pipeline cache every pipeline made through this device goes through
+    /// (`VK_NULL_HANDLE`: none).
+    fn pipeline_cache(&self) -> vk::PipelineCache {
+        vk::PipelineCache::null()
+    }
 }
 
 impl GpuDevice for Context {
@@ -408,6 +422,9 @@ impl GpuDevice for Context {
     }
     fn synchronization2(&self) -> bool {
         self.features.synchronization2
+    }
+    fn pipeline_cache(&self) -> vk::PipelineCache {
+        self.pipeline_cache
     }
 }
 
@@ -422,6 +439,7 @@ impl Drop for Context {
                 let _ = self.device.device_wait_idle();
             }
             std::mem::ManuallyDrop::drop(&mut self.allocator);
+            super::cache::save_and_destroy(&self.device, self.pipeline_cache);
             self.device.destroy_command_pool(self.pool, None);
             self.device.destroy_device(None);
             if let Some((du, m)) = self.debug.take() {

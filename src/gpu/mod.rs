@@ -5,6 +5,7 @@
 //! `// SAFETY:` line and every `unsafe fn` a `# Safety` section (`Cargo.toml`'s `[lints]`).
 #![warn(missing_docs)]
 pub mod accel;
+pub mod cache;
 pub mod caps;
 pub mod context;
 pub mod creation;

@@ -273,7 +273,7 @@ pub fn create(ctx: &impl GpuDevice, d: &PipelineDesc) -> Result<vk::Pipeline> {
         || {
             // SAFETY: every pointer in `info` refers to locals alive for this call; the modules
             // are destroyed right after, which Vulkan allows once the pipeline exists.
-            unsafe { ctx.device().create_graphics_pipelines(vk::PipelineCache::null(), &[info], None) }
+            unsafe { ctx.device().create_graphics_pipelines(ctx.pipeline_cache(), &[info], None) }
                 .map_err(|(_, e)| Error::Vulkan { call: "vkCreateGraphicsPipelines", result: e })
         },
     );

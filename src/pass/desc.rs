@@ -390,6 +390,11 @@ pub struct ShadowPassDesc {
     /// Build the debug pipeline that draws the volumes translucent over a colour target of
     /// this format ([`Diagnostics::cmd_draw_volume_overlay`](super::diagnostics::Diagnostics::cmd_draw_volume_overlay)).
     pub debug_color_format: Option<vk::Format>,
+    /// The host's `VkPipelineCache`, which every pipeline the pass creates goes through
+    /// (`VK_NULL_HANDLE`, the default: none). It must outlive the pass; the pass never
+    /// destroys it. A driver whose compiler is slow (SwiftShader) then compiles each pipeline
+    /// once per cache, not once per pass.
+    pub pipeline_cache: vk::PipelineCache,
 }
 
 impl ShadowPassDesc {
@@ -446,6 +451,7 @@ impl Default for ShadowPassDesc {
             settings: PassSettings::default(),
             transmit_format: None,
             debug_color_format: None,
+            pipeline_cache: vk::PipelineCache::null(),
         }
     }
 }

@@ -14,6 +14,8 @@ use std::sync::{Arc, Mutex};
 pub(crate) struct PassDevice {
     pub device: ash::Device,
     pub allocator: Arc<Mutex<Allocator>>,
+    /// The host's pipeline cache ([`ShadowPassDesc::pipeline_cache`]), or null.
+    pub pipeline_cache: vk::PipelineCache,
 }
 
 impl GpuDevice for PassDevice {
@@ -26,6 +28,9 @@ impl GpuDevice for PassDevice {
     /// The pass asks for Vulkan 1.1 only: its barriers are Vulkan 1.0 `vkCmdPipelineBarrier`.
     fn synchronization2(&self) -> bool {
         false
+    }
+    fn pipeline_cache(&self) -> vk::PipelineCache {
+        self.pipeline_cache
     }
 }
 

@@ -229,7 +229,7 @@ impl ShadowPass {
             device_caps.query_format(instance, physical_device, f);
         }
         let caps = Self::capabilities_for(&device_caps, desc)?;
-        let dev = PassDevice { device: device.clone(), allocator };
+        let dev = PassDevice { device: device.clone(), allocator, pipeline_cache: desc.pipeline_cache };
         let pipes = Pipelines::new(&dev, desc, caps.depth_clamp, caps.depth_bounds, caps.r32f_blend)?;
         let id = NEXT_PASS_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let slots = (0..desc.frames_in_flight)

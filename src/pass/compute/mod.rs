@@ -206,6 +206,7 @@ impl ComputePipes {
         self.layout = pipeline_layout(dev, &[self.set_layout], SilhouettePush::SIZE, vk::ShaderStageFlags::COMPUTE)?;
         let module = pipeline::shader_module(dev, shaders::SILHOUETTE_WGSL)?;
         let d = dev.device();
+        let cache = dev.pipeline_cache();
         let make = |entry: &std::ffi::CStr| -> Result<vk::Pipeline> {
             let stage = vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::COMPUTE).module(module).name(entry);
             let info = [vk::ComputePipelineCreateInfo::default().stage(stage).layout(self.layout)];
@@ -213,7 +214,7 @@ impl ComputePipes {
                 || format!("silhouette.wgsl:{}", entry.to_string_lossy()),
                 || {
                     // SAFETY: valid device, module and layout; the create info points at locals.
-                    unsafe { d.create_compute_pipelines(vk::PipelineCache::null(), &info, None) }
+                    unsafe { d.create_compute_pipelines(cache, &info, None) }
                         .map(|p| p[0])
                         .map_err(|(_, e)| Error::vk("vkCreateComputePipelines")(e))
                 },
