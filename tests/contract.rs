@@ -98,63 +98,55 @@ fn light(kind: LightKind) -> Light {
     Light { kind, direction: Vec3::new(0.2, -1.0, 0.1), cone_deg: 60.0, ..Light::point(Vec3::new(1.0, 5.0, 2.0)) }
 }
 
-/// Probes of `prepare` with one light of `kind` changed by `f(value)`.
-fn light_probes<T: Copy + std::fmt::Debug + 'static>(kind: LightKind, values: &[T], f: fn(&mut Light, T)) -> Vec<(String, Probe)> {
+/// Probes that each take the input `base` makes, change it by `set(value)`, and hand it to the
+/// public call `call`.
+fn probes<I: 'static, T: Copy + std::fmt::Debug + 'static>(
+    values: &[T],
+    base: impl Fn(&Harness) -> I + Clone + 'static,
+    set: fn(&mut I, T),
+    call: fn(&mut Harness, I) -> umbrage::Result<()>,
+) -> Vec<(String, Probe)> {
     values
         .iter()
         .map(|&v| {
+            let base = base.clone();
             let probe: Probe = Box::new(move |h: &mut Harness| {
-                let mut l = light(kind);
-                f(&mut l, v);
-                h.pass.prepare(0, &view(), &[l]).map(drop)
+                let mut input = base(h);
+                set(&mut input, v);
+                call(h, input)
             });
             (format!("{v:?}"), probe)
         })
         .collect()
 }
 
-fn view_probes<T: Copy + std::fmt::Debug + 'static>(values: &[T], f: fn(&mut ShadowView, T)) -> Vec<(String, Probe)> {
-    values
-        .iter()
-        .map(|&v| {
-            let probe: Probe = Box::new(move |h: &mut Harness| {
-                let mut w = view();
-                f(&mut w, v);
-                h.pass.prepare(0, &w, &[light(LightKind::Point)]).map(drop)
-            });
-            (format!("{v:?}"), probe)
-        })
-        .collect()
+/// `prepare` with one light of `kind` changed by `set(value)`.
+fn light_probes<T: Copy + std::fmt::Debug + 'static>(kind: LightKind, values: &[T], set: fn(&mut Light, T)) -> Vec<(String, Probe)> {
+    probes(values, move |_| light(kind), set, |h, l| h.pass.prepare(0, &view(), &[l]).map(drop))
 }
 
-fn desc_probes<T: Copy + std::fmt::Debug + 'static>(values: &[T], f: fn(&mut ShadowPassDesc, T)) -> Vec<(String, Probe)> {
-    values
-        .iter()
-        .map(|&v| {
-            let probe: Probe = Box::new(move |h: &mut Harness| {
-                let mut d = h.desc();
-                f(&mut d, v);
-                h.new_pass(&d)
-            });
-            (format!("{v:?}"), probe)
-        })
-        .collect()
+/// `prepare` with the view changed by `set(value)`.
+fn view_probes<T: Copy + std::fmt::Debug + 'static>(values: &[T], set: fn(&mut ShadowView, T)) -> Vec<(String, Probe)> {
+    probes(values, |_| view(), set, |h, w| h.pass.prepare(0, &w, &[light(LightKind::Point)]).map(drop))
 }
 
-fn settings_probes<T: Copy + std::fmt::Debug + 'static>(values: &[T], f: fn(&mut PassSettings, T)) -> Vec<(String, Probe)> {
-    values
-        .iter()
-        .map(|&v| {
-            let probe: Probe = Box::new(move |h: &mut Harness| {
-                let mut s = PassSettings::default();
-                f(&mut s, v);
-                let r = h.pass.set_settings(s);
-                h.pass.set_settings(PassSettings::default()).unwrap();
-                r
-            });
-            (format!("{v:?}"), probe)
-        })
-        .collect()
+/// `ShadowPass::new` with the description changed by `set(value)`.
+fn desc_probes<T: Copy + std::fmt::Debug + 'static>(values: &[T], set: fn(&mut ShadowPassDesc, T)) -> Vec<(String, Probe)> {
+    probes(values, |h| h.desc(), set, |h, d| h.new_pass(&d))
+}
+
+/// `set_settings` with the settings changed by `set(value)` (the defaults restored after).
+fn settings_probes<T: Copy + std::fmt::Debug + 'static>(values: &[T], set: fn(&mut PassSettings, T)) -> Vec<(String, Probe)> {
+    probes(
+        values,
+        |_| PassSettings::default(),
+        set,
+        |h, s| {
+            let r = h.pass.set_settings(s);
+            h.pass.set_settings(PassSettings::default()).unwrap();
+            r
+        },
+    )
 }
 
 fn mesh_probes(values: Vec<(&'static str, Mesh)>) -> Vec<(String, Probe)> {
