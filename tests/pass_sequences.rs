@@ -29,7 +29,7 @@ use proptest::test_runner::Config;
 use proptest_state_machine::{ReferenceStateMachine, StateMachineTest};
 use std::cell::RefCell;
 use umbrage::geom::{Light, Mesh, Sphere};
-use umbrage::gpu::resources::transition;
+use umbrage::gpu::resources::{cleared_depth_stencil, transition};
 use umbrage::gpu::{Buffer, Context, Image};
 use umbrage::pass::{
     CasterId, DepthStencilTarget, PassSettings, PreparedFrame, ShadowPass, ShadowPassDesc, ShadowView, SphereId, Technique,
@@ -268,12 +268,7 @@ fn record(h: &Harness, pass: &ShadowPass, frame: &PreparedFrame, submit: bool) -
     let rec = |cb: vk::CommandBuffer| {
         let ds = vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
         transition(ctx, cb, &h.image, vk::ImageLayout::UNDEFINED, ds);
-        let att = vk::RenderingAttachmentInfo::default()
-            .image_view(h.image.view)
-            .image_layout(ds)
-            .load_op(vk::AttachmentLoadOp::CLEAR)
-            .store_op(vk::AttachmentStoreOp::STORE)
-            .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: RECEIVER_DEPTH, stencil: 0 } });
+        let att = cleared_depth_stencil(h.image.view, (RECEIVER_DEPTH, 0));
         let extent = vk::Extent2D { width: W, height: H };
         let info = vk::RenderingInfo::default().render_area(extent.into()).layer_count(1).depth_attachment(&att).stencil_attachment(&att);
         // SAFETY: `cb` is recording outside rendering; the image is in `ds`; the frame is live

@@ -5,7 +5,7 @@
 
 use crate::error::{Error, Result};
 use crate::gpu::pipeline::{self, PipelineDesc};
-use crate::gpu::resources::{aspect_copy, memory_barrier, transition};
+use crate::gpu::resources::{aspect_copy, cleared_depth_stencil, transfer_to_host_barrier, transition};
 use crate::gpu::{shaders, Buffer, Context, Image};
 use ash::vk;
 use glam::Mat4;
@@ -250,12 +250,7 @@ pub fn render(
         let (depth_buf, stencil_buf) = (buffers[0].raw, buffers[1].raw);
         ctx.one_shot(|cb| {
             transition(ctx, cb, img, vk::ImageLayout::UNDEFINED, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
-            let att = vk::RenderingAttachmentInfo::default()
-                .image_view(img.view)
-                .image_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
-                .load_op(vk::AttachmentLoadOp::CLEAR)
-                .store_op(vk::AttachmentStoreOp::STORE)
-                .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: clear_depth, stencil: clear_stencil } });
+            let att = cleared_depth_stencil(img.view, (clear_depth, clear_stencil));
             let area = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent };
             let info = vk::RenderingInfo::default().render_area(area).layer_count(1).depth_attachment(&att).stencil_attachment(&att);
             let viewport = vk::Viewport { x: 0.0, y: 0.0, width: width as f32, height: height as f32, min_depth: 0.0, max_depth: 1.0 };
@@ -273,12 +268,7 @@ pub fn render(
             // SAFETY: recording; the image is in TRANSFER_SRC_OPTIMAL and the buffers are large
             // enough for one aspect each (4 bytes per depth texel, 1 per stencil texel).
             unsafe { copy_aspects(ctx, cb, img, (depth_buf, stencil_buf)) };
-            memory_barrier(
-                ctx,
-                cb,
-                (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE),
-                (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
-            );
+            transfer_to_host_barrier(ctx, cb);
         })?;
         let depth_bytes = buffers[0].read()?;
         let depth = depth_bytes.chunks_exact(4).map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();

@@ -454,6 +454,29 @@ fn layout_scope(layout: vk::ImageLayout, src: bool) -> (vk::PipelineStageFlags2,
     }
 }
 
+/// The barrier that makes a command buffer's transfer writes (readback copies) visible to the
+/// host once its fence has signalled.
+pub fn transfer_to_host_barrier(ctx: &impl GpuDevice, cb: vk::CommandBuffer) {
+    memory_barrier(
+        ctx,
+        cb,
+        (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE),
+        (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
+    );
+}
+
+/// A depth-stencil attachment of `view` in `DEPTH_STENCIL_ATTACHMENT_OPTIMAL`, cleared to
+/// `(depth, stencil)` and stored: what a pass that draws into a fresh depth-stencil image
+/// begins its rendering with (use it as both the depth and the stencil attachment).
+pub fn cleared_depth_stencil(view: vk::ImageView, (depth, stencil): (f32, u32)) -> vk::RenderingAttachmentInfo<'static> {
+    vk::RenderingAttachmentInfo::default()
+        .image_view(view)
+        .image_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
+        .load_op(vk::AttachmentLoadOp::CLEAR)
+        .store_op(vk::AttachmentStoreOp::STORE)
+        .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth, stencil } })
+}
+
 /// Records a global memory barrier into `cb` (which must be recording): `src` and `dst` are
 /// `(stages, accesses)` before and after the barrier.
 pub fn memory_barrier(

@@ -3,6 +3,7 @@
 
 use super::swapchain::{color_range, Swapchain};
 use crate::error::{Error, Result};
+use crate::gpu::resources::transfer_to_host_barrier;
 use crate::gpu::{Buffer, Context, Image};
 use ash::vk;
 
@@ -160,12 +161,7 @@ pub fn present(
                 depth: 1,
             });
             d.cmd_copy_image_to_buffer(cb, image, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, buf.raw, &[region]);
-            crate::gpu::resources::memory_barrier(
-                ctx,
-                cb,
-                (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE),
-                (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
-            );
+            transfer_to_host_barrier(ctx, cb);
             last = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
         }
         transition(ctx, cb, image, last, vk::ImageLayout::PRESENT_SRC_KHR);

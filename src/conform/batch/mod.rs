@@ -12,7 +12,7 @@ mod pipe;
 use super::cases::{Case, Config, DepthKind, RenderModel, StateModel};
 use super::model::to_raw;
 use crate::error::{Error, Result};
-use crate::gpu::resources::{aspect_copy, memory_barrier, transition};
+use crate::gpu::resources::{aspect_copy, transfer_to_host_barrier, transition};
 use crate::gpu::{Buffer, Context, Image};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -260,12 +260,7 @@ fn run_inner(ctx: &Context, cfg: Config, cases: &[&Case], origins: &[(u32, u32)]
             }
             transition(ctx, cb, img, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL, vk::ImageLayout::TRANSFER_SRC_OPTIMAL);
             d.cmd_copy_image_to_buffer(cb, img.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, read_buf, &regions);
-            memory_barrier(
-                ctx,
-                cb,
-                (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE),
-                (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
-            );
+            transfer_to_host_barrier(ctx, cb);
         }
     })?;
     let mut counts = vec![0u64; queries as usize];

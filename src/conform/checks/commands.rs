@@ -28,7 +28,7 @@ use super::rect;
 use crate::conform::harness::{self, DrawCall, Draws, Indices, PipeSpec};
 use crate::conform::CheckResult;
 use crate::error::{Error, Result};
-use crate::gpu::resources::{aspect_copy, memory_barrier, transition};
+use crate::gpu::resources::{aspect_copy, cleared_depth_stencil, memory_barrier, transfer_to_host_barrier, transition};
 use crate::gpu::{Buffer, Context, Image};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -395,12 +395,7 @@ fn read_aspects(s: &mut Scratch<'_>, i: usize, format: vk::Format, layout: vk::I
         // buffer holds both aspects at these offsets (a multiple of 4: n is).
         unsafe { ctx.device.cmd_copy_image_to_buffer(cb, img.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, buf, &regions) };
         transition(ctx, cb, img, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, layout);
-        memory_barrier(
-            ctx,
-            cb,
-            (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE),
-            (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
-        );
+        transfer_to_host_barrier(ctx, cb);
     })?;
     let bytes = s.buffers[b].read()?;
     let split = (n * db) as usize;
@@ -485,12 +480,7 @@ pub fn copy_aspects(ctx: &Context) -> Result<CheckResult> {
             // SAFETY: recording outside rendering; the image is in TRANSFER_SRC_OPTIMAL; the
             // buffer holds both regions (offsets multiples of 4, as depth-stencil copies need).
             unsafe { ctx.device.cmd_copy_image_to_buffer(cb, img.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, buf, &regions) };
-            memory_barrier(
-                ctx,
-                cb,
-                (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE),
-                (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
-            );
+            transfer_to_host_barrier(ctx, cb);
         })?;
         let got = s.buffers[b].read()?;
         // Every byte: a region texel where the spec puts it, untouched everywhere else (but
@@ -666,12 +656,7 @@ pub fn blit_copy_color(ctx: &Context) -> Result<CheckResult> {
                 d.cmd_copy_image_to_buffer(cb, img.raw, L::TRANSFER_SRC_OPTIMAL, down, &[whole(dw, dh, offset)]);
             }
         }
-        memory_barrier(
-            ctx,
-            cb,
-            (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE),
-            (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
-        );
+        transfer_to_host_barrier(ctx, cb);
     })?;
     let got = s.buffers[out].read()?;
     let mut numbers = serde_json::Map::new();
@@ -729,12 +714,7 @@ pub fn buffers(ctx: &Context) -> Result<CheckResult> {
             .collect();
         // SAFETY: as above; the regions do not overlap each other or their sources.
         unsafe { ctx.device.cmd_copy_buffer(cb, buf, buf, &copies) };
-        memory_barrier(
-            ctx,
-            cb,
-            (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE),
-            (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
-        );
+        transfer_to_host_barrier(ctx, cb);
     })?;
     let mut want = vec![UNTOUCHED; size];
     want[at..at + data.len()].copy_from_slice(&data);
@@ -818,12 +798,7 @@ pub fn queries(ctx: &Context) -> Result<CheckResult> {
                 }
             }
             transition(ctx, cb, img, vk::ImageLayout::UNDEFINED, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
-            let att = vk::RenderingAttachmentInfo::default()
-                .image_view(img.view)
-                .image_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
-                .load_op(vk::AttachmentLoadOp::CLEAR)
-                .store_op(vk::AttachmentStoreOp::STORE)
-                .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } });
+            let att = cleared_depth_stencil(img.view, (1.0, 0));
             let info = vk::RenderingInfo::default().render_area(area).layer_count(1).depth_attachment(&att).stencil_attachment(&att);
             let viewport = vk::Viewport { x: 0.0, y: 0.0, width: W as f32, height: H as f32, min_depth: 0.0, max_depth: 1.0 };
             // SAFETY: as above.

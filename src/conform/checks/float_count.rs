@@ -10,7 +10,7 @@
 
 use crate::conform::CheckResult;
 use crate::error::{Error, Result};
-use crate::gpu::resources::{aspect_copy, memory_barrier};
+use crate::gpu::resources::{aspect_copy, transfer_to_host_barrier};
 use crate::gpu::{pipeline, shaders, Buffer, Context, Image};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
@@ -277,12 +277,7 @@ fn render(ctx: &Context, o: &mut Objects, vertices: &[[f32; 4]]) -> Result<Count
                 &[region(vk::ImageAspectFlags::STENCIL)],
             );
         }
-        memory_barrier(
-            ctx,
-            cb,
-            (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE),
-            (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
-        );
+        transfer_to_host_barrier(ctx, cb);
     })?;
     let float = o.buffers[1].read()?.chunks_exact(4).map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]])).collect();
     let stencil = o.buffers[2].read()?.to_vec();

@@ -20,7 +20,7 @@ use crate::conform::CheckResult;
 use crate::error::{Error, Result};
 use crate::gpu::descriptors::{pipeline_layout, Binding, DescriptorSet};
 use crate::gpu::pipeline::{self, PipelineDesc};
-use crate::gpu::resources::{aspect_copy, memory_barrier, transition};
+use crate::gpu::resources::{aspect_copy, cleared_depth_stencil, transfer_to_host_barrier, transition};
 use crate::gpu::{shaders, Buffer, Context, Image};
 use crate::render::standard_sample_locations;
 use ash::vk;
@@ -163,12 +163,7 @@ fn render_inner(ctx: &Context, n: u32, draws: &Draws, o: &mut Objects) -> Result
     ctx.one_shot(|cb| {
         let d = &ctx.device;
         transition(ctx, cb, ds, vk::ImageLayout::UNDEFINED, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
-        let att = vk::RenderingAttachmentInfo::default()
-            .image_view(ds.view)
-            .image_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
-            .load_op(vk::AttachmentLoadOp::CLEAR)
-            .store_op(vk::AttachmentStoreOp::STORE)
-            .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } });
+        let att = cleared_depth_stencil(ds.view, (1.0, 0));
         let info = vk::RenderingInfo::default().render_area(area).layer_count(1).depth_attachment(&att).stencil_attachment(&att);
         // SAFETY: `cb` is recording (one_shot); every handle was created on this device above
         // and outlives the submission, which one_shot waits for.
@@ -205,12 +200,7 @@ fn render_inner(ctx: &Context, n: u32, draws: &Draws, o: &mut Objects) -> Result
             unsafe { d.cmd_copy_image_to_buffer(cb, out.raw, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, buffer, &[region]) };
             transition(ctx, cb, out, vk::ImageLayout::TRANSFER_SRC_OPTIMAL, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
         }
-        memory_barrier(
-            ctx,
-            cb,
-            (vk::PipelineStageFlags2::ALL_TRANSFER, vk::AccessFlags2::TRANSFER_WRITE),
-            (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
-        );
+        transfer_to_host_barrier(ctx, cb);
     })?;
     let texels: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(o.buffers[0].read()?);
     Ok(texels.chunks_exact((SIZE * SIZE) as usize).map(|s| s.iter().map(|t| t[0]).collect()).collect())

@@ -28,7 +28,7 @@
 use crate::error::{Error, Result};
 use crate::gpu::descriptors::{pipeline_layout, Binding, DescriptorSet};
 use crate::gpu::pipeline::{self, Blend, PipelineDesc};
-use crate::gpu::resources::{memory_barrier, transition};
+use crate::gpu::resources::{cleared_depth_stencil, memory_barrier, transition};
 use crate::gpu::{shaders, Buffer, Context, Image};
 use crate::render::targets::{Targets, COUNT_FORMAT};
 use crate::render::{CubeFaces, Pcf};
@@ -340,12 +340,7 @@ impl ShadowMapper {
         unsafe { ctx.device.cmd_update_buffer(cb, self.faces.raw, 0, bytemuck::cast_slice(&rows)) };
         memory_barrier(ctx, cb, transfer_write, shader_read);
         transition(ctx, cb, &self.atlas, vk::ImageLayout::UNDEFINED, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
-        let map_att = vk::RenderingAttachmentInfo::default()
-            .image_view(self.atlas.view)
-            .image_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
-            .load_op(vk::AttachmentLoadOp::CLEAR)
-            .store_op(vk::AttachmentStoreOp::STORE)
-            .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } });
+        let map_att = cleared_depth_stencil(self.atlas.view, (1.0, 0));
         let one = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: vk::Extent2D { width: self.size, height: self.size } };
         let info = vk::RenderingInfo::default().layer_count(1).depth_attachment(&map_att);
         match (&self.views, faces.len()) {
