@@ -3,10 +3,82 @@
 //! `umbrage bench` runs it once per frame and light; `streaming_sum` beside them reads the
 //! bytes the planner must at least touch (every caster's positions and triangles) as a plain
 //! streaming sum, so its time can be held against memory speed in the same run.
+//!
+//! `plan/buildings` (only when `target/assets/buildings.obj` is there: `scripts/fetch-assets.sh`)
+//! plans the OpenFOAM city block (400k triangles, 26 parts) for its two lights, as the file
+//! orders its triangles and shuffled, each as loaded (`Caster::new`: the silhouette structures
+//! in the load-time spatial order) and scanning in the mesh's own triangle order (no reordering).
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::hint::black_box;
+use umbrage::geom::silhouette::{EdgeScan, FacePlanes};
+use umbrage::geom::Mesh;
 use umbrage::shadow::{plan_light, Caster, Method, PlanInput};
+#[path = "../src/geom/testmesh.rs"]
+#[allow(dead_code)]
+mod testmesh;
+
+/// `caster` with its silhouette structures in the mesh's own triangle order (no reordering).
+fn in_caller_order(caster: &Caster) -> Caster {
+    let mut c = caster.clone();
+    c.planes = FacePlanes::new(c.mesh());
+    for p in &mut c.parts {
+        p.scan = EdgeScan::new(p.scan.edges().to_vec());
+    }
+    c
+}
+
+/// The OpenFOAM city block, z-up, rotated y-up, with a street light among the buildings and a
+/// directional light (as tests/parts.rs renders it).
+const CITY: &str = r#"
+[camera]
+eye = [120.0, 260.0, 60.0]
+target = [120.0, 0.0, -90.0]
+[[light]]
+kind = "point"
+position = [120.0, 12.0, -95.0]
+[[light]]
+kind = "directional"
+direction = [-0.3, -1.0, -0.45]
+[[mesh]]
+name = "city"
+obj = "OBJ"
+rotate_deg = [-90.0, 0.0, 0.0]
+"#;
+
+fn buildings(c: &mut Criterion) {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/target/assets/buildings.obj");
+    if !std::path::Path::new(path).is_file() {
+        eprintln!("NOTE: {path} missing (scripts/fetch-assets.sh): plan/buildings not measured");
+        return;
+    }
+    let scene = umbrage::scene::load_str(&CITY.replace("OBJ", path), "buildings", std::path::Path::new(".")).expect("city loads");
+    let city = &scene.meshes[0];
+    let loaded = city.caster().expect("city caster");
+    let shuffled = Caster::new("city", &testmesh::shuffled(&city.mesh), city.transform).expect("shuffled city caster");
+    let (w, h) = (640u32, 480u32);
+    let cam = &scene.camera;
+    let vp = cam.proj_infinite(w as f32 / h as f32) * cam.view();
+    let mut g = c.benchmark_group("plan/buildings");
+    g.throughput(Throughput::Elements(loaded.triangle_count as u64));
+    g.sample_size(20);
+    let variants = [
+        ("file_order/reordered", loaded.clone()),
+        ("file_order/caller_order", in_caller_order(&loaded)),
+        ("shuffled/reordered", shuffled.clone()),
+        ("shuffled/caller_order", in_caller_order(&shuffled)),
+    ];
+    for (li, light) in scene.lights.iter().enumerate() {
+        let input = PlanInput { camera: cam, width: w, height: h, view_proj: vp, light, method: Method::McGuire };
+        for (name, caster) in &variants {
+            let casters = std::slice::from_ref(caster);
+            g.bench_function(format!("{name}/light{li}-{:?}", light.kind).to_lowercase(), |b| {
+                b.iter(|| black_box(plan_light(black_box(&input), casters).casters.len()))
+            });
+        }
+    }
+    g.finish();
+}
 
 fn bench(c: &mut Criterion) {
     let scene = umbrage::scene::load("bench/vertex").expect("bench/vertex loads");
@@ -37,5 +109,5 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench);
+criterion_group!(benches, bench, buildings);
 criterion_main!(benches);

@@ -1,22 +1,34 @@
 //! Possible-silhouette extraction (facing bits + edge scan) on UV spheres of 10k, 100k and
-//! 1M triangles, as the planner does it per light: triangle planes precomputed once
-//! (`FacePlanes::new`, outside the timed loops), facing as one f32 dot product per triangle
-//! with packed bits and the exact fallback near the planes (threads from
+//! 1M triangles, as the planner does it per light, on the structures a caster built by
+//! `Caster::new` holds: triangle planes and edge scan precomputed once at load, in the caster's
+//! scan order (each part's triangles spatially sorted by meshoptimizer; outside the timed
+//! loops), facing as one f32 dot product per triangle with packed bits, whole 64-triangle
+//! blocks decided at once and the exact fallback near the planes (threads from
 //! `PLANES_PARALLEL_THRESHOLD` triangles), then the edge scan on the packed bits.
-//! `edge_scan_serial` is `EdgeScan`'s scan (distance classes a facing word at a time, the
-//! other edges by lookups), `edge_scan` the per-edge scan of the full edge records.
-//! `streaming_sum` is a plain streaming read of the same bytes the new path reads (the four
-//! plane arrays and `EdgeScan::bytes`), in the same run, so the throughput of the
-//! other functions (the group's throughput is those bytes) can be compared to memory speed.
-//! `facing+silhouette_shuffled` is the same work on the same sphere with its triangles in
-//! random order: no distance classes and no decidable blocks, the worst case (compare its time:
-//! it reads more bytes than the group's throughput counts).
+//!
+//! * `facing+silhouette`: the sphere in its generator's (row) order, loaded as a caster;
+//! * `facing+silhouette_shuffled`: the same sphere with its triangles in a fixed pseudo-random
+//!   order, loaded as a caster (the load-time reordering makes it the ordered one's equal);
+//! * `facing+silhouette_caller_order` and `facing+silhouette_shuffled_caller_order`: the same
+//!   two meshes scanned in their own triangle order (no reordering: the shuffled one is the
+//!   worst case, with no decidable blocks and no skippable word pairs);
+//! * `facing_serial`, `edge_scan_serial`: the two halves of `facing+silhouette`;
+//!   `edge_scan` the per-edge scan of the full edge records;
+//! * `streaming_sum`: a plain streaming read of the bytes `facing+silhouette` may read (the
+//!   four plane arrays and `EdgeScan::bytes`), in the same run, so the throughput of the other
+//!   functions (the group's throughput is those bytes) can be compared to memory speed.
+//!
+//! The `load/1M` group times `Caster::new` on the 1M sphere, ordered and shuffled, and the
+//! reordering alone (`TriangleOrder::spatial`).
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use glam::Mat4;
 use glam::Vec4;
 use std::hint::black_box;
 use umbrage::geom::silhouette::{possible_silhouette_packed_into, EdgeScan, FacePlanes, SilhouetteEdge};
 use umbrage::geom::topology::Topology;
+use umbrage::geom::TriangleOrder;
+use umbrage::shadow::Caster;
 #[path = "../src/geom/testmesh.rs"]
 #[allow(dead_code)]
 mod testmesh;
@@ -53,12 +65,13 @@ fn bench(c: &mut Criterion) {
     let light = Vec4::new(3.0, 2.0, 1.0, 1.0);
     let threads = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
     for (name, slices, stacks) in [("10k", 100u32, 51u32), ("100k", 317, 159), ("1M", 1000, 501)] {
-        let topo = Topology::build(&uv_sphere(1.0, slices, stacks));
-        assert!(topo.is_closed_manifold());
-        let planes = FacePlanes::new(&topo.mesh);
-        let scan = EdgeScan::new(topo.manifold_edges.clone());
+        let sphere = uv_sphere(1.0, slices, stacks);
+        let caster = Caster::new("sphere", &sphere, Mat4::IDENTITY).expect("sphere caster");
+        assert!(caster.is_manifold() && caster.parts.len() == 1);
+        let (planes, scan) = (&caster.planes, &caster.parts[0].scan);
+        let mesh = caster.mesh();
         // as many 8-byte records as the scan reads (class masks and residual pairs)
-        let pairs: Vec<[u32; 2]> = (0..scan.bytes() / 8).map(|i| [i as u32 ^ 1, i as u32 ^ 3]).collect();
+        let pairs: Vec<[u32; 2]> = (0..scan.bytes().div_ceil(8)).map(|i| [i as u32 ^ 1, i as u32 ^ 3]).collect();
         let words = planes.bytes() / 16;
         let plain = PlainArrays {
             a: (0..words).map(|i| i as f32).collect(),
@@ -66,39 +79,52 @@ fn bench(c: &mut Criterion) {
             c: (0..words).map(|i| (i * 7) as f32).collect(),
             d: (0..words).map(|i| (i * 11) as f32).collect(),
         };
-        let bytes = bytes_of(&planes, &scan);
+        let bytes = bytes_of(planes, scan);
         let mut g = c.benchmark_group(format!("silhouette/{name}"));
         g.throughput(Throughput::Bytes(bytes));
         if slices >= 1000 {
             g.sample_size(10);
         }
-        let tris = topo.mesh.triangles.len();
+        let tris = mesh.triangles.len();
         let mut bits: Vec<u64> = Vec::new();
         let mut sil: Vec<SilhouetteEdge> = Vec::new();
         g.bench_function(BenchmarkId::new("streaming_sum", tris), |b| {
             b.iter(|| black_box(streaming_sum(black_box(&plain), black_box(&pairs))))
         });
-        g.bench_function(BenchmarkId::new("facing+silhouette", tris), |b| {
-            b.iter(|| {
-                planes.facing_packed_auto(&topo.mesh, black_box(light), false, &mut bits);
-                sil.clear();
-                scan.scan_into(&bits, &mut sil);
-                black_box(sil.len())
-            })
-        });
+        let mut facing_silhouette = |g: &mut criterion::BenchmarkGroup<_>, id: &str, planes: &FacePlanes, scan: &EdgeScan, mesh: &Mesh| {
+            g.bench_function(BenchmarkId::new(id, tris), |b| {
+                b.iter(|| {
+                    planes.facing_packed_auto(mesh, black_box(light), false, &mut bits);
+                    sil.clear();
+                    scan.scan_into(&bits, &mut sil);
+                    black_box(sil.len())
+                })
+            });
+        };
+        facing_silhouette(&mut g, "facing+silhouette", planes, scan, mesh);
+        // the same sphere, triangles shuffled, loaded as a caster (reordered at load)
+        let shuffled_mesh = shuffled(&sphere);
+        let sc = Caster::new("shuffled", &shuffled_mesh, Mat4::IDENTITY).expect("shuffled caster");
+        facing_silhouette(&mut g, "facing+silhouette_shuffled", &sc.planes, &sc.parts[0].scan, sc.mesh());
+        // both meshes in their own triangle order (no reordering)
+        for (id, m) in [("facing+silhouette_caller_order", mesh), ("facing+silhouette_shuffled_caller_order", sc.mesh())] {
+            let topo = Topology::build(m);
+            let (p, s) = (FacePlanes::new(&topo.mesh), EdgeScan::new(topo.manifold_edges.clone()));
+            facing_silhouette(&mut g, id, &p, &s, &topo.mesh);
+        }
         g.bench_function(BenchmarkId::new("facing_serial", tris), |b| {
             b.iter(|| {
-                planes.facing_packed(&topo.mesh, black_box(light), false, &mut bits);
+                planes.facing_packed(mesh, black_box(light), false, &mut bits);
                 black_box(bits.len())
             })
         });
         g.bench_function(BenchmarkId::new("facing", tris), |b| {
             b.iter(|| {
-                planes.facing_packed_threads(&topo.mesh, black_box(light), false, threads, &mut bits);
+                planes.facing_packed_threads(mesh, black_box(light), false, threads, &mut bits);
                 black_box(bits.len())
             })
         });
-        planes.facing_packed(&topo.mesh, light, false, &mut bits);
+        planes.facing_packed(mesh, light, false, &mut bits);
         g.bench_function(BenchmarkId::new("edge_scan_serial", tris), |b| {
             b.iter(|| {
                 sil.clear();
@@ -106,26 +132,29 @@ fn bench(c: &mut Criterion) {
                 black_box(sil.len())
             })
         });
+        let mut own = Vec::new();
+        FacePlanes::new(mesh).facing_packed(mesh, light, false, &mut own);
         g.bench_function(BenchmarkId::new("edge_scan", tris), |b| {
             b.iter(|| {
                 sil.clear();
-                possible_silhouette_packed_into(&topo.manifold_edges, black_box(&bits), &mut sil);
-                black_box(sil.len())
-            })
-        });
-        // The worst case for the edge scan's distance classes and the facing's block bounds:
-        // the same sphere with its triangles in a fixed pseudo-random order.
-        let shuffled = Topology::build(&shuffled(&uv_sphere(1.0, slices, stacks)));
-        let (splanes, sscan) = (FacePlanes::new(&shuffled.mesh), EdgeScan::new(shuffled.manifold_edges.clone()));
-        g.bench_function(BenchmarkId::new("facing+silhouette_shuffled", tris), |b| {
-            b.iter(|| {
-                splanes.facing_packed_auto(&shuffled.mesh, black_box(light), false, &mut bits);
-                sil.clear();
-                sscan.scan_into(&bits, &mut sil);
+                possible_silhouette_packed_into(&caster.topology.manifold_edges, black_box(&own), &mut sil);
                 black_box(sil.len())
             })
         });
         g.finish();
+        if slices >= 1000 {
+            let mut g = c.benchmark_group(format!("load/{name}"));
+            g.sample_size(10);
+            g.bench_function("caster_new", |b| {
+                b.iter(|| black_box(Caster::new("sphere", black_box(&sphere), Mat4::IDENTITY).unwrap().triangle_count))
+            });
+            g.bench_function("caster_new_shuffled", |b| {
+                b.iter(|| black_box(Caster::new("shuffled", black_box(&shuffled_mesh), Mat4::IDENTITY).unwrap().triangle_count))
+            });
+            let all: Vec<u32> = (0..tris as u32).collect();
+            g.bench_function("triangle_order_spatial", |b| b.iter(|| black_box(TriangleOrder::spatial(black_box(mesh), &[&all]).len())));
+            g.finish();
+        }
     }
 }
 

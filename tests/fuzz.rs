@@ -17,7 +17,6 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Once;
 use std::time::Instant;
-use umbrage::geom::silhouette::packed_bit;
 use umbrage::geom::topology::{Topology, Weld};
 use umbrage::geom::{Camera, Light, LightKind, Mesh};
 use umbrage::scene::{obj::load_obj_str, shapes};
@@ -1107,7 +1106,7 @@ fn check_plan(casters: &[Caster], plans: &[CasterPlan], directional: bool) {
                 for &e in &part.edges {
                     let edge = &topo.edges[e as usize];
                     let mult: i32 =
-                        topo.edge_uses(e as usize).iter().map(|u| if u.forward == packed_bit(&bits, u.tri) { 1 } else { -1 }).sum();
+                        topo.edge_uses(e as usize).iter().map(|u| if u.forward == caster.planes.bit(&bits, u.tri) { 1 } else { -1 }).sum();
                     if mult != 0 {
                         nonzero += 1;
                         mmax = mmax.max(mult.unsigned_abs());

@@ -1,17 +1,32 @@
 //! The per-light edge scan ([`EdgeScan`]): the possible silhouette from packed facing bits,
-//! a whole facing word (64 triangles) at a time wherever the mesh's triangle order allows.
+//! a whole facing word (64 triangles) at a time wherever the triangle order allows.
 //!
-//! A possible-silhouette edge is a manifold edge whose two triangles `lo < hi` have different
-//! facing bits. Meshes are rarely in random triangle order: strips, grids and fans put most
-//! edges between triangles a few fixed distances apart (all but a UV sphere's seam and pole
-//! edges have `hi - lo = 1`, inside a row, or `2 slices + 1`, across rows). For every such distance
-//! `δ` that covers enough edges, the scan keeps one mask bit per triangle `lo` with an edge to
-//! `lo + δ`; the silhouette bits of 64 such edges are then `(F[w] ^ (F >> δ)[w]) & mask[w]`:
-//! a handful of word operations, with no per-edge table lookup at all. The edges no class
-//! covers (seams, poles, irregular meshes: in the worst case all of them) take the per-edge
-//! path, two byte lookups an edge. Both paths test exactly the same two bits of every edge,
-//! so the result is the plain scan's, edge for edge.
+//! A possible-silhouette edge is a manifold edge whose two triangles have different facing
+//! bits. The scan works on the triangles' slots in a [`TriangleOrder`] (the order of the
+//! [`FacePlanes`](super::planes::FacePlanes) bits; casters use a spatial one): with `lo < hi`
+//! the two slots of an edge,
+//!
+//! * **distance classes**: strips, grids and fans put many edges between slots a few fixed
+//!   distances apart (all but a UV sphere's seam and pole edges have `hi - lo = 1`, inside a
+//!   row, or `2 slices + 1`, across rows). For every distance `δ` that covers enough edges, the
+//!   scan keeps one mask bit per slot `lo` with an edge to `lo + δ`; the silhouette bits of 64
+//!   such edges are then `(F[w] ^ (F >> δ)[w]) & mask[w]`: a handful of word operations.
+//! * **word pairs**: every other edge is filed under the pair of facing words its two slots
+//!   lie in, with its two bit positions (two bytes an edge). A pair whose two words are both
+//!   all ones or both all zeros (a light far from a compact patch: most pairs, in a spatial
+//!   order) holds no silhouette edge and is skipped whole; the others test each edge's two
+//!   bits in the two words already loaded, with no further memory access.
+//!
+//! Per light, the scan first finds the **runs** of equal uniform words (all ones or all zeros)
+//! over the words it touches: a class skips every word whose reach (the word and the words `δ`
+//! slots on) lies in one run, a run at a time, and a facing word whose word pairs all end
+//! inside its run skips them all at once. In a spatial order the work is then about the words
+//! the light's terminator crosses, not the mesh's size.
+//!
+//! Both paths test exactly the same two bits of every edge, so the result is the plain scan's,
+//! edge for edge, and its edges keep the caller's triangle ids.
 
+use super::order::TriangleOrder;
 use super::silhouette::SilhouetteEdge;
 use super::topology::ManifoldEdge;
 
@@ -20,29 +35,52 @@ const MAX_CLASSES: usize = 8;
 /// A class must hold at least this many edges per facing word it spans on average: below it,
 /// its word pass costs more than the per-edge lookups it saves.
 const MIN_EDGES_PER_WORD: usize = 2;
-/// Residual edges needing the byte-a-triangle table: fewer take two direct bit lookups each
-/// (building the table costs about one byte store per triangle).
-const TABLE_MIN_EDGES: usize = 4096;
 
 /// Manifold edges prepared for the per-light scan ([`EdgeScan::scan_into`]): distance classes
-/// scanned a facing word at a time, and the residual edges' triangle pairs packed 8 bytes an
-/// edge. Built once per caster part; the scan reads only these, and the full edge records of
-/// the few edges on the possible silhouette.
+/// scanned a facing word at a time, and the other edges filed by the pair of facing words
+/// they join, two bytes an edge. Built once per caster part; the scan reads only these, and the
+/// full edge records of the few edges on the possible silhouette.
 #[derive(Clone, Debug, Default)]
 pub struct EdgeScan {
     /// Scan order: each class's edges by increasing `lo`, class after class, then the residual
-    /// edges in their given order.
+    /// edges by word pair.
     edges: Vec<ManifoldEdge>,
     classes: Vec<DeltaClass>,
     /// `edges[rest..]` are the residual edges.
     rest: usize,
-    /// Their triangle pairs `(t0, t1)`.
-    pairs: Vec<[u32; 2]>,
-    /// Largest triangle id of any residual edge.
-    max_tri: u32,
+    /// The facing words with residual edges at their `lo` slot, increasing.
+    lo_words: Vec<LoWord>,
+    /// The residual edges' word pairs, by increasing `(lo word, hi word)`.
+    pairs: Vec<WordPair>,
+    /// Per residual edge: the bit of its `lo` slot in the pair's `lo` word, plus 128 when
+    /// that slot is `t0`'s; the bit of its `hi` slot in the `hi` word.
+    offsets: Vec<[u8; 2]>,
+    /// The facing words the scan reads: `words.0 .. words.1`.
+    words: (usize, usize),
 }
 
-/// The edges between triangles `lo` and `lo + delta`.
+/// The word pairs `pairs[start .. end]` (`start` the previous `LoWord`'s `end`) have their
+/// `lo` slots in facing word `w`, and their `hi` words at most `max_hi`; those before
+/// `far` have their `hi` word less than 64 words on, bit `hi - w` of `near`.
+#[derive(Clone, Copy, Debug, Default)]
+struct LoWord {
+    w: u32,
+    max_hi: u32,
+    end: u32,
+    far: u32,
+    near: u64,
+}
+
+/// The residual edges with their `lo` slot in the facing word of their [`LoWord`] and their
+/// `hi` slot in word `hi`: `edges[rest + start .. rest + end]`, `start` the previous pair's
+/// `end`.
+#[derive(Clone, Copy, Debug, Default)]
+struct WordPair {
+    hi: u32,
+    end: u32,
+}
+
+/// The edges between slots `lo` and `lo + delta`.
 #[derive(Clone, Debug, Default)]
 struct DeltaClass {
     delta: u32,
@@ -50,14 +88,12 @@ struct DeltaClass {
     first_word: usize,
     /// Bit `k` of `masks[i]`: an edge with `lo = 64 (first_word + i) + k`.
     masks: Vec<u64>,
+    /// Bit `k` of `lo_t0[i]`: that edge's `lo` slot is its `t0`'s.
+    lo_t0: Vec<u64>,
     /// Edges of the class in the words before word `i` (the rank of a mask bit's edge).
     ranks: Vec<u32>,
     /// The class's edges start at `edges[first]`.
     first: usize,
-}
-
-fn lo_hi(e: &ManifoldEdge) -> (u32, u32) {
-    (e.t0.min(e.t1), e.t0.max(e.t1))
 }
 
 #[inline]
@@ -69,14 +105,8 @@ fn oriented(e: &ManifoldEdge, t0_lit: bool) -> SilhouetteEdge {
     }
 }
 
-/// The facing bit of triangle `t` (false past the end of the bits).
-#[inline]
-fn bit(bits: &[u64], t: u32) -> bool {
-    bits.get(t as usize / 64).is_some_and(|w| (w >> (t % 64)) & 1 != 0)
-}
-
 /// Word `i` of the facing bits shifted down by `delta` bits: bit `k` is the facing of
-/// triangle `64 i + k + delta` (0 past the end).
+/// slot `64 i + k + delta` (0 past the end).
 #[inline]
 fn shifted(bits: &[u64], i: usize, delta: u32) -> u64 {
     let word = |j: usize| bits.get(j).copied().unwrap_or(0);
@@ -88,16 +118,18 @@ fn shifted(bits: &[u64], i: usize, delta: u32) -> u64 {
     }
 }
 
+/// An edge with its slots: `(lo, hi, lo is t0's slot)`.
+type Slotted = (ManifoldEdge, u32, u32, bool);
+
+fn slotted(e: ManifoldEdge, order: &TriangleOrder) -> Slotted {
+    let (s0, s1) = (order.slot(e.t0), order.slot(e.t1));
+    (e, s0.min(s1), s0.max(s1), s0 <= s1)
+}
+
 /// The distances worth a class, most edges first: at most [`MAX_CLASSES`], each with at least
 /// [`MIN_EDGES_PER_WORD`] edges per facing word between its first and last `lo`.
-fn choose_deltas(edges: &[ManifoldEdge]) -> Vec<u32> {
-    let mut by_delta: Vec<(u32, u32)> = edges
-        .iter()
-        .filter_map(|e| {
-            let (lo, hi) = lo_hi(e);
-            (hi > lo).then_some((hi - lo, lo))
-        })
-        .collect();
+fn choose_deltas(edges: &[Slotted]) -> Vec<u32> {
+    let mut by_delta: Vec<(u32, u32)> = edges.iter().filter_map(|&(_, lo, hi, _)| (hi > lo).then_some((hi - lo, lo))).collect();
     by_delta.sort_unstable();
     let mut counts: Vec<(usize, u32)> = Vec::new();
     for run in by_delta.chunk_by(|x, y| x.0 == y.0) {
@@ -112,15 +144,25 @@ fn choose_deltas(edges: &[ManifoldEdge]) -> Vec<u32> {
 }
 
 impl EdgeScan {
-    /// The scan over `edges` (its [`edges`](Self::edges) are the same edges, in scan order).
+    /// The scan over `edges` with the triangles in their own order (its
+    /// [`edges`](Self::edges) are the same edges, in scan order).
     pub fn new(edges: Vec<ManifoldEdge>) -> EdgeScan {
+        EdgeScan::with_order(edges, &TriangleOrder::identity())
+    }
+
+    /// The scan over `edges` for facing bits in `order` (bit `order.slot(t)` is triangle
+    /// `t`'s: the order of the [`FacePlanes`](super::planes::FacePlanes) whose bits it will
+    /// scan). Its [`edges`](Self::edges) are the same edges, with the same triangle ids, in
+    /// scan order.
+    pub fn with_order(edges: Vec<ManifoldEdge>, order: &TriangleOrder) -> EdgeScan {
+        let edges: Vec<Slotted> = edges.into_iter().map(|e| slotted(e, order)).collect();
         let deltas = choose_deltas(&edges);
         // every edge goes to the first class of its distance, unless that class already has an
         // edge at its `lo` (two edges between the same two triangles): then to the residual
-        let mut members: Vec<Vec<ManifoldEdge>> = vec![Vec::new(); deltas.len()];
+        let mut members: Vec<Vec<Slotted>> = vec![Vec::new(); deltas.len()];
         let mut residual = Vec::new();
         for e in edges {
-            let (lo, hi) = lo_hi(&e);
+            let (_, lo, hi, _) = e;
             match deltas.iter().position(|&d| hi > lo && hi - lo == d) {
                 Some(c) => members[c].push(e),
                 None => residual.push(e),
@@ -128,22 +170,24 @@ impl EdgeScan {
         }
         let mut scan = EdgeScan::default();
         for (&delta, mut es) in deltas.iter().zip(members) {
-            es.sort_by_key(|e| lo_hi(e).0);
-            let mut kept: Vec<ManifoldEdge> = Vec::with_capacity(es.len());
+            es.sort_by_key(|e| e.1);
+            let mut kept: Vec<Slotted> = Vec::with_capacity(es.len());
             for e in es {
-                if kept.last().is_some_and(|k| lo_hi(k).0 == lo_hi(&e).0) {
+                if kept.last().is_some_and(|k| k.1 == e.1) {
                     residual.push(e);
                 } else {
                     kept.push(e);
                 }
             }
             let Some(last) = kept.last() else { continue };
-            let first_word = lo_hi(&kept[0]).0 as usize / 64;
-            let words = lo_hi(last).0 as usize / 64 - first_word + 1;
+            let first_word = kept[0].1 as usize / 64;
+            let words = last.1 as usize / 64 - first_word + 1;
             let mut masks = vec![0u64; words];
-            for e in &kept {
-                let lo = lo_hi(e).0 as usize;
+            let mut lo_t0 = vec![0u64; words];
+            for &(_, lo, _, is_t0) in &kept {
+                let lo = lo as usize;
                 masks[lo / 64 - first_word] |= 1 << (lo % 64);
+                lo_t0[lo / 64 - first_word] |= u64::from(is_t0) << (lo % 64);
             }
             let mut ranks = Vec::with_capacity(words);
             let mut before = 0u32;
@@ -151,13 +195,38 @@ impl EdgeScan {
                 ranks.push(before);
                 before += m.count_ones();
             }
-            scan.classes.push(DeltaClass { delta, first_word, masks, ranks, first: scan.edges.len() });
-            scan.edges.extend(kept);
+            scan.classes.push(DeltaClass { delta, first_word, masks, lo_t0, ranks, first: scan.edges.len() });
+            scan.edges.extend(kept.into_iter().map(|k| k.0));
         }
         scan.rest = scan.edges.len();
-        scan.pairs = residual.iter().map(|e| [e.t0, e.t1]).collect();
-        scan.max_tri = residual.iter().map(|e| e.t0.max(e.t1)).max().unwrap_or(0);
-        scan.edges.extend(residual);
+        // residual edges by word pair (stable: the given order inside a pair)
+        residual.sort_by_key(|&(_, lo, hi, _)| (lo / 64, hi / 64));
+        for by_lo in residual.chunk_by(|x, y| x.1 / 64 == y.1 / 64) {
+            let first_offset = scan.offsets.len();
+            for run in by_lo.chunk_by(|x, y| x.2 / 64 == y.2 / 64) {
+                for &(e, lo, hi, is_t0) in run {
+                    scan.offsets.push([(lo % 64) as u8 | (u8::from(is_t0) << 7), (hi % 64) as u8]);
+                    scan.edges.push(e);
+                }
+                scan.pairs.push(WordPair { hi: run[0].2 / 64, end: scan.offsets.len() as u32 });
+            }
+            let w = by_lo[0].1 / 64;
+            let max_hi = by_lo.iter().map(|x| x.2 / 64).max().unwrap_or(0);
+            let far = scan.pairs.partition_point(|p| p.end as usize <= first_offset || p.hi < w + 64) as u32;
+            let near = by_lo.iter().filter(|x| x.2 / 64 < w + 64).fold(0u64, |m, x| m | 1 << (x.2 / 64 - w));
+            scan.lo_words.push(LoWord { w, max_hi, end: scan.pairs.len() as u32, far, near });
+        }
+        // the words read: each class's own and shifted words, each pair's two words
+        let mut words = (usize::MAX, 0usize);
+        for c in &scan.classes {
+            words.0 = words.0.min(c.first_word);
+            words.1 = words.1.max(c.first_word + c.masks.len() + (c.delta as usize).div_ceil(64) + 1);
+        }
+        for l in &scan.lo_words {
+            words.0 = words.0.min(l.w as usize);
+            words.1 = words.1.max(l.max_hi as usize + 1);
+        }
+        scan.words = if words.0 < words.1 { words } else { (0, 0) };
         scan
     }
 
@@ -166,143 +235,189 @@ impl EdgeScan {
         &self.edges
     }
 
-    /// Bytes one scan reads: the class masks and the residual triangle pairs.
+    /// Bytes one scan reads (at most): the class masks and orientation bits, the residual word
+    /// pairs and their edges' bit positions.
     pub fn bytes(&self) -> usize {
-        self.classes.iter().map(|c| c.masks.len() * 8).sum::<usize>() + self.pairs.len() * 8
+        self.classes.iter().map(|c| c.masks.len() * 16).sum::<usize>()
+            + self.lo_words.len() * std::mem::size_of::<LoWord>()
+            + self.pairs.len() * std::mem::size_of::<WordPair>()
+            + self.offsets.len() * 2
     }
 
-    /// Edges scanned a facing word at a time (the rest take two lookups each).
+    /// Edges scanned a facing word at a time by a distance class (the rest are filed by
+    /// word pair).
     pub fn word_scanned_edges(&self) -> usize {
         self.rest
     }
 
-    /// Appends the possible silhouette for the packed facing `bits` to `out`: the edges of
-    /// [`edges`](Self::edges) whose triangles' bits differ, in that order, each oriented as in
-    /// its light-facing triangle; the same list as [`possible_silhouette`] over
-    /// [`edges`](Self::edges) and the unpacked bits (a triangle past the bits counts as not
-    /// facing).
+    /// Appends the possible silhouette for the packed facing `bits` (in the scan's order) to
+    /// `out`: the edges of [`edges`](Self::edges) whose triangles' bits differ, in that order,
+    /// each oriented as in its light-facing triangle; the same list as [`possible_silhouette`]
+    /// over [`edges`](Self::edges) and the bits looked up by slot (a slot past the bits counts
+    /// as not facing).
     ///
     /// [`possible_silhouette`]: super::silhouette::possible_silhouette
     pub fn scan_into(&self, bits: &[u64], out: &mut Vec<SilhouetteEdge>) {
-        for c in &self.classes {
-            self.scan_class(c, bits, out);
-        }
+        RUNS.with_borrow_mut(|runs| {
+            let runs = Runs::new(bits, self.words, runs);
+            for c in &self.classes {
+                self.scan_class(c, bits, &runs, out);
+            }
+            self.scan_pairs(bits, &runs, out);
+        })
+    }
+
+    fn scan_pairs(&self, bits: &[u64], runs: &Runs, out: &mut Vec<SilhouetteEdge>) {
         let rest = &self.edges[self.rest..];
-        if self.pairs.len() >= TABLE_MIN_EDGES {
-            scan_table(&self.pairs, rest, self.max_tri, bits, out);
-        } else {
-            for (p, e) in self.pairs.iter().zip(rest) {
-                let f0 = bit(bits, p[0]);
-                if f0 != bit(bits, p[1]) {
-                    out.push(oriented(e, f0));
+        let word = |w: u32| bits.get(w as usize).copied().unwrap_or(0);
+        let mut first_pair = 0usize;
+        for l in &self.lo_words {
+            let pairs = first_pair..l.end as usize;
+            first_pair = l.end as usize;
+            // every pair of the word ends inside its run: nothing on the silhouette
+            if runs.end(l.w as usize) > l.max_hi as usize {
+                continue;
+            }
+            let a = word(l.w);
+            // every near pair's hi word is uniform and equal to the uniform lo word: only the
+            // far pairs are left
+            let pairs = if runs.same_as(l.w as usize, a, l.near) { l.far as usize..pairs.end } else { pairs };
+            let mut start = if pairs.start == 0 { 0 } else { self.pairs[pairs.start - 1].end as usize };
+            for p in &self.pairs[pairs] {
+                let end = p.end as usize;
+                let b = word(p.hi);
+                // both words all ones or both all zeros: no edge of the pair is on the silhouette
+                if a != b || a.wrapping_add(1) > 1 {
+                    for (o, e) in self.offsets[start..end].iter().zip(&rest[start..end]) {
+                        let fl = (a >> (o[0] & 63)) & 1;
+                        let fh = (b >> (o[1] & 63)) & 1;
+                        if fl != fh {
+                            out.push(oriented(e, (fl != 0) == (o[0] >= 128)));
+                        }
+                    }
                 }
+                start = end;
             }
         }
     }
 
-    fn scan_class(&self, c: &DeltaClass, bits: &[u64], out: &mut Vec<SilhouetteEdge>) {
+    fn scan_class(&self, c: &DeltaClass, bits: &[u64], runs: &Runs, out: &mut Vec<SilhouetteEdge>) {
         let edges = &self.edges[c.first..];
-        let mut hit = |i: usize, m: u64, mut s: u64| {
+        // the words `w .. w + reach` are read for the class's word `w`
+        let reach = (c.delta as usize).div_ceil(64);
+        let mut i = 0;
+        while i < c.masks.len() {
+            let w = c.first_word + i;
+            let end = runs.end(w);
+            if end > w + reach {
+                // the word and its shifted words lie in one uniform run, and so do those of the
+                // next words up to the run's end: no edge of theirs is on the silhouette
+                i = end - reach - c.first_word;
+                continue;
+            }
+            let m = c.masks[i];
+            let f = bits.get(w).copied().unwrap_or(0);
+            let mut s = (f ^ shifted(bits, w, c.delta)) & m;
             while s != 0 {
                 let k = s.trailing_zeros();
                 s &= s - 1;
                 let rank = c.ranks[i] + (m & ((1u64 << k) - 1)).count_ones();
                 let e = &edges[rank as usize];
-                out.push(oriented(e, bit(bits, e.t0)));
+                // `f`'s bit k is slot lo's
+                let lo_lit = (f >> k) & 1 != 0;
+                let lo_is_t0 = (c.lo_t0[i] >> k) & 1 != 0;
+                out.push(oriented(e, lo_lit == lo_is_t0));
             }
-        };
-        let (q, r) = ((c.delta / 64) as usize, c.delta % 64);
-        // Words whose own and shifted words all lie inside the bits: plain slices, no bounds
-        // checks in the loop (a shift by 64 would overflow, so r == 0 reads one word).
-        let inside = bits.len().saturating_sub(c.first_word + q + 1).min(c.masks.len());
-        let own = bits.get(c.first_word..).unwrap_or(&[]);
-        let far = bits.get(c.first_word + q..).unwrap_or(&[]);
-        if r == 0 {
-            for (i, ((&m, &f), &g)) in c.masks[..inside].iter().zip(own).zip(far).enumerate() {
-                let s = (f ^ g) & m;
-                if s != 0 {
-                    hit(i, m, s);
-                }
-            }
-        } else {
-            for (i, ((&m, &f), g)) in c.masks[..inside].iter().zip(own).zip(far.windows(2)).enumerate() {
-                let s = (f ^ ((g[0] >> r) | (g[1] << (64 - r)))) & m;
-                if s != 0 {
-                    hit(i, m, s);
-                }
-            }
-        }
-        for (i, &m) in c.masks.iter().enumerate().skip(inside) {
-            let w = c.first_word + i;
-            let f = bits.get(w).copied().unwrap_or(0);
-            let s = (f ^ shifted(bits, w, c.delta)) & m;
-            if s != 0 {
-                hit(i, m, s);
-            }
+            i += 1;
         }
     }
 }
 
-/// The residual scan with a byte a triangle: the two lookups an edge are then plain byte
-/// loads. The table is this thread's, reused across calls (no allocation and no zeroing of
-/// fresh pages per light), sized to a power of two so that a masked index needs no bounds
-/// check; triangle ids past the bits read 0.
-fn scan_table(pairs: &[[u32; 2]], edges: &[ManifoldEdge], max_tri: u32, bits: &[u64], out: &mut Vec<SilhouetteEdge>) {
-    let need = (max_tri as usize + 1).max(bits.len() * 64);
-    let size = need.next_power_of_two();
-    let mask = size - 1;
-    SCAN_TABLE.with_borrow_mut(|table| {
-        if table.len() < size {
-            table.clear();
-            table.resize(size, 0);
+/// The runs of equal uniform facing words over the words `first .. first + end.len()`:
+/// `end[w - first]` is the end (exclusive) of the run of words equal to word `w` from `w` on
+/// when `w` is all ones or all zeros, else `w` (words past the bits are zeros; outside the
+/// range every word is its own, empty, run).
+///
+/// Also the sets of all-ones and all-zeros words over the same range, one bit a word
+/// (`ones`, `zeros`: bit `w - first`).
+struct Runs<'a> {
+    first: usize,
+    end: &'a [u32],
+    ones: &'a [u64],
+    zeros: &'a [u64],
+}
+
+/// [`Runs`]' tables.
+#[derive(Default)]
+struct RunScratch {
+    end: Vec<u32>,
+    ones: Vec<u64>,
+    zeros: Vec<u64>,
+}
+
+impl<'a> Runs<'a> {
+    fn new(bits: &[u64], (first, last): (usize, usize), scratch: &'a mut RunScratch) -> Runs<'a> {
+        let RunScratch { end: scratch, ones, zeros } = scratch;
+        let sets = (last - first).div_ceil(64) + 1;
+        for v in [&mut *ones, &mut *zeros] {
+            v.clear();
+            v.resize(sets, 0);
         }
-        let table = &mut table[..size];
-        for (dst, &w) in table.chunks_exact_mut(64).zip(bits) {
-            for (d8, byte) in dst.chunks_exact_mut(8).zip(w.to_le_bytes()) {
-                d8.copy_from_slice(&SPREAD[byte as usize].to_le_bytes());
-            }
+        scratch.clear();
+        scratch.resize(last - first, 0);
+        let word = |w: usize| bits.get(w).copied().unwrap_or(0);
+        let mut next = (u64::MAX / 3, last as u32); // (word w + 1, its run end): none yet
+        for w in (first..last).rev() {
+            let a = word(w);
+            let e = if a.wrapping_add(1) > 1 {
+                w as u32
+            } else if next.0 == a {
+                next.1
+            } else {
+                w as u32 + 1
+            };
+            scratch[w - first] = e;
+            next = (a, e);
+            let i = w - first;
+            ones[i / 64] |= u64::from(a == u64::MAX) << (i % 64);
+            zeros[i / 64] |= u64::from(a == 0) << (i % 64);
         }
-        table[(bits.len() * 64).min(size)..need].fill(0);
-        let tab: &[u8] = table;
-        let fast = |t: u32| tab[t as usize & mask];
-        for (chunk, es) in pairs.chunks(16).zip(edges.chunks(16)) {
-            // most blocks hold no silhouette edge: one OR-reduction, and only the rare blocks
-            // with one are walked again
-            let mut any = 0u8;
-            for p in chunk {
-                any |= fast(p[0]) ^ fast(p[1]);
-            }
-            if any == 0 {
-                continue;
-            }
-            for (p, e) in chunk.iter().zip(es) {
-                if fast(p[0]) != fast(p[1]) {
-                    out.push(oriented(e, fast(p[0]) != 0));
-                }
-            }
+        Runs { first, end: scratch, ones, zeros }
+    }
+
+    /// True when word `w` (its bits `a`) is all ones or all zeros and so is every word
+    /// `w + k` for bit `k` of `near`, with the same bits (words outside the range count as
+    /// mixed).
+    #[inline]
+    fn same_as(&self, w: usize, a: u64, near: u64) -> bool {
+        let set = if a == u64::MAX {
+            self.ones
+        } else if a == 0 {
+            self.zeros
+        } else {
+            return false;
+        };
+        let Some(i) = w.checked_sub(self.first) else { return false };
+        let (q, r) = (i / 64, i % 64);
+        let lo = set.get(q).copied().unwrap_or(0) >> r;
+        let window = if r == 0 { lo } else { lo | (set.get(q + 1).copied().unwrap_or(0) << (64 - r)) };
+        window & near == near
+    }
+
+    /// The end of word `w`'s run (`w` when it has none).
+    #[inline]
+    fn end(&self, w: usize) -> usize {
+        match w.checked_sub(self.first).and_then(|i| self.end.get(i)) {
+            Some(&e) => e as usize,
+            None => w,
         }
-    });
+    }
 }
 
 thread_local! {
-    /// [`scan_table`]'s byte-a-triangle table, kept per thread across calls.
-    static SCAN_TABLE: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
+    /// [`Runs`]' table, kept per thread across calls.
+    static RUNS: std::cell::RefCell<RunScratch> = std::cell::RefCell::new(RunScratch::default());
 }
-
-/// Byte `k` of `SPREAD[b]` is bit `k` of `b`.
-static SPREAD: [u64; 256] = {
-    let mut t = [0u64; 256];
-    let mut b = 0;
-    while b < 256 {
-        let mut k = 0;
-        while k < 8 {
-            t[b] |= (((b >> k) & 1) as u64) << (8 * k);
-            k += 1;
-        }
-        b += 1;
-    }
-    t
-};
 
 #[cfg(test)]
 mod tests {
@@ -310,11 +425,27 @@ mod tests {
     use crate::geom::silhouette::{possible_silhouette_packed, FacePlanes};
     use crate::geom::testmesh::{cube, shuffled, uv_sphere};
     use crate::geom::topology::Topology;
+    use crate::geom::TriangleOrder;
     use glam::{Vec3, Vec4};
     use proptest::prelude::*;
 
     fn check(edges: Vec<ManifoldEdge>, bits: &[u64]) -> EdgeScan {
-        let scan = EdgeScan::new(edges.clone());
+        check_in(edges, bits, &TriangleOrder::identity())
+    }
+
+    /// The plain scan over `edges` with bits looked up by slot.
+    fn plain(edges: &[ManifoldEdge], bits: &[u64], order: &TriangleOrder) -> Vec<SilhouetteEdge> {
+        let slotted: Vec<ManifoldEdge> = edges.iter().map(|e| ManifoldEdge { t0: order.slot(e.t0), t1: order.slot(e.t1), ..*e }).collect();
+        let mut out = possible_silhouette_packed(&slotted, bits);
+        for s in &mut out {
+            s.lit = order.triangle(s.lit);
+            s.unlit = order.triangle(s.unlit);
+        }
+        out
+    }
+
+    fn check_in(edges: Vec<ManifoldEdge>, bits: &[u64], order: &TriangleOrder) -> EdgeScan {
+        let scan = EdgeScan::with_order(edges.clone(), order);
         let mut sorted_in = edges.clone();
         let mut sorted_scan = scan.edges().to_vec();
         let key = |e: &ManifoldEdge| (e.a, e.b, e.t0, e.t1, e.c0, e.c1);
@@ -323,7 +454,10 @@ mod tests {
         assert_eq!(sorted_in, sorted_scan, "the scan holds exactly the given edges");
         let mut sil = Vec::new();
         scan.scan_into(bits, &mut sil);
-        assert_eq!(sil, possible_silhouette_packed(scan.edges(), bits));
+        assert_eq!(sil, plain(scan.edges(), bits, order));
+        if order.is_identity() {
+            assert_eq!(sil, possible_silhouette_packed(scan.edges(), bits));
+        }
         scan
     }
 
@@ -352,13 +486,31 @@ mod tests {
 
     #[test]
     fn shuffled_triangles_take_the_residual_path() {
-        // a fixed pseudo-random triangle order: no distance class, every edge looked up
+        // a fixed pseudo-random triangle order: no distance class, every edge in its own pair
         let t = Topology::build(&shuffled(&uv_sphere(1.0, 200, 101)));
         let mut bits = Vec::new();
         FacePlanes::new(&t.mesh).facing_packed(&t.mesh, Vec4::new(3.0, 2.0, 1.0, 1.0), false, &mut bits);
         let scan = check(t.manifold_edges.clone(), &bits);
-        assert!(scan.pairs.len() >= TABLE_MIN_EDGES, "the byte table path is exercised");
         assert!(scan.word_scanned_edges() * 10 < t.manifold_edges.len());
+        assert!(scan.pairs.len() * 2 > t.manifold_edges.len());
+        // in a spatial order the same mesh's edges fall into few word pairs, most skipped whole
+        let all: Vec<u32> = (0..t.mesh.triangles.len() as u32).collect();
+        let order = TriangleOrder::spatial(&t.mesh, &[&all]);
+        let planes = FacePlanes::with_order(&t.mesh, order.clone());
+        for l in [Vec4::new(3.0, 2.0, 1.0, 1.0), Vec4::new(0.1, 0.2, -0.3, 1.0), Vec4::new(-1.0, 0.5, 0.2, 0.0)] {
+            planes.facing_packed(&t.mesh, l, false, &mut bits);
+            let scan = check_in(t.manifold_edges.clone(), &bits, &order);
+            assert!(scan.pairs.len() * 8 < t.manifold_edges.len(), "{} pairs", scan.pairs.len());
+            // the same silhouette as the mesh's own order, edge set for edge set
+            let mut own = Vec::new();
+            FacePlanes::new(&t.mesh).facing_packed(&t.mesh, l, false, &mut own);
+            let mut a = plain(scan.edges(), &bits, &order);
+            let mut b = possible_silhouette_packed(&t.manifold_edges, &own);
+            let key = |e: &SilhouetteEdge| (e.a, e.b, e.lit, e.unlit);
+            a.sort_by_key(key);
+            b.sort_by_key(key);
+            assert_eq!(a, b);
+        }
     }
 
     #[test]
@@ -401,7 +553,18 @@ mod tests {
                 .enumerate()
                 .map(|(i, &(t, d))| ManifoldEdge { a: i as u32, b: i as u32 + 1, t0: t, c0: 0, t1: t + d % 3 * (d / 3), c1: 2 })
                 .collect();
-            check(edges, &bits);
+            check(edges.clone(), &bits);
+            // any order: a random permutation of the triangles
+            let n = 800usize;
+            let mut perm: Vec<u32> = (0..n as u32).collect();
+            let mut x = bits.first().copied().unwrap_or(7) | 1;
+            for i in (1..n).rev() {
+                x ^= x << 13;
+                x ^= x >> 7;
+                x ^= x << 17;
+                perm.swap(i, (x % (i as u64 + 1)) as usize);
+            }
+            check_in(edges, &bits, &TriangleOrder::from_slots(perm).unwrap());
         }
     }
 }

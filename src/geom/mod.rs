@@ -8,6 +8,8 @@ pub use area::{AreaLight, AreaShape};
 pub mod bounds;
 pub mod edgescan;
 pub mod light;
+pub use order::TriangleOrder;
+pub mod order;
 pub use light::{Camera, Light, LightKind};
 pub mod planes;
 pub mod predicates;

@@ -2,6 +2,7 @@
 //! planes with a proven error bound, the exact predicate only where the sign is in doubt.
 
 use super::mesh::Mesh;
+use super::order::TriangleOrder;
 use super::predicates::facing_exact;
 use super::silhouette::PLANES_PARALLEL_THRESHOLD;
 use glam::{Vec3, Vec4};
@@ -12,6 +13,8 @@ const PLANE_RANGE: f64 = (1u64 << 60) as f64;
 /// Triangles whose cross product cancels by more than this factor (`Σ|e_i f_j| / |e × f|_1`)
 /// are always decided exactly (zero-area triangles and slivers).
 const PLANE_CONDITION: f64 = 65536.0;
+/// Blocks (facing words) per super-block bound, coarse to fine.
+const SUPER_BLOCKS: [usize; 1] = [8];
 /// Unit roundoff of f32.
 const U32: f64 = 1.0 / (1u64 << 24) as f64;
 
@@ -27,7 +30,13 @@ const U32: f64 = 1.0 / (1u64 << 24) as f64;
 ///
 /// Each block of 64 triangles (one word of bits) also keeps its centre plane and spread
 /// (`BlockBound`): a light far enough from every plane of a block decides its whole word
-/// with a dozen f64 operations instead of 64 dot products, with the same bits.
+/// with a dozen f64 operations instead of 64 dot products, with the same bits; and so does
+/// each run of 8 blocks (512 triangles), for their 8 words at once.
+///
+/// The planes, blocks and bits are in the planes' [`TriangleOrder`] ([`FacePlanes::with_order`];
+/// the mesh's own order for [`FacePlanes::new`]): bit `s` is the facing of triangle
+/// `order().triangle(s)`, so that a block is a compact patch of the surface whatever the
+/// order of the mesh's triangles. Look a triangle's bit up with [`FacePlanes::bit`].
 ///
 /// ## Error bound
 /// Let `u = 2^-24`, `R` the largest |coordinate| of the mesh, `p` the light point (`l.xyz / l.w`
@@ -63,6 +72,11 @@ pub struct FacePlanes {
     /// One bound per 64-triangle block (word of facing bits): lets a light decide a whole word
     /// without its 64 dot products (see [`BlockBound`]).
     blocks: Vec<BlockBound>,
+    /// One bound per `SUPER_BLOCKS[i]` blocks for each level `i` (compact patches of 512
+    /// triangles in a spatial order): a light far from all of them decides their words at once.
+    supers: [Vec<BlockBound>; 1],
+    /// The scan order: slot `s` (bit `s` of the packed bits) is triangle `order.triangle(s)`.
+    order: TriangleOrder,
 }
 
 /// The planes of one block of 64 triangles as a centre plane and its spread, for deciding the
@@ -142,15 +156,45 @@ impl FacePlanes {
     /// The planes of every triangle of `mesh` (positions as stored; a triangle with an index
     /// out of range gets no plane and is never light-facing).
     pub fn new(mesh: &Mesh) -> FacePlanes {
-        let mut p = FacePlanes::default();
+        FacePlanes::with_order(mesh, TriangleOrder::identity())
+    }
+
+    /// [`new`](Self::new) with the triangles in `order` (bit `s` of the packed bits is triangle
+    /// `order.triangle(s)`); an order that does not fit the mesh's triangle count is replaced by
+    /// the identity.
+    pub fn with_order(mesh: &Mesh, order: TriangleOrder) -> FacePlanes {
+        let mut p = FacePlanes { order, ..FacePlanes::default() };
         p.recompute(mesh);
         p
     }
 
+    /// The order of the planes and of the packed bits.
+    pub fn order(&self) -> &TriangleOrder {
+        &self.order
+    }
+
+    /// Triangle `t`'s facing bit in packed `bits` from [`facing_packed`](Self::facing_packed)
+    /// (false past the end of the bits).
+    #[inline]
+    pub fn bit(&self, bits: &[u64], t: u32) -> bool {
+        let s = self.order.slot(t);
+        bits.get(s as usize / 64).is_some_and(|w| (w >> (s % 64)) & 1 != 0)
+    }
+
+    /// The triangle of mesh `mesh` in slot `s` (the identity when the order does not fit).
+    #[inline]
+    fn tri(&self, s: usize) -> usize {
+        self.order.triangle(s as u32) as usize
+    }
+
     /// Recomputes every plane from `mesh`'s current positions (deforming casters call this
-    /// whenever the positions change; the triangles may change too). Reuses the allocations.
+    /// whenever the positions change; the triangles may change too: then an order that no
+    /// longer fits their count becomes the identity). Reuses the allocations.
     pub fn recompute(&mut self, mesh: &Mesh) {
         let n = mesh.triangles.len();
+        if !self.order.fits(n) {
+            self.order = TriangleOrder::identity();
+        }
         let padded = n.div_ceil(64) * 64;
         for v in [&mut self.nx, &mut self.ny, &mut self.nz, &mut self.d] {
             v.clear();
@@ -159,6 +203,7 @@ impl FacePlanes {
         self.exact = 0;
         self.len = n;
         self.blocks.clear();
+        self.supers = Default::default();
         let reach =
             mesh.positions.iter().map(|p| p.abs().max_element() as f64).fold(0.0f64, |a, b| if b > a || b.is_nan() { b } else { a });
         self.reach = reach;
@@ -168,7 +213,7 @@ impl FacePlanes {
         }
         let mut exact_ids = Vec::new();
         for t in 0..n {
-            let Some([p0, p1, p2]) = corners(mesh, t) else {
+            let Some([p0, p1, p2]) = corners(mesh, self.tri(t)) else {
                 // no plane, no exact test: never light-facing (see exact_bit)
                 self.exact += 1;
                 exact_ids.push(t);
@@ -196,6 +241,11 @@ impl FacePlanes {
             always_exact[t] = true;
         }
         self.blocks = (0..n.div_ceil(64)).map(|b| self.block_bound(mesh, b * 64..n.min(b * 64 + 64), &always_exact)).collect();
+        for (level, size) in SUPER_BLOCKS.iter().enumerate() {
+            let step = 64 * size;
+            self.supers[level] =
+                (0..n.div_ceil(step)).map(|b| self.block_bound(mesh, b * step..n.min(b * step + step), &always_exact)).collect();
+        }
     }
 
     /// The [`BlockBound`] of triangles `ts` (one block).
@@ -207,7 +257,7 @@ impl FacePlanes {
         let plane = |t: usize| ([self.nx[t] as f64, self.ny[t] as f64, self.nz[t] as f64], self.d[t] as f64);
         let mut c = [0.0f64; 3];
         for t in ts.clone() {
-            let Some([p0, ..]) = corners(mesh, t) else { return BlockBound::default() };
+            let Some([p0, ..]) = corners(mesh, self.tri(t)) else { return BlockBound::default() };
             for (ci, pi) in c.iter_mut().zip(p0.to_array()) {
                 *ci += pi as f64 / k;
             }
@@ -267,12 +317,21 @@ impl FacePlanes {
         }
     }
 
-    /// The f32 plane `(nx, ny, nz, d)` of every triangle, in triangle order (zero for the
-    /// triangles always decided exactly; all zero when the mesh is out of the filter's range):
-    /// what the GPU facing pass (`--method compute`) filters with, together with
-    /// [`error_bound`](Self::error_bound).
+    /// The f32 plane `(nx, ny, nz, d)` of every triangle, in the mesh's triangle order (not
+    /// the planes' [order](Self::order); zero for the triangles always decided exactly; all
+    /// zero when the mesh is out of the filter's range): what the GPU facing pass
+    /// (`--method compute`) filters with, together with [`error_bound`](Self::error_bound).
     pub fn planes_xyzd(&self) -> Vec<[f32; 4]> {
-        (0..self.len).map(|t| if self.all_exact { [0.0; 4] } else { [self.nx[t], self.ny[t], self.nz[t], self.d[t]] }).collect()
+        (0..self.len)
+            .map(|t| {
+                let s = self.order.slot(t as u32) as usize;
+                if self.all_exact {
+                    [0.0; 4]
+                } else {
+                    [self.nx[s], self.ny[s], self.nz[s], self.d[s]]
+                }
+            })
+            .collect()
     }
 
     /// Bytes the facing pass reads per light (the four plane arrays).
@@ -296,10 +355,12 @@ impl FacePlanes {
     }
 
     /// Facing bits of every triangle for the object-space homogeneous light `l`, packed 64 to a
-    /// `u64` word (bit `t % 64` of word `t / 64`; bits past the last triangle are 0), into `out`
-    /// (resized). Exactly `facing_exact(p0, p1, p2, l)` per triangle (`(p0, p2, p1)` when `flip`,
-    /// for mirroring transforms), for the `mesh` the planes were computed from; if `mesh` has a
-    /// different triangle count every triangle is decided exactly.
+    /// `u64` word in the planes' [order](Self::order) (bit `s % 64` of word `s / 64` is
+    /// triangle `order().triangle(s)`: look bits up with [`bit`](Self::bit); bits past the last
+    /// triangle are 0), into `out` (resized). Exactly `facing_exact(p0, p1, p2, l)` per triangle
+    /// (`(p0, p2, p1)` when `flip`, for mirroring transforms), for the `mesh` the planes were
+    /// computed from; if `mesh` has a different triangle count every triangle is decided
+    /// exactly, in the mesh's own order.
     pub fn facing_packed(&self, mesh: &Mesh, l: Vec4, flip: bool, out: &mut Vec<u64>) {
         let n = mesh.triangles.len();
         let words = n.div_ceil(64);
@@ -307,8 +368,9 @@ impl FacePlanes {
         out.resize(words, 0);
         let filter = if n == self.len { self.error_bound(l) } else { None };
         let Some((lf, e)) = filter else {
+            let same = n == self.len;
             for t in 0..n {
-                if exact_bit(mesh, t, l, flip) {
+                if exact_bit(mesh, if same { self.tri(t) } else { t }, l, flip) {
                     out[t / 64] |= 1 << (t % 64);
                 }
             }
@@ -360,10 +422,26 @@ impl FacePlanes {
             .zip(self.ny[a..b].chunks_exact(64))
             .zip(self.nz[a..b].chunks_exact(64))
             .zip(self.d[a..b].chunks_exact(64));
+        let (words, last) = (n.div_ceil(64), first + out.len());
+        // words before `decided.0` belong to a super-block decided `decided.1`
+        let mut decided = (0usize, false);
         for (i, (o, (((nx, ny), nz), d))) in out.iter_mut().zip(blocks).enumerate() {
-            let base = a + i * 64;
+            let (base, w) = (a + i * 64, first + i);
             let valid = if base + 64 <= n { u64::MAX } else { (1u64 << (n - base)) - 1 };
-            if let Some(all) = self.blocks.get(first + i).and_then(|b| b.decide(lf, e as f64)) {
+            if w < decided.0 {
+                *o = if decided.1 { valid } else { 0 };
+                continue;
+            }
+            let sup = SUPER_BLOCKS.iter().zip(&self.supers).find_map(|(&size, bounds)| {
+                let end = (w + size).min(words);
+                (w % size == 0 && end <= last).then(|| bounds.get(w / size).and_then(|b| b.decide(lf, e as f64)).map(|all| (end, all)))?
+            });
+            if let Some(d) = sup {
+                decided = d;
+                *o = if d.1 { valid } else { 0 };
+                continue;
+            }
+            if let Some(all) = self.blocks.get(w).and_then(|b| b.decide(lf, e as f64)) {
                 *o = if all { valid } else { 0 };
                 continue;
             }
@@ -373,7 +451,7 @@ impl FacePlanes {
             while u != 0 {
                 let k = u.trailing_zeros() as usize;
                 u &= u - 1;
-                w = (w & !(1 << k)) | (u64::from(exact_bit(mesh, base + k, l, flip)) << k);
+                w = (w & !(1 << k)) | (u64::from(exact_bit(mesh, self.tri(base + k), l, flip)) << k);
             }
             *o = w;
         }
@@ -475,6 +553,55 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn ordered_planes_give_the_permuted_bits() {
+        // a shuffled sphere: in its own order few blocks are decidable; in the spatial order
+        // most are, and every bit is the exact one of the triangle in its slot
+        let m = crate::geom::testmesh::shuffled(&uv_sphere(1.0, 200, 101));
+        let all: Vec<u32> = (0..m.triangles.len() as u32).collect();
+        let order = TriangleOrder::spatial(&m, &[&all]);
+        let (own, ordered) = (FacePlanes::new(&m), FacePlanes::with_order(&m, order.clone()));
+        assert_eq!(ordered.order(), &order);
+        let mut far = m.clone();
+        far.positions[0] *= 1e30; // out of the filter's range: every triangle exact
+        let far_planes = FacePlanes::with_order(&far, order.clone());
+        let mut bits = Vec::new();
+        for l in [Vec4::new(3.0, 2.0, 1.0, 1.0), Vec4::new(0.0, 0.99, 0.0, 1.0), Vec4::new(-1.0, 0.5, 0.2, 0.0)] {
+            for flip in [false, true] {
+                let want = exact(&m, l, flip);
+                ordered.facing_packed(&m, l, flip, &mut bits);
+                for t in 0..m.triangles.len() as u32 {
+                    let s = order.slot(t);
+                    assert_eq!(ordered.bit(&bits, t), (want[t as usize / 64] >> (t % 64)) & 1 != 0);
+                    assert_eq!(ordered.bit(&bits, t), (bits[s as usize / 64] >> (s % 64)) & 1 != 0);
+                }
+                let mut threaded = Vec::new();
+                ordered.facing_packed_threads(&m, l, flip, 3, &mut threaded);
+                assert_eq!(threaded, bits);
+                let want_far = exact(&far, l, flip);
+                far_planes.facing_packed(&far, l, flip, &mut bits);
+                for t in 0..m.triangles.len() as u32 {
+                    assert_eq!(far_planes.bit(&bits, t), (want_far[t as usize / 64] >> (t % 64)) & 1 != 0);
+                }
+            }
+            if l.w != 0.0 && l.y != 0.99 {
+                let (a, b) = (own.decided_blocks(l, false), ordered.decided_blocks(l, false));
+                assert!(a * 10 < own.blocks.len() && b * 2 > ordered.blocks.len(), "{a} / {b} of {} blocks decided", own.blocks.len());
+            }
+        }
+        // the GPU's planes stay in triangle order
+        let (p0, p1) = (own.planes_xyzd(), ordered.planes_xyzd());
+        assert_eq!(p0, p1);
+        // a mesh with another triangle count: every triangle exact, in the mesh's order
+        let mut fewer = m.clone();
+        fewer.triangles.truncate(100);
+        ordered.facing_packed(&fewer, Vec4::new(3.0, 2.0, 1.0, 1.0), false, &mut bits);
+        assert_eq!(bits, exact(&fewer, Vec4::new(3.0, 2.0, 1.0, 1.0), false));
+        let mut re = ordered.clone();
+        re.recompute(&fewer);
+        assert!(re.order().is_identity());
     }
 
     proptest! {

@@ -9,7 +9,7 @@
 use crate::error::{Error, Result};
 use crate::geom::silhouette::{EdgeScan, FacePlanes};
 use crate::geom::topology::Topology;
-use crate::geom::{Aabb, Mesh};
+use crate::geom::{Aabb, Mesh, TriangleOrder};
 use crate::shadow::VolumePath;
 use glam::{Mat4, Vec3};
 
@@ -89,8 +89,9 @@ pub struct Part {
     pub object_bounds: Aabb,
     /// Ids of the part's undirected edges in [`Topology::edges`], ascending.
     pub edges: Vec<u32>,
-    /// The part's manifold edges (in [`Topology::manifold_edges`] order), ready for the
-    /// per-light possible-silhouette scan.
+    /// The part's manifold edges, ready for the per-light possible-silhouette scan of facing
+    /// bits in the caster's scan order ([`Caster::planes`]); its edges and output keep the
+    /// welded triangle ids.
     pub scan: EdgeScan,
 }
 
@@ -114,6 +115,14 @@ pub struct Caster {
     /// Object-space plane of every welded triangle, for the per-light facing bits
     /// ([`FacePlanes::facing_packed`]); recompute with [`Caster::recompute_planes`] after
     /// changing the welded positions.
+    ///
+    /// The planes and their packed bits are in the caster's **scan order**
+    /// ([`FacePlanes::order`]), computed once at load: each part's triangles, part after part,
+    /// in meshoptimizer's spatial order ([`TriangleOrder::spatial`]), so that facing blocks and
+    /// edge word pairs are compact patches whatever the order of the caller's triangles. Only
+    /// the silhouette structures (these planes, [`Part::scan`]) use it: look a welded
+    /// triangle's bit up with [`FacePlanes::bit`]; everything else (mesh, chunks, triangle ids,
+    /// plans) is in the caller's order.
     pub planes: FacePlanes,
     /// The welded mesh split into pieces of at most [`MAX_CHUNK_VERTICES`] vertices (never
     /// mixing parts).
@@ -165,7 +174,7 @@ impl Caster {
             return Err(Error::mesh(name, "transform is singular"));
         }
         let object_bounds = topology.mesh.bounds();
-        let (parts, chunks, tri_chunk) = build_parts(&topology, limit, false);
+        let (parts, chunks, tri_chunk, order) = build_parts(&topology, limit, false, None);
         let kind = if parts.len() > 1 && parts.iter().all(|p| p.kind == CasterKind::Manifold) { CasterKind::Manifold } else { kind };
         let max_local_vertices = chunks.iter().map(|c| c.vertices.len()).max().unwrap_or(0);
         let coincident = match kind {
@@ -178,7 +187,7 @@ impl Caster {
             kind,
             coincident,
             triangle_count: topology.mesh.triangles.len(),
-            planes: FacePlanes::new(&topology.mesh),
+            planes: FacePlanes::with_order(&topology.mesh, order),
             topology,
             chunks,
             parts,
@@ -198,7 +207,8 @@ impl Caster {
     /// connected mesh the chunks stay the same) and the coincident groups.
     pub fn make_whole_multiplicity(&mut self, reason: String) {
         self.kind = CasterKind::Multiplicity { reason };
-        let (parts, chunks, tri_chunk) = build_parts(&self.topology, self.chunk_limit, true);
+        let order = self.planes.order().clone();
+        let (parts, chunks, tri_chunk, _) = build_parts(&self.topology, self.chunk_limit, true, Some(order));
         self.parts = parts;
         self.chunks = chunks;
         self.tri_chunk = tri_chunk;
@@ -263,9 +273,15 @@ fn coincident_groups(mesh: &Mesh) -> Vec<u32> {
     out
 }
 
+/// What [`build_parts`] returns: the parts, the chunks, every triangle's (chunk, local index)
+/// and the scan order.
+type Built = (Vec<Part>, Vec<Chunk>, Vec<(u32, u32)>, TriangleOrder);
+
 /// Connected components of the welded mesh (triangles sharing a vertex), each with its kind,
-/// bounds, edges and chunks; `whole`: one multiplicity part with every triangle.
-fn build_parts(topo: &Topology, limit: usize, whole: bool) -> (Vec<Part>, Vec<Chunk>, Vec<(u32, u32)>) {
+/// bounds, edges and chunks; `whole`: one multiplicity part with every triangle. The parts'
+/// edge scans are for facing bits in `order`, or, when `None`, in the spatial order of each
+/// part's triangles, part after part (returned).
+fn build_parts(topo: &Topology, limit: usize, whole: bool, order: Option<TriangleOrder>) -> Built {
     let mesh = &topo.mesh;
     let nt = mesh.triangles.len();
     // union-find over vertices
@@ -307,6 +323,10 @@ fn build_parts(topo: &Topology, limit: usize, whole: bool) -> (Vec<Part>, Vec<Ch
     for (t, &c) in comp_of_tri.iter().enumerate() {
         tris[c as usize].push(t as u32);
     }
+    let order = order.unwrap_or_else(|| {
+        let groups: Vec<&[u32]> = tris.iter().map(|t| t.as_slice()).collect();
+        TriangleOrder::spatial(mesh, &groups)
+    });
     // per-part edge problems (an edge's uses all lie in one part)
     let mut edges: Vec<Vec<u32>> = vec![Vec::new(); ncomp];
     let mut problems = vec![[0usize; 3]; ncomp]; // boundary, non-manifold, inconsistent
@@ -366,10 +386,10 @@ fn build_parts(topo: &Topology, limit: usize, whole: bool) -> (Vec<Part>, Vec<Ch
             chunks: first..chunks.len(),
             object_bounds: bounds,
             edges: pedges,
-            scan: EdgeScan::new(pman),
+            scan: EdgeScan::with_order(pman, &order),
         });
     }
-    (parts, chunks, tri_chunk)
+    (parts, chunks, tri_chunk, order)
 }
 
 /// Where [`build_chunks`] writes: the chunks, each triangle's (chunk, index in it), and the

@@ -42,7 +42,7 @@
 use super::caster::{Caster, CasterKind};
 
 use crate::geom::bounds::{box_distance, light_depth_bounds, light_scissor, shadow_volume_outside_frustum, Frustum, OcclusionPyramid};
-use crate::geom::silhouette::{packed_bit, SilhouetteEdge};
+use crate::geom::silhouette::{FacePlanes, SilhouetteEdge};
 use crate::geom::Aabb;
 use crate::geom::{Light, LightKind};
 use glam::Vec4;
@@ -139,13 +139,17 @@ impl FacingSet for [bool] {
     }
 }
 
-/// Packed facing bits (see [`FacingSet`]).
-struct Packed<'a>(&'a [u64]);
+/// Packed facing bits in the caster's scan order, looked up by welded triangle id (see
+/// [`FacingSet`]).
+struct Packed<'a> {
+    bits: &'a [u64],
+    planes: &'a FacePlanes,
+}
 
 impl FacingSet for Packed<'_> {
     #[inline]
     fn get(&self, t: u32) -> bool {
-        packed_bit(self.0, t)
+        self.planes.bit(self.bits, t)
     }
 }
 
@@ -334,7 +338,7 @@ fn plan_part(
     let PartJob { part: pi, multiplicity, case } = job;
     let part = &caster.parts[pi];
     let directional = l_obj.w == 0.0;
-    let facing = Packed(bits);
+    let facing = Packed { bits, planes: &caster.planes };
     let inside = !directional && part.object_bounds.contains(l_obj.truncate());
     if multiplicity {
         let mult = edge_multiplicities_with(caster, &part.edges, &facing);
