@@ -181,6 +181,30 @@ impl FacePlanes {
         bits.get(s as usize / 64).is_some_and(|w| (w >> (s % 64)) & 1 != 0)
     }
 
+    /// The packed `bits` of [`facing_packed`](Self::facing_packed) (scan order) in triangle
+    /// order, into `out` (resized): bit `t` is [`bit(bits, t)`](Self::bit). One pass over the
+    /// set bits, for work that walks every triangle in the mesh's order.
+    pub fn unpermute(&self, bits: &[u64], out: &mut Vec<u64>) {
+        out.clear();
+        out.resize(self.len.div_ceil(64), 0);
+        if self.order.is_identity() {
+            let n = out.len().min(bits.len());
+            out[..n].copy_from_slice(&bits[..n]);
+            return;
+        }
+        for (w, &word) in bits.iter().enumerate().take(out.len()) {
+            let mut x = word;
+            while x != 0 {
+                let s = w * 64 + x.trailing_zeros() as usize;
+                x &= x - 1;
+                if s < self.len {
+                    let t = self.order.triangle(s as u32) as usize;
+                    out[t / 64] |= 1 << (t % 64);
+                }
+            }
+        }
+    }
+
     /// The triangle of mesh `mesh` in slot `s` (the identity when the order does not fit).
     #[inline]
     fn tri(&self, s: usize) -> usize {
@@ -577,6 +601,9 @@ mod tests {
                     assert_eq!(ordered.bit(&bits, t), (want[t as usize / 64] >> (t % 64)) & 1 != 0);
                     assert_eq!(ordered.bit(&bits, t), (bits[s as usize / 64] >> (s % 64)) & 1 != 0);
                 }
+                let mut unpermuted = Vec::new();
+                ordered.unpermute(&bits, &mut unpermuted);
+                assert_eq!(unpermuted, want);
                 let mut threaded = Vec::new();
                 ordered.facing_packed_threads(&m, l, flip, 3, &mut threaded);
                 assert_eq!(threaded, bits);

@@ -42,7 +42,7 @@
 use super::caster::{Caster, CasterKind};
 
 use crate::geom::bounds::{box_distance, light_depth_bounds, light_scissor, shadow_volume_outside_frustum, Frustum, OcclusionPyramid};
-use crate::geom::silhouette::{FacePlanes, SilhouetteEdge};
+use crate::geom::silhouette::{packed_bit, SilhouetteEdge};
 use crate::geom::Aabb;
 use crate::geom::{Light, LightKind};
 use glam::Vec4;
@@ -139,17 +139,13 @@ impl FacingSet for [bool] {
     }
 }
 
-/// Packed facing bits in the caster's scan order, looked up by welded triangle id (see
-/// [`FacingSet`]).
-struct Packed<'a> {
-    bits: &'a [u64],
-    planes: &'a FacePlanes,
-}
+/// Packed facing bits in welded triangle order (see [`FacingSet`]).
+struct Packed<'a>(&'a [u64]);
 
 impl FacingSet for Packed<'_> {
     #[inline]
     fn get(&self, t: u32) -> bool {
-        self.planes.bit(self.bits, t)
+        packed_bit(self.0, t)
     }
 }
 
@@ -325,20 +321,21 @@ struct PartJob {
     case: Case,
 }
 
-/// Plans one part of a caster for which the facing `bits` are decided; returns the part plan
-/// and its draws.
+/// Plans one part of a caster for which the facing `bits` are decided (in the caster's scan
+/// order, for the edge scan; `tri_bits`: the same bits in welded triangle order, for the
+/// per-triangle work); returns the part plan and its draws.
 fn plan_part(
     input: &PlanInput,
     caster: &Caster,
     job: PartJob,
     l_obj: Vec4,
-    bits: &[u64],
+    (bits, tri_bits): (&[u64], &[u64]),
     sil: &mut Vec<SilhouetteEdge>,
 ) -> (PartPlan, Vec<ChunkDraw>) {
     let PartJob { part: pi, multiplicity, case } = job;
     let part = &caster.parts[pi];
     let directional = l_obj.w == 0.0;
-    let facing = Packed { bits, planes: &caster.planes };
+    let facing = Packed(tri_bits);
     let inside = !directional && part.object_bounds.contains(l_obj.truncate());
     if multiplicity {
         let mult = edge_multiplicities_with(caster, &part.edges, &facing);
@@ -398,6 +395,11 @@ fn plan_part(
     (pp, draws)
 }
 
+/// True when emitting `e` walks every triangle's facing bit (caps), not only the silhouette.
+fn needs_triangles(e: Emit) -> bool {
+    e.light_cap || matches!(e.dark_cap, DarkCap::FrontFaces | DarkCap::BackFaces)
+}
+
 /// Plans every caster's shadow volume for one light.
 pub fn plan_light(input: &PlanInput, casters: &[Caster]) -> LightPlan {
     plan_light_opts(input, casters, false)
@@ -424,6 +426,7 @@ pub fn plan_light_with(input: &PlanInput, casters: &[Caster], opts: &PlanOptions
     let mut sil_time = 0.0f64;
     let mut plans = Vec::with_capacity(casters.len());
     let mut bits = Vec::new();
+    let mut tri_bits = Vec::new();
     let mut sil = Vec::new();
     for (ci, caster) in casters.iter().enumerate() {
         let wb = caster.world_bounds();
@@ -482,6 +485,7 @@ pub fn plan_light_with(input: &PlanInput, casters: &[Caster], opts: &PlanOptions
             cp.path = VolumePath::Compute;
         }
         let mut best = 0u8;
+        let mut tri_bits_for = None;
         for (pi, &case) in cases.iter().enumerate() {
             let part = &caster.parts[pi];
             let multiplicity = whole_multiplicity || part.kind != CasterKind::Manifold;
@@ -501,7 +505,21 @@ pub fn plan_light_with(input: &PlanInput, casters: &[Caster], opts: &PlanOptions
                 cp.parts.push(PartPlan::undrawn(pi, case, path, DarkCap::None, Formulation::Front));
                 continue;
             }
-            let (pp, draws) = plan_part(input, caster, PartJob { part: pi, multiplicity, case }, l_obj, &bits, &mut sil);
+            let permuted = !caster.planes.order().is_identity();
+            if permuted && tri_bits_for != Some(ci) && (multiplicity || needs_triangles(manifold_emit(input.method, part, case, l_obj))) {
+                // walking triangles: the bits in welded order once, not a permutation lookup each
+                caster.planes.unpermute(&bits, &mut tri_bits);
+                tri_bits_for = Some(ci);
+            }
+            // (a part that walks no triangle reads no bit of `tb`)
+            let tb: &[u64] = if !permuted {
+                &bits
+            } else if tri_bits_for == Some(ci) {
+                &tri_bits
+            } else {
+                &[]
+            };
+            let (pp, draws) = plan_part(input, caster, PartJob { part: pi, multiplicity, case }, l_obj, (&bits, tb), &mut sil);
             cp.silhouette_edges += pp.silhouette_edges;
             cp.multiplicity_max = cp.multiplicity_max.max(pp.multiplicity_max);
             cp.sides += pp.sides;
