@@ -259,8 +259,8 @@ mod tests {
     }
 
     #[test]
-    fn scan_table_reused_across_meshes() {
-        // the per-thread table is reused: larger and smaller meshes in turn, and bits shorter
+    fn scan_scratch_reused_across_meshes() {
+        // the per-thread run tables are reused: larger and smaller meshes in turn, and bits shorter
         // than the triangle ids (the missing triangles read as not facing, never stale bytes)
         let big = Topology::build(&uv_sphere(1.0, 60, 31));
         let small = Topology::build(&cube(Vec3::ZERO, 1.0));
