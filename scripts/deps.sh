@@ -117,7 +117,7 @@ else
     xvfb xauth xdotool libxkbcommon-x11-0 libxcursor1 libxrandr2 libxi6 libx11-xcb1; do
     have_pkg "$p" || need+=("$p")
   done
-  if ! command -v cc >/dev/null 2>&1; then need+=(build-essential); fi
+  if ! command -v cc >/dev/null 2>&1 || ! command -v c++ >/dev/null 2>&1; then need+=(build-essential); fi  # meshopt builds C++
   if ! command -v curl >/dev/null 2>&1 && ! command -v cargo >/dev/null 2>&1; then need+=(curl ca-certificates); fi
 
   if [ ${#need[@]} -gt 0 ]; then

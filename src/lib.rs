@@ -15,8 +15,8 @@
 //!
 //! - `cli` (default): everything above, and the crates it needs (tobj, image, clap, serde, toml,
 //!   serde_json). An engine depends on umbrage with `default-features = false` and gets
-//!   [`geom`], [`shadow`], [`pass`], [`gpu`] and [`Error`] on ash, glam, gpu-allocator, robust, thiserror
-//!   and bytemuck only.
+//!   [`geom`], [`shadow`], [`pass`], [`gpu`] and [`Error`] on ash, glam, gpu-allocator, robust, thiserror,
+//!   bytemuck and meshopt (which builds meshoptimizer's C++: a C++ compiler is needed) only.
 //! - `serde` (enabled by `cli`): `serde::Serialize` on the planner's public types.
 //!
 //! # Example
