@@ -1,8 +1,8 @@
 use super::*;
 use crate::geom::silhouette::facing_bits;
 use crate::geom::testmesh::{cube, signed_volume, torus, uv_sphere};
-use crate::geom::Camera;
 use crate::geom::Mesh;
+use crate::geom::{Camera, Light};
 use glam::Mat4;
 use glam::{DVec3, Vec3};
 use std::collections::HashMap;

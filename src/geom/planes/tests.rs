@@ -1,0 +1,139 @@
+//! `FacePlanes` against the exact predicate: block bounds, super-blocks and scan orders.
+
+use super::*;
+use crate::geom::testmesh::uv_sphere;
+use proptest::prelude::*;
+
+impl FacePlanes {
+    /// Blocks the light decides whole (no per-triangle dot products).
+    fn decided_blocks(&self, l: Vec4, flip: bool) -> usize {
+        let Some((lf, e)) = self.error_bound(l) else { return 0 };
+        let lf = if flip { -lf } else { lf };
+        self.blocks.iter().filter(|b| b.decide(lf, e as f64).is_some()).count()
+    }
+}
+
+fn exact(m: &Mesh, l: Vec4, flip: bool) -> Vec<u64> {
+    let mut w = vec![0u64; m.triangles.len().div_ceil(64)];
+    for t in 0..m.triangles.len() {
+        if exact_bit(m, t, l, flip) {
+            w[t / 64] |= 1 << (t % 64);
+        }
+    }
+    w
+}
+
+#[test]
+fn whole_blocks_decided_and_exact() {
+    let mut bits = Vec::new();
+    for (r, off) in [(1.0f32, Vec3::ZERO), (1e-3, Vec3::splat(1e4)), (5e3, Vec3::new(-3e6, 2e6, 1e6))] {
+        let mut m = uv_sphere(r, 400, 201);
+        for p in &mut m.positions {
+            *p += off;
+        }
+        let planes = FacePlanes::new(&m);
+        for l in [
+            (off + Vec3::new(3.0, 2.0, 1.0) * r).extend(1.0),
+            (off + Vec3::new(0.0, 1.0001, 0.0) * r).extend(1.0),
+            Vec3::new(-1.0, 0.5, 0.2).extend(0.0),
+            (off * 2.0 + Vec3::new(6.0, 4.0, 2.0) * r).extend(2.0),
+        ] {
+            for flip in [false, true] {
+                planes.facing_packed(&m, l, flip, &mut bits);
+                assert_eq!(bits, exact(&m, l, flip), "r {r} off {off} light {l} flip {flip}");
+            }
+            if off == Vec3::ZERO && l.w != 0.0 && l.y != 1.0001 {
+                let decided = planes.decided_blocks(l, false);
+                assert!(decided * 2 > planes.blocks.len(), "{decided} of {} blocks decided", planes.blocks.len());
+            }
+        }
+    }
+}
+
+#[test]
+fn ordered_planes_give_the_permuted_bits() {
+    // a shuffled sphere: in its own order few blocks are decidable; in the spatial order
+    // most are, and every bit is the exact one of the triangle in its slot
+    let m = crate::geom::testmesh::shuffled(&uv_sphere(1.0, 200, 101));
+    let all: Vec<u32> = (0..m.triangles.len() as u32).collect();
+    let order = TriangleOrder::spatial(&m, &[&all]);
+    let (own, ordered) = (FacePlanes::new(&m), FacePlanes::with_order(&m, order.clone()));
+    assert_eq!(ordered.order(), &order);
+    let mut far = m.clone();
+    far.positions[0] *= 1e30; // out of the filter's range: every triangle exact
+    let far_planes = FacePlanes::with_order(&far, order.clone());
+    let mut bits = Vec::new();
+    for l in [Vec4::new(3.0, 2.0, 1.0, 1.0), Vec4::new(0.0, 0.99, 0.0, 1.0), Vec4::new(-1.0, 0.5, 0.2, 0.0)] {
+        for flip in [false, true] {
+            let want = exact(&m, l, flip);
+            ordered.facing_packed(&m, l, flip, &mut bits);
+            for t in 0..m.triangles.len() as u32 {
+                let s = order.slot(t);
+                assert_eq!(ordered.bit(&bits, t), (want[t as usize / 64] >> (t % 64)) & 1 != 0);
+                assert_eq!(ordered.bit(&bits, t), (bits[s as usize / 64] >> (s % 64)) & 1 != 0);
+            }
+            let mut unpermuted = Vec::new();
+            ordered.unpermute(&bits, &mut unpermuted);
+            assert_eq!(unpermuted, want);
+            let mut threaded = Vec::new();
+            ordered.facing_packed_threads(&m, l, flip, 3, &mut threaded);
+            assert_eq!(threaded, bits);
+            let want_far = exact(&far, l, flip);
+            far_planes.facing_packed(&far, l, flip, &mut bits);
+            for t in 0..m.triangles.len() as u32 {
+                assert_eq!(far_planes.bit(&bits, t), (want_far[t as usize / 64] >> (t % 64)) & 1 != 0);
+            }
+        }
+        if l.w != 0.0 && l.y != 0.99 {
+            let (a, b) = (own.decided_blocks(l, false), ordered.decided_blocks(l, false));
+            assert!(a * 10 < own.blocks.len() && b * 2 > ordered.blocks.len(), "{a} / {b} of {} blocks decided", own.blocks.len());
+        }
+    }
+    // the GPU's planes stay in triangle order
+    let (p0, p1) = (own.planes_xyzd(), ordered.planes_xyzd());
+    assert_eq!(p0, p1);
+    // a mesh with another triangle count: every triangle exact, in the mesh's order
+    let mut fewer = m.clone();
+    fewer.triangles.truncate(100);
+    ordered.facing_packed(&fewer, Vec4::new(3.0, 2.0, 1.0, 1.0), false, &mut bits);
+    assert_eq!(bits, exact(&fewer, Vec4::new(3.0, 2.0, 1.0, 1.0), false));
+    let mut re = ordered.clone();
+    re.recompute(&fewer);
+    assert!(re.order().is_identity());
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(48))]
+    #[test]
+    fn flat_grids_lights_a_hair_off_the_plane(z in -1e-3f32..1e-3, h in prop_oneof![Just(0.0f32), -1e-6f32..1e-6, -1e-3f32..1e-3], x in -50f32..50.0, big in prop_oneof![Just(1.0f32), Just(1e5)]) {
+        // 8 blocks of exactly coplanar (or tilted by h) triangles: their spread is zero,
+        // so the block test decides them from lights barely off the plane; it must never
+        // disagree with the exact predicate
+        let mut positions = Vec::new();
+        for i in 0..17 {
+            for j in 0..17 {
+                positions.push(Vec3::new(i as f32, j as f32, z + (i as f32) * h) * big);
+            }
+        }
+        let mut triangles = Vec::new();
+        for i in 0..16u32 {
+            for j in 0..16u32 {
+                let v = i * 17 + j;
+                triangles.push([v, v + 17, v + 1]);
+                triangles.push([v + 1, v + 17, v + 18]);
+            }
+        }
+        let m = Mesh { positions, triangles };
+        let planes = FacePlanes::new(&m);
+        let mut bits = Vec::new();
+        for lz in [0.0f32, 1e-7, -1e-7, 1e-4, 3.0] {
+            let l = (Vec3::new(x, 4.0, z + lz) * big).extend(1.0);
+            for flip in [false, true] {
+                planes.facing_packed(&m, l, flip, &mut bits);
+                prop_assert_eq!(&bits, &exact(&m, l, flip));
+            }
+        }
+        let far = Vec3::new(x, 4.0, z + 3.0) * big;
+        prop_assert!(planes.decided_blocks(far.extend(1.0), false) > 0 || h.abs() > 1e-4);
+    }
+}
