@@ -59,7 +59,7 @@ impl ShadowView {
             ));
         }
         let r = glam::DMat3::from_mat4(v);
-        if !(r * r.transpose()).abs_diff_eq(glam::DMat3::IDENTITY, 1e-4) || (v.row(3) - glam::DVec4::W).length() > 1e-9 {
+        if !orthonormal(&r) || (v.row(3) - glam::DVec4::W).length() > 1e-9 {
             return Err(Error::argument("ShadowView::from_view_matrix", "the view matrix is not a rotation and a translation"));
         }
         let rotation = Mat4::from_mat3(glam::Mat3::from_mat4(view));
@@ -92,7 +92,7 @@ impl ShadowView {
         }
         let v = self.view.as_dmat4();
         let r = glam::DMat3::from_mat4(v);
-        let rigid = (r * r.transpose()).abs_diff_eq(glam::DMat3::IDENTITY, 1e-4) && r.determinant() > 0.0;
+        let rigid = orthonormal(&r) && r.determinant() > 0.0;
         if !rigid || v.w_axis != glam::DVec4::W || (v.row(3) - glam::DVec4::W).length() != 0.0 {
             return Err(Error::argument(
                 "ShadowView::view",
@@ -111,4 +111,9 @@ impl ShadowView {
         }
         Ok(())
     }
+}
+
+/// Whether `r`'s columns are orthonormal to 1e-4 (a rotation, or a rotation and a mirror).
+fn orthonormal(r: &glam::DMat3) -> bool {
+    (*r * r.transpose()).abs_diff_eq(glam::DMat3::IDENTITY, 1e-4)
 }
