@@ -57,7 +57,7 @@ impl Renderer {
     /// ones carries a warning naming the defect.
     ///
     /// # Errors
-    /// [`Error::InvalidDesc`] when `at` does not hold one finite location in [0, 1)² per
+    /// [`Error::InvalidDesc`](crate::Error::InvalidDesc) when `at` does not hold one finite location in [0, 1)² per
     /// sample of the frame.
     pub fn use_sample_depth_locations(&mut self, at: &[(f64, f64)]) -> Result<()> {
         let n = self.own.parts.config.samples as usize;
