@@ -1,23 +1,36 @@
-// GPU possible silhouettes (`--method compute`): per caster and light, two passes.
+// GPU possible silhouettes (`--method compute`): every (light, caster) pair of the frame in
+// one dispatch per stage, whatever the number of casters.
 //
-// `facing` (one invocation a triangle), then `exact` (the few triangles `facing` could not
-// decide): the facing bit from the caster's static object-space
-// plane, exactly as the CPU's `FacePlanes::facing_packed` decides it: the f32 plane value is
-// trusted only beyond the CPU's proven error bound (`bound`, computed on the CPU per caster
-// and light), and every other triangle, degenerate ones included (their planes are zero), is
-// decided by the EXACT sign of orient3d of its f32 vertices, evaluated here as a sum of
-// 48 (point light) or 24 (directional) products of three f32 values in a fixed-point
-// accumulator of 12-bit limbs (no rounding at all). The bits are therefore the CPU's, bit for
-// bit, and every edge is derived from one bit per triangle: the volume is closed by
-// construction. (The exact test is its own entry point: in the filter's entry its code made
-// lavapipe ten times slower on every triangle.)
+// The casters' static tables live in one pass-wide arena (planes, triangles, positions,
+// edges: one storage buffer each); the frame's job table gives each (light, caster) pair its
+// object-space light, filter, arena offsets, chunk records and facing bits, and the first
+// workgroup it owns in each stage (a prefix over the jobs: a workgroup finds its job by a
+// binary search, uniform across the workgroup). Stages (`cmd_compute_silhouettes`):
 //
-// `edges` (one invocation a triangle and a manifold edge): the triangle's face caps (dark cap
-// of front or back faces, light cap) for the chunks whose case needs them, and an edge whose two triangles' bits differ is a
-// possible silhouette edge; its side quad (and, for McGuire's fan dark cap, one fan triangle)
-// go to the chunk of the light-facing triangle (front formulation) or of the other one (back
-// formulation, the light inside the part's bounds), with the same winding as the CPU's
-// `shadow::plan::emit`.
+// 1. `facing`, a workgroup per GROUP triangles of a job: the facing bit, exactly as the
+//    CPU's `FacePlanes::facing_packed` decides it: the f32 plane value is trusted only beyond
+//    the CPU's proven error bound (`bound`, computed on the CPU per caster and light). A
+//    light-facing triangle sets its bit (the words were cleared by a fill). Every triangle the
+//    filter cannot decide (grazing light, degenerate triangles) goes to the frame's exact
+//    list, whose indirect dispatch size the same atomics keep up to date.
+// 2. `exact` (indirect, over the exact list): the EXACT sign of orient3d of the triangle's f32
+//    vertices, evaluated as a sum of 48 (point light) or 24 (directional) products of three
+//    f32 values in a fixed-point accumulator of 12-bit limbs (no rounding at all). The bits are
+//    therefore the CPU's, bit for bit, and every edge is derived from one bit per triangle:
+//    the volume is closed by construction. (Its own stage: in the filter's, its code made
+//    lavapipe ten times slower on every triangle.)
+// 3. `find`, a workgroup per GROUP manifold edges of a job: an edge whose two triangles' bits
+//    differ is a possible silhouette edge, appended to the frame's silhouette list (an atomic
+//    per silhouette edge: O(sqrt(n)) of n). Nothing else happens per edge: on lavapipe a
+//    branch's code costs every lane whether it is taken or not, and the emitting code in this
+//    stage made it 190 ms instead of 13 at 490k triangles. (A workgroup aggregation of the
+//    appends, with two workgroup barriers, measured no faster there: 25-27 ms either way.)
+//    `caps`, in the same barrier interval, a workgroup per GROUP triangles of the jobs whose
+//    chunks need face caps (dark cap of front or back faces, light cap): the caps.
+// 4. `emit` (indirect, over the silhouette list): each edge's side quad (one triangle for a
+//    directional light) and, for McGuire's fan dark cap, its fan triangle, into the chunk of
+//    the light-facing triangle (front formulation) or of the other one (back formulation, the
+//    light inside the part's bounds), with the same winding as the CPU's `shadow::plan::emit`.
 //
 // Output: 16-bit indices into the chunk's dual-length vertex buffer (index i < n: (p, 1),
 // i + n: (p, 0)), packed two to a u32 word. A chunk's region is allocated with an atomic add
@@ -27,31 +40,52 @@
 // past the region is not made and flags the record's overflow word instead (never silent).
 
 struct Push {
+    jobs: u32,
+    // Workgroups of the `facing`, `find` and `caps` stages (the sums over the jobs).
+    facing_groups: u32,
+    find_groups: u32,
+    cap_groups: u32,
+    // Entry offset of the silhouette list in `lists` (the exact list starts at 0).
+    sil_base: u32,
+    // Steps of the binary search over the jobs: ceil(log2(jobs)).
+    steps: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+// One (light, caster) pair (`pass::compute::frame::GpuJob`).
+struct Job {
     // The light in the caster's object space (w = 1 point, w = 0 directional), f32 as the
     // CPU planner has it.
     light: vec4<f32>,
-    // The plane filter's light (negated for mirroring transforms), and its error bound
-    // (+inf: every triangle exact).
+    // The plane filter's light (negated for mirroring transforms).
     filt: vec4<f32>,
+    // The filter's error bound (+inf: every triangle exact).
     bound: f32,
     // 1: mirroring transform (triangle corners 1 and 2 swapped for the exact test).
     flip: u32,
     tris: u32,
     edges: u32,
-    // Word offset of this caster's chunk records for this light.
+    // The caster's first element in each arena table.
+    plane_base: u32,
+    tri_base: u32,
+    pos_base: u32,
+    edge_base: u32,
+    // Word offset of the pair's chunk records.
     rec_base: u32,
-    // Offset of this caster and light's facing words (2 per triangle: the bits, then the list
-    // of triangles the filter left to the exact test).
+    // Word offset of the pair's facing bits (a bit per triangle, whole workgroups).
     fac_base: u32,
-    // Word offset of this caster and light's job header in the records (word 0: the length
-    // of the exact list).
-    job_base: u32,
-    // 1: some chunk of this job has face caps (dark cap of front or back faces, light cap).
-    caps: u32,
+    // The pair's first workgroup in the `facing`, `find` and `caps` stages.
+    g_facing: u32,
+    g_find: u32,
+    g_caps: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 struct Tri {
-    // welded vertex ids (positions)
+    // welded vertex ids (positions, relative to the caster's first)
     g: vec4<u32>,
     // chunk-local corner indices, chunk in w
     l: vec4<u32>,
@@ -61,11 +95,21 @@ struct Tri {
 @group(0) @binding(1) var<storage, read> tris: array<Tri>;
 @group(0) @binding(2) var<storage, read> positions: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read> edge_table: array<vec4<u32>>;
-@group(0) @binding(4) var<storage, read_write> facing_bits: array<u32>;
-@group(0) @binding(5) var<storage, read_write> records: array<atomic<u32>>;
-@group(0) @binding(6) var<storage, read_write> out_words: array<atomic<u32>>;
+@group(0) @binding(4) var<storage, read> jobs: array<Job>;
+@group(0) @binding(5) var<storage, read_write> facing_bits: array<atomic<u32>>;
+@group(0) @binding(6) var<storage, read_write> records: array<atomic<u32>>;
+@group(0) @binding(7) var<storage, read_write> out_words: array<atomic<u32>>;
+@group(0) @binding(8) var<storage, read_write> lists: array<vec2<u32>>;
 
 var<immediate> pc: Push;
+
+// The frame's header at the start of `records` (`pass::compute::rec::H_*`): the two lists'
+// lengths and their indirect dispatch commands (x, y, z).
+const H_EXACT: u32 = 0u;
+const H_EXACT_X: u32 = 1u;
+const H_SIL: u32 = 4u;
+const H_SIL_X: u32 = 5u;
+const MAX_GROUPS: u32 = 65535u;
 
 // Chunk record layout (u32 words, RECORD_WORDS a chunk): the volume's indirect command
 // (0..5), the light cap's (5..10), then counters and parameters.
@@ -91,6 +135,58 @@ const F_LIGHT_CAP: u32 = 32u;
 const DC_FAN: u32 = 1u;
 const DC_FRONT: u32 = 2u;
 const DC_BACK: u32 = 3u;
+
+// Triangles (facing, caps) or edges (find) of one job a workgroup (`pass::compute::GROUP`).
+const GROUP: u32 = 256u;
+
+const STAGE_FACING: u32 = 0u;
+const STAGE_FIND: u32 = 1u;
+const STAGE_CAPS: u32 = 2u;
+
+
+// ---- jobs ----
+
+// (One field read, not the whole job: this runs log2(jobs) times per invocation.)
+fn first_group(j: u32, stage: u32) -> u32 {
+    if (stage == STAGE_FACING) {
+        return jobs[j].g_facing;
+    }
+    if (stage == STAGE_FIND) {
+        return jobs[j].g_find;
+    }
+    return jobs[j].g_caps;
+}
+
+// The job owning workgroup `w` of `stage`: the last job whose first group is at most `w`
+// (jobs with no group in the stage share the next one's first group and are passed over).
+// `pc.steps` = ceil(log2(jobs)) steps, no early exit: uniform control flow.
+fn job_of(w: u32, stage: u32) -> u32 {
+    var lo = 0u;
+    var hi = pc.jobs;
+    for (var i = 0u; i < pc.steps; i = i + 1u) {
+        let open = lo + 1u < hi;
+        let mid = (lo + hi) / 2u;
+        let le = first_group(min(mid, pc.jobs - 1u), stage) <= w;
+        lo = select(lo, mid, open && le);
+        hi = select(hi, mid, open && !le);
+    }
+    return lo;
+}
+
+// The linear workgroup index of a stage dispatched as (min(n, 65535), ceil(n / 65535)).
+fn group_index(wg: vec3<u32>, nwg: vec3<u32>) -> u32 {
+    return wg.x + wg.y * nwg.x;
+}
+
+fn facing_bit(job: Job, t: u32) -> bool {
+    return ((atomicLoad(&facing_bits[job.fac_base + (t >> 5u)]) >> (t & 31u)) & 1u) != 0u;
+}
+
+// Appends to a list whose indirect dispatch command is at `x_word`: its x grows to cover
+// entry `k` (64 entries a workgroup; the stage strides beyond 65535 workgroups).
+fn grow_dispatch(x_word: u32, end: u32) {
+    atomicMax(&records[x_word], min((end + 63u) / 64u, MAX_GROUPS));
+}
 
 // ---- exact orient3d: fixed-point sum of products of three f32 values ----
 
@@ -192,25 +288,26 @@ fn acc_sign() -> i32 {
     return 0;
 }
 
+
 // Exact facing: point light: det[p0 - L, p1 - L, p2 - L] < 0; directional:
 // det[p1 - p0, p2 - p0, d] > 0 (`geom::predicates::facing_exact`). The determinant is the
 // sum over the six permutations (i, j, k) of its rows' components, each a product of three
 // differences expanded into its terms: point light, rows (x0 - x1) (y0 - y1) (z0 - z1) with
 // x = (p0, L), y = (p1, L), z = (p2, L): 8 terms; directional, x = (p1, p0), y = (p2, p0),
 // z = d: 4 terms. One loop over the 48 (or 24) terms, so `add3` is inlined once.
-fn facing_exact(t: u32) -> bool {
-    let tri = tris[t];
+fn facing_exact(job: Job, t: u32) -> bool {
+    let tri = tris[job.tri_base + t];
     var i1 = tri.g.y;
     var i2 = tri.g.z;
-    if (pc.flip != 0u) {
+    if (job.flip != 0u) {
         i1 = tri.g.z;
         i2 = tri.g.y;
     }
-    let p0 = positions[tri.g.x].xyz;
-    let p1 = positions[i1].xyz;
-    let p2 = positions[i2].xyz;
-    let l = pc.light.xyz;
-    let point = pc.light.w != 0.0;
+    let p0 = positions[job.pos_base + tri.g.x].xyz;
+    let p1 = positions[job.pos_base + i1].xyz;
+    let p2 = positions[job.pos_base + i2].xyz;
+    let l = job.light.xyz;
+    let point = job.light.w != 0.0;
     let x0 = select(p1, p0, point);
     let x1 = select(p0, l, point);
     let y0 = select(p2, p1, point);
@@ -237,13 +334,13 @@ fn facing_exact(t: u32) -> bool {
 }
 
 // The filter's verdict: 1 light-facing, 0 not, 2 undecided (the exact test decides).
-fn filtered(t: u32) -> u32 {
-    let pl = planes[t];
-    let f = pc.filt;
+fn filtered(job: Job, t: u32) -> u32 {
+    let pl = planes[job.plane_base + t];
+    let f = job.filt;
     // the CPU's order: ((nx lx + ny ly) + nz lz) + d lw
     let v = ((pl.x * f.x + pl.y * f.y) + pl.z * f.z) + pl.w * f.w;
-    if (abs(v) > pc.bound) {
-        return select(0u, 1u, v > pc.bound);
+    if (abs(v) > job.bound) {
+        return select(0u, 1u, v > job.bound);
     }
     return 2u;
 }
@@ -298,41 +395,79 @@ fn emit(r: u32, cap: bool, idx: array<u32, 9>, count: u32) {
     put(atomicLoad(&records[r + first]) + at, idx, count);
 }
 
-fn total_threads(nwg: vec3<u32>) -> u32 {
-    return nwg.x * 64u;
-}
+// ---- stages ----
 
-// Pass 1: the filter. Undecided triangles are listed for pass 2 (rare: grazing light,
-// degenerate triangles; all of them for meshes beyond the filter's range).
-@compute @workgroup_size(64)
-fn facing(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let stride = total_threads(nwg);
-    for (var t = gid.x; t < pc.tris; t = t + stride) {
-        let v = filtered(t);
-        facing_bits[pc.fac_base + t] = v & 1u;
+// Stage 1: the plane filter, GROUP triangles of one job a workgroup (the facing words were
+// cleared by the frame's fill).
+@compute @workgroup_size(GROUP)
+fn facing(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>,
+          @builtin(local_invocation_index) lid: u32) {
+    let w = group_index(wg, nwg);
+    let j = job_of(w, STAGE_FACING);
+    let job = jobs[j];
+    let local = w - job.g_facing;
+    let t = local * GROUP + lid;
+    if (w < pc.facing_groups && t < job.tris) {
+        let v = filtered(job, t);
+        if (v == 1u) {
+            atomicOr(&facing_bits[job.fac_base + (t >> 5u)], 1u << (t & 31u));
+        }
         if (v == 2u) {
-            let k = atomicAdd(&records[pc.job_base], 1u);
-            facing_bits[pc.fac_base + pc.tris + k] = t;
+            let k = atomicAdd(&records[H_EXACT], 1u);
+            lists[k] = vec2<u32>(j, t);
+            grow_dispatch(H_EXACT_X, k + 1u);
         }
     }
 }
 
-// Pass 2: the exact test for the listed triangles (a few workgroups striding over the list,
-// so that the common case, an empty list, costs nothing).
+// Stage 2: the exact test for the listed triangles (indirect: as many workgroups as the list
+// needs, striding beyond the dispatch limit).
 @compute @workgroup_size(64)
 fn exact(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let stride = total_threads(nwg);
-    let count = atomicLoad(&records[pc.job_base]);
+    let stride = nwg.x * 64u;
+    let count = atomicLoad(&records[H_EXACT]);
     for (var k = gid.x; k < count; k = k + stride) {
-        let t = facing_bits[pc.fac_base + pc.tris + k];
-        facing_bits[pc.fac_base + t] = select(0u, 1u, facing_exact(t));
+        let e = lists[k];
+        let job = jobs[e.x];
+        if (facing_exact(job, e.y)) {
+            atomicOr(&facing_bits[job.fac_base + (e.y >> 5u)], 1u << (e.y & 31u));
+        }
     }
 }
 
-fn face_caps(t: u32) {
-    let f = facing_bits[pc.fac_base + t] != 0u;
-    let tri = tris[t];
-    let r = pc.rec_base + tri.l.w * RECORD_WORDS;
+// Stage 3a: possible silhouette edges, GROUP edges of one job a workgroup, appended to the
+// silhouette list (an atomic per silhouette edge: they are few).
+@compute @workgroup_size(GROUP)
+fn find(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>,
+        @builtin(local_invocation_index) lid: u32) {
+    let w = group_index(wg, nwg);
+    let j = job_of(w, STAGE_FIND);
+    let job = jobs[j];
+    let i = (w - job.g_find) * GROUP + lid;
+    if (w < pc.find_groups && i < job.edges) {
+        let e = edge_table[job.edge_base + i];
+        if (facing_bit(job, e.x) != facing_bit(job, e.y)) {
+            let k = atomicAdd(&records[H_SIL], 1u);
+            lists[pc.sil_base + k] = vec2<u32>(j, i);
+            grow_dispatch(H_SIL_X, k + 1u);
+        }
+    }
+}
+
+// Stage 3b: triangle t's face caps (dark cap of front or back faces, light cap) for the
+// chunks whose case needs them; GROUP triangles of one job with caps a workgroup.
+@compute @workgroup_size(GROUP)
+fn caps(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>,
+        @builtin(local_invocation_index) lid: u32) {
+    let w = group_index(wg, nwg);
+    let job = jobs[job_of(w, STAGE_CAPS)];
+    let t = (w - job.g_caps) * GROUP + lid;
+    if (w >= pc.cap_groups || t >= job.tris) {
+        return;
+    }
+    let f = facing_bit(job, t);
+    let tri = tris[job.tri_base + t];
+    let r = job.rec_base + tri.l.w * RECORD_WORDS;
     let flags = atomicLoad(&records[r + R_FLAGS]);
     if ((flags & F_ENABLED) == 0u) {
         return;
@@ -371,75 +506,69 @@ fn corner(l: vec4<u32>, k: u32) -> u32 {
     return l.z;
 }
 
-// Pass 3: triangle i's face caps (when its chunk's case needs them) and edge i's side.
-@compute @workgroup_size(64)
-fn edges(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let stride = total_threads(nwg);
-    var n = pc.edges;
-    if (pc.caps != 0u) {
-        n = max(pc.tris, pc.edges);
+// The side (and fan triangle) of silhouette edge `i` of job `j`.
+fn side(j: u32, i: u32) {
+    let job = jobs[j];
+    let e = edge_table[job.edge_base + i];
+    let f0 = facing_bit(job, e.x);
+    // lit: the light-facing triangle and the corner where a -> b starts in it
+    var lit = e.x;
+    var lit_c = e.z & 0xffu;
+    var unlit = e.y;
+    var unlit_c = (e.z >> 8u) & 0xffu;
+    if (!f0) {
+        lit = e.y;
+        lit_c = (e.z >> 8u) & 0xffu;
+        unlit = e.x;
+        unlit_c = e.z & 0xffu;
     }
-    for (var i = gid.x; i < n; i = i + stride) {
-        if (pc.caps != 0u && i < pc.tris) {
-            face_caps(i);
-        }
-        if (i >= pc.edges) {
-            continue;
-        }
-        let e = edge_table[i];
-        let f0 = facing_bits[pc.fac_base + e.x];
-        let f1 = facing_bits[pc.fac_base + e.y];
-        if (f0 == f1) {
-            continue;
-        }
-        // lit: the light-facing triangle and the corner where a -> b starts in it
-        var lit = e.x;
-        var lit_c = e.z & 0xffu;
-        var unlit = e.y;
-        var unlit_c = (e.z >> 8u) & 0xffu;
-        if (f0 == 0u) {
-            lit = e.y;
-            lit_c = (e.z >> 8u) & 0xffu;
-            unlit = e.x;
-            unlit_c = e.z & 0xffu;
-        }
-        // which chunk's record decides: the lit triangle's (front) or the unlit one's (back)
-        let lit_tri = tris[lit];
-        let r_lit = pc.rec_base + lit_tri.l.w * RECORD_WORDS;
-        let back = (atomicLoad(&records[r_lit + R_FLAGS]) & F_BACK) != 0u;
-        var tri = lit_tri;
-        var k = lit_c;
-        if (back) {
-            tri = tris[unlit];
-            k = unlit_c;
-        }
-        let r = pc.rec_base + tri.l.w * RECORD_WORDS;
-        let flags = atomicLoad(&records[r + R_FLAGS]);
-        if ((flags & F_ENABLED) == 0u) {
-            continue;
-        }
-        let n = atomicLoad(&records[r + R_N]);
-        var a = corner(tri.l, k);
-        var b = corner(tri.l, (k + 1u) % 3u);
-        if (back) {
-            let s = a;
-            a = b;
-            b = s;
-        }
-        atomicAdd(&records[r + R_EDGES], 1u);
-        if ((flags & F_DIRECTIONAL) != 0u) {
-            emit(r, false, array<u32, 9>(b, a, a + n, 0u, 0u, 0u, 0u, 0u, 0u), 3u);
-            atomicAdd(&records[r + R_SIDES], 1u);
-            continue;
-        }
-        let dc = (flags >> 3u) & 3u;
-        if (dc == DC_FAN) {
-            let apex = n - 1u;
-            emit(r, false, array<u32, 9>(b, a, a + n, b, a + n, b + n, apex + n, b + n, a + n), 9u);
-            atomicAdd(&records[r + R_DARK], 1u);
-        } else {
-            emit(r, false, array<u32, 9>(b, a, a + n, b, a + n, b + n, 0u, 0u, 0u), 6u);
-        }
-        atomicAdd(&records[r + R_SIDES], 2u);
+    // which chunk's record decides: the lit triangle's (front) or the unlit one's (back)
+    let lit_tri = tris[job.tri_base + lit];
+    let r_lit = job.rec_base + lit_tri.l.w * RECORD_WORDS;
+    let back = (atomicLoad(&records[r_lit + R_FLAGS]) & F_BACK) != 0u;
+    var tri = lit_tri;
+    var k = lit_c;
+    if (back) {
+        tri = tris[job.tri_base + unlit];
+        k = unlit_c;
+    }
+    let r = job.rec_base + tri.l.w * RECORD_WORDS;
+    let flags = atomicLoad(&records[r + R_FLAGS]);
+    if ((flags & F_ENABLED) == 0u) {
+        return;
+    }
+    let n = atomicLoad(&records[r + R_N]);
+    var a = corner(tri.l, k);
+    var b = corner(tri.l, (k + 1u) % 3u);
+    if (back) {
+        let s = a;
+        a = b;
+        b = s;
+    }
+    atomicAdd(&records[r + R_EDGES], 1u);
+    if ((flags & F_DIRECTIONAL) != 0u) {
+        emit(r, false, array<u32, 9>(b, a, a + n, 0u, 0u, 0u, 0u, 0u, 0u), 3u);
+        atomicAdd(&records[r + R_SIDES], 1u);
+        return;
+    }
+    let dc = (flags >> 3u) & 3u;
+    if (dc == DC_FAN) {
+        let apex = n - 1u;
+        emit(r, false, array<u32, 9>(b, a, a + n, b, a + n, b + n, apex + n, b + n, a + n), 9u);
+        atomicAdd(&records[r + R_DARK], 1u);
+    } else {
+        emit(r, false, array<u32, 9>(b, a, a + n, b, a + n, b + n, 0u, 0u, 0u), 6u);
+    }
+    atomicAdd(&records[r + R_SIDES], 2u);
+}
+
+// Stage 4: the listed silhouette edges' sides (indirect, striding beyond the dispatch limit).
+@compute @workgroup_size(64)
+fn sides(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let stride = nwg.x * 64u;
+    let count = atomicLoad(&records[H_SIL]);
+    for (var k = gid.x; k < count; k = k + stride) {
+        let e = lists[pc.sil_base + k];
+        side(e.x, e.y);
     }
 }

@@ -2,7 +2,8 @@
 //! dual-length vertex buffers, uploads recorded into the host's command buffer, and deferred
 //! release once every frame in flight that could use a buffer has retired.
 
-use super::compute::{padded_bytes, ComputeMesh, ComputeStatic};
+use super::compute::arena::{add_elements, mesh_elements, ComputeArena, ELEMENT_BYTES, TABLES};
+use super::compute::{ComputeMesh, ComputeStatic};
 use super::device::PassDevice;
 use crate::error::{Error, Result};
 use crate::geom::Mesh;
@@ -27,6 +28,8 @@ pub struct CasterId {
 pub(crate) struct Upload {
     pub src: vk::Buffer,
     pub dst: vk::Buffer,
+    /// Where in `dst` the bytes go.
+    pub dst_offset: u64,
     pub size: u64,
 }
 
@@ -61,8 +64,8 @@ pub(crate) struct GpuCaster {
     pub chunks: Vec<Buffer>,
     /// Edge quads, built the first time a frame asks for them (closed opaque casters only).
     pub edge_quads: Option<EdgeQuadGpu>,
-    /// The compute pass's static tables, built the first time a frame asks for them
-    /// (opaque casters with a closed manifold part).
+    /// Where the compute pass's static tables are in the arena, placed the first time a frame
+    /// asks for them (opaque casters with a closed manifold part).
     pub compute: Option<ComputeStatic>,
     /// Bumped by every `update_positions` (the ray-query bottom levels follow it).
     pub version: u64,
@@ -88,6 +91,8 @@ pub(crate) struct CasterTable {
     /// Staging copies not yet known to have reached the GPU.
     pub pending: Vec<PendingUpload>,
     graves: Vec<Grave>,
+    /// The compute pass's static tables of every caster that has them.
+    pub arena: ComputeArena,
 }
 
 /// The dual-length vertex data of a chunk: every vertex with w = 1, then again with w = 0.
@@ -100,7 +105,15 @@ fn dual_length(vertices: &[Vec3]) -> Vec<[f32; 4]> {
 
 impl CasterTable {
     pub fn new(pass: u64) -> CasterTable {
-        CasterTable { pass, cpu: Vec::new(), live: Vec::new(), slots: Vec::new(), pending: Vec::new(), graves: Vec::new() }
+        CasterTable {
+            pass,
+            cpu: Vec::new(),
+            live: Vec::new(),
+            slots: Vec::new(),
+            pending: Vec::new(),
+            graves: Vec::new(),
+            arena: ComputeArena::default(),
+        }
     }
 
     /// Dense index of a live id of this pass.
@@ -131,9 +144,20 @@ impl CasterTable {
                 return Err(e);
             }
         };
-        let up = Upload { src: staging.raw, dst: dst.raw, size: data.len() as u64 };
+        let up = Upload { src: staging.raw, dst: dst.raw, dst_offset: 0, size: data.len() as u64 };
         self.pending.push(PendingUpload { staging, up, carried: 0 });
         Ok(dst)
+    }
+
+    /// Stages `data` for a copy into `dst` at `dst_offset` that the next frame records.
+    fn staged_into(&mut self, dev: &PassDevice, name: &str, data: &[u8], dst: vk::Buffer, dst_offset: u64) -> Result<()> {
+        if data.is_empty() {
+            return Ok(());
+        }
+        let staging = Buffer::with_data(dev, &format!("{name} (staging)"), data, vk::BufferUsageFlags::TRANSFER_SRC)?;
+        let up = Upload { src: staging.raw, dst, dst_offset, size: data.len() as u64 };
+        self.pending.push(PendingUpload { staging, up, carried: 0 });
+        Ok(())
     }
 
     fn upload_chunks(&mut self, dev: &PassDevice, caster: &Caster) -> Result<Vec<Buffer>> {
@@ -183,7 +207,7 @@ impl CasterTable {
             buffers.push(eq.indices);
         }
         if let Some(cs) = c.compute.take() {
-            buffers.extend(cs.buffers());
+            self.arena.free(cs.elements);
         }
         self.retire(buffers, all_slots);
         Ok(())
@@ -234,9 +258,10 @@ impl CasterTable {
             old.push(eq.vertices);
             old.push(eq.indices);
         }
-        // New positions: new planes and positions for the compute pass (rebuilt on demand).
+        // New positions: new planes and positions for the compute pass (placed again on
+        // demand: the old ranges stay as they are for the frames in flight).
         if let Some(cs) = entry.compute.take() {
-            old.extend(cs.buffers());
+            self.arena.free(cs.elements);
         }
         self.cpu[i] = caster;
         self.retire(old, all_slots);
@@ -262,48 +287,69 @@ impl CasterTable {
         Ok(())
     }
 
-    /// Builds the compute pass's static tables of every opaque caster with a closed manifold
-    /// part that lacks them (staged copies, recorded by the frame's `cmd_upload`).
-    pub fn ensure_compute(&mut self, dev: &PassDevice) -> Result<()> {
-        for i in 0..self.live.len() {
-            let c = &self.cpu[i];
-            if self.live[i].compute.is_some() || c.transmittance.is_some() || !c.parts.iter().any(|p| p.kind == CasterKind::Manifold) {
-                continue;
-            }
-            let m = ComputeMesh::new(c);
-            let chunk_tris = c.chunks.iter().map(|ch| ch.local_tris.len() as u32).collect();
-            let usage = vk::BufferUsageFlags::STORAGE_BUFFER;
-            let mut made: Vec<Buffer> = Vec::new();
-            let parts: [(&str, Vec<u8>); 4] = [
-                ("compute planes", padded_bytes(&m.planes, 16)),
-                ("compute triangles", padded_bytes(&m.tris, 32)),
-                ("compute positions", padded_bytes(&m.positions, 16)),
-                ("compute edges", padded_bytes(&m.edges, 16)),
-            ];
-            for (name, bytes) in parts {
-                match self.staged(dev, name, &bytes, usage) {
-                    Ok(b) => made.push(b),
-                    Err(e) => {
-                        // the staged copies already queued still refer to `made`: leave them
-                        // to the graves of the next frames (freed once no frame can use them)
-                        self.retire(made, u64::MAX);
-                        return Err(e);
-                    }
+    /// Whether caster `i` gets compute tables (opaque, with a closed manifold part).
+    fn wants_compute(&self, i: usize) -> bool {
+        let c = &self.cpu[i];
+        c.transmittance.is_none() && c.parts.iter().any(|p| p.kind == CasterKind::Manifold)
+    }
+
+    /// Places the compute pass's static tables of every opaque caster with a closed manifold
+    /// part that lacks them in the arena (staged copies, recorded by the frame's `cmd_upload`).
+    /// When they do not fit, the arena is rebuilt for every such caster (twice their size),
+    /// the old tables retired until the slots in `all_slots` have been prepared again.
+    pub fn ensure_compute(&mut self, dev: &PassDevice, all_slots: u64) -> Result<()> {
+        let todo: Vec<usize> = (0..self.live.len()).filter(|&i| self.live[i].compute.is_none() && self.wants_compute(i)).collect();
+        if todo.is_empty() {
+            return Ok(());
+        }
+        let mut meshes: Vec<(usize, ComputeMesh)> = todo.iter().map(|&i| (i, ComputeMesh::new(&self.cpu[i]))).collect();
+        let mut need = [0u64; 4];
+        for (_, m) in &meshes {
+            add_elements(&mut need, mesh_elements(m));
+        }
+        if !self.arena.fits(need) {
+            // Rebuild for every live caster's tables: the placed ones are staged again.
+            let mut live = need;
+            for g in &self.live {
+                if let Some(cs) = &g.compute {
+                    add_elements(&mut live, cs.elements);
                 }
             }
-            let mut it = made.into_iter();
-            let (Some(planes), Some(tris), Some(positions), Some(edges)) = (it.next(), it.next(), it.next(), it.next()) else {
-                return Err(Error::Internal("compute tables".into()));
-            };
+            if let Some(old) = self.arena.rebuild(dev, live)? {
+                self.retire(old.into(), all_slots);
+            }
+            for i in 0..self.live.len() {
+                if self.live[i].compute.take().is_some() {
+                    meshes.push((i, ComputeMesh::new(&self.cpu[i])));
+                }
+            }
+        }
+        let tables = self.arena.raw();
+        for (i, m) in meshes {
+            let elements = mesh_elements(&m);
+            let base = self.arena.allocate(elements);
+            let bytes: [&[u8]; 4] = [
+                bytemuck::cast_slice(&m.planes),
+                bytemuck::cast_slice(&m.tris),
+                bytemuck::cast_slice(&m.positions),
+                bytemuck::cast_slice(&m.edges),
+            ];
+            for k in 0..4 {
+                let offset = base[k] as u64 * ELEMENT_BYTES[k];
+                if let Err(e) = self.staged_into(dev, &format!("compute {}", TABLES[k]), bytes[k], tables[k], offset) {
+                    // the ranges stay allocated, unused; the copies already staged are harmless
+                    self.arena.free(elements);
+                    return Err(e);
+                }
+            }
+            let c = &self.cpu[i];
             self.live[i].compute = Some(ComputeStatic {
-                planes,
-                tris,
-                positions,
-                edges,
+                base,
+                elements,
                 triangles: m.tris.len() as u32,
                 edge_count: m.edges.len() as u32,
                 chunk_edges: m.chunk_edges,
-                chunk_tris,
+                chunk_tris: c.chunks.iter().map(|ch| ch.local_tris.len() as u32).collect(),
             });
         }
         Ok(())
@@ -371,12 +417,9 @@ impl CasterTable {
                 eq.vertices.destroy(dev);
                 eq.indices.destroy(dev);
             }
-            if let Some(cs) = c.compute.take() {
-                for mut b in cs.buffers() {
-                    b.destroy(dev);
-                }
-            }
+            c.compute = None;
         }
+        self.arena.destroy(dev);
         self.live.clear();
         self.cpu.clear();
         for mut p in self.pending.drain(..) {

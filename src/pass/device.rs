@@ -16,6 +16,9 @@ pub(crate) struct PassDevice {
     pub allocator: Arc<Mutex<Allocator>>,
     /// The host's pipeline cache ([`ShadowPassDesc::pipeline_cache`]), or null.
     pub pipeline_cache: vk::PipelineCache,
+    /// The device's `maxStorageBufferRange` (the compute pass's tables and lists are bound
+    /// whole, each at most this long).
+    pub max_storage_range: u64,
 }
 
 impl GpuDevice for PassDevice {

@@ -229,7 +229,12 @@ impl ShadowPass {
             device_caps.query_format(instance, physical_device, f);
         }
         let caps = Self::capabilities_for(&device_caps, desc)?;
-        let dev = PassDevice { device: device.clone(), allocator, pipeline_cache: desc.pipeline_cache };
+        let dev = PassDevice {
+            device: device.clone(),
+            allocator,
+            pipeline_cache: desc.pipeline_cache,
+            max_storage_range: device_caps.limits.max_storage_buffer_range as u64,
+        };
         let pipes = Pipelines::new(&dev, desc, caps.depth_clamp, caps.depth_bounds, caps.r32f_blend)?;
         let id = NEXT_PASS_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let slots = (0..desc.frames_in_flight)
@@ -499,7 +504,8 @@ impl ShadowPass {
         }
         if self.settings.technique == Technique::Compute {
             self.create_pipelines(Technique::Compute)?;
-            self.casters.ensure_compute(&self.dev)?;
+            let all = self.all_slots();
+            self.casters.ensure_compute(&self.dev, all)?;
         }
         // What the slot's previous frame recorded has reached the GPU; everything else still
         // pending rides with this frame (a dropped or abandoned frame loses nothing).

@@ -82,7 +82,7 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
             if let (Some(cf), Some(st)) = (compute.as_mut(), gpu.compute.as_ref()) {
                 if cp.parts.iter().any(|p| p.path == VolumePath::Compute && p.case != Case::Culled) {
                     let buffers: Vec<vk::Buffer> = gpu.chunks.iter().map(|b| b.raw).collect();
-                    let at = crate::pass::compute::frame::CasterAt { light: li, stat: cstats.len(), caster: cp.caster };
+                    let at = crate::pass::compute::frame::CasterAt { light: li, stat: cstats.len() };
                     cf.add_caster(at, caster, st, cp, &buffers, &mut draws);
                     fmt_used = UsedIndexFormat::U16;
                 }

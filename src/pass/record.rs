@@ -178,7 +178,7 @@ impl ShadowPass {
         // frame's slot is prepared again.
         unsafe {
             for up in &frame.uploads {
-                d.cmd_copy_buffer(cb, up.src, up.dst, &[vk::BufferCopy { src_offset: 0, dst_offset: 0, size: up.size }]);
+                d.cmd_copy_buffer(cb, up.src, up.dst, &[vk::BufferCopy { src_offset: 0, dst_offset: up.dst_offset, size: up.size }]);
             }
         }
         crate::gpu::resources::memory_barrier(
@@ -381,7 +381,7 @@ impl ShadowPass {
     /// Refuses a frame whose uploads or GPU silhouettes would have to be recorded inside the
     /// host's render pass.
     pub(super) fn check_recorded_before_rendering(&self, frame: &PreparedFrame) -> Result<()> {
-        let compute_pending = frame.compute.as_ref().is_some_and(|cf| !cf.recorded.get() && !cf.jobs.iter().all(|j| j.is_empty()));
+        let compute_pending = frame.compute.as_ref().is_some_and(|cf| !cf.recorded.get() && !cf.jobs.is_empty());
         if frame.pending_uploads() > 0 || compute_pending {
             return Err(Misuse::Order(
                 "the frame's uploads or GPU silhouettes are not recorded: call cmd_before_rendering before beginning the render pass"

@@ -9,8 +9,12 @@ pub use crate::pass::stats::{Cases, CasterStats, CpuMs, LightStats, Totals, Tria
 pub struct GpuMs {
     /// The G-buffer pass.
     pub depth: f64,
-    /// Every light's determination, summed.
+    /// Every light's determination, summed (with the GPU silhouettes of
+    /// [`Technique::Compute`](crate::pass::Technique::Compute), recorded once for every light).
     pub shadow: f64,
+    /// Of `shadow`, the GPU possible silhouettes of every light (`Technique::Compute`: the
+    /// compute pass; 0 for the other techniques).
+    pub silhouettes: f64,
     /// Every light's illumination, summed.
     pub illuminate: f64,
     /// The whole frame.

@@ -1,6 +1,7 @@
-//! One frame's layout for the compute pass: per light and caster a dispatch pair ([`Job`])
-//! and one record per chunk (in one host-visible buffer), the chunks' output regions (in one
-//! index buffer), and after the frame the counts read back into `--stats`.
+//! One frame's layout for the compute pass: per light and caster a job ([`GpuJob`]) with its
+//! first workgroup in each stage, one record per chunk (after the frame's header, in one
+//! host-visible buffer), the chunks' output regions (in one index buffer), and after the frame
+//! the counts read back into `--stats`.
 //!
 //! A chunk's regions are sized for the worst case of its part's case, so the shader can never
 //! run out of room: volume `k · e + f · t` indices (`e` edges of the table touching the chunk,
@@ -8,7 +9,7 @@
 //! `f` = 3 with a dark cap of front or back faces, else 0; `t` the chunk's triangles) and
 //! light cap `3 t` in case 3.
 
-use super::{rec, ComputeStatic, SilhouettePush, RECORD_WORDS};
+use super::{rec, ComputeStatic, SilhouettePush, GROUP, HEADER_WORDS, RECORD_WORDS};
 use crate::error::{Error, Result};
 use crate::pass::draw::{Draw, LightFrame};
 use crate::pass::stats::{CasterStats, Totals, UsedIndexFormat};
@@ -16,14 +17,42 @@ use crate::pass::IndexFormat;
 use crate::shadow::plan::{Case, CasterPlan, DarkCap, Formulation, VolumePath};
 use crate::shadow::Caster;
 use ash::vk;
+use bytemuck::{Pod, Zeroable};
 use std::cell::Cell;
 
-/// One caster's dispatches for one light.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Job {
-    /// Index of the caster in the pass's table.
-    pub caster: usize,
-    pub push: SilhouettePush,
+/// One (light, caster) pair as `shaders/silhouette.wgsl` reads it (`struct Job`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub(crate) struct GpuJob {
+    /// The light in the caster's object space (w = 1 point, w = 0 directional).
+    pub light: [f32; 4],
+    /// The plane filter's light (negated for mirroring transforms).
+    pub filt: [f32; 4],
+    /// The filter's error bound (+inf: every triangle to the exact test).
+    pub bound: f32,
+    /// 1: mirroring transform.
+    pub flip: u32,
+    pub tris: u32,
+    pub edges: u32,
+    /// The caster's first element in each arena table.
+    pub plane_base: u32,
+    pub tri_base: u32,
+    pub pos_base: u32,
+    pub edge_base: u32,
+    /// Word offset of the pair's chunk records.
+    pub rec_base: u32,
+    /// Word offset of the pair's facing bits (a bit per triangle, whole workgroups).
+    pub fac_base: u32,
+    /// The pair's first workgroup in the `facing`, `find` and `caps` stages.
+    pub g_facing: u32,
+    pub g_find: u32,
+    pub g_caps: u32,
+    pub pad: [u32; 3],
+}
+
+/// Workgroups of `n` items, [`GROUP`] a workgroup.
+fn groups_of(n: u32) -> u32 {
+    n.div_ceil(GROUP)
 }
 
 /// Where a chunk record's counts go in the stats.
@@ -38,45 +67,86 @@ pub(crate) struct RecordMeta {
     pub part: usize,
 }
 
-/// The frame's compute work, built by `pack` (sizes and records) and completed by `prepare`
-/// (buffers and descriptor sets).
-#[derive(Debug, Default)]
+/// The frame's compute work, built by `pack` (sizes, jobs and records) and completed by
+/// `prepare` (buffers and the descriptor set).
+#[derive(Debug)]
 pub(crate) struct ComputeFrame {
-    /// Per light, its jobs.
-    pub jobs: Vec<Vec<Job>>,
-    /// The records of every light, as written to the slot's records buffer.
+    /// Every (light, caster) pair with GPU work, lights in order.
+    pub jobs: Vec<GpuJob>,
+    /// The header, then the records of every light, as written to the slot's records buffer.
     pub records: Vec<u32>,
     pub metas: Vec<RecordMeta>,
     /// Output size in 16-bit indices.
     pub out_indices: u64,
     /// Facing words.
     pub facing_words: u64,
-    /// Per caster of the table that has jobs, its descriptor set (filled by `prepare`).
-    pub sets: Vec<(usize, vk::DescriptorSet)>,
+    /// Workgroups of the `facing`, `find` and `caps` stages.
+    pub groups: [u32; 3],
+    /// Room for the exact list (every job's triangles) and the silhouette list (every job's
+    /// edges), in entries.
+    pub exact_capacity: u64,
+    pub sil_capacity: u64,
+    /// The frame's descriptor set (filled by `prepare`).
+    pub set: vk::DescriptorSet,
     pub records_buffer: vk::Buffer,
     pub out_buffer: vk::Buffer,
+    /// The facing bits (cleared before the `facing` stage sets the light-facing ones).
+    pub facing_buffer: vk::Buffer,
     pub recorded: Cell<bool>,
     pub read_back: Cell<bool>,
 }
 
-/// Where a caster's compute work goes: its light, its index in that light's stats, and its
-/// index among the pass's casters.
+impl Default for ComputeFrame {
+    fn default() -> Self {
+        let mut records = vec![0u32; HEADER_WORDS];
+        // the lists' dispatch commands: x grows with the lists, y = z = 1
+        for w in [rec::H_EXACT_X, rec::H_SIL_X] {
+            records[w + 1] = 1;
+            records[w + 2] = 1;
+        }
+        ComputeFrame {
+            jobs: Vec::new(),
+            records,
+            metas: Vec::new(),
+            out_indices: 0,
+            facing_words: 0,
+            groups: [0; 3],
+            exact_capacity: 0,
+            sil_capacity: 0,
+            set: vk::DescriptorSet::null(),
+            records_buffer: vk::Buffer::null(),
+            out_buffer: vk::Buffer::null(),
+            facing_buffer: vk::Buffer::null(),
+            recorded: Cell::new(false),
+            read_back: Cell::new(false),
+        }
+    }
+}
+
+/// Where a caster's compute work goes: its light and its index in that light's stats.
 #[derive(Clone, Copy, Debug)]
 pub struct CasterAt {
     /// The light.
     pub light: usize,
     /// The caster's index in the light's lists (its stats).
     pub stat: usize,
-    /// The caster's index in the pass.
-    pub caster: usize,
 }
 
 impl ComputeFrame {
-    pub fn set_of(&self, caster: usize) -> Option<vk::DescriptorSet> {
-        self.sets.iter().find(|(c, _)| *c == caster).map(|&(_, s)| s)
+    /// The frame's push constants.
+    pub fn push(&self) -> SilhouettePush {
+        SilhouettePush {
+            jobs: self.jobs.len() as u32,
+            facing_groups: self.groups[0],
+            find_groups: self.groups[1],
+            cap_groups: self.groups[2],
+            sil_base: self.exact_capacity as u32,
+            steps: self.jobs.len().next_power_of_two().trailing_zeros(),
+            pad: [0; 2],
+        }
     }
 
-    /// Lays out caster `at.caster`'s chunk records for light `at.light` from its plan `cp` (the
+    /// Lays out a caster's job and chunk records for light `at.light` from its plan `cp` (the
     /// parts the planner left to the GPU: path `"compute"`), and appends the chunks' indirect
     /// draws to `draws`.
     pub fn add_caster(
@@ -88,13 +158,8 @@ impl ComputeFrame {
         chunk_buffers: &[vk::Buffer],
         draws: &mut Vec<Draw>,
     ) {
-        let CasterAt { light: li, stat, caster: ci } = at;
-        while self.jobs.len() <= li {
-            self.jobs.push(Vec::new());
-        }
-        // a header of 4 words (word 0: the length of the exact test's list), then the chunks
-        let job_base = self.records.len();
-        let rec_base = job_base + 4;
+        let CasterAt { light: li, stat } = at;
+        let rec_base = self.records.len();
         self.records.resize(rec_base + RECORD_WORDS * caster.chunks.len(), 0);
         let l_obj = glam::Vec4::from_array(cp.light_object);
         let mut caps = false;
@@ -166,20 +231,34 @@ impl ComputeFrame {
             Some((lf, e)) => (if caster.mirrored { -lf } else { lf }, e),
             None => (glam::Vec4::ZERO, f32::INFINITY),
         };
-        let push = SilhouettePush {
+        let tri_groups = groups_of(st.triangles);
+        let job = GpuJob {
             light: cp.light_object,
             filt: filt.to_array(),
             bound,
             flip: caster.mirrored as u32,
             tris: st.triangles,
             edges: st.edge_count,
+            plane_base: st.base[0],
+            tri_base: st.base[1],
+            pos_base: st.base[2],
+            edge_base: st.base[3],
             rec_base: rec_base as u32,
             fac_base: self.facing_words as u32,
-            job_base: job_base as u32,
-            caps: caps as u32,
+            g_facing: self.groups[0],
+            g_find: self.groups[1],
+            g_caps: self.groups[2],
+            pad: [0; 3],
         };
-        self.facing_words += 2 * st.triangles as u64;
-        self.jobs[li].push(Job { caster: ci, push });
+        self.groups[0] += tri_groups;
+        self.groups[1] += groups_of(st.edge_count);
+        if caps {
+            self.groups[2] += tri_groups;
+        }
+        self.facing_words += (tri_groups * (GROUP / 32)) as u64;
+        self.exact_capacity += st.triangles as u64;
+        self.sil_capacity += st.edge_count as u64;
+        self.jobs.push(job);
     }
 
     /// Adds the counts the GPU left in the records (`words`, the slot's records buffer after
@@ -188,6 +267,15 @@ impl ComputeFrame {
     pub fn read_back(&self, words: &[u32], lights: &mut [LightFrame], totals: &mut Totals) -> Result<()> {
         if self.read_back.replace(true) {
             return Ok(());
+        }
+        // The lists can never outgrow their room (each entry is one triangle or edge of one
+        // job); a count beyond it would mean entries were written out of bounds.
+        let (exact, sil) = (words.get(rec::H_EXACT).copied().unwrap_or(0), words.get(rec::H_SIL).copied().unwrap_or(0));
+        if exact as u64 > self.exact_capacity || sil as u64 > self.sil_capacity {
+            return Err(Error::Internal(format!(
+                "compute silhouettes: the lists overflowed ({exact} of {} exact triangles, {sil} of {} silhouette edges)",
+                self.exact_capacity, self.sil_capacity
+            )));
         }
         for m in &self.metas {
             let r = words.get(m.word..m.word + RECORD_WORDS).ok_or_else(|| Error::Internal("compute records short".into()))?;

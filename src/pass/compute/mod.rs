@@ -1,5 +1,6 @@
 //! GPU possible silhouettes ([`Technique::Compute`](super::Technique::Compute)): the static
-//! per-caster tables the compute pass reads, its pipelines, and the per-slot buffers it writes.
+//! per-caster tables the compute pass reads (in one pass-wide [`arena`]), its pipelines, and
+//! the per-slot buffers it writes.
 //!
 //! Per caster, uploaded once (and again only when a deforming caster moves its vertices):
 //! * the object-space f32 plane of every triangle ([`FacePlanes::planes_xyzd`]), the filter of
@@ -8,11 +9,13 @@
 //!   positions: the exact fallback of the facing test and the indices the caps are made of;
 //! * the edge table: every edge of the closed manifold parts, `(t0, t1, c0 | c1 << 8)`.
 //!
-//! Per frame and light the CPU writes only one small record per chunk (`RECORD_WORDS` words:
-//! the chunk's two `VkDrawIndexedIndirectCommand`s, with zero counts and the first index of the
-//! chunk's region, its case parameters and its capacities); the shader
-//! (`shaders/silhouette.wgsl`) does the rest. See [`frame`] for the layout and [`record`] for
-//! the commands and barriers.
+//! Per frame the CPU writes one job per (light, caster) pair ([`frame::GpuJob`]: the light,
+//! the arena offsets, the first workgroup of the pair in each stage) and one small record per
+//! chunk (`RECORD_WORDS` words: the chunk's two `VkDrawIndexedIndirectCommand`s, with zero
+//! counts and the first index of the chunk's region, its case parameters and its capacities);
+//! the shader (`shaders/silhouette.wgsl`) does the rest, in five dispatches per frame whatever
+//! the number of casters and lights. See [`frame`] for the layout and [`record`] for the
+//! commands and barriers.
 //!
 //! Facing is bit for bit the CPU's ([`FacePlanes::facing_packed`]): the same f32 plane filter
 //! with the CPU's error bound (Vulkan's f32 add and multiply are correctly rounded, and the
@@ -20,6 +23,7 @@
 //! the f32 vertices, summed without rounding in a fixed-point accumulator. So the GPU's
 //! triangle counts equal the CPU planner's for the same light and caster.
 
+pub(crate) mod arena;
 pub(crate) mod frame;
 mod prepare;
 pub(crate) mod record;
@@ -33,10 +37,22 @@ use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use gpu_allocator::MemoryLocation;
 
+/// Triangles (or edges) of one job a workgroup of the `facing`, `find` and `caps` stages
+/// (`GROUP` in `shaders/silhouette.wgsl`).
+pub(crate) const GROUP: u32 = 256;
 /// Words of one chunk record (see `shaders/silhouette.wgsl`).
 pub(crate) const RECORD_WORDS: usize = 20;
+/// Words of the frame's header at the start of the records: the exact and silhouette lists'
+/// lengths and their `VkDispatchIndirectCommand`s.
+pub(crate) const HEADER_WORDS: usize = 16;
 /// Record word offsets.
 pub(crate) mod rec {
+    /// Header: the exact list's length, then its dispatch command (x, y, z).
+    pub const H_EXACT: usize = 0;
+    pub const H_EXACT_X: usize = 1;
+    /// Header: the silhouette list's length, then its dispatch command (x, y, z).
+    pub const H_SIL: usize = 4;
+    pub const H_SIL_X: usize = 5;
     pub const VOL_COUNT: usize = 0;
     pub const VOL_INSTANCES: usize = 1;
     pub const VOL_FIRST: usize = 2;
@@ -60,21 +76,20 @@ pub(crate) mod rec {
     pub const DC_BACK: u32 = 3;
 }
 
-/// The push-constant block of `shaders/silhouette.wgsl` (`struct Push`).
+/// The push-constant block of `shaders/silhouette.wgsl` (`struct Push`): one per frame.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub(crate) struct SilhouettePush {
-    pub light: [f32; 4],
-    pub filt: [f32; 4],
-    pub bound: f32,
-    pub flip: u32,
-    pub tris: u32,
-    pub edges: u32,
-    pub rec_base: u32,
-    pub fac_base: u32,
-    pub job_base: u32,
-    /// 1 when some chunk of the job writes face caps.
-    pub caps: u32,
+    pub jobs: u32,
+    /// Workgroups of the `facing`, `find` and `caps` stages.
+    pub facing_groups: u32,
+    pub find_groups: u32,
+    pub cap_groups: u32,
+    /// Entry offset of the silhouette list in the lists buffer (the exact list starts at 0).
+    pub sil_base: u32,
+    /// Steps of the shader's binary search over the jobs: ceil(log2(jobs)).
+    pub steps: u32,
+    pub pad: [u32; 2],
 }
 
 impl SilhouettePush {
@@ -129,12 +144,13 @@ impl ComputeMesh {
     }
 }
 
-/// A caster's static tables on the GPU (device local, uploaded through staging copies).
+/// Where a caster's static tables are in the pass's [`arena::ComputeArena`].
+#[derive(Clone, Debug)]
 pub(crate) struct ComputeStatic {
-    pub planes: Buffer,
-    pub tris: Buffer,
-    pub positions: Buffer,
-    pub edges: Buffer,
+    /// The first element of its range in each table (planes, triangles, positions, edges).
+    pub base: [u32; 4],
+    /// Elements of its range in each table.
+    pub elements: [u64; 4],
     pub triangles: u32,
     pub edge_count: u32,
     pub chunk_edges: Vec<u32>,
@@ -142,33 +158,21 @@ pub(crate) struct ComputeStatic {
     pub chunk_tris: Vec<u32>,
 }
 
-impl ComputeStatic {
-    pub fn buffers(self) -> [Buffer; 4] {
-        [self.planes, self.tris, self.positions, self.edges]
-    }
-}
-
-/// Bytes of `v`, at least `min` long (zero padded: a copy of zero bytes is invalid).
-pub(crate) fn padded_bytes<T: Pod>(v: &[T], min: usize) -> Vec<u8> {
-    let mut b = bytemuck::cast_slice(v).to_vec();
-    if b.len() < min {
-        b.resize(min, 0);
-    }
-    b
-}
-
-/// The compute pipelines (facing filter, exact facing, then caps and edges) and their layout.
+/// The compute pipelines (one per stage: facing filter, exact facing, silhouette edges, face
+/// caps, sides) and their layout.
 pub(crate) struct ComputePipes {
     pub set_layout: vk::DescriptorSetLayout,
     pub layout: vk::PipelineLayout,
-    pub facing: vk::Pipeline,
-    pub exact: vk::Pipeline,
-    pub edges: vk::Pipeline,
+    /// In stage order: `facing`, `exact`, `find`, `caps`, `sides`.
+    pub stages: [vk::Pipeline; 5],
 }
 
-/// Storage-buffer bindings of the set: 0..4 the caster's tables, 4 facing words, 5 the
-/// chunk records, 6 the output indices.
-pub(crate) const BINDINGS: u32 = 7;
+/// The entry points of `shaders/silhouette.wgsl`, in [`ComputePipes::stages`] order.
+const ENTRIES: [&std::ffi::CStr; 5] = [c"facing", c"exact", c"find", c"caps", c"sides"];
+
+/// Storage-buffer bindings of the set: 0..4 the arena's tables, 4 the jobs, 5 facing bits,
+/// 6 the header and chunk records, 7 the output indices, 8 the exact and silhouette lists.
+pub(crate) const BINDINGS: u32 = 9;
 
 impl ComputePipes {
     pub fn new(dev: &PassDevice) -> Result<ComputePipes> {
@@ -185,13 +189,7 @@ impl ComputePipes {
         // SAFETY: creation on a valid device from locals; destroyed in `destroy` (or below on error).
         let set_layout = unsafe { d.create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None) }
             .map_err(Error::vk("vkCreateDescriptorSetLayout"))?;
-        let mut me = ComputePipes {
-            set_layout,
-            layout: vk::PipelineLayout::null(),
-            facing: vk::Pipeline::null(),
-            exact: vk::Pipeline::null(),
-            edges: vk::Pipeline::null(),
-        };
+        let mut me = ComputePipes { set_layout, layout: vk::PipelineLayout::null(), stages: [vk::Pipeline::null(); 5] };
         match me.create(dev) {
             Ok(()) => Ok(me),
             Err(e) => {
@@ -220,14 +218,16 @@ impl ComputePipes {
                 },
             )
         };
-        let r = make(c"facing").and_then(|f| {
-            self.facing = f;
-            make(c"exact")
-        });
-        let r = r.and_then(|x| {
-            self.exact = x;
-            make(c"edges").map(|e| self.edges = e)
-        });
+        let mut r = Ok(());
+        for (k, entry) in ENTRIES.iter().enumerate() {
+            match make(entry) {
+                Ok(p) => self.stages[k] = p,
+                Err(e) => {
+                    r = Err(e);
+                    break;
+                }
+            }
+        }
         // SAFETY: the pipelines keep what they need of the module.
         unsafe { d.destroy_shader_module(module, None) };
         r
@@ -238,24 +238,29 @@ impl ComputePipes {
     pub unsafe fn destroy(&mut self, d: &ash::Device) {
         // SAFETY: the caller's contract; null handles are ignored.
         unsafe {
-            d.destroy_pipeline(self.facing, None);
-            d.destroy_pipeline(self.exact, None);
-            d.destroy_pipeline(self.edges, None);
+            for p in self.stages {
+                d.destroy_pipeline(p, None);
+            }
             d.destroy_pipeline_layout(self.layout, None);
             d.destroy_descriptor_set_layout(self.set_layout, None);
         }
     }
 }
 
-/// One ring slot's buffers and descriptor sets for the compute pass.
+/// One ring slot's buffers and descriptor set for the compute pass.
 #[derive(Default)]
 pub(crate) struct SlotCompute {
-    /// Chunk records of every light (host visible: written at prepare, read back for stats).
+    /// The header and the chunk records of every light (host visible: written at prepare,
+    /// read back for stats).
     pub records: Option<Buffer>,
     /// Output indices (u16, two a word), every light's regions.
     pub out: Option<Buffer>,
-    /// Two facing words per triangle, per caster and light (the bits, the exact test's list).
+    /// Facing bits, two words per 64 triangles of each job.
     pub facing: Option<Buffer>,
+    /// The frame's jobs (host visible).
+    pub jobs: Option<Buffer>,
+    /// The exact and silhouette lists (`(job, triangle or edge)` pairs).
+    pub lists: Option<Buffer>,
     pub pool: vk::DescriptorPool,
     pub pool_sets: u32,
 }
@@ -307,7 +312,7 @@ impl SlotCompute {
     }
 
     pub fn destroy(&mut self, dev: &PassDevice) {
-        for b in [&mut self.records, &mut self.out, &mut self.facing] {
+        for b in [&mut self.records, &mut self.out, &mut self.facing, &mut self.jobs, &mut self.lists] {
             if let Some(mut b) = b.take() {
                 b.destroy(dev);
             }
@@ -358,9 +363,15 @@ mod tests {
     }
 
     #[test]
-    fn push_matches_the_wgsl_block() {
-        assert_eq!(SilhouettePush::SIZE, 64);
-        assert_eq!(std::mem::offset_of!(SilhouettePush, bound), 32);
-        assert_eq!(std::mem::offset_of!(SilhouettePush, rec_base), 48);
+    fn push_and_job_match_the_wgsl_blocks() {
+        use super::frame::GpuJob;
+        assert_eq!(SilhouettePush::SIZE, 32);
+        assert_eq!(std::mem::offset_of!(SilhouettePush, sil_base), 16);
+        assert_eq!(std::mem::size_of::<GpuJob>(), 96);
+        assert_eq!(std::mem::offset_of!(GpuJob, bound), 32);
+        assert_eq!(std::mem::offset_of!(GpuJob, plane_base), 48);
+        assert_eq!(std::mem::offset_of!(GpuJob, rec_base), 64);
+        assert_eq!(std::mem::offset_of!(GpuJob, g_facing), 72);
+        assert_eq!(std::mem::offset_of!(GpuJob, g_caps), 80);
     }
 }

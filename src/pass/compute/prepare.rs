@@ -1,16 +1,16 @@
 //! The compute pass's share of `prepare` (the slot's buffers, records and descriptor sets)
 //! and the counts read back after the frame.
 
-use super::frame::ComputeFrame;
-use super::SlotCompute;
+use super::frame::{ComputeFrame, GpuJob};
+use super::{SlotCompute, BINDINGS};
 use crate::error::{Error, Misuse, Result};
 use crate::pass::{PreparedFrame, ShadowPass};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
 impl ShadowPass {
-    /// Sizes the slot's compute buffers for `cf`, writes its records and one descriptor set
-    /// per caster with jobs. The slot's previous frame has retired.
+    /// Sizes the slot's compute buffers for `cf`, writes its jobs and records and the frame's
+    /// one descriptor set. The slot's previous frame has retired.
     pub(crate) fn prepare_compute(&mut self, slot: usize, mut cf: ComputeFrame) -> Result<ComputeFrame> {
         let Some(pipes) = self.compute_pipes.as_ref() else {
             return Err(
@@ -19,78 +19,84 @@ impl ShadowPass {
         };
         let set_layout = pipes.set_layout;
         let dev = &self.dev;
+        let arena = self.casters.arena.raw();
         let sc = &mut self.slots[slot].compute;
-        let records_bytes = (cf.records.len() * 4) as u64;
-        SlotCompute::ensure(
-            dev,
-            &mut sc.records,
-            &format!("compute records {slot}"),
-            records_bytes,
-            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::INDIRECT_BUFFER,
-            MemoryLocation::CpuToGpu,
-        )?;
-        SlotCompute::ensure(
-            dev,
-            &mut sc.out,
-            &format!("compute indices {slot}"),
-            cf.out_indices * 2,
-            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::INDEX_BUFFER,
-            MemoryLocation::GpuOnly,
-        )?;
-        SlotCompute::ensure(
-            dev,
-            &mut sc.facing,
-            &format!("compute facing {slot}"),
-            cf.facing_words * 4,
-            vk::BufferUsageFlags::STORAGE_BUFFER,
-            MemoryLocation::GpuOnly,
-        )?;
-        let (Some(records), Some(out), Some(facing)) = (sc.records.as_mut(), sc.out.as_ref(), sc.facing.as_ref()) else {
+        let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
+        // (buffer, name, bytes, usage, where): every range the set binds, each at most the
+        // device's maxStorageBufferRange
+        let sizes = [
+            ("records", (cf.records.len() * 4) as u64),
+            ("indices", cf.out_indices * 2),
+            ("facing bits", cf.facing_words * 4),
+            ("jobs", (cf.jobs.len() * std::mem::size_of::<GpuJob>()) as u64),
+            ("lists", (cf.exact_capacity + cf.sil_capacity) * 8),
+        ];
+        for (name, bytes) in sizes {
+            if bytes > dev.max_storage_range {
+                return Err(Error::Unsupported(format!(
+                    "Technique::Compute: the frame's compute {name} need {bytes} bytes, more than the device's \
+                     maxStorageBufferRange ({} bytes); use Technique::Volumes, or fewer lights or casters",
+                    dev.max_storage_range
+                )));
+            }
+        }
+        let ranges: Vec<u64> = sizes.iter().map(|&(_, b)| b.max(16)).collect();
+        let specs = [
+            (&mut sc.records, storage | vk::BufferUsageFlags::INDIRECT_BUFFER, MemoryLocation::CpuToGpu),
+            (&mut sc.out, storage | vk::BufferUsageFlags::INDEX_BUFFER, MemoryLocation::GpuOnly),
+            (&mut sc.facing, storage | vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuOnly),
+            (&mut sc.jobs, storage, MemoryLocation::CpuToGpu),
+            (&mut sc.lists, storage, MemoryLocation::GpuOnly),
+        ];
+        for ((b, usage, loc), (&range, (name, _))) in specs.into_iter().zip(ranges.iter().zip(sizes)) {
+            SlotCompute::ensure(dev, b, &format!("compute {name} {slot}"), range, usage, loc)?;
+        }
+        let (Some(records), Some(out), Some(facing), Some(jobs), Some(lists)) =
+            (sc.records.as_mut(), sc.out.as_ref(), sc.facing.as_ref(), sc.jobs.as_mut(), sc.lists.as_ref())
+        else {
             return Err(Error::Internal("compute silhouettes: slot buffers missing".into()));
         };
         records.write(0, bytemuck::cast_slice(&cf.records))?;
+        jobs.write(0, bytemuck::cast_slice(&cf.jobs))?;
+        let slot_buffers = [records.raw, out.raw, facing.raw, jobs.raw, lists.raw];
         let (records_raw, out_raw, facing_raw) = (records.raw, out.raw, facing.raw);
-        let mut casters: Vec<usize> = cf.jobs.iter().flatten().map(|j| j.caster).collect();
-        casters.sort_unstable();
-        casters.dedup();
-        sc.reset_pool(dev, casters.len() as u32)?;
-        cf.sets.clear();
-        if !casters.is_empty() {
-            let layouts = vec![set_layout; casters.len()];
+        sc.reset_pool(dev, 1)?;
+        cf.set = vk::DescriptorSet::null();
+        if !cf.jobs.is_empty() {
             let d = &dev.device;
-            // SAFETY: the pool was reset or created for at least this many sets; the slot's
-            // previous frame (the only user of its sets) has retired.
+            // SAFETY: the pool was reset or created for at least one set; the slot's previous
+            // frame (the only user of its set) has retired.
             let sets = unsafe {
-                d.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(sc.pool).set_layouts(&layouts))
+                d.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(sc.pool).set_layouts(&[set_layout]))
             }
             .map_err(Error::vk("vkAllocateDescriptorSets"))?;
-            let mut infos: Vec<[vk::DescriptorBufferInfo; 1]> = Vec::with_capacity(casters.len() * 7);
-            for &ci in &casters {
-                let st = self.casters.live[ci].compute.as_ref().ok_or_else(|| Error::Internal("compute tables missing".into()))?;
-                for b in [st.planes.raw, st.tris.raw, st.positions.raw, st.edges.raw, facing_raw, records_raw, out_raw] {
-                    infos.push([vk::DescriptorBufferInfo { buffer: b, offset: 0, range: vk::WHOLE_SIZE }]);
-                }
+            let set = sets[0];
+            // binding order: the arena's four tables, jobs, facing, records, indices, lists
+            let whole = |buffer| [vk::DescriptorBufferInfo { buffer, offset: 0, range: vk::WHOLE_SIZE }];
+            let ranged = |k: usize| [vk::DescriptorBufferInfo { buffer: slot_buffers[k], offset: 0, range: ranges[k] }];
+            let infos: [[vk::DescriptorBufferInfo; 1]; BINDINGS as usize] =
+                [whole(arena[0]), whole(arena[1]), whole(arena[2]), whole(arena[3]), ranged(3), ranged(2), ranged(0), ranged(1), ranged(4)];
+            if arena.contains(&vk::Buffer::null()) {
+                return Err(Error::Internal("compute silhouettes: jobs without the arena".into()));
             }
-            let writes: Vec<vk::WriteDescriptorSet> = sets
+            let writes: Vec<vk::WriteDescriptorSet> = infos
                 .iter()
                 .enumerate()
-                .flat_map(|(k, &set)| {
-                    let infos = &infos;
-                    (0..7).map(move |b| {
-                        vk::WriteDescriptorSet::default()
-                            .dst_set(set)
-                            .dst_binding(b as u32)
-                            .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                            .buffer_info(&infos[k * 7 + b])
-                    })
+                .map(|(b, info)| {
+                    vk::WriteDescriptorSet::default()
+                        .dst_set(set)
+                        .dst_binding(b as u32)
+                        .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                        .buffer_info(info)
                 })
                 .collect();
-            // SAFETY: the sets are not in use (just allocated); the buffers are alive.
+            // SAFETY: the set is not in use (just allocated); the buffers are alive.
             unsafe { d.update_descriptor_sets(&writes, &[]) };
-            cf.sets = casters.into_iter().zip(sets).collect();
+            cf.set = set;
         }
         cf.records_buffer = records_raw;
         cf.out_buffer = out_raw;
+        cf.facing_buffer = facing_raw;
         Ok(cf)
     }
 

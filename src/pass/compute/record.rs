@@ -2,29 +2,21 @@
 //! draw, for every light at once (each light has its own records and regions, so the volume
 //! overlay and later passes can draw any light's volumes again).
 //!
-//! Barriers (global memory barriers, synchronization2):
+//! Barriers (global memory barriers):
 //! 1. earlier indirect, index and compute accesses (a previous frame on the queue) and the
 //!    caster uploads -> compute reads and writes;
-//! 2. the facing filter's writes -> the exact facing pass; its writes -> the caps-and-edges
-//!    pass's reads and atomics;
+//! 2. between the stages (facing | exact | find and caps | sides): compute writes -> compute
+//!    reads and atomics, and the indirect dispatch reads of the lists' sizes;
 //! 3. the compute writes -> indirect-command reads, index reads, and host reads (the counts
 //!    `--stats` reads back after the fence).
 
 use super::super::ShadowPass;
-use super::frame::ComputeFrame;
-use super::SilhouettePush;
+use super::rec;
 use crate::pass::PreparedFrame;
 use ash::vk;
 
-/// Most workgroups of one dispatch (the shader strides over the rest).
+/// Most workgroups of one dispatch dimension (every device has at least this many).
 const MAX_GROUPS: u32 = 65535;
-/// Workgroups of the exact facing pass (it strides over the filter's list of undecided
-/// triangles, usually empty).
-const EXACT_GROUPS: u32 = 16;
-
-fn groups(n: u32) -> u32 {
-    n.div_ceil(64).min(MAX_GROUPS)
-}
 
 /// A global memory barrier, recorded as Vulkan 1.0 (the pass needs no synchronization2).
 fn barrier(
@@ -38,13 +30,15 @@ fn barrier(
 
 impl ShadowPass {
     /// Records the GPU possible silhouettes of every light of `frame`
-    /// ([`Technique::Compute`](crate::pass::Technique::Compute)): per caster and light a facing
-    /// filter, the exact test of what it left undecided, and a caps-and-edges pass writing 16-bit indices and the indirect draw counts, then a barrier
-    /// to the indirect draws and index reads. Nothing for other techniques. Idempotent per
-    /// frame; also recorded by the first `cmd_determine` / `cmd_count_float` /
-    /// `cmd_light_intensity` of the frame when the host did not call it (hosts drawing with
-    /// [`cmd_draw_volumes`](Self::cmd_draw_volumes) inside their own rendering instance call it
-    /// first, after [`cmd_upload`](Self::cmd_upload)).
+    /// ([`Technique::Compute`](crate::pass::Technique::Compute)): five dispatches for every
+    /// (light, caster) pair at once, whatever their number: the facing filter, the exact test
+    /// of what it left undecided, the possible silhouette edges (compacted into a list) and the
+    /// face caps, then the listed edges' sides, writing 16-bit indices and the indirect draw
+    /// counts; then a barrier to the indirect draws and index reads. Nothing for other
+    /// techniques. Idempotent per frame; also recorded by the first `cmd_determine` /
+    /// `cmd_count_float` / `cmd_light_intensity` of the frame when the host did not call it
+    /// (hosts drawing with [`cmd_draw_volumes`](Self::cmd_draw_volumes) inside their own
+    /// rendering instance call it first, after [`cmd_upload`](Self::cmd_upload)).
     ///
     /// # Safety
     /// As [`cmd_upload`](Self::cmd_upload): `cb` is recording outside any rendering instance on
@@ -53,7 +47,7 @@ impl ShadowPass {
     pub unsafe fn cmd_compute_silhouettes(&self, cb: vk::CommandBuffer, frame: &PreparedFrame) -> crate::error::Result<()> {
         self.check_frame(frame)?;
         let Some(cf) = frame.compute.as_ref() else { return Ok(()) };
-        if cf.recorded.replace(true) || cf.jobs.iter().all(|j| j.is_empty()) {
+        if cf.recorded.replace(true) || cf.jobs.is_empty() {
             return Ok(());
         }
         let Some(cp) = self.compute_pipes.as_ref() else {
@@ -67,6 +61,15 @@ impl ShadowPass {
         use vk::AccessFlags2 as A;
         use vk::PipelineStageFlags2 as S;
         let rw = A::SHADER_READ | A::SHADER_WRITE;
+        // compute writes -> the next stage's reads, atomics and indirect dispatch
+        let to_next = |this: &Self| {
+            barrier(
+                &this.dev,
+                cb,
+                (S::COMPUTE_SHADER, A::SHADER_WRITE),
+                (S::COMPUTE_SHADER | S::DRAW_INDIRECT, rw | A::INDIRECT_COMMAND_READ),
+            )
+        };
         barrier(
             &self.dev,
             cb,
@@ -74,26 +77,37 @@ impl ShadowPass {
                 S::DRAW_INDIRECT | S::VERTEX_INPUT | S::COMPUTE_SHADER | S::TRANSFER,
                 A::INDIRECT_COMMAND_READ | A::INDEX_READ | rw | A::TRANSFER_WRITE,
             ),
-            (S::COMPUTE_SHADER, rw),
+            (S::COMPUTE_SHADER | S::TRANSFER, rw | A::TRANSFER_WRITE),
         );
-        // SAFETY: the caller's contract; the pipelines, sets and buffers live until the slot
-        // is prepared again.
+        let [facing, exact, find, caps, sides] = cp.stages;
+        let push = cf.push();
+        let records = cf.records_buffer;
+        // SAFETY: the caller's contract; the pipelines, the set and its buffers live until the
+        // slot is prepared again; the set binds the frame's buffers and the arena's tables.
+        // The facing bits start cleared: the `facing` stage sets the light-facing ones.
         unsafe {
-            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, cp.facing);
-            self.dispatch_all(cb, cf, cp.layout, |p| groups(p.tris));
+            d.cmd_fill_buffer(cb, cf.facing_buffer, 0, (cf.facing_words * 4).max(4), 0);
         }
-        barrier(&self.dev, cb, (S::COMPUTE_SHADER, A::SHADER_WRITE), (S::COMPUTE_SHADER, rw));
+        barrier(&self.dev, cb, (S::TRANSFER, A::TRANSFER_WRITE), (S::COMPUTE_SHADER, rw));
         // SAFETY: as above.
         unsafe {
-            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, cp.exact);
-            // a few workgroups striding over the (usually empty) list
-            self.dispatch_all(cb, cf, cp.layout, |p| groups(p.tris).min(EXACT_GROUPS));
-        }
-        barrier(&self.dev, cb, (S::COMPUTE_SHADER, A::SHADER_WRITE), (S::COMPUTE_SHADER, rw));
-        // SAFETY: as above.
-        unsafe {
-            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, cp.edges);
-            self.dispatch_all(cb, cf, cp.layout, |p| groups(if p.caps != 0 { p.edges.max(p.tris) } else { p.edges }));
+            d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::COMPUTE, cp.layout, 0, &[cf.set], &[]);
+            d.cmd_push_constants(cb, cp.layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::bytes_of(&push));
+            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, facing);
+            dispatch_groups(d, cb, cf.groups[0]);
+            to_next(self);
+            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, exact);
+            d.cmd_dispatch_indirect(cb, records, (rec::H_EXACT_X * 4) as u64);
+            to_next(self);
+            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, find);
+            dispatch_groups(d, cb, cf.groups[1]);
+            if cf.groups[2] > 0 {
+                d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, caps);
+                dispatch_groups(d, cb, cf.groups[2]);
+            }
+            to_next(self);
+            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, sides);
+            d.cmd_dispatch_indirect(cb, records, (rec::H_SIL_X * 4) as u64);
         }
         barrier(
             &self.dev,
@@ -103,33 +117,17 @@ impl ShadowPass {
         );
         Ok(())
     }
+}
 
-    /// # Safety
-    /// `cb` is recording outside a rendering instance with a compute pipeline of `layout` bound.
-    unsafe fn dispatch_all(
-        &self,
-        cb: vk::CommandBuffer,
-        cf: &ComputeFrame,
-        layout: vk::PipelineLayout,
-        count: impl Fn(&SilhouettePush) -> u32,
-    ) {
-        let d = &self.dev.device;
-        let mut bound = None;
-        for job in cf.jobs.iter().flatten() {
-            let Some(set) = cf.set_of(job.caster) else { continue };
-            let g = count(&job.push);
-            if g == 0 {
-                continue;
-            }
-            // SAFETY: the caller's contract; the set was written for this slot's buffers.
-            unsafe {
-                if bound != Some(set) {
-                    d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::COMPUTE, layout, 0, &[set], &[]);
-                    bound = Some(set);
-                }
-                d.cmd_push_constants(cb, layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::bytes_of(&job.push));
-                d.cmd_dispatch(cb, g, 1, 1);
-            }
-        }
+/// Dispatches `n` workgroups as `(min(n, 65535), ceil(n / 65535))` (the shader's linear
+/// workgroup index skips the last row's extras).
+///
+/// # Safety
+/// `cb` is recording outside a rendering instance with a compute pipeline bound.
+unsafe fn dispatch_groups(d: &ash::Device, cb: vk::CommandBuffer, n: u32) {
+    if n == 0 {
+        return;
     }
+    // SAFETY: the caller's contract.
+    unsafe { d.cmd_dispatch(cb, n.min(MAX_GROUPS), n.div_ceil(MAX_GROUPS), 1) };
 }

@@ -81,6 +81,8 @@ struct InFlight {
 struct FrameSpans {
     /// The frame's acceleration-structure builds (ray query).
     accel: Span,
+    /// The GPU possible silhouettes of every light (`Technique::Compute`).
+    silhouettes: Span,
     depth: Span,
     frame: Span,
     shadow: Vec<Span>,

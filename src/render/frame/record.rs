@@ -51,6 +51,12 @@ impl Renderer {
             pass.cmd_upload(rec.cb, frame)?;
             gbuffer::record(rec, &sd, spheres);
             spans.depth.end = stamp(all);
+            if self.settings.technique == Technique::Compute {
+                // every light's GPU silhouettes at once, timed on their own (`gpu_ms.silhouettes`)
+                spans.silhouettes.begin = spans.depth.end;
+                pass.cmd_compute_silhouettes(rec.cb, frame)?;
+                spans.silhouettes.end = stamp(all);
+            }
             let into = match (&self.own.parts.shadow_mapper, self.settings.counter) {
                 (Some(_), _) => determine::CountInto::External,
                 (None, Counter::Float) => determine::CountInto::Float,

@@ -27,9 +27,11 @@ impl Renderer {
                         illuminate: i.ms(&raw, p),
                     })
                     .collect();
+                let silhouettes = f.spans.silhouettes.ms(&raw, p);
                 Some(GpuMs {
                     depth: f.spans.depth.ms(&raw, p),
-                    shadow: per_light.iter().map(|l| l.shadow).sum(),
+                    shadow: silhouettes + per_light.iter().map(|l| l.shadow).sum::<f64>(),
+                    silhouettes,
                     illuminate: per_light.iter().map(|l| l.illuminate).sum(),
                     frame: f.spans.frame.ms(&raw, p),
                     accel: f.spans.accel.ms(&raw, p),

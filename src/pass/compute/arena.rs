@@ -1,0 +1,137 @@
+//! The compute pass's static tables of every caster, in one pass-wide arena: four storage
+//! buffers (face planes, triangles, welded positions, edges) that one descriptor set binds, so
+//! one dispatch per stage serves every (light, caster) pair of a frame.
+//!
+//! A caster's tables are bump-allocated at the end of each table and filled by staged copies
+//! (pending uploads: they ride with every frame until one that recorded them retires, like the
+//! casters' vertex buffers). Nothing in the arena is ever written twice in place: a caster
+//! that is removed, or that moves its vertices (`update_positions`), leaves its ranges dead
+//! and takes new ones, so a frame still in flight reads what it was prepared with. When a
+//! table is full, the arena is rebuilt: new buffers sized for twice the live tables, every live
+//! caster's tables staged again, the old buffers retired until every slot has been prepared
+//! again (the frames in flight keep reading them).
+
+use super::ComputeMesh;
+use crate::error::{Error, Result};
+use crate::gpu::Buffer;
+use crate::pass::device::PassDevice;
+use ash::vk;
+use gpu_allocator::MemoryLocation;
+
+/// The tables, in binding order.
+pub(crate) const TABLES: [&str; 4] = ["planes", "triangles", "positions", "edges"];
+/// Bytes of one element of each table (`vec4<f32>`, `Tri`, `vec4<f32>`, `vec4<u32>`).
+pub(crate) const ELEMENT_BYTES: [u64; 4] = [16, 32, 16, 16];
+/// The smallest table, in elements.
+const MIN_ELEMENTS: u64 = 1024;
+
+/// `a += b`, table by table.
+pub(crate) fn add_elements(a: &mut [u64; 4], b: [u64; 4]) {
+    for (x, y) in a.iter_mut().zip(b) {
+        *x += y;
+    }
+}
+
+/// Elements of each table a caster's [`ComputeMesh`] takes.
+pub(crate) fn mesh_elements(m: &ComputeMesh) -> [u64; 4] {
+    [m.planes.len() as u64, m.tris.len() as u64, m.positions.len() as u64, m.edges.len() as u64]
+}
+
+/// The pass-wide arena (see the module docs).
+#[derive(Default)]
+pub(crate) struct ComputeArena {
+    /// The four tables (absent until the first compute caster).
+    pub tables: Option<[Buffer; 4]>,
+    /// Capacity of each table, in elements.
+    pub capacity: [u64; 4],
+    /// Elements allocated in each table (live and dead).
+    pub used: [u64; 4],
+    /// Elements of dead ranges (removed casters, moved vertices) in each table.
+    pub dead: [u64; 4],
+    /// Times the arena was rebuilt (statistics, and the tests' check of the growth policy).
+    pub rebuilds: u64,
+}
+
+impl ComputeArena {
+    /// Whether `need` more elements fit each table as it is.
+    pub fn fits(&self, need: [u64; 4]) -> bool {
+        self.tables.is_some() && (0..4).all(|k| self.used[k] + need[k] <= self.capacity[k])
+    }
+
+    /// Bump-allocates `n` elements in each table: the first element of each range.
+    pub fn allocate(&mut self, n: [u64; 4]) -> [u32; 4] {
+        let mut base = [0u32; 4];
+        for k in 0..4 {
+            base[k] = self.used[k] as u32;
+            self.used[k] += n[k];
+        }
+        base
+    }
+
+    /// Marks a caster's ranges dead.
+    pub fn free(&mut self, n: [u64; 4]) {
+        add_elements(&mut self.dead, n);
+    }
+
+    /// New, empty tables with room for `live` elements twice over (at least
+    /// [`MIN_ELEMENTS`]); the old buffers are returned for the caller to retire. A table the
+    /// device cannot bind whole (`maxStorageBufferRange`) is an error naming it.
+    pub fn rebuild(&mut self, dev: &PassDevice, live: [u64; 4]) -> Result<Option<[Buffer; 4]>> {
+        let mut capacity = [0u64; 4];
+        for k in 0..4 {
+            let want = (live[k] * 2).max(MIN_ELEMENTS).next_power_of_two();
+            let limit = dev.max_storage_range / ELEMENT_BYTES[k];
+            if live[k] > limit {
+                return Err(Error::Unsupported(format!(
+                    "Technique::Compute: the casters' {} table needs {} bytes, more than the device's \
+                     maxStorageBufferRange ({} bytes); use Technique::Volumes for this scene",
+                    TABLES[k],
+                    live[k] * ELEMENT_BYTES[k],
+                    dev.max_storage_range
+                )));
+            }
+            capacity[k] = want.min(limit).max(live[k]).max(1);
+        }
+        let mut made: Vec<Buffer> = Vec::with_capacity(4);
+        for k in 0..4 {
+            let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
+            match Buffer::new(dev, &format!("compute arena: {}", TABLES[k]), capacity[k] * ELEMENT_BYTES[k], usage, MemoryLocation::GpuOnly)
+            {
+                Ok(b) => made.push(b),
+                Err(e) => {
+                    for mut b in made {
+                        b.destroy(dev);
+                    }
+                    return Err(e);
+                }
+            }
+        }
+        let mut it = made.into_iter();
+        let (Some(a), Some(b), Some(c), Some(d)) = (it.next(), it.next(), it.next(), it.next()) else {
+            return Err(Error::Internal("compute arena tables".into()));
+        };
+        let old = self.tables.replace([a, b, c, d]);
+        self.capacity = capacity;
+        self.used = [0; 4];
+        self.dead = [0; 4];
+        self.rebuilds += 1;
+        Ok(old)
+    }
+
+    /// The raw handles of the tables (null before the first compute caster).
+    pub fn raw(&self) -> [vk::Buffer; 4] {
+        match &self.tables {
+            Some(t) => [t[0].raw, t[1].raw, t[2].raw, t[3].raw],
+            None => [vk::Buffer::null(); 4],
+        }
+    }
+
+    /// Frees the tables (the host guarantees the device no longer uses them).
+    pub fn destroy(&mut self, dev: &PassDevice) {
+        if let Some(tables) = self.tables.take() {
+            for mut b in tables {
+                b.destroy(dev);
+            }
+        }
+    }
+}
