@@ -11,13 +11,17 @@
 //! casters replaced before each comparison: a fresh pass per frame would compile its
 //! pipelines hundreds of times). Every refused call must leave the model's picture unchanged
 //! (the next comparison checks it), and validation must stay clean. Configurations:
-//! `frames_in_flight` 1 to 3, dynamic rendering (the classic render-pass target model is
-//! covered by tests/embed.rs and tests/pass_contract.rs, not here). Each frame is waited for
-//! before the next is prepared.
+//! `frames_in_flight` 1 to 3; each sequence draws its target model, dynamic rendering or the
+//! host's `VkRenderPass` (`TargetModel::RenderPass`: the determination recorded inside the
+//! subpass of a render pass that clears the depth-stencil attachment, transparent casters
+//! refused for want of `transmit_format`). Both are compared with the same dynamic-rendering
+//! reference: the two models must leave the same stencil. Each frame is waited for before the
+//! next is prepared.
 //!
-//! CI runs `PASS_SEQUENCES_CASES` (default 200) sequences of 30 steps (shrunk on failure) per configuration;
-//! before a release run more: `PASS_SEQUENCES_CASES=5000 cargo test --release --test
-//! pass_sequences`. Failing seeds are kept in `proptest-regressions/`.
+//! CI runs `PASS_SEQUENCES_CASES` (default 200) sequences of 30 steps (shrunk on failure) per
+//! `frames_in_flight`, split at random between the two target models; before a release run
+//! more: `PASS_SEQUENCES_CASES=5000 cargo test --release --test pass_sequences`. Failing seeds
+//! are kept in `proptest-regressions/pass_sequences.txt` and replayed first.
 
 mod common;
 
@@ -25,17 +29,20 @@ use ash::vk;
 use glam::{DMat4, DVec3, Vec3};
 use gpu_allocator::MemoryLocation;
 use proptest::prelude::*;
-use proptest::test_runner::Config;
+use proptest::test_runner::{Config, FileFailurePersistence};
 use proptest_state_machine::{ReferenceStateMachine, StateMachineTest};
 use std::cell::RefCell;
+use umbrage::error::Misuse;
 use umbrage::geom::{Light, Mesh, Sphere};
 use umbrage::gpu::resources::{cleared_depth_stencil, transition};
 use umbrage::gpu::{Buffer, Context, Image};
 use umbrage::pass::{
-    CasterId, DepthStencilTarget, PassSettings, PreparedFrame, ShadowPass, ShadowPassDesc, ShadowView, SphereId, Technique,
+    CasterId, DepthStencilTarget, PassSettings, PreparedFrame, RenderPassTarget, ShadowPass, ShadowPassDesc, ShadowView, SphereId,
+    TargetModel, Technique,
 };
 use umbrage::scene::shapes;
 use umbrage::shadow::Method;
+use umbrage::Error;
 
 const W: u32 = 48;
 const H: u32 = 36;
@@ -84,9 +91,19 @@ struct ModelSphere {
     radius: u8,
 }
 
+/// Where the system under test records its determination ([`TargetModel`]): its own
+/// rendering instances, or inside the harness's render pass (which has no colour target, so
+/// `transmit_format` and with it transparent casters are refused there).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Target {
+    DynamicRendering,
+    RenderPass,
+}
+
 #[derive(Clone, Debug)]
 struct Model {
     frames_in_flight: usize,
+    target: Target,
     casters: Vec<ModelCaster>,
     spheres: Vec<ModelSphere>,
     transparent: Vec<ModelCaster>,
@@ -145,7 +162,17 @@ impl ReferenceStateMachine for Reference {
 
     fn init_state() -> BoxedStrategy<Model> {
         let fif = FRAMES_IN_FLIGHT.with(|f| f.get());
-        Just(Model { frames_in_flight: fif, casters: vec![], spheres: vec![], transparent: vec![], method: Method::McGuire }).boxed()
+        // The target model is drawn per sequence: the cases split between the two.
+        prop_oneof![Just(Target::DynamicRendering), Just(Target::RenderPass)]
+            .prop_map(move |target| Model {
+                frames_in_flight: fif,
+                target,
+                casters: vec![],
+                spheres: vec![],
+                transparent: vec![],
+                method: Method::McGuire,
+            })
+            .boxed()
     }
 
     fn transitions(state: &Model) -> BoxedStrategy<Step> {
@@ -194,7 +221,9 @@ impl ReferenceStateMachine for Reference {
                 state.spheres.remove(*i);
             }
             Step::SetSphere(i, s) => state.spheres[*i] = s.clone(),
-            Step::AddTransparent(c) => state.transparent.push(c.clone()),
+            // Refused by a render-pass pass (no transmit_format): nothing changes.
+            Step::AddTransparent(c) if state.target == Target::DynamicRendering => state.transparent.push(c.clone()),
+            Step::AddTransparent(_) => {}
             Step::RemoveTransparent(i) => {
                 state.transparent.remove(*i);
             }
@@ -212,7 +241,13 @@ struct Harness {
     ctx: Context,
     image: Image,
     readback: Buffer,
-    /// The comparison pass of each `frames_in_flight`.
+    /// The host's render pass of [`Target::RenderPass`]: one subpass whose only attachment is
+    /// `image`, depth and stencil cleared at its start (to the receiver plane and 0).
+    render_pass: vk::RenderPass,
+    rp_target: RenderPassTarget,
+    framebuffer: vk::Framebuffer,
+    /// The comparison pass of each `frames_in_flight` (dynamic rendering whatever the target
+    /// model under test: both must leave the same stencil).
     reference: Vec<(usize, ShadowPass)>,
     /// A second pass whose ids the SUT must refuse.
     other: ShadowPass,
@@ -222,8 +257,9 @@ struct Harness {
 
 thread_local! {
     static HARNESS: RefCell<Option<Harness>> = const { RefCell::new(None) };
-    /// Frames compared, those with a shadow, refused calls, abandoned frames.
-    static COUNTS: std::cell::Cell<[usize; 4]> = const { std::cell::Cell::new([0; 4]) };
+    /// Frames compared, those with a shadow, refused calls, abandoned frames, frames compared
+    /// of the render-pass model and those with a shadow.
+    static COUNTS: std::cell::Cell<[usize; 6]> = const { std::cell::Cell::new([0; 6]) };
 }
 
 fn count(k: usize) {
@@ -234,17 +270,41 @@ fn count(k: usize) {
     });
 }
 
-fn desc(ctx: &Context, frames_in_flight: usize) -> ShadowPassDesc {
-    ShadowPassDesc {
+/// A pass of `frames_in_flight` slots recording with dynamic rendering (`render_pass`: None,
+/// transparent casters configured) or inside the render pass.
+fn new_pass(ctx: &Context, frames_in_flight: usize, render_pass: Option<RenderPassTarget>) -> ShadowPass {
+    let desc = ShadowPassDesc {
         depth_stencil_format: ctx.depth_format,
         frames_in_flight,
-        transmit_format: Some(vk::Format::R16G16B16A16_SFLOAT),
+        target: render_pass.map_or(TargetModel::DynamicRendering, TargetModel::RenderPass),
+        transmit_format: render_pass.is_none().then_some(vk::Format::R16G16B16A16_SFLOAT),
         ..Default::default()
-    }
+    };
+    ShadowPass::new(&ctx.instance, ctx.physical, &ctx.device, (*ctx.allocator).clone(), &desc).unwrap()
 }
 
-fn new_pass(ctx: &Context, frames_in_flight: usize) -> ShadowPass {
-    ShadowPass::new(&ctx.instance, ctx.physical, &ctx.device, (*ctx.allocator).clone(), &desc(ctx, frames_in_flight)).unwrap()
+/// The host's render pass: one subpass whose only attachment is a depth-stencil image of the
+/// context's format, cleared when the pass begins and left in DEPTH_STENCIL_ATTACHMENT_OPTIMAL.
+fn host_render_pass(ctx: &Context) -> (vk::RenderPass, RenderPassTarget) {
+    let ds = vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+    let attachments = [vk::AttachmentDescription::default()
+        .format(ctx.depth_format)
+        .samples(vk::SampleCountFlags::TYPE_1)
+        .load_op(vk::AttachmentLoadOp::CLEAR)
+        .store_op(vk::AttachmentStoreOp::STORE)
+        .stencil_load_op(vk::AttachmentLoadOp::CLEAR)
+        .stencil_store_op(vk::AttachmentStoreOp::STORE)
+        .initial_layout(vk::ImageLayout::UNDEFINED)
+        .final_layout(ds)];
+    let ds_ref = vk::AttachmentReference { attachment: 0, layout: ds };
+    let subpasses =
+        [vk::SubpassDescription::default().pipeline_bind_point(vk::PipelineBindPoint::GRAPHICS).depth_stencil_attachment(&ds_ref)];
+    let info = vk::RenderPassCreateInfo::default().attachments(&attachments).subpasses(&subpasses);
+    // SAFETY: a well-formed create info on the context's device; destroyed by the test.
+    let rp = unsafe { ctx.device.create_render_pass(&info, None) }.unwrap();
+    // SAFETY: `info` is the create info `rp` was made from, its pointers alive.
+    let target = unsafe { RenderPassTarget::new(rp, &info, 0) }.unwrap();
+    (rp, target)
 }
 
 fn with_harness<R>(f: impl FnOnce(&mut Harness) -> R) -> R {
@@ -262,23 +322,49 @@ fn deformed(shape: usize, k: u8) -> Vec<Vec3> {
 
 /// Records `frame`'s determination of light 0 into the harness's target (cleared to the
 /// receiver plane) and, when `submit`, runs it and returns the stencil; otherwise resets the
-/// command buffer unsubmitted.
-fn record(h: &Harness, pass: &ShadowPass, frame: &PreparedFrame, submit: bool) -> Option<Vec<u8>> {
+/// command buffer unsubmitted. `target` is the model `pass` was made for: with
+/// [`Target::RenderPass`] the clear is the render pass's and the determination records inside
+/// its subpass.
+fn record(h: &Harness, pass: &ShadowPass, frame: &PreparedFrame, target: Target, submit: bool) -> Option<Vec<u8>> {
     let ctx = &h.ctx;
     let rec = |cb: vk::CommandBuffer| {
         let ds = vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
-        transition(ctx, cb, &h.image, vk::ImageLayout::UNDEFINED, ds);
-        let att = cleared_depth_stencil(h.image.view, (RECEIVER_DEPTH, 0));
         let extent = vk::Extent2D { width: W, height: H };
-        let info = vk::RenderingInfo::default().render_area(extent.into()).layer_count(1).depth_attachment(&att).stencil_attachment(&att);
-        // SAFETY: `cb` is recording outside rendering; the image is in `ds`; the frame is live
-        // and its slot's previous frame has completed (every frame is waited for).
-        unsafe {
-            pass.cmd_before_rendering(cb, frame).unwrap();
-            ctx.device.cmd_begin_rendering(cb, &info);
-            ctx.device.cmd_end_rendering(cb);
-            transition(ctx, cb, &h.image, ds, ds);
-            pass.cmd_determine(cb, frame, 0, &DepthStencilTarget::new(h.image.raw, h.image.view, extent)).unwrap();
+        let determine = DepthStencilTarget::new(h.image.raw, h.image.view, extent);
+        match target {
+            Target::DynamicRendering => {
+                transition(ctx, cb, &h.image, vk::ImageLayout::UNDEFINED, ds);
+                let att = cleared_depth_stencil(h.image.view, (RECEIVER_DEPTH, 0));
+                let info =
+                    vk::RenderingInfo::default().render_area(extent.into()).layer_count(1).depth_attachment(&att).stencil_attachment(&att);
+                // SAFETY: `cb` is recording outside rendering; the image is in `ds`; the frame
+                // is live and its slot's previous frame has completed.
+                unsafe {
+                    pass.cmd_before_rendering(cb, frame).unwrap();
+                    ctx.device.cmd_begin_rendering(cb, &info);
+                    ctx.device.cmd_end_rendering(cb);
+                    transition(ctx, cb, &h.image, ds, ds);
+                    pass.cmd_determine(cb, frame, 0, &determine).unwrap();
+                }
+            }
+            Target::RenderPass => {
+                let clear = [vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: RECEIVER_DEPTH, stencil: 0 } }];
+                let begin = vk::RenderPassBeginInfo::default()
+                    .render_pass(h.render_pass)
+                    .framebuffer(h.framebuffer)
+                    .render_area(extent.into())
+                    .clear_values(&clear);
+                // SAFETY: `cb` is recording outside rendering; the frame's uploads are recorded
+                // before the render pass begins, the determination inside its only subpass,
+                // whose attachment is the image (DEPTH_STENCIL_ATTACHMENT_OPTIMAL there, and
+                // after it); the frame is live and its slot's previous frame has completed.
+                unsafe {
+                    pass.cmd_before_rendering(cb, frame).unwrap();
+                    ctx.device.cmd_begin_render_pass(cb, &begin, vk::SubpassContents::INLINE);
+                    pass.cmd_determine(cb, frame, 0, &determine).unwrap();
+                    ctx.device.cmd_end_render_pass(cb);
+                }
+            }
         }
         let src = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
         transition(ctx, cb, &h.image, ds, src);
@@ -308,14 +394,14 @@ fn record(h: &Harness, pass: &ShadowPass, frame: &PreparedFrame, submit: bool) -
 fn reference_stencil(h: &mut Harness, model: &Model) -> Vec<u8> {
     let fif = model.frames_in_flight;
     if !h.reference.iter().any(|(f, _)| *f == fif) {
-        let p = new_pass(&h.ctx, fif);
+        let p = new_pass(&h.ctx, fif, None);
         h.reference.push((fif, p));
     }
     let i = h.reference.iter().position(|(f, _)| *f == fif).unwrap();
     let (_, mut pass) = h.reference.swap_remove(i);
     let fresh = new_pass_state(&mut pass, model);
     let frame = pass.prepare(0, &view(), &[light()]).unwrap();
-    let stencil = record(h, &pass, &frame, true).unwrap();
+    let stencil = record(h, &pass, &frame, Target::DynamicRendering, true).unwrap();
     drop(frame);
     for id in fresh.0 {
         pass.remove_caster(id).unwrap();
@@ -349,6 +435,7 @@ fn sphere_of(s: &ModelSphere) -> Sphere {
 
 struct Sut {
     pass: ShadowPass,
+    target: Target,
     casters: Vec<CasterId>,
     spheres: Vec<SphereId>,
     transparent: Vec<CasterId>,
@@ -362,8 +449,11 @@ impl StateMachineTest for Sequences {
     type Reference = Reference;
 
     fn init_test(model: &Model) -> Sut {
-        let pass = with_harness(|h| new_pass(&h.ctx, model.frames_in_flight));
-        Sut { pass, casters: vec![], spheres: vec![], transparent: vec![], frames: 0 }
+        let pass = with_harness(|h| {
+            let rp = (model.target == Target::RenderPass).then_some(h.rp_target);
+            new_pass(&h.ctx, model.frames_in_flight, rp)
+        });
+        Sut { pass, target: model.target, casters: vec![], spheres: vec![], transparent: vec![], frames: 0 }
     }
 
     fn apply(mut sut: Sut, model: &Model, step: Step) -> Sut {
@@ -384,8 +474,15 @@ impl StateMachineTest for Sequences {
             Step::RemoveSphere(i) => sut.pass.remove_sphere(sut.spheres.remove(i)).unwrap(),
             Step::SetSphere(i, s) => sut.pass.set_sphere(sut.spheres[i], sphere_of(&s)).unwrap(),
             Step::AddTransparent(c) => {
-                let id = sut.pass.add_transparent_caster("t", &meshes[c.shape], transform(c.pos, c.turn), Vec3::splat(0.5)).unwrap();
-                sut.transparent.push(id);
+                let r = sut.pass.add_transparent_caster("t", &meshes[c.shape], transform(c.pos, c.turn), Vec3::splat(0.5));
+                match sut.target {
+                    Target::DynamicRendering => sut.transparent.push(r.unwrap()),
+                    Target::RenderPass => {
+                        let e = r.expect_err("a transparent caster accepted without transmit_format");
+                        assert!(matches!(e, Error::Misuse(Misuse::NotConfigured { .. })), "{e}");
+                        count(2);
+                    }
+                }
             }
             Step::RemoveTransparent(i) => sut.pass.remove_caster(sut.transparent.remove(i)).unwrap(),
             Step::SetMethod(m) => sut.pass.set_settings(PassSettings { technique: Technique::Volumes(m), ..Default::default() }).unwrap(),
@@ -399,22 +496,29 @@ impl StateMachineTest for Sequences {
                 match fate {
                     FrameFate::Dropped => drop(frame),
                     FrameFate::Abandoned => {
-                        with_harness(|h| record(h, &sut.pass, &frame, false));
+                        with_harness(|h| record(h, &sut.pass, &frame, sut.target, false));
                         sut.pass.abandon_frame(slot).unwrap();
                         count(3);
                     }
                     FrameFate::Submitted => {
                         let (got, want) = with_harness(|h| {
-                            let got = record(h, &sut.pass, &frame, true).unwrap();
+                            let got = record(h, &sut.pass, &frame, sut.target, true).unwrap();
                             (got, reference_stencil(h, model))
                         });
                         let differ = got.iter().zip(&want).filter(|(a, b)| a != b).count();
                         let shadowed = want.iter().filter(|&&v| v != 0).count();
                         assert_eq!(differ, 0, "{differ} stencil bytes differ from a fresh pass's ({shadowed} shadowed there)");
                         sut.frames += 1;
+                        let rp = sut.target == Target::RenderPass;
                         count(0);
+                        if rp {
+                            count(4);
+                        }
                         if shadowed > 0 {
                             count(1);
+                            if rp {
+                                count(5);
+                            }
                         }
                     }
                 }
@@ -452,6 +556,19 @@ fn cases() -> u32 {
     std::env::var("PASS_SEQUENCES_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(200)
 }
 
+/// On a failure, leaks the harness instead of letting the thread-local destructor tear the
+/// device down under passes and frames still alive (that crashed the process before the test
+/// harness printed the failure).
+struct LeakHarnessOnPanic;
+
+impl Drop for LeakHarnessOnPanic {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            std::mem::forget(HARNESS.with(|h| h.borrow_mut().take()));
+        }
+    }
+}
+
 #[test]
 fn every_call_sequence_matches_a_fresh_pass() {
     let Some(ctx) = common::context() else { return };
@@ -461,11 +578,36 @@ fn every_call_sequence_matches_a_fresh_pass() {
         .unwrap();
     let readback =
         Buffer::new(&ctx, "readback", (W * H) as u64 + 256, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu).unwrap();
-    let mut other = new_pass(&ctx, 1);
+    let (render_pass, rp_target) = host_render_pass(&ctx);
+    let views = [image.view];
+    let fb = vk::FramebufferCreateInfo::default().render_pass(render_pass).attachments(&views).width(W).height(H).layers(1);
+    // SAFETY: the image view is of the render pass's attachment format and the framebuffer's
+    // size; destroyed before the image.
+    let framebuffer = unsafe { ctx.device.create_framebuffer(&fb, None) }.unwrap();
+    let mut other = new_pass(&ctx, 1, None);
     let other_caster = other.add_caster("other", &meshes()[0], DMat4::IDENTITY).unwrap();
     let other_sphere = other.add_sphere_caster("other", Sphere { center: DVec3::Y, radius: 0.5 }, None).unwrap();
-    HARNESS.with(|h| *h.borrow_mut() = Some(Harness { ctx, image, readback, reference: vec![], other, other_caster, other_sphere }));
-    let config = Config { cases: cases(), max_shrink_iters: 2000, source_file: Some(file!()), ..Config::default() };
+    let _leak = LeakHarnessOnPanic;
+    HARNESS.with(|h| {
+        *h.borrow_mut() = Some(Harness {
+            ctx,
+            image,
+            readback,
+            render_pass,
+            rp_target,
+            framebuffer,
+            reference: vec![],
+            other,
+            other_caster,
+            other_sphere,
+        })
+    });
+    // Failing seeds persist in proptest-regressions/pass_sequences.txt (`SourceParallel`, the
+    // default, finds no lib.rs above tests/ and persists nothing) and are replayed first.
+    let failure_persistence =
+        Some(Box::new(FileFailurePersistence::Direct(concat!(env!("CARGO_MANIFEST_DIR"), "/proptest-regressions/pass_sequences.txt")))
+            as Box<dyn proptest::test_runner::FailurePersistence>);
+    let config = Config { cases: cases(), max_shrink_iters: 2000, failure_persistence, ..Config::default() };
     for fif in 1..=3 {
         FRAMES_IN_FLIGHT.with(|f| f.set(fif));
         let mut runner = proptest::test_runner::TestRunner::new(config.clone());
@@ -477,13 +619,23 @@ fn every_call_sequence_matches_a_fresh_pass() {
             panic!("frames_in_flight {fif}: {e}");
         }
     }
-    let [compared, shadowed, refused, abandoned] = COUNTS.with(|c| c.get());
-    eprintln!("{compared} frames compared ({shadowed} with a shadow), {refused} calls refused, {abandoned} frames abandoned");
-    // The comparisons must have had something to compare.
+    let [compared, shadowed, refused, abandoned, rp_compared, rp_shadowed] = COUNTS.with(|c| c.get());
+    eprintln!(
+        "{compared} frames compared ({shadowed} with a shadow; {rp_compared} ({rp_shadowed}) of them in the host's render pass), \
+         {refused} calls refused, {abandoned} frames abandoned"
+    );
+    // The comparisons must have had something to compare, under both target models.
     assert!(shadowed * 3 >= compared && compared >= cases() as usize, "{shadowed} of {compared} frames had a shadow");
+    let dr_shadowed = shadowed - rp_shadowed;
+    assert!(rp_shadowed * 5 >= shadowed && dr_shadowed * 5 >= shadowed, "{rp_shadowed} of {shadowed} shadowed frames in the render pass");
     let mut h = HARNESS.with(|h| h.borrow_mut().take()).unwrap();
     h.reference.clear();
     drop(h.other);
+    // SAFETY: every command buffer using them has completed (each frame is waited for).
+    unsafe {
+        h.ctx.device.destroy_framebuffer(h.framebuffer, None);
+        h.ctx.device.destroy_render_pass(h.render_pass, None);
+    }
     h.image.destroy(&h.ctx);
     h.readback.destroy(&h.ctx);
     h.ctx.check_validation().unwrap();
