@@ -11,13 +11,24 @@
 //! casters replaced before each comparison: a fresh pass per frame would compile its
 //! pipelines hundreds of times). Every refused call must leave the model's picture unchanged
 //! (the next comparison checks it), and validation must stay clean. Configurations:
-//! `frames_in_flight` 1 to 3, dynamic rendering (the classic render-pass target model is
-//! covered by tests/embed.rs and tests/pass_contract.rs, not here). Each frame is waited for
-//! before the next is prepared.
+//! `frames_in_flight` 1 to 3; each sequence draws its target model, dynamic rendering or the
+//! host's `VkRenderPass` (`TargetModel::RenderPass`: the determination recorded inside the
+//! subpass of a render pass that clears the depth-stencil attachment, transparent casters
+//! refused for want of `transmit_format`). Both are compared with the same dynamic-rendering
+//! reference: the two models must leave the same stencil.
 //!
-//! CI runs `PASS_SEQUENCES_CASES` (default 200) sequences of 30 steps (shrunk on failure) per configuration;
-//! before a release run more: `PASS_SEQUENCES_CASES=5000 cargo test --release --test
-//! pass_sequences`. Failing seeds are kept in `proptest-regressions/`.
+//! Frames overlap on the GPU as a real host's do: each slot has its own command buffer, fence
+//! and target image; a submitted frame is waited for only when its slot is prepared again (or
+//! the sequence ends), and its stencil is read back and compared then, against the model it
+//! was prepared from, while the other slots' frames stay in flight and the host's later calls
+//! (removals, new positions, settings) happen around them. The points where the host waits
+//! are fixed by the sequence, so a run is as deterministic as the frames' results must be;
+//! validation reports a buffer destroyed under a frame still in flight.
+//!
+//! CI runs `PASS_SEQUENCES_CASES` (default 200) sequences of 30 steps (shrunk on failure) per
+//! `frames_in_flight`, split at random between the two target models; before a release run
+//! more: `PASS_SEQUENCES_CASES=5000 cargo test --release --test pass_sequences`. Failing seeds
+//! are kept in `proptest-regressions/pass_sequences.txt` and replayed first.
 
 mod common;
 
@@ -25,17 +36,20 @@ use ash::vk;
 use glam::{DMat4, DVec3, Vec3};
 use gpu_allocator::MemoryLocation;
 use proptest::prelude::*;
-use proptest::test_runner::Config;
+use proptest::test_runner::{Config, FileFailurePersistence};
 use proptest_state_machine::{ReferenceStateMachine, StateMachineTest};
 use std::cell::RefCell;
+use umbrage::error::Misuse;
 use umbrage::geom::{Light, Mesh, Sphere};
-use umbrage::gpu::resources::{cleared_depth_stencil, transition};
+use umbrage::gpu::resources::{cleared_depth_stencil, memory_barrier, transition};
 use umbrage::gpu::{Buffer, Context, Image};
 use umbrage::pass::{
-    CasterId, DepthStencilTarget, PassSettings, PreparedFrame, ShadowPass, ShadowPassDesc, ShadowView, SphereId, Technique,
+    CasterId, DepthStencilTarget, PassSettings, PreparedFrame, RenderPassTarget, ShadowPass, ShadowPassDesc, ShadowView, SphereId,
+    TargetModel, Technique,
 };
 use umbrage::scene::shapes;
 use umbrage::shadow::Method;
+use umbrage::Error;
 
 const W: u32 = 48;
 const H: u32 = 36;
@@ -84,9 +98,19 @@ struct ModelSphere {
     radius: u8,
 }
 
+/// Where the system under test records its determination ([`TargetModel`]): its own
+/// rendering instances, or inside the harness's render pass (which has no colour target, so
+/// `transmit_format` and with it transparent casters are refused there).
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Target {
+    DynamicRendering,
+    RenderPass,
+}
+
 #[derive(Clone, Debug)]
 struct Model {
     frames_in_flight: usize,
+    target: Target,
     casters: Vec<ModelCaster>,
     spheres: Vec<ModelSphere>,
     transparent: Vec<ModelCaster>,
@@ -145,7 +169,17 @@ impl ReferenceStateMachine for Reference {
 
     fn init_state() -> BoxedStrategy<Model> {
         let fif = FRAMES_IN_FLIGHT.with(|f| f.get());
-        Just(Model { frames_in_flight: fif, casters: vec![], spheres: vec![], transparent: vec![], method: Method::McGuire }).boxed()
+        // The target model is drawn per sequence: the cases split between the two.
+        prop_oneof![Just(Target::DynamicRendering), Just(Target::RenderPass)]
+            .prop_map(move |target| Model {
+                frames_in_flight: fif,
+                target,
+                casters: vec![],
+                spheres: vec![],
+                transparent: vec![],
+                method: Method::McGuire,
+            })
+            .boxed()
     }
 
     fn transitions(state: &Model) -> BoxedStrategy<Step> {
@@ -194,7 +228,9 @@ impl ReferenceStateMachine for Reference {
                 state.spheres.remove(*i);
             }
             Step::SetSphere(i, s) => state.spheres[*i] = s.clone(),
-            Step::AddTransparent(c) => state.transparent.push(c.clone()),
+            // Refused by a render-pass pass (no transmit_format): nothing changes.
+            Step::AddTransparent(c) if state.target == Target::DynamicRendering => state.transparent.push(c.clone()),
+            Step::AddTransparent(_) => {}
             Step::RemoveTransparent(i) => {
                 state.transparent.remove(*i);
             }
@@ -207,23 +243,52 @@ impl ReferenceStateMachine for Reference {
 
 // ---- The system under test ------------------------------------------------------------------
 
-/// The device and the target every pass draws into (one per test thread).
-struct Harness {
-    ctx: Context,
+/// A depth-stencil image the determination draws into, its framebuffer of the host's render
+/// pass, and the buffer its stencil is copied to.
+struct HostTarget {
     image: Image,
+    framebuffer: vk::Framebuffer,
     readback: Buffer,
-    /// The comparison pass of each `frames_in_flight`.
+}
+
+/// One frame slot of the host: its own target, command buffer and fence, so that up to
+/// `frames_in_flight` submitted frames are in flight at once.
+struct HostSlot {
+    target: HostTarget,
+    cb: vk::CommandBuffer,
+    fence: vk::Fence,
+}
+
+/// The device, the host's render pass and targets (one per test thread). Fields drop in
+/// order: nothing here destroys Vulkan objects on drop but the passes, before the context.
+struct Harness {
+    /// The host's render pass of [`Target::RenderPass`]: one subpass whose only attachment is
+    /// the target's image, depth and stencil cleared at its start (to the receiver plane and 0).
+    render_pass: vk::RenderPass,
+    rp_target: RenderPassTarget,
+    /// The command buffers' pool (each buffer resettable).
+    pool: vk::CommandPool,
+    /// The slots of the system under test: as many as the most frames in flight.
+    slots: Vec<HostSlot>,
+    /// The comparison pass of each `frames_in_flight` (dynamic rendering whatever the target
+    /// model under test: both must leave the same stencil), and its target.
     reference: Vec<(usize, ShadowPass)>,
+    reference_target: HostTarget,
     /// A second pass whose ids the SUT must refuse.
     other: ShadowPass,
     other_caster: CasterId,
     other_sphere: SphereId,
+    ctx: Context,
 }
+
+const MAX_FRAMES_IN_FLIGHT: usize = 3;
 
 thread_local! {
     static HARNESS: RefCell<Option<Harness>> = const { RefCell::new(None) };
-    /// Frames compared, those with a shadow, refused calls, abandoned frames.
-    static COUNTS: std::cell::Cell<[usize; 4]> = const { std::cell::Cell::new([0; 4]) };
+    /// Frames compared, those with a shadow, refused calls, abandoned frames, frames compared
+    /// of the render-pass model and those with a shadow, frames submitted while an earlier one
+    /// was still in flight (not waited for).
+    static COUNTS: std::cell::Cell<[usize; 7]> = const { std::cell::Cell::new([0; 7]) };
 }
 
 fn count(k: usize) {
@@ -234,17 +299,41 @@ fn count(k: usize) {
     });
 }
 
-fn desc(ctx: &Context, frames_in_flight: usize) -> ShadowPassDesc {
-    ShadowPassDesc {
+/// A pass of `frames_in_flight` slots recording with dynamic rendering (`render_pass`: None,
+/// transparent casters configured) or inside the render pass.
+fn new_pass(ctx: &Context, frames_in_flight: usize, render_pass: Option<RenderPassTarget>) -> ShadowPass {
+    let desc = ShadowPassDesc {
         depth_stencil_format: ctx.depth_format,
         frames_in_flight,
-        transmit_format: Some(vk::Format::R16G16B16A16_SFLOAT),
+        target: render_pass.map_or(TargetModel::DynamicRendering, TargetModel::RenderPass),
+        transmit_format: render_pass.is_none().then_some(vk::Format::R16G16B16A16_SFLOAT),
         ..Default::default()
-    }
+    };
+    ShadowPass::new(&ctx.instance, ctx.physical, &ctx.device, (*ctx.allocator).clone(), &desc).unwrap()
 }
 
-fn new_pass(ctx: &Context, frames_in_flight: usize) -> ShadowPass {
-    ShadowPass::new(&ctx.instance, ctx.physical, &ctx.device, (*ctx.allocator).clone(), &desc(ctx, frames_in_flight)).unwrap()
+/// The host's render pass: one subpass whose only attachment is a depth-stencil image of the
+/// context's format, cleared when the pass begins and left in DEPTH_STENCIL_ATTACHMENT_OPTIMAL.
+fn host_render_pass(ctx: &Context) -> (vk::RenderPass, RenderPassTarget) {
+    let ds = vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+    let attachments = [vk::AttachmentDescription::default()
+        .format(ctx.depth_format)
+        .samples(vk::SampleCountFlags::TYPE_1)
+        .load_op(vk::AttachmentLoadOp::CLEAR)
+        .store_op(vk::AttachmentStoreOp::STORE)
+        .stencil_load_op(vk::AttachmentLoadOp::CLEAR)
+        .stencil_store_op(vk::AttachmentStoreOp::STORE)
+        .initial_layout(vk::ImageLayout::UNDEFINED)
+        .final_layout(ds)];
+    let ds_ref = vk::AttachmentReference { attachment: 0, layout: ds };
+    let subpasses =
+        [vk::SubpassDescription::default().pipeline_bind_point(vk::PipelineBindPoint::GRAPHICS).depth_stencil_attachment(&ds_ref)];
+    let info = vk::RenderPassCreateInfo::default().attachments(&attachments).subpasses(&subpasses);
+    // SAFETY: a well-formed create info on the context's device; destroyed by the test.
+    let rp = unsafe { ctx.device.create_render_pass(&info, None) }.unwrap();
+    // SAFETY: `info` is the create info `rp` was made from, its pointers alive.
+    let target = unsafe { RenderPassTarget::new(rp, &info, 0) }.unwrap();
+    (rp, target)
 }
 
 fn with_harness<R>(f: impl FnOnce(&mut Harness) -> R) -> R {
@@ -260,62 +349,82 @@ fn deformed(shape: usize, k: u8) -> Vec<Vec3> {
     meshes()[shape].positions.iter().map(|p| *p * s).collect()
 }
 
-/// Records `frame`'s determination of light 0 into the harness's target (cleared to the
-/// receiver plane) and, when `submit`, runs it and returns the stencil; otherwise resets the
-/// command buffer unsubmitted.
-fn record(h: &Harness, pass: &ShadowPass, frame: &PreparedFrame, submit: bool) -> Option<Vec<u8>> {
+/// Records into `cb` (recording, outside rendering) `frame`'s determination of light 0 into
+/// `t` (cleared to the receiver plane), then the copy of its stencil into `t.readback`, made
+/// visible to the host. `target` is the model `pass` was made for: with
+/// [`Target::RenderPass`] the clear is the render pass's and the determination records inside
+/// its subpass.
+///
+/// The caller has waited for every earlier use of `t` (its slot's fence) and for the frame's
+/// slot's previous submission.
+fn record(h: &Harness, t: &HostTarget, cb: vk::CommandBuffer, pass: &ShadowPass, frame: &PreparedFrame, target: Target) {
     let ctx = &h.ctx;
-    let rec = |cb: vk::CommandBuffer| {
-        let ds = vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
-        transition(ctx, cb, &h.image, vk::ImageLayout::UNDEFINED, ds);
-        let att = cleared_depth_stencil(h.image.view, (RECEIVER_DEPTH, 0));
-        let extent = vk::Extent2D { width: W, height: H };
-        let info = vk::RenderingInfo::default().render_area(extent.into()).layer_count(1).depth_attachment(&att).stencil_attachment(&att);
-        // SAFETY: `cb` is recording outside rendering; the image is in `ds`; the frame is live
-        // and its slot's previous frame has completed (every frame is waited for).
-        unsafe {
-            pass.cmd_before_rendering(cb, frame).unwrap();
-            ctx.device.cmd_begin_rendering(cb, &info);
-            ctx.device.cmd_end_rendering(cb);
-            transition(ctx, cb, &h.image, ds, ds);
-            pass.cmd_determine(cb, frame, 0, &DepthStencilTarget::new(h.image.raw, h.image.view, extent)).unwrap();
+    let ds = vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+    let extent = vk::Extent2D { width: W, height: H };
+    let determine = DepthStencilTarget::new(t.image.raw, t.image.view, extent);
+    match target {
+        Target::DynamicRendering => {
+            transition(ctx, cb, &t.image, vk::ImageLayout::UNDEFINED, ds);
+            let att = cleared_depth_stencil(t.image.view, (RECEIVER_DEPTH, 0));
+            let info =
+                vk::RenderingInfo::default().render_area(extent.into()).layer_count(1).depth_attachment(&att).stencil_attachment(&att);
+            // SAFETY: `cb` is recording outside rendering; the image is in `ds`; the frame is
+            // live and its slot's previous submission has completed (the caller's contract).
+            unsafe {
+                pass.cmd_before_rendering(cb, frame).unwrap();
+                ctx.device.cmd_begin_rendering(cb, &info);
+                ctx.device.cmd_end_rendering(cb);
+                transition(ctx, cb, &t.image, ds, ds);
+                pass.cmd_determine(cb, frame, 0, &determine).unwrap();
+            }
         }
-        let src = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
-        transition(ctx, cb, &h.image, ds, src);
-        let copy = vk::BufferImageCopy::default()
-            .image_subresource(vk::ImageSubresourceLayers::default().aspect_mask(vk::ImageAspectFlags::STENCIL).layer_count(1))
-            .image_extent(vk::Extent3D { width: W, height: H, depth: 1 });
-        // SAFETY: the image is in TRANSFER_SRC_OPTIMAL; the buffer holds W x H bytes.
-        unsafe { ctx.device.cmd_copy_image_to_buffer(cb, h.image.raw, src, h.readback.raw, &[copy]) };
-    };
-    if submit {
-        ctx.one_shot(rec).unwrap();
-        return Some(h.readback.read().unwrap()[..(W * H) as usize].to_vec());
+        Target::RenderPass => {
+            let clear = [vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: RECEIVER_DEPTH, stencil: 0 } }];
+            let begin = vk::RenderPassBeginInfo::default()
+                .render_pass(h.render_pass)
+                .framebuffer(t.framebuffer)
+                .render_area(extent.into())
+                .clear_values(&clear);
+            // SAFETY: `cb` is recording outside rendering; the frame's uploads are recorded
+            // before the render pass begins, the determination inside its only subpass, whose
+            // attachment is the image (DEPTH_STENCIL_ATTACHMENT_OPTIMAL there, and after it);
+            // the frame is live and its slot's previous submission has completed.
+            unsafe {
+                pass.cmd_before_rendering(cb, frame).unwrap();
+                ctx.device.cmd_begin_render_pass(cb, &begin, vk::SubpassContents::INLINE);
+                pass.cmd_determine(cb, frame, 0, &determine).unwrap();
+                ctx.device.cmd_end_render_pass(cb);
+            }
+        }
     }
-    let info = vk::CommandBufferAllocateInfo::default().command_pool(ctx.pool).command_buffer_count(1);
-    // SAFETY: a new primary buffer, recorded, ended and freed without being submitted.
-    unsafe {
-        let cb = ctx.device.allocate_command_buffers(&info).unwrap()[0];
-        ctx.device.begin_command_buffer(cb, &vk::CommandBufferBeginInfo::default()).unwrap();
-        rec(cb);
-        ctx.device.end_command_buffer(cb).unwrap();
-        ctx.device.free_command_buffers(ctx.pool, &[cb]);
-    }
-    None
+    let src = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
+    transition(ctx, cb, &t.image, ds, src);
+    let copy = vk::BufferImageCopy::default()
+        .image_subresource(vk::ImageSubresourceLayers::default().aspect_mask(vk::ImageAspectFlags::STENCIL).layer_count(1))
+        .image_extent(vk::Extent3D { width: W, height: H, depth: 1 });
+    // SAFETY: the image is in TRANSFER_SRC_OPTIMAL; the buffer holds W x H bytes.
+    unsafe { ctx.device.cmd_copy_image_to_buffer(cb, t.image.raw, src, t.readback.raw, &[copy]) };
+    use vk::{AccessFlags2 as A, PipelineStageFlags2 as S};
+    memory_barrier(ctx, cb, (S::TRANSFER, A::TRANSFER_WRITE), (S::HOST, A::HOST_READ));
+}
+
+fn stencil(t: &HostTarget) -> Vec<u8> {
+    t.readback.read().unwrap()[..(W * H) as usize].to_vec()
 }
 
 /// The stencil of a pass holding exactly the model's casters, prepared from scratch.
 fn reference_stencil(h: &mut Harness, model: &Model) -> Vec<u8> {
     let fif = model.frames_in_flight;
     if !h.reference.iter().any(|(f, _)| *f == fif) {
-        let p = new_pass(&h.ctx, fif);
+        let p = new_pass(&h.ctx, fif, None);
         h.reference.push((fif, p));
     }
     let i = h.reference.iter().position(|(f, _)| *f == fif).unwrap();
     let (_, mut pass) = h.reference.swap_remove(i);
     let fresh = new_pass_state(&mut pass, model);
     let frame = pass.prepare(0, &view(), &[light()]).unwrap();
-    let stencil = record(h, &pass, &frame, true).unwrap();
+    h.ctx.one_shot(|cb| record(h, &h.reference_target, cb, &pass, &frame, Target::DynamicRendering)).unwrap();
+    let stencil = stencil(&h.reference_target);
     drop(frame);
     for id in fresh.0 {
         pass.remove_caster(id).unwrap();
@@ -347,12 +456,114 @@ fn sphere_of(s: &ModelSphere) -> Sphere {
     Sphere { center: transform(s.pos, 0).w_axis.truncate(), radius: s.radius as f64 * 0.25 }
 }
 
+/// A submitted frame not yet waited for: the model it was prepared from, and its place in
+/// submission order.
+struct InFlight {
+    model: Model,
+    serial: usize,
+}
+
 struct Sut {
     pass: ShadowPass,
+    target: Target,
     casters: Vec<CasterId>,
     spheres: Vec<SphereId>,
     transparent: Vec<CasterId>,
-    frames: usize,
+    /// Per slot, its submitted frame until the slot is prepared again or the sequence ends
+    /// (the host waits for the slot's fence then, and the comparison reads its stencil).
+    in_flight: Vec<Option<InFlight>>,
+    submitted: usize,
+}
+
+impl Sut {
+    /// Waits for `slot`'s submitted frame, if any, and compares its stencil with a fresh
+    /// pass's holding the casters of the model it was prepared from (later calls must not
+    /// have reached it).
+    fn retire(&mut self, slot: usize) {
+        let Some(InFlight { model, .. }) = self.in_flight.get_mut(slot).and_then(Option::take) else { return };
+        let (got, want) = with_harness(|h| {
+            let s = &h.slots[slot];
+            // SAFETY: the fence was submitted with the slot's frame; reset once signalled.
+            unsafe {
+                h.ctx.device.wait_for_fences(&[s.fence], true, u64::MAX).unwrap();
+                h.ctx.device.reset_fences(&[s.fence]).unwrap();
+            }
+            let got = stencil(&h.slots[slot].target);
+            (got, reference_stencil(h, &model))
+        });
+        let differ = got.iter().zip(&want).filter(|(a, b)| a != b).count();
+        let shadowed = want.iter().filter(|&&v| v != 0).count();
+        assert_eq!(differ, 0, "slot {slot}: {differ} stencil bytes differ from a fresh pass's ({shadowed} shadowed there)");
+        let rp = self.target == Target::RenderPass;
+        count(0);
+        if rp {
+            count(4);
+        }
+        if shadowed > 0 {
+            count(1);
+            if rp {
+                count(5);
+            }
+        }
+    }
+
+    /// Records `frame` into `slot`'s command buffer, then submits it with the slot's fence
+    /// (not waited for) or resets it unsubmitted.
+    fn record_slot(&mut self, model: &Model, slot: usize, frame: &PreparedFrame, submit: bool) {
+        let target = self.target;
+        let pass = &self.pass;
+        with_harness(|h| {
+            let s = &h.slots[slot];
+            let d = &h.ctx.device;
+            // SAFETY: the slot's buffer is not pending (its fence was waited for before the
+            // slot was prepared) and its pool's buffers are resettable; recorded, then
+            // submitted with the unsignalled fence, or reset unsubmitted.
+            unsafe {
+                d.reset_command_buffer(s.cb, vk::CommandBufferResetFlags::empty()).unwrap();
+                let begin = vk::CommandBufferBeginInfo::default().flags(vk::CommandBufferUsageFlags::ONE_TIME_SUBMIT);
+                d.begin_command_buffer(s.cb, &begin).unwrap();
+                record(h, &s.target, s.cb, pass, frame, target);
+                d.end_command_buffer(s.cb).unwrap();
+                if submit {
+                    let cbs = [s.cb];
+                    d.queue_submit(h.ctx.queue, &[vk::SubmitInfo::default().command_buffers(&cbs)], s.fence).unwrap();
+                } else {
+                    d.reset_command_buffer(s.cb, vk::CommandBufferResetFlags::empty()).unwrap();
+                }
+            }
+        });
+        if submit {
+            if self.in_flight.iter().any(Option::is_some) {
+                count(6);
+            }
+            self.in_flight[slot] = Some(InFlight { model: model.clone(), serial: self.submitted });
+            self.submitted += 1;
+        }
+    }
+}
+
+impl Drop for Sut {
+    /// After a failure: waits for the frames still in flight (uncompared) before the pass is
+    /// dropped, so that the next case finds the harness's slots idle.
+    fn drop(&mut self) {
+        let slots: Vec<usize> = (0..self.in_flight.len()).filter(|&i| self.in_flight[i].take().is_some()).collect();
+        if slots.is_empty() {
+            return;
+        }
+        let _ = HARNESS.try_with(|h| {
+            if let Ok(mut h) = h.try_borrow_mut() {
+                if let Some(h) = h.as_mut() {
+                    for i in slots {
+                        // SAFETY: the fence was submitted with the slot's frame.
+                        unsafe {
+                            let _ = h.ctx.device.wait_for_fences(&[h.slots[i].fence], true, u64::MAX);
+                            let _ = h.ctx.device.reset_fences(&[h.slots[i].fence]);
+                        }
+                    }
+                }
+            }
+        });
+    }
 }
 
 struct Sequences;
@@ -362,8 +573,12 @@ impl StateMachineTest for Sequences {
     type Reference = Reference;
 
     fn init_test(model: &Model) -> Sut {
-        let pass = with_harness(|h| new_pass(&h.ctx, model.frames_in_flight));
-        Sut { pass, casters: vec![], spheres: vec![], transparent: vec![], frames: 0 }
+        let pass = with_harness(|h| {
+            let rp = (model.target == Target::RenderPass).then_some(h.rp_target);
+            new_pass(&h.ctx, model.frames_in_flight, rp)
+        });
+        let in_flight = (0..model.frames_in_flight).map(|_| None).collect();
+        Sut { pass, target: model.target, casters: vec![], spheres: vec![], transparent: vec![], in_flight, submitted: 0 }
     }
 
     fn apply(mut sut: Sut, model: &Model, step: Step) -> Sut {
@@ -384,12 +599,22 @@ impl StateMachineTest for Sequences {
             Step::RemoveSphere(i) => sut.pass.remove_sphere(sut.spheres.remove(i)).unwrap(),
             Step::SetSphere(i, s) => sut.pass.set_sphere(sut.spheres[i], sphere_of(&s)).unwrap(),
             Step::AddTransparent(c) => {
-                let id = sut.pass.add_transparent_caster("t", &meshes[c.shape], transform(c.pos, c.turn), Vec3::splat(0.5)).unwrap();
-                sut.transparent.push(id);
+                let r = sut.pass.add_transparent_caster("t", &meshes[c.shape], transform(c.pos, c.turn), Vec3::splat(0.5));
+                match sut.target {
+                    Target::DynamicRendering => sut.transparent.push(r.unwrap()),
+                    Target::RenderPass => {
+                        let e = r.expect_err("a transparent caster accepted without transmit_format");
+                        assert!(matches!(e, Error::Misuse(Misuse::NotConfigured { .. })), "{e}");
+                        count(2);
+                    }
+                }
             }
             Step::RemoveTransparent(i) => sut.pass.remove_caster(sut.transparent.remove(i)).unwrap(),
             Step::SetMethod(m) => sut.pass.set_settings(PassSettings { technique: Technique::Volumes(m), ..Default::default() }).unwrap(),
             Step::Prepare(slot, fate) => {
+                // As a host: before preparing a slot again, wait for its previous frame (here
+                // also compared); the other slots' frames stay in flight.
+                sut.retire(slot);
                 let r = sut.pass.prepare(slot, &view(), &[light()]);
                 if slot >= model.frames_in_flight {
                     assert!(r.is_err(), "slot {slot} of {} was accepted", model.frames_in_flight);
@@ -399,24 +624,11 @@ impl StateMachineTest for Sequences {
                 match fate {
                     FrameFate::Dropped => drop(frame),
                     FrameFate::Abandoned => {
-                        with_harness(|h| record(h, &sut.pass, &frame, false));
+                        sut.record_slot(model, slot, &frame, false);
                         sut.pass.abandon_frame(slot).unwrap();
                         count(3);
                     }
-                    FrameFate::Submitted => {
-                        let (got, want) = with_harness(|h| {
-                            let got = record(h, &sut.pass, &frame, true).unwrap();
-                            (got, reference_stencil(h, model))
-                        });
-                        let differ = got.iter().zip(&want).filter(|(a, b)| a != b).count();
-                        let shadowed = want.iter().filter(|&&v| v != 0).count();
-                        assert_eq!(differ, 0, "{differ} stencil bytes differ from a fresh pass's ({shadowed} shadowed there)");
-                        sut.frames += 1;
-                        count(0);
-                        if shadowed > 0 {
-                            count(1);
-                        }
-                    }
+                    FrameFate::Submitted => sut.record_slot(model, slot, &frame, true),
                 }
             }
             Step::Invalid(k) => {
@@ -426,7 +638,11 @@ impl StateMachineTest for Sequences {
                     2 => with_harness(|h| sut.pass.remove_caster(h.other_caster).err()),
                     3 => with_harness(|h| sut.pass.set_transform(h.other_caster, DMat4::IDENTITY).err()),
                     4 => with_harness(|h| sut.pass.remove_sphere(h.other_sphere).err()),
-                    5 => sut.pass.prepare(0, &view(), &[Light { radius: Some(-1.0), ..light() }]).err(),
+                    5 => {
+                        // `prepare`'s contract holds for a refused call too: slot 0 has retired.
+                        sut.retire(0);
+                        sut.pass.prepare(0, &view(), &[Light { radius: Some(-1.0), ..light() }]).err()
+                    }
                     6 => sut.casters.first().and_then(|&id| sut.pass.update_positions(id, &[Vec3::ZERO]).err()),
                     _ => sut.pass.set_settings(PassSettings { technique: Technique::shadow_map(256), ..Default::default() }).err(),
                 };
@@ -446,27 +662,105 @@ impl StateMachineTest for Sequences {
             assert!(errors.is_empty(), "validation: {errors:#?}");
         });
     }
+
+    /// The end of the sequence: the frames still in flight are waited for and compared, in
+    /// the order they were submitted.
+    fn teardown(mut sut: Sut, model: Model) {
+        let mut slots: Vec<(usize, usize)> =
+            sut.in_flight.iter().enumerate().filter_map(|(i, f)| f.as_ref().map(|f| (f.serial, i))).collect();
+        slots.sort();
+        for (_, slot) in slots {
+            sut.retire(slot);
+        }
+        Self::check_invariants(&sut, &model);
+    }
 }
 
 fn cases() -> u32 {
     std::env::var("PASS_SEQUENCES_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(200)
 }
 
+/// On a failure, leaks the harness instead of letting the thread-local destructor tear the
+/// device down under passes and frames still alive (that crashed the process before the test
+/// harness printed the failure).
+struct LeakHarnessOnPanic;
+
+impl Drop for LeakHarnessOnPanic {
+    fn drop(&mut self) {
+        if std::thread::panicking() {
+            std::mem::forget(HARNESS.with(|h| h.borrow_mut().take()));
+        }
+    }
+}
+
+/// A W x H depth-stencil image, its framebuffer of `render_pass` and its readback buffer.
+fn host_target(ctx: &Context, render_pass: vk::RenderPass, name: &str) -> HostTarget {
+    let extent = vk::Extent2D { width: W, height: H };
+    let usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
+    let image =
+        Image::new_2d(ctx, name, ctx.depth_format, extent, usage, vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL).unwrap();
+    let readback = Buffer::new(ctx, name, (W * H) as u64 + 256, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu).unwrap();
+    let views = [image.view];
+    let fb = vk::FramebufferCreateInfo::default().render_pass(render_pass).attachments(&views).width(W).height(H).layers(1);
+    // SAFETY: the image view is of the render pass's attachment format and the framebuffer's
+    // size; destroyed before the image.
+    let framebuffer = unsafe { ctx.device.create_framebuffer(&fb, None) }.unwrap();
+    HostTarget { image, framebuffer, readback }
+}
+
+fn destroy_target(ctx: &Context, mut t: HostTarget) {
+    // SAFETY: every command buffer using the framebuffer has completed.
+    unsafe { ctx.device.destroy_framebuffer(t.framebuffer, None) };
+    t.image.destroy(ctx);
+    t.readback.destroy(ctx);
+}
+
 #[test]
 fn every_call_sequence_matches_a_fresh_pass() {
     let Some(ctx) = common::context() else { return };
-    let extent = vk::Extent2D { width: W, height: H };
-    let usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC;
-    let image = Image::new_2d(&ctx, "target", ctx.depth_format, extent, usage, vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL)
-        .unwrap();
-    let readback =
-        Buffer::new(&ctx, "readback", (W * H) as u64 + 256, vk::BufferUsageFlags::TRANSFER_DST, MemoryLocation::GpuToCpu).unwrap();
-    let mut other = new_pass(&ctx, 1);
+    let (render_pass, rp_target) = host_render_pass(&ctx);
+    let pool_info =
+        vk::CommandPoolCreateInfo::default().queue_family_index(ctx.queue_family).flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER);
+    // SAFETY: a pool of the context's queue family, destroyed at the end.
+    let pool = unsafe { ctx.device.create_command_pool(&pool_info, None) }.unwrap();
+    let cb_info = vk::CommandBufferAllocateInfo::default().command_pool(pool).command_buffer_count(MAX_FRAMES_IN_FLIGHT as u32);
+    // SAFETY: primary buffers of `pool`, freed with it.
+    let cbs = unsafe { ctx.device.allocate_command_buffers(&cb_info) }.unwrap();
+    let slots = cbs
+        .into_iter()
+        .enumerate()
+        .map(|(i, cb)| {
+            // SAFETY: an unsignalled fence, destroyed at the end.
+            let fence = unsafe { ctx.device.create_fence(&vk::FenceCreateInfo::default(), None) }.unwrap();
+            HostSlot { target: host_target(&ctx, render_pass, &format!("slot {i}")), cb, fence }
+        })
+        .collect();
+    let reference_target = host_target(&ctx, render_pass, "reference");
+    let mut other = new_pass(&ctx, 1, None);
     let other_caster = other.add_caster("other", &meshes()[0], DMat4::IDENTITY).unwrap();
     let other_sphere = other.add_sphere_caster("other", Sphere { center: DVec3::Y, radius: 0.5 }, None).unwrap();
-    HARNESS.with(|h| *h.borrow_mut() = Some(Harness { ctx, image, readback, reference: vec![], other, other_caster, other_sphere }));
-    let config = Config { cases: cases(), max_shrink_iters: 2000, source_file: Some(file!()), ..Config::default() };
-    for fif in 1..=3 {
+    let _leak = LeakHarnessOnPanic;
+    HARNESS.with(|h| {
+        *h.borrow_mut() = Some(Harness {
+            render_pass,
+            rp_target,
+            pool,
+            slots,
+            reference: vec![],
+            reference_target,
+            other,
+            other_caster,
+            other_sphere,
+            ctx,
+        })
+    });
+    // Failing seeds persist in proptest-regressions/pass_sequences.txt (`SourceParallel`, the
+    // default, finds no lib.rs above tests/ and persists nothing) and are replayed first.
+    let failure_persistence =
+        Some(Box::new(FileFailurePersistence::Direct(concat!(env!("CARGO_MANIFEST_DIR"), "/proptest-regressions/pass_sequences.txt")))
+            as Box<dyn proptest::test_runner::FailurePersistence>);
+    let config = Config { cases: cases(), max_shrink_iters: 2000, failure_persistence, ..Config::default() };
+    for fif in 1..=MAX_FRAMES_IN_FLIGHT {
         FRAMES_IN_FLIGHT.with(|f| f.set(fif));
         let mut runner = proptest::test_runner::TestRunner::new(config.clone());
         let result = runner.run(&Reference::sequential_strategy(30..31), |(initial, transitions, seen)| {
@@ -477,14 +771,29 @@ fn every_call_sequence_matches_a_fresh_pass() {
             panic!("frames_in_flight {fif}: {e}");
         }
     }
-    let [compared, shadowed, refused, abandoned] = COUNTS.with(|c| c.get());
-    eprintln!("{compared} frames compared ({shadowed} with a shadow), {refused} calls refused, {abandoned} frames abandoned");
-    // The comparisons must have had something to compare.
+    let [compared, shadowed, refused, abandoned, rp_compared, rp_shadowed, overlapped] = COUNTS.with(|c| c.get());
+    eprintln!(
+        "{compared} frames compared ({shadowed} with a shadow; {rp_compared} ({rp_shadowed}) of them in the host's render pass), \
+         {overlapped} submitted with an earlier frame in flight, {refused} calls refused, {abandoned} frames abandoned"
+    );
+    // The comparisons must have had something to compare, under both target models, and
+    // frames must have overlapped.
     assert!(shadowed * 3 >= compared && compared >= cases() as usize, "{shadowed} of {compared} frames had a shadow");
+    let dr_shadowed = shadowed - rp_shadowed;
+    assert!(rp_shadowed * 5 >= shadowed && dr_shadowed * 5 >= shadowed, "{rp_shadowed} of {shadowed} shadowed frames in the render pass");
+    assert!(overlapped * 5 >= compared, "{overlapped} of {compared} frames submitted with another in flight");
     let mut h = HARNESS.with(|h| h.borrow_mut().take()).unwrap();
     h.reference.clear();
     drop(h.other);
-    h.image.destroy(&h.ctx);
-    h.readback.destroy(&h.ctx);
+    // SAFETY: every submission has completed (each sequence's teardown waited for its frames).
+    unsafe {
+        for s in h.slots.drain(..) {
+            h.ctx.device.destroy_fence(s.fence, None);
+            destroy_target(&h.ctx, s.target);
+        }
+        h.ctx.device.destroy_command_pool(h.pool, None);
+        h.ctx.device.destroy_render_pass(h.render_pass, None);
+    }
+    destroy_target(&h.ctx, h.reference_target);
     h.ctx.check_validation().unwrap();
 }
