@@ -2,7 +2,9 @@
 //! (proptest-state-machine). The model is the live casters (mesh, transform, deformation),
 //! sphere casters and transparent casters, and the settings; the transitions are the host's
 //! calls: add, remove and update casters, sphere casters and transparent casters,
-//! `set_transform`, `update_positions`, `set_settings`, `prepare` on any slot (including
+//! `set_transform`, `update_positions`, `set_settings` (volume methods and
+//! `Technique::Compute`, whose casters' tables live in a pass-wide arena that additions,
+//! removals and deformations grow, leave holes in and rebuild), `prepare` on any slot (including
 //! invalid ones) with the frame then dropped, recorded and submitted, or recorded and never
 //! submitted (`abandon_frame`), interleaved with invalid arguments and another pass's ids.
 //!
@@ -136,7 +138,9 @@ enum Step {
     SetSphere(usize, ModelSphere),
     AddTransparent(ModelCaster),
     RemoveTransparent(usize),
-    SetMethod(Method),
+    /// A volume method, or `None`: `Technique::Compute` (McGuire's cases with the GPU's
+    /// possible silhouettes; its stencil is McGuire's byte for byte).
+    SetMethod(Option<Method>),
     Prepare(usize, FrameFate),
     /// A call with an invalid argument, or another pass's id: refused, nothing changes.
     Invalid(u8),
@@ -154,7 +158,12 @@ fn sphere() -> impl Strategy<Value = ModelSphere> {
     (pos(), 1u8..=3).prop_map(|(pos, radius)| ModelSphere { pos, radius })
 }
 
-const METHODS: [Method; 4] = [Method::McGuire, Method::ZPass, Method::ZFail, Method::Lengyel];
+const METHODS: [Option<Method>; 5] = [Some(Method::McGuire), Some(Method::ZPass), Some(Method::ZFail), Some(Method::Lengyel), None];
+
+/// The technique the system under test runs for a [`Step::SetMethod`].
+fn technique(m: Option<Method>) -> Technique {
+    m.map_or(Technique::Compute, Technique::Volumes)
+}
 
 struct Reference;
 
@@ -234,7 +243,7 @@ impl ReferenceStateMachine for Reference {
             Step::RemoveTransparent(i) => {
                 state.transparent.remove(*i);
             }
-            Step::SetMethod(m) => state.method = *m,
+            Step::SetMethod(m) => state.method = m.unwrap_or(Method::McGuire),
             Step::Prepare(..) | Step::Invalid(_) => {}
         }
         state
@@ -610,7 +619,7 @@ impl StateMachineTest for Sequences {
                 }
             }
             Step::RemoveTransparent(i) => sut.pass.remove_caster(sut.transparent.remove(i)).unwrap(),
-            Step::SetMethod(m) => sut.pass.set_settings(PassSettings { technique: Technique::Volumes(m), ..Default::default() }).unwrap(),
+            Step::SetMethod(m) => sut.pass.set_settings(PassSettings { technique: technique(m), ..Default::default() }).unwrap(),
             Step::Prepare(slot, fate) => {
                 // As a host: before preparing a slot again, wait for its previous frame (here
                 // also compared); the other slots' frames stay in flight.
