@@ -121,6 +121,8 @@ enum MethodArg {
     Planar,
     /// McGuire's cases with GPU possible silhouettes (compute pass, indirect draws).
     Compute,
+    /// McGuire's cases with mesh-shader extrusion (VK_EXT_mesh_shader: Mesa lavapipe 25).
+    Mesh,
     /// The shadow-map baseline (PCF 3x3).
     Shadowmap,
     /// One shadow ray per pixel with VK_KHR_ray_query (Mesa lavapipe 25: scripts/drivers.sh).
@@ -141,6 +143,7 @@ impl MethodArg {
             MethodArg::Edgequad => Technique::EdgeQuads,
             MethodArg::Planar => Technique::Planar,
             MethodArg::Compute => Technique::Compute,
+            MethodArg::Mesh => Technique::Mesh,
             MethodArg::Shadowmap => shadow_map,
             MethodArg::Rayquery => Technique::RayQuery,
         }

@@ -422,6 +422,7 @@ impl Host {
             index_type_uint8: picked.index_type_uint8,
             // This host's G-buffer is depth only: no positions and normals for rays.
             ray_query: false,
+            mesh_shader: false,
         };
         let device = create_device(&host.instance, &picked, dynamic)?;
         host.device = Some(device.clone());

@@ -255,6 +255,7 @@ impl Host {
                 depth_bounds: false,
                 index_type_uint8: host.gpu.index_type_uint8,
                 ray_query: false,
+                mesh_shader: false,
             },
             ..Default::default()
         };

@@ -21,14 +21,16 @@ pub fn volume_methods() -> Vec<Method> {
 /// Every technique, shadow maps once per size in `shadow_map_sizes` (none when empty; each
 /// size twice, atlas and multiview cube faces, with `multiview`: a device whose multiview the
 /// renderer trusts), and ray query when the device has it (`ray_query`:
-/// [`crate::gpu::Features::ray_query`]).
-pub fn all_techniques(shadow_map_sizes: &[u32], ray_query: bool, multiview: bool) -> Vec<Technique> {
+/// [`crate::gpu::Features::ray_query`]), and mesh-shader extrusion when the device has mesh
+/// shaders (`mesh_shader`: [`crate::gpu::Features::mesh_shader`]).
+pub fn all_techniques(shadow_map_sizes: &[u32], ray_query: bool, multiview: bool, mesh_shader: bool) -> Vec<Technique> {
     let mut out: Vec<Technique> = volume_methods().into_iter().map(Technique::Volumes).collect();
     // Exhaustive on purpose: a new Technique variant is a compile error until listed below.
     let listed = |t: Technique| match t {
         Technique::Volumes(_)
         | Technique::EdgeQuads
         | Technique::Compute
+        | Technique::Mesh
         | Technique::Planar
         | Technique::ShadowMap { .. }
         | Technique::RayQuery => (),
@@ -43,6 +45,10 @@ pub fn all_techniques(shadow_map_sizes: &[u32], ray_query: bool, multiview: bool
             out.push(Technique::ShadowMap { size, pcf: crate::render::Pcf::Taps, cube: crate::render::CubeFaces::Multiview });
         }
     }
+    if mesh_shader {
+        listed(Technique::Mesh);
+        out.push(Technique::Mesh);
+    }
     if ray_query {
         listed(Technique::RayQuery);
         out.push(Technique::RayQuery);
@@ -55,7 +61,7 @@ pub fn all_techniques(shadow_map_sizes: &[u32], ray_query: bool, multiview: bool
 pub fn is_exact(t: Technique) -> bool {
     match t {
         Technique::Volumes(m) => !matches!(m, Method::ZPass | Method::ZPassClear),
-        Technique::EdgeQuads | Technique::Compute | Technique::RayQuery => true,
+        Technique::EdgeQuads | Technique::Compute | Technique::Mesh | Technique::RayQuery => true,
         Technique::Planar | Technique::ShadowMap { .. } => false,
     }
 }
@@ -65,9 +71,9 @@ mod tests {
     use super::*;
     #[test]
     fn every_method_once() {
-        let all = all_techniques(&[512, 4096], true, false);
-        assert_eq!(all.len(), volume_methods().len() + 6);
-        assert_eq!(all_techniques(&[512, 4096], true, true).len(), volume_methods().len() + 8);
+        let all = all_techniques(&[512, 4096], true, false, true);
+        assert_eq!(all.len(), volume_methods().len() + 7);
+        assert_eq!(all_techniques(&[512, 4096], true, true, false).len(), volume_methods().len() + 8);
         for (i, a) in all.iter().enumerate() {
             assert!(!all[i + 1..].contains(a), "{a:?} listed twice");
         }

@@ -318,7 +318,7 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
     };
     // Multiview cube faces where the renderer trusts the device's multiview (gpu::quirks).
     let multiview = ctx.features.multiview && crate::gpu::quirks::multiview_defect(&ctx.info).is_none();
-    let techniques = all_techniques(&scale.shadow_map_sizes(), ctx.features.ray_query, multiview);
+    let techniques = all_techniques(&scale.shadow_map_sizes(), ctx.features.ray_query, multiview, ctx.features.mesh_shader);
     let points = sweeps::points(scale);
     // The tiny suite (tests) leaves the 435k-triangle vertex scene out.
     let named: &[&str] = if scale == Scale::Tiny { &["bench/fill", "default"] } else { &["bench/fill", "bench/vertex"] };

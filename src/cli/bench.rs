@@ -192,8 +192,8 @@ fn bench_techniques(
     let size = if shadow_map_size > 0 { shadow_map_size } else { 2048 };
     let listed: Vec<Technique> = if methods.is_empty() {
         let sizes: &[u32] = if shadow_map_size > 0 { &[size] } else { &[] };
-        // Ray query joins once the device is known (`bench`).
-        umbrage::bench::methods::all_techniques(sizes, false, false)
+        // Ray query and mesh shaders join once the device is known (`bench`).
+        umbrage::bench::methods::all_techniques(sizes, false, false, false)
     } else {
         methods.iter().map(|m| m.technique(Technique::shadow_map(size))).collect()
     };
@@ -228,6 +228,9 @@ fn bench(
     let scenes = if scenes.is_empty() { vec!["bench/fill".into(), "bench/vertex".into(), "default".into()] } else { scenes };
     let ctx = umbrage::gpu::Context::new()?;
     let mut techniques = techniques;
+    if default_list && ctx.features.mesh_shader {
+        techniques.push(Technique::Mesh);
+    }
     if default_list && ctx.features.ray_query {
         techniques.push(Technique::RayQuery);
     }

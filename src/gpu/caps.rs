@@ -352,6 +352,8 @@ pub fn choose(caps: &DeviceCaps, minimum: Minimum) -> Result<Choice> {
         && f.ray_query
         && f.buffer_device_address;
     let depth_range_unrestricted = caps.has_extension(ash::ext::depth_range_unrestricted::NAME);
+    // Mesh shaders: naga writes them as SPIR-V 1.4, which Vulkan 1.2 takes.
+    let mesh_shader = v12 && caps.has_extension(ash::ext::mesh_shader::NAME) && f.mesh_shader;
     let blendable = |fmt: vk::Format| caps.format_features(fmt).contains(vk::FormatFeatureFlags::COLOR_ATTACHMENT_BLEND);
     let l = &caps.limits;
     let features = Features {
@@ -373,6 +375,8 @@ pub fn choose(caps: &DeviceCaps, minimum: Minimum) -> Result<Choice> {
         rgba32f_blend: blendable(vk::Format::R32G32B32A32_SFLOAT),
         ray_query,
         multiview: v12 && f.multiview,
+        mesh_shader,
+        task_shader: mesh_shader && f.task_shader,
         sample_rate_shading: f.sample_rate_shading,
         standard_sample_locations: l.standard_sample_locations == vk::TRUE,
         frame_sample_counts: (l.framebuffer_color_sample_counts
@@ -392,6 +396,9 @@ pub fn choose(caps: &DeviceCaps, minimum: Minimum) -> Result<Choice> {
     }
     if depth_range_unrestricted {
         extensions.push(ash::ext::depth_range_unrestricted::NAME);
+    }
+    if mesh_shader {
+        extensions.push(ash::ext::mesh_shader::NAME);
     }
     Ok(Choice { features, depth_format, extensions })
 }
@@ -452,6 +459,12 @@ pub struct Features {
     /// `multiview` (Vulkan 1.1 core) is supported and enabled: the shadow-map baseline can
     /// render a point light's six cube faces as six views of one draw (`--cube multiview`).
     pub multiview: bool,
+    /// `VK_EXT_mesh_shader` with `meshShader` (Vulkan 1.2 or newer) is present and enabled:
+    /// `--method mesh` can run (Mesa lavapipe 25 has it; 22.3 has not).
+    pub mesh_shader: bool,
+    /// `taskShader` of `VK_EXT_mesh_shader` is present and enabled too (only with
+    /// [`mesh_shader`](Self::mesh_shader)).
+    pub task_shader: bool,
     /// `sampleRateShading` is supported and enabled: the renderer's multisampled frame
     /// (`--msaa N`) shades its G-buffer and lighting per sample.
     pub sample_rate_shading: bool,

@@ -46,6 +46,7 @@ pub(super) fn open_device(
     let ray_query = features.ray_query;
     let u8_supported = features.index_type_uint8;
     let multiview = features.multiview;
+    let mesh_shader = features.mesh_shader;
     let enabled = vk::PhysicalDeviceFeatures::default()
         .depth_clamp(features.depth_clamp)
         .depth_bounds(features.depth_bounds)
@@ -60,6 +61,7 @@ pub(super) fn open_device(
     let mut e_rq = vk::PhysicalDeviceRayQueryFeaturesKHR::default().ray_query(true);
     let mut e12 = vk::PhysicalDeviceVulkan12Features::default().buffer_device_address(true);
     let mut e11 = vk::PhysicalDeviceVulkan11Features::default().multiview(true);
+    let mut e_mesh = vk::PhysicalDeviceMeshShaderFeaturesEXT::default().mesh_shader(true).task_shader(features.task_shader);
     let mut dev_exts: Vec<_> = extensions.iter().map(|e| e.as_ptr()).collect();
     for &e in extra_extensions {
         if !caps.has_extension(e) {
@@ -82,6 +84,9 @@ pub(super) fn open_device(
     }
     if ray_query {
         dinfo = dinfo.push_next(&mut e_as).push_next(&mut e_rq).push_next(&mut e12);
+    }
+    if mesh_shader {
+        dinfo = dinfo.push_next(&mut e_mesh);
     }
     // SAFETY: all pointers refer to locals alive for the call.
     let device = unsafe { instance.create_device(physical, &dinfo, None) }.map_err(vkerr("vkCreateDevice"))?;

@@ -242,6 +242,14 @@ pub enum Technique {
     /// geometry sent per frame. Parts on the multiplicity path (open, non-manifold) and
     /// transparent casters keep the CPU path.
     Compute,
+    /// Mesh-shader extrusion (`VK_EXT_mesh_shader`): McGuire's three cases chosen on the CPU
+    /// from bounds, the facing bits found on the GPU as [`Compute`](Technique::Compute) finds
+    /// them (bit for bit the CPU's), then per (light, caster part) one `vkCmdDrawMeshTasksEXT`
+    /// over the part's meshlets (built once per caster, each edge owned by exactly one
+    /// meshlet) that emits the side quads, the fan dark cap and, for z-fail, the caps, with
+    /// no index buffer (docs/mesh.md). Needs [`Capabilities::mesh_shader`]. Parts on the
+    /// multiplicity path (open, non-manifold) and transparent casters keep the CPU path.
+    Mesh,
     /// The shadow-map baseline (PCF 3x3) with maps of `size` texels a side (renderer only).
     ShadowMap {
         /// Texels per side of one map (16..=8192).
@@ -260,23 +268,26 @@ pub enum Technique {
 
 impl Technique {
     /// The name on the command line and in `--stats` (`mcguire`, ..., `edgequad`, `compute`,
-    /// `shadowmap`, `rayquery`).
+    /// `mesh`, `shadowmap`, `rayquery`).
     pub fn name(self) -> &'static str {
         match self {
             Technique::Volumes(m) => m.name(),
             Technique::EdgeQuads => "edgequad",
             Technique::Planar => "planar",
             Technique::Compute => "compute",
+            Technique::Mesh => "mesh",
             Technique::ShadowMap { .. } => "shadowmap",
             Technique::RayQuery => "rayquery",
         }
     }
-    /// The case rule the planner uses (edge quads, compute, and the renderer-only techniques'
+    /// The case rule the planner uses (edge quads, compute, mesh, and the renderer-only techniques'
     /// culling use McGuire's rule).
     pub fn method(self) -> Method {
         match self {
             Technique::Volumes(m) => m,
-            Technique::EdgeQuads | Technique::Compute | Technique::ShadowMap { .. } | Technique::RayQuery => Method::McGuire,
+            Technique::EdgeQuads | Technique::Compute | Technique::Mesh | Technique::ShadowMap { .. } | Technique::RayQuery => {
+                Method::McGuire
+            }
             // Culling only: the casters' draws are replaced by their flattened triangles.
             Technique::Planar => Method::ZPass,
         }
@@ -290,7 +301,12 @@ impl Technique {
     /// the renderer-only shadow-map baseline.
     pub fn pass_technique(self) -> Option<Technique> {
         match self {
-            Technique::Volumes(_) | Technique::EdgeQuads | Technique::Planar | Technique::Compute | Technique::RayQuery => Some(self),
+            Technique::Volumes(_)
+            | Technique::EdgeQuads
+            | Technique::Planar
+            | Technique::Compute
+            | Technique::Mesh
+            | Technique::RayQuery => Some(self),
             Technique::ShadowMap { .. } => None,
         }
     }
@@ -304,19 +320,20 @@ impl Technique {
         Method::ALL.iter().map(|&m| Technique::Volumes(m)).collect()
     }
     /// Parses a `--method` value: `auto` (= mcguire), a volume method, `edgequad`, `planar`,
-    /// `compute`, `rayquery` or `shadowmap` (with maps of `shadow_map_size` texels, read with
+    /// `compute`, `mesh`, `rayquery` or `shadowmap` (with maps of `shadow_map_size` texels, read with
     /// [`Pcf::Taps`], cube faces in an [`CubeFaces::Atlas`]).
     pub fn parse(s: &str, shadow_map_size: u32) -> Result<Technique> {
         match s {
             "edgequad" => Ok(Technique::EdgeQuads),
             "planar" => Ok(Technique::Planar),
             "compute" => Ok(Technique::Compute),
+            "mesh" => Ok(Technique::Mesh),
             "shadowmap" => Ok(Technique::shadow_map(shadow_map_size)),
             "rayquery" => Ok(Technique::RayQuery),
             _ => s.parse::<Method>().map(Technique::Volumes).map_err(|_| Error::UnknownName {
                 what: "method",
                 name: s.into(),
-                expected: format!("auto, {}, edgequad, planar, compute, shadowmap, rayquery", Method::ALL.map(|m| m.name()).join(", ")),
+                expected: format!("auto, {}, edgequad, planar, compute, mesh, shadowmap, rayquery", Method::ALL.map(|m| m.name()).join(", ")),
             }),
         }
     }
@@ -358,6 +375,9 @@ pub struct EnabledFeatures {
     /// (`accelerationStructure`) with Vulkan 1.2's `bufferDeviceAddress`, and the host's
     /// gpu-allocator created with `buffer_device_address`: [`Technique::RayQuery`].
     pub ray_query: bool,
+    /// `VK_EXT_mesh_shader` with `meshShader` (Vulkan 1.2 or newer):
+    /// [`Technique::Mesh`].
+    pub mesh_shader: bool,
 }
 
 /// What a [`ShadowPass`](super::ShadowPass) is created for. Everything here is fixed for the
@@ -514,6 +534,8 @@ pub struct Capabilities {
     pub index_type_uint8: bool,
     /// `R32_SFLOAT` colour attachments blend (float counter).
     pub r32f_blend: bool,
+    /// Mesh shaders enabled and present ([`EnabledFeatures::mesh_shader`]).
+    pub mesh_shader: bool,
 }
 
 /// Refuses a depth-stencil format without a depth aspect or without 8 stencil bits.
@@ -535,7 +557,7 @@ impl PassSettings {
                 field: "PassSettings::technique",
                 msg: format!(
                     "{} is a renderer technique (umbrage::render::Renderer), not one a ShadowPass records: \
-                     use Volumes, EdgeQuads, Planar, Compute or RayQuery",
+                     use Volumes, EdgeQuads, Planar, Compute, Mesh or RayQuery",
                     self.technique.name()
                 ),
             });
@@ -550,6 +572,9 @@ impl PassSettings {
                     msg: "Technique::RayQuery writes the stencil (non-zero = shadowed), not a volume count: use Counter::Stencil".into(),
                 });
             }
+        }
+        if self.technique == Technique::Mesh && !caps.mesh_shader {
+            return Err(mesh_missing());
         }
         if self.index_format == IndexFormat::U8 && !caps.index_type_uint8 {
             return Err(Error::Unsupported(
@@ -581,6 +606,16 @@ pub(crate) fn rays_missing() -> Error {
         "Technique::RayQuery needs VK_KHR_ray_query and VK_KHR_acceleration_structure with bufferDeviceAddress (Vulkan 1.2), \
          enabled by the host (EnabledFeatures::ray_query, and the allocator created with buffer_device_address); \
          Mesa lavapipe 25.0.7 has them: `scripts/drivers.sh install 25.0.7`"
+            .into(),
+    )
+}
+
+/// The clear error for a pass without mesh shaders.
+pub(crate) fn mesh_missing() -> Error {
+    Error::Unsupported(
+        "Technique::Mesh needs VK_EXT_mesh_shader with meshShader (Vulkan 1.2 or newer), enabled by the host \
+         (EnabledFeatures::mesh_shader); use Technique::Compute or Technique::Volumes. Mesa lavapipe 25.0.7 has it: \
+         `scripts/drivers.sh install 25.0.7`"
             .into(),
     )
 }

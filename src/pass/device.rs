@@ -79,6 +79,7 @@ pub(super) fn capabilities(caps: &DeviceCaps, desc: &ShadowPassDesc) -> Result<C
         && f.acceleration_structure
         && f.buffer_device_address;
     let u8_ext = has(ash::ext::index_type_uint8::NAME) || has(ash::khr::index_type_uint8::NAME);
+    let mesh_shader = api >= vk::API_VERSION_1_2 && has(ash::ext::mesh_shader::NAME) && f.mesh_shader;
     Ok(Capabilities {
         ray_query: desc.features.ray_query && ray_query,
         depth_clamp: desc.features.depth_clamp && f.depth_clamp,
@@ -86,6 +87,7 @@ pub(super) fn capabilities(caps: &DeviceCaps, desc: &ShadowPassDesc) -> Result<C
         index_type_uint8: desc.features.index_type_uint8 && u8_ext && f.index_type_uint8,
         r32f_blend: caps.format_features(COUNT_FORMAT).contains(vk::FormatFeatureFlags::COLOR_ATTACHMENT_BLEND)
             && desc.target == TargetModel::DynamicRendering,
+        mesh_shader: desc.features.mesh_shader && mesh_shader,
     })
 }
 

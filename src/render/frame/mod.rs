@@ -488,6 +488,7 @@ impl Parts {
                 depth_bounds: f.depth_bounds,
                 index_type_uint8: f.index_type_uint8,
                 ray_query: f.ray_query,
+                mesh_shader: f.mesh_shader,
             },
             settings: pass_settings(&settings),
             transmit_format: Some(transmit_format),
