@@ -4,6 +4,7 @@
 #![warn(missing_docs)]
 pub mod caster;
 pub mod edgequad;
+pub mod meshlet;
 pub mod plan;
 
 pub use caster::{Caster, CasterKind, Chunk, Part, TRANSMITTANCE_FLOOR};
