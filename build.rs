@@ -98,7 +98,12 @@ fn compile(path: &Path, define: Option<&str>) -> Result<Vec<u32>, String> {
     spv.flags.remove(naga::back::spv::WriterFlags::ADJUST_COORDINATE_SPACE);
     // SPIR-V 1.0 for the GLSL graphics shaders, the version a Vulkan 1.0 device accepts (the
     // conformance suite runs there); the WGSL compute modules use storage buffers as SPIR-V 1.3
-    // has them (the compute path needs a Vulkan 1.3 device anyway).
-    spv.lang_version = if path.extension().and_then(|e| e.to_str()) == Some("wgsl") { (1, 3) } else { (1, 0) };
+    // has them (the compute path needs a Vulkan 1.3 device anyway); mesh and task shaders need
+    // SPIR-V 1.4 (`VK_EXT_mesh_shader` on Vulkan 1.2 or newer).
+    spv.lang_version = match path.extension().and_then(|e| e.to_str()) {
+        Some("wgsl") if source.contains("enable wgpu_mesh_shader;") => (1, 4),
+        Some("wgsl") => (1, 3),
+        _ => (1, 0),
+    };
     naga::back::spv::write_vec(&module, &info, &spv, None).map_err(|e| format!("{file}: SPIR-V output: {e}"))
 }

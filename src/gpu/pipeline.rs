@@ -85,6 +85,10 @@ pub struct PipelineDesc<'a> {
     /// pipeline is used in; 0 (the default): no multiview. Non-zero needs the `multiview`
     /// feature and dynamic rendering.
     pub view_mask: u32,
+    /// A mesh-shader pipeline (`VK_EXT_mesh_shader`, enabled): the SPIR-V module and its
+    /// mesh entry point replace the vertex stage (`vertex`, the vertex input and the input
+    /// assembly are then ignored). `None` (the default): a vertex pipeline.
+    pub mesh: Option<(&'a [u8], &'a std::ffi::CStr)>,
 }
 
 impl<'a> PipelineDesc<'a> {
@@ -116,6 +120,7 @@ impl<'a> PipelineDesc<'a> {
             samples: vk::SampleCountFlags::TYPE_1,
             render_pass: None,
             view_mask: 0,
+            mesh: None,
         }
     }
 }
@@ -136,12 +141,20 @@ pub fn shader_module(ctx: &impl GpuDevice, spirv: &[u8]) -> Result<vk::ShaderMod
 /// shader modules are created and destroyed here; the pipeline is the caller's to destroy,
 /// and `d.layout` must outlive every use of it.
 pub fn create(ctx: &impl GpuDevice, d: &PipelineDesc) -> Result<vk::Pipeline> {
-    let vs = shader_module(ctx, d.vertex)?;
-    let fs = match d.fragment {
-        Some(f) => Some(shader_module(ctx, f)?),
-        None => None,
+    let (first_module, first_stage, first_entry) = match d.mesh {
+        Some((module, entry)) => (module, vk::ShaderStageFlags::MESH_EXT, entry),
+        None => (d.vertex, vk::ShaderStageFlags::VERTEX, c"main"),
     };
-    let mut stages = vec![vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::VERTEX).module(vs).name(c"main")];
+    let vs = shader_module(ctx, first_module)?;
+    let fs = match d.fragment.map(|f| shader_module(ctx, f)).transpose() {
+        Ok(fs) => fs,
+        Err(e) => {
+            // SAFETY: the module was just created and is used by nothing.
+            unsafe { ctx.device().destroy_shader_module(vs, None) };
+            return Err(e);
+        }
+    };
+    let mut stages = vec![vk::PipelineShaderStageCreateInfo::default().stage(first_stage).module(vs).name(first_entry)];
     if let Some(fs) = fs {
         stages.push(vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::FRAGMENT).module(fs).name(d.fragment_entry));
     }
@@ -253,10 +266,11 @@ pub fn create(ctx: &impl GpuDevice, d: &PipelineDesc) -> Result<vk::Pipeline> {
         .depth_attachment_format(d.depth_format)
         .stencil_attachment_format(if has_stencil { d.depth_format } else { vk::Format::UNDEFINED })
         .view_mask(d.view_mask);
-    let mut info = vk::GraphicsPipelineCreateInfo::default()
-        .stages(&stages)
-        .vertex_input_state(&vertex_input)
-        .input_assembly_state(&ia)
+    let mut info = vk::GraphicsPipelineCreateInfo::default().stages(&stages);
+    if d.mesh.is_none() {
+        info = info.vertex_input_state(&vertex_input).input_assembly_state(&ia);
+    }
+    info = info
         .viewport_state(&vp)
         .rasterization_state(&rs)
         .multisample_state(&ms)
@@ -290,7 +304,10 @@ pub fn create(ctx: &impl GpuDevice, d: &PipelineDesc) -> Result<vk::Pipeline> {
 /// A graphics pipeline's name in [`super::creation`]'s log: its shaders and the state that
 /// tells the renderer's pipelines apart.
 fn label(d: &PipelineDesc) -> String {
-    let mut s = super::creation::shader_name(d.vertex);
+    let mut s = match d.mesh {
+        Some((module, entry)) => format!("{}:{}", super::creation::shader_name(module), entry.to_string_lossy()),
+        None => super::creation::shader_name(d.vertex),
+    };
     if let Some(f) = d.fragment {
         s += &format!(" + {}", super::creation::shader_name(f));
         if d.fragment_entry != c"main" {

@@ -303,7 +303,7 @@ impl CasterTable {
             return Ok(());
         }
         let mut meshes: Vec<(usize, ComputeMesh)> = todo.iter().map(|&i| (i, ComputeMesh::new(&self.cpu[i]))).collect();
-        let mut need = [0u64; 4];
+        let mut need = [0u64; super::compute::arena::N];
         for (_, m) in &meshes {
             add_elements(&mut need, mesh_elements(m));
         }
@@ -328,13 +328,18 @@ impl CasterTable {
         for (i, m) in meshes {
             let elements = mesh_elements(&m);
             let base = self.arena.allocate(elements);
-            let bytes: [&[u8]; 4] = [
+            // the meshlets' firsts, absolute in their tables
+            let meshlets: Vec<[u32; 4]> = m.meshlets.iter().map(|&[ft, tc, fe, ec]| [ft + base[5], tc, fe + base[6], ec]).collect();
+            let bytes: [&[u8]; super::compute::arena::N] = [
                 bytemuck::cast_slice(&m.planes),
                 bytemuck::cast_slice(&m.tris),
                 bytemuck::cast_slice(&m.positions),
                 bytemuck::cast_slice(&m.edges),
+                bytemuck::cast_slice(&meshlets),
+                bytemuck::cast_slice(&m.meshlet_tris),
+                bytemuck::cast_slice(&m.meshlet_edges),
             ];
-            for k in 0..4 {
+            for k in 0..super::compute::arena::N {
                 let offset = base[k] as u64 * ELEMENT_BYTES[k];
                 if let Err(e) = self.staged_into(dev, &format!("compute {}", TABLES[k]), bytes[k], tables[k], offset) {
                     // the ranges stay allocated, unused; the copies already staged are harmless
@@ -350,6 +355,8 @@ impl CasterTable {
                 edge_count: m.edges.len() as u32,
                 chunk_edges: m.chunk_edges,
                 chunk_tris: c.chunks.iter().map(|ch| ch.local_tris.len() as u32).collect(),
+                part_meshlets: m.part_meshlets,
+                apex_base: m.apex_base,
             });
         }
         Ok(())

@@ -333,7 +333,10 @@ impl Technique {
             _ => s.parse::<Method>().map(Technique::Volumes).map_err(|_| Error::UnknownName {
                 what: "method",
                 name: s.into(),
-                expected: format!("auto, {}, edgequad, planar, compute, mesh, shadowmap, rayquery", Method::ALL.map(|m| m.name()).join(", ")),
+                expected: format!(
+                    "auto, {}, edgequad, planar, compute, mesh, shadowmap, rayquery",
+                    Method::ALL.map(|m| m.name()).join(", ")
+                ),
             }),
         }
     }

@@ -114,7 +114,8 @@ impl Diagnostics for ShadowPass {
         unsafe { self.dev.device.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipe) };
         for lf in &frame.lights {
             for c in lf.casters.iter().filter(|c| c.case != Case::Culled) {
-                for dr in c.draws.iter().filter(|dr| !dr.light_cap) {
+                // (mesh draws have no vertex pipeline: the overlay leaves Technique::Mesh's out)
+                for dr in c.draws.iter().filter(|dr| !dr.light_cap && dr.mesh.is_none()) {
                     let color = match dr.case {
                         Case::Culled => continue,
                         Case::ZPass => [0.2f32, 0.4, 1.0, 0.12],

@@ -24,6 +24,9 @@ pub(crate) struct Draw {
     /// `VkDrawIndexedIndirectCommand` in the frame's compute records, the indices (u16) are in
     /// its compute output buffer, and `count` is unknown (0) until read back.
     pub indirect: bool,
+    /// Mesh-shader extrusion: a `vkCmdDrawMeshTasksEXT` over a caster part's meshlets (no
+    /// vertex or index buffer: `vertices`, `offset`, `count` and `format` are unused).
+    pub mesh: Option<super::mesh::MeshDraw>,
 }
 
 /// Edge-quad geometry of a caster (static buffers).

@@ -93,6 +93,7 @@ pub mod diagnostics;
 mod draw;
 mod eye;
 mod frame;
+mod mesh;
 mod pack;
 mod pipelines;
 mod planar;
@@ -165,6 +166,8 @@ pub struct ShadowPass {
     serial: u64,
     planar_receiver: glam::DVec4,
     compute_pipes: Option<compute::ComputePipes>,
+    /// [`Technique::Mesh`]'s pipelines (made with its first frame or `create_pipelines`).
+    mesh_pipes: Option<mesh::MeshPipes>,
     /// Analytic sphere casters, in draw order (after the mesh casters).
     spheres: Vec<spheres::SphereCaster>,
     next_sphere: u64,
@@ -251,6 +254,7 @@ impl ShadowPass {
             serial: 0,
             planar_receiver: glam::DVec4::Y,
             compute_pipes: None,
+            mesh_pipes: None,
             spheres: Vec::new(),
             next_sphere: 0,
             id,
@@ -422,12 +426,24 @@ impl ShadowPass {
     }
 
     /// Creates now the pipelines that the first frame of `technique` would otherwise create
-    /// (the GPU silhouettes' compute pipelines of [`Technique::Compute`]; the other
-    /// techniques' are made with the pass), so that frame does not wait for the driver's
-    /// shader compiler. Idempotent.
+    /// (the GPU silhouettes' compute pipelines of [`Technique::Compute`], and with them the
+    /// mesh pipelines of [`Technique::Mesh`]; the other techniques' are made with the pass), so
+    /// that frame does not wait for the driver's shader compiler. Idempotent.
+    ///
+    /// Errors: [`Technique::Mesh`] on a pass without [`Capabilities::mesh_shader`]
+    /// ([`Error::Unsupported`]), or the driver's.
     pub fn create_pipelines(&mut self, technique: Technique) -> Result<()> {
-        if technique == Technique::Compute && self.compute_pipes.is_none() {
+        let gpu = matches!(technique, Technique::Compute | Technique::Mesh);
+        if technique == Technique::Mesh && !self.caps.mesh_shader {
+            return Err(desc::mesh_missing());
+        }
+        if gpu && self.compute_pipes.is_none() {
             self.compute_pipes = Some(compute::ComputePipes::new(&self.dev)?);
+        }
+        if technique == Technique::Mesh && self.mesh_pipes.is_none() {
+            let c = &self.caps;
+            self.mesh_pipes =
+                Some(mesh::MeshPipes::new(&self.instance, &self.dev, &self.desc, (c.depth_clamp, c.depth_bounds, c.r32f_blend))?);
         }
         Ok(())
     }
@@ -502,8 +518,8 @@ impl ShadowPass {
         if self.settings.technique == Technique::EdgeQuads {
             self.casters.ensure_edge_quads(&self.dev)?;
         }
-        if self.settings.technique == Technique::Compute {
-            self.create_pipelines(Technique::Compute)?;
+        if matches!(self.settings.technique, Technique::Compute | Technique::Mesh) {
+            self.create_pipelines(self.settings.technique)?;
             let all = self.all_slots();
             self.casters.ensure_compute(&self.dev, all)?;
         }
@@ -576,6 +592,10 @@ impl Drop for ShadowPass {
         if let Some(mut c) = self.compute_pipes.take() {
             // SAFETY: as above.
             unsafe { c.destroy(&self.dev.device) };
+        }
+        if let Some(mut m) = self.mesh_pipes.take() {
+            // SAFETY: as above.
+            unsafe { m.destroy(&self.dev.device) };
         }
         self.casters.destroy(&self.dev);
         if let Some(mut r) = self.rays.take() {

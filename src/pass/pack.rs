@@ -51,8 +51,10 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
     let vp_rel_d = view.proj.as_dmat4() * view.view.as_dmat4();
     let camera = Camera { eye: view.eye.as_vec3(), ..Camera::default() };
     let edge_quads = input.settings.technique == Technique::EdgeQuads;
-    let gpu_silhouettes = input.settings.technique == Technique::Compute;
-    let mut compute = gpu_silhouettes.then(ComputeFrame::default);
+    // Mesh-shader extrusion plans as the compute path does and runs its facing stages.
+    let mesh = input.settings.technique == Technique::Mesh;
+    let gpu_silhouettes = input.settings.technique == Technique::Compute || mesh;
+    let mut compute = gpu_silhouettes.then(|| ComputeFrame { mesh, ..ComputeFrame::default() });
     let method = input.settings.technique.method();
     let mvps: Vec<Mat4> = table.live.iter().map(|g| (vp_rel_d * DMat4::from_translation(-view.eye) * g.transform).as_mat4()).collect();
     let full = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: vk::Extent2D { width: view.width, height: view.height } };
@@ -69,6 +71,17 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
             &PlanOptions { edge_quads, case_per_part: true, gpu_silhouettes, no_culling: !input.settings.toggles.culling },
         );
         let mut plan = plan;
+        if mesh {
+            // the parts left to the GPU are drawn by mesh draws
+            for cp in &mut plan.casters {
+                if cp.path == VolumePath::Compute {
+                    cp.path = VolumePath::Mesh;
+                }
+                for pp in cp.parts.iter_mut().filter(|p| p.path == VolumePath::Compute) {
+                    pp.path = VolumePath::Mesh;
+                }
+            }
+        }
         let planar_mvp = (input.settings.technique == Technique::Planar).then(|| flatten(&mut plan, table, light, input.planar_receiver));
         cpu.silhouettes += plan.silhouette_ms;
         // plan_ms covers the whole planner, facing and silhouettes included
@@ -80,11 +93,14 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
             let gpu = &table.live[cp.caster];
             let ChunkDraws { mut draws, index_bytes, vertex_bytes, mut fmt_used } = write_chunks(&mut stream, input, caster, gpu, cp);
             if let (Some(cf), Some(st)) = (compute.as_mut(), gpu.compute.as_ref()) {
+                let at = crate::pass::compute::frame::CasterAt { light: li, stat: cstats.len() };
                 if cp.parts.iter().any(|p| p.path == VolumePath::Compute && p.case != Case::Culled) {
                     let buffers: Vec<vk::Buffer> = gpu.chunks.iter().map(|b| b.raw).collect();
-                    let at = crate::pass::compute::frame::CasterAt { light: li, stat: cstats.len() };
                     cf.add_caster(at, caster, st, cp, &buffers, &mut draws);
                     fmt_used = UsedIndexFormat::U16;
+                }
+                if cp.parts.iter().any(|p| p.path == VolumePath::Mesh && p.case != Case::Culled) {
+                    cf.add_caster_mesh(at, caster, st, cp, &mut draws);
                 }
             }
             let tris = Triangles { sides: cp.sides as u64, dark_cap: cp.dark_cap as u64, light_cap: cp.light_cap as u64 };
@@ -236,6 +252,7 @@ fn write_chunks(
                 case: cd.case,
                 light_cap: cap,
                 indirect: false,
+                mesh: None,
             });
         }
     }

@@ -171,7 +171,7 @@ impl ShadowPass {
         crate::gpu::resources::memory_barrier(
             &self.dev,
             cb,
-            (S::VERTEX_INPUT | S::COMPUTE_SHADER, A::NONE),
+            (S::VERTEX_INPUT | S::COMPUTE_SHADER | if self.caps.mesh_shader { S::MESH_SHADER_EXT } else { S::NONE }, A::NONE),
             (S::TRANSFER, A::TRANSFER_WRITE),
         );
         // SAFETY: the caller's contract; the staging and destination buffers live until the
@@ -181,11 +181,13 @@ impl ShadowPass {
                 d.cmd_copy_buffer(cb, up.src, up.dst, &[vk::BufferCopy { src_offset: 0, dst_offset: up.dst_offset, size: up.size }]);
             }
         }
+        // (the mesh draws of Technique::Mesh read the compute arena's tables directly)
+        let mesh = if self.caps.mesh_shader { S::MESH_SHADER_EXT } else { S::NONE };
         crate::gpu::resources::memory_barrier(
             &self.dev,
             cb,
             (S::TRANSFER, A::TRANSFER_WRITE),
-            (S::VERTEX_INPUT | S::COMPUTE_SHADER, A::VERTEX_ATTRIBUTE_READ | A::INDEX_READ | A::SHADER_READ),
+            (S::VERTEX_INPUT | S::COMPUTE_SHADER | mesh, A::VERTEX_ATTRIBUTE_READ | A::INDEX_READ | A::SHADER_READ),
         );
         Ok(())
     }

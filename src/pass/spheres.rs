@@ -110,6 +110,7 @@ fn stream_tris(stream: &mut Vec<u8>, tris: &[[DVec4; 3]], case: Case, light_cap:
         case,
         light_cap,
         indirect: false,
+        mesh: None,
     }
 }
 

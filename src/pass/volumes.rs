@@ -105,6 +105,15 @@ impl ShadowPass {
             }
             let mut pushed = None;
             for dr in &c.draws {
+                if let Some(md) = &dr.mesh {
+                    // SAFETY: the caller's contract; the mesh draw's set and tables live until
+                    // the slot is prepared again.
+                    if unsafe { self.record_mesh_draw(cb, frame, kind, c, dr, md)? } {
+                        bound = vk::Pipeline::null();
+                        pushed = None;
+                    }
+                    continue;
+                }
                 let planar = frame.settings.technique == super::desc::Technique::Planar;
                 let Some(pipe) = self.pipeline_for(kind, count, dr.case, dr.light_cap, planar) else { continue };
                 // Parts of one caster may take different cases: the sign follows the draw's.
@@ -124,6 +133,68 @@ impl ShadowPass {
             }
         }
         Ok(())
+    }
+
+    /// Records one mesh draw of [`Technique::Mesh`](super::desc::Technique::Mesh) for `kind`
+    /// (its pipeline, the frame's mesh set, its push block, `vkCmdDrawMeshTasksEXT`); returns
+    /// whether anything was bound (a kind the mesh path has no pipeline for draws nothing:
+    /// the light-intensity map's casters are never on it).
+    ///
+    /// # Safety
+    /// As [`cmd_draw_volumes`](Self::cmd_draw_volumes); `dr` and `md` are a draw of `c`, of
+    /// `frame`.
+    unsafe fn record_mesh_draw(
+        &self,
+        cb: vk::CommandBuffer,
+        frame: &PreparedFrame,
+        kind: VolumeKind,
+        c: &super::draw::CasterDraw,
+        dr: &super::draw::Draw,
+        md: &super::mesh::MeshDraw,
+    ) -> Result<bool> {
+        let (Some(mp), Some(cf)) = (self.mesh_pipes.as_ref(), frame.compute.as_ref()) else {
+            return Err(Misuse::NotConfigured { call: "cmd_draw_volumes (mesh draws)", needs: "Technique::Mesh's pipelines" }.into());
+        };
+        let zpass = dr.case == Case::ZPass;
+        let pipe = match kind {
+            VolumeKind::Stencil => mp.stencil_for(dr.case, dr.light_cap),
+            VolumeKind::Rasterised => mp.raster,
+            VolumeKind::Float => match mp.count {
+                Some(p) => {
+                    p[if zpass {
+                        0
+                    } else if dr.light_cap {
+                        2
+                    } else {
+                        1
+                    }]
+                }
+                None => return Ok(false),
+            },
+            VolumeKind::FloatDepthTested => match mp.count {
+                Some(p) => p[if zpass { 0 } else { 1 }],
+                None => return Ok(false),
+            },
+            VolumeKind::Transmit { .. } => return Ok(false),
+        };
+        let sign = if zpass { 1.0 } else { -1.0 };
+        let volume = VolumePush::new(c.mvp, c.light_object, [sign, 0.0, 0.0, 0.0]);
+        let push = md.push(&volume);
+        let d = &self.dev.device;
+        // SAFETY: the caller's contract; the push block matches the mesh layout's range.
+        unsafe {
+            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipe);
+            d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, mp.layout, 0, &[cf.mesh_set], &[]);
+            d.cmd_push_constants(
+                cb,
+                mp.layout,
+                vk::ShaderStageFlags::MESH_EXT | vk::ShaderStageFlags::FRAGMENT,
+                0,
+                bytemuck::bytes_of(&push),
+            );
+            mp.loader.cmd_draw_mesh_tasks(cb, md.meshlets, 1, 1);
+        }
+        Ok(true)
     }
 
     /// Which pipeline counts a draw.
@@ -201,6 +272,10 @@ impl ShadowPass {
     pub(super) unsafe fn record_draw(&self, cb: vk::CommandBuffer, frame: &PreparedFrame, dr: &Draw) {
         let d = &self.dev.device;
         let stream = frame.stream;
+        if dr.mesh.is_some() {
+            // mesh draws are recorded by `record_mesh_draw`, never from a vertex pipeline
+            return;
+        }
         // SAFETY: the caller's contract; offsets were computed from the stream just written.
         unsafe {
             if dr.indirect {

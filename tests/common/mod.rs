@@ -36,6 +36,19 @@ pub fn ray_query_context(test: &str) -> Option<Context> {
     None
 }
 
+/// A validated context on a device with mesh shaders (`VK_EXT_mesh_shader`), for the test
+/// named `test`: as [`ray_query_context`], re-running the test on Mesa lavapipe 25.0.7 when
+/// the default device has none.
+pub fn mesh_shader_context(test: &str) -> Option<Context> {
+    let ctx = context()?;
+    if ctx.features.mesh_shader {
+        return Some(ctx);
+    }
+    drop(ctx);
+    rerun_on_lavapipe_25(test, false, &[]);
+    None
+}
+
 /// Runs test `test` of this binary (`ignored`: an `#[ignore]`d helper test) in a child process
 /// whose only Vulkan device is Mesa lavapipe 25.0.7 from `.drivers/` (`scripts/drivers.sh env
 /// 25.0.7`), with `env` added, and asserts that it passed. Returns false when that driver is

@@ -1,6 +1,8 @@
-//! The compute pass's static tables of every caster, in one pass-wide arena: four storage
-//! buffers (face planes, triangles, welded positions, edges) that one descriptor set binds, so
-//! one dispatch per stage serves every (light, caster) pair of a frame.
+//! The compute pass's static tables of every caster, in one pass-wide arena: seven storage
+//! buffers (face planes, triangles, welded positions and the parts' apexes, edges; and for
+//! mesh-shader extrusion the meshlets, their triangles and their owned edges) that one
+//! descriptor set binds, so one dispatch per stage (or one mesh draw per caster part) serves
+//! every (light, caster) pair of a frame.
 //!
 //! A caster's tables are bump-allocated at the end of each table and filled by staged copies
 //! (pending uploads: they ride with every frame until one that recorded them retires, like the
@@ -19,49 +21,60 @@ use ash::vk;
 use gpu_allocator::MemoryLocation;
 
 /// The tables, in binding order.
-pub(crate) const TABLES: [&str; 4] = ["planes", "triangles", "positions", "edges"];
-/// Bytes of one element of each table (`vec4<f32>`, `Tri`, `vec4<f32>`, `vec4<u32>`).
-pub(crate) const ELEMENT_BYTES: [u64; 4] = [16, 32, 16, 16];
+pub(crate) const TABLES: [&str; N] = ["planes", "triangles", "positions", "edges", "meshlets", "meshlet triangles", "meshlet edges"];
+/// The number of tables.
+pub(crate) const N: usize = 7;
+/// Bytes of one element of each table (`vec4<f32>`, `Tri`, `vec4<f32>`, `vec4<u32>`,
+/// `vec4<u32>`, `u32`, `vec4<u32>`).
+pub(crate) const ELEMENT_BYTES: [u64; N] = [16, 32, 16, 16, 16, 4, 16];
 /// The smallest table, in elements.
 const MIN_ELEMENTS: u64 = 1024;
 
 /// `a += b`, table by table.
-pub(crate) fn add_elements(a: &mut [u64; 4], b: [u64; 4]) {
+pub(crate) fn add_elements(a: &mut [u64; N], b: [u64; N]) {
     for (x, y) in a.iter_mut().zip(b) {
         *x += y;
     }
 }
 
 /// Elements of each table a caster's [`ComputeMesh`] takes.
-pub(crate) fn mesh_elements(m: &ComputeMesh) -> [u64; 4] {
-    [m.planes.len() as u64, m.tris.len() as u64, m.positions.len() as u64, m.edges.len() as u64]
+pub(crate) fn mesh_elements(m: &ComputeMesh) -> [u64; N] {
+    [
+        m.planes.len() as u64,
+        m.tris.len() as u64,
+        m.positions.len() as u64,
+        m.edges.len() as u64,
+        m.meshlets.len() as u64,
+        m.meshlet_tris.len() as u64,
+        m.meshlet_edges.len() as u64,
+    ]
 }
 
 /// The pass-wide arena (see the module docs).
 #[derive(Default)]
 pub(crate) struct ComputeArena {
-    /// The four tables (absent until the first compute caster).
-    pub tables: Option<[Buffer; 4]>,
+    /// The tables (absent until the first compute caster).
+    pub tables: Option<[Buffer; N]>,
     /// Capacity of each table, in elements.
-    pub capacity: [u64; 4],
+    pub capacity: [u64; N],
     /// Elements allocated in each table (live and dead).
-    pub used: [u64; 4],
+    pub used: [u64; N],
     /// Elements of dead ranges (removed casters, moved vertices) in each table.
-    pub dead: [u64; 4],
+    pub dead: [u64; N],
     /// Times the arena was rebuilt (statistics, and the tests' check of the growth policy).
     pub rebuilds: u64,
 }
 
 impl ComputeArena {
     /// Whether `need` more elements fit each table as it is.
-    pub fn fits(&self, need: [u64; 4]) -> bool {
-        self.tables.is_some() && (0..4).all(|k| self.used[k] + need[k] <= self.capacity[k])
+    pub fn fits(&self, need: [u64; N]) -> bool {
+        self.tables.is_some() && (0..N).all(|k| self.used[k] + need[k] <= self.capacity[k])
     }
 
     /// Bump-allocates `n` elements in each table: the first element of each range.
-    pub fn allocate(&mut self, n: [u64; 4]) -> [u32; 4] {
-        let mut base = [0u32; 4];
-        for k in 0..4 {
+    pub fn allocate(&mut self, n: [u64; N]) -> [u32; N] {
+        let mut base = [0u32; N];
+        for k in 0..N {
             base[k] = self.used[k] as u32;
             self.used[k] += n[k];
         }
@@ -69,16 +82,16 @@ impl ComputeArena {
     }
 
     /// Marks a caster's ranges dead.
-    pub fn free(&mut self, n: [u64; 4]) {
+    pub fn free(&mut self, n: [u64; N]) {
         add_elements(&mut self.dead, n);
     }
 
     /// New, empty tables with room for `live` elements twice over (at least
     /// [`MIN_ELEMENTS`]); the old buffers are returned for the caller to retire. A table the
     /// device cannot bind whole (`maxStorageBufferRange`) is an error naming it.
-    pub fn rebuild(&mut self, dev: &PassDevice, live: [u64; 4]) -> Result<Option<[Buffer; 4]>> {
-        let mut capacity = [0u64; 4];
-        for k in 0..4 {
+    pub fn rebuild(&mut self, dev: &PassDevice, live: [u64; N]) -> Result<Option<[Buffer; N]>> {
+        let mut capacity = [0u64; N];
+        for k in 0..N {
             let want = (live[k] * 2).max(MIN_ELEMENTS).next_power_of_two();
             let limit = dev.max_storage_range / ELEMENT_BYTES[k];
             if live[k] > limit {
@@ -92,8 +105,8 @@ impl ComputeArena {
             }
             capacity[k] = want.min(limit).max(live[k]).max(1);
         }
-        let mut made: Vec<Buffer> = Vec::with_capacity(4);
-        for k in 0..4 {
+        let mut made: Vec<Buffer> = Vec::with_capacity(N);
+        for k in 0..N {
             let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
             match Buffer::new(dev, &format!("compute arena: {}", TABLES[k]), capacity[k] * ELEMENT_BYTES[k], usage, MemoryLocation::GpuOnly)
             {
@@ -106,23 +119,20 @@ impl ComputeArena {
                 }
             }
         }
-        let mut it = made.into_iter();
-        let (Some(a), Some(b), Some(c), Some(d)) = (it.next(), it.next(), it.next(), it.next()) else {
-            return Err(Error::Internal("compute arena tables".into()));
-        };
-        let old = self.tables.replace([a, b, c, d]);
+        let tables: [Buffer; N] = made.try_into().map_err(|_| Error::Internal("compute arena tables".into()))?;
+        let old = self.tables.replace(tables);
         self.capacity = capacity;
-        self.used = [0; 4];
-        self.dead = [0; 4];
+        self.used = [0; N];
+        self.dead = [0; N];
         self.rebuilds += 1;
         Ok(old)
     }
 
     /// The raw handles of the tables (null before the first compute caster).
-    pub fn raw(&self) -> [vk::Buffer; 4] {
+    pub fn raw(&self) -> [vk::Buffer; N] {
         match &self.tables {
-            Some(t) => [t[0].raw, t[1].raw, t[2].raw, t[3].raw],
-            None => [vk::Buffer::null(); 4],
+            Some(t) => std::array::from_fn(|k| t[k].raw),
+            None => [vk::Buffer::null(); N],
         }
     }
 

@@ -12,6 +12,7 @@
 use super::{rec, ComputeStatic, SilhouettePush, GROUP, HEADER_WORDS, RECORD_WORDS};
 use crate::error::{Error, Result};
 use crate::pass::draw::{Draw, LightFrame};
+use crate::pass::mesh::{MeshDraw, COUNT_WORDS, MAX_TASKS};
 use crate::pass::stats::{CasterStats, Totals, UsedIndexFormat};
 use crate::pass::IndexFormat;
 use crate::shadow::plan::{Case, CasterPlan, DarkCap, Formulation, VolumePath};
@@ -94,6 +95,17 @@ pub(crate) struct ComputeFrame {
     pub facing_buffer: vk::Buffer,
     pub recorded: Cell<bool>,
     pub read_back: Cell<bool>,
+    /// Mesh-shader extrusion ([`Technique::Mesh`](crate::pass::Technique::Mesh)): only the
+    /// `facing` and `exact` stages run; the parts are drawn by mesh draws.
+    pub mesh: bool,
+    /// Per mesh-drawn part, where its counters are (`word`: their first word in the counts
+    /// buffer) and where they go in the stats.
+    pub mesh_metas: Vec<RecordMeta>,
+    /// Words of the mesh draws' counters.
+    pub counts_words: u64,
+    /// The mesh draws' descriptor set and counters (filled by `prepare`).
+    pub mesh_set: vk::DescriptorSet,
+    pub counts_buffer: vk::Buffer,
 }
 
 impl Default for ComputeFrame {
@@ -119,6 +131,11 @@ impl Default for ComputeFrame {
             facing_buffer: vk::Buffer::null(),
             recorded: Cell::new(false),
             read_back: Cell::new(false),
+            mesh: false,
+            mesh_metas: Vec::new(),
+            counts_words: 0,
+            mesh_set: vk::DescriptorSet::null(),
+            counts_buffer: vk::Buffer::null(),
         }
     }
 }
@@ -220,6 +237,7 @@ impl ComputeFrame {
                     case: pp.case,
                     light_cap: cap_draw,
                     indirect: true,
+                    mesh: None,
                 };
                 draws.push(draw(false, offset));
                 if light_cap {
@@ -227,11 +245,19 @@ impl ComputeFrame {
                 }
             }
         }
+        self.push_job(caster, st, cp, rec_base, caps);
+    }
+
+    /// Appends the job of a (light, caster) pair whose records start at word `rec_base`, with
+    /// `caps` workgroups (face caps) or not; returns its facing bits' first word.
+    fn push_job(&mut self, caster: &Caster, st: &ComputeStatic, cp: &CasterPlan, rec_base: usize, caps: bool) -> u32 {
+        let l_obj = glam::Vec4::from_array(cp.light_object);
         let (filt, bound) = match caster.planes.error_bound(l_obj) {
             Some((lf, e)) => (if caster.mirrored { -lf } else { lf }, e),
             None => (glam::Vec4::ZERO, f32::INFINITY),
         };
         let tri_groups = groups_of(st.triangles);
+        let fac_base = self.facing_words as u32;
         let job = GpuJob {
             light: cp.light_object,
             filt: filt.to_array(),
@@ -259,6 +285,69 @@ impl ComputeFrame {
         self.exact_capacity += st.triangles as u64;
         self.sil_capacity += st.edge_count as u64;
         self.jobs.push(job);
+        fac_base
+    }
+
+    /// [`Technique::Mesh`](crate::pass::Technique::Mesh): the caster's job (its facing bits
+    /// only) for light `at.light`, and per part the planner left to the GPU (path `"mesh"`) its
+    /// mesh draws, appended to `draws`: the sides (with the fan dark cap's triangles), the dark
+    /// cap of front or back faces where the part's case has one, the light cap in case 3; at
+    /// most [`MAX_TASKS`] meshlets a draw.
+    pub fn add_caster_mesh(&mut self, at: CasterAt, caster: &Caster, st: &ComputeStatic, cp: &CasterPlan, draws: &mut Vec<Draw>) {
+        use crate::pass::mesh::flags as F;
+        let fac_base = self.push_job(caster, st, cp, self.records.len(), false);
+        // the `find` and `caps` stages do not run for mesh frames
+        if let Some(j) = self.jobs.last_mut() {
+            j.edges = 0;
+        }
+        self.sil_capacity -= st.edge_count as u64;
+        let directional = cp.light_object[3] == 0.0;
+        for (pp_index, pp) in cp.parts.iter().enumerate() {
+            if pp.path != VolumePath::Mesh || pp.case == Case::Culled {
+                continue;
+            }
+            let Some(range) = st.part_meshlets.get(pp.part).filter(|r| !r.is_empty()) else { continue };
+            let stat = self.counts_words as u32;
+            self.counts_words += COUNT_WORDS as u64;
+            self.mesh_metas.push(RecordMeta { word: stat as usize, light: at.light, caster: at.stat, part: pp_index });
+            let mut work = Vec::with_capacity(3);
+            let fan = !directional && pp.dark_cap_kind == DarkCap::Fan;
+            work.push((F::SIDES | if directional { F::DIRECTIONAL } else { 0 } | if fan { F::FAN } else { 0 }, false));
+            match pp.dark_cap_kind {
+                DarkCap::FrontFaces if !directional => work.push((F::DARK | F::WANT, false)),
+                DarkCap::BackFaces if !directional => work.push((F::DARK, false)),
+                _ => {}
+            }
+            if pp.case == Case::ZFailLightCap {
+                work.push((F::LIGHT | if pp.formulation == Formulation::Front { F::WANT } else { 0 }, true));
+            }
+            for (flags, light_cap) in work {
+                let mut first = range.start;
+                while first < range.end {
+                    let n = (range.end - first).min(MAX_TASKS);
+                    draws.push(Draw {
+                        vertices: vk::Buffer::null(),
+                        offset: 0,
+                        count: 0,
+                        format: IndexFormat::U16,
+                        case: pp.case,
+                        light_cap,
+                        indirect: false,
+                        mesh: Some(MeshDraw {
+                            meshlet_base: st.base[4] + first,
+                            meshlets: n,
+                            tri_base: st.base[1],
+                            pos_base: st.base[2],
+                            fac_base,
+                            flags,
+                            apex: st.base[2] + st.apex_base + pp.part as u32,
+                            stat,
+                        }),
+                    });
+                    first += n;
+                }
+            }
+        }
     }
 
     /// Adds the counts the GPU left in the records (`words`, the slot's records buffer after
@@ -290,6 +379,29 @@ impl ComputeFrame {
             }
             let (sides, dark, cap, edges) = (r[rec::SIDES] as u64, r[rec::DARK] as u64, r[rec::CAP_COUNT] as u64 / 3, r[rec::EDGES] as u64);
             let bytes = 2 * (r[rec::VOL_COUNT] as u64 + r[rec::CAP_COUNT] as u64);
+            add_counts(lights, totals, m, [sides, dark, cap, edges], bytes, UsedIndexFormat::U16);
+        }
+        Ok(())
+    }
+
+    /// Adds the mesh draws' counters (`words`: the slot's counts buffer after the frame
+    /// completed) to the lights' plans and stats and to `totals` (no index bytes: the mesh
+    /// draws read none).
+    pub fn read_back_mesh(&self, words: &[u32], lights: &mut [LightFrame], totals: &mut Totals) -> Result<()> {
+        for m in &self.mesh_metas {
+            let r = words.get(m.word..m.word + COUNT_WORDS).ok_or_else(|| Error::Internal("mesh counters short".into()))?;
+            add_counts(lights, totals, m, [r[0] as u64, r[1] as u64, r[2] as u64, r[3] as u64], 0, UsedIndexFormat::None);
+        }
+        Ok(())
+    }
+}
+
+/// Adds one part's GPU counts (`[sides, dark cap, light cap, silhouette edges]`, and the
+/// index bytes read) to its light's plan and stats and to `totals`.
+fn add_counts(lights: &mut [LightFrame], totals: &mut Totals, m: &RecordMeta, counts: [u64; 4], bytes: u64, format: UsedIndexFormat) {
+    let [sides, dark, cap, edges] = counts;
+    {
+        {
             let lf = &mut lights[m.light];
             let cs: &mut CasterStats = &mut lf.stats.casters[m.caster];
             cs.triangles.sides += sides;
@@ -297,7 +409,9 @@ impl ComputeFrame {
             cs.triangles.light_cap += cap;
             cs.silhouette_edges += edges;
             cs.index_bytes += bytes;
-            cs.index_format = UsedIndexFormat::U16;
+            if format != UsedIndexFormat::None {
+                cs.index_format = format;
+            }
             cs.multiplicity_max = cs.multiplicity_max.max(u32::from(edges > 0));
             let n = cs.triangles.total();
             cs.bytes_per_triangle = if n > 0 { (cs.index_bytes + cs.vertex_bytes) as f64 / n as f64 } else { 0.0 };
@@ -324,6 +438,5 @@ impl ComputeFrame {
             totals.triangles.light_cap += cap;
             totals.index_bytes += bytes;
         }
-        Ok(())
     }
 }

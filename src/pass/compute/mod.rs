@@ -32,6 +32,7 @@ use super::device::PassDevice;
 use crate::error::{Error, Result};
 use crate::gpu::descriptors::pipeline_layout;
 use crate::gpu::{pipeline, shaders, Buffer, GpuDevice};
+use crate::shadow::meshlet::Meshlets;
 use crate::shadow::{Caster, CasterKind};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -109,6 +110,19 @@ pub(crate) struct ComputeMesh {
     pub edges: Vec<[u32; 4]>,
     /// Per chunk: edges of the table with a triangle in the chunk (the side capacity).
     pub chunk_edges: Vec<u32>,
+    /// Mesh-shader extrusion: the meshlets of the closed manifold parts
+    /// ([`Meshlets`]), `(first triangle, triangles, first edge, edges)`, the firsts relative
+    /// to the caster's ranges of the two tables below (made absolute when placed in the arena).
+    pub meshlets: Vec<[u32; 4]>,
+    /// The meshlets' welded triangle ids.
+    pub meshlet_tris: Vec<u32>,
+    /// The meshlets' owned edges, `(t0, t1, c0 | c1 << 8, 0)`.
+    pub meshlet_edges: Vec<[u32; 4]>,
+    /// Per part, its meshlets (relative to the caster's first).
+    pub part_meshlets: Vec<std::ops::Range<u32>>,
+    /// The index of part 0's apex in `positions` (part `p`'s is `apex_base + p`): the welded
+    /// positions come first.
+    pub apex_base: u32,
 }
 
 impl ComputeMesh {
@@ -126,7 +140,14 @@ impl ComputeMesh {
                 [t[0], t[1], t[2], 0, l[0] as u32, l[1] as u32, l[2] as u32, ci]
             })
             .collect();
-        let positions = mesh.positions.iter().map(|p| [p.x, p.y, p.z, 1.0]).collect();
+        let mut positions: Vec<[f32; 4]> = mesh.positions.iter().map(|p| [p.x, p.y, p.z, 1.0]).collect();
+        // Each part's apex (the fan dark cap's common vertex: the last vertex of each of the
+        // part's chunks, the same f32 values), after the welded positions.
+        let apex_base = positions.len() as u32;
+        positions.extend(caster.parts.iter().map(|p| {
+            let a = p.chunks.clone().next().and_then(|c| caster.chunks[c].vertices.last().copied()).unwrap_or(p.object_bounds.center());
+            [a.x, a.y, a.z, 1.0]
+        }));
         let mut edges = Vec::new();
         let mut chunk_edges = vec![0u32; caster.chunks.len()];
         let whole_multiplicity = caster.kind != CasterKind::Manifold && caster.parts.len() == 1;
@@ -140,22 +161,40 @@ impl ComputeMesh {
                 }
             }
         }
-        ComputeMesh { planes, tris, positions, edges, chunk_edges }
+        let ml = Meshlets::build(caster);
+        let meshlets = ml.meshlets.iter().map(|m| [m.first_triangle, m.triangle_count, m.first_edge, m.edge_count]).collect();
+        let meshlet_edges = ml.edges.iter().map(|e| [e.t0, e.t1, e.c0 as u32 | (e.c1 as u32) << 8, 0]).collect();
+        ComputeMesh {
+            planes,
+            tris,
+            positions,
+            edges,
+            chunk_edges,
+            meshlets,
+            meshlet_tris: ml.triangles,
+            meshlet_edges,
+            part_meshlets: ml.parts,
+            apex_base,
+        }
     }
 }
 
 /// Where a caster's static tables are in the pass's [`arena::ComputeArena`].
 #[derive(Clone, Debug)]
 pub(crate) struct ComputeStatic {
-    /// The first element of its range in each table (planes, triangles, positions, edges).
-    pub base: [u32; 4],
+    /// The first element of its range in each table ([`arena::TABLES`]).
+    pub base: [u32; arena::N],
     /// Elements of its range in each table.
-    pub elements: [u64; 4],
+    pub elements: [u64; arena::N],
     pub triangles: u32,
     pub edge_count: u32,
     pub chunk_edges: Vec<u32>,
     /// Triangles per chunk.
     pub chunk_tris: Vec<u32>,
+    /// Per part, its meshlets (relative to `base[4]`).
+    pub part_meshlets: Vec<std::ops::Range<u32>>,
+    /// Part `p`'s apex is position `apex_base + p` (relative to `base[2]`).
+    pub apex_base: u32,
 }
 
 /// The compute pipelines (one per stage: facing filter, exact facing, silhouette edges, face
@@ -261,6 +300,9 @@ pub(crate) struct SlotCompute {
     pub jobs: Option<Buffer>,
     /// The exact and silhouette lists (`(job, triangle or edge)` pairs).
     pub lists: Option<Buffer>,
+    /// [`Technique::Mesh`](crate::pass::Technique::Mesh): the mesh draws' counters (host
+    /// visible: read back for stats).
+    pub counts: Option<Buffer>,
     pub pool: vk::DescriptorPool,
     pub pool_sets: u32,
 }
@@ -312,7 +354,7 @@ impl SlotCompute {
     }
 
     pub fn destroy(&mut self, dev: &PassDevice) {
-        for b in [&mut self.records, &mut self.out, &mut self.facing, &mut self.jobs, &mut self.lists] {
+        for b in [&mut self.records, &mut self.out, &mut self.facing, &mut self.jobs, &mut self.lists, &mut self.counts] {
             if let Some(mut b) = b.take() {
                 b.destroy(dev);
             }

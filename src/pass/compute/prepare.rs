@@ -18,6 +18,11 @@ impl ShadowPass {
             );
         };
         let set_layout = pipes.set_layout;
+        let mesh_layout = match (cf.mesh, self.mesh_pipes.as_ref()) {
+            (false, _) => None,
+            (true, Some(m)) => Some(m.set_layout),
+            (true, None) => return Err(crate::pass::desc::mesh_missing()),
+        };
         let dev = &self.dev;
         let arena = self.casters.arena.raw();
         let sc = &mut self.slots[slot].compute;
@@ -60,8 +65,22 @@ impl ShadowPass {
         jobs.write(0, bytemuck::cast_slice(&cf.jobs))?;
         let slot_buffers = [records.raw, out.raw, facing.raw, jobs.raw, lists.raw];
         let (records_raw, out_raw, facing_raw) = (records.raw, out.raw, facing.raw);
-        sc.reset_pool(dev, 1)?;
+        let counts_range = (cf.counts_words * 4).max(16);
+        if mesh_layout.is_some() {
+            if counts_range > dev.max_storage_range {
+                return Err(Error::Unsupported(format!(
+                    "Technique::Mesh: the frame's mesh counters need {counts_range} bytes, more than the device's \
+                     maxStorageBufferRange ({} bytes); use fewer lights or casters",
+                    dev.max_storage_range
+                )));
+            }
+            let usage = storage | vk::BufferUsageFlags::TRANSFER_DST;
+            SlotCompute::ensure(dev, &mut sc.counts, &format!("mesh counters {slot}"), counts_range, usage, MemoryLocation::GpuToCpu)?;
+        }
+        let counts_raw = sc.counts.as_ref().map(|b| b.raw).unwrap_or_default();
+        sc.reset_pool(dev, 2)?;
         cf.set = vk::DescriptorSet::null();
+        cf.mesh_set = vk::DescriptorSet::null();
         if !cf.jobs.is_empty() {
             let d = &dev.device;
             // SAFETY: the pool was reset or created for at least one set; the slot's previous
@@ -93,7 +112,34 @@ impl ShadowPass {
             // SAFETY: the set is not in use (just allocated); the buffers are alive.
             unsafe { d.update_descriptor_sets(&writes, &[]) };
             cf.set = set;
+            if let Some(layout) = mesh_layout {
+                // SAFETY: as above (the pool has room for two sets).
+                let sets = unsafe {
+                    d.allocate_descriptor_sets(&vk::DescriptorSetAllocateInfo::default().descriptor_pool(sc.pool).set_layouts(&[layout]))
+                }
+                .map_err(Error::vk("vkAllocateDescriptorSets"))?;
+                // binding order (`shaders/extrude.wgsl`): positions, triangles, meshlets, meshlet
+                // triangles, meshlet edges (the arena's), facing bits, counters
+                let counts = [vk::DescriptorBufferInfo { buffer: counts_raw, offset: 0, range: counts_range }];
+                let infos: [[vk::DescriptorBufferInfo; 1]; crate::pass::mesh::MESH_BINDINGS as usize] =
+                    [whole(arena[2]), whole(arena[1]), whole(arena[4]), whole(arena[5]), whole(arena[6]), ranged(2), counts];
+                let writes: Vec<vk::WriteDescriptorSet> = infos
+                    .iter()
+                    .enumerate()
+                    .map(|(b, info)| {
+                        vk::WriteDescriptorSet::default()
+                            .dst_set(sets[0])
+                            .dst_binding(b as u32)
+                            .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                            .buffer_info(info)
+                    })
+                    .collect();
+                // SAFETY: as above.
+                unsafe { d.update_descriptor_sets(&writes, &[]) };
+                cf.mesh_set = sets[0];
+            }
         }
+        cf.counts_buffer = counts_raw;
         cf.records_buffer = records_raw;
         cf.out_buffer = out_raw;
         cf.facing_buffer = facing_raw;
@@ -115,6 +161,16 @@ impl ShadowPass {
         if slot.serial != Some(frame.serial) {
             let current = slot.serial.unwrap_or(0);
             return Err(Misuse::StaleFrame { slot: frame.slot, serial: frame.serial, current }.into());
+        }
+        if cf.mesh {
+            if cf.read_back.replace(true) || cf.mesh_metas.is_empty() {
+                return Ok(());
+            }
+            let Some(counts) = slot.compute.counts.as_ref() else { return Ok(()) };
+            let bytes = counts.read()?;
+            let words: &[u32] = bytemuck::try_cast_slice(&bytes[..cf.counts_words as usize * 4])
+                .map_err(|e| Error::Internal(format!("mesh counters: {e}")))?;
+            return cf.read_back_mesh(words, &mut frame.lights, &mut frame.totals);
         }
         if cf.metas.is_empty() {
             return Ok(());

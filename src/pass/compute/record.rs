@@ -61,6 +61,9 @@ impl ShadowPass {
         use vk::AccessFlags2 as A;
         use vk::PipelineStageFlags2 as S;
         let rw = A::SHADER_READ | A::SHADER_WRITE;
+        // Mesh frames: the mesh draws read the facing bits and write their counters (a
+        // previous frame's mesh draws may still read the bits this frame rewrites).
+        let mesh = if self.caps.mesh_shader { S::MESH_SHADER_EXT } else { S::NONE };
         // compute writes -> the next stage's reads, atomics and indirect dispatch
         let to_next = |this: &Self| {
             barrier(
@@ -74,7 +77,7 @@ impl ShadowPass {
             &self.dev,
             cb,
             (
-                S::DRAW_INDIRECT | S::VERTEX_INPUT | S::COMPUTE_SHADER | S::TRANSFER,
+                S::DRAW_INDIRECT | S::VERTEX_INPUT | S::COMPUTE_SHADER | S::TRANSFER | mesh,
                 A::INDIRECT_COMMAND_READ | A::INDEX_READ | rw | A::TRANSFER_WRITE,
             ),
             (S::COMPUTE_SHADER | S::TRANSFER, rw | A::TRANSFER_WRITE),
@@ -87,6 +90,10 @@ impl ShadowPass {
         // The facing bits start cleared: the `facing` stage sets the light-facing ones.
         unsafe {
             d.cmd_fill_buffer(cb, cf.facing_buffer, 0, (cf.facing_words * 4).max(4), 0);
+            if cf.mesh {
+                // the mesh draws' counters start at zero
+                d.cmd_fill_buffer(cb, cf.counts_buffer, 0, (cf.counts_words * 4).max(4), 0);
+            }
         }
         barrier(&self.dev, cb, (S::TRANSFER, A::TRANSFER_WRITE), (S::COMPUTE_SHADER, rw));
         // SAFETY: as above.
@@ -98,6 +105,19 @@ impl ShadowPass {
             to_next(self);
             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, exact);
             d.cmd_dispatch_indirect(cb, records, (rec::H_EXACT_X * 4) as u64);
+        }
+        if cf.mesh {
+            // The facing bits are all the mesh draws need; the counters' fill too.
+            barrier(
+                &self.dev,
+                cb,
+                (S::COMPUTE_SHADER | S::TRANSFER, A::SHADER_WRITE | A::TRANSFER_WRITE),
+                (S::MESH_SHADER_EXT | S::HOST, A::SHADER_READ | A::SHADER_WRITE | A::HOST_READ),
+            );
+            return Ok(());
+        }
+        // SAFETY: as above.
+        unsafe {
             to_next(self);
             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, find);
             dispatch_groups(d, cb, cf.groups[1]);

@@ -51,7 +51,7 @@ impl Renderer {
             pass.cmd_upload(rec.cb, frame)?;
             gbuffer::record(rec, &sd, spheres);
             spans.depth.end = stamp(all);
-            if self.settings.technique == Technique::Compute {
+            if matches!(self.settings.technique, Technique::Compute | Technique::Mesh) {
                 // every light's GPU silhouettes at once, timed on their own (`gpu_ms.silhouettes`)
                 spans.silhouettes.begin = spans.depth.end;
                 pass.cmd_compute_silhouettes(rec.cb, frame)?;

@@ -131,6 +131,8 @@ crate::named_enum::named_enum!(
         Planar => "planar",
         /// GPU possible silhouettes (left to the compute pass).
         Compute => "compute",
+        /// Mesh-shader extrusion (left to the mesh draws of `Technique::Mesh`).
+        Mesh => "mesh",
         /// An analytic sphere's circumscribed polygon.
         Sphere => "sphere",
     }
