@@ -117,8 +117,9 @@ fn corner(g: vec4<u32>, k: u32) -> u32 {
 
 // shadow.vert's position of welded vertex `v`'s w = 1 copy.
 fn near(v: u32) -> vec4<f32> {
+    // (w as stored, 1.0: the multiply by it is shadow.vert's, not folded away)
     let p = positions[v];
-    return pc.mvp * vec4<f32>(p.xyz, 1.0);
+    return pc.mvp * p;
 }
 
 // shadow.vert's position of the w = 0 copy of the vertex at `index` of the position table.
