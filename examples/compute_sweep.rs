@@ -7,7 +7,9 @@
 //! medians over FRAMES frames (default 7, after one warm-up frame): CPU ms (the pass's
 //! planning with silhouettes + stream / record building, the renderer's recording included),
 //! shadow triangles, GPU shadow ms (the determination, compute dispatches included), and the
-//! geometry bytes the CPU sent.
+//! geometry bytes the CPU sent. On a device with mesh shaders (`VK_EXT_mesh_shader`: Mesa
+//! lavapipe 25.0.7, `eval "$(scripts/drivers.sh env 25.0.7)"`) `mesh` (mesh-shader extrusion)
+//! joins the table. `SWEEP_QUICK=1`: the 10k and 100k spheres only, both views.
 use umbrage::render::{RenderOptions, Renderer, Technique};
 use umbrage::shadow::Method;
 
@@ -48,13 +50,14 @@ fn main() -> umbrage::Result<()> {
     let mut ctx = umbrage::gpu::Context::new()?;
     println!("device: {}, 320x240, medians of {frames} frames\n", ctx.info.name);
     println!(
-        "| view | triangles | method | CPU ms (plan + record) | of which silhouettes | shadow triangles | GPU shadow ms | bytes sent |"
+        "| view | triangles | method | CPU ms (plan + record) | of which silhouettes | shadow triangles | GPU shadow ms | of which GPU silhouettes | bytes sent |"
     );
-    println!("|---|---:|---|---:|---:|---:|---:|---:|");
+    println!("|---|---:|---|---:|---:|---:|---:|---:|---:|");
     let quick = std::env::var_os("SWEEP_QUICK").is_some();
+    let mesh = ctx.features.mesh_shader.then_some(Technique::Mesh);
     let views = [("outside (z-pass)", [0.0f32, 4.0, 9.0]), ("in the shadow (z-fail, fan cap)", [0.2, 0.3, 0.4])];
     let sizes = [(32u32, 17u32), (100, 51), (317, 159), (1000, 501)];
-    for (view, eye) in if quick { &views[..1] } else { &views[..] } {
+    for (view, eye) in &views {
         for &(segments, rings) in if quick { &sizes[1..3] } else { &sizes[..] } {
             let eye = *eye;
             let src = scene(segments, rings, eye);
@@ -62,24 +65,26 @@ fn main() -> umbrage::Result<()> {
             let tris = s.meshes[1].mesh.triangles.len();
             let opts = RenderOptions { width: 320, height: 240, ..Default::default() };
             let mut r = Renderer::new(ctx, s, opts)?;
-            for t in [Technique::Volumes(Method::McGuire), Technique::Compute] {
+            for t in [Technique::Volumes(Method::McGuire), Technique::Compute].into_iter().chain(mesh) {
                 r.settings.technique = t;
                 r.render()?; // warm-up: uploads, static tables
-                let (mut cpu, mut sil, mut gpu, mut bytes, mut st) = (Vec::new(), Vec::new(), Vec::new(), 0, 0);
+                let (mut cpu, mut sil, mut gpu, mut gsil, mut bytes, mut st) = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), 0, 0);
                 for _ in 0..frames {
                     let f = r.render()?;
                     cpu.push(f.stats.cpu_ms.plan + f.stats.cpu_ms.record);
                     sil.push(f.stats.cpu_ms.silhouettes);
                     gpu.push(f.stats.gpu_ms.as_ref().map_or(f64::NAN, |g| g.shadow));
+                    gsil.push(f.stats.gpu_ms.as_ref().map_or(f64::NAN, |g| g.silhouettes));
                     bytes = f.stats.totals.bytes_sent;
                     st = f.stats.totals.triangles.total();
                 }
                 println!(
-                    "| {view} | {tris} | {} | {:.3} | {:.3} | {st} | {:.2} | {bytes} |",
+                    "| {view} | {tris} | {} | {:.3} | {:.3} | {st} | {:.2} | {:.2} | {bytes} |",
                     t.name(),
                     median(cpu),
                     median(sil),
-                    median(gpu)
+                    median(gpu),
+                    median(gsil)
                 );
             }
             ctx = r.into_context();

@@ -13,7 +13,7 @@ pub struct GpuMs {
     /// [`Technique::Compute`](crate::pass::Technique::Compute), recorded once for every light).
     pub shadow: f64,
     /// Of `shadow`, the GPU possible silhouettes of every light (`Technique::Compute`: the
-    /// compute pass; 0 for the other techniques).
+    /// compute pass; `Technique::Mesh`: its facing stages; 0 for the other techniques).
     pub silhouettes: f64,
     /// Every light's illumination, summed.
     pub illuminate: f64,
