@@ -29,8 +29,9 @@ struct FrameArgs {
     size: (u32, u32),
     /// Shadow method: auto (= mcguire, with open / non-manifold casters on the multiplicity
     /// path), mcguire, lengyel, everitt-kilgard, zfail, zpass, zpass-clear; edgequad (GPU-only silhouettes,
-    /// the Cg article); planar; compute (GPU possible silhouettes); shadowmap (the PCF baseline);
-    /// or rayquery (one shadow ray a pixel; needs VK_KHR_ray_query).
+    /// the Cg article); planar; compute (GPU possible silhouettes); mesh (mesh-shader extrusion;
+    /// needs VK_EXT_mesh_shader); shadowmap (the PCF baseline); or rayquery (one shadow ray a
+    /// pixel; needs VK_KHR_ray_query).
     #[arg(long, value_enum, default_value = "auto")]
     method: MethodArg,
     /// infinite (far plane at infinity) or clamp (finite far plane + depthClamp).
