@@ -10,6 +10,7 @@
 #![warn(missing_docs)]
 
 pub mod classic;
+pub mod compute_read;
 pub mod limits;
 mod markdown;
 pub mod methods;
