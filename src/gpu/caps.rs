@@ -352,6 +352,7 @@ pub fn choose(caps: &DeviceCaps, minimum: Minimum) -> Result<Choice> {
         && f.ray_query
         && f.buffer_device_address;
     let depth_range_unrestricted = caps.has_extension(ash::ext::depth_range_unrestricted::NAME);
+    let storage_buffer_ext = !v11 && caps.has_extension(ash::khr::storage_buffer_storage_class::NAME);
     let blendable = |fmt: vk::Format| caps.format_features(fmt).contains(vk::FormatFeatureFlags::COLOR_ATTACHMENT_BLEND);
     let l = &caps.limits;
     let features = Features {
@@ -375,6 +376,7 @@ pub fn choose(caps: &DeviceCaps, minimum: Minimum) -> Result<Choice> {
         multiview: v12 && f.multiview,
         sample_rate_shading: f.sample_rate_shading,
         standard_sample_locations: l.standard_sample_locations == vk::TRUE,
+        storage_buffer_storage_class: v11 || storage_buffer_ext,
         frame_sample_counts: (l.framebuffer_color_sample_counts
             & l.framebuffer_depth_sample_counts
             & l.framebuffer_stencil_sample_counts
@@ -392,6 +394,9 @@ pub fn choose(caps: &DeviceCaps, minimum: Minimum) -> Result<Choice> {
     }
     if depth_range_unrestricted {
         extensions.push(ash::ext::depth_range_unrestricted::NAME);
+    }
+    if storage_buffer_ext {
+        extensions.push(ash::khr::storage_buffer_storage_class::NAME);
     }
     Ok(Choice { features, depth_format, extensions })
 }
@@ -462,6 +467,11 @@ pub struct Features {
     /// `standardSampleLocations`: multisampled images use Vulkan's standard sample locations
     /// (a multisampled capture's positions are found at them).
     pub standard_sample_locations: bool,
+    /// SPIR-V 1.0 modules may declare storage buffers through
+    /// `SPV_KHR_storage_buffer_storage_class` (as naga writes them): Vulkan 1.1 core, or
+    /// `VK_KHR_storage_buffer_storage_class` (enabled where present on a Vulkan 1.0 device).
+    /// The conformance suite's compute checks need it.
+    pub storage_buffer_storage_class: bool,
 }
 
 /// Identification of the chosen physical device, for `umbrage info`, logs and the stats JSON.
