@@ -57,10 +57,27 @@ fn tiny_suite(tag: &str, driver: &[(String, Option<String>)]) -> serde_json::Val
     let limits = &v["limits"];
     keys(
         limits,
-        &["stencil_fill_gfrag_s", "color_fill_gfrag_s", "small_tri_mtri_s", "big_tri_mtri_s", "draws_per_s", "cpu_stream_gib_s", "units"],
+        &[
+            "stencil_fill_gfrag_s",
+            "color_fill_gfrag_s",
+            "small_tri_mtri_s",
+            "big_tri_mtri_s",
+            "draws_per_s",
+            "cpu_stream_gib_s",
+            "compute_read_gib_s",
+            "units",
+        ],
         "limits",
     );
-    for k in ["stencil_fill_gfrag_s", "color_fill_gfrag_s", "small_tri_mtri_s", "big_tri_mtri_s", "draws_per_s", "cpu_stream_gib_s"] {
+    for k in [
+        "stencil_fill_gfrag_s",
+        "color_fill_gfrag_s",
+        "small_tri_mtri_s",
+        "big_tri_mtri_s",
+        "draws_per_s",
+        "cpu_stream_gib_s",
+        "compute_read_gib_s",
+    ] {
         let x = limits[k].as_f64().unwrap_or(0.0);
         assert!(x.is_finite() && x > 0.0, "limit {k} = {x}");
     }
