@@ -188,6 +188,14 @@ fn grow_dispatch(x_word: u32, end: u32) {
     atomicMax(&records[x_word], min((end + 63u) / 64u, MAX_GROUPS));
 }
 
+// Appends `entry` to the list whose length is header word `count_word`, its entries from
+// `base` in `lists`, its dispatch command's x at `x_word`.
+fn append(count_word: u32, x_word: u32, base: u32, entry: vec2<u32>) {
+    let k = atomicAdd(&records[count_word], 1u);
+    lists[base + k] = entry;
+    grow_dispatch(x_word, k + 1u);
+}
+
 // ---- exact orient3d: fixed-point sum of products of three f32 values ----
 
 const LIMBS: u32 = 72u;
@@ -404,9 +412,7 @@ fn facing(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: ve
             atomicOr(&facing_bits[jobs[j].fac_base + (t >> 5u)], 1u << (t & 31u));
         } else if (!(v < -bound)) {
             // undecided (|v| <= bound, or NaN): the exact test decides
-            let k = atomicAdd(&records[H_EXACT], 1u);
-            lists[k] = vec2<u32>(j, t);
-            grow_dispatch(H_EXACT_X, k + 1u);
+            append(H_EXACT, H_EXACT_X, 0u, vec2<u32>(j, t));
         }
     }
 }
@@ -440,9 +446,7 @@ fn find(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3
         let b0 = (atomicLoad(&facing_bits[fac + (e.x >> 5u)]) >> (e.x & 31u)) & 1u;
         let b1 = (atomicLoad(&facing_bits[fac + (e.y >> 5u)]) >> (e.y & 31u)) & 1u;
         if (b0 != b1) {
-            let k = atomicAdd(&records[H_SIL], 1u);
-            lists[pc.sil_base + k] = vec2<u32>(j, i);
-            grow_dispatch(H_SIL_X, k + 1u);
+            append(H_SIL, H_SIL_X, pc.sil_base, vec2<u32>(j, i));
         }
     }
 }

@@ -124,17 +124,7 @@ fn measure_with(ctx: &Context, reps: usize, max_planes: u64, made: &mut Made) ->
         [vk::DescriptorBufferInfo { buffer: planes_raw, offset: 0, range: vk::WHOLE_SIZE }],
         [vk::DescriptorBufferInfo { buffer: bits_raw, offset: 0, range: vk::WHOLE_SIZE }],
     ];
-    let writes: Vec<_> = infos
-        .iter()
-        .enumerate()
-        .map(|(b, info)| {
-            vk::WriteDescriptorSet::default()
-                .dst_set(set)
-                .dst_binding(b as u32)
-                .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                .buffer_info(info)
-        })
-        .collect();
+    let writes = crate::gpu::descriptors::storage_buffer_writes(set, &infos);
     // SAFETY: the set is not in use; the buffers are alive.
     unsafe { d.update_descriptor_sets(&writes, &[]) };
 
