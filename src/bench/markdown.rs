@@ -348,6 +348,21 @@ impl SuiteReport {
     }
 }
 
+/// A row's bound cell: only a bound its ablation confirmed (bold); otherwise `unconfirmed`,
+/// with what the model named and why it stands unproven.
+fn bound_cell(r: &SuiteRow) -> String {
+    if r.bound_confirmed {
+        return format!("**{}**", r.bound);
+    }
+    let why = match &r.ablation {
+        Some(a) if a.predicted_saving_ms.is_some() => "ablation disagrees",
+        Some(_) => "no ablation",
+        None if r.bound_clear => "no ablation for this bound",
+        None => "within spread",
+    };
+    format!("unconfirmed ({}: {why})", r.bound)
+}
+
 fn table<'a>(rows: impl Iterator<Item = &'a SuiteRow>, error: bool) -> String {
     let f2 = |v: Option<f64>| v.map(|x| format!("{x:.2}")).unwrap_or_else(|| "—".into());
     let pct = |v: Option<f64>| v.map(|x| format!("{:.0}%", x * 100.0)).unwrap_or_else(|| "—".into());
@@ -386,7 +401,7 @@ fn table<'a>(rows: impl Iterator<Item = &'a SuiteRow>, error: bool) -> String {
             pct(r.draw_fraction),
             pct(r.fixed_fraction),
             pct(r.cpu_fraction),
-            if r.bound_clear { format!("**{}**", r.bound) } else { format!("{} (within spread)", r.bound) }
+            bound_cell(r)
         );
         if error {
             let _ = write!(s, " {} |", r.error_fraction.map(|e| format!("{:.4}%", e * 100.0)).unwrap_or_else(|| "—".into()));

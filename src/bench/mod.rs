@@ -10,12 +10,16 @@
 #![warn(missing_docs)]
 
 pub mod classic;
+pub mod identify;
 pub mod limits;
 mod markdown;
 pub mod methods;
 pub mod model;
 pub mod plots;
+pub mod proof;
 pub mod report;
+pub mod reshape;
+mod runner;
 pub mod scenes;
 pub mod suite;
 pub mod sweeps;

@@ -15,8 +15,14 @@
 //! draw and fixed fractions are its terms of that fit, grouped, over its measured time — or
 //! over the prediction where that is larger (the terms then share the time in proportion),
 //! so the fractions sum to at most one, and to about one where the model fits.
+//!
+//! Which coefficients the rows pin down is judged beside the fit ([`super::identify`]: a
+//! bootstrap over rows, the design's correlations and condition number); each row's
+//! [`bound_shares`](SuiteRow::bound_shares) keep the identified terms only, and its
+//! `unidentified_fraction` the rest: only identified terms name a bound.
 
-use super::report::SuiteRow;
+use super::identify::{self, Identifiability};
+use super::report::{BoundShares, SuiteRow};
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -99,6 +105,18 @@ pub struct Model {
     /// The run's own repeatability, the floor any model is judged against: rows measured twice
     /// in this run (the same scene, technique, size and variant in two sweeps).
     pub repeat: Repeat,
+    /// What the rows identify: each coefficient's bootstrap interval, the pairs of terms the
+    /// rows cannot tell apart, the design's condition number.
+    pub identifiability: Identifiability,
+}
+
+impl Model {
+    /// The model's GPU shadow ms for `r`'s counted work (`None` where the row cannot be
+    /// modelled: untimed or without counters).
+    pub fn predict(&self, r: &SuiteRow) -> Option<f64> {
+        let f = features(r)?;
+        Some(TERMS.iter().zip(&f).map(|((n, _, _), v)| self.coefficients.get(*n).copied().unwrap_or(0.0) * 1e-6 * v).sum())
+    }
 }
 
 /// How far apart two measurements of the same row in one run land ([`repeatability`]).
@@ -276,6 +294,10 @@ pub fn fit(rows: &mut [SuiteRow], limit_ns: BTreeMap<String, f64>) -> Model {
             held[k] = (dot(&c, &x[k]) - y[k]).abs() / y[k];
         }
     }
+    let names: Vec<&str> = TERMS.iter().map(|(n, _, _)| *n).collect();
+    let design = identify::Design { x: &x, y: &y, names: &names, value: &all, scale: 1e6 };
+    let ident = identify::identify(&design, &fit_relative, identify::RESAMPLES, identify::SEED);
+    let known: Vec<bool> = names.iter().map(|n| ident.identified(n)).collect();
     let mut fit_err = Vec::with_capacity(idx.len());
     let mut by_method: BTreeMap<String, Vec<f64>> = BTreeMap::new();
     for (k, &i) in idx.iter().enumerate() {
@@ -295,6 +317,11 @@ pub fn fit(rows: &mut [SuiteRow], limit_ns: BTreeMap<String, f64>) -> Model {
         r.draw_fraction = Some(group(Group::Draw));
         r.fixed_fraction = Some(group(Group::Fixed));
         r.model_rel_error = Some(held[k]);
+        let known_group = |g: Group| {
+            TERMS.iter().zip(&terms).zip(&known).filter(|(((_, tg, _), _), k)| *tg == g && **k).map(|((_, v), _)| v).sum::<f64>() / whole
+        };
+        r.bound_shares = Some(BoundShares { fill: known_group(Group::Fill), vertex: known_group(Group::Vertex), draw: known_group(Group::Draw) });
+        r.unidentified_fraction = Some(terms.iter().zip(&known).filter(|(_, k)| !**k).map(|(v, _)| v).sum::<f64>() / whole);
     }
     Model {
         form: "gpu_shadow_ms = 1e-6 * sum_k c_k * count_k, c_k >= 0 in ns per unit; non-negative least squares in relative error, reweighted to least absolute relative error"
@@ -310,6 +337,7 @@ pub fn fit(rows: &mut [SuiteRow], limit_ns: BTreeMap<String, f64>) -> Model {
         limit_ns,
         median_rel_error_by_method: by_method.into_iter().map(|(m, e)| (m, quantile(&e, 0.5))).collect(),
         repeat: repeatability(rows),
+        identifiability: ident,
     }
 }
 
