@@ -274,9 +274,7 @@ pub fn estimate_correlations(x: &[Vec<f64>], cols: &[usize]) -> Vec<Vec<f64>> {
     }
     (0..k)
         .map(|a| {
-            (0..k)
-                .map(|b| if norm[a] > 0.0 && norm[b] > 0.0 { inv[a][b] / (inv[a][a] * inv[b][b]).sqrt() } else { f64::NAN })
-                .collect()
+            (0..k).map(|b| if norm[a] > 0.0 && norm[b] > 0.0 { inv[a][b] / (inv[a][a] * inv[b][b]).sqrt() } else { f64::NAN }).collect()
         })
         .collect()
 }

@@ -320,7 +320,8 @@ pub fn fit(rows: &mut [SuiteRow], limit_ns: BTreeMap<String, f64>) -> Model {
         let known_group = |g: Group| {
             TERMS.iter().zip(&terms).zip(&known).filter(|(((_, tg, _), _), k)| *tg == g && **k).map(|((_, v), _)| v).sum::<f64>() / whole
         };
-        r.bound_shares = Some(BoundShares { fill: known_group(Group::Fill), vertex: known_group(Group::Vertex), draw: known_group(Group::Draw) });
+        r.bound_shares =
+            Some(BoundShares { fill: known_group(Group::Fill), vertex: known_group(Group::Vertex), draw: known_group(Group::Draw) });
         r.unidentified_fraction = Some(terms.iter().zip(&known).filter(|(_, k)| !**k).map(|(v, _)| v).sum::<f64>() / whole);
     }
     Model {

@@ -162,7 +162,13 @@ pub(super) fn prove(run: &mut Runner, rows: &mut [SuiteRow], origins: &[Origin],
             v
         };
         let (fill, vertex, draw) = (of_kind("fill"), of_kind("vertex"), of_kind("draw"));
-        let all: Vec<Variant> = fill.iter().chain(&vertex).chain(&draw).cloned().collect();
+        // A variant two rows share (the same point in two sweeps) is re-timed once.
+        let mut all: Vec<Variant> = Vec::new();
+        for v in fill.iter().chain(&vertex).chain(&draw) {
+            if !all.contains(v) {
+                all.push(v.clone());
+            }
+        }
         let (scene, name) = scene_of(&g.scene)?;
         run.bar.set_message(format!("proofs {name} {}x{}", g.size.0, g.size.1));
         let merged = if draw.is_empty() { None } else { merged_casters(&scene, &name) };
@@ -175,7 +181,9 @@ pub(super) fn prove(run: &mut Runner, rows: &mut [SuiteRow], origins: &[Origin],
         let coarse = match (vertex.is_empty(), coarser(&g.scene)) {
             (true, _) => None,
             (false, Ok(Some((s, n)))) => Some(measure_on(run, s, &n, g.size, &vertex)),
-            (false, Ok(None)) => Some(Ablated { rows: Err("not run: no coarser tessellation of these shapes".into()), scene: name.clone(), size: g.size }),
+            (false, Ok(None)) => {
+                Some(Ablated { rows: Err("not run: no coarser tessellation of these shapes".into()), scene: name.clone(), size: g.size })
+            }
             (false, Err(e)) => Some(Ablated { rows: Err(format!("not run: {e}")), scene: name.clone(), size: g.size }),
         };
         let joined = match (draw.is_empty(), merged) {

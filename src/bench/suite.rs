@@ -42,7 +42,6 @@ pub struct SuiteConfig {
     pub progress: bool,
 }
 
-
 /// Runs the suite on `ctx` and writes its outputs into `cfg.out`.
 pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
     let start = Instant::now();
@@ -146,7 +145,11 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
     for &n in ablation_scenes {
         run.bar.set_message(format!("ablation {n}"));
         let scene = crate::scene::load(n)?;
-        keep(run.point(Point { sweep: "ablation", x: 0.0, name: n }, scene, base, &toggle_variants, false)?, &PointScene::Named(n.into()), base);
+        keep(
+            run.point(Point { sweep: "ablation", x: 0.0, name: n }, scene, base, &toggle_variants, false)?,
+            &PointScene::Named(n.into()),
+            base,
+        );
     }
     // Lights with a range, casters beyond some of them: what scissor and culling are for.
     let ranged = super::scenes::SweepScene::ranged();

@@ -200,11 +200,10 @@ pub fn classify(row: &mut SuiteRow, limits: RowLimits) {
         Some(s) => (Some(s.fill), Some(s.vertex), Some(s.draw)),
         None => (row.fill_fraction, row.vertex_fraction, row.draw_fraction),
     };
-    let mut candidates: Vec<(&str, f64)> =
-        [("fill", fill), ("vertex", vertex), ("draw", draw), ("cpu", row.cpu_fraction)]
-            .iter()
-            .filter_map(|(n, f)| f.filter(|f| f.is_finite()).map(|f| (*n, f)))
-            .collect();
+    let mut candidates: Vec<(&str, f64)> = [("fill", fill), ("vertex", vertex), ("draw", draw), ("cpu", row.cpu_fraction)]
+        .iter()
+        .filter_map(|(n, f)| f.filter(|f| f.is_finite()).map(|f| (*n, f)))
+        .collect();
     candidates.sort_by(|a, b| b.1.total_cmp(&a.1));
     row.bound = candidates.first().map_or("none", |c| c.0).to_string();
     let spread = match (row.gpu_shadow_ms_p10, row.gpu_shadow_ms_p90) {
@@ -450,7 +449,9 @@ mod tests {
             let casters = of(ONE_FACTOR[0]);
             assert!(casters.len() >= 2);
             // The same triangles, as few and as many casters as there are spheres.
-            assert!(casters.iter().all(|s| s.built_triangles() == casters[0].built_triangles() && s.light_height == casters[0].light_height));
+            assert!(casters
+                .iter()
+                .all(|s| s.built_triangles() == casters[0].built_triangles() && s.light_height == casters[0].light_height));
             let counts: Vec<u32> = casters.iter().map(|s| s.caster_count()).collect();
             assert_eq!((counts[0], *counts.last().unwrap()), (1, casters[0].casters), "{counts:?}");
             // Tessellation: the same casters, more triangles.
