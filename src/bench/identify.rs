@@ -215,13 +215,13 @@ pub fn symmetric_eigen(mut a: Vec<Vec<f64>>) -> (Vec<f64>, Vec<Vec<f64>>) {
                 let t = if theta == 0.0 { 1.0 } else { t };
                 let c = 1.0 / (t * t + 1.0).sqrt();
                 let s = t * c;
-                for k in 0..n {
-                    let (akp, akq) = (a[k][p], a[k][q]);
-                    a[k][p] = c * akp - s * akq;
-                    a[k][q] = s * akp + c * akq;
+                for row in a.iter_mut() {
+                    let (akp, akq) = (row[p], row[q]);
+                    row[p] = c * akp - s * akq;
+                    row[q] = s * akp + c * akq;
                 }
-                for k in 0..n {
-                    let (apk, aqk) = (a[p][k], a[q][k]);
+                let (rp, rq) = (a[p].clone(), a[q].clone());
+                for (k, (apk, aqk)) in rp.into_iter().zip(rq).enumerate() {
                     a[p][k] = c * apk - s * aqk;
                     a[q][k] = s * apk + c * aqk;
                 }
@@ -300,9 +300,10 @@ pub fn condition_number(x: &[Vec<f64>], cols: &[usize]) -> f64 {
             }
         }
     }
-    for a in 0..k {
-        for b in 0..a {
-            g[a][b] = g[b][a];
+    for a in 1..k {
+        let (upper, lower) = g.split_at_mut(a);
+        for (b, above) in upper.iter().enumerate() {
+            lower[0][b] = above[a];
         }
     }
     let ev = symmetric_eigenvalues(g);
@@ -419,11 +420,12 @@ mod tests {
             if a[c][c].abs() < 1e-12 {
                 continue;
             }
-            for i in 0..n {
+            let pivot = a[c].clone();
+            for (i, row) in a.iter_mut().enumerate() {
                 if i != c {
-                    let f = a[i][c] / a[c][c];
-                    for j in c..=n {
-                        a[i][j] -= f * a[c][j];
+                    let f = row[c] / pivot[c];
+                    for (x, p) in row.iter_mut().zip(&pivot).skip(c) {
+                        *x -= f * p;
                     }
                 }
             }
