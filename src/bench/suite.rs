@@ -5,7 +5,7 @@
 //! Each point: one renderer for the scene and size; per variant one *counting* frame
 //! (`FrameSettings::counters`: exact rasterised fragments and pipeline statistics; not timed),
 //! then a warm-up frame and `frames` timed frames round-robin over the variants (drift hits
-//! every variant alike), medians of the GPU timestamps ([`super::runner`]).
+//! every variant alike), medians of the GPU timestamps (`bench/runner.rs`).
 //!
 //! Then the model is fitted on every row (with what the rows identify of it), each row's bound
 //! named and, where claimed, put to the test by its ablation ([`super::proof`]); crossovers
