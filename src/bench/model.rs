@@ -275,6 +275,26 @@ pub fn quantile(v: &[f64], q: f64) -> f64 {
     }
 }
 
+/// A row's fill, vertex and draw shares from the identified terms only, and the share of
+/// the unidentified ones (any group): `terms` are the row's terms in [`TERMS`] order (ms),
+/// `known` whether each is identified, `whole` the time they are shares of.
+pub fn identified_shares(terms: &[f64], known: &[bool], whole: f64) -> (BoundShares, f64) {
+    let share = |keep: &dyn Fn(Group, bool) -> bool| -> f64 {
+        let sum: f64 = TERMS.iter().zip(terms).zip(known).filter(|(((_, g, _), _), k)| keep(*g, **k)).map(|((_, v), _)| v).sum();
+        if whole > 0.0 {
+            sum / whole
+        } else {
+            0.0
+        }
+    };
+    let shares = BoundShares {
+        fill: share(&|g, k| k && g == Group::Fill),
+        vertex: share(&|g, k| k && g == Group::Vertex),
+        draw: share(&|g, k| k && g == Group::Draw),
+    };
+    (shares, share(&|_, k| !k))
+}
+
 /// Fits the model on `rows` (fitted in ms, reported in ns per unit), fills in each row's
 /// prediction and model fractions, and returns the model. `limit_ns`: each term's cost at
 /// the measured limit.
@@ -317,12 +337,9 @@ pub fn fit(rows: &mut [SuiteRow], limit_ns: BTreeMap<String, f64>) -> Model {
         r.draw_fraction = Some(group(Group::Draw));
         r.fixed_fraction = Some(group(Group::Fixed));
         r.model_rel_error = Some(held[k]);
-        let known_group = |g: Group| {
-            TERMS.iter().zip(&terms).zip(&known).filter(|(((_, tg, _), _), k)| *tg == g && **k).map(|((_, v), _)| v).sum::<f64>() / whole
-        };
-        r.bound_shares =
-            Some(BoundShares { fill: known_group(Group::Fill), vertex: known_group(Group::Vertex), draw: known_group(Group::Draw) });
-        r.unidentified_fraction = Some(terms.iter().zip(&known).filter(|(_, k)| !**k).map(|(v, _)| v).sum::<f64>() / whole);
+        let (shares, unidentified) = identified_shares(&terms, &known, whole);
+        r.bound_shares = Some(shares);
+        r.unidentified_fraction = Some(unidentified);
     }
     Model {
         form: "gpu_shadow_ms = 1e-6 * sum_k c_k * count_k, c_k >= 0 in ns per unit; non-negative least squares in relative error, reweighted to least absolute relative error"
@@ -393,6 +410,27 @@ mod tests {
         // Only the pair from two sweeps counts; the same sweep twice is not a repeat.
         assert_eq!(r.pairs, 1);
         assert!((r.median_rel_diff - 0.5).abs() < 1e-12 && r.over_30_percent == 1.0, "{r:?}");
+    }
+
+    #[test]
+    fn unidentified_terms_give_no_bound_share() {
+        let names: Vec<&str> = TERMS.iter().map(|(n, _, _)| *n).collect();
+        let at = |n: &str| names.iter().position(|x| *x == n).unwrap();
+        let mut terms = vec![0.0; TERMS.len()];
+        terms[at("fragments")] = 2.0;
+        terms[at("setup_triangles")] = 1.0;
+        terms[at("draws")] = 4.0;
+        terms[at("caster_passes")] = 2.0;
+        terms[at("lights")] = 1.0;
+        // The draws and caster passes are confounded: not identified, nor are the lights.
+        let known: Vec<bool> = names.iter().map(|n| !matches!(*n, "draws" | "caster_passes" | "lights")).collect();
+        let (s, u) = identified_shares(&terms, &known, 10.0);
+        assert_eq!(s, BoundShares { fill: 0.2, vertex: 0.1, draw: 0.0 });
+        assert!((u - 0.7).abs() < 1e-12, "{u}");
+        let all = vec![true; TERMS.len()];
+        let (s, u) = identified_shares(&terms, &all, 10.0);
+        assert!((s.draw - 0.6).abs() < 1e-12 && u == 0.0);
+        assert_eq!(identified_shares(&terms, &all, 0.0), (BoundShares::default(), 0.0));
     }
 
     #[test]
