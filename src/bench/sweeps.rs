@@ -4,7 +4,7 @@
 use super::report::{Crossover, RowLimits, SuiteRow};
 use super::scenes::SweepScene;
 
-/// How many points: the full suite, `--quick` (about 5 minutes on lavapipe on 2 cores), or
+/// How many points: the full suite, `--quick` (about 10 minutes on lavapipe on 2 cores), or
 /// the tiny one the tests run (two points a sweep, small targets).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Scale {
