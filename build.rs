@@ -2,6 +2,8 @@
 //! `$OUT_DIR/shaders.rs`, which embeds them (`include_bytes!`) as `SHADER_<NAME>_<STAGE>`.
 //! A shader error fails the build with the file, line and naga's message.
 //!
+//! SPIR-V 1.0 for GLSL, 1.3 for WGSL unless the module has a line `// @spirv 1.0`.
+//!
 //! Variants: a line `// @variant NAME DEFINE` in a shader also builds the module with
 //! `#define DEFINE 1` (several: `DEF1,DEF2`) as `SHADER_<STEM>_<NAME>_<STAGE>` (naga has no specialisation constants).
 
@@ -99,10 +101,14 @@ fn compile(path: &Path, define: Option<&str>) -> Result<Vec<u32>, String> {
     // SPIR-V 1.0 for the GLSL graphics shaders, the version a Vulkan 1.0 device accepts (the
     // conformance suite runs there); the WGSL compute modules use storage buffers as SPIR-V 1.3
     // has them (the compute path needs a Vulkan 1.3 device anyway); mesh and task shaders need
-    // SPIR-V 1.4 (`VK_EXT_mesh_shader` on Vulkan 1.2 or newer).
+    // SPIR-V 1.4 (`VK_EXT_mesh_shader` on Vulkan 1.2 or newer). A WGSL module with the line
+    // `// @spirv 1.0` is written as SPIR-V 1.0 (storage buffers through
+    // SPV_KHR_storage_buffer_storage_class): the conformance suite's compute checks run on
+    // Vulkan 1.0 devices that have VK_KHR_storage_buffer_storage_class.
+    let spirv_1_0 = source.lines().any(|l| l.trim() == "// @spirv 1.0");
     spv.lang_version = match path.extension().and_then(|e| e.to_str()) {
         Some("wgsl") if source.contains("enable wgpu_mesh_shader;") => (1, 4),
-        Some("wgsl") => (1, 3),
+        Some("wgsl") if !spirv_1_0 => (1, 3),
         _ => (1, 0),
     };
     naga::back::spv::write_vec(&module, &info, &spv, None).map_err(|e| format!("{file}: SPIR-V output: {e}"))

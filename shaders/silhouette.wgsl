@@ -188,6 +188,14 @@ fn grow_dispatch(x_word: u32, end: u32) {
     atomicMax(&records[x_word], min((end + 63u) / 64u, MAX_GROUPS));
 }
 
+// Appends `entry` to the list whose length is header word `count_word`, its entries from
+// `base` in `lists`, its dispatch command's x at `x_word`.
+fn append(count_word: u32, x_word: u32, base: u32, entry: vec2<u32>) {
+    let k = atomicAdd(&records[count_word], 1u);
+    lists[base + k] = entry;
+    grow_dispatch(x_word, k + 1u);
+}
+
 // ---- exact orient3d: fixed-point sum of products of three f32 values ----
 
 const LIMBS: u32 = 72u;
@@ -333,18 +341,6 @@ fn facing_exact(job: Job, t: u32) -> bool {
     return select(sign > 0, sign < 0, point);
 }
 
-// The filter's verdict: 1 light-facing, 0 not, 2 undecided (the exact test decides).
-fn filtered(job: Job, t: u32) -> u32 {
-    let pl = planes[job.plane_base + t];
-    let f = job.filt;
-    // the CPU's order: ((nx lx + ny ly) + nz lz) + d lw
-    let v = ((pl.x * f.x + pl.y * f.y) + pl.z * f.z) + pl.w * f.w;
-    if (abs(v) > job.bound) {
-        return select(0u, 1u, v > job.bound);
-    }
-    return 2u;
-}
-
 // ---- output ----
 
 fn put_half(pos: u32, value: u32) {
@@ -398,24 +394,25 @@ fn emit(r: u32, cap: bool, idx: array<u32, 9>, count: u32) {
 // ---- stages ----
 
 // Stage 1: the plane filter, GROUP triangles of one job a workgroup (the facing words were
-// cleared by the frame's fill).
+// cleared by the frame's fill). The job's fields are read one by one: loading the whole job
+// per invocation cost lavapipe more than the planes themselves.
 @compute @workgroup_size(GROUP)
 fn facing(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>,
           @builtin(local_invocation_index) lid: u32) {
     let w = group_index(wg, nwg);
     let j = job_of(w, STAGE_FACING);
-    let job = jobs[j];
-    let local = w - job.g_facing;
-    let t = local * GROUP + lid;
-    if (w < pc.facing_groups && t < job.tris) {
-        let v = filtered(job, t);
-        if (v == 1u) {
-            atomicOr(&facing_bits[job.fac_base + (t >> 5u)], 1u << (t & 31u));
-        }
-        if (v == 2u) {
-            let k = atomicAdd(&records[H_EXACT], 1u);
-            lists[k] = vec2<u32>(j, t);
-            grow_dispatch(H_EXACT_X, k + 1u);
+    let t = (w - jobs[j].g_facing) * GROUP + lid;
+    if (w < pc.facing_groups && t < jobs[j].tris) {
+        let pl = planes[jobs[j].plane_base + t];
+        let f = jobs[j].filt;
+        let bound = jobs[j].bound;
+        // the CPU's order: ((nx lx + ny ly) + nz lz) + d lw
+        let v = ((pl.x * f.x + pl.y * f.y) + pl.z * f.z) + pl.w * f.w;
+        if (v > bound) {
+            atomicOr(&facing_bits[jobs[j].fac_base + (t >> 5u)], 1u << (t & 31u));
+        } else if (!(v < -bound)) {
+            // undecided (|v| <= bound, or NaN): the exact test decides
+            append(H_EXACT, H_EXACT_X, 0u, vec2<u32>(j, t));
         }
     }
 }
@@ -442,14 +439,14 @@ fn find(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3
         @builtin(local_invocation_index) lid: u32) {
     let w = group_index(wg, nwg);
     let j = job_of(w, STAGE_FIND);
-    let job = jobs[j];
-    let i = (w - job.g_find) * GROUP + lid;
-    if (w < pc.find_groups && i < job.edges) {
-        let e = edge_table[job.edge_base + i];
-        if (facing_bit(job, e.x) != facing_bit(job, e.y)) {
-            let k = atomicAdd(&records[H_SIL], 1u);
-            lists[pc.sil_base + k] = vec2<u32>(j, i);
-            grow_dispatch(H_SIL_X, k + 1u);
+    let i = (w - jobs[j].g_find) * GROUP + lid;
+    if (w < pc.find_groups && i < jobs[j].edges) {
+        let e = edge_table[jobs[j].edge_base + i];
+        let fac = jobs[j].fac_base;
+        let b0 = (atomicLoad(&facing_bits[fac + (e.x >> 5u)]) >> (e.x & 31u)) & 1u;
+        let b1 = (atomicLoad(&facing_bits[fac + (e.y >> 5u)]) >> (e.y & 31u)) & 1u;
+        if (b0 != b1) {
+            append(H_SIL, H_SIL_X, pc.sil_base, vec2<u32>(j, i));
         }
     }
 }

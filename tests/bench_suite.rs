@@ -57,10 +57,27 @@ fn tiny_suite(tag: &str, driver: &[(String, Option<String>)]) -> serde_json::Val
     let limits = &v["limits"];
     keys(
         limits,
-        &["stencil_fill_gfrag_s", "color_fill_gfrag_s", "small_tri_mtri_s", "big_tri_mtri_s", "draws_per_s", "cpu_stream_gib_s", "units"],
+        &[
+            "stencil_fill_gfrag_s",
+            "color_fill_gfrag_s",
+            "small_tri_mtri_s",
+            "big_tri_mtri_s",
+            "draws_per_s",
+            "cpu_stream_gib_s",
+            "compute_read_gib_s",
+            "units",
+        ],
         "limits",
     );
-    for k in ["stencil_fill_gfrag_s", "color_fill_gfrag_s", "small_tri_mtri_s", "big_tri_mtri_s", "draws_per_s", "cpu_stream_gib_s"] {
+    for k in [
+        "stencil_fill_gfrag_s",
+        "color_fill_gfrag_s",
+        "small_tri_mtri_s",
+        "big_tri_mtri_s",
+        "draws_per_s",
+        "cpu_stream_gib_s",
+        "compute_read_gib_s",
+    ] {
         let x = limits[k].as_f64().unwrap_or(0.0);
         assert!(x.is_finite() && x > 0.0, "limit {k} = {x}");
     }
@@ -113,6 +130,9 @@ fn tiny_suite(tag: &str, driver: &[(String, Option<String>)]) -> serde_json::Val
     for s in ["scenes", "resolution", "tessellation", "lights", "light_distance", "casters", "caps", "ablation"] {
         assert!(rows.iter().any(|r| r["sweep"] == s), "no {s} rows");
     }
+    one_factor_sweeps(rows);
+    identifiability(&v["model"]);
+    bound_proofs(&v);
     let methods: Vec<&str> = rows.iter().filter(|r| r["sweep"] == "tessellation").filter_map(|r| r["method"].as_str()).collect();
     for m in ["zpass", "zfail", "everitt-kilgard", "lengyel", "mcguire", "zpass-clear", "edgequad", "planar", "shadowmap-512"] {
         assert!(methods.contains(&m), "tessellation sweep lacks {m}");
@@ -155,9 +175,127 @@ fn tiny_suite(tag: &str, driver: &[(String, Option<String>)]) -> serde_json::Val
     assert_eq!(&png[1..4], b"PNG");
     let md = std::fs::read_to_string(dir.join("bench.md")).unwrap();
     assert!(md.contains("## Limits") && md.contains("## Crossovers") && md.contains("## Ablations"));
+    assert!(md.contains("## What the rows identify") && md.contains("## Bounds proven by ablation") && md.contains("### Disagreements"));
     assert!(md.contains("## Cost model") && md.contains("## Shadow maps: map against lookup") && md.contains("## The paper's claim"));
     let _ = std::fs::remove_dir_all(&dir);
     v
+}
+
+/// The one-factor sweeps (issue #38): each moves one count while the others stay.
+fn one_factor_sweeps(rows: &[serde_json::Value]) {
+    let of = |sweep: &str, method: &str| -> Vec<&serde_json::Value> {
+        rows.iter().filter(|r| r["sweep"] == sweep && r["method"] == method).collect()
+    };
+    let u = |r: &serde_json::Value, k: &str| r[k].as_u64().unwrap_or_else(|| panic!("{k} of {r}"));
+    for m in ["mcguire", "zpass", "shadowmap-512"] {
+        // Casters at fixed triangles: the same caster triangles as 1 and as many casters.
+        let c = of("casters_same_triangles", m);
+        assert!(c.len() >= 2, "casters_same_triangles {m}: {} rows", c.len());
+        assert!(c.iter().all(|r| u(r, "triangles") == u(c[0], "triangles")), "casters_same_triangles moves the triangles");
+        let casters: Vec<u64> = c.iter().map(|r| u(r, "casters")).collect();
+        assert!(casters.contains(&1) && casters.iter().any(|n| *n > 1), "{casters:?}");
+        // Triangles at fixed casters.
+        let t = of("triangles_same_casters", m);
+        assert!(t.len() >= 2 && t.iter().all(|r| u(r, "casters") == u(t[0], "casters")));
+        assert!(t.windows(2).all(|w| u(w[0], "triangles") < u(w[1], "triangles")), "tessellation does not grow");
+        // Coverage at fixed triangles and casters.
+        let f = of("coverage_same_triangles", m);
+        assert!(f.len() >= 2 && f.iter().all(|r| u(r, "casters") == u(f[0], "casters") && u(r, "triangles") == u(f[0], "triangles")));
+    }
+    // For the volumes, the casters sweep moves the (light, caster) passes (edge quads' draws
+    // too; the CPU-planned volumes draw per connected part, merged or not) and the coverage
+    // sweep the fragments.
+    let c = of("casters_same_triangles", "mcguire");
+    assert!(u(c[0], "caster_passes") != u(c[c.len() - 1], "caster_passes"), "merging casters leaves the caster passes");
+    let e = of("casters_same_triangles", "edgequad");
+    assert!(u(e[0], "draws") != u(e[e.len() - 1], "draws"), "merging casters leaves the edge quads' draws");
+    let f = of("coverage_same_triangles", "mcguire");
+    assert!(u(f[0], "stencil_fragments") != u(f[f.len() - 1], "stencil_fragments"), "the light's height leaves the fragments");
+}
+
+/// `model.identifiability`: the keys of issue #38, and verdicts that follow the intervals and
+/// the confounded pairs.
+fn identifiability(model: &serde_json::Value) {
+    let id = &model["identifiability"];
+    keys(
+        id,
+        &["bootstrap_resamples", "coefficients", "condition_number", "confounded_pairs", "max_ci_ratio", "confounded_at"],
+        "identifiability",
+    );
+    assert_eq!(id["bootstrap_resamples"].as_u64(), Some(200));
+    let ratio = id["max_ci_ratio"].as_f64().unwrap();
+    let at = id["confounded_at"].as_f64().unwrap();
+    let pairs = id["confounded_pairs"].as_array().unwrap();
+    for p in pairs {
+        keys(p, &["a", "b", "correlation"], "confounded pair");
+        assert!(p["correlation"].as_f64().unwrap().abs() >= at, "{p}");
+    }
+    let coefficients = id["coefficients"].as_array().unwrap();
+    assert_eq!(coefficients.len(), model["coefficients"].as_object().unwrap().len(), "a verdict per term");
+    let mut identified = 0;
+    for c in coefficients {
+        keys(c, &["term", "value", "ci_low", "ci_high", "identified"], "coefficient");
+        let term = c["term"].as_str().unwrap();
+        let value = c["value"].as_f64().unwrap();
+        assert!((value - model["coefficients"][term].as_f64().unwrap()).abs() <= 1e-9 * value.abs().max(1.0), "{term}: another value");
+        if c["identified"] == true {
+            identified += 1;
+            let (lo, hi) = (c["ci_low"].as_f64().unwrap(), c["ci_high"].as_f64().unwrap());
+            assert!(lo > 0.0 && hi <= ratio * lo * (1.0 + 1e-12) && lo <= hi, "{term} identified with [{lo}, {hi}]");
+            assert!(!pairs.iter().any(|p| p["a"] == term || p["b"] == term), "{term} identified yet confounded");
+        } else {
+            assert!(!c["reason"].as_str().unwrap().is_empty(), "{term}: no reason");
+        }
+    }
+    assert!(identified > 0, "the rows identify no term at all");
+}
+
+/// Every claimed bound has its ablation, and `confirmed` follows the measured saving, the
+/// predicted one and the spread.
+fn bound_proofs(v: &serde_json::Value) {
+    let rows = v["rows"].as_array().unwrap();
+    let (mut claimed, mut ablated, mut confirmed) = (0u64, 0u64, 0u64);
+    for r in rows {
+        keys(r, &["ablation", "bound_confirmed", "unidentified_fraction", "bound_shares"], "row");
+        let what = format!("{} {} {} {}", r["sweep"], r["scene"], r["method"], r["variant"]);
+        let a = &r["ablation"];
+        let provable = r["bound_clear"] == true && ["fill", "vertex", "draw"].contains(&r["bound"].as_str().unwrap());
+        if !provable {
+            assert!(a.is_null(), "{what}: an ablation without a claimed bound");
+            assert_eq!(r["bound_confirmed"], false, "{what}");
+            continue;
+        }
+        claimed += 1;
+        keys(a, &["kind", "predicted_saving_ms", "measured_saving_ms", "confirmed", "spread_ms"], "ablation");
+        assert_eq!(a["kind"], r["bound"], "{what}: ablation of another bound");
+        assert_eq!(a["confirmed"], r["bound_confirmed"], "{what}");
+        let (Some(p), Some(m), Some(s)) = (a["predicted_saving_ms"].as_f64(), a["measured_saving_ms"].as_f64(), a["spread_ms"].as_f64())
+        else {
+            assert_eq!(a["confirmed"], false, "{what}: confirmed without a measurement");
+            continue;
+        };
+        ablated += 1;
+        let agrees = s > 0.0 && m > s && (m - p).abs() <= s;
+        assert_eq!(a["confirmed"].as_bool(), Some(agrees), "{what}: predicted {p}, measured {m}, spread {s}");
+        confirmed += agrees as u64;
+        let (b, x) = (a["baseline_ms"].as_f64().unwrap(), a["ablated_ms"].as_f64().unwrap());
+        assert!((b - x - m).abs() < 1e-9, "{what}: measured saving is not baseline less ablated");
+    }
+    let summary = &v["bound_proofs"];
+    assert_eq!(summary["claimed"].as_u64(), Some(claimed), "bound_proofs.claimed");
+    assert_eq!(summary["ablated"].as_u64(), Some(ablated), "bound_proofs.ablated");
+    assert_eq!(summary["confirmed"].as_u64(), Some(confirmed), "bound_proofs.confirmed");
+    assert!(ablated > 0, "no ablation ran");
+    // Bound crossovers join confirmed bounds only.
+    for c in v["crossovers"].as_array().unwrap().iter().filter(|c| c["kind"] == "bound") {
+        let confirmed_at = |x: f64| {
+            rows.iter().any(|r| {
+                r["sweep"] == c["sweep"] && r["method"] == c["method"] && r["x"].as_f64() == Some(x) && r["bound_confirmed"] == true
+            })
+        };
+        let between = c["between"].as_array().unwrap();
+        assert!(confirmed_at(between[0].as_f64().unwrap()) && confirmed_at(between[1].as_f64().unwrap()), "{c}");
+    }
 }
 
 #[test]

@@ -120,7 +120,7 @@ fn bench_accepts_every_render_method() {
         "--scene",
         "default",
         "--methods",
-        "edgequad,mcguire,shadowmap,auto",
+        "edgequad,mcguire,compute,shadowmap,auto",
         "--frames",
         "2",
         "--size",
@@ -134,8 +134,22 @@ fn bench_accepts_every_render_method() {
     let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     let rows = v["rows"].as_array().unwrap();
     let methods: Vec<&str> = rows.iter().map(|r| r["method"].as_str().unwrap()).collect();
-    assert_eq!(methods, ["edgequad", "mcguire", "shadowmap-256"], "auto is mcguire, listed once");
+    assert_eq!(methods, ["edgequad", "mcguire", "compute", "shadowmap-256"], "auto is mcguire, listed once");
+    // The compute silhouettes are timed on their own and put against the compute read rate
+    // measured in the same run.
+    let rate = v["compute_read_gib_s"].as_f64().unwrap();
+    assert!(rate > 0.0 && v["compute_read_sweep"].as_array().is_some_and(|s| s.len() == 3), "{v}");
     for r in rows {
+        let silhouettes = r["gpu_silhouettes_ms"].as_f64();
+        if r["method"] == "compute" {
+            let (ms, bytes, fraction) =
+                (silhouettes.unwrap(), r["silhouette_read_bytes"].as_u64().unwrap(), r["silhouette_limit_fraction"].as_f64().unwrap());
+            assert!(ms > 0.0 && ms < r["gpu_shadow_ms"].as_f64().unwrap() && bytes > 0, "{r}");
+            let expected = bytes as f64 / (rate * (1u64 << 30) as f64) * 1e3 / ms;
+            assert!((fraction - expected).abs() <= 1e-9 * expected.max(1.0), "{r}");
+        } else {
+            assert!(silhouettes.is_none() && r["silhouette_limit_fraction"].is_null(), "{r}");
+        }
         assert!(r["throughput_fps"].as_f64().unwrap() > 0.0, "{r}");
         assert!(r["wall_ms"].as_f64().unwrap() > 0.0, "{r}");
         // The shadow map's time splits into its maps and its lookup; the volumes have neither.
@@ -258,7 +272,7 @@ fn info_pipelines_creates_and_times_every_pipeline() {
     assert!(text.contains("all created"), "{text}");
     for what in [
         "silhouette.wgsl:exact",
-        "silhouette.wgsl:edges",
+        "silhouette.wgsl:sides",
         "shadow.vert depth LESS stencil",
         "fullscreen.vert + illuminate.frag",
         "render-pass",

@@ -64,15 +64,15 @@ const COVERAGE: &[Row] = &[
     exact("vkCmdCopyBuffer", &["commands.buffers"], "two regions at offsets within one buffer: every byte"),
     exact("vkCmdCopyImage", &["commands.blit_copy_color"], "RGBA8 to RGBA8: every byte"),
     exact("vkCmdCopyImageToBuffer", &["commands.copy_aspects", "commands.blit_copy_color", "*"], "depth (2 bytes D16, 4 bytes X8D24/D32) and stencil (1 byte) aspects at buffer offsets with row length and image height beyond the region, from an image offset; every case reads back through it"),
-    gap("vkCmdDispatch", "the compute silhouettes (`--method compute`): held to the exact reference by tests/hard_cases.rs and tests/compute.rs; no conformance family dispatches"),
-    gap("vkCmdDispatchIndirect", "the compute silhouettes' exact and sides stages, sized by the GPU's own list lengths: held to the exact reference by tests/hard_cases.rs and tests/compute.rs; no conformance family dispatches"),
+    exact("vkCmdDispatch", &["commands.dispatch", "commands.dispatch_indirect"], "2D group counts (65535, 2) as the compute silhouettes split a dispatch: every group and invocation once with workgroup_id, num_workgroups and local index; storage-buffer atomicAdd, atomicOr and atomicMax exact; ids past n skip; group counts of 0 dispatch nothing"),
+    exact("vkCmdDispatchIndirect", &["commands.dispatch_indirect"], "a command at byte offset 20 of a host-visible storage buffer, grown by an earlier dispatch's atomicMax (compute write -> indirect read barrier): exactly its groups, each once with its workgroup_id and num_workgroups; x = 0 dispatches nothing"),
     exact("vkCmdDraw", EVERY_DRAW, "every non-indexed case"),
     exact("vkCmdDrawIndexed", &["legacy.index_types", "watertight.*"], "indexed meshes, split across draws"),
     exact("vkCmdDrawIndexedIndirect", &["commands.indirect"], "one record per call at non-zero offsets (stride 20), firstIndex, vertexOffset, instanceCount 0 and 2"),
     exact("vkCmdEndQuery", &["commands.queries", "occlusion.*"], "as vkCmdBeginQuery"),
     exact("vkCmdEndRenderPass", &["*.render_pass.*", "commands.clears"], "store ops of both aspects"),
     exact("vkCmdEndRendering", &["*.dynamic_rendering.*", "commands.clears"], "store ops of both aspects"),
-    gap("vkCmdFillBuffer", "clears the compute silhouettes' facing bits before the `facing` stage sets the light-facing ones: held to the exact reference by tests/hard_cases.rs and tests/compute.rs (a stale bit would open the volume); no conformance family fills a buffer"),
+    exact("vkCmdFillBuffer", &["commands.fill_buffer", "commands.dispatch", "commands.dispatch_indirect"], "sub-ranges at offsets, over an earlier fill, VK_WHOLE_SIZE to the last whole word: every byte; zeroes the words compute atomics then accumulate"),
     gap("vkCmdNextSubpass", "examples/embed's render-pass host only (its second subpass): tests/embed.rs compares its stencil with the dynamic-rendering host's; the suite's render passes have one subpass"),
     exact("vkCmdPipelineBarrier", &["commands.layouts", "*"], "Vulkan 1.0-1.2 devices' barriers: layout transitions keep contents"),
     exact("vkCmdPipelineBarrier2", &["commands.layouts", "*"], "layout transitions keep both aspects' contents through every layout umbrage uses"),
@@ -268,7 +268,7 @@ fn render(found: &BTreeMap<String, BTreeSet<String>>) -> String {
          The test fails when something is recorded that this table lacks, or when a family names no case.\n\n\
          The `commands.*` family (`src/conform/checks/commands.rs`) was added for this table: clears and load ops per aspect, \
          aspect copies with offsets and strides, layout transitions, blits and copies, buffer updates and copies, queries, \
-         scissors and indirect draws.\n\n\
+         scissors and indirect draws; buffer fills, dispatches and indirect dispatches.\n\n\
          | item | covered | families | what is checked | recorded in |\n|---|---|---|---|---|\n",
     );
     let (mut exact, mut e2e, mut gaps) = (0, 0, 0);

@@ -63,6 +63,15 @@ pub struct BenchRow {
     /// `ALLOW_UPDATE`, then refitted; the caster is put back afterwards), its acceleration
     /// span, ms (`None` otherwise, or with no mesh caster).
     pub blas_refit_ms: Option<f64>,
+    /// `compute`: median GPU time of the silhouettes' compute pass (every light), ms (`None`
+    /// for the other techniques).
+    pub gpu_silhouettes_ms: Option<f64>,
+    /// `compute`: bytes that pass reads from the static tables a frame (16 a triangle, 16 an
+    /// edge, per light and caster).
+    pub silhouette_read_bytes: Option<u64>,
+    /// `compute`: the time a plain compute read of those bytes takes at the device's measured
+    /// rate ([`BenchReport::compute_read_gib_s`]) over the pass's time (1 = at the limit).
+    pub silhouette_limit_fraction: Option<f64>,
 }
 
 /// Frames [`refit_ms`] times.
@@ -115,6 +124,11 @@ pub struct BenchReport {
     pub height: u32,
     /// One row per scene and variant, in the order measured.
     pub rows: Vec<BenchRow>,
+    /// With `compute` among the methods: the device's compute streaming-read rate, measured in
+    /// the same run ([`super::compute_read`]), GiB / s.
+    pub compute_read_gib_s: Option<f64>,
+    /// Its sweep: `[planes, GiB / s]` per point.
+    pub compute_read_sweep: Vec<[f64; 2]>,
 }
 
 pub(crate) fn median(mut v: Vec<f64>) -> f64 {
@@ -183,6 +197,12 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
     }
     let device = ctx.info.name.clone();
     let driver = format!("{} {}", ctx.info.driver, ctx.info.driver_info);
+    // The compute silhouettes are reported against a plain compute read of their bytes.
+    let read = match cfg.techniques.contains(&Technique::Compute) {
+        true => Some(super::compute_read::measure(&ctx, 5, 1 << 22)?),
+        false => None,
+    };
+    let read_gib_s = read.as_ref().map(|r| r.gib_s);
     let mut ctx = Some(ctx);
     let mut rows = Vec::new();
     for name in &cfg.scenes {
@@ -212,6 +232,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
             illum: Vec<f64>,
             map: Vec<f64>,
             accel: Vec<f64>,
+            silhouettes: Vec<f64>,
             wall: Vec<f64>,
             plan: Vec<f64>,
             last: Option<crate::render::Stats>,
@@ -232,6 +253,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                     a.illum.push(g.illuminate);
                     a.map.push(g.shadow_map);
                     a.accel.push(g.accel);
+                    a.silhouettes.push(g.silhouettes);
                 }
                 a.wall.push(f.stats.wall_ms);
                 a.plan.push(f.stats.cpu_ms.plan + f.stats.cpu_ms.silhouettes);
@@ -249,6 +271,13 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
             // The acceleration structures' stats and times are the ray-query rows' only.
             let ray = technique == Technique::RayQuery;
             let rays = s.ray_query.as_ref().filter(|_| ray);
+            let compute = technique == Technique::Compute && !a.silhouettes.is_empty();
+            let silhouettes_ms = compute.then(|| median(a.silhouettes));
+            let read_bytes = compute.then_some(s.totals.silhouette_read_bytes);
+            let fraction = match (silhouettes_ms, read_bytes, read_gib_s) {
+                (Some(ms), Some(b), Some(rate)) if ms > 0.0 && rate > 0.0 => Some(b as f64 / (rate * (1u64 << 30) as f64) * 1e3 / ms),
+                _ => None,
+            };
             let row = BenchRow {
                 scene: name.clone(),
                 method: technique_label(technique),
@@ -272,6 +301,9 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 blas_build_ms: rays.map(|q| q.bottom_level_build_ms),
                 blas_bytes: rays.map(|q| q.bottom_level_bytes),
                 blas_refit_ms: if ray { refit_ms(&mut r)? } else { None },
+                gpu_silhouettes_ms: silhouettes_ms,
+                silhouette_read_bytes: read_bytes,
+                silhouette_limit_fraction: fraction,
             };
             progress(&row);
             rows.push(row);
@@ -282,7 +314,15 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
     if let Some(c) = &ctx {
         c.check_validation()?;
     }
-    Ok(BenchReport { device, driver, width: cfg.opts.width, height: cfg.opts.height, rows })
+    Ok(BenchReport {
+        device,
+        driver,
+        width: cfg.opts.width,
+        height: cfg.opts.height,
+        rows,
+        compute_read_gib_s: read_gib_s,
+        compute_read_sweep: read.map(|r| r.sweep).unwrap_or_default(),
+    })
 }
 
 impl BenchReport {
@@ -322,6 +362,20 @@ impl BenchReport {
                 r.cases[2],
                 r.cases[3]
             );
+        }
+        if let Some(rate) = self.compute_read_gib_s {
+            s += &format!("\nCompute streaming read (measured in this run, `shaders/compute_read.wgsl`): {rate:.2} GiB/s.\n");
+            for r in self.rows.iter().filter(|r| r.gpu_silhouettes_ms.is_some()) {
+                if let (Some(ms), Some(b), Some(frac)) = (r.gpu_silhouettes_ms, r.silhouette_read_bytes, r.silhouette_limit_fraction) {
+                    s += &format!(
+                        "- {} `{}`: silhouettes {ms:.2} ms for {:.1} MB of tables = {:.0} % of the read limit\n",
+                        r.scene,
+                        r.method,
+                        b as f64 / 1e6,
+                        frac * 100.0
+                    );
+                }
+            }
         }
         s
     }

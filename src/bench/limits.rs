@@ -16,6 +16,7 @@
 //! | index fetch | one 256-vertex patch drawn through u8, u16 and u32 indices and as streamed 4 x f32 vertices | vertex and index fetch of small triangles |
 //! | draw calls | one tiny triangle per `vkCmdDraw`, each with its push constants and vertex binding (as the shadow pass) | per-draw cost |
 //! | CPU stream | a sum over a buffer far larger than the caches | host memory bandwidth |
+//! | compute read | a compute shader reading 16-byte planes, a bit set per plane facing a light ([`super::compute_read`]) | what the GPU silhouettes' per-triangle and per-edge reads can reach |
 //!
 //! GPU times come from timestamps written outside the rendering instances (on lavapipe those
 //! inside do not include rasterisation); each point of a sweep is the median of several
@@ -59,6 +60,9 @@ pub struct Limits {
     pub draws_per_s: f64,
     /// The CPU's memory-stream read bandwidth (one thread): GiB / s.
     pub cpu_stream_gib_s: f64,
+    /// A plain compute read of 16-byte planes (the GPU silhouettes' `facing` stage without its
+    /// jobs, [`super::compute_read`]): GiB / s.
+    pub compute_read_gib_s: f64,
     /// Indexed small triangles through 8-bit indices: Mtriangles / s (`None`: skipped, see
     /// [`Limits::skipped`]).
     pub index_u8_mtri_s: Option<f64>,
@@ -353,6 +357,8 @@ fn measure_with(ctx: &Context, cfg: &LimitsConfig, made: &mut Made) -> Result<Li
     let tiny_vb = upload("limits-tiny", bytes(&tiny), vb)?;
     let draws = 1024u32;
     let draw_rate = lab.peak("draws_per_s", Workload { draws, ..draw(stencil, tiny_vb, 3) }, draws as f64, 1.0, true)?;
+    let read = super::compute_read::measure(ctx, lab.reps, if quick { 1 << 20 } else { 1 << 22 })?;
+    lab.sweeps.insert("compute_read_gib_s".into(), read.sweep.clone());
 
     Ok(Limits {
         stencil_fill_gfrag_s: stencil_fill,
@@ -364,6 +370,7 @@ fn measure_with(ctx: &Context, cfg: &LimitsConfig, made: &mut Made) -> Result<Li
         sliver_tri_mtri_s: sliver_rate,
         draws_per_s: draw_rate,
         cpu_stream_gib_s: cpu_stream_gib_s(cfg.scale, cfg.reps),
+        compute_read_gib_s: read.gib_s,
         index_u8_mtri_s: u8_rate,
         index_u16_mtri_s: u16_rate,
         index_u32_mtri_s: u32_rate,

@@ -50,6 +50,7 @@ impl SuiteReport {
         );
         let _ = writeln!(s, "| draw calls | {:.0} draws/s |", l.draws_per_s);
         let _ = writeln!(s, "| CPU memory stream (one thread) | {:.2} GiB/s |", l.cpu_stream_gib_s);
+        let _ = writeln!(s, "| compute read (16-byte planes) | {:.2} GiB/s |", l.compute_read_gib_s);
         for (k, why) in &l.skipped {
             let _ = writeln!(s, "| {k} | skipped: {why} |");
         }
@@ -59,6 +60,8 @@ impl SuiteReport {
             l.sweeps.iter().map(|(k, v)| format!("{k} {} points", v.len())).collect::<Vec<_>>().join(", ")
         );
         s += &self.model_markdown();
+        s += &self.identifiability_markdown();
+        s += &self.proof_markdown();
         s += &self.shadow_map_markdown();
         s += &self.claim_markdown();
         let _ = writeln!(s, "## Named scenes\n");
@@ -103,7 +106,8 @@ impl SuiteReport {
                 let _ = writeln!(s, "\n![{p}]({plot_dir}/{p})");
             }
         }
-        for sweep in ["resolution", "tessellation", "lights", "light_distance", "casters", "caps", "ablation"] {
+        let sweeps = ["resolution", "tessellation", "lights", "light_distance", "casters"].into_iter().chain(super::sweeps::ONE_FACTOR);
+        for sweep in sweeps.chain(["caps", "ablation"]) {
             let rows: Vec<&SuiteRow> = self.rows.iter().filter(|r| r.sweep == sweep).collect();
             if rows.is_empty() {
                 continue;
@@ -121,7 +125,7 @@ impl SuiteReport {
         let mut s = String::from("## Cost model\n\n");
         let _ = writeln!(
             s,
-            "GPU shadow ms ≈ 10⁻⁶ · Σ c·count (c in ns per unit, c ≥ 0), fitted by non-negative least squares in relative error on the {} timed rows of this run. Checked on rows it was not fitted on ({}-fold cross-validation): median error **{:.1}%**, 80th percentile **{:.1}%**, **{:.0}%** of rows within 30% (on the fitted rows: median {:.1}%). Each row's fill, vertex and draw fractions are its model terms over its measured time (over the prediction where the model predicts more, so no share exceeds the time); `fixed` is the per-light and per-frame constant. A bound is claimed (bold) only where the largest fraction leads the next by more than the row's spread and the model's error on it.\n",
+            "GPU shadow ms ≈ 10⁻⁶ · Σ c·count (c in ns per unit, c ≥ 0), fitted by non-negative least squares in relative error on the {} timed rows of this run. Checked on rows it was not fitted on ({}-fold cross-validation): median error **{:.1}%**, 80th percentile **{:.1}%**, **{:.0}%** of rows within 30% (on the fitted rows: median {:.1}%). Each row's fill, vertex and draw fractions are its model terms over its measured time (over the prediction where the model predicts more, so no share exceeds the time); `fixed` is the per-light and per-frame constant. A bound is claimed only where the largest share of identified terms leads the next by more than the row's spread (or the model's error on it, whichever is larger) plus the row's share of unidentified terms, and shown (bold) only where its ablation in this run confirmed it (below).\n",
             m.rows,
             m.folds,
             m.median_rel_error * 100.0,
@@ -348,6 +352,21 @@ impl SuiteReport {
     }
 }
 
+/// A row's bound cell: only a bound its ablation confirmed (bold); otherwise `unconfirmed`,
+/// with what the model named and why it stands unproven.
+fn bound_cell(r: &SuiteRow) -> String {
+    if r.bound_confirmed {
+        return format!("**{}**", r.bound);
+    }
+    let why = match &r.ablation {
+        Some(a) if a.predicted_saving_ms.is_some() => "ablation disagrees",
+        Some(_) => "no ablation",
+        None if r.bound_clear => "no ablation for this bound",
+        None => "within spread",
+    };
+    format!("unconfirmed ({}: {why})", r.bound)
+}
+
 fn table<'a>(rows: impl Iterator<Item = &'a SuiteRow>, error: bool) -> String {
     let f2 = |v: Option<f64>| v.map(|x| format!("{x:.2}")).unwrap_or_else(|| "—".into());
     let pct = |v: Option<f64>| v.map(|x| format!("{:.0}%", x * 100.0)).unwrap_or_else(|| "—".into());
@@ -386,7 +405,7 @@ fn table<'a>(rows: impl Iterator<Item = &'a SuiteRow>, error: bool) -> String {
             pct(r.draw_fraction),
             pct(r.fixed_fraction),
             pct(r.cpu_fraction),
-            if r.bound_clear { format!("**{}**", r.bound) } else { format!("{} (within spread)", r.bound) }
+            bound_cell(r)
         );
         if error {
             let _ = write!(s, " {} |", r.error_fraction.map(|e| format!("{:.4}%", e * 100.0)).unwrap_or_else(|| "—".into()));

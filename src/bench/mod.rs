@@ -6,16 +6,25 @@
 //!   run ([`limits`]), the shadow pass's counters per point, sweeps that cross from
 //!   vertex-bound to fill-bound ([`sweeps`]), a cost model fitted on the rows ([`model`]) that
 //!   gives each pass its fill, vertex and draw shares and the bound it is closest to, the crossovers, ablations, and the outputs ([`report`]: JSON,
-//!   CSV; `markdown`: the report; [`plots`]: SVG and PNG).
+//!   CSV; `markdown`: the report; [`plots`]: SVG and PNG);
+//! - what the rows identify of the model ([`identify`]: bootstrap intervals, confounded pairs,
+//!   condition number), and every claimed bound proven by an ablation in the same run
+//!   ([`proof`], on the scenes [`reshape`] derives: coarser tessellation, casters merged).
 #![warn(missing_docs)]
 
 pub mod classic;
+pub mod compute_read;
+mod evidence;
+pub mod identify;
 pub mod limits;
 mod markdown;
 pub mod methods;
 pub mod model;
 pub mod plots;
+pub mod proof;
 pub mod report;
+pub mod reshape;
+mod runner;
 pub mod scenes;
 pub mod suite;
 pub mod sweeps;

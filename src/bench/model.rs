@@ -15,8 +15,14 @@
 //! draw and fixed fractions are its terms of that fit, grouped, over its measured time — or
 //! over the prediction where that is larger (the terms then share the time in proportion),
 //! so the fractions sum to at most one, and to about one where the model fits.
+//!
+//! Which coefficients the rows pin down is judged beside the fit ([`super::identify`]: a
+//! bootstrap over rows, the design's correlations and condition number); each row's
+//! [`bound_shares`](SuiteRow::bound_shares) keep the identified terms only, and its
+//! `unidentified_fraction` the rest: only identified terms name a bound.
 
-use super::report::SuiteRow;
+use super::identify::{self, Identifiability};
+use super::report::{BoundShares, SuiteRow};
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -99,6 +105,18 @@ pub struct Model {
     /// The run's own repeatability, the floor any model is judged against: rows measured twice
     /// in this run (the same scene, technique, size and variant in two sweeps).
     pub repeat: Repeat,
+    /// What the rows identify: each coefficient's bootstrap interval, the pairs of terms the
+    /// rows cannot tell apart, the design's condition number.
+    pub identifiability: Identifiability,
+}
+
+impl Model {
+    /// The model's GPU shadow ms for `r`'s counted work (`None` where the row cannot be
+    /// modelled: untimed or without counters).
+    pub fn predict(&self, r: &SuiteRow) -> Option<f64> {
+        let f = features(r)?;
+        Some(TERMS.iter().zip(&f).map(|((n, _, _), v)| self.coefficients.get(*n).copied().unwrap_or(0.0) * 1e-6 * v).sum())
+    }
 }
 
 /// How far apart two measurements of the same row in one run land ([`repeatability`]).
@@ -257,6 +275,26 @@ pub fn quantile(v: &[f64], q: f64) -> f64 {
     }
 }
 
+/// A row's fill, vertex and draw shares from the identified terms only, and the share of
+/// the unidentified ones (any group): `terms` are the row's terms in [`TERMS`] order (ms),
+/// `known` whether each is identified, `whole` the time they are shares of.
+pub fn identified_shares(terms: &[f64], known: &[bool], whole: f64) -> (BoundShares, f64) {
+    let share = |keep: &dyn Fn(Group, bool) -> bool| -> f64 {
+        let sum: f64 = TERMS.iter().zip(terms).zip(known).filter(|(((_, g, _), _), k)| keep(*g, **k)).map(|((_, v), _)| v).sum();
+        if whole > 0.0 {
+            sum / whole
+        } else {
+            0.0
+        }
+    };
+    let shares = BoundShares {
+        fill: share(&|g, k| k && g == Group::Fill),
+        vertex: share(&|g, k| k && g == Group::Vertex),
+        draw: share(&|g, k| k && g == Group::Draw),
+    };
+    (shares, share(&|_, k| !k))
+}
+
 /// Fits the model on `rows` (fitted in ms, reported in ns per unit), fills in each row's
 /// prediction and model fractions, and returns the model. `limit_ns`: each term's cost at
 /// the measured limit.
@@ -276,6 +314,10 @@ pub fn fit(rows: &mut [SuiteRow], limit_ns: BTreeMap<String, f64>) -> Model {
             held[k] = (dot(&c, &x[k]) - y[k]).abs() / y[k];
         }
     }
+    let names: Vec<&str> = TERMS.iter().map(|(n, _, _)| *n).collect();
+    let design = identify::Design { x: &x, y: &y, names: &names, value: &all, scale: 1e6 };
+    let ident = identify::identify(&design, &fit_relative, identify::RESAMPLES, identify::SEED);
+    let known: Vec<bool> = names.iter().map(|n| ident.identified(n)).collect();
     let mut fit_err = Vec::with_capacity(idx.len());
     let mut by_method: BTreeMap<String, Vec<f64>> = BTreeMap::new();
     for (k, &i) in idx.iter().enumerate() {
@@ -295,6 +337,9 @@ pub fn fit(rows: &mut [SuiteRow], limit_ns: BTreeMap<String, f64>) -> Model {
         r.draw_fraction = Some(group(Group::Draw));
         r.fixed_fraction = Some(group(Group::Fixed));
         r.model_rel_error = Some(held[k]);
+        let (shares, unidentified) = identified_shares(&terms, &known, whole);
+        r.bound_shares = Some(shares);
+        r.unidentified_fraction = Some(unidentified);
     }
     Model {
         form: "gpu_shadow_ms = 1e-6 * sum_k c_k * count_k, c_k >= 0 in ns per unit; non-negative least squares in relative error, reweighted to least absolute relative error"
@@ -310,6 +355,7 @@ pub fn fit(rows: &mut [SuiteRow], limit_ns: BTreeMap<String, f64>) -> Model {
         limit_ns,
         median_rel_error_by_method: by_method.into_iter().map(|(m, e)| (m, quantile(&e, 0.5))).collect(),
         repeat: repeatability(rows),
+        identifiability: ident,
     }
 }
 
@@ -364,6 +410,27 @@ mod tests {
         // Only the pair from two sweeps counts; the same sweep twice is not a repeat.
         assert_eq!(r.pairs, 1);
         assert!((r.median_rel_diff - 0.5).abs() < 1e-12 && r.over_30_percent == 1.0, "{r:?}");
+    }
+
+    #[test]
+    fn unidentified_terms_give_no_bound_share() {
+        let names: Vec<&str> = TERMS.iter().map(|(n, _, _)| *n).collect();
+        let at = |n: &str| names.iter().position(|x| *x == n).unwrap();
+        let mut terms = vec![0.0; TERMS.len()];
+        terms[at("fragments")] = 2.0;
+        terms[at("setup_triangles")] = 1.0;
+        terms[at("draws")] = 4.0;
+        terms[at("caster_passes")] = 2.0;
+        terms[at("lights")] = 1.0;
+        // The draws and caster passes are confounded: not identified, nor are the lights.
+        let known: Vec<bool> = names.iter().map(|n| !matches!(*n, "draws" | "caster_passes" | "lights")).collect();
+        let (s, u) = identified_shares(&terms, &known, 10.0);
+        assert_eq!(s, BoundShares { fill: 0.2, vertex: 0.1, draw: 0.0 });
+        assert!((u - 0.7).abs() < 1e-12, "{u}");
+        let all = vec![true; TERMS.len()];
+        let (s, u) = identified_shares(&terms, &all, 10.0);
+        assert!((s.draw - 0.6).abs() < 1e-12 && u == 0.0);
+        assert_eq!(identified_shares(&terms, &all, 0.0), (BoundShares::default(), 0.0));
     }
 
     #[test]

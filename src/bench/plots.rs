@@ -238,18 +238,19 @@ where
         .map_err(err(&title))?
         .label("limit (100%)");
     chart.draw_series(LineSeries::new(vec![(a0, 1.0), (a1, 1.0)], RED.mix(0.6).stroke_width(2))).map_err(err(&title))?;
-    for (i, sweep) in ["scenes", "resolution", "tessellation", "lights", "light_distance", "casters", "caps", "ablation"].iter().enumerate()
-    {
+    let sweeps =
+        ["scenes", "resolution", "tessellation", "lights", "light_distance", "casters"].into_iter().chain(super::sweeps::ONE_FACTOR);
+    for (i, sweep) in sweeps.chain(["caps", "ablation"]).enumerate() {
         let color = series_colour(i);
         let pts: Vec<(f64, f64)> =
-            rows.iter().filter(|x| x.sweep == *sweep).filter_map(|x| Some((x.fill_fraction?, x.vertex_fraction?))).collect();
+            rows.iter().filter(|x| x.sweep == sweep).filter_map(|x| Some((x.fill_fraction?, x.vertex_fraction?))).collect();
         if pts.is_empty() {
             continue;
         }
         chart
             .draw_series(pts.iter().map(|&p| Circle::new(p, 3, color.filled())))
             .map_err(err(&title))?
-            .label(*sweep)
+            .label(sweep)
             .legend(move |(x, y)| Circle::new((x + 8, y), 4, color.filled()));
     }
     chart

@@ -135,10 +135,85 @@ pub struct SuiteRow {
     /// The largest fraction's name: `fill`, `vertex`, `draw` or `cpu` (`none` without timings).
     pub bound: String,
     /// Whether the bound is claimed: the largest fraction leads the next by more than the
-    /// row's spread ((p90 - p10) / median) and the model's error on it.
+    /// row's spread ((p90 - p10) / median), the model's error on it and the share of terms
+    /// the rows do not identify. A claimed bound is put to the test by an ablation
+    /// ([`SuiteRow::ablation`]).
     pub bound_clear: bool,
+    /// The fill, vertex and draw shares of the row's time from the terms the rows identify
+    /// only (`model.identifiability`): what names the bound.
+    pub bound_shares: Option<BoundShares>,
+    /// The share of the row's time in terms the rows do not identify (any group): it could
+    /// belong to any bound, so a bound must lead by more than it.
+    pub unidentified_fraction: Option<f64>,
+    /// Whether the bound is proven: claimed, and its ablation in the same run saved what the
+    /// model predicted, beyond the spread ([`RowAblation::confirmed`]).
+    pub bound_confirmed: bool,
+    /// The claimed bound's ablation (`None` where no bound is claimed).
+    pub ablation: Option<RowAblation>,
     /// The limits the fractions were computed against.
     pub limits: RowLimits,
+}
+
+/// A row's fill, vertex and draw shares from identified terms only.
+#[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
+pub struct BoundShares {
+    /// Identified fill terms over the time.
+    pub fill: f64,
+    /// Identified vertex terms over the time.
+    pub vertex: f64,
+    /// Identified draw terms over the time.
+    pub draw: f64,
+}
+
+/// A claimed bound put to the test: the row's work with what the bound counts cut (fill: the
+/// same volumes at half the width and height; vertex: the same shapes, coarser tessellation;
+/// draw: the casters merged into one), timed next to the row itself re-timed, against the
+/// model's predicted saving. The first four keys are a contract (issue #38).
+#[derive(Clone, Debug, Default, Serialize, PartialEq)]
+pub struct RowAblation {
+    /// `fill`, `vertex` or `draw`: the bound tested.
+    pub kind: String,
+    /// The model's time for the row less its time for the ablated work (both from their
+    /// counted work), ms; `None` where the ablation could not run.
+    pub predicted_saving_ms: Option<f64>,
+    /// The re-timed row's median less the ablated one's, ms.
+    pub measured_saving_ms: Option<f64>,
+    /// Whether the bound is proven: the measured saving exceeds `spread_ms` and lies within
+    /// `spread_ms` of the predicted one.
+    pub confirmed: bool,
+    /// Half the sum of the two timings' p10–p90 widths, ms: how far apart repeat timings of
+    /// the two land.
+    pub spread_ms: Option<f64>,
+    /// The re-timed row: median GPU shadow ms.
+    pub baseline_ms: Option<f64>,
+    /// The ablated work: median GPU shadow ms.
+    pub ablated_ms: Option<f64>,
+    /// The ablated scene's name.
+    pub ablated_scene: String,
+    /// The ablated frame size.
+    pub ablated_size: [u32; 2],
+    /// Timed frames of each of the two.
+    pub frames: usize,
+    /// The verdict in words (why not confirmed, or why the ablation could not run).
+    pub verdict: String,
+}
+
+/// How many claimed bounds the run proved (`bench.json`'s `bound_proofs`).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct ProofSummary {
+    /// Rows with a claimed fill, vertex or draw bound.
+    pub claimed: usize,
+    /// Of them, rows whose ablation ran.
+    pub ablated: usize,
+    /// Of them, rows whose bound the ablation confirmed.
+    pub confirmed: usize,
+    /// Rows whose ablation could not run (no coarser tessellation of the shapes, a single
+    /// caster to merge, a variant the device skips).
+    pub not_run: usize,
+    /// Timed frames per side of each ablation.
+    pub frames: usize,
+    /// Wall seconds the ablations took.
+    pub seconds: f64,
 }
 
 /// Where something changes along a sweep: the bound, or which of two methods is faster.
@@ -222,6 +297,8 @@ pub struct SuiteReport {
     /// Variants left out, and why (e.g. big shadow maps with many lights, u8 indices without
     /// the extension).
     pub skipped: Vec<String>,
+    /// How many claimed bounds their ablations proved (each row's `ablation` has the detail).
+    pub bound_proofs: ProofSummary,
 }
 
 /// The CSV columns, in order (every scalar of a row).
@@ -273,6 +350,13 @@ pub const CSV_COLUMNS: &[&str] = &[
     "bound_clear",
     "gpu_tlas_ms",
     "blas_build_ms",
+    "unidentified_fraction",
+    "bound_confirmed",
+    "ablation_kind",
+    "ablation_predicted_saving_ms",
+    "ablation_measured_saving_ms",
+    "ablation_spread_ms",
+    "ablation_confirmed",
 ];
 
 fn opt<T: ToString>(v: Option<T>) -> String {
@@ -330,6 +414,13 @@ impl SuiteRow {
             r.bound_clear.to_string(),
             opt(r.gpu_tlas_ms),
             opt(r.blas_build_ms),
+            opt(r.unidentified_fraction),
+            r.bound_confirmed.to_string(),
+            r.ablation.as_ref().map(|a| a.kind.clone()).unwrap_or_default(),
+            opt(r.ablation.as_ref().and_then(|a| a.predicted_saving_ms)),
+            opt(r.ablation.as_ref().and_then(|a| a.measured_saving_ms)),
+            opt(r.ablation.as_ref().and_then(|a| a.spread_ms)),
+            opt(r.ablation.as_ref().map(|a| a.confirmed)),
         ]
         .iter()
         .map(|f| if f.contains(',') { format!("\"{f}\"") } else { f.clone() })

@@ -2,7 +2,9 @@
 //! point lights on a ring above them. Each sweep moves one parameter: the spheres'
 //! tessellation (vertex work grows, fill stays), the number of lights, the lights' height
 //! above the casters (close: volumes fan out over the screen, fill grows; far: thin volumes),
-//! the number of casters (draw calls), while the resolution sweep renders `bench/fill`.
+//! the number of casters (draw calls), while the resolution sweep renders `bench/fill`. With
+//! [`SweepScene::groups`] the same spheres are merged into fewer casters: the same triangles
+//! and the same shadows in fewer draws (the one-factor casters sweep).
 
 use crate::geom::Mesh;
 use crate::scene::{shapes, Camera, Light, LightKind, Scene, SceneMesh};
@@ -22,11 +24,14 @@ pub struct SweepScene {
     /// The lights' range in sphere spacings (`None`: unbounded, so their scissor is the whole
     /// target and no caster is out of range).
     pub light_range: Option<f32>,
+    /// The spheres merged into this many casters (contiguous runs of the grid, each one mesh
+    /// in world space); `None`: one caster per sphere.
+    pub groups: Option<u32>,
 }
 
 impl Default for SweepScene {
     fn default() -> Self {
-        SweepScene { casters: 4, triangles: 16_000, lights: 1, light_height: 1.5, light_range: None }
+        SweepScene { casters: 4, triangles: 16_000, lights: 1, light_height: 1.5, light_range: None, groups: None }
     }
 }
 
@@ -40,13 +45,21 @@ impl SweepScene {
     /// The ablations' scene: 64 spheres under 8 lights of limited range (scissors smaller
     /// than the target, casters out of some lights' range).
     pub fn ranged() -> SweepScene {
-        SweepScene { casters: 64, triangles: 64 * 2000, lights: 8, light_height: 1.0, light_range: Some(3.0) }
+        SweepScene { casters: 64, triangles: 64 * 2000, lights: 8, light_height: 1.0, light_range: Some(3.0), groups: None }
     }
 
-    /// The scene's name in reports (`sweep/c4-t16000-l1-h1.5`).
+    /// The scene's name in reports (`sweep/c4-t16000-l1-h1.5`; merged into 16 casters:
+    /// `sweep/c256-t131072-l1-h1.5-m16`).
     pub fn name(&self) -> String {
         let range = self.light_range.map(|r| format!("-r{r}")).unwrap_or_default();
-        format!("sweep/c{}-t{}-l{}-h{}{range}", self.casters, self.triangles, self.lights, self.light_height)
+        let merged = self.groups.map(|g| format!("-m{g}")).unwrap_or_default();
+        format!("sweep/c{}-t{}-l{}-h{}{range}{merged}", self.casters, self.triangles, self.lights, self.light_height)
+    }
+
+    /// Shadow-casting meshes the scene holds (spheres, or their groups).
+    pub fn caster_count(&self) -> u32 {
+        let n = self.casters.max(1);
+        self.groups.map_or(n, |g| g.clamp(1, n))
     }
 
     /// Builds the scene.
@@ -77,18 +90,32 @@ impl SweepScene {
             },
         ];
         let y = 1.5f32;
-        for k in 0..n {
-            let (i, j) = (k % side, k / side);
-            let x = (i as f32 - (side - 1) as f32 * 0.5) * spacing;
-            let z = (j as f32 - (side - 1) as f32 * 0.5) * spacing;
-            meshes.push(SceneMesh {
-                name: format!("sphere{k}"),
-                mesh: sphere.clone(),
-                transform: Mat4::from_translation(Vec3::new(x, y, z)),
-                color: Vec3::new(0.5, 0.6, 0.9),
-                opacity: 1.0,
-                casts_shadow: true,
-            });
+        let spheres: Vec<SceneMesh> = (0..n)
+            .map(|k| {
+                let (i, j) = (k % side, k / side);
+                let x = (i as f32 - (side - 1) as f32 * 0.5) * spacing;
+                let z = (j as f32 - (side - 1) as f32 * 0.5) * spacing;
+                SceneMesh {
+                    name: format!("sphere{k}"),
+                    mesh: sphere.clone(),
+                    transform: Mat4::from_translation(Vec3::new(x, y, z)),
+                    color: Vec3::new(0.5, 0.6, 0.9),
+                    opacity: 1.0,
+                    casts_shadow: true,
+                }
+            })
+            .collect();
+        match self.groups {
+            None => meshes.extend(spheres),
+            Some(_) => {
+                let g = self.caster_count() as usize;
+                let n = n as usize;
+                // Group `k` holds spheres [k n / g, (k + 1) n / g): contiguous, sizes within one.
+                for k in 0..g {
+                    let run = &spheres[k * n / g..(k + 1) * n / g];
+                    meshes.push(merged(run, &format!("group{k}")));
+                }
+            }
         }
         let h = y + self.light_height * spacing;
         let ring = if self.lights > 1 { extent * 0.35 } else { 0.0 };
@@ -120,6 +147,35 @@ impl SweepScene {
     }
 }
 
+/// `meshes` as one mesh named `name`: their triangles in world space (each transform applied,
+/// the winding kept where a transform mirrors), identity transform, the first one's colour
+/// and opacity, shadow-casting if any of them is. The same triangles in one draw.
+pub fn merged(meshes: &[SceneMesh], name: &str) -> SceneMesh {
+    let mut mesh = Mesh { positions: Vec::new(), triangles: Vec::new() };
+    for m in meshes {
+        let base = mesh.positions.len() as u32;
+        mesh.positions.extend(m.mesh.positions.iter().map(|p| m.transform.transform_point3(*p)));
+        let mirror = m.transform.determinant() < 0.0;
+        mesh.triangles.extend(m.mesh.triangles.iter().map(|t| {
+            let [a, b, c] = t.map(|i| i + base);
+            if mirror {
+                [a, c, b]
+            } else {
+                [a, b, c]
+            }
+        }));
+    }
+    let first = meshes.first();
+    SceneMesh {
+        name: name.to_string(),
+        mesh,
+        transform: Mat4::IDENTITY,
+        color: first.map_or(Vec3::splat(0.7), |m| m.color),
+        opacity: first.map_or(1.0, |m| m.opacity),
+        casts_shadow: meshes.iter().any(|m| m.casts_shadow),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -135,5 +191,39 @@ mod tests {
         let s = SweepScene { casters: 10, lights: 7, ..Default::default() }.build();
         assert_eq!(s.meshes.iter().filter(|m| m.casts_shadow).count(), 10);
         assert_eq!(s.lights.len(), 7);
+    }
+
+    #[test]
+    fn merged_groups_keep_the_triangles_and_their_places() {
+        let apart = SweepScene { casters: 16, triangles: 16 * 64, ..Default::default() };
+        let world = |s: &Scene| -> Vec<[Vec3; 3]> {
+            let mut t: Vec<[Vec3; 3]> = s
+                .meshes
+                .iter()
+                .filter(|m| m.casts_shadow)
+                .flat_map(|m| m.mesh.triangles.iter().map(|t| t.map(|i| m.transform.transform_point3(m.mesh.positions[i as usize]))))
+                .collect();
+            t.sort_by(|a, b| format!("{a:?}").cmp(&format!("{b:?}")));
+            t
+        };
+        let reference = world(&apart.build());
+        for g in [1, 4, 16, 5] {
+            let s = SweepScene { groups: Some(g), ..apart };
+            let scene = s.build();
+            assert_eq!(scene.meshes.iter().filter(|m| m.casts_shadow).count() as u32, g.min(16));
+            assert_eq!(s.caster_count(), g.min(16));
+            assert_eq!(world(&scene), reference, "groups {g}: other triangles");
+            assert!(s.name().ends_with(&format!("-m{g}")), "{}", s.name());
+        }
+        // A mirroring transform keeps the outward winding.
+        let one = SweepScene { casters: 1, ..Default::default() }.build();
+        let mut m = one.meshes.iter().find(|m| m.casts_shadow).unwrap().clone();
+        m.transform = Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0));
+        let flat = merged(std::slice::from_ref(&m), "x");
+        let t = flat.mesh.triangles[0];
+        let normal = |p: [Vec3; 3]| (p[1] - p[0]).cross(p[2] - p[0]);
+        let before = normal(m.mesh.triangles[0].map(|i| m.mesh.positions[i as usize]));
+        let after = normal(t.map(|i| flat.mesh.positions[i as usize]));
+        assert!(after.dot(Vec3::new(-before.x, before.y, before.z)) > 0.0, "winding flipped by the mirror");
     }
 }

@@ -97,6 +97,7 @@ pub(super) fn limit_units() -> BTreeMap<String, String> {
         ("sliver_tri_mtri_s", "Mtriangles/s"),
         ("draws_per_s", "draws/s"),
         ("cpu_stream_gib_s", "GiB/s"),
+        ("compute_read_gib_s", "GiB/s"),
         ("index_u8_mtri_s", "Mtriangles/s"),
         ("index_u16_mtri_s", "Mtriangles/s"),
         ("index_u32_mtri_s", "Mtriangles/s"),

@@ -354,6 +354,7 @@ pub fn choose(caps: &DeviceCaps, minimum: Minimum) -> Result<Choice> {
     let depth_range_unrestricted = caps.has_extension(ash::ext::depth_range_unrestricted::NAME);
     // Mesh shaders: naga writes them as SPIR-V 1.4, which Vulkan 1.2 takes.
     let mesh_shader = v12 && caps.has_extension(ash::ext::mesh_shader::NAME) && f.mesh_shader;
+    let storage_buffer_ext = !v11 && caps.has_extension(ash::khr::storage_buffer_storage_class::NAME);
     let blendable = |fmt: vk::Format| caps.format_features(fmt).contains(vk::FormatFeatureFlags::COLOR_ATTACHMENT_BLEND);
     let l = &caps.limits;
     let features = Features {
@@ -379,6 +380,7 @@ pub fn choose(caps: &DeviceCaps, minimum: Minimum) -> Result<Choice> {
         task_shader: mesh_shader && f.task_shader,
         sample_rate_shading: f.sample_rate_shading,
         standard_sample_locations: l.standard_sample_locations == vk::TRUE,
+        storage_buffer_storage_class: v11 || storage_buffer_ext,
         frame_sample_counts: (l.framebuffer_color_sample_counts
             & l.framebuffer_depth_sample_counts
             & l.framebuffer_stencil_sample_counts
@@ -399,6 +401,9 @@ pub fn choose(caps: &DeviceCaps, minimum: Minimum) -> Result<Choice> {
     }
     if mesh_shader {
         extensions.push(ash::ext::mesh_shader::NAME);
+    }
+    if storage_buffer_ext {
+        extensions.push(ash::khr::storage_buffer_storage_class::NAME);
     }
     Ok(Choice { features, depth_format, extensions })
 }
@@ -475,6 +480,11 @@ pub struct Features {
     /// `standardSampleLocations`: multisampled images use Vulkan's standard sample locations
     /// (a multisampled capture's positions are found at them).
     pub standard_sample_locations: bool,
+    /// SPIR-V 1.0 modules may declare storage buffers through
+    /// `SPV_KHR_storage_buffer_storage_class` (as naga writes them): Vulkan 1.1 core, or
+    /// `VK_KHR_storage_buffer_storage_class` (enabled where present on a Vulkan 1.0 device).
+    /// The conformance suite's compute checks need it.
+    pub storage_buffer_storage_class: bool,
 }
 
 /// Identification of the chosen physical device, for `umbrage info`, logs and the stats JSON.

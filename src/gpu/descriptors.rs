@@ -163,3 +163,19 @@ pub fn pipeline_layout(
     // SAFETY: valid device; the create info points at locals alive for the call.
     unsafe { ctx.device().create_pipeline_layout(&info, None) }.map_err(vkerr("vkCreatePipelineLayout"))
 }
+
+/// One write per entry of `infos` into `set`'s storage-buffer bindings 0, 1, 2, ... (binding
+/// `k` gets `infos[k]`).
+pub fn storage_buffer_writes(set: vk::DescriptorSet, infos: &[[vk::DescriptorBufferInfo; 1]]) -> Vec<vk::WriteDescriptorSet<'_>> {
+    infos
+        .iter()
+        .enumerate()
+        .map(|(b, info)| {
+            vk::WriteDescriptorSet::default()
+                .dst_set(set)
+                .dst_binding(b as u32)
+                .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                .buffer_info(info)
+        })
+        .collect()
+}

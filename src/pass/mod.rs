@@ -561,6 +561,9 @@ impl ShadowPass {
         cpu.record = record_start.elapsed().as_secs_f64() * 1e3;
         let mut totals = packed.totals;
         totals.bytes_sent += upload_bytes;
+        if let Some(cf) = &compute {
+            totals.silhouette_read_bytes = 16 * (cf.exact_capacity + cf.sil_capacity);
+        }
         let warnings = overflow_warnings(&self.casters, &packed.lights, self.settings.counter);
         let serial = self.serial;
         self.serial += 1;

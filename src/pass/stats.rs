@@ -182,6 +182,11 @@ pub struct Totals {
     pub cases: Cases,
     /// Volume draw calls the determination records (all lights; an edge-quad caster's two).
     pub draws: u64,
+    /// [`Technique::Compute`](super::Technique::Compute): bytes the GPU silhouettes' `facing`
+    /// and `find` stages read from the casters' static tables (16 a triangle for its plane, 16
+    /// an edge, per light and caster); 0 for the other techniques. With `gpu_ms.silhouettes`,
+    /// the pass's read rate.
+    pub silhouette_read_bytes: u64,
 }
 
 #[derive(Clone, Debug, Default)]

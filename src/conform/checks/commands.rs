@@ -23,6 +23,13 @@
 //! - `indirect`: `vkCmdDrawIndexedIndirect` one record at a time at non-zero offsets, with
 //!   `firstIndex`, `vertexOffset` and an `instanceCount` of 0, as `ShadowPass`'s compute path
 //!   draws its volumes.
+//! - `fill_buffer`: `vkCmdFillBuffer` at offsets, over an earlier fill, and `VK_WHOLE_SIZE` to
+//!   the last whole word of a buffer whose size is not a multiple of 4: every byte.
+//! - `dispatch`: `vkCmdDispatch` with the 2D group counts `--method compute` splits a large
+//!   dispatch into, after a `vkCmdFillBuffer`: every group and invocation once with its
+//!   builtins, storage-buffer atomics exact; group counts of 0 dispatch nothing.
+//! - `dispatch_indirect`: `vkCmdDispatchIndirect` of a command at a non-zero offset that an
+//!   earlier dispatch grew with `atomicMax`: exactly its groups; a command with x = 0 nothing.
 
 use super::rect;
 use crate::conform::harness::{self, DrawCall, Draws, Indices, PipeSpec};
@@ -35,7 +42,19 @@ use gpu_allocator::MemoryLocation;
 use serde_json::json;
 
 /// The checks' names (cases `commands.<name>`), in run order.
-pub const NAMES: [&str; 8] = ["clears", "copy_aspects", "layouts", "blit_copy_color", "buffers", "queries", "scissor", "indirect"];
+pub const NAMES: [&str; 11] = [
+    "clears",
+    "copy_aspects",
+    "layouts",
+    "blit_copy_color",
+    "buffers",
+    "queries",
+    "scissor",
+    "indirect",
+    "fill_buffer",
+    "dispatch",
+    "dispatch_indirect",
+];
 
 fn vkerr(call: &'static str) -> impl Fn(vk::Result) -> Error {
     Error::vk(call)
@@ -730,5 +749,7 @@ pub fn buffers(ctx: &Context) -> Result<CheckResult> {
     Ok(CheckResult::from_fails("buffers", fails, numbers, "vkCmdUpdateBuffer at an offset and vkCmdCopyBuffer of two regions: every byte"))
 }
 
+mod dispatch;
 mod draws;
+pub use dispatch::{dispatch, dispatch_indirect, fill_buffer};
 pub use draws::{indirect, queries, scissor};

@@ -98,17 +98,7 @@ impl ShadowPass {
             if arena.contains(&vk::Buffer::null()) {
                 return Err(Error::Internal("compute silhouettes: jobs without the arena".into()));
             }
-            let writes: Vec<vk::WriteDescriptorSet> = infos
-                .iter()
-                .enumerate()
-                .map(|(b, info)| {
-                    vk::WriteDescriptorSet::default()
-                        .dst_set(set)
-                        .dst_binding(b as u32)
-                        .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                        .buffer_info(info)
-                })
-                .collect();
+            let writes = crate::gpu::descriptors::storage_buffer_writes(set, &infos);
             // SAFETY: the set is not in use (just allocated); the buffers are alive.
             unsafe { d.update_descriptor_sets(&writes, &[]) };
             cf.set = set;
