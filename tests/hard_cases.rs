@@ -17,25 +17,39 @@ fn names() -> Vec<&'static str> {
 }
 
 /// Ray query on every scene of `names` it traces (transparent casters are refused, and left
-/// out), at the table's size.
-fn measure_rayquery(mut ctx: Context, names: &[&str]) -> (Context, Vec<Row>) {
+/// out), at the table's size; and where the device has mesh shaders, `--method mesh` on every
+/// scene with both counters. Returns `(counter, row)` pairs (ray query, counter-independent,
+/// under the stencil counter).
+fn measure_rayquery(mut ctx: Context, names: &[&str]) -> (Context, Vec<(Counter, Row)>) {
     let mut rows = Vec::new();
+    let mesh = ctx.features.mesh_shader;
     for name in names {
         let scene = umbrage::scene::load(name).unwrap();
-        if scene.meshes.iter().any(|m| m.casts_shadow && m.opacity < 1.0) {
-            continue;
+        let transparent = scene.meshes.iter().any(|m| m.casts_shadow && m.opacity < 1.0);
+        for counter in [Counter::Stencil, Counter::Float] {
+            let mut techniques = Vec::new();
+            if counter == Counter::Stencil && !transparent {
+                techniques.push(Technique::RayQuery);
+            }
+            if mesh {
+                techniques.push(Technique::Mesh);
+            }
+            if techniques.is_empty() {
+                continue;
+            }
+            let opts = RenderOptions { width: 256, height: 192, counter, ..Default::default() };
+            let mut r = Renderer::new(ctx, scene.clone(), opts).unwrap();
+            rows.extend(evaluate(&mut r, name, &techniques, 1).unwrap().into_iter().map(|row| (counter, row)));
+            r.context().check_validation().unwrap();
+            ctx = r.into_context();
         }
-        let mut r = Renderer::new(ctx, scene, RenderOptions { width: 256, height: 192, ..Default::default() }).unwrap();
-        rows.extend(evaluate(&mut r, name, &[Technique::RayQuery], 1).unwrap());
-        r.context().check_validation().unwrap();
-        ctx = r.into_context();
     }
     (ctx, rows)
 }
 
-/// The rayquery rows and the device they were measured on: here when this device has ray
-/// query, else by `rayquery_rows` on lavapipe 25.0.7, passed back through a file.
-fn rayquery_column(ctx: Context, names: &[&str]) -> (Context, Vec<Row>, String) {
+/// The rayquery (and mesh) rows and the device they were measured on: here when this device has
+/// ray query, else by `rayquery_rows` on lavapipe 25.0.7, passed back through a file.
+fn rayquery_column(ctx: Context, names: &[&str]) -> (Context, Vec<(Counter, Row)>, String) {
     if ctx.features.ray_query {
         let device = format!("{} ({})", ctx.info.name, ctx.info.driver_info);
         let (ctx, rows) = measure_rayquery(ctx, names);
@@ -53,18 +67,24 @@ fn rayquery_column(ctx: Context, names: &[&str]) -> (Context, Vec<Row>, String) 
     let rows = lines
         .map(|l| {
             let f: Vec<&str> = l.split('\t').collect();
-            Row {
+            let counter = if f[1] == "float" { Counter::Float } else { Counter::Stencil };
+            let row = Row {
                 scene: f[0].to_string(),
-                method: "rayquery".into(),
-                mismatches: f[1].parse().unwrap(),
-                compared: f[2].parse().unwrap(),
-                ambiguous: f[3].parse().unwrap(),
-                fraction: f[4].parse().unwrap(),
-                expected_failure: None,
-                passed: f[5] == "true",
+                method: f[2].to_string(),
+                mismatches: f[3].parse().unwrap(),
+                compared: f[4].parse().unwrap(),
+                ambiguous: f[5].parse().unwrap(),
+                fraction: f[6].parse().unwrap(),
+                // mesh runs McGuire's cases: its expected failures are McGuire's
+                expected_failure: match f[2] {
+                    "mesh" => umbrage::accuracy::expected_failure(f[0], Method::McGuire, counter),
+                    _ => None,
+                },
+                passed: f[7] == "true",
                 per_light: Vec::new(),
                 shadow_triangles: 0,
-            }
+            };
+            (counter, row)
         })
         .collect();
     (ctx, rows, device)
@@ -81,8 +101,18 @@ fn rayquery_rows() {
     let device = format!("{} ({})", ctx.info.name, ctx.info.driver_info);
     let (_, rows) = measure_rayquery(ctx, &names());
     let mut out = device + "\n";
-    for r in &rows {
-        out += &format!("{}\t{}\t{}\t{}\t{:e}\t{}\n", r.scene, r.mismatches, r.compared, r.ambiguous, r.fraction, r.passed);
+    for (c, r) in &rows {
+        out += &format!(
+            "{}\t{}\t{}\t{}\t{}\t{}\t{:e}\t{}\n",
+            r.scene,
+            c.name(),
+            r.method,
+            r.mismatches,
+            r.compared,
+            r.ambiguous,
+            r.fraction,
+            r.passed
+        );
     }
     std::fs::write(path, out).unwrap();
 }
@@ -98,8 +128,8 @@ fn every_method_on_every_hard_case_matches_the_reference() {
          (grazing light, decision changing within a pixel's footprint) counted apart. The worst light of each scene is shown. \
          Threshold: {}%. Expected failures are asserted to fail. `zpass-clear` (the lecture notes' eye-in-shadow \
          clear) is expected to fail exactly where the frame reports a volume crossing the near-plane rectangle. `rayquery` \
-         (one shadow ray a pixel, counter-independent: the same cells in both tables) needs `VK_KHR_ray_query`, so its \
-         column is measured on {rq_device}.\n",
+         (one shadow ray a pixel, counter-independent: the same cells in both tables) needs `VK_KHR_ray_query`, and `mesh` \
+         (mesh-shader extrusion, docs/mesh.md) `VK_EXT_mesh_shader`, so their columns are measured on {rq_device}.\n",
         ctx.info.name,
         umbrage::accuracy::THRESHOLD * 100.0,
     );
@@ -113,7 +143,7 @@ fn every_method_on_every_hard_case_matches_the_reference() {
 /// Both counters' tables over `names`: every volume method, edge quads, zpass-clear and the
 /// compute silhouettes (and the ray-query rows given, in their column when `rayquery`).
 /// Returns the markdown, the failures and the context.
-fn tables(mut ctx: Context, names: &[&str], rq_rows: &[Row], rayquery: bool) -> (String, Vec<String>, Context) {
+fn tables(mut ctx: Context, names: &[&str], rq_rows: &[(Counter, Row)], rayquery: bool) -> (String, Vec<String>, Context) {
     let mut doc = String::new();
     let mut failed = Vec::new();
     for counter in [Counter::Stencil, Counter::Float] {
@@ -127,7 +157,13 @@ fn tables(mut ctx: Context, names: &[&str], rq_rows: &[Row], rayquery: bool) -> 
             rows.extend(evaluate(&mut r, name, &[Technique::EdgeQuads, Technique::Volumes(Method::ZPassClear)], 1).unwrap());
             // GPU possible silhouettes (tests/compute.rs checks its counts equal mcguire's).
             rows.extend(evaluate(&mut r, name, &[Technique::Compute], 1).unwrap());
-            rows.extend(rq_rows.iter().filter(|row| row.scene == *name).cloned());
+            // ray query (counter-independent: the same rows in both tables) and mesh (per counter)
+            rows.extend(
+                rq_rows
+                    .iter()
+                    .filter(|(c, row)| row.scene == *name && (*c == counter || row.method == "rayquery"))
+                    .map(|(_, row)| row.clone()),
+            );
             r.context().check_validation().unwrap();
             ctx = r.into_context();
         }
@@ -137,6 +173,9 @@ fn tables(mut ctx: Context, names: &[&str], rq_rows: &[Row], rayquery: bool) -> 
         columns.push("compute");
         if rayquery {
             columns.push("rayquery");
+        }
+        if rows.iter().any(|r| r.method == "mesh") {
+            columns.push("mesh");
         }
         let table = markdown_table(&rows, &columns);
         doc += &format!("\n## Counter: {}\n\n{}\n", counter.name(), table);
