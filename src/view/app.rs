@@ -176,16 +176,20 @@ pub(super) struct Live {
     pub resizes: u32,
 }
 
-/// The techniques `M` cycles through, in the order of `render --method`.
-pub(super) fn technique_cycle(shadow_map: Technique, ray_query: bool) -> Vec<Technique> {
+/// The techniques `M` cycles through, in the order of `render --method`: ray query and mesh
+/// shaders where the device has them.
+pub(super) fn technique_cycle(shadow_map: Technique, ray_query: bool, mesh_shader: bool) -> Vec<Technique> {
     let mut v: Vec<Technique> =
         [Method::McGuire, Method::Lengyel, Method::EverittKilgard, Method::ZFail, Method::ZPass, Method::ZPassClear]
             .into_iter()
             .map(Technique::Volumes)
             .collect();
-    v.extend([Technique::EdgeQuads, Technique::Planar, shadow_map]);
+    v.extend([Technique::EdgeQuads, Technique::Planar, Technique::Compute, shadow_map]);
     if ray_query {
         v.push(Technique::RayQuery);
+    }
+    if mesh_shader {
+        v.push(Technique::Mesh);
     }
     v
 }
@@ -242,7 +246,7 @@ impl Live {
             t @ Technique::ShadowMap { .. } => t,
             _ => Technique::shadow_map(2048),
         };
-        let mut techniques = technique_cycle(shadow_map, ctx.features.ray_query);
+        let mut techniques = technique_cycle(shadow_map, ctx.features.ray_query, ctx.features.mesh_shader);
         let technique = match techniques.iter().position(|t| *t == opts.technique) {
             Some(i) => i,
             None => {
@@ -485,6 +489,26 @@ impl Live {
         match errors.first() {
             None => Ok(()),
             Some(first) => Err(Error::Validation { count: errors.len(), first: first.clone() }),
+        }
+    }
+}
+
+#[cfg(test)]
+mod cycle_tests {
+    use super::*;
+
+    #[test]
+    fn the_cycle_offers_every_technique_the_device_has_once() {
+        let sm = Technique::shadow_map(2048);
+        let base = technique_cycle(sm, false, false);
+        assert_eq!(base[0], Technique::Volumes(Method::McGuire));
+        assert!(base.contains(&Technique::Compute) && base.contains(&sm));
+        assert!(!base.contains(&Technique::RayQuery) && !base.contains(&Technique::Mesh));
+        let all = technique_cycle(sm, true, true);
+        assert_eq!(all.len(), base.len() + 2);
+        assert_eq!(&all[all.len() - 2..], &[Technique::RayQuery, Technique::Mesh]);
+        for (i, t) in all.iter().enumerate() {
+            assert!(!all[i + 1..].contains(t), "{} twice", t.name());
         }
     }
 }
