@@ -15,6 +15,7 @@ pub mod limits;
 mod markdown;
 pub mod methods;
 pub mod model;
+pub mod pass_limits;
 pub mod plots;
 pub mod report;
 pub mod scenes;

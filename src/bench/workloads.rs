@@ -98,6 +98,8 @@ pub(super) fn limit_units() -> BTreeMap<String, String> {
         ("draws_per_s", "draws/s"),
         ("cpu_stream_gib_s", "GiB/s"),
         ("compute_read_gib_s", "GiB/s"),
+        ("lighting_gpix_s", "Gpixels/s"),
+        ("gbuffer_tri_mtri_s", "Mtriangles/s"),
         ("index_u8_mtri_s", "Mtriangles/s"),
         ("index_u16_mtri_s", "Mtriangles/s"),
         ("index_u32_mtri_s", "Mtriangles/s"),
