@@ -155,6 +155,8 @@ fn bench_accepts_every_render_method() {
         let (fl, fg) = (r["lighting_limit_fraction"].as_f64().unwrap(), r["gbuffer_limit_fraction"].as_f64().unwrap());
         let (el, eg) = (pixels as f64 / (light * 1e9) * 1e3 / illum_ms, tris as f64 / (tri * 1e6) * 1e3 / gbuffer_ms);
         assert!(fl > 0.0 && (fl - el).abs() <= 1e-9 * el.max(1.0), "{r}");
+        // Against the first point of the sweep (one draw an instance), never above the peak.
+        assert!(r["lighting_one_draw_fraction"].as_f64().is_some_and(|x| x >= fl * (1.0 - 1e-9)), "{r}");
         assert!(fg > 0.0 && (fg - eg).abs() <= 1e-9 * eg.max(1.0), "{r}");
     }
     for r in rows {

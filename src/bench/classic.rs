@@ -82,6 +82,9 @@ pub struct BenchRow {
     /// `lit_pixels` at the measured lighting limit ([`BenchReport::lighting_gpix_s`]) over
     /// `gpu_illuminate_ms` (1 = at the limit).
     pub lighting_limit_fraction: Option<f64>,
+    /// `lit_pixels` at the lighting limit's first sweep point (one full-screen draw in its own
+    /// rendering instance, as each light's pass is drawn) over `gpu_illuminate_ms`.
+    pub lighting_one_draw_fraction: Option<f64>,
     /// `gbuffer_triangles` at the measured G-buffer geometry limit
     /// ([`BenchReport::gbuffer_tri_mtri_s`]) over `gpu_gbuffer_ms` (1 = at the limit).
     pub gbuffer_limit_fraction: Option<f64>,
@@ -240,6 +243,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
     };
     let lighting_gpix_s = passes.as_ref().map(|p| p.lighting_gpix_s);
     let gbuffer_tri_mtri_s = passes.as_ref().map(|p| p.gbuffer_tri_mtri_s);
+    let lighting_one_draw = passes.as_ref().and_then(|p| p.lighting_sweep.first()).map(|p| p[1]);
     let mut ctx = Some(ctx);
     let mut rows = Vec::new();
     for name in &cfg.scenes {
@@ -358,6 +362,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 gbuffer_triangles,
                 lit_pixels,
                 lighting_limit_fraction: at(lit_pixels, lighting_gpix_s, 1e9, illum_ms),
+                lighting_one_draw_fraction: at(lit_pixels, lighting_one_draw, 1e9, illum_ms),
                 gbuffer_limit_fraction: at(gbuffer_triangles, gbuffer_tri_mtri_s, 1e6, gbuffer_ms),
             };
             progress(&row);
@@ -440,11 +445,13 @@ impl BenchReport {
         }
         if let (Some(light), Some(tri)) = (self.lighting_gpix_s, self.gbuffer_tri_mtri_s) {
             s += &format!(
-                "\nPass limits (measured in this run, `bench::pass_limits`): lighting {light:.3} Gpixels/s (G-buffer reads + additive blend + stencil test, no shading math), G-buffer geometry {tri:.2} Mtriangles/s (the G-buffer pipeline, 2-pixel triangles).\n"
+                "\nPass limits (measured in this run, `bench::pass_limits`): lighting {light:.3} Gpixels/s (G-buffer reads + additive blend + stencil test, no shading math; {} with one full-screen draw per rendering instance, as each light's pass; the real `illuminate.frag` through the same state {} Gpixels/s), G-buffer geometry {tri:.2} Mtriangles/s (the G-buffer pipeline, 2-pixel triangles).\n",
+                self.lighting_sweep.first().map(|p| format!("{:.3}", p[1])).unwrap_or_else(|| "—".into()),
+                f(self.lighting_shaded_gpix_s)
             );
             for r in &self.rows {
                 s += &format!(
-                    "- {} `{}` {}: G-buffer {} ms for {} triangles = {} of its limit; lighting {} ms for {:.2} Mpixels = {} of its limit\n",
+                    "- {} `{}` {}: G-buffer {} ms for {} triangles = {} of its limit; lighting {} ms for {:.2} Mpixels = {} of its limit ({} of its one-draw rate)\n",
                     r.scene,
                     r.method,
                     r.counter,
@@ -454,6 +461,7 @@ impl BenchReport {
                     f(r.gpu_illuminate_ms),
                     r.lit_pixels as f64 / 1e6,
                     r.lighting_limit_fraction.map(|x| format!("{:.0} %", x * 100.0)).unwrap_or_else(|| "—".into()),
+                    r.lighting_one_draw_fraction.map(|x| format!("{:.0} %", x * 100.0)).unwrap_or_else(|| "—".into()),
                 );
             }
         }
