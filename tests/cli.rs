@@ -158,6 +158,9 @@ fn bench_accepts_every_render_method() {
         // Against the first point of the sweep (one draw an instance), never above the peak.
         assert!(r["lighting_one_draw_fraction"].as_f64().is_some_and(|x| x >= fl * (1.0 - 1e-9)), "{r}");
         assert!(fg > 0.0 && (fg - eg).abs() <= 1e-9 * eg.max(1.0), "{r}");
+        let fill = v["gbuffer_fill_gpix_s"].as_f64().unwrap();
+        let ef = (96.0 * 64.0) / (fill * 1e9) * 1e3 / gbuffer_ms;
+        assert!(r["gbuffer_fill_fraction"].as_f64().is_some_and(|x| x > 0.0 && (x - ef).abs() <= 1e-9 * ef.max(1.0)), "{r}");
     }
     for r in rows {
         let silhouettes = r["gpu_silhouettes_ms"].as_f64();

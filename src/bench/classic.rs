@@ -88,6 +88,10 @@ pub struct BenchRow {
     /// `gbuffer_triangles` at the measured G-buffer geometry limit
     /// ([`BenchReport::gbuffer_tri_mtri_s`]) over `gpu_gbuffer_ms` (1 = at the limit).
     pub gbuffer_limit_fraction: Option<f64>,
+    /// The target's pixels at the measured G-buffer fill limit
+    /// ([`BenchReport::gbuffer_fill_gpix_s`]) over `gpu_gbuffer_ms`: the pass's fill against its
+    /// limit where the scene covers the target once (more overdraw: more; background: less).
+    pub gbuffer_fill_fraction: Option<f64>,
 }
 
 /// Frames [`refit_ms`] times.
@@ -161,6 +165,8 @@ pub struct BenchReport {
     pub gbuffer_tri_mtri_s: Option<f64>,
     /// Its sweep: `[triangles, Mtriangles / s]` per point.
     pub gbuffer_sweep: Vec<[f64; 2]>,
+    /// The G-buffer fill limit measured in this run, Gpixels / s (`None` without timestamps).
+    pub gbuffer_fill_gpix_s: Option<f64>,
 }
 
 pub(crate) fn median(mut v: Vec<f64>) -> f64 {
@@ -243,6 +249,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
     };
     let lighting_gpix_s = passes.as_ref().map(|p| p.lighting_gpix_s);
     let gbuffer_tri_mtri_s = passes.as_ref().map(|p| p.gbuffer_tri_mtri_s);
+    let gbuffer_fill_gpix_s = passes.as_ref().map(|p| p.gbuffer_fill_gpix_s);
     let lighting_one_draw = passes.as_ref().and_then(|p| p.lighting_sweep.first()).map(|p| p[1]);
     let mut ctx = Some(ctx);
     let mut rows = Vec::new();
@@ -364,6 +371,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 lighting_limit_fraction: at(lit_pixels, lighting_gpix_s, 1e9, illum_ms),
                 lighting_one_draw_fraction: at(lit_pixels, lighting_one_draw, 1e9, illum_ms),
                 gbuffer_limit_fraction: at(gbuffer_triangles, gbuffer_tri_mtri_s, 1e6, gbuffer_ms),
+                gbuffer_fill_fraction: at(s.width as u64 * s.height as u64, gbuffer_fill_gpix_s, 1e9, gbuffer_ms),
             };
             progress(&row);
             rows.push(row);
@@ -384,6 +392,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         compute_read_sweep: read.map(|r| r.sweep).unwrap_or_default(),
         lighting_gpix_s,
         gbuffer_tri_mtri_s,
+        gbuffer_fill_gpix_s,
         lighting_shaded_gpix_s: passes.as_ref().map(|p| p.lighting_shaded_gpix_s),
         lighting_instance_ms: passes.as_ref().map(|p| p.lighting_instance_ms),
         lighting_sweep: passes.as_ref().map(|p| p.lighting_sweep.clone()).unwrap_or_default(),
@@ -445,19 +454,21 @@ impl BenchReport {
         }
         if let (Some(light), Some(tri)) = (self.lighting_gpix_s, self.gbuffer_tri_mtri_s) {
             s += &format!(
-                "\nPass limits (measured in this run, `bench::pass_limits`): lighting {light:.3} Gpixels/s (G-buffer reads + additive blend + stencil test, no shading math; {} with one full-screen draw per rendering instance, as each light's pass; the real `illuminate.frag` through the same state {} Gpixels/s), G-buffer geometry {tri:.2} Mtriangles/s (the G-buffer pipeline, 2-pixel triangles).\n",
+                "\nPass limits (measured in this run, `bench::pass_limits`): lighting {light:.3} Gpixels/s (G-buffer reads + additive blend + stencil test, no shading math; {} with one full-screen draw per rendering instance, as each light's pass; the real `illuminate.frag` through the same state {} Gpixels/s), G-buffer geometry {tri:.2} Mtriangles/s (the G-buffer pipeline, 2-pixel triangles), G-buffer fill {} Gpixels/s.\n",
                 self.lighting_sweep.first().map(|p| format!("{:.3}", p[1])).unwrap_or_else(|| "—".into()),
-                f(self.lighting_shaded_gpix_s)
+                f(self.lighting_shaded_gpix_s),
+                self.gbuffer_fill_gpix_s.map(|x| format!("{x:.3}")).unwrap_or_else(|| "—".into())
             );
             for r in &self.rows {
                 s += &format!(
-                    "- {} `{}` {}: G-buffer {} ms for {} triangles = {} of its limit; lighting {} ms for {:.2} Mpixels = {} of its limit ({} of its one-draw rate)\n",
+                    "- {} `{}` {}: G-buffer {} ms for {} triangles = {} of its triangle limit, the target's pixels {} of its fill limit; lighting {} ms for {:.2} Mpixels = {} of its limit ({} of its one-draw rate)\n",
                     r.scene,
                     r.method,
                     r.counter,
                     f(r.gpu_gbuffer_ms),
                     r.gbuffer_triangles,
                     r.gbuffer_limit_fraction.map(|x| format!("{:.0} %", x * 100.0)).unwrap_or_else(|| "—".into()),
+                    r.gbuffer_fill_fraction.map(|x| format!("{:.0} %", x * 100.0)).unwrap_or_else(|| "—".into()),
                     f(r.gpu_illuminate_ms),
                     r.lit_pixels as f64 / 1e6,
                     r.lighting_limit_fraction.map(|x| format!("{:.0} %", x * 100.0)).unwrap_or_else(|| "—".into()),

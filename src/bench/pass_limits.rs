@@ -7,6 +7,8 @@
 //! | lighting | full-screen triangles through `fullscreen.vert` and `shaders/lighting_limit.frag`: the illumination pass's three G-buffer reads (texelFetch of position, normal, albedo in their formats), its background test and its additive blend into [`ACCUM_FORMAT`], stencil test EQUAL 0 as the stencil pass, without the Blinn-Phong math; every pixel foreground and unshadowed | the illumination pass per pixel it covers (`lighting_gpix_s`) |
 //! | G-buffer geometry | the G-buffer pipeline itself (`gbuffer.vert` / `gbuffer.frag`, its vertex layout, four colour targets and depth LESS with writes, two-sided), non-indexed as the pass draws, over a grid of 2-pixel triangles (the target's first rows, at most 16384 triangles a draw), each draw nearer than the last (every fragment passes the depth test and writes) | the G-buffer pass per triangle (`gbuffer_tri_mtri_s`) |
 //!
+//! | G-buffer fill | full-screen layers through the same pipeline, each nearer than the last | the G-buffer pass per pixel it writes (`gbuffer_fill_gpix_s`) |
+//!
 //! `bench::classic` sets each pass's time against these: the pixels the lighting passes cover
 //! (every light's scissor) at `lighting_gpix_s`, the opaque triangles at `gbuffer_tri_mtri_s`.
 
@@ -40,6 +42,11 @@ pub struct PassLimits {
     pub gbuffer_tri_mtri_s: f64,
     /// Its sweep: `[triangles, Mtriangles / s]` per point.
     pub gbuffer_sweep: Vec<[f64; 2]>,
+    /// G-buffer fill: full-screen layers through the same pipeline, every fragment written to
+    /// the four targets and depth, Gpixels / s.
+    pub gbuffer_fill_gpix_s: f64,
+    /// Its sweep: `[pixels, Gpixels / s]` per point.
+    pub gbuffer_fill_sweep: Vec<[f64; 2]>,
 }
 
 /// The objects made, destroyed whatever happens.
@@ -204,7 +211,14 @@ fn measure_with(ctx: &Context, w: u32, h: u32, reps: usize, max_steps: u32, made
     debug_assert_eq!(std::mem::size_of_val(&rows) as u64, INSTANCE_BYTES);
     let ib = Buffer::with_data(ctx, "pass limits: instance", bytemuck::cast_slice(&rows), vk::BufferUsageFlags::VERTEX_BUFFER)?;
     made.buffers.push(ib);
-    let (vb, ib) = (made.buffers[0].raw, made.buffers[1].raw);
+    // A full-screen quad in the same layout (the fill limit's layer).
+    let quad: Vec<[f32; 14]> = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]]
+        .iter()
+        .map(|p| [p[0], p[1], 0.9, 0.0, 0.0, 1.0, 0.6, 0.5, 0.4, 1.0, 0.0, 0.0, 1.0, 0.0])
+        .collect();
+    let qb = Buffer::with_data(ctx, "pass limits: quad", bytemuck::cast_slice(&quad), vk::BufferUsageFlags::VERTEX_BUFFER)?;
+    made.buffers.push(qb);
+    let (vb, ib, qb) = (made.buffers[0].raw, made.buffers[1].raw, made.buffers[2].raw);
     let tris = (grid.len() / 3) as f64;
     let im = &made.images;
     let area = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent };
@@ -233,7 +247,7 @@ fn measure_with(ctx: &Context, w: u32, h: u32, reps: usize, max_steps: u32, made
         }
         memory_barrier(ctx, cb, all, all);
     };
-    let gb_timed = |cb: vk::CommandBuffer, k: u32| {
+    let gb_timed = |cb: vk::CommandBuffer, (vb, count): (vk::Buffer, u32), k: u32| {
         let cols: Vec<_> = im[..DS].iter().map(|i| color_att(i, vk::AttachmentLoadOp::LOAD, [0.0; 4])).collect();
         let ds = ds_att(&im[DS], vk::AttachmentLoadOp::LOAD);
         let info = vk::RenderingInfo::default()
@@ -254,12 +268,18 @@ fn measure_with(ctx: &Context, w: u32, h: u32, reps: usize, max_steps: u32, made
                 let vp = Mat4::from_translation(glam::Vec3::new(0.0, 0.0, -(i as f32) * step));
                 let push = GBufferPush { view_proj: vp.to_cols_array(), ambient: [0.1, 0.1, 0.1, 0.0] };
                 d.cmd_push_constants(cb, gb_layout, vf, 0, bytemuck::bytes_of(&push));
-                d.cmd_draw(cb, grid.len() as u32, 1, 0, 0);
+                d.cmd_draw(cb, count, 1, 0, 0);
             }
             d.cmd_end_rendering(cb);
         }
     };
-    let (gbuffer_tri_mtri_s, gbuffer_sweep) = sweep(ctx, made.queries, reps, max_steps, tris, 1e6, &gb_prep, &gb_timed)?;
+    let grid_draw = (vb, grid.len() as u32);
+    let (gbuffer_tri_mtri_s, gbuffer_sweep) =
+        sweep(ctx, made.queries, reps, max_steps, tris, 1e6, &gb_prep, &|cb, k| gb_timed(cb, grid_draw, k))?;
+    let quad_draw = (qb, quad.len() as u32);
+    let layer = w as f64 * h as f64;
+    let (gbuffer_fill_gpix_s, gbuffer_fill_sweep) =
+        sweep(ctx, made.queries, reps, max_steps, layer, 1e9, &gb_prep, &|cb, k| gb_timed(cb, quad_draw, k))?;
 
     // Lighting: the G-buffer filled once (foreground everywhere: position w = 1), then per
     // repetition the accumulation target and the stencil cleared, `k` full-screen triangles.
@@ -329,7 +349,16 @@ fn measure_with(ctx: &Context, w: u32, h: u32, reps: usize, max_steps: u32, made
         sweep(ctx, made.queries, reps, max_steps, px, 1e9, &light_prep, &|cb, k| light_timed(cb, lighting, k))?;
     let (lighting_shaded_gpix_s, _) = sweep(ctx, made.queries, reps, max_steps, px, 1e9, &light_prep, &|cb, k| light_timed(cb, shaded, k))?;
     let lighting_instance_ms = time(ctx, made.queries, reps, &light_prep, &|cb| light_timed(cb, lighting, 0))?;
-    Ok(PassLimits { lighting_gpix_s, lighting_sweep, lighting_shaded_gpix_s, lighting_instance_ms, gbuffer_tri_mtri_s, gbuffer_sweep })
+    Ok(PassLimits {
+        lighting_gpix_s,
+        lighting_sweep,
+        lighting_shaded_gpix_s,
+        lighting_instance_ms,
+        gbuffer_tri_mtri_s,
+        gbuffer_sweep,
+        gbuffer_fill_gpix_s,
+        gbuffer_fill_sweep,
+    })
 }
 
 /// Sweeps `timed` with k = 1, 2, 4, ... repetitions of `units` (in `unit` per second) until

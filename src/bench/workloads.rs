@@ -100,6 +100,7 @@ pub(super) fn limit_units() -> BTreeMap<String, String> {
         ("compute_read_gib_s", "GiB/s"),
         ("lighting_gpix_s", "Gpixels/s"),
         ("gbuffer_tri_mtri_s", "Mtriangles/s"),
+        ("gbuffer_fill_gpix_s", "Gpixels/s"),
         ("index_u8_mtri_s", "Mtriangles/s"),
         ("index_u16_mtri_s", "Mtriangles/s"),
         ("index_u32_mtri_s", "Mtriangles/s"),
