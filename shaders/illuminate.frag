@@ -80,9 +80,15 @@ void main() {
     vec4 albedo = FETCH(t_albedo, px);
     vec3 to_light = pc.light_pos.xyz - pos.xyz * pc.light_pos.w;
     float dist = length(to_light);
+    // Nothing is lit at or beyond a bounded light's radius (the attenuation below is 0 there):
+    // those pixels skip the shading.
+    if (pc.params.x > 0.0 && dist >= pc.params.x) {
+        discard;
+    }
     vec3 l = to_light / max(dist, 1e-30);
-    // Facing by the face normal: what the shadow volumes and the reference decide by.
-    if (dot(normalize(normal.xyz), l) <= 0.0) {
+    // Facing by the face normal: what the shadow volumes and the reference decide by (its sign
+    // needs no normalisation).
+    if (dot(normal.xyz, l) <= 0.0) {
         discard;
     }
     // Shading by the smooth normal, shifted by the terminator bound: 0 on every face that looks
@@ -102,7 +108,13 @@ void main() {
     }
     vec3 v = normalize(-pos.xyz);
     vec3 h = normalize(l + v);
-    float spec = pow(max(dot(n, h), 0.0), 48.0) * 0.3 * clamp(diffuse * 8.0, 0.0, 1.0);
+    // x^48 by squaring ((x^3)^16: six products), not pow's exp2(48 log2 x).
+    float x = max(dot(n, h), 0.0);
+    float x3 = x * x * x;
+    float x6 = x3 * x3;
+    float x12 = x6 * x6;
+    float x24 = x12 * x12;
+    float spec = x24 * x24 * 0.3 * clamp(diffuse * 8.0, 0.0, 1.0);
     vec3 light = pc.color.rgb * atten;
 #ifdef TRANSMIT
     vec3 t = texelFetch(sampler2D(t_transmit, s_nearest), px, 0).rgb;

@@ -65,6 +65,9 @@ fn tiny_suite(tag: &str, driver: &[(String, Option<String>)]) -> serde_json::Val
             "draws_per_s",
             "cpu_stream_gib_s",
             "compute_read_gib_s",
+            "lighting_gpix_s",
+            "gbuffer_tri_mtri_s",
+            "gbuffer_fill_gpix_s",
             "units",
         ],
         "limits",
@@ -77,9 +80,17 @@ fn tiny_suite(tag: &str, driver: &[(String, Option<String>)]) -> serde_json::Val
         "draws_per_s",
         "cpu_stream_gib_s",
         "compute_read_gib_s",
+        "lighting_gpix_s",
+        "gbuffer_tri_mtri_s",
+        "gbuffer_fill_gpix_s",
     ] {
         let x = limits[k].as_f64().unwrap_or(0.0);
         assert!(x.is_finite() && x > 0.0, "limit {k} = {x}");
+    }
+    // The pass limits come with their sweeps and units.
+    for k in ["lighting_gpix_s", "gbuffer_tri_mtri_s", "gbuffer_fill_gpix_s"] {
+        assert!(limits["sweeps"][k].as_array().is_some_and(|s| !s.is_empty()), "sweep of {k}");
+        assert!(limits["units"][k].is_string(), "unit of {k}");
     }
     let rows = v["rows"].as_array().unwrap();
     let contract = [

@@ -139,6 +139,29 @@ fn bench_accepts_every_render_method() {
     // measured in the same run.
     let rate = v["compute_read_gib_s"].as_f64().unwrap();
     assert!(rate > 0.0 && v["compute_read_sweep"].as_array().is_some_and(|s| s.len() == 3), "{v}");
+    // The lighting and G-buffer passes are put against their own limits, measured in the same run.
+    let (light, tri) = (v["lighting_gpix_s"].as_f64().unwrap(), v["gbuffer_tri_mtri_s"].as_f64().unwrap());
+    assert!(light > 0.0 && tri > 0.0, "{v}");
+    assert!(v["lighting_shaded_gpix_s"].as_f64().is_some_and(|x| x > 0.0) && v["lighting_instance_ms"].as_f64().is_some(), "{v}");
+    for k in ["lighting_sweep", "gbuffer_sweep"] {
+        assert!(v[k].as_array().is_some_and(|s| !s.is_empty()), "{k}: {v}");
+    }
+    for r in rows {
+        let (gbuffer_ms, illum_ms) = (r["gpu_gbuffer_ms"].as_f64().unwrap(), r["gpu_illuminate_ms"].as_f64().unwrap());
+        let (tris, pixels) = (r["gbuffer_triangles"].as_u64().unwrap(), r["lit_pixels"].as_u64().unwrap());
+        assert!(gbuffer_ms > 0.0 && illum_ms > 0.0 && tris > 0 && pixels > 0, "{r}");
+        // default: three lights, each at most the whole 96x64 target.
+        assert!(pixels <= 3 * 96 * 64, "{r}");
+        let (fl, fg) = (r["lighting_limit_fraction"].as_f64().unwrap(), r["gbuffer_limit_fraction"].as_f64().unwrap());
+        let (el, eg) = (pixels as f64 / (light * 1e9) * 1e3 / illum_ms, tris as f64 / (tri * 1e6) * 1e3 / gbuffer_ms);
+        assert!(fl > 0.0 && (fl - el).abs() <= 1e-9 * el.max(1.0), "{r}");
+        // Against the first point of the sweep (one draw an instance), never above the peak.
+        assert!(r["lighting_one_draw_fraction"].as_f64().is_some_and(|x| x >= fl * (1.0 - 1e-9)), "{r}");
+        assert!(fg > 0.0 && (fg - eg).abs() <= 1e-9 * eg.max(1.0), "{r}");
+        let fill = v["gbuffer_fill_gpix_s"].as_f64().unwrap();
+        let ef = (96.0 * 64.0) / (fill * 1e9) * 1e3 / gbuffer_ms;
+        assert!(r["gbuffer_fill_fraction"].as_f64().is_some_and(|x| x > 0.0 && (x - ef).abs() <= 1e-9 * ef.max(1.0)), "{r}");
+    }
     for r in rows {
         let silhouettes = r["gpu_silhouettes_ms"].as_f64();
         if r["method"] == "compute" {

@@ -72,6 +72,26 @@ pub struct BenchRow {
     /// `compute`: the time a plain compute read of those bytes takes at the device's measured
     /// rate ([`BenchReport::compute_read_gib_s`]) over the pass's time (1 = at the limit).
     pub silhouette_limit_fraction: Option<f64>,
+    /// Median GPU time of the G-buffer pass, ms (`gpu_ms.depth`).
+    pub gpu_gbuffer_ms: Option<f64>,
+    /// Triangles the G-buffer pass draws a frame: every opaque mesh's, 12 a sphere (its cube).
+    pub gbuffer_triangles: u64,
+    /// Pixels the illumination passes cover a frame: every light's scissor (the whole target
+    /// without one).
+    pub lit_pixels: u64,
+    /// `lit_pixels` at the measured lighting limit ([`BenchReport::lighting_gpix_s`]) over
+    /// `gpu_illuminate_ms` (1 = at the limit).
+    pub lighting_limit_fraction: Option<f64>,
+    /// `lit_pixels` at the lighting limit's first sweep point (one full-screen draw in its own
+    /// rendering instance, as each light's pass is drawn) over `gpu_illuminate_ms`.
+    pub lighting_one_draw_fraction: Option<f64>,
+    /// `gbuffer_triangles` at the measured G-buffer geometry limit
+    /// ([`BenchReport::gbuffer_tri_mtri_s`]) over `gpu_gbuffer_ms` (1 = at the limit).
+    pub gbuffer_limit_fraction: Option<f64>,
+    /// The target's pixels at the measured G-buffer fill limit
+    /// ([`BenchReport::gbuffer_fill_gpix_s`]) over `gpu_gbuffer_ms`: the pass's fill against its
+    /// limit where the scene covers the target once (more overdraw: more; background: less).
+    pub gbuffer_fill_fraction: Option<f64>,
 }
 
 /// Frames [`refit_ms`] times.
@@ -129,6 +149,24 @@ pub struct BenchReport {
     pub compute_read_gib_s: Option<f64>,
     /// Its sweep: `[planes, GiB / s]` per point.
     pub compute_read_sweep: Vec<[f64; 2]>,
+    /// The lighting limit measured in this run on a target of the bench's size
+    /// ([`super::pass_limits`]), Gpixels / s (`None` without timestamps).
+    pub lighting_gpix_s: Option<f64>,
+    /// Its sweep: `[pixels, Gpixels / s]` per point.
+    pub lighting_sweep: Vec<[f64; 2]>,
+    /// Ablation: the real `illuminate.frag` through the lighting limit's state and sweep,
+    /// Gpixels / s ([`super::pass_limits::PassLimits::lighting_shaded_gpix_s`]).
+    pub lighting_shaded_gpix_s: Option<f64>,
+    /// Ablation: a lighting rendering instance with no draw, ms
+    /// ([`super::pass_limits::PassLimits::lighting_instance_ms`]).
+    pub lighting_instance_ms: Option<f64>,
+    /// The G-buffer geometry limit measured in this run, Mtriangles / s (`None` without
+    /// timestamps).
+    pub gbuffer_tri_mtri_s: Option<f64>,
+    /// Its sweep: `[triangles, Mtriangles / s]` per point.
+    pub gbuffer_sweep: Vec<[f64; 2]>,
+    /// The G-buffer fill limit measured in this run, Gpixels / s (`None` without timestamps).
+    pub gbuffer_fill_gpix_s: Option<f64>,
 }
 
 pub(crate) fn median(mut v: Vec<f64>) -> f64 {
@@ -203,6 +241,16 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         false => None,
     };
     let read_gib_s = read.as_ref().map(|r| r.gib_s);
+    // The lighting and G-buffer passes are reported against their own limits, measured here
+    // on a target of the frames' size.
+    let passes = match ctx.features.timestamps {
+        true => Some(super::pass_limits::measure(&ctx, cfg.opts.width, cfg.opts.height, 5, 9)?),
+        false => None,
+    };
+    let lighting_gpix_s = passes.as_ref().map(|p| p.lighting_gpix_s);
+    let gbuffer_tri_mtri_s = passes.as_ref().map(|p| p.gbuffer_tri_mtri_s);
+    let gbuffer_fill_gpix_s = passes.as_ref().map(|p| p.gbuffer_fill_gpix_s);
+    let lighting_one_draw = passes.as_ref().and_then(|p| p.lighting_sweep.first()).map(|p| p[1]);
     let mut ctx = Some(ctx);
     let mut rows = Vec::new();
     for name in &cfg.scenes {
@@ -218,6 +266,9 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         let spheres = r.scene().spheres.iter().any(|s| s.casts_shadow);
         variants
             .extend(cfg.techniques.iter().filter(|t| matches!(t, Technique::ShadowMap { .. }) && !spheres).map(|&t| (t, Counter::Float)));
+        let sc = r.scene();
+        let gbuffer_triangles = sc.meshes.iter().filter(|m| m.opacity >= 1.0).map(|m| m.mesh.triangles.len() as u64).sum::<u64>()
+            + 12 * sc.spheres.len() as u64;
         let mut errors = Vec::new();
         for &(technique, counter) in &variants {
             r.settings.counter = counter;
@@ -228,6 +279,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         #[derive(Default)]
         struct Acc {
             gpu: Vec<f64>,
+            depth: Vec<f64>,
             shadow: Vec<f64>,
             illum: Vec<f64>,
             map: Vec<f64>,
@@ -249,6 +301,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 let a = &mut acc[k];
                 if let Some(g) = &f.stats.gpu_ms {
                     a.gpu.push(g.frame);
+                    a.depth.push(g.depth);
                     a.shadow.push(g.shadow);
                     a.illum.push(g.illuminate);
                     a.map.push(g.shadow_map);
@@ -278,6 +331,14 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 (Some(ms), Some(b), Some(rate)) if ms > 0.0 && rate > 0.0 => Some(b as f64 / (rate * (1u64 << 30) as f64) * 1e3 / ms),
                 _ => None,
             };
+            let lit_pixels: u64 =
+                s.lights.iter().map(|l| l.scissor.map_or(s.width as u64 * s.height as u64, |[_, _, w, h]| w as u64 * h as u64)).sum();
+            let illum_ms = (!a.illum.is_empty()).then(|| median(a.illum));
+            let gbuffer_ms = (!a.depth.is_empty()).then(|| median(a.depth));
+            let at = |n: u64, rate: Option<f64>, unit: f64, ms: Option<f64>| match (rate, ms) {
+                (Some(rate), Some(ms)) if rate > 0.0 && ms > 0.0 => Some(n as f64 / (rate * unit) * 1e3 / ms),
+                _ => None,
+            };
             let row = BenchRow {
                 scene: name.clone(),
                 method: technique_label(technique),
@@ -286,7 +347,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 frames: cfg.frames,
                 gpu_frame_ms: (!a.gpu.is_empty()).then(|| median(a.gpu)),
                 gpu_shadow_ms: (!a.shadow.is_empty()).then(|| median(a.shadow)),
-                gpu_illuminate_ms: (!a.illum.is_empty()).then(|| median(a.illum)),
+                gpu_illuminate_ms: illum_ms,
                 gpu_map_ms: maps.then(|| median(a.map)),
                 gpu_lookup_ms: maps.then(|| median(lookup)),
                 wall_ms: median(a.wall),
@@ -304,6 +365,13 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 gpu_silhouettes_ms: silhouettes_ms,
                 silhouette_read_bytes: read_bytes,
                 silhouette_limit_fraction: fraction,
+                gpu_gbuffer_ms: gbuffer_ms,
+                gbuffer_triangles,
+                lit_pixels,
+                lighting_limit_fraction: at(lit_pixels, lighting_gpix_s, 1e9, illum_ms),
+                lighting_one_draw_fraction: at(lit_pixels, lighting_one_draw, 1e9, illum_ms),
+                gbuffer_limit_fraction: at(gbuffer_triangles, gbuffer_tri_mtri_s, 1e6, gbuffer_ms),
+                gbuffer_fill_fraction: at(s.width as u64 * s.height as u64, gbuffer_fill_gpix_s, 1e9, gbuffer_ms),
             };
             progress(&row);
             rows.push(row);
@@ -322,6 +390,13 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         rows,
         compute_read_gib_s: read_gib_s,
         compute_read_sweep: read.map(|r| r.sweep).unwrap_or_default(),
+        lighting_gpix_s,
+        gbuffer_tri_mtri_s,
+        gbuffer_fill_gpix_s,
+        lighting_shaded_gpix_s: passes.as_ref().map(|p| p.lighting_shaded_gpix_s),
+        lighting_instance_ms: passes.as_ref().map(|p| p.lighting_instance_ms),
+        lighting_sweep: passes.as_ref().map(|p| p.lighting_sweep.clone()).unwrap_or_default(),
+        gbuffer_sweep: passes.map(|p| p.gbuffer_sweep).unwrap_or_default(),
     })
 }
 
@@ -375,6 +450,30 @@ impl BenchReport {
                         frac * 100.0
                     );
                 }
+            }
+        }
+        if let (Some(light), Some(tri)) = (self.lighting_gpix_s, self.gbuffer_tri_mtri_s) {
+            s += &format!(
+                "\nPass limits (measured in this run, `bench::pass_limits`): lighting {light:.3} Gpixels/s (G-buffer reads + additive blend + stencil test, no shading math; {} with one full-screen draw per rendering instance, as each light's pass; the real `illuminate.frag` through the same state {} Gpixels/s), G-buffer geometry {tri:.2} Mtriangles/s (the G-buffer pipeline, 2-pixel triangles), G-buffer fill {} Gpixels/s.\n",
+                self.lighting_sweep.first().map(|p| format!("{:.3}", p[1])).unwrap_or_else(|| "—".into()),
+                f(self.lighting_shaded_gpix_s),
+                self.gbuffer_fill_gpix_s.map(|x| format!("{x:.3}")).unwrap_or_else(|| "—".into())
+            );
+            for r in &self.rows {
+                s += &format!(
+                    "- {} `{}` {}: G-buffer {} ms for {} triangles = {} of its triangle limit, the target's pixels {} of its fill limit; lighting {} ms for {:.2} Mpixels = {} of its limit ({} of its one-draw rate)\n",
+                    r.scene,
+                    r.method,
+                    r.counter,
+                    f(r.gpu_gbuffer_ms),
+                    r.gbuffer_triangles,
+                    r.gbuffer_limit_fraction.map(|x| format!("{:.0} %", x * 100.0)).unwrap_or_else(|| "—".into()),
+                    r.gbuffer_fill_fraction.map(|x| format!("{:.0} %", x * 100.0)).unwrap_or_else(|| "—".into()),
+                    f(r.gpu_illuminate_ms),
+                    r.lit_pixels as f64 / 1e6,
+                    r.lighting_limit_fraction.map(|x| format!("{:.0} %", x * 100.0)).unwrap_or_else(|| "—".into()),
+                    r.lighting_one_draw_fraction.map(|x| format!("{:.0} %", x * 100.0)).unwrap_or_else(|| "—".into()),
+                );
             }
         }
         s

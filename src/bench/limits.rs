@@ -17,6 +17,9 @@
 //! | draw calls | one tiny triangle per `vkCmdDraw`, each with its push constants and vertex binding (as the shadow pass) | per-draw cost |
 //! | CPU stream | a sum over a buffer far larger than the caches | host memory bandwidth |
 //! | compute read | a compute shader reading 16-byte planes, a bit set per plane facing a light ([`super::compute_read`]) | what the GPU silhouettes' per-triangle and per-edge reads can reach |
+//! | lighting | full-screen triangles reading the G-buffer (three texelFetch) and adding into the accumulation target, stencil EQUAL 0 ([`super::pass_limits`]) | the illumination pass per pixel, without its shading math |
+//! | G-buffer fill | full-screen layers through the same pipeline, every fragment written ([`super::pass_limits`]) | the G-buffer pass per pixel |
+//! | G-buffer geometry | 2-pixel triangles through the G-buffer pass's own pipeline (its shaders, vertex layout, four targets, depth writes; [`super::pass_limits`]) | the G-buffer pass per triangle |
 //!
 //! GPU times come from timestamps written outside the rendering instances (on lavapipe those
 //! inside do not include rasterisation); each point of a sweep is the median of several
@@ -63,6 +66,16 @@ pub struct Limits {
     /// A plain compute read of 16-byte planes (the GPU silhouettes' `facing` stage without its
     /// jobs, [`super::compute_read`]): GiB / s.
     pub compute_read_gib_s: f64,
+    /// A full-screen pass reading the G-buffer (position, normal, albedo) and adding a colour
+    /// into the accumulation target, the illumination pass without its shading math
+    /// ([`super::pass_limits`]): Gpixels / s.
+    pub lighting_gpix_s: f64,
+    /// The G-buffer pass's own pipeline over 2-pixel triangles (its vertex layout, four colour
+    /// targets, depth LESS with writes; [`super::pass_limits`]): Mtriangles / s.
+    pub gbuffer_tri_mtri_s: f64,
+    /// Full-screen layers through the G-buffer pass's pipeline, every fragment written
+    /// ([`super::pass_limits`]): Gpixels / s.
+    pub gbuffer_fill_gpix_s: f64,
     /// Indexed small triangles through 8-bit indices: Mtriangles / s (`None`: skipped, see
     /// [`Limits::skipped`]).
     pub index_u8_mtri_s: Option<f64>,
@@ -359,6 +372,10 @@ fn measure_with(ctx: &Context, cfg: &LimitsConfig, made: &mut Made) -> Result<Li
     let draw_rate = lab.peak("draws_per_s", Workload { draws, ..draw(stencil, tiny_vb, 3) }, draws as f64, 1.0, true)?;
     let read = super::compute_read::measure(ctx, lab.reps, if quick { 1 << 20 } else { 1 << 22 })?;
     lab.sweeps.insert("compute_read_gib_s".into(), read.sweep.clone());
+    let passes = super::pass_limits::measure(ctx, w, h, lab.reps, lab.max_steps)?;
+    lab.sweeps.insert("lighting_gpix_s".into(), passes.lighting_sweep.clone());
+    lab.sweeps.insert("gbuffer_tri_mtri_s".into(), passes.gbuffer_sweep.clone());
+    lab.sweeps.insert("gbuffer_fill_gpix_s".into(), passes.gbuffer_fill_sweep.clone());
 
     Ok(Limits {
         stencil_fill_gfrag_s: stencil_fill,
@@ -371,6 +388,9 @@ fn measure_with(ctx: &Context, cfg: &LimitsConfig, made: &mut Made) -> Result<Li
         draws_per_s: draw_rate,
         cpu_stream_gib_s: cpu_stream_gib_s(cfg.scale, cfg.reps),
         compute_read_gib_s: read.gib_s,
+        lighting_gpix_s: passes.lighting_gpix_s,
+        gbuffer_tri_mtri_s: passes.gbuffer_tri_mtri_s,
+        gbuffer_fill_gpix_s: passes.gbuffer_fill_gpix_s,
         index_u8_mtri_s: u8_rate,
         index_u16_mtri_s: u16_rate,
         index_u32_mtri_s: u32_rate,

@@ -51,6 +51,9 @@ impl SuiteReport {
         let _ = writeln!(s, "| draw calls | {:.0} draws/s |", l.draws_per_s);
         let _ = writeln!(s, "| CPU memory stream (one thread) | {:.2} GiB/s |", l.cpu_stream_gib_s);
         let _ = writeln!(s, "| compute read (16-byte planes) | {:.2} GiB/s |", l.compute_read_gib_s);
+        let _ = writeln!(s, "| lighting (full screen: G-buffer reads, additive, stencil test) | {:.3} Gpixels/s |", l.lighting_gpix_s);
+        let _ = writeln!(s, "| G-buffer geometry (the G-buffer pipeline, 2 px triangles) | {:.2} Mtriangles/s |", l.gbuffer_tri_mtri_s);
+        let _ = writeln!(s, "| G-buffer fill (the G-buffer pipeline, full-screen layers) | {:.3} Gpixels/s |", l.gbuffer_fill_gpix_s);
         for (k, why) in &l.skipped {
             let _ = writeln!(s, "| {k} | skipped: {why} |");
         }

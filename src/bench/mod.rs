@@ -20,6 +20,7 @@ pub mod limits;
 mod markdown;
 pub mod methods;
 pub mod model;
+pub mod pass_limits;
 pub mod plots;
 pub mod proof;
 pub mod report;

@@ -22,10 +22,10 @@ mod frame_output;
 pub(crate) mod guard;
 pub mod options;
 pub(crate) mod passes;
-mod pipelines;
+pub(crate) mod pipelines;
 pub mod push;
 mod readback;
-mod scene_gpu;
+pub(crate) mod scene_gpu;
 /// The shadow-map baseline (a pass of the frame, in `passes/`).
 pub use passes::shadowmap;
 mod sphere_gpu;
