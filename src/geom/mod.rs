@@ -4,6 +4,7 @@
 pub mod mesh;
 pub use mesh::{Aabb, Mesh};
 pub mod area;
+mod area_shape;
 pub use area::{AreaLight, AreaShape};
 pub mod bounds;
 pub mod edgescan;
