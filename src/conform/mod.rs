@@ -54,6 +54,7 @@ pub mod isolate;
 pub mod junit;
 pub mod matrix;
 pub mod model;
+mod outcome;
 pub mod raster;
 pub mod report;
 pub mod suite;

@@ -1,8 +1,10 @@
-//! The suite's single-configuration units: the `legacy.*` checks (split into the `legacy` unit
-//! and the `multiview` unit, which crash isolation runs apart) and the `pipeline.hard_cases.*`
-//! renders against the CPU reference.
+//! The suite's units ([`Unit`]: what crash isolation runs in one child) and the
+//! single-configuration ones: the `legacy.*` checks (split into the `legacy` unit and the
+//! `multiview` unit, which crash isolation runs apart) and the `pipeline.hard_cases.*` renders
+//! against the CPU reference.
 
-use super::suite::{selected, CaseOutcome, SuiteOptions};
+use super::cases::{Config, FORMATS};
+use super::outcome::{selected, CaseOutcome, SuiteOptions};
 use super::{CheckResult, Status};
 use crate::error::Result;
 use crate::gpu::Context;
@@ -20,6 +22,53 @@ pub(crate) const LEGACY: [&str; 10] = [
     super::checks::MSAA_DEPTH_LOCATIONS,
     super::checks::MULTIVIEW_CUBE_FACES,
 ];
+
+/// One unit of the suite, as named on the child's command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Unit {
+    /// One configuration's submission (`d24s8.render_pass.static_state`).
+    Config(Config),
+    /// The `legacy.*` single-configuration checks, but multiview.
+    Legacy,
+    /// `legacy.multiview_cube_faces` on its own (a multiview crash costs no other check).
+    Multiview,
+    /// The `pipeline.hard_cases.*` renders against the CPU reference, of the hard scenes whose
+    /// index is `shard` modulo `shards` (split so that `--jobs` children share them).
+    Pipeline {
+        /// This unit's share.
+        shard: usize,
+        /// How many units share the scenes (at least 1).
+        shards: usize,
+    },
+}
+
+impl Unit {
+    /// The name a child is given: the configuration's name, `legacy`, `multiview` or `pipeline`.
+    pub fn name(&self) -> String {
+        match self {
+            Unit::Config(c) => c.name(),
+            Unit::Legacy => "legacy".into(),
+            Unit::Multiview => "multiview".into(),
+            Unit::Pipeline { shards: 1, .. } => "pipeline".into(),
+            Unit::Pipeline { shard, shards } => format!("pipeline.{shard}of{shards}"),
+        }
+    }
+
+    /// Parses [`Unit::name`].
+    pub fn parse(s: &str) -> Option<Unit> {
+        match s {
+            "legacy" => Some(Unit::Legacy),
+            "multiview" => Some(Unit::Multiview),
+            "pipeline" => Some(Unit::Pipeline { shard: 0, shards: 1 }),
+            _ if s.starts_with("pipeline.") => {
+                let (k, n) = s["pipeline.".len()..].split_once("of")?;
+                let (shard, shards) = (k.parse().ok()?, n.parse().ok()?);
+                (shard < shards).then_some(Unit::Pipeline { shard, shards })
+            }
+            _ => Config::all(&FORMATS).into_iter().find(|c| c.name() == s).map(Unit::Config),
+        }
+    }
+}
 
 /// The `commands.*` checks (run in the `legacy` unit): what umbrage records besides draws.
 pub(crate) const COMMANDS: [&str; 11] = super::checks::commands::NAMES;
