@@ -57,6 +57,11 @@ pub fn run_unit(ctx: &Context, unit: Unit, new_context: &dyn Fn() -> Result<Cont
             let legacy = suite::run_legacy(ctx, new_context, opts, &names, &mut cases);
             ChildResult { cases, config: None, legacy }
         }
+        Unit::Mesh => {
+            let mut cases = Vec::new();
+            let legacy = suite::run_mesh(ctx, opts, &mut cases);
+            ChildResult { cases, config: None, legacy }
+        }
         Unit::Pipeline { shard, shards } => {
             let mut cases = Vec::new();
             let legacy = suite::run_pipeline(ctx, new_context, opts, (shard, shards), &mut cases);
@@ -118,7 +123,7 @@ pub fn run_suite_isolated(ctx: &Context, opts: &SuiteOptions, iso: &Isolation, a
         }
     }
     let shards = iso.jobs.max(1);
-    let units = [Unit::Legacy, Unit::Multiview].into_iter().chain((0..shards).map(|shard| Unit::Pipeline { shard, shards }));
+    let units = [Unit::Legacy, Unit::Multiview, Unit::Mesh].into_iter().chain((0..shards).map(|shard| Unit::Pipeline { shard, shards }));
     for unit in units {
         let names = suite::unit_case_names(unit, &opts.filter);
         if names.is_empty() {
@@ -207,6 +212,7 @@ pub fn run_suite_isolated(ctx: &Context, opts: &SuiteOptions, iso: &Isolation, a
 fn unit_group(unit: Unit) -> &'static str {
     match unit {
         Unit::Pipeline { .. } => "pipeline",
+        Unit::Mesh => "mesh",
         _ => "legacy",
     }
 }

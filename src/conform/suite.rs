@@ -13,8 +13,8 @@ use std::time::Instant;
 
 pub(crate) use super::outcome::selected;
 pub use super::outcome::{matches, CaseOutcome, QueryOutcome, SuiteOptions};
-use super::units::{pipeline_shard_names, Unit, COMMANDS, LEGACY};
-pub use super::units::{run_legacy, run_pipeline};
+use super::units::{pipeline_shard_names, Unit, COMMANDS, LEGACY, MESH};
+pub use super::units::{run_legacy, run_mesh, run_pipeline};
 
 /// Whether a depth-stencil format was usable.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -86,6 +86,7 @@ pub fn unit_case_names(unit: Unit, filter: &[String]) -> Vec<String> {
     let all = match unit {
         Unit::Legacy => super::units::legacy_unit().into_iter().map(super::units::full_name).collect(),
         Unit::Multiview => super::units::MULTIVIEW.iter().map(|n| format!("legacy.{n}")).collect(),
+        Unit::Mesh => MESH.iter().map(|n| format!("mesh.{n}")).collect(),
         Unit::Pipeline { shard, shards } => pipeline_shard_names((shard, shards)),
         Unit::Config(_) => Vec::new(),
     };
@@ -97,6 +98,7 @@ pub fn all_names() -> Vec<String> {
     let mut v: Vec<String> = cases::all(&Config::all(&FORMATS)).into_iter().map(|c| c.name).collect();
     v.extend(LEGACY.iter().map(|n| format!("legacy.{n}")));
     v.extend(COMMANDS.iter().map(|n| format!("commands.{n}")));
+    v.extend(MESH.iter().map(|n| format!("mesh.{n}")));
     v.extend(pipeline_shard_names((0, 1)));
     v
 }
@@ -326,6 +328,7 @@ pub fn run_suite(ctx: &Context, new_context: &dyn Fn() -> Result<Context>, opts:
     }
     let every: Vec<&str> = LEGACY.iter().chain(COMMANDS.iter()).copied().collect();
     let mut legacy = run_legacy(ctx, new_context, opts, &every, &mut outcomes);
+    legacy.extend(run_mesh(ctx, opts, &mut outcomes));
     legacy.extend(run_pipeline(ctx, new_context, opts, (0, 1), &mut outcomes));
     Report {
         device: ctx.info.clone(),
