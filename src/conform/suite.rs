@@ -59,7 +59,8 @@ pub struct Report {
     pub configs: Vec<ConfigRun>,
     /// Every selected case, in name order of generation.
     pub cases: Vec<CaseOutcome>,
-    /// The legacy single-configuration checks' full results (numbers), when selected.
+    /// The single-configuration checks' full results (numbers: `legacy.*`, `commands.*`,
+    /// `mesh.*`, the pipeline check), when selected.
     pub legacy: Vec<CheckResult>,
     /// Wall time of the whole run.
     pub seconds: f64,
