@@ -1,5 +1,7 @@
 //! The command line as a user meets it: bad input gives a clear message and a non-zero exit,
 //! never a panic; good input writes what it says.
+mod common;
+
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
@@ -350,4 +352,31 @@ fn the_pipeline_cache_file_round_trips_and_ignores_foreign_data() {
     }
     assert!(render("off").status.success());
     let _ = std::fs::remove_dir_all(&d);
+}
+
+/// `--method mesh` on a device without `VK_EXT_mesh_shader` (Mesa lavapipe 22.3.6): a clear
+/// error naming the extension and how to get a driver that has it, from the command line and
+/// as the library's `Error::Unsupported`.
+#[test]
+fn mesh_without_the_extension_names_it_and_the_driver_script() {
+    use umbrage::pass::{Capabilities, PassSettings, Technique};
+    let s = PassSettings { technique: Technique::Mesh, ..Default::default() };
+    let e = s.check(&Capabilities::default()).unwrap_err();
+    assert!(matches!(e, umbrage::Error::Unsupported(_)), "{e:?}");
+    let text = e.to_string();
+    assert!(text.contains("VK_EXT_mesh_shader") && text.contains("scripts/drivers.sh install 25.0.7"), "{text}");
+    let Some(env) = common::driver_env("22.3.6") else {
+        let why = "Mesa lavapipe 22.3.6 is not installed (scripts/drivers.sh install 22.3.6)";
+        assert!(std::env::var_os("CI").is_none(), "CI needs {why}");
+        eprintln!("SKIPPED: {why}");
+        return;
+    };
+    let d = tmp("mesh");
+    let mut c = Command::new(env!("CARGO_BIN_EXE_umbrage"));
+    c.args(["render", "--method", "mesh", "--size", "64x48", "--out", d.join("mesh.png").to_str().unwrap()]).env("UMBRAGE_VALIDATION", "1");
+    common::apply_driver_env(&mut c, &env);
+    let out = c.output().unwrap();
+    fails_with(&out, "VK_EXT_mesh_shader");
+    fails_with(&out, "scripts/drivers.sh install 25.0.7");
+    assert!(!d.join("mesh.png").exists(), "nothing is written");
 }
