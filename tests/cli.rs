@@ -129,6 +129,8 @@ fn bench_accepts_every_render_method() {
         "96x64",
         "--shadow-map-size",
         "256",
+        "--compute-draws",
+        "auto,per-chunk",
         "--json",
         json.to_str().unwrap(),
     ]);
@@ -136,7 +138,11 @@ fn bench_accepts_every_render_method() {
     let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     let rows = v["rows"].as_array().unwrap();
     let methods: Vec<&str> = rows.iter().map(|r| r["method"].as_str().unwrap()).collect();
-    assert_eq!(methods, ["edgequad", "mcguire", "compute", "shadowmap-256"], "auto is mcguire, listed once");
+    assert_eq!(methods, ["edgequad", "mcguire", "compute", "compute-per-chunk", "shadowmap-256"], "auto is mcguire, listed once");
+    // The compute path's volume draw calls: merged (one per light and pipeline) where the
+    // device has the indirect-draw features, else as many as per chunk; the same shadow.
+    let draws = |m: &str| rows.iter().find(|r| r["method"] == m).and_then(|r| r["volume_draws"].as_u64()).unwrap();
+    assert!(draws("compute") > 0 && draws("compute") <= draws("compute-per-chunk") && draws("mcguire") > 0, "{v}");
     // The compute silhouettes are timed on their own and put against the compute read rate
     // measured in the same run.
     let rate = v["compute_read_gib_s"].as_f64().unwrap();
@@ -166,7 +172,7 @@ fn bench_accepts_every_render_method() {
     }
     for r in rows {
         let silhouettes = r["gpu_silhouettes_ms"].as_f64();
-        if r["method"] == "compute" {
+        if r["method"].as_str().is_some_and(|m| m.starts_with("compute")) {
             let (ms, bytes, fraction) =
                 (silhouettes.unwrap(), r["silhouette_read_bytes"].as_u64().unwrap(), r["silhouette_limit_fraction"].as_f64().unwrap());
             assert!(ms > 0.0 && ms < r["gpu_shadow_ms"].as_f64().unwrap() && bytes > 0, "{r}");

@@ -6,7 +6,7 @@
 use crate::accuracy::evaluate;
 use crate::error::{Error, Result};
 use crate::gpu::Context;
-use crate::render::{Counter, RenderOptions, Renderer, Technique};
+use crate::render::{ComputeDraws, Counter, RenderOptions, Renderer, Technique};
 use serde::Serialize;
 
 /// One (scene, method, counter) measurement: medians over the measured frames.
@@ -51,6 +51,10 @@ pub struct BenchRow {
     pub error_fraction: f64,
     /// (caster, light) pairs per case in one frame: `[culled, z-pass, z-fail, z-fail + light cap]`.
     pub cases: [u64; 4],
+    /// Volume draw calls the frame's determinations record, all lights (`totals.draws` in
+    /// `--stats`): one per chunk and case, or for `compute`'s merged draws one per light and
+    /// pipeline (`count`, `multi`).
+    pub volume_draws: u64,
     /// Ray query: median GPU time of the frame's top-level build, ms (`None` otherwise).
     pub gpu_tlas_ms: Option<f64>,
     /// Ray query: GPU time of the frame that built the bottom levels (its acceleration span:
@@ -188,6 +192,9 @@ pub struct BenchConfig {
     pub counters: Vec<Counter>,
     /// Frames measured per variant (at least 1), round-robin over the variants.
     pub frames: usize,
+    /// `compute` runs once per way of recording its volume draws here (rows `compute` for
+    /// [`ComputeDraws::Auto`], `compute-<way>` for the others); empty: `Auto` only.
+    pub compute_draws: Vec<ComputeDraws>,
     /// Renderer options for everything else (size, depth mode, ...).
     pub opts: RenderOptions,
 }
@@ -257,21 +264,32 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         let scene = crate::scene::load(name)?;
         let c = ctx.take().ok_or_else(|| Error::Other("context lost".into()))?;
         let mut r = Renderer::new(c, scene, cfg.opts.clone())?;
-        // (technique, counter) variants, and their error against the reference.
-        let mut variants: Vec<(Technique, Counter)> = Vec::new();
+        // (technique, counter, compute draws) variants, and their error against the reference.
+        let ways: &[ComputeDraws] = if cfg.compute_draws.is_empty() { &[ComputeDraws::Auto] } else { &cfg.compute_draws };
+        let mut variants: Vec<(Technique, Counter, ComputeDraws)> = Vec::new();
         for &counter in &cfg.counters {
-            variants.extend(cfg.techniques.iter().filter(|t| !matches!(t, Technique::ShadowMap { .. })).map(|&t| (t, counter)));
+            for &t in cfg.techniques.iter().filter(|t| !matches!(t, Technique::ShadowMap { .. })) {
+                match t {
+                    Technique::Compute => variants.extend(ways.iter().map(|&w| (t, counter, w))),
+                    _ => variants.push((t, counter, ComputeDraws::Auto)),
+                }
+            }
         }
         // Shadow maps do not draw analytic sphere casters (the renderer refuses them): left out.
         let spheres = r.scene().spheres.iter().any(|s| s.casts_shadow);
-        variants
-            .extend(cfg.techniques.iter().filter(|t| matches!(t, Technique::ShadowMap { .. }) && !spheres).map(|&t| (t, Counter::Float)));
+        variants.extend(
+            cfg.techniques
+                .iter()
+                .filter(|t| matches!(t, Technique::ShadowMap { .. }) && !spheres)
+                .map(|&t| (t, Counter::Float, ComputeDraws::Auto)),
+        );
         let sc = r.scene();
         let gbuffer_triangles = sc.meshes.iter().filter(|m| m.opacity >= 1.0).map(|m| m.mesh.triangles.len() as u64).sum::<u64>()
             + 12 * sc.spheres.len() as u64;
         let mut errors = Vec::new();
-        for &(technique, counter) in &variants {
+        for &(technique, counter, draws) in &variants {
             r.settings.counter = counter;
+            r.settings.toggles.compute_draws = draws;
             errors.extend(evaluate(&mut r, name, &[technique], 1)?);
         }
         // Round-robin over variants, frame by frame, so that drift (thermal, other load) hits
@@ -291,9 +309,10 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         }
         let mut acc: Vec<Acc> = variants.iter().map(|_| Acc::default()).collect();
         for frame in 0..=cfg.frames {
-            for (k, &(technique, counter)) in variants.iter().enumerate() {
+            for (k, &(technique, counter, draws)) in variants.iter().enumerate() {
                 r.settings.technique = technique;
                 r.settings.counter = counter;
+                r.settings.toggles.compute_draws = draws;
                 let f = r.render()?;
                 if frame == 0 {
                     continue; // warm-up: buffers sized, caches hot
@@ -313,9 +332,10 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 a.last = Some(f.stats);
             }
         }
-        for ((&(technique, counter), err), a) in variants.iter().zip(&errors).zip(acc) {
+        for ((&(technique, counter, draws), err), a) in variants.iter().zip(&errors).zip(acc) {
             r.settings.technique = technique;
             r.settings.counter = counter;
+            r.settings.toggles.compute_draws = draws;
             let throughput = r.throughput(cfg.frames.max(2))?;
             let s = a.last.ok_or_else(|| Error::Other("no frame".into()))?;
             let c = &s.totals.cases;
@@ -341,7 +361,10 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
             };
             let row = BenchRow {
                 scene: name.clone(),
-                method: technique_label(technique),
+                method: match draws {
+                    ComputeDraws::Auto => technique_label(technique),
+                    w => format!("{}-{}", technique_label(technique), w.name()),
+                },
                 counter: counter.name().to_string(),
                 index_format: s.index_format.name().to_string(),
                 frames: cfg.frames,
@@ -358,6 +381,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 shadow_bytes: s.totals.index_bytes + s.totals.vertex_bytes,
                 error_fraction: err.fraction,
                 cases: [c.culled, c.zpass, c.zfail, c.zfail_light_cap],
+                volume_draws: s.totals.draws,
                 gpu_tlas_ms: (ray && !a.accel.is_empty()).then(|| median(a.accel)),
                 blas_build_ms: rays.map(|q| q.bottom_level_build_ms),
                 blas_bytes: rays.map(|q| q.bottom_level_bytes),
@@ -407,12 +431,12 @@ impl BenchReport {
             "Device: {} ({}), {}x{}. Medians; wall ms = one frame at a time (latency), fps = throughput with frames in flight; error = mismatched pixels outside a 1-pixel band vs the CPU reference (worst light).\n\n",
             self.device, self.driver, self.width, self.height
         );
-        s += "| scene | method | counter | GPU frame ms | GPU shadow ms | map / lookup ms | BLAS build / refit / TLAS ms | wall ms | fps | plan ms | shadow tris | bytes | error | cases c/1/2/3 |\n";
-        s += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        s += "| scene | method | counter | GPU frame ms | GPU shadow ms | map / lookup ms | BLAS build / refit / TLAS ms | wall ms | fps | plan ms | shadow tris | draws | bytes | error | cases c/1/2/3 |\n";
+        s += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
         let f = |v: Option<f64>| v.map(|x| format!("{x:.2}")).unwrap_or_else(|| "—".into());
         for r in &self.rows {
             s += &format!(
-                "| {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.1} | {:.3} | {} | {} | {:.4}% | {}/{}/{}/{} |\n",
+                "| {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.1} | {:.3} | {} | {} | {} | {:.4}% | {}/{}/{}/{} |\n",
                 r.scene,
                 r.method,
                 r.counter,
@@ -430,6 +454,7 @@ impl BenchReport {
                 r.throughput_fps,
                 r.cpu_plan_ms,
                 r.shadow_triangles,
+                r.volume_draws,
                 r.shadow_bytes,
                 r.error_fraction * 100.0,
                 r.cases[0],

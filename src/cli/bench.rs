@@ -42,6 +42,11 @@ pub(crate) struct BenchArgs {
     /// (atlas, multiview): one row each (`shadowmap-2048`, `shadowmap-2048-multiview`).
     #[arg(long, value_enum, value_delimiter = ',', default_value = "atlas")]
     cube: Vec<umbrage::render::CubeFaces>,
+    /// Comma-separated ways to record the compute technique's volume draws (auto, count,
+    /// multi, per-record, per-chunk): one row each (`compute`, `compute-per-chunk`, ...), side
+    /// by side; a way the device lacks fails the run.
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "auto")]
+    compute_draws: Vec<umbrage::render::ComputeDraws>,
     /// Write the report as JSON.
     #[arg(long)]
     json: Option<PathBuf>,
@@ -97,7 +102,8 @@ pub(crate) fn bench_command(a: BenchArgs) -> Result<ExitCode> {
         frames_in_flight: a.frames_in_flight,
         ..Default::default()
     };
-    bench(a.scenes, (techniques, a.methods.is_empty()), a.counters, a.frames, opts, a.json.as_deref(), a.markdown.as_deref())
+    let variants = (techniques, a.methods.is_empty(), a.compute_draws);
+    bench(a.scenes, variants, a.counters, a.frames, opts, a.json.as_deref(), a.markdown.as_deref())
 }
 
 /// `bench --suite fill-vertex`: runs the suite, writes its outputs, prints the Markdown.
@@ -218,7 +224,7 @@ fn bench_techniques(
 
 fn bench(
     scenes: Vec<String>,
-    (techniques, default_list): (Vec<Technique>, bool),
+    (techniques, default_list, compute_draws): (Vec<Technique>, bool, Vec<umbrage::render::ComputeDraws>),
     counters: Vec<Counter>,
     frames: usize,
     opts: RenderOptions,
@@ -234,7 +240,7 @@ fn bench(
     if default_list && ctx.features.ray_query {
         techniques.push(Technique::RayQuery);
     }
-    let cfg = umbrage::bench::BenchConfig { scenes, techniques, counters, frames, opts };
+    let cfg = umbrage::bench::BenchConfig { scenes, techniques, counters, frames, opts, compute_draws };
     let report = umbrage::bench::run(ctx, &cfg, |r| {
         eprintln!(
             "{:<14} {:<16} {:<8} gpu {:>8} ms  shadow {:>8} ms  {:>7.1} fps  {:>8} tris  error {:.4}%",

@@ -77,7 +77,7 @@ impl Unit {
 }
 
 /// The `commands.*` checks (run in the `legacy` unit): what umbrage records besides draws.
-pub(crate) const COMMANDS: [&str; 11] = super::checks::commands::NAMES;
+pub(crate) const COMMANDS: [&str; 13] = super::checks::commands::NAMES;
 
 /// The `mesh.*` checks (the `mesh` unit): the mesh-shader family.
 pub(crate) const MESH: [&str; 4] = super::mesh::NAMES;
@@ -129,7 +129,7 @@ pub fn run_legacy(
     type Run<'a> = Box<dyn Fn() -> Result<CheckResult> + 'a>;
     let on_ctx = |f: Check| -> Run<'_> { Box::new(move || f(ctx)) };
     use super::checks::commands;
-    let unit: [(&str, Run<'_>); 21] = [
+    let unit: [(&str, Run<'_>); 23] = [
         (LEGACY[0], on_ctx(super::checks::w0_vertices_and_infinity)),
         (LEGACY[1], on_ctx(super::checks::depth_clamp)),
         (LEGACY[2], on_ctx(super::checks::watertight_fan)),
@@ -152,6 +152,8 @@ pub fn run_legacy(
         (COMMANDS[8], on_ctx(commands::fill_buffer)),
         (COMMANDS[9], on_ctx(commands::dispatch)),
         (COMMANDS[10], on_ctx(commands::dispatch_indirect)),
+        (COMMANDS[11], on_ctx(commands::multi_draw_indirect)),
+        (COMMANDS[12], on_ctx(commands::draw_indirect_count)),
     ];
     let mut results = Vec::new();
     for (name, f) in unit {

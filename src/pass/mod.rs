@@ -109,8 +109,8 @@ mod volumes;
 
 pub use casters::CasterId;
 pub use desc::{
-    reverse_z, Capabilities, Counter, CubeFaces, DepthDirection, DepthMode, EnabledFeatures, IndexFormat, PassSettings, PassToggles, Pcf,
-    RenderPassTarget, ShadowPassDesc, TargetModel, Technique,
+    reverse_z, Capabilities, ComputeDraws, Counter, CubeFaces, DepthDirection, DepthMode, EnabledFeatures, IndexFormat, PassSettings,
+    PassToggles, Pcf, RenderPassTarget, ShadowPassDesc, TargetModel, Technique,
 };
 pub use draw::LightFrame;
 pub use frame::{PreparedFrame, MAX_CONE_DEG};
@@ -165,6 +165,9 @@ pub struct ShadowPass {
     serial: u64,
     planar_receiver: glam::DVec4,
     compute_pipes: Option<compute::ComputePipes>,
+    /// [`Technique::Compute`]'s merged draws' pipelines (with the compute pipelines, where the
+    /// pass has `drawIndirectFirstInstance`).
+    merged_pipes: Option<compute::draws_record::DrawPipes>,
     /// [`Technique::Mesh`]'s pipelines (made with its first frame or `create_pipelines`).
     mesh_pipes: Option<mesh::MeshPipes>,
     /// Analytic sphere casters, in draw order (after the mesh casters).
@@ -236,6 +239,7 @@ impl ShadowPass {
             allocator,
             pipeline_cache: desc.pipeline_cache,
             max_storage_range: device_caps.limits.max_storage_buffer_range as u64,
+            max_draw_indirect_count: device_caps.limits.max_draw_indirect_count.max(1),
         };
         let pipes = Pipelines::new(&dev, desc, caps.depth_clamp, caps.depth_bounds, caps.r32f_blend)?;
         let id = NEXT_PASS_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -253,6 +257,7 @@ impl ShadowPass {
             serial: 0,
             planar_receiver: glam::DVec4::Y,
             compute_pipes: None,
+            merged_pipes: None,
             mesh_pipes: None,
             spheres: Vec::new(),
             next_sphere: 0,
@@ -338,6 +343,11 @@ impl ShadowPass {
         }
         if gpu && self.compute_pipes.is_none() {
             self.compute_pipes = Some(compute::ComputePipes::new(&self.dev)?);
+        }
+        if technique == Technique::Compute && self.caps.draw_indirect_first_instance && self.merged_pipes.is_none() {
+            let c = &self.caps;
+            let caps = (c.depth_clamp, c.depth_bounds, c.r32f_blend);
+            self.merged_pipes = Some(compute::draws_record::DrawPipes::new(&self.dev, &self.desc, self.pipes.layout, caps)?);
         }
         if technique == Technique::Mesh && self.mesh_pipes.is_none() {
             let c = &self.caps;
@@ -446,7 +456,14 @@ impl ShadowPass {
         let stream = self.write_stream(slot, &packed.stream)?;
         // The compute pass's records and descriptor sets count as recording work too.
         let compute = match packed.compute {
-            Some(cf) => Some(self.prepare_compute(slot, cf)?),
+            Some(cf) => {
+                // (mesh frames draw with mesh tasks: no indirect records to merge)
+                let draws = match self.settings.technique {
+                    Technique::Compute => self.caps.compute_draws(self.settings.toggles.compute_draws)?,
+                    _ => ComputeDraws::PerChunk,
+                };
+                Some(self.prepare_compute(slot, cf, (lights.len(), draws))?)
+            }
             None => None,
         };
         let ray_frame = match rays {
@@ -462,6 +479,9 @@ impl ShadowPass {
         totals.bytes_sent += upload_bytes;
         if let Some(cf) = &compute {
             totals.silhouette_read_bytes = 16 * (cf.exact_capacity + cf.sil_capacity);
+            if let Some(m) = &cf.merged {
+                totals.draws = totals.draws - m.per_chunk_calls + m.calls;
+            }
         }
         let warnings = overflow_warnings(&self.casters, &packed.lights, self.settings.counter);
         let serial = self.serial;
@@ -494,6 +514,10 @@ impl Drop for ShadowPass {
         if let Some(mut c) = self.compute_pipes.take() {
             // SAFETY: as above.
             unsafe { c.destroy(&self.dev.device) };
+        }
+        if let Some(mut m) = self.merged_pipes.take() {
+            // SAFETY: as above.
+            unsafe { m.destroy(&self.dev.device) };
         }
         if let Some(mut m) = self.mesh_pipes.take() {
             // SAFETY: as above.

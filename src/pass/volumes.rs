@@ -63,6 +63,11 @@ impl ShadowPass {
             }
             _ => {}
         }
+        // Technique::Compute's merged draws: the light's GPU-silhouette volumes in one draw
+        // call per pipeline (src/pass/compute/draws.rs); their chunk draws are skipped below.
+        // SAFETY: the caller's contract; `kind` was checked above.
+        unsafe { self.record_merged(cb, frame, light, kind)? };
+        let merged = frame.compute.as_ref().is_some_and(|cf| cf.merged.is_some());
         let mut bound = vk::Pipeline::null();
         for c in lf.casters.iter().filter(|c| c.case != Case::Culled) {
             let wanted = match kind {
@@ -112,6 +117,9 @@ impl ShadowPass {
                         bound = vk::Pipeline::null();
                         pushed = None;
                     }
+                    continue;
+                }
+                if dr.indirect && merged {
                     continue;
                 }
                 let planar = frame.settings.technique == super::desc::Technique::Planar;
@@ -280,7 +288,9 @@ impl ShadowPass {
         unsafe {
             if dr.indirect {
                 let Some(cf) = frame.compute.as_ref() else { return };
-                d.cmd_bind_vertex_buffers(cb, 0, &[dr.vertices], &[0]);
+                // with the merged draws the records address the arena's vertex table
+                let vertices = cf.merged.as_ref().map_or(dr.vertices, |m| m.handles.vertices);
+                d.cmd_bind_vertex_buffers(cb, 0, &[vertices], &[0]);
                 d.cmd_bind_index_buffer(cb, cf.out_buffer, 0, vk::IndexType::UINT16);
                 d.cmd_draw_indexed_indirect(cb, cf.records_buffer, dr.offset, 1, 20);
                 return;

@@ -2,7 +2,9 @@
 //! buffers (face planes, triangles, welded positions and the parts' apexes, edges; and for
 //! mesh-shader extrusion the meshlets, their triangles and their owned edges) that one
 //! descriptor set binds, so one dispatch per stage (or one mesh draw per caster part) serves
-//! every (light, caster) pair of a frame.
+//! every (light, caster) pair of a frame; and an eighth, the chunks' dual-length vertices
+//! (a vertex buffer), so the merged volume draws address every chunk by its record's
+//! `vertexOffset` ([`super::draws`]).
 //!
 //! A caster's tables are bump-allocated at the end of each table and filled by staged copies
 //! (pending uploads: they ride with every frame until one that recorded them retires, like the
@@ -21,12 +23,15 @@ use ash::vk;
 use gpu_allocator::MemoryLocation;
 
 /// The tables, in binding order.
-pub(crate) const TABLES: [&str; N] = ["planes", "triangles", "positions", "edges", "meshlets", "meshlet triangles", "meshlet edges"];
+pub(crate) const TABLES: [&str; N] =
+    ["planes", "triangles", "positions", "edges", "meshlets", "meshlet triangles", "meshlet edges", "volume vertices"];
 /// The number of tables.
-pub(crate) const N: usize = 7;
+pub(crate) const N: usize = 8;
+/// The chunks' dual-length vertices (a vertex buffer, not bound to the compute set).
+pub(crate) const VERTICES: usize = 7;
 /// Bytes of one element of each table (`vec4<f32>`, `Tri`, `vec4<f32>`, `vec4<u32>`,
-/// `vec4<u32>`, `u32`, `vec4<u32>`).
-pub(crate) const ELEMENT_BYTES: [u64; N] = [16, 32, 16, 16, 16, 4, 16];
+/// `vec4<u32>`, `u32`, `vec4<u32>`, `vec4<f32>`).
+pub(crate) const ELEMENT_BYTES: [u64; N] = [16, 32, 16, 16, 16, 4, 16, 16];
 /// The smallest table, in elements.
 const MIN_ELEMENTS: u64 = 1024;
 
@@ -47,6 +52,7 @@ pub(crate) fn mesh_elements(m: &ComputeMesh) -> [u64; N] {
         m.meshlets.len() as u64,
         m.meshlet_tris.len() as u64,
         m.meshlet_edges.len() as u64,
+        m.vertices.len() as u64,
     ]
 }
 
@@ -107,7 +113,10 @@ impl ComputeArena {
         }
         let mut made: Vec<Buffer> = Vec::with_capacity(N);
         for k in 0..N {
-            let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
+            let mut usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
+            if k == VERTICES {
+                usage |= vk::BufferUsageFlags::VERTEX_BUFFER;
+            }
             match Buffer::new(dev, &format!("compute arena: {}", TABLES[k]), capacity[k] * ELEMENT_BYTES[k], usage, MemoryLocation::GpuOnly)
             {
                 Ok(b) => made.push(b),

@@ -24,6 +24,8 @@
 //! triangle counts equal the CPU planner's for the same light and caster.
 
 pub(crate) mod arena;
+pub(crate) mod draws;
+pub(crate) mod draws_record;
 pub(crate) mod frame;
 mod prepare;
 pub(crate) mod record;
@@ -68,6 +70,17 @@ pub(crate) mod rec {
     pub const VOL_CAP: usize = 15;
     pub const CAP_CAP: usize = 16;
     pub const OVERFLOW: usize = 17;
+    /// The volume and light-cap commands' `vertexOffset` and `firstInstance` (written by the
+    /// CPU for the merged draws: the chunk's first vertex in the arena, the pair's transform).
+    pub const VOL_VERTEX_OFFSET: usize = 3;
+    pub const VOL_FIRST_INSTANCE: usize = 4;
+    pub const CAP_VERTEX_OFFSET: usize = 8;
+    pub const CAP_FIRST_INSTANCE: usize = 9;
+    /// The merged draws' lists the two commands go to (`shaders/compact_draws.wgsl`): the
+    /// word offset of the list's count, or [`NO_LIST`].
+    pub const VOL_LIST: usize = 18;
+    pub const CAP_LIST: usize = 19;
+    pub const NO_LIST: u32 = u32::MAX;
     pub const F_ENABLED: u32 = 1;
     pub const F_BACK: u32 = 2;
     pub const F_DIRECTIONAL: u32 = 4;
@@ -123,6 +136,19 @@ pub(crate) struct ComputeMesh {
     /// The index of part 0's apex in `positions` (part `p`'s is `apex_base + p`): the welded
     /// positions come first.
     pub apex_base: u32,
+    /// Every chunk's dual-length vertices (n with w = 1, then n with w = 0), chunk after chunk:
+    /// the merged volume draws' vertex arena.
+    pub vertices: Vec<[f32; 4]>,
+    /// Per chunk, its first vertex in `vertices`.
+    pub chunk_vertices: Vec<u32>,
+}
+
+/// The dual-length vertex data of a chunk: every vertex with w = 1, then again with w = 0.
+pub(crate) fn dual_length(vertices: &[glam::Vec3]) -> Vec<[f32; 4]> {
+    let mut data: Vec<[f32; 4]> = Vec::with_capacity(vertices.len() * 2);
+    data.extend(vertices.iter().map(|v| [v.x, v.y, v.z, 1.0]));
+    data.extend(vertices.iter().map(|v| [v.x, v.y, v.z, 0.0]));
+    data
 }
 
 impl ComputeMesh {
@@ -161,6 +187,12 @@ impl ComputeMesh {
                 }
             }
         }
+        let mut vertices = Vec::new();
+        let mut chunk_vertices = Vec::with_capacity(caster.chunks.len());
+        for ch in &caster.chunks {
+            chunk_vertices.push(vertices.len() as u32);
+            vertices.extend(dual_length(&ch.vertices));
+        }
         let ml = Meshlets::build(caster);
         let meshlets = ml.meshlets.iter().map(|m| [m.first_triangle, m.triangle_count, m.first_edge, m.edge_count]).collect();
         let meshlet_edges = ml.edges.iter().map(|e| [e.t0, e.t1, e.c0 as u32 | (e.c1 as u32) << 8, 0]).collect();
@@ -175,6 +207,39 @@ impl ComputeMesh {
             meshlet_edges,
             part_meshlets: ml.parts,
             apex_base,
+            vertices,
+            chunk_vertices,
+        }
+    }
+
+    /// The bytes of each arena table, placed at `base` (the meshlets' firsts made absolute).
+    pub fn table_bytes(&self, base: &[u32; arena::N]) -> [std::borrow::Cow<'_, [u8]>; arena::N] {
+        use std::borrow::Cow;
+        let meshlets: Vec<[u32; 4]> = self.meshlets.iter().map(|&[ft, tc, fe, ec]| [ft + base[5], tc, fe + base[6], ec]).collect();
+        [
+            Cow::Borrowed(bytemuck::cast_slice(&self.planes)),
+            Cow::Borrowed(bytemuck::cast_slice(&self.tris)),
+            Cow::Borrowed(bytemuck::cast_slice(&self.positions)),
+            Cow::Borrowed(bytemuck::cast_slice(&self.edges)),
+            Cow::Owned(bytemuck::cast_slice(&meshlets).to_vec()),
+            Cow::Borrowed(bytemuck::cast_slice(&self.meshlet_tris)),
+            Cow::Borrowed(bytemuck::cast_slice(&self.meshlet_edges)),
+            Cow::Borrowed(bytemuck::cast_slice(&self.vertices)),
+        ]
+    }
+
+    /// Where the tables of `caster` are once placed at `base` (`elements` each).
+    pub fn placed(self, caster: &Caster, base: [u32; arena::N], elements: [u64; arena::N]) -> ComputeStatic {
+        ComputeStatic {
+            base,
+            elements,
+            triangles: self.tris.len() as u32,
+            edge_count: self.edges.len() as u32,
+            chunk_edges: self.chunk_edges,
+            chunk_tris: caster.chunks.iter().map(|ch| ch.local_tris.len() as u32).collect(),
+            part_meshlets: self.part_meshlets,
+            apex_base: self.apex_base,
+            chunk_vertex_base: self.chunk_vertices.iter().map(|&v| v + base[arena::VERTICES]).collect(),
         }
     }
 }
@@ -195,6 +260,9 @@ pub(crate) struct ComputeStatic {
     pub part_meshlets: Vec<std::ops::Range<u32>>,
     /// Part `p`'s apex is position `apex_base + p` (relative to `base[2]`).
     pub apex_base: u32,
+    /// Per chunk, its first vertex in the arena's vertex table (absolute: the merged draws'
+    /// `vertexOffset`).
+    pub chunk_vertex_base: Vec<u32>,
 }
 
 /// The compute pipelines (one per stage: facing filter, exact facing, silhouette edges, face
@@ -303,6 +371,10 @@ pub(crate) struct SlotCompute {
     /// [`Technique::Mesh`](crate::pass::Technique::Mesh): the mesh draws' counters (host
     /// visible: read back for stats).
     pub counts: Option<Buffer>,
+    /// The merged draws ([`draws`]): per (light, caster) pair its transform and light (host
+    /// visible, per-instance vertex attributes), and the per-light lists of compacted commands.
+    pub xforms: Option<Buffer>,
+    pub draw_lists: Option<Buffer>,
     pub pool: vk::DescriptorPool,
     pub pool_sets: u32,
 }
@@ -354,7 +426,16 @@ impl SlotCompute {
     }
 
     pub fn destroy(&mut self, dev: &PassDevice) {
-        for b in [&mut self.records, &mut self.out, &mut self.facing, &mut self.jobs, &mut self.lists, &mut self.counts] {
+        for b in [
+            &mut self.records,
+            &mut self.out,
+            &mut self.facing,
+            &mut self.jobs,
+            &mut self.lists,
+            &mut self.counts,
+            &mut self.xforms,
+            &mut self.draw_lists,
+        ] {
             if let Some(mut b) = b.take() {
                 b.destroy(dev);
             }

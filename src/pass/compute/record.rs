@@ -7,8 +7,10 @@
 //!    caster uploads -> compute reads and writes;
 //! 2. between the stages (facing | exact | find and caps | sides): compute writes -> compute
 //!    reads and atomics, and the indirect dispatch reads of the lists' sizes;
-//! 3. the compute writes -> indirect-command reads, index reads, and host reads (the counts
-//!    `--stats` reads back after the fence).
+//! 3. with the merged draws' compaction ([`super::draws`]): the sides' writes -> its reads;
+//! 4. the compute writes -> indirect-command reads, index reads, and host reads (the counts
+//!    `--stats` reads back after the fence): the one barrier between the compute and the
+//!    draws.
 
 use super::super::ShadowPass;
 use super::rec;
@@ -16,7 +18,7 @@ use crate::pass::PreparedFrame;
 use ash::vk;
 
 /// Most workgroups of one dispatch dimension (every device has at least this many).
-const MAX_GROUPS: u32 = 65535;
+pub(crate) const MAX_GROUPS: u32 = 65535;
 
 /// A global memory barrier, recorded as Vulkan 1.0 (the pass needs no synchronization2).
 fn barrier(
@@ -34,7 +36,9 @@ impl ShadowPass {
     /// (light, caster) pair at once, whatever their number: the facing filter, the exact test
     /// of what it left undecided, the possible silhouette edges (compacted into a list) and the
     /// face caps, then the listed edges' sides, writing 16-bit indices and the indirect draw
-    /// counts; then a barrier to the indirect draws and index reads. Nothing for other
+    /// counts (and with the merged draws' lists of
+    /// [`PassToggles::compute_draws`](crate::pass::PassToggles::compute_draws), a sixth: their
+    /// compaction); then one barrier to the indirect draws and index reads. Nothing for other
     /// techniques. Idempotent per frame; also recorded by the first `cmd_determine` /
     /// `cmd_count_float` / `cmd_light_intensity` of the frame when the host did not call it
     /// (hosts drawing with [`cmd_draw_volumes`](Self::cmd_draw_volumes) inside their own
@@ -94,8 +98,13 @@ impl ShadowPass {
                 // the mesh draws' counters start at zero
                 d.cmd_fill_buffer(cb, cf.counts_buffer, 0, (cf.counts_words * 4).max(4), 0);
             }
+            // the merged draws' lists start empty (counts 0, every command empty)
+            if let Some(m) = &cf.merged {
+                self.cmd_clear_draw_lists(cb, m);
+            }
         }
-        barrier(&self.dev, cb, (S::TRANSFER, A::TRANSFER_WRITE), (S::COMPUTE_SHADER, rw));
+        // (the merged draws read the cleared tail of their lists as empty commands)
+        barrier(&self.dev, cb, (S::TRANSFER, A::TRANSFER_WRITE), (S::COMPUTE_SHADER | S::DRAW_INDIRECT, rw | A::INDIRECT_COMMAND_READ));
         // SAFETY: as above.
         unsafe {
             d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::COMPUTE, cp.layout, 0, &[cf.set], &[]);
@@ -128,6 +137,12 @@ impl ShadowPass {
             to_next(self);
             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, sides);
             d.cmd_dispatch_indirect(cb, records, (rec::H_SIL_X * 4) as u64);
+        }
+        // The merged draws: every non-empty command into its light and pipeline's list.
+        if let Some(m) = cf.merged.as_ref().filter(|m| m.compacts()) {
+            to_next(self);
+            // SAFETY: as above; the lists were cleared above, the records' counts are final.
+            unsafe { self.cmd_compact_draws(cb, m)? };
         }
         barrier(
             &self.dev,
