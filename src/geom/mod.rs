@@ -6,6 +6,7 @@ pub use mesh::{Aabb, Mesh};
 pub mod area;
 pub use area::{AreaLight, AreaShape};
 pub mod bounds;
+pub mod cone;
 pub mod edgescan;
 pub mod light;
 pub use order::TriangleOrder;
