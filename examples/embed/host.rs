@@ -423,6 +423,7 @@ impl Host {
             // This host's G-buffer is depth only: no positions and normals for rays.
             ray_query: false,
             mesh_shader: false,
+            task_shader: false,
         };
         let device = create_device(&host.instance, &picked, dynamic)?;
         host.device = Some(device.clone());

@@ -256,6 +256,7 @@ impl Host {
                 index_type_uint8: host.gpu.index_type_uint8,
                 ray_query: false,
                 mesh_shader: false,
+                task_shader: false,
             },
             ..Default::default()
         };

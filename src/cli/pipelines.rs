@@ -61,6 +61,7 @@ fn pass_groups(ctx: &Context, out: &mut Vec<Group>) {
         index_type_uint8: f.index_type_uint8,
         ray_query: f.ray_query,
         mesh_shader: f.mesh_shader,
+        task_shader: f.task_shader,
     };
     let mut modes = vec![sp::DepthMode::Infinite];
     if f.depth_clamp {

@@ -329,7 +329,7 @@ impl CasterTable {
             let elements = mesh_elements(&m);
             let base = self.arena.allocate(elements);
             // the meshlets' firsts, absolute in their tables
-            let meshlets: Vec<[u32; 4]> = m.meshlets.iter().map(|&[ft, tc, fe, ec]| [ft + base[5], tc, fe + base[6], ec]).collect();
+            let meshlets: Vec<[u32; 16]> = m.meshlets.iter().map(|&row| super::mesh::placed(row, base[5], base[6])).collect();
             let bytes: [&[u8]; super::compute::arena::N] = [
                 bytemuck::cast_slice(&m.planes),
                 bytemuck::cast_slice(&m.tris),

@@ -204,6 +204,10 @@ pub struct EnabledFeatures {
     /// `VK_EXT_mesh_shader` with `meshShader` (Vulkan 1.2 or newer):
     /// [`Technique::Mesh`].
     pub mesh_shader: bool,
+    /// `taskShader` of `VK_EXT_mesh_shader` (with [`mesh_shader`](Self::mesh_shader)):
+    /// [`Technique::Mesh`] culls the meshlets that would emit nothing in a task stage
+    /// ([`PassToggles::mesh_task`]); without it every meshlet's mesh workgroup runs.
+    pub task_shader: bool,
 }
 
 /// What a [`ShadowPass`](super::ShadowPass) is created for. Everything here is fixed for the
@@ -338,11 +342,17 @@ pub struct PassToggles {
     /// on lavapipe (1.1-1.3x, docs/raytrace.md): the rays cost the same, and the per-light
     /// resolve passes cost more than the G-buffer reads they save.
     pub ray_batch: bool,
+    /// [`Technique::Mesh`] on a pass with [`Capabilities::task_shader`]: a task stage launches
+    /// the mesh workgroups of only the meshlets that emit something, decided by each
+    /// meshlet's normal cone and bounding sphere where they prove it and by the facing bits
+    /// otherwise (off: every meshlet's mesh workgroup runs, as without task shaders). The same
+    /// triangles either way.
+    pub mesh_task: bool,
 }
 
 impl Default for PassToggles {
     fn default() -> Self {
-        PassToggles { scissor: true, depth_bounds: true, culling: true, ray_batch: false }
+        PassToggles { scissor: true, depth_bounds: true, culling: true, ray_batch: false, mesh_task: true }
     }
 }
 
@@ -362,6 +372,8 @@ pub struct Capabilities {
     pub r32f_blend: bool,
     /// Mesh shaders enabled and present ([`EnabledFeatures::mesh_shader`]).
     pub mesh_shader: bool,
+    /// Task shaders too ([`EnabledFeatures::task_shader`]).
+    pub task_shader: bool,
 }
 
 /// Refuses a depth-stencil format without a depth aspect or without 8 stencil bits.

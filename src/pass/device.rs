@@ -88,6 +88,7 @@ pub(super) fn capabilities(caps: &DeviceCaps, desc: &ShadowPassDesc) -> Result<C
         r32f_blend: caps.format_features(COUNT_FORMAT).contains(vk::FormatFeatureFlags::COLOR_ATTACHMENT_BLEND)
             && desc.target == TargetModel::DynamicRendering,
         mesh_shader: desc.features.mesh_shader && mesh_shader,
+        task_shader: desc.features.mesh_shader && mesh_shader && desc.features.task_shader && f.task_shader,
     })
 }
 

@@ -25,8 +25,8 @@ pub(crate) const TABLES: [&str; N] = ["planes", "triangles", "positions", "edges
 /// The number of tables.
 pub(crate) const N: usize = 7;
 /// Bytes of one element of each table (`vec4<f32>`, `Tri`, `vec4<f32>`, `vec4<u32>`,
-/// `vec4<u32>`, `u32`, `vec4<u32>`).
-pub(crate) const ELEMENT_BYTES: [u64; N] = [16, 32, 16, 16, 16, 4, 16];
+/// `Meshlet` of `shaders/extrude.wgsl`, `u32`, `vec4<u32>`).
+pub(crate) const ELEMENT_BYTES: [u64; N] = [16, 32, 16, 16, 64, 4, 16];
 /// The smallest table, in elements.
 const MIN_ELEMENTS: u64 = 1024;
 

@@ -112,8 +112,9 @@ pub(crate) struct ComputeMesh {
     pub chunk_edges: Vec<u32>,
     /// Mesh-shader extrusion: the meshlets of the closed manifold parts
     /// ([`Meshlets`]), `(first triangle, triangles, first edge, edges)`, the firsts relative
-    /// to the caster's ranges of the two tables below (made absolute when placed in the arena).
-    pub meshlets: Vec<[u32; 4]>,
+    /// to the caster's ranges of the two tables below (made absolute when placed in the arena),
+    /// then their culling bounds (`crate::pass::mesh::meshlet_rows`).
+    pub meshlets: Vec<[u32; crate::pass::mesh::MESHLET_WORDS]>,
     /// The meshlets' welded triangle ids.
     pub meshlet_tris: Vec<u32>,
     /// The meshlets' owned edges, `(t0, t1, c0 | c1 << 8, 0)`.
@@ -162,7 +163,7 @@ impl ComputeMesh {
             }
         }
         let ml = Meshlets::build(caster);
-        let meshlets = ml.meshlets.iter().map(|m| [m.first_triangle, m.triangle_count, m.first_edge, m.edge_count]).collect();
+        let meshlets = crate::pass::mesh::meshlet_rows(&ml);
         let meshlet_edges = ml.edges.iter().map(|e| [e.t0, e.t1, e.c0 as u32 | (e.c1 as u32) << 8, 0]).collect();
         ComputeMesh {
             planes,

@@ -489,6 +489,7 @@ impl Parts {
                 index_type_uint8: f.index_type_uint8,
                 ray_query: f.ray_query,
                 mesh_shader: f.mesh_shader,
+                task_shader: f.task_shader,
             },
             settings: pass_settings(&settings),
             transmit_format: Some(transmit_format),
