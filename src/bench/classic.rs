@@ -188,6 +188,10 @@ pub struct BenchConfig {
     pub counters: Vec<Counter>,
     /// Frames measured per variant (at least 1), round-robin over the variants.
     pub frames: usize,
+    /// [`Technique::Mesh`]'s task stage ([`crate::pass::PassToggles::mesh_task`]): a row per
+    /// value, `mesh` (on) and `mesh-notask` (off: every meshlet's mesh workgroup runs), side
+    /// by side; empty: on only.
+    pub mesh_task: Vec<bool>,
     /// Renderer options for everything else (size, depth mode, ...).
     pub opts: RenderOptions,
 }
@@ -211,6 +215,10 @@ pub fn technique_label(t: Technique) -> String {
         t => t.name().to_string(),
     }
 }
+
+/// What a `mesh` row's label has appended when its task stage was off
+/// ([`BenchConfig::mesh_task`]).
+const NOTASK_SUFFIX: &str = "-notask";
 
 /// What [`technique_label`] appends for a shadow map whose cube faces are multiview views.
 const MULTIVIEW_SUFFIX: &str = "-multiview";
@@ -257,21 +265,27 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         let scene = crate::scene::load(name)?;
         let c = ctx.take().ok_or_else(|| Error::Other("context lost".into()))?;
         let mut r = Renderer::new(c, scene, cfg.opts.clone())?;
-        // (technique, counter) variants, and their error against the reference.
-        let mut variants: Vec<(Technique, Counter)> = Vec::new();
+        // (technique, counter, mesh task stage) variants, and their error against the reference.
+        let tasks: &[bool] = if cfg.mesh_task.is_empty() { &[true] } else { &cfg.mesh_task };
+        let mut variants: Vec<(Technique, Counter, bool)> = Vec::new();
         for &counter in &cfg.counters {
-            variants.extend(cfg.techniques.iter().filter(|t| !matches!(t, Technique::ShadowMap { .. })).map(|&t| (t, counter)));
+            for &t in cfg.techniques.iter().filter(|t| !matches!(t, Technique::ShadowMap { .. })) {
+                let each: &[bool] = if t == Technique::Mesh { tasks } else { &[true] };
+                variants.extend(each.iter().map(|&task| (t, counter, task)));
+            }
         }
         // Shadow maps do not draw analytic sphere casters (the renderer refuses them): left out.
         let spheres = r.scene().spheres.iter().any(|s| s.casts_shadow);
-        variants
-            .extend(cfg.techniques.iter().filter(|t| matches!(t, Technique::ShadowMap { .. }) && !spheres).map(|&t| (t, Counter::Float)));
+        variants.extend(
+            cfg.techniques.iter().filter(|t| matches!(t, Technique::ShadowMap { .. }) && !spheres).map(|&t| (t, Counter::Float, true)),
+        );
         let sc = r.scene();
         let gbuffer_triangles = sc.meshes.iter().filter(|m| m.opacity >= 1.0).map(|m| m.mesh.triangles.len() as u64).sum::<u64>()
             + 12 * sc.spheres.len() as u64;
         let mut errors = Vec::new();
-        for &(technique, counter) in &variants {
+        for &(technique, counter, task) in &variants {
             r.settings.counter = counter;
+            r.settings.toggles.mesh_task = task;
             errors.extend(evaluate(&mut r, name, &[technique], 1)?);
         }
         // Round-robin over variants, frame by frame, so that drift (thermal, other load) hits
@@ -291,9 +305,10 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         }
         let mut acc: Vec<Acc> = variants.iter().map(|_| Acc::default()).collect();
         for frame in 0..=cfg.frames {
-            for (k, &(technique, counter)) in variants.iter().enumerate() {
+            for (k, &(technique, counter, task)) in variants.iter().enumerate() {
                 r.settings.technique = technique;
                 r.settings.counter = counter;
+                r.settings.toggles.mesh_task = task;
                 let f = r.render()?;
                 if frame == 0 {
                     continue; // warm-up: buffers sized, caches hot
@@ -313,9 +328,10 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 a.last = Some(f.stats);
             }
         }
-        for ((&(technique, counter), err), a) in variants.iter().zip(&errors).zip(acc) {
+        for ((&(technique, counter, task), err), a) in variants.iter().zip(&errors).zip(acc) {
             r.settings.technique = technique;
             r.settings.counter = counter;
+            r.settings.toggles.mesh_task = task;
             let throughput = r.throughput(cfg.frames.max(2))?;
             let s = a.last.ok_or_else(|| Error::Other("no frame".into()))?;
             let c = &s.totals.cases;
@@ -341,7 +357,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
             };
             let row = BenchRow {
                 scene: name.clone(),
-                method: technique_label(technique),
+                method: if task { technique_label(technique) } else { format!("{}{NOTASK_SUFFIX}", technique_label(technique)) },
                 counter: counter.name().to_string(),
                 index_format: s.index_format.name().to_string(),
                 frames: cfg.frames,

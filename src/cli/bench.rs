@@ -42,6 +42,10 @@ pub(crate) struct BenchArgs {
     /// (atlas, multiview): one row each (`shadowmap-2048`, `shadowmap-2048-multiview`).
     #[arg(long, value_enum, value_delimiter = ',', default_value = "atlas")]
     cube: Vec<umbrage::render::CubeFaces>,
+    /// Comma-separated task-stage settings for the mesh technique (on, off): one row each
+    /// (`mesh`, `mesh-notask`: no task stage, every meshlet's mesh workgroup runs).
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "on")]
+    mesh_task: Vec<OnOff>,
     /// Write the report as JSON.
     #[arg(long)]
     json: Option<PathBuf>,
@@ -64,6 +68,15 @@ pub(crate) struct BenchArgs {
     tiny: bool,
     #[command(flatten)]
     soak: SoakArgs,
+}
+
+/// A setting switched on or off.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum OnOff {
+    /// On.
+    On,
+    /// Off.
+    Off,
 }
 
 /// `bench --suite`.
@@ -97,7 +110,9 @@ pub(crate) fn bench_command(a: BenchArgs) -> Result<ExitCode> {
         frames_in_flight: a.frames_in_flight,
         ..Default::default()
     };
-    bench(a.scenes, (techniques, a.methods.is_empty()), a.counters, a.frames, opts, a.json.as_deref(), a.markdown.as_deref())
+    let mesh_task: Vec<bool> = a.mesh_task.iter().map(|&t| t == OnOff::On).collect();
+    let what = (techniques, a.methods.is_empty(), mesh_task);
+    bench(a.scenes, what, a.counters, a.frames, opts, a.json.as_deref(), a.markdown.as_deref())
 }
 
 /// `bench --suite fill-vertex`: runs the suite, writes its outputs, prints the Markdown.
@@ -218,7 +233,7 @@ fn bench_techniques(
 
 fn bench(
     scenes: Vec<String>,
-    (techniques, default_list): (Vec<Technique>, bool),
+    (techniques, default_list, mesh_task): (Vec<Technique>, bool, Vec<bool>),
     counters: Vec<Counter>,
     frames: usize,
     opts: RenderOptions,
@@ -234,7 +249,7 @@ fn bench(
     if default_list && ctx.features.ray_query {
         techniques.push(Technique::RayQuery);
     }
-    let cfg = umbrage::bench::BenchConfig { scenes, techniques, counters, frames, opts };
+    let cfg = umbrage::bench::BenchConfig { scenes, techniques, counters, frames, opts, mesh_task };
     let report = umbrage::bench::run(ctx, &cfg, |r| {
         eprintln!(
             "{:<14} {:<16} {:<8} gpu {:>8} ms  shadow {:>8} ms  {:>7.1} fps  {:>8} tris  error {:.4}%",
