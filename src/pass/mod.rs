@@ -327,8 +327,10 @@ impl ShadowPass {
 
     /// Creates now the pipelines that the first frame of `technique` would otherwise create
     /// (the GPU silhouettes' compute pipelines of [`Technique::Compute`], and with them the
-    /// mesh pipelines of [`Technique::Mesh`]; the other techniques' are made with the pass), so
-    /// that frame does not wait for the driver's shader compiler. Idempotent.
+    /// mesh pipelines of [`Technique::Mesh`]: with the task stage or without it, as the
+    /// current [`PassToggles::mesh_task`] and [`Capabilities::task_shader`] choose; the other
+    /// techniques' are made with the pass), so that frame does not wait for the driver's
+    /// shader compiler. Idempotent.
     ///
     /// Errors: [`Technique::Mesh`] on a pass without [`Capabilities::mesh_shader`]
     /// ([`Error::Unsupported`]), or the driver's.
