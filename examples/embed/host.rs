@@ -428,6 +428,7 @@ impl Host {
             draw_indirect_first_instance: false,
             multi_draw_indirect: false,
             draw_indirect_count: false,
+            task_shader: false,
         };
         let device = create_device(&host.instance, &picked, dynamic)?;
         host.device = Some(device.clone());

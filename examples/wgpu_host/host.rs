@@ -259,6 +259,7 @@ impl Host {
                 draw_indirect_first_instance: false,
                 multi_draw_indirect: false,
                 draw_indirect_count: false,
+                task_shader: false,
             },
             ..Default::default()
         };

@@ -195,6 +195,10 @@ pub struct BenchConfig {
     /// `compute` runs once per way of recording its volume draws here (rows `compute` for
     /// [`ComputeDraws::Auto`], `compute-<way>` for the others); empty: `Auto` only.
     pub compute_draws: Vec<ComputeDraws>,
+    /// [`Technique::Mesh`]'s task stage ([`crate::pass::PassToggles::mesh_task`]): a row per
+    /// value, `mesh` (on) and `mesh-notask` (off: every meshlet's mesh workgroup runs), side
+    /// by side; empty: on only.
+    pub mesh_task: Vec<bool>,
     /// Renderer options for everything else (size, depth mode, ...).
     pub opts: RenderOptions,
 }
@@ -218,6 +222,42 @@ pub fn technique_label(t: Technique) -> String {
         t => t.name().to_string(),
     }
 }
+
+/// One row's settings: its technique and counter, and the compute and mesh techniques' own.
+#[derive(Clone, Copy, Debug)]
+struct Variant {
+    technique: Technique,
+    counter: Counter,
+    /// [`crate::pass::PassToggles::compute_draws`] (only `Auto` for the other techniques).
+    draws: ComputeDraws,
+    /// [`crate::pass::PassToggles::mesh_task`] (only `true` for the other techniques).
+    task: bool,
+}
+
+impl Variant {
+    /// Sets the renderer up to draw this variant.
+    fn apply(&self, r: &mut Renderer) {
+        r.settings.technique = self.technique;
+        r.settings.counter = self.counter;
+        r.settings.toggles.compute_draws = self.draws;
+        r.settings.toggles.mesh_task = self.task;
+    }
+
+    /// The row's `method`: [`technique_label`], then `-<way>` for a compute way other than
+    /// `Auto`, or [`NOTASK_SUFFIX`] for a mesh row without its task stage.
+    fn label(&self) -> String {
+        let base = technique_label(self.technique);
+        match (self.draws, self.task) {
+            (ComputeDraws::Auto, true) => base,
+            (ComputeDraws::Auto, false) => format!("{base}{NOTASK_SUFFIX}"),
+            (w, _) => format!("{base}-{}", w.name()),
+        }
+    }
+}
+
+/// What a `mesh` row's label has appended when its task stage was off
+/// ([`BenchConfig::mesh_task`]).
+const NOTASK_SUFFIX: &str = "-notask";
 
 /// What [`technique_label`] appends for a shadow map whose cube faces are multiview views.
 const MULTIVIEW_SUFFIX: &str = "-multiview";
@@ -264,33 +304,36 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         let scene = crate::scene::load(name)?;
         let c = ctx.take().ok_or_else(|| Error::Other("context lost".into()))?;
         let mut r = Renderer::new(c, scene, cfg.opts.clone())?;
-        // (technique, counter, compute draws) variants, and their error against the reference.
+        // The variants (technique, counter, compute draws, mesh task stage), and their error
+        // against the reference.
         let ways: &[ComputeDraws] = if cfg.compute_draws.is_empty() { &[ComputeDraws::Auto] } else { &cfg.compute_draws };
-        let mut variants: Vec<(Technique, Counter, ComputeDraws)> = Vec::new();
+        let tasks: &[bool] = if cfg.mesh_task.is_empty() { &[true] } else { &cfg.mesh_task };
+        let mut variants: Vec<Variant> = Vec::new();
         for &counter in &cfg.counters {
-            for &t in cfg.techniques.iter().filter(|t| !matches!(t, Technique::ShadowMap { .. })) {
-                match t {
-                    Technique::Compute => variants.extend(ways.iter().map(|&w| (t, counter, w))),
-                    _ => variants.push((t, counter, ComputeDraws::Auto)),
+            for &technique in cfg.techniques.iter().filter(|t| !matches!(t, Technique::ShadowMap { .. })) {
+                let one = Variant { technique, counter, draws: ComputeDraws::Auto, task: true };
+                match technique {
+                    Technique::Compute => variants.extend(ways.iter().map(|&draws| Variant { draws, ..one })),
+                    Technique::Mesh => variants.extend(tasks.iter().map(|&task| Variant { task, ..one })),
+                    _ => variants.push(one),
                 }
             }
         }
         // Shadow maps do not draw analytic sphere casters (the renderer refuses them): left out.
         let spheres = r.scene().spheres.iter().any(|s| s.casts_shadow);
-        variants.extend(
-            cfg.techniques
-                .iter()
-                .filter(|t| matches!(t, Technique::ShadowMap { .. }) && !spheres)
-                .map(|&t| (t, Counter::Float, ComputeDraws::Auto)),
-        );
+        variants.extend(cfg.techniques.iter().filter(|t| matches!(t, Technique::ShadowMap { .. }) && !spheres).map(|&technique| Variant {
+            technique,
+            counter: Counter::Float,
+            draws: ComputeDraws::Auto,
+            task: true,
+        }));
         let sc = r.scene();
         let gbuffer_triangles = sc.meshes.iter().filter(|m| m.opacity >= 1.0).map(|m| m.mesh.triangles.len() as u64).sum::<u64>()
             + 12 * sc.spheres.len() as u64;
         let mut errors = Vec::new();
-        for &(technique, counter, draws) in &variants {
-            r.settings.counter = counter;
-            r.settings.toggles.compute_draws = draws;
-            errors.extend(evaluate(&mut r, name, &[technique], 1)?);
+        for v in &variants {
+            v.apply(&mut r);
+            errors.extend(evaluate(&mut r, name, &[v.technique], 1)?);
         }
         // Round-robin over variants, frame by frame, so that drift (thermal, other load) hits
         // every variant alike: the ratios are measured side by side.
@@ -309,10 +352,8 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         }
         let mut acc: Vec<Acc> = variants.iter().map(|_| Acc::default()).collect();
         for frame in 0..=cfg.frames {
-            for (k, &(technique, counter, draws)) in variants.iter().enumerate() {
-                r.settings.technique = technique;
-                r.settings.counter = counter;
-                r.settings.toggles.compute_draws = draws;
+            for (k, v) in variants.iter().enumerate() {
+                v.apply(&mut r);
                 let f = r.render()?;
                 if frame == 0 {
                     continue; // warm-up: buffers sized, caches hot
@@ -332,10 +373,9 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 a.last = Some(f.stats);
             }
         }
-        for ((&(technique, counter, draws), err), a) in variants.iter().zip(&errors).zip(acc) {
-            r.settings.technique = technique;
-            r.settings.counter = counter;
-            r.settings.toggles.compute_draws = draws;
+        for ((v, err), a) in variants.iter().zip(&errors).zip(acc) {
+            v.apply(&mut r);
+            let Variant { technique, counter, .. } = *v;
             let throughput = r.throughput(cfg.frames.max(2))?;
             let s = a.last.ok_or_else(|| Error::Other("no frame".into()))?;
             let c = &s.totals.cases;
@@ -361,10 +401,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
             };
             let row = BenchRow {
                 scene: name.clone(),
-                method: match draws {
-                    ComputeDraws::Auto => technique_label(technique),
-                    w => format!("{}-{}", technique_label(technique), w.name()),
-                },
+                method: v.label(),
                 counter: counter.name().to_string(),
                 index_format: s.index_format.name().to_string(),
                 frames: cfg.frames,

@@ -7,6 +7,7 @@ pub mod area;
 mod area_shape;
 pub use area::{AreaLight, AreaShape};
 pub mod bounds;
+pub mod cone;
 pub mod edgescan;
 pub mod light;
 pub use order::TriangleOrder;

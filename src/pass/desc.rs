@@ -216,6 +216,10 @@ pub struct EnabledFeatures {
     /// above, the draw count comes from the GPU (`vkCmdDrawIndexedIndirectCount`,
     /// [`ComputeDraws::Count`]).
     pub draw_indirect_count: bool,
+    /// `taskShader` of `VK_EXT_mesh_shader` (with [`mesh_shader`](Self::mesh_shader)):
+    /// [`Technique::Mesh`] culls the meshlets that would emit nothing in a task stage
+    /// ([`PassToggles::mesh_task`]); without it every meshlet's mesh workgroup runs.
+    pub task_shader: bool,
 }
 
 named_enum!(
@@ -383,11 +387,24 @@ pub struct PassToggles {
     /// best the device allows); the same stencil every way. A way the pass cannot use is
     /// refused by [`PassSettings::check`] for `Technique::Compute` frames.
     pub compute_draws: ComputeDraws,
+    /// [`Technique::Mesh`] on a pass with [`Capabilities::task_shader`]: a task stage launches
+    /// the mesh workgroups of only the meshlets that emit something, decided by each
+    /// meshlet's normal cone and bounding sphere where they prove it and by the facing bits
+    /// otherwise (off: every meshlet's mesh workgroup runs, as without task shaders). The same
+    /// triangles either way.
+    pub mesh_task: bool,
 }
 
 impl Default for PassToggles {
     fn default() -> Self {
-        PassToggles { scissor: true, depth_bounds: true, culling: true, ray_batch: false, compute_draws: ComputeDraws::Auto }
+        PassToggles {
+            scissor: true,
+            depth_bounds: true,
+            culling: true,
+            ray_batch: false,
+            compute_draws: ComputeDraws::Auto,
+            mesh_task: true,
+        }
     }
 }
 
@@ -413,6 +430,8 @@ pub struct Capabilities {
     pub multi_draw_indirect: bool,
     /// `drawIndirectCount` (Vulkan 1.2) enabled and present.
     pub draw_indirect_count: bool,
+    /// Task shaders too ([`EnabledFeatures::task_shader`]).
+    pub task_shader: bool,
 }
 
 impl Capabilities {

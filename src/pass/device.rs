@@ -93,6 +93,7 @@ pub(super) fn capabilities(caps: &DeviceCaps, desc: &ShadowPassDesc) -> Result<C
         draw_indirect_first_instance: desc.features.draw_indirect_first_instance && f.draw_indirect_first_instance,
         multi_draw_indirect: desc.features.multi_draw_indirect && f.multi_draw_indirect,
         draw_indirect_count: desc.features.draw_indirect_count && api >= vk::API_VERSION_1_2 && f.draw_indirect_count,
+        task_shader: desc.features.mesh_shader && mesh_shader && desc.features.task_shader && f.task_shader,
     })
 }
 

@@ -94,6 +94,7 @@ mod draw;
 mod eye;
 mod frame;
 mod mesh;
+mod mesh_pipes;
 mod pack;
 mod pipelines;
 mod planar;
@@ -169,7 +170,7 @@ pub struct ShadowPass {
     /// pass has `drawIndirectFirstInstance`).
     merged_pipes: Option<compute::draws_record::DrawPipes>,
     /// [`Technique::Mesh`]'s pipelines (made with its first frame or `create_pipelines`).
-    mesh_pipes: Option<mesh::MeshPipes>,
+    mesh_pipes: Option<mesh_pipes::MeshPipes>,
     /// Analytic sphere casters, in draw order (after the mesh casters).
     spheres: Vec<spheres::SphereCaster>,
     next_sphere: u64,
@@ -331,8 +332,10 @@ impl ShadowPass {
 
     /// Creates now the pipelines that the first frame of `technique` would otherwise create
     /// (the GPU silhouettes' compute pipelines of [`Technique::Compute`], and with them the
-    /// mesh pipelines of [`Technique::Mesh`]; the other techniques' are made with the pass), so
-    /// that frame does not wait for the driver's shader compiler. Idempotent.
+    /// mesh pipelines of [`Technique::Mesh`]: with the task stage or without it, as the
+    /// current [`PassToggles::mesh_task`] and [`Capabilities::task_shader`] choose; the other
+    /// techniques' are made with the pass), so that frame does not wait for the driver's
+    /// shader compiler. Idempotent.
     ///
     /// Errors: [`Technique::Mesh`] on a pass without [`Capabilities::mesh_shader`]
     /// ([`Error::Unsupported`]), or the driver's.
@@ -349,12 +352,29 @@ impl ShadowPass {
             let caps = (c.depth_clamp, c.depth_bounds, c.r32f_blend);
             self.merged_pipes = Some(compute::draws_record::DrawPipes::new(&self.dev, &self.desc, self.pipes.layout, caps)?);
         }
-        if technique == Technique::Mesh && self.mesh_pipes.is_none() {
+        if technique == Technique::Mesh {
             let c = &self.caps;
-            self.mesh_pipes =
-                Some(mesh::MeshPipes::new(&self.instance, &self.dev, &self.desc, (c.depth_clamp, c.depth_bounds, c.r32f_blend))?);
+            if self.mesh_pipes.is_none() {
+                let features = (c.depth_clamp, c.depth_bounds, c.r32f_blend);
+                self.mesh_pipes = Some(mesh_pipes::MeshPipes::new(&self.instance, &self.dev, features, c.task_shader)?);
+            }
+            let culled = c.task_shader && self.settings.toggles.mesh_task;
+            if let Some(m) = self.mesh_pipes.as_mut() {
+                m.ensure(&self.dev, &self.desc, culled)?;
+            }
         }
         Ok(())
+    }
+
+    /// The pipeline stages the mesh draws read and write in: the mesh stage, and the task
+    /// stage where the pass has task shaders (none without mesh shaders).
+    fn mesh_stages(&self) -> ash::vk::PipelineStageFlags2 {
+        use ash::vk::PipelineStageFlags2 as S;
+        match (self.caps.mesh_shader, self.caps.task_shader) {
+            (false, _) => S::NONE,
+            (true, false) => S::MESH_SHADER_EXT,
+            (true, true) => S::MESH_SHADER_EXT | S::TASK_SHADER_EXT,
+        }
     }
 
     fn all_slots(&self) -> u64 {

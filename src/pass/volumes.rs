@@ -144,9 +144,9 @@ impl ShadowPass {
     }
 
     /// Records one mesh draw of [`Technique::Mesh`](super::desc::Technique::Mesh) for `kind`
-    /// (its pipeline, the frame's mesh set, its push block, `vkCmdDrawMeshTasksEXT`); returns
-    /// whether anything was bound (a kind the mesh path has no pipeline for draws nothing:
-    /// the light-intensity map's casters are never on it).
+    /// (its pipeline, then [`record_mesh`](Self::record_mesh)); returns whether anything was
+    /// bound (a kind the mesh path has no pipeline for draws nothing: the light-intensity
+    /// map's casters are never on it).
     ///
     /// # Safety
     /// As [`cmd_draw_volumes`](Self::cmd_draw_volumes); `dr` and `md` are a draw of `c`, of
@@ -160,14 +160,12 @@ impl ShadowPass {
         dr: &super::draw::Draw,
         md: &super::mesh::MeshDraw,
     ) -> Result<bool> {
-        let (Some(mp), Some(cf)) = (self.mesh_pipes.as_ref(), frame.compute.as_ref()) else {
-            return Err(Misuse::NotConfigured { call: "cmd_draw_volumes (mesh draws)", needs: "Technique::Mesh's pipelines" }.into());
-        };
+        let set = self.mesh_set(frame)?;
         let zpass = dr.case == Case::ZPass;
         let pipe = match kind {
-            VolumeKind::Stencil => mp.stencil_for(dr.case, dr.light_cap),
-            VolumeKind::Rasterised => mp.raster,
-            VolumeKind::Float => match mp.count {
+            VolumeKind::Stencil => set.stencil_for(dr.case, dr.light_cap),
+            VolumeKind::Rasterised => set.raster,
+            VolumeKind::Float => match set.count {
                 Some(p) => {
                     p[if zpass {
                         0
@@ -179,30 +177,61 @@ impl ShadowPass {
                 }
                 None => return Ok(false),
             },
-            VolumeKind::FloatDepthTested => match mp.count {
+            VolumeKind::FloatDepthTested => match set.count {
                 Some(p) => p[if zpass { 0 } else { 1 }],
                 None => return Ok(false),
             },
             VolumeKind::Transmit { .. } => return Ok(false),
         };
         let sign = if zpass { 1.0 } else { -1.0 };
-        let volume = VolumePush::new(c.mvp, c.light_object, [sign, 0.0, 0.0, 0.0]);
-        let push = md.push(&volume);
+        // SAFETY: forwarded contract.
+        unsafe { self.record_mesh(cb, frame, pipe, c, md, [sign, 0.0, 0.0, 0.0])? };
+        Ok(true)
+    }
+
+    /// The mesh pipelines `frame` draws with: the culled set (task stage first) where the pass
+    /// has task shaders and the frame's [`PassToggles::mesh_task`](super::PassToggles::mesh_task) is on, else the plain one.
+    pub(super) fn mesh_set(&self, frame: &PreparedFrame) -> Result<&super::mesh_pipes::MeshPipeSet> {
+        let culled = self.caps.task_shader && frame.settings.toggles.mesh_task;
+        self.mesh_pipes
+            .as_ref()
+            .and_then(|mp| mp.set(culled))
+            .ok_or_else(|| Misuse::NotConfigured { call: "cmd_draw_volumes (mesh draws)", needs: "Technique::Mesh's pipelines" }.into())
+    }
+
+    /// Binds `pipe` (a mesh pipeline of the frame's set) and the frame's mesh set, pushes the
+    /// caster's block with `color` and draws `md`'s meshlets (`vkCmdDrawMeshTasksEXT`: with
+    /// the task stage, one task workgroup per [`TASK_GROUP`](super::mesh::TASK_GROUP)
+    /// meshlets).
+    ///
+    /// # Safety
+    /// As [`cmd_draw_volumes`](Self::cmd_draw_volumes) (or inside the overlay's rendering
+    /// instance); `md` is a mesh draw of `c`, of `frame`.
+    pub(super) unsafe fn record_mesh(
+        &self,
+        cb: vk::CommandBuffer,
+        frame: &PreparedFrame,
+        pipe: vk::Pipeline,
+        c: &super::draw::CasterDraw,
+        md: &super::mesh::MeshDraw,
+        color: [f32; 4],
+    ) -> Result<()> {
+        let culled = self.caps.task_shader && frame.settings.toggles.mesh_task;
+        let (Some(mp), Some(cf)) = (self.mesh_pipes.as_ref(), frame.compute.as_ref()) else {
+            return Err(Misuse::NotConfigured { call: "cmd_draw_volumes (mesh draws)", needs: "Technique::Mesh's pipelines" }.into());
+        };
+        let push = md.push(&VolumePush::new(c.mvp, c.light_object, color));
+        let groups = if culled { md.meshlets.div_ceil(super::mesh::TASK_GROUP) } else { md.meshlets };
         let d = &self.dev.device;
-        // SAFETY: the caller's contract; the push block matches the mesh layout's range.
+        // SAFETY: the caller's contract; the push block matches the mesh layout's range; the
+        // frame's mesh set and the arena's tables live until the slot is prepared again.
         unsafe {
             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipe);
             d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, mp.layout, 0, &[cf.mesh_set], &[]);
-            d.cmd_push_constants(
-                cb,
-                mp.layout,
-                vk::ShaderStageFlags::MESH_EXT | vk::ShaderStageFlags::FRAGMENT,
-                0,
-                bytemuck::bytes_of(&push),
-            );
-            mp.loader.cmd_draw_mesh_tasks(cb, md.meshlets, 1, 1);
+            d.cmd_push_constants(cb, mp.layout, mp.stages, 0, bytemuck::bytes_of(&push));
+            mp.loader.cmd_draw_mesh_tasks(cb, groups, 1, 1);
         }
-        Ok(true)
+        Ok(())
     }
 
     /// Which pipeline counts a draw.

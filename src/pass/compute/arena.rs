@@ -30,8 +30,8 @@ pub(crate) const N: usize = 8;
 /// The chunks' dual-length vertices (a vertex buffer, not bound to the compute set).
 pub(crate) const VERTICES: usize = 7;
 /// Bytes of one element of each table (`vec4<f32>`, `Tri`, `vec4<f32>`, `vec4<u32>`,
-/// `vec4<u32>`, `u32`, `vec4<u32>`, `vec4<f32>`).
-pub(crate) const ELEMENT_BYTES: [u64; N] = [16, 32, 16, 16, 16, 4, 16, 16];
+/// `Meshlet` of `shaders/extrude.wgsl` (16 words), `u32`, `vec4<u32>`, `vec4<f32>`).
+pub(crate) const ELEMENT_BYTES: [u64; N] = [16, 32, 16, 16, 64, 4, 16, 16];
 /// The smallest table, in elements.
 const MIN_ELEMENTS: u64 = 1024;
 

@@ -411,6 +411,7 @@ impl ComputeFrame {
         for m in &self.mesh_metas {
             let r = words.get(m.word..m.word + COUNT_WORDS).ok_or_else(|| Error::Internal("mesh counters short".into()))?;
             add_counts(lights, totals, m, [r[0] as u64, r[1] as u64, r[2] as u64, r[3] as u64], 0, UsedIndexFormat::None);
+            (totals.mesh_meshlets, totals.mesh_workgroups) = (totals.mesh_meshlets + r[4] as u64, totals.mesh_workgroups + r[5] as u64);
         }
         Ok(())
     }

@@ -125,8 +125,9 @@ pub(crate) struct ComputeMesh {
     pub chunk_edges: Vec<u32>,
     /// Mesh-shader extrusion: the meshlets of the closed manifold parts
     /// ([`Meshlets`]), `(first triangle, triangles, first edge, edges)`, the firsts relative
-    /// to the caster's ranges of the two tables below (made absolute when placed in the arena).
-    pub meshlets: Vec<[u32; 4]>,
+    /// to the caster's ranges of the two tables below (made absolute when placed in the arena),
+    /// then their culling bounds (`crate::pass::mesh::meshlet_rows`).
+    pub meshlets: Vec<[u32; crate::pass::mesh::MESHLET_WORDS]>,
     /// The meshlets' welded triangle ids.
     pub meshlet_tris: Vec<u32>,
     /// The meshlets' owned edges, `(t0, t1, c0 | c1 << 8, 0)`.
@@ -194,7 +195,7 @@ impl ComputeMesh {
             vertices.extend(dual_length(&ch.vertices));
         }
         let ml = Meshlets::build(caster);
-        let meshlets = ml.meshlets.iter().map(|m| [m.first_triangle, m.triangle_count, m.first_edge, m.edge_count]).collect();
+        let meshlets = crate::pass::mesh::meshlet_rows(&ml);
         let meshlet_edges = ml.edges.iter().map(|e| [e.t0, e.t1, e.c0 as u32 | (e.c1 as u32) << 8, 0]).collect();
         ComputeMesh {
             planes,
@@ -215,7 +216,8 @@ impl ComputeMesh {
     /// The bytes of each arena table, placed at `base` (the meshlets' firsts made absolute).
     pub fn table_bytes(&self, base: &[u32; arena::N]) -> [std::borrow::Cow<'_, [u8]>; arena::N] {
         use std::borrow::Cow;
-        let meshlets: Vec<[u32; 4]> = self.meshlets.iter().map(|&[ft, tc, fe, ec]| [ft + base[5], tc, fe + base[6], ec]).collect();
+        let meshlets: Vec<[u32; crate::pass::mesh::MESHLET_WORDS]> =
+            self.meshlets.iter().map(|&row| crate::pass::mesh::placed(row, base[5], base[6])).collect();
         [
             Cow::Borrowed(bytemuck::cast_slice(&self.planes)),
             Cow::Borrowed(bytemuck::cast_slice(&self.tris)),

@@ -67,7 +67,7 @@ impl ShadowPass {
         let rw = A::SHADER_READ | A::SHADER_WRITE;
         // Mesh frames: the mesh draws read the facing bits and write their counters (a
         // previous frame's mesh draws may still read the bits this frame rewrites).
-        let mesh = if self.caps.mesh_shader { S::MESH_SHADER_EXT } else { S::NONE };
+        let mesh = self.mesh_stages();
         // compute writes -> the next stage's reads, atomics and indirect dispatch
         let to_next = |this: &Self| {
             barrier(
@@ -121,7 +121,7 @@ impl ShadowPass {
                 &self.dev,
                 cb,
                 (S::COMPUTE_SHADER | S::TRANSFER, A::SHADER_WRITE | A::TRANSFER_WRITE),
-                (S::MESH_SHADER_EXT | S::HOST, A::SHADER_READ | A::SHADER_WRITE | A::HOST_READ),
+                (mesh | S::HOST, A::SHADER_READ | A::SHADER_WRITE | A::HOST_READ),
             );
             return Ok(());
         }

@@ -492,6 +492,7 @@ impl Parts {
                 draw_indirect_first_instance: f.draw_indirect_first_instance,
                 multi_draw_indirect: f.multi_draw_indirect,
                 draw_indirect_count: f.draw_indirect_count,
+                task_shader: f.task_shader,
             },
             settings: pass_settings(&settings),
             transmit_format: Some(transmit_format),
