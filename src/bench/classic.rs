@@ -3,6 +3,7 @@
 //! timestamps and wall clock), the shadow geometry sent, and the mismatch fraction against
 //! the CPU reference.
 
+use super::stats::median;
 use crate::accuracy::evaluate;
 use crate::error::{Error, Result};
 use crate::gpu::Context;
@@ -171,14 +172,6 @@ pub struct BenchReport {
     pub gbuffer_sweep: Vec<[f64; 2]>,
     /// The G-buffer fill limit measured in this run, Gpixels / s (`None` without timestamps).
     pub gbuffer_fill_gpix_s: Option<f64>,
-}
-
-pub(crate) fn median(mut v: Vec<f64>) -> f64 {
-    if v.is_empty() {
-        return f64::NAN;
-    }
-    v.sort_by(f64::total_cmp);
-    v[v.len() / 2]
 }
 
 /// What to measure.

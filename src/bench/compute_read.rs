@@ -7,6 +7,7 @@
 //! rate is how near it runs to what the device allows a plain compute read
 //! (`bench::classic`'s `silhouette_limit_fraction`).
 
+use super::saturate::time_gpu;
 use crate::error::{Error, Result};
 use crate::gpu::descriptors::pipeline_layout;
 use crate::gpu::{pipeline, shaders, Buffer, Context};
@@ -148,42 +149,31 @@ fn measure_with(ctx: &Context, reps: usize, max_planes: u64, made: &mut Made) ->
 
 /// The median GPU time of `reps` dispatches over `n` planes (after one warm-up), ms.
 fn time(ctx: &Context, made: &Made, set: vk::DescriptorSet, n: u64, bits_bytes: u64, reps: usize) -> Result<f64> {
+    use vk::AccessFlags2 as A;
+    use vk::PipelineStageFlags2 as S;
     let d = &ctx.device;
     let groups = n.div_ceil(256) as u32;
     let push = Push { light: [0.0, 1.0, 0.0, 1.0], n: n as u32, pad: [0; 3] };
     let bits_raw = made.buffers[2].raw;
-    let mut ms = Vec::with_capacity(reps);
-    for rep in 0..=reps.max(1) {
-        ctx.one_shot(|cb| {
-            use vk::AccessFlags2 as A;
-            use vk::PipelineStageFlags2 as S;
-            // SAFETY: `cb` is recording (one_shot waits for it); every handle outlives it; the
-            // query pool has 2 queries.
-            unsafe {
-                d.cmd_reset_query_pool(cb, made.queries, 0, 2);
-                d.cmd_fill_buffer(cb, bits_raw, 0, bits_bytes, 0);
-                crate::gpu::resources::memory_barrier(
-                    ctx,
-                    cb,
-                    (S::TRANSFER, A::TRANSFER_WRITE),
-                    (S::COMPUTE_SHADER, A::SHADER_READ | A::SHADER_WRITE),
-                );
-                d.cmd_write_timestamp2(cb, S::ALL_COMMANDS, made.queries, 0);
-                d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, made.pipeline);
-                d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::COMPUTE, made.layout, 0, &[set], &[]);
-                d.cmd_push_constants(cb, made.layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::bytes_of(&push));
-                d.cmd_dispatch(cb, groups.min(65535), groups.div_ceil(65535), 1);
-                d.cmd_write_timestamp2(cb, S::ALL_COMMANDS, made.queries, 1);
-            }
-        })?;
-        let mut raw = [0u64; 2];
-        // SAFETY: one_shot waited for the submission: both queries are available.
-        unsafe { d.get_query_pool_results(made.queries, 0, &mut raw, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT) }
-            .map_err(Error::vk("vkGetQueryPoolResults"))?;
-        if rep > 0 {
-            ms.push(raw[1].wrapping_sub(raw[0]) as f64 * ctx.features.timestamp_period_ns as f64 * 1e-6);
+    let prep = |cb: vk::CommandBuffer| {
+        // SAFETY: `cb` is recording (one_shot waits for it); the bits buffer outlives it.
+        unsafe { d.cmd_fill_buffer(cb, bits_raw, 0, bits_bytes, 0) };
+        crate::gpu::resources::memory_barrier(
+            ctx,
+            cb,
+            (S::TRANSFER, A::TRANSFER_WRITE),
+            (S::COMPUTE_SHADER, A::SHADER_READ | A::SHADER_WRITE),
+        );
+    };
+    let timed = |cb: vk::CommandBuffer| {
+        // SAFETY: `cb` is recording (one_shot waits for it); the pipeline, layout and set
+        // outlive it; the set's buffers hold `n` planes and their bits.
+        unsafe {
+            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, made.pipeline);
+            d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::COMPUTE, made.layout, 0, &[set], &[]);
+            d.cmd_push_constants(cb, made.layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::bytes_of(&push));
+            d.cmd_dispatch(cb, groups.min(65535), groups.div_ceil(65535), 1);
         }
-    }
-    ms.sort_by(f64::total_cmp);
-    Ok(ms[ms.len() / 2])
+    };
+    time_gpu(ctx, made.queries, reps, &prep, &timed)
 }

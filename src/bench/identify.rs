@@ -19,6 +19,7 @@
 //! is given: no GPU, no rows of the suite (the unit tests use synthetic data with known
 //! answers).
 
+use super::stats::quantile;
 use serde::Serialize;
 
 /// Bootstrap resamples of the rows.
@@ -110,21 +111,6 @@ pub fn splitmix64(state: &mut u64) -> u64 {
 fn resample(n: usize, seed: u64, k: usize) -> Vec<usize> {
     let mut s = seed ^ (k as u64).wrapping_mul(0xd134_2543_de82_ef95);
     (0..n).map(|_| (splitmix64(&mut s) % n.max(1) as u64) as usize).collect()
-}
-
-/// The `q`-quantile of finite `v` (linear between order statistics); NaN when none.
-fn quantile(v: &[f64], q: f64) -> f64 {
-    let mut s: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
-    if s.is_empty() {
-        return f64::NAN;
-    }
-    s.sort_by(f64::total_cmp);
-    let p = q.clamp(0.0, 1.0) * (s.len() - 1) as f64;
-    let (i, f) = (p.floor() as usize, p - p.floor());
-    match s.get(i + 1) {
-        Some(next) => s[i] * (1.0 - f) + next * f,
-        None => s[i],
-    }
 }
 
 /// Coefficients of `resamples` fits of `fit` on rows drawn with replacement from `(x, y)`:

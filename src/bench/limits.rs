@@ -26,6 +26,7 @@
 //! repetitions. u8 indices need `VK_EXT_index_type_uint8`: without it the limit is skipped
 //! with the reason.
 
+use super::saturate::{depth_stencil, saturate, time_gpu, Rules};
 use super::workloads::{big_triangles, clipped_triangles, limit_units, setup_triangles, sliver_fan, small_triangles};
 use crate::error::{Error, Result};
 use crate::gpu::descriptors::pipeline_layout;
@@ -70,6 +71,19 @@ pub struct Limits {
     /// into the accumulation target, the illumination pass without its shading math
     /// ([`super::pass_limits`]): Gpixels / s.
     pub lighting_gpix_s: f64,
+    /// The lighting sweep's first point: one full-screen draw in a rendering instance of its
+    /// own, as each light's illumination is drawn: Gpixels / s.
+    pub lighting_one_draw_gpix_s: f64,
+    /// Ablation of the lighting limit, not a limit: the real `illuminate.frag` (its shading
+    /// math: Blinn-Phong, every pixel lit by an unbounded point light) through the same state
+    /// and sweep, its peak: Gpixels / s.
+    pub lighting_shaded_gpix_s: f64,
+    /// The same, one shaded draw in an instance of its own (the sweep's first point): what a
+    /// light's illumination pass can reach: Gpixels / s.
+    pub lighting_shaded_one_draw_gpix_s: f64,
+    /// Ablation: one lighting rendering instance with no draw (its targets loaded and stored),
+    /// the median: what every light's illumination pays before its first pixel, ms.
+    pub lighting_instance_ms: f64,
     /// The G-buffer pass's own pipeline over 2-pixel triangles (its vertex layout, four colour
     /// targets, depth LESS with writes; [`super::pass_limits`]): Mtriangles / s.
     pub gbuffer_tri_mtri_s: f64,
@@ -180,10 +194,8 @@ struct Lab<'a> {
     ctx: &'a Context,
     t: &'a Target,
     reps: usize,
-    /// Most doublings a sweep takes.
-    max_steps: u32,
-    /// A point whose repetition takes longer than this ends the sweep, ms.
-    max_ms: f64,
+    /// Most doublings a sweep takes, and the time of a point that ends it.
+    rules: Rules,
     sweeps: BTreeMap<String, Vec<[f64; 2]>>,
 }
 
@@ -193,25 +205,9 @@ impl Lab<'_> {
     /// `unit`) gains under 5 % twice running, a point takes `max_ms`, or `max_steps` points
     /// ran; returns the peak and records the sweep under `key`.
     fn peak(&mut self, key: &str, base: Workload, units: f64, unit: f64, per_draw: bool) -> Result<f64> {
-        let (mut best, mut flat) = (0.0f64, 0);
-        let mut points = Vec::new();
-        let mut k = 1u32;
-        for _ in 0..self.max_steps {
-            let wl = Workload { draws: if per_draw { base.draws * k } else { k }, ..base };
-            let ms = time(self.ctx, self.t, &wl, self.reps)?;
-            let rate = units * k as f64 / (ms.max(1e-6) * 1e-3) / unit;
-            points.push([units * k as f64, rate]);
-            if rate > best * 1.05 {
-                flat = 0;
-            } else {
-                flat += 1;
-            }
-            best = best.max(rate);
-            if flat >= 2 || ms > self.max_ms {
-                break;
-            }
-            k *= 2;
-        }
+        let (best, points) = saturate(self.rules, units, unit, |k| {
+            time(self.ctx, self.t, &Workload { draws: if per_draw { base.draws * k } else { k }, ..base }, self.reps)
+        })?;
         self.sweeps.insert(key.to_string(), points);
         Ok(best)
     }
@@ -225,14 +221,7 @@ fn setup(ctx: &Context, cfg: &LimitsConfig, made: &mut Made) -> Result<(vk::Pipe
     if !ctx.features.timestamps {
         return Err(Error::Unsupported("the suite's limits need timestamp queries, which this device lacks".into()));
     }
-    let ds = Image::new_2d(
-        ctx,
-        "limits-ds",
-        ctx.depth_format,
-        extent,
-        vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
-        vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL,
-    )?;
+    let ds = depth_stencil(ctx, "limits-ds", extent)?;
     let color = match Image::new_2d(
         ctx,
         "limits-color",
@@ -307,8 +296,7 @@ fn measure_with(ctx: &Context, cfg: &LimitsConfig, made: &mut Made) -> Result<Li
         ctx,
         t,
         reps: cfg.reps.max(1),
-        max_steps: if quick { 7 } else { 9 },
-        max_ms: if quick { 150.0 } else { 400.0 },
+        rules: Rules { max_steps: if quick { 7 } else { 9 }, max_ms: if quick { 150.0 } else { 400.0 } },
         sweeps: BTreeMap::new(),
     };
     let buffers = &mut made.buffers;
@@ -372,8 +360,10 @@ fn measure_with(ctx: &Context, cfg: &LimitsConfig, made: &mut Made) -> Result<Li
     let draw_rate = lab.peak("draws_per_s", Workload { draws, ..draw(stencil, tiny_vb, 3) }, draws as f64, 1.0, true)?;
     let read = super::compute_read::measure(ctx, lab.reps, if quick { 1 << 20 } else { 1 << 22 })?;
     lab.sweeps.insert("compute_read_gib_s".into(), read.sweep.clone());
-    let passes = super::pass_limits::measure(ctx, w, h, lab.reps, lab.max_steps)?;
+    let passes = super::pass_limits::measure(ctx, w, h, lab.reps, lab.rules.max_steps)?;
     lab.sweeps.insert("lighting_gpix_s".into(), passes.lighting_sweep.clone());
+    lab.sweeps.insert("lighting_shaded_gpix_s".into(), passes.lighting_shaded_sweep.clone());
+    let first = |sweep: &[[f64; 2]]| sweep.first().map_or(0.0, |p| p[1]);
     lab.sweeps.insert("gbuffer_tri_mtri_s".into(), passes.gbuffer_sweep.clone());
     lab.sweeps.insert("gbuffer_fill_gpix_s".into(), passes.gbuffer_fill_sweep.clone());
 
@@ -389,6 +379,10 @@ fn measure_with(ctx: &Context, cfg: &LimitsConfig, made: &mut Made) -> Result<Li
         cpu_stream_gib_s: cpu_stream_gib_s(cfg.scale, cfg.reps),
         compute_read_gib_s: read.gib_s,
         lighting_gpix_s: passes.lighting_gpix_s,
+        lighting_one_draw_gpix_s: first(&passes.lighting_sweep),
+        lighting_shaded_gpix_s: passes.lighting_shaded_gpix_s,
+        lighting_shaded_one_draw_gpix_s: first(&passes.lighting_shaded_sweep),
+        lighting_instance_ms: passes.lighting_instance_ms,
         gbuffer_tri_mtri_s: passes.gbuffer_tri_mtri_s,
         gbuffer_fill_gpix_s: passes.gbuffer_fill_gpix_s,
         index_u8_mtri_s: u8_rate,
@@ -461,93 +455,84 @@ fn index_limits(
 /// Median GPU ms of `reps` repetitions of `wl` (each in its own submission, the target cleared
 /// first in a rendering instance of its own, timestamps around the timed one).
 fn time(ctx: &Context, t: &Target, wl: &Workload, reps: usize) -> Result<f64> {
-    let mut ms = Vec::with_capacity(reps);
     let area = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: t.extent };
     let viewport =
         vk::Viewport { x: 0.0, y: 0.0, width: t.extent.width as f32, height: t.extent.height as f32, min_depth: 0.0, max_depth: 1.0 };
     let push = VolumePush::new(Mat4::IDENTITY, Vec4::W, [0.01, 0.01, 0.01, 0.0]);
-    // One warm-up repetition (first-use costs), then the timed ones.
-    for rep in 0..=reps {
-        ctx.one_shot(|cb| {
-            let all = (vk::PipelineStageFlags2::ALL_COMMANDS, vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE);
-            transition(ctx, cb, &t.ds, vk::ImageLayout::UNDEFINED, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
-            transition(ctx, cb, &t.color, vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
-            let attachments = |load: vk::AttachmentLoadOp| {
-                let ds = vk::RenderingAttachmentInfo::default()
-                    .image_view(t.ds.view)
-                    .image_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
-                    .load_op(load)
-                    .store_op(vk::AttachmentStoreOp::STORE)
-                    .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } });
-                let col = vk::RenderingAttachmentInfo::default()
-                    .image_view(t.color.view)
-                    .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
-                    .load_op(load)
-                    .store_op(vk::AttachmentStoreOp::STORE)
-                    .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: [0.0; 4] } });
-                (ds, col)
-            };
-            let (ds_clear, col_clear) = attachments(vk::AttachmentLoadOp::CLEAR);
-            let (ds_load, col_load) = attachments(vk::AttachmentLoadOp::LOAD);
-            let cols_clear = [col_clear];
-            let cols_load = [col_load];
-            let clear = vk::RenderingInfo::default()
-                .render_area(area)
-                .layer_count(1)
-                .color_attachments(&cols_clear)
-                .depth_attachment(&ds_clear)
-                .stencil_attachment(&ds_clear);
-            let load = vk::RenderingInfo::default()
-                .render_area(area)
-                .layer_count(1)
-                .color_attachments(&cols_load)
-                .depth_attachment(&ds_load)
-                .stencil_attachment(&ds_load);
-            let d = &ctx.device;
-            // SAFETY: `cb` is recording (one_shot); every handle was created on this device and
-            // outlives the submission, which one_shot waits for; the query pool has 2 queries.
-            unsafe {
-                d.cmd_reset_query_pool(cb, t.pool, 0, 2);
-                d.cmd_begin_rendering(cb, &clear);
-                d.cmd_end_rendering(cb);
-                memory_barrier(ctx, cb, all, all);
-                d.cmd_write_timestamp2(cb, vk::PipelineStageFlags2::ALL_COMMANDS, t.pool, 0);
-                d.cmd_begin_rendering(cb, &load);
-                d.cmd_set_viewport(cb, 0, &[viewport]);
-                d.cmd_set_scissor(cb, 0, &[area]);
-                d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, wl.pipe);
-                if let Some((ib, ty, _)) = wl.indices {
-                    d.cmd_bind_index_buffer(cb, ib, 0, ty);
-                }
-                // Each draw with its own push constants and vertex binding, as the shadow pass
-                // issues one per caster chunk.
-                for _ in 0..wl.draws {
-                    d.cmd_push_constants(
-                        cb,
-                        t.layout,
-                        vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
-                        0,
-                        bytemuck::bytes_of(&push),
-                    );
-                    d.cmd_bind_vertex_buffers(cb, 0, &[wl.vertices], &[0]);
-                    match wl.indices {
-                        Some((_, _, n)) => d.cmd_draw_indexed(cb, n, 1, 0, 0, 0),
-                        None => d.cmd_draw(cb, wl.vertex_count, 1, 0, 0),
-                    }
-                }
-                d.cmd_end_rendering(cb);
-                d.cmd_write_timestamp2(cb, vk::PipelineStageFlags2::ALL_COMMANDS, t.pool, 1);
-            }
-        })?;
-        let mut raw = [0u64; 2];
-        // SAFETY: one_shot waited for the submission: both queries are available.
-        unsafe { ctx.device.get_query_pool_results(t.pool, 0, &mut raw, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT) }
-            .map_err(Error::vk("vkGetQueryPoolResults"))?;
-        if rep > 0 {
-            ms.push(raw[1].wrapping_sub(raw[0]) as f64 * ctx.features.timestamp_period_ns as f64 * 1e-6);
+    let info = |load: vk::AttachmentLoadOp| {
+        let ds = vk::RenderingAttachmentInfo::default()
+            .image_view(t.ds.view)
+            .image_layout(vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL)
+            .load_op(load)
+            .store_op(vk::AttachmentStoreOp::STORE)
+            .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } });
+        let col = vk::RenderingAttachmentInfo::default()
+            .image_view(t.color.view)
+            .image_layout(vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL)
+            .load_op(load)
+            .store_op(vk::AttachmentStoreOp::STORE)
+            .clear_value(vk::ClearValue { color: vk::ClearColorValue { float32: [0.0; 4] } });
+        (ds, [col])
+    };
+    let d = &ctx.device;
+    let prep = |cb: vk::CommandBuffer| {
+        let all = (vk::PipelineStageFlags2::ALL_COMMANDS, vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE);
+        transition(ctx, cb, &t.ds, vk::ImageLayout::UNDEFINED, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
+        transition(ctx, cb, &t.color, vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
+        let (ds, cols) = info(vk::AttachmentLoadOp::CLEAR);
+        let clear = vk::RenderingInfo::default()
+            .render_area(area)
+            .layer_count(1)
+            .color_attachments(&cols)
+            .depth_attachment(&ds)
+            .stencil_attachment(&ds);
+        // SAFETY: `cb` is recording outside any instance; both images were just transitioned to
+        // their attachment layouts.
+        unsafe {
+            d.cmd_begin_rendering(cb, &clear);
+            d.cmd_end_rendering(cb);
         }
-    }
-    Ok(super::classic::median(ms))
+        memory_barrier(ctx, cb, all, all);
+    };
+    let timed = |cb: vk::CommandBuffer| {
+        let (ds, cols) = info(vk::AttachmentLoadOp::LOAD);
+        let load = vk::RenderingInfo::default()
+            .render_area(area)
+            .layer_count(1)
+            .color_attachments(&cols)
+            .depth_attachment(&ds)
+            .stencil_attachment(&ds);
+        // SAFETY: `cb` is recording (one_shot); every handle was created on this device and
+        // outlives the submission, which one_shot waits for; the images are in attachment
+        // layouts (prep).
+        unsafe {
+            d.cmd_begin_rendering(cb, &load);
+            d.cmd_set_viewport(cb, 0, &[viewport]);
+            d.cmd_set_scissor(cb, 0, &[area]);
+            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, wl.pipe);
+            if let Some((ib, ty, _)) = wl.indices {
+                d.cmd_bind_index_buffer(cb, ib, 0, ty);
+            }
+            // Each draw with its own push constants and vertex binding, as the shadow pass
+            // issues one per caster chunk.
+            for _ in 0..wl.draws {
+                d.cmd_push_constants(
+                    cb,
+                    t.layout,
+                    vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT,
+                    0,
+                    bytemuck::bytes_of(&push),
+                );
+                d.cmd_bind_vertex_buffers(cb, 0, &[wl.vertices], &[0]);
+                match wl.indices {
+                    Some((_, _, n)) => d.cmd_draw_indexed(cb, n, 1, 0, 0, 0),
+                    None => d.cmd_draw(cb, wl.vertex_count, 1, 0, 0),
+                }
+            }
+            d.cmd_end_rendering(cb);
+        }
+    };
+    time_gpu(ctx, t.pool, reps, &prep, &timed)
 }
 
 /// One thread summing a buffer of 256 MiB (64 MiB at small scales): the best of `reps` runs.

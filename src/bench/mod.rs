@@ -15,20 +15,26 @@
 pub mod classic;
 pub mod compute_read;
 mod evidence;
+mod frame_passes;
 pub mod identify;
 pub mod limits;
 mod markdown;
 pub mod methods;
 pub mod model;
 pub mod pass_limits;
+mod phases;
 pub mod plots;
 pub mod proof;
 pub mod report;
 pub mod reshape;
+mod row;
 mod runner;
+mod saturate;
 pub mod scenes;
+mod stats;
 pub mod suite;
 pub mod sweeps;
+mod toggles;
 mod workloads;
 
 pub use classic::{run, technique_label, BenchConfig, BenchReport, BenchRow};

@@ -7,7 +7,8 @@
 //!
 //! over [`TERMS`] (fragments, per-pixel light passes, shadow-map lookups (taps or gathers) and texels, rays,
 //! triangles submitted and set up, clipped triangles, vertices shaded, caster triangles bound, compute
-//! silhouette triangles, draws, caster passes, lights and a constant), fitted by non-negative least squares on the suite's own rows, in relative error
+//! silhouette and mesh-shader triangles read, draws, caster passes per technique family, lights and a
+//! constant), fitted by non-negative least squares on the suite's own rows, in relative error
 //! (each row weighted by 1 / its time, so a 0.3 ms row counts as much as a 300 ms one). It is
 //! checked on rows it was not fitted on: `FOLDS`-fold cross-validation, every row predicted
 //! by the fit of the other folds; `median_rel_error` and `p80_rel_error` are those held-out
@@ -22,7 +23,7 @@
 //! `unidentified_fraction` the rest: only identified terms name a bound.
 
 use super::identify::{self, Identifiability};
-use super::report::{BoundShares, SuiteRow};
+use super::row::{BoundShares, SuiteRow};
 use serde::Serialize;
 use std::collections::BTreeMap;
 
@@ -57,6 +58,7 @@ pub const TERMS: &[(&str, Group, &str)] = &[
         "caster triangles per light not culled, in the buffers the CPU-planned volumes index (not what they draw)",
     ),
     ("silhouette_triangles", Group::Vertex, "lights x caster triangles the compute silhouette pass reads (compute only)"),
+    ("mesh_triangles", Group::Vertex, "lights x caster triangles the mesh path's facing pass and meshlets read (mesh only)"),
     ("draws", Group::Draw, "volume draw calls"),
     ("caster_passes", Group::Draw, "(light, caster) pairs not culled, CPU-planned volumes (per pair: state, index streams)"),
     ("caster_passes_edgequad", Group::Draw, "(light, caster) pairs not culled, edge quads (per pair: state, two draws)"),
@@ -64,6 +66,11 @@ pub const TERMS: &[(&str, Group, &str)] = &[
         "caster_passes_compute",
         Group::Draw,
         "(light, caster) pairs not culled, compute silhouettes (per pair: dispatch, barrier, indirect draw)",
+    ),
+    (
+        "caster_passes_mesh",
+        Group::Draw,
+        "(light, caster) pairs not culled, mesh shaders (per pair: a facing dispatch, one vkCmdDrawMeshTasksEXT a part)",
     ),
     ("caster_passes_planar", Group::Draw, "(light, caster) pairs not culled, planar projection (per pair: state, one draw)"),
     ("caster_passes_other", Group::Draw, "(light, caster) pairs not culled, shadow maps and ray query"),
@@ -182,10 +189,12 @@ pub fn features(r: &SuiteRow) -> Option<Vec<f64>> {
         r.vertex_invocations? as f64,
         only(planned, r.bound_triangles as f64),
         only(r.method == "compute", r.triangles as f64 * lights),
+        only(r.method == "mesh", r.triangles as f64 * lights),
         r.draws as f64,
         only(planned, r.caster_passes as f64),
         only(r.method == "edgequad", r.caster_passes as f64),
         only(r.method == "compute", r.caster_passes as f64),
+        only(r.method == "mesh", r.caster_passes as f64),
         only(r.method == "planar", r.caster_passes as f64),
         only(map || ray, r.caster_passes as f64),
         lights,
@@ -259,21 +268,7 @@ fn dot(a: &[f64], b: &[f64]) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
-/// The `q`-quantile of `v` (linear between order statistics; NaN when empty).
-pub fn quantile(v: &[f64], q: f64) -> f64 {
-    let mut s: Vec<f64> = v.iter().copied().filter(|x| x.is_finite()).collect();
-    if s.is_empty() {
-        return f64::NAN;
-    }
-    s.sort_by(f64::total_cmp);
-    let p = q.clamp(0.0, 1.0) * (s.len() - 1) as f64;
-    let (i, f) = (p.floor() as usize, p - p.floor());
-    if i + 1 < s.len() {
-        s[i] * (1.0 - f) + s[i + 1] * f
-    } else {
-        s[i]
-    }
-}
+pub use super::stats::quantile;
 
 /// A row's fill, vertex and draw shares from the identified terms only, and the share of
 /// the unidentified ones (any group): `terms` are the row's terms in [`TERMS`] order (ms),
@@ -431,12 +426,5 @@ mod tests {
         let (s, u) = identified_shares(&terms, &all, 10.0);
         assert!((s.draw - 0.6).abs() < 1e-12 && u == 0.0);
         assert_eq!(identified_shares(&terms, &all, 0.0), (BoundShares::default(), 0.0));
-    }
-
-    #[test]
-    fn quantiles() {
-        assert_eq!(quantile(&[3.0, 1.0, 2.0], 0.5), 2.0);
-        assert!((quantile(&[0.0, 10.0], 0.1) - 1.0).abs() < 1e-12);
-        assert!(quantile(&[], 0.5).is_nan());
     }
 }

@@ -12,6 +12,7 @@
 //! `bench::classic` sets each pass's time against these: the pixels the lighting passes cover
 //! (every light's scissor) at `lighting_gpix_s`, the opaque triangles at `gbuffer_tri_mtri_s`.
 
+use super::saturate::{depth_stencil, saturate, time_gpu, Rules};
 use super::workloads::small_triangles;
 use crate::error::{Error, Result};
 use crate::gpu::descriptors::{pipeline_layout, Binding, DescriptorSet};
@@ -34,6 +35,9 @@ pub struct PassLimits {
     /// Ablation, not a limit: the real `illuminate.frag` (Blinn-Phong, every pixel lit, an
     /// unbounded point light) through the same pipeline state and sweep, Gpixels / s.
     pub lighting_shaded_gpix_s: f64,
+    /// Its sweep: `[pixels, Gpixels / s]` per point (the first: one shaded draw in its own
+    /// rendering instance, as each light's pass is drawn).
+    pub lighting_shaded_sweep: Vec<[f64; 2]>,
     /// Ablation: one rendering instance of the lighting state with no draw (the accumulation
     /// and depth-stencil targets loaded and stored), the median, ms: what every light's
     /// illumination pays before its first pixel.
@@ -132,14 +136,7 @@ fn measure_with(ctx: &Context, w: u32, h: u32, reps: usize, max_steps: u32, made
     ] {
         made.images.push(Image::new_2d(ctx, name, format, extent, usage, vk::ImageAspectFlags::COLOR)?);
     }
-    made.images.push(Image::new_2d(
-        ctx,
-        "pass limits: depth-stencil",
-        ctx.depth_format,
-        extent,
-        vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT,
-        vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL,
-    )?);
+    made.images.push(depth_stencil(ctx, "pass limits: depth-stencil", extent)?);
     // SAFETY: creation on a valid device; destroyed by `measure`.
     made.sampler = unsafe {
         d.create_sampler(&vk::SamplerCreateInfo::default().mag_filter(vk::Filter::NEAREST).min_filter(vk::Filter::NEAREST), None)
@@ -233,33 +230,16 @@ fn measure_with(ctx: &Context, w: u32, h: u32, reps: usize, max_steps: u32, made
         }
         transition(ctx, cb, &im[DS], vk::ImageLayout::UNDEFINED, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
         let cols: Vec<_> = im[..DS].iter().map(|i| color_att(i, vk::AttachmentLoadOp::CLEAR, [0.0; 4])).collect();
-        let ds = ds_att(&im[DS], vk::AttachmentLoadOp::CLEAR);
-        let info = vk::RenderingInfo::default()
-            .render_area(area)
-            .layer_count(1)
-            .color_attachments(&cols)
-            .depth_attachment(&ds)
-            .stencil_attachment(&ds);
-        // SAFETY: `cb` is recording; the images are in attachment layouts.
-        unsafe {
-            d.cmd_begin_rendering(cb, &info);
-            d.cmd_end_rendering(cb);
-        }
+        clear(ctx, cb, area, &cols, &ds_att(&im[DS], vk::AttachmentLoadOp::CLEAR));
         memory_barrier(ctx, cb, all, all);
     };
     let gb_timed = |cb: vk::CommandBuffer, (vb, count): (vk::Buffer, u32), k: u32| {
         let cols: Vec<_> = im[..DS].iter().map(|i| color_att(i, vk::AttachmentLoadOp::LOAD, [0.0; 4])).collect();
-        let ds = ds_att(&im[DS], vk::AttachmentLoadOp::LOAD);
-        let info = vk::RenderingInfo::default()
-            .render_area(area)
-            .layer_count(1)
-            .color_attachments(&cols)
-            .depth_attachment(&ds)
-            .stencil_attachment(&ds);
+        begin(ctx, cb, area, &cols, &ds_att(&im[DS], vk::AttachmentLoadOp::LOAD));
         let step = 0.8 / k.max(1) as f32;
-        // SAFETY: `cb` is recording; every handle outlives the submission (one_shot waits).
+        // SAFETY: `cb` is recording inside the instance begun above; every handle outlives the
+        // submission (one_shot waits).
         unsafe {
-            d.cmd_begin_rendering(cb, &info);
             d.cmd_set_viewport(cb, 0, &[viewport]);
             d.cmd_set_scissor(cb, 0, &[area]);
             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, gbuffer);
@@ -273,13 +253,16 @@ fn measure_with(ctx: &Context, w: u32, h: u32, reps: usize, max_steps: u32, made
             d.cmd_end_rendering(cb);
         }
     };
+    let queries = made.queries;
+    let rules = Rules { max_steps, max_ms: 400.0 };
+    let sweep = |units: f64, unit: f64, prep: &dyn Fn(vk::CommandBuffer), timed: &dyn Fn(vk::CommandBuffer, u32)| {
+        saturate(rules, units, unit, |k| time_gpu(ctx, queries, reps, prep, &|cb| timed(cb, k)))
+    };
     let grid_draw = (vb, grid.len() as u32);
-    let (gbuffer_tri_mtri_s, gbuffer_sweep) =
-        sweep(ctx, made.queries, reps, max_steps, tris, 1e6, &gb_prep, &|cb, k| gb_timed(cb, grid_draw, k))?;
+    let (gbuffer_tri_mtri_s, gbuffer_sweep) = sweep(tris, 1e6, &gb_prep, &|cb, k| gb_timed(cb, grid_draw, k))?;
     let quad_draw = (qb, quad.len() as u32);
     let layer = w as f64 * h as f64;
-    let (gbuffer_fill_gpix_s, gbuffer_fill_sweep) =
-        sweep(ctx, made.queries, reps, max_steps, layer, 1e9, &gb_prep, &|cb, k| gb_timed(cb, quad_draw, k))?;
+    let (gbuffer_fill_gpix_s, gbuffer_fill_sweep) = sweep(layer, 1e9, &gb_prep, &|cb, k| gb_timed(cb, quad_draw, k))?;
 
     // Lighting: the G-buffer filled once (foreground everywhere: position w = 1), then per
     // repetition the accumulation target and the stencil cleared, `k` full-screen triangles.
@@ -302,37 +285,24 @@ fn measure_with(ctx: &Context, w: u32, h: u32, reps: usize, max_steps: u32, made
     let light_prep = |cb: vk::CommandBuffer| {
         transition(ctx, cb, &im[ACCUM], vk::ImageLayout::UNDEFINED, vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL);
         transition(ctx, cb, &im[DS], vk::ImageLayout::UNDEFINED, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
-        let cols = [color_att(&im[ACCUM], vk::AttachmentLoadOp::CLEAR, [0.0; 4])];
-        let ds = ds_att(&im[DS], vk::AttachmentLoadOp::CLEAR);
-        let info = vk::RenderingInfo::default()
-            .render_area(area)
-            .layer_count(1)
-            .color_attachments(&cols)
-            .depth_attachment(&ds)
-            .stencil_attachment(&ds);
-        // SAFETY: `cb` is recording; the images are in attachment layouts.
-        unsafe {
-            d.cmd_begin_rendering(cb, &info);
-            d.cmd_end_rendering(cb);
-        }
+        clear(
+            ctx,
+            cb,
+            area,
+            &[color_att(&im[ACCUM], vk::AttachmentLoadOp::CLEAR, [0.0; 4])],
+            &ds_att(&im[DS], vk::AttachmentLoadOp::CLEAR),
+        );
         memory_barrier(ctx, cb, all, all);
     };
     // An unbounded white point light at the eye: every pixel (position (0.1, 0.2, -3), normal
     // +z) faces it and is lit.
     let push = LightPush { light_pos: [0.0, 0.0, 0.0, 1.0], color: [1.0, 1.0, 1.0, 0.0], spot: [0.0, 0.0, -1.0, -2.0], params: [0.0; 4] };
     let light_timed = |cb: vk::CommandBuffer, pipe: vk::Pipeline, k: u32| {
-        let cols = [color_att(&im[ACCUM], vk::AttachmentLoadOp::LOAD, [0.0; 4])];
-        let ds = ds_att(&im[DS], vk::AttachmentLoadOp::LOAD);
-        let info = vk::RenderingInfo::default()
-            .render_area(area)
-            .layer_count(1)
-            .color_attachments(&cols)
-            .depth_attachment(&ds)
-            .stencil_attachment(&ds);
-        // SAFETY: `cb` is recording; the G-buffer is in SHADER_READ_ONLY_OPTIMAL (the set's
-        // contract); every handle outlives the submission (one_shot waits).
+        begin(ctx, cb, area, &[color_att(&im[ACCUM], vk::AttachmentLoadOp::LOAD, [0.0; 4])], &ds_att(&im[DS], vk::AttachmentLoadOp::LOAD));
+        // SAFETY: `cb` is recording inside the instance begun above; the G-buffer is in
+        // SHADER_READ_ONLY_OPTIMAL (the set's contract); every handle outlives the submission
+        // (one_shot waits).
         unsafe {
-            d.cmd_begin_rendering(cb, &info);
             d.cmd_set_viewport(cb, 0, &[viewport]);
             d.cmd_set_scissor(cb, 0, &[area]);
             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipe);
@@ -345,14 +315,14 @@ fn measure_with(ctx: &Context, w: u32, h: u32, reps: usize, max_steps: u32, made
         }
     };
     let px = w as f64 * h as f64;
-    let (lighting_gpix_s, lighting_sweep) =
-        sweep(ctx, made.queries, reps, max_steps, px, 1e9, &light_prep, &|cb, k| light_timed(cb, lighting, k))?;
-    let (lighting_shaded_gpix_s, _) = sweep(ctx, made.queries, reps, max_steps, px, 1e9, &light_prep, &|cb, k| light_timed(cb, shaded, k))?;
-    let lighting_instance_ms = time(ctx, made.queries, reps, &light_prep, &|cb| light_timed(cb, lighting, 0))?;
+    let (lighting_gpix_s, lighting_sweep) = sweep(px, 1e9, &light_prep, &|cb, k| light_timed(cb, lighting, k))?;
+    let (lighting_shaded_gpix_s, lighting_shaded_sweep) = sweep(px, 1e9, &light_prep, &|cb, k| light_timed(cb, shaded, k))?;
+    let lighting_instance_ms = time_gpu(ctx, queries, reps, &light_prep, &|cb| light_timed(cb, lighting, 0))?;
     Ok(PassLimits {
         lighting_gpix_s,
         lighting_sweep,
         lighting_shaded_gpix_s,
+        lighting_shaded_sweep,
         lighting_instance_ms,
         gbuffer_tri_mtri_s,
         gbuffer_sweep,
@@ -361,65 +331,20 @@ fn measure_with(ctx: &Context, w: u32, h: u32, reps: usize, max_steps: u32, made
     })
 }
 
-/// Sweeps `timed` with k = 1, 2, 4, ... repetitions of `units` (in `unit` per second) until
-/// the rate gains under 5 % twice running, a point takes over 400 ms, or `max_steps` ran:
-/// the peak and the points.
-#[allow(clippy::too_many_arguments)]
-fn sweep(
-    ctx: &Context,
-    queries: vk::QueryPool,
-    reps: usize,
-    max_steps: u32,
-    units: f64,
-    unit: f64,
-    prep: &dyn Fn(vk::CommandBuffer),
-    timed: &dyn Fn(vk::CommandBuffer, u32),
-) -> Result<(f64, Vec<[f64; 2]>)> {
-    let (mut best, mut flat, mut k) = (0.0f64, 0, 1u32);
-    let mut points = Vec::new();
-    for _ in 0..max_steps {
-        let ms = time(ctx, queries, reps, prep, &|cb| timed(cb, k))?;
-        let rate = units * k as f64 / (ms.max(1e-6) * 1e-3) / unit;
-        points.push([units * k as f64, rate]);
-        flat = if rate > best * 1.05 { 0 } else { flat + 1 };
-        best = best.max(rate);
-        if flat >= 2 || ms > 400.0 {
-            break;
-        }
-        k *= 2;
-    }
-    Ok((best, points))
+/// Begins a rendering instance over `area` into `cols` with `ds` as its depth and stencil
+/// attachment (`cb` recording outside any instance, every image in the layout its attachment
+/// declares).
+fn begin(ctx: &Context, cb: vk::CommandBuffer, area: vk::Rect2D, cols: &[vk::RenderingAttachmentInfo], ds: &vk::RenderingAttachmentInfo) {
+    let info =
+        vk::RenderingInfo::default().render_area(area).layer_count(1).color_attachments(cols).depth_attachment(ds).stencil_attachment(ds);
+    // SAFETY: the caller records `cb` outside any instance, with the attachments' images in
+    // their declared layouts (every caller here transitions them first).
+    unsafe { ctx.device.cmd_begin_rendering(cb, &info) };
 }
 
-/// The median GPU time of `reps` repetitions of `timed` (after one warm-up), each in its own
-/// submission after `prep`, timestamps around it, ms.
-fn time(
-    ctx: &Context,
-    queries: vk::QueryPool,
-    reps: usize,
-    prep: &dyn Fn(vk::CommandBuffer),
-    timed: &dyn Fn(vk::CommandBuffer),
-) -> Result<f64> {
-    let d = &ctx.device;
-    let mut ms = Vec::with_capacity(reps);
-    for rep in 0..=reps {
-        ctx.one_shot(|cb| {
-            // SAFETY: `cb` is recording (one_shot waits for it); the pool has 2 queries.
-            unsafe { d.cmd_reset_query_pool(cb, queries, 0, 2) };
-            prep(cb);
-            // SAFETY: as above.
-            unsafe { d.cmd_write_timestamp2(cb, vk::PipelineStageFlags2::ALL_COMMANDS, queries, 0) };
-            timed(cb);
-            // SAFETY: as above.
-            unsafe { d.cmd_write_timestamp2(cb, vk::PipelineStageFlags2::ALL_COMMANDS, queries, 1) };
-        })?;
-        let mut raw = [0u64; 2];
-        // SAFETY: one_shot waited for the submission: both queries are available.
-        unsafe { d.get_query_pool_results(queries, 0, &mut raw, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT) }
-            .map_err(Error::vk("vkGetQueryPoolResults"))?;
-        if rep > 0 {
-            ms.push(raw[1].wrapping_sub(raw[0]) as f64 * ctx.features.timestamp_period_ns as f64 * 1e-6);
-        }
-    }
-    Ok(super::classic::median(ms))
+/// A rendering instance that only clears (or loads) its attachments: [`begin`], then its end.
+fn clear(ctx: &Context, cb: vk::CommandBuffer, area: vk::Rect2D, cols: &[vk::RenderingAttachmentInfo], ds: &vk::RenderingAttachmentInfo) {
+    begin(ctx, cb, area, cols, ds);
+    // SAFETY: `cb` is inside the instance just begun.
+    unsafe { ctx.device.cmd_end_rendering(cb) };
 }

@@ -1,17 +1,24 @@
-//! Every claimed bound proven by an ablation in the same run (issue #38): where a row is
-//! called fill-, vertex- or draw-bound, its work is cut where the bound says the time goes —
-//! fill: the same volumes at half the width and height; vertex: a coarser tessellation of the
-//! same shapes ([`super::reshape::coarser`]); draw: the casters merged into one
-//! ([`super::reshape::merged_casters`]) — and timed right after the row itself, re-timed. The
-//! bound is *confirmed* when the measured saving is beyond the two timings' spread and agrees
-//! with the model's predicted saving (its time for the row's counted work less its time for
-//! the ablated work's) within that spread ([`decide`]). Rows sharing a scene and a size share
-//! their renderers: one re-timing of the row's variants, then one ablated scene per kind.
+//! Every bound the report claims, proven by an ablation in the same run (issue #38). Where the
+//! model names a row fill-, vertex- or draw-bound clearly (its *candidate*), the row's work is
+//! cut where that bound says the time goes — fill: the same volumes at half the width and
+//! height; vertex: a coarser tessellation of the same shapes ([`super::reshape::coarser`]);
+//! draw: the casters merged into one ([`super::reshape::merged_casters`]) — and timed beside
+//! the row. The candidate is *confirmed*, and only then claimed, when the measured saving is
+//! beyond the two timings' spread and agrees with the model's predicted saving (its time for
+//! the row's counted work less its time for the ablated work's) within that spread
+//! ([`decide`]); otherwise the ablation refutes it (a disagreement the report lists).
+//!
+//! Where the ablated work is a point the sweeps measured anyway ([`ablated_point`]: the
+//! resolution and caps sweeps' half sizes, the one-factor triangles sweep's quarter, the
+//! one-factor casters sweep's single caster, each measured right after its partner), the two
+//! rows are compared as measured; every other candidate row is re-timed right before its
+//! ablation, rows sharing a scene and a size on one renderer, then one ablated scene per kind.
 
 use super::model::Model;
 use super::report::{ProofSummary, RowAblation, SuiteRow};
 use super::reshape::{coarser, merged_casters};
 use super::runner::{scene_of, Point, Runner, Variant};
+use super::scenes::SweepScene;
 use super::sweeps::PointScene;
 use crate::error::Result;
 use crate::render::Renderer;
@@ -94,7 +101,23 @@ pub fn half_size((w, h): (u32, u32)) -> Option<(u32, u32)> {
     (w >= 2 && h >= 2).then_some((w / 2, h / 2))
 }
 
-/// Rows of one scene and size with a claimed bound.
+/// The point a `kind` ablation of `scene` at `size` renders, where it is a point a sweep may
+/// have measured: the same scene at half the size (fill), the sphere grid with a quarter of
+/// the triangles (vertex), the same spheres as one caster (draw). `None` where the ablation
+/// renders a scene no sweep has (a named scene coarsened or merged) or cannot run.
+pub fn ablated_point(kind: &str, scene: &PointScene, size: (u32, u32)) -> Option<(PointScene, (u32, u32))> {
+    match (kind, scene) {
+        ("fill", _) => Some((scene.clone(), half_size(size)?)),
+        ("vertex", PointScene::Param(s)) => {
+            let c = SweepScene { triangles: s.triangles / 4, ..*s };
+            (c.built_triangles() < s.built_triangles()).then_some((PointScene::Param(c), size))
+        }
+        ("draw", PointScene::Param(s)) => (s.caster_count() > 1).then_some((PointScene::Param(SweepScene { groups: Some(1), ..*s }), size)),
+        _ => None,
+    }
+}
+
+/// Rows of one scene and size with a candidate bound to re-time.
 struct Group {
     scene: PointScene,
     size: (u32, u32),
@@ -133,14 +156,102 @@ fn measure_half(run: &mut Runner, r: &mut Renderer, name: &str, size: (u32, u32)
     Ablated { rows, scene: name.into(), size: half }
 }
 
-/// Runs the ablation of every row with a claimed fill, vertex or draw bound (`rows[i]`
-/// measured as `origins[i]`), `frames` timed frames a side, and fills in each such row's
-/// `ablation` and `bound_confirmed` against `model`'s predictions.
+/// Relative change allowed in the work an ablation must leave alone ([`isolation`]).
+pub const ISOLATION_TOLERANCE: f64 = 0.02;
+
+/// Why `kind`'s ablation (`base` against `ablated`, their counted work) does not test the bound
+/// alone, or `None` where it does: it must cut the bound's work and leave the rest within
+/// [`ISOLATION_TOLERANCE`] — fill: the volumes' triangles, draws and (light, caster) passes
+/// (half the size changes none of them unless culling or a case moves); vertex: the draws and
+/// passes (the fragments move with the coarser outline, counted by the prediction); draw: the
+/// shadow triangles and fragments (merging casters keeps the volumes unless it changes a
+/// caster's case or culling, as a merged caster under lights of limited range does).
+pub fn isolation(kind: &str, base: &SuiteRow, ablated: &SuiteRow) -> Option<String> {
+    let moved = |what: &str, a: Option<u64>, b: Option<u64>| -> Option<String> {
+        let (a, b) = (a? as f64, b? as f64);
+        let change = (b - a).abs() / a.max(b).max(1.0);
+        (change > ISOLATION_TOLERANCE).then(|| format!("{what} {a:.0} -> {b:.0}"))
+    };
+    let triangles = moved("shadow triangles", Some(base.shadow_triangles), Some(ablated.shadow_triangles));
+    let draws = moved("draws", Some(base.draws), Some(ablated.draws));
+    let passes = moved("caster passes", Some(base.caster_passes), Some(ablated.caster_passes));
+    let fragments = moved("stencil fragments", base.stencil_fragments, ablated.stencil_fragments);
+    let changed: Vec<String> = match kind {
+        "fill" => [triangles, draws, passes].into_iter().flatten().collect(),
+        "vertex" => [draws, passes].into_iter().flatten().collect(),
+        _ => [triangles, fragments].into_iter().flatten().collect(),
+    };
+    (!changed.is_empty()).then(|| format!("not isolated: the {kind} ablation also changed {}", changed.join(", ")))
+}
+
+/// `kind`'s ablation of the row timed as `base`, the ablated work timed as `ablated`: the
+/// model's predicted saving against the measured one, where the ablation cuts the bound's
+/// work alone ([`isolation`]; otherwise no test, and the verdict says what else moved).
+fn judge(kind: &str, base: &SuiteRow, ablated: &SuiteRow, model: &Model, frames: usize) -> RowAblation {
+    let mut a = RowAblation { kind: kind.into(), frames, ..Default::default() };
+    if let Some(why) = isolation(kind, base, ablated) {
+        (a.baseline_ms, a.ablated_ms, a.verdict) = (base.gpu_shadow_ms, ablated.gpu_shadow_ms, why);
+        return a;
+    }
+    match (Timing::of(base), Timing::of(ablated), model.predict(base), model.predict(ablated)) {
+        (Some(tb), Some(tx), Some(pb), Some(px)) => {
+            let v = decide(tb, tx, pb - px);
+            a.predicted_saving_ms = Some(pb - px);
+            a.measured_saving_ms = Some(v.measured);
+            a.spread_ms = Some(v.spread);
+            a.baseline_ms = Some(tb.median);
+            a.ablated_ms = Some(tx.median);
+            a.confirmed = v.confirmed;
+            a.verdict = v.why;
+        }
+        _ => a.verdict = "not run: untimed or without counters".into(),
+    }
+    a
+}
+
+/// Records `a` as row `r`'s ablation, counted in `summary`.
+fn record(summary: &mut ProofSummary, r: &mut SuiteRow, a: RowAblation) {
+    summary.claimed += 1;
+    match a.predicted_saving_ms {
+        Some(_) => {
+            summary.ablated += 1;
+            summary.confirmed += a.confirmed as usize;
+            summary.refuted += !a.confirmed as usize;
+            summary.from_sweep += a.from_sweep as usize;
+        }
+        None => summary.not_run += 1,
+    }
+    r.bound_confirmed = a.confirmed;
+    r.ablation = Some(a);
+}
+
+/// Runs the ablation of every row where the model names a fill, vertex or draw bound clearly
+/// (`rows[i]` measured as `origins[i]`) and fills in its `ablation` and `bound_confirmed`
+/// against `model`'s predictions. Where the ablated work is itself a point the sweeps measured
+/// with the same variant ([`ablated_point`]: the resolution and caps sweeps' half sizes, the
+/// triangles sweep's quarter, the casters sweep's one caster), the two rows are compared as
+/// they are, the nearest such point in measurement order; every other row is re-timed
+/// (`frames` timed frames a side) right before its ablation, rows of one scene and size on one
+/// renderer.
 pub(super) fn prove(run: &mut Runner, rows: &mut [SuiteRow], origins: &[Origin], model: &Model, frames: usize) -> Result<ProofSummary> {
     let start = Instant::now();
+    let mut summary = ProofSummary { frames, ..Default::default() };
     let mut groups: Vec<Group> = Vec::new();
-    for (i, (r, o)) in rows.iter().zip(origins).enumerate() {
-        if !r.bound_clear || kind_of(&r.bound).is_none() || Timing::of(r).is_none() {
+    for i in 0..rows.len() {
+        let Some(kind) = kind_of(&rows[i].bound).filter(|_| rows[i].bound_clear && Timing::of(&rows[i]).is_some()) else { continue };
+        let o = &origins[i];
+        let twin = ablated_point(kind, &o.scene, o.size).and_then(|(scene, size)| {
+            (0..rows.len())
+                .filter(|&j| j != i && origins[j].scene == scene && origins[j].size == size && origins[j].variant == o.variant)
+                .filter(|&j| Timing::of(&rows[j]).is_some())
+                .min_by_key(|&j| j.abs_diff(i))
+        });
+        if let Some(j) = twin {
+            let mut a = judge(kind, &rows[i], &rows[j], model, rows[i].frames.min(rows[j].frames));
+            a.from_sweep = true;
+            a.ablated_scene = rows[j].scene.clone();
+            a.ablated_size = [rows[j].width, rows[j].height];
+            record(&mut summary, &mut rows[i], a);
             continue;
         }
         match groups.iter_mut().find(|g| g.scene == o.scene && g.size == o.size) {
@@ -150,7 +261,6 @@ pub(super) fn prove(run: &mut Runner, rows: &mut [SuiteRow], origins: &[Origin],
     }
     let saved_frames = std::mem::replace(&mut run.frames, frames);
     run.bar.inc_length(groups.iter().map(|g| 2 * g.rows.len() as u64).sum());
-    let mut summary = ProofSummary { frames, ..Default::default() };
     for g in &groups {
         let of_kind = |k: &str| -> Vec<Variant> {
             let mut v: Vec<Variant> = Vec::new();
@@ -171,9 +281,14 @@ pub(super) fn prove(run: &mut Runner, rows: &mut [SuiteRow], origins: &[Origin],
         }
         let (scene, name) = scene_of(&g.scene)?;
         run.bar.set_message(format!("proofs {name} {}x{}", g.size.0, g.size.1));
-        let merged = if draw.is_empty() { None } else { merged_casters(&scene, &name) };
+        let merged = match (draw.is_empty(), ablated_point("draw", &g.scene, g.size)) {
+            (true, _) => None,
+            (false, Some((p, _))) => Some(scene_of(&p)?),
+            (false, None) => merged_casters(&scene, &name),
+        };
         // The rows re-timed, then at half the size on the same renderer.
         let mut r = run.renderer(scene, g.size)?;
+        summary.points += 1;
         let base = run.measure(&mut r, Point { sweep: "proof", x: 0.0, name: &name }, &all, false);
         let half = if fill.is_empty() { None } else { Some(measure_half(run, &mut r, &name, g.size, &fill)) };
         run.release(r);
@@ -191,6 +306,7 @@ pub(super) fn prove(run: &mut Runner, rows: &mut [SuiteRow], origins: &[Origin],
             (false, Some((s, n))) => Some(measure_on(run, s, &n, g.size, &draw)),
             (false, None) => Some(Ablated { rows: Err("not run: one caster, nothing to merge".into()), scene: name.clone(), size: g.size }),
         };
+        summary.points += coarse.is_some() as usize + joined.is_some() as usize;
         for &i in &g.rows {
             let kind = kind_of(&rows[i].bound).unwrap_or("fill");
             let ablated = match kind {
@@ -200,11 +316,6 @@ pub(super) fn prove(run: &mut Runner, rows: &mut [SuiteRow], origins: &[Origin],
             };
             let variant = &origins[i].variant;
             let find = |set: &[(SuiteRow, Variant)]| set.iter().find(|(_, v)| v == variant).map(|(r, _)| r.clone());
-            let mut a = RowAblation { kind: kind.into(), frames, ..Default::default() };
-            if let Some(ab) = ablated {
-                a.ablated_scene = ab.scene.clone();
-                a.ablated_size = [ab.size.0, ab.size.1];
-            }
             let pair = match ablated.map(|ab| &ab.rows) {
                 Some(Ok(set)) => match (find(&base), find(set)) {
                     (Some(b), Some(x)) => Ok((b, x)),
@@ -213,30 +324,15 @@ pub(super) fn prove(run: &mut Runner, rows: &mut [SuiteRow], origins: &[Origin],
                 Some(Err(why)) => Err(why.clone()),
                 None => Err("not run".to_string()),
             };
-            match pair {
-                Ok((b, x)) => match (Timing::of(&b), Timing::of(&x), model.predict(&b), model.predict(&x)) {
-                    (Some(tb), Some(tx), Some(pb), Some(px)) => {
-                        let v = decide(tb, tx, pb - px);
-                        a.predicted_saving_ms = Some(pb - px);
-                        a.measured_saving_ms = Some(v.measured);
-                        a.spread_ms = Some(v.spread);
-                        a.baseline_ms = Some(tb.median);
-                        a.ablated_ms = Some(tx.median);
-                        a.confirmed = v.confirmed;
-                        a.verdict = v.why;
-                        summary.ablated += 1;
-                    }
-                    _ => a.verdict = "not run: untimed or without counters".into(),
-                },
-                Err(why) => a.verdict = why,
+            let mut a = match pair {
+                Ok((b, x)) => judge(kind, &b, &x, model, frames),
+                Err(why) => RowAblation { kind: kind.into(), frames, verdict: why, ..Default::default() },
+            };
+            if let Some(ab) = ablated {
+                a.ablated_scene = ab.scene.clone();
+                a.ablated_size = [ab.size.0, ab.size.1];
             }
-            if a.predicted_saving_ms.is_none() {
-                summary.not_run += 1;
-            }
-            summary.confirmed += a.confirmed as usize;
-            summary.claimed += 1;
-            rows[i].bound_confirmed = a.confirmed;
-            rows[i].ablation = Some(a);
+            record(&mut summary, &mut rows[i], a);
         }
     }
     run.frames = saved_frames;
@@ -276,6 +372,52 @@ mod tests {
         assert!(!decide(t(5.0, 4.9, 5.1), t(6.0, 5.9, 6.1), -1.0).confirmed);
         assert!(!decide(t(f64::NAN, 1.0, 2.0), t(1.0, 1.0, 1.0), 1.0).confirmed);
         assert!(!decide(t(10.0, 9.0, 11.0), t(1.0, 0.5, 1.5), f64::INFINITY).confirmed);
+    }
+
+    #[test]
+    fn an_ablation_that_moves_other_work_tests_nothing() {
+        let row = |tris: u64, frags: u64, draws: u64, passes: u64| SuiteRow {
+            shadow_triangles: tris,
+            stencil_fragments: Some(frags),
+            draws,
+            caster_passes: passes,
+            ..Default::default()
+        };
+        // Merging casters: the same volumes, fewer passes: a draw test.
+        assert_eq!(isolation("draw", &row(1000, 5000, 256, 256), &row(1000, 5000, 256, 1)), None);
+        // A merged caster that lost its culling draws more volumes: no draw test.
+        let why = isolation("draw", &row(1000, 5000, 8, 8), &row(3000, 9000, 1, 1)).unwrap();
+        assert!(why.contains("shadow triangles 1000 -> 3000") && why.contains("stencil fragments"), "{why}");
+        // Half the size: a quarter of the fragments, the same triangles: a fill test.
+        assert_eq!(isolation("fill", &row(1000, 4000, 4, 4), &row(1000, 1000, 4, 4)), None);
+        assert!(isolation("fill", &row(1000, 4000, 4, 4), &row(900, 1000, 4, 4)).is_some());
+        // Coarser: fewer triangles, the outline's fragments move a little: a vertex test.
+        assert_eq!(isolation("vertex", &row(1000, 4000, 4, 4), &row(500, 3900, 4, 4)), None);
+        assert!(isolation("vertex", &row(1000, 4000, 4, 4), &row(500, 3900, 2, 4)).is_some());
+    }
+
+    #[test]
+    fn the_quick_sweeps_hold_their_own_ablations() {
+        use super::super::sweeps::{points, Scale, ONE_FACTOR};
+        let quick = points(Scale::Quick);
+        let at = |sweep: &str, x: f64| quick.iter().find(|p| p.sweep == sweep && p.x == x).unwrap_or_else(|| panic!("{sweep} {x}"));
+        let measured = |target: Option<(PointScene, (u32, u32))>| {
+            let (scene, size) = target.expect("an ablation");
+            quick.iter().any(|p| p.scene == scene && p.size == size)
+        };
+        // The 256 separate spheres merged: the one-factor casters sweep's single caster.
+        let separate = at("casters", 256.0);
+        let one = ablated_point("draw", &separate.scene, separate.size).unwrap();
+        assert_eq!(one.0, at(ONE_FACTOR[0], 1.0).scene);
+        // The centre's quarter of the triangles; the resolution and caps sweeps' half sizes.
+        let centre = at(ONE_FACTOR[0], 16.0);
+        assert!(measured(ablated_point("vertex", &centre.scene, centre.size)));
+        assert!(measured(ablated_point("draw", &centre.scene, centre.size)));
+        let full_hd = quick.iter().find(|p| p.sweep == "resolution" && p.size == (1920, 1080)).unwrap();
+        assert!(measured(ablated_point("fill", &full_hd.scene, full_hd.size)));
+        // A named scene is coarsened or merged by the proof itself; one caster merges nothing.
+        assert_eq!(ablated_point("vertex", &PointScene::Named("bench/vertex".into()), (960, 540)), None);
+        assert_eq!(ablated_point("draw", &at("casters", 1.0).scene, (960, 540)), None);
     }
 
     #[test]

@@ -1,11 +1,12 @@
 //! Measuring one point of the suite: a renderer for a scene at a size, one counting frame per
-//! variant (exact fragments and pipeline statistics; not timed), then a warm-up round and
+//! variant (exact fragments and pipeline statistics; not timed: the warm-up round too), then
 //! timed rounds over the variants (round-robin, so drift hits every variant alike), medians
 //! and the p10–p90 spread of the GPU timestamps. The suite ([`super::suite`]) measures its
 //! sweeps through it, the bound proofs ([`super::proof`]) their ablations.
 
-use super::classic::{median, technique_label};
+use super::classic::technique_label;
 use super::report::{RowLimits, SuiteRow};
+use super::stats::{median, quantile};
 use super::sweeps::{self, PointScene};
 use crate::accuracy::evaluate;
 use crate::error::{Error, Result};
@@ -44,6 +45,8 @@ struct PointShape {
     map_faces: u64,
     /// Each shadow-casting mesh's triangles, by name.
     mesh_triangles: HashMap<String, u64>,
+    /// Triangles the G-buffer pass draws: every opaque mesh's, 12 a sphere (its cube).
+    gbuffer_triangles: u64,
 }
 
 impl PointShape {
@@ -56,6 +59,8 @@ impl PointShape {
             // Six faces per point light, one per spot or directional light.
             map_faces: scene.lights.iter().map(|l| if l.kind == crate::scene::LightKind::Point { 6 } else { 1 }).sum(),
             mesh_triangles: casting().map(|m| (m.name.clone(), m.mesh.triangles.len() as u64)).collect(),
+            gbuffer_triangles: scene.meshes.iter().filter(|m| m.opacity >= 1.0).map(|m| m.mesh.triangles.len() as u64).sum::<u64>()
+                + 12 * scene.spheres.len() as u64,
         }
     }
 }
@@ -86,7 +91,7 @@ pub(super) struct Runner {
 /// Fewest timed frames a point is cut to by its budget.
 pub const MIN_FRAMES: usize = 5;
 
-/// Timed rounds for a point whose warm-up round took `round_s` wall seconds: `frames`, or
+/// Timed rounds for a point whose warm-up (counting) round took `round_s` wall seconds: `frames`, or
 /// as many as fit `budget_s` where fewer do, never below [`MIN_FRAMES`] (nor above `frames`).
 pub fn frames_within(frames: usize, round_s: f64, budget_s: f64) -> usize {
     let fit = budget_s / round_s.max(1e-6);
@@ -125,7 +130,9 @@ impl Runner {
         variants: &[Variant],
         errors: bool,
     ) -> Result<Vec<(SuiteRow, Variant)>> {
+        let t = Instant::now();
         let mut r = self.renderer(scene, size)?;
+        self.note("renderer built", t);
         let result = self.measure(&mut r, at, variants, errors);
         self.release(r);
         result
@@ -151,6 +158,13 @@ impl Runner {
         self.ctx = Some(r.into_context());
     }
 
+    /// With a log, how long `what` took since `since`.
+    fn note(&self, what: &str, since: Instant) {
+        if self.log {
+            eprintln!("           {what}: {:.1} s", since.elapsed().as_secs_f64());
+        }
+    }
+
     /// Measures every variant on `r`'s scene at its size (see [`point`](Runner::point)).
     pub fn measure(&mut self, r: &mut Renderer, at: Point, variants: &[Variant], errors: bool) -> Result<Vec<(SuiteRow, Variant)>> {
         let Point { sweep, x, name } = at;
@@ -158,7 +172,7 @@ impl Runner {
             let (w, h) = (r.config().width, r.config().height);
             eprintln!("[{:>6.1} s] {sweep} {name} {w}x{h} ({} variants)", self.start.elapsed().as_secs_f64(), variants.len());
         }
-        let PointShape { casters, triangles, nlights, map_faces, mesh_triangles } = PointShape::of(r.scene());
+        let PointShape { casters, triangles, nlights, map_faces, mesh_triangles, gbuffer_triangles } = PointShape::of(r.scene());
         let mut kept: Vec<&Variant> = Vec::with_capacity(variants.len());
         for v in variants {
             match v.technique {
@@ -176,12 +190,15 @@ impl Runner {
         let variants = kept;
         let mut error: HashMap<Technique, f64> = HashMap::new();
         if errors {
+            let t = Instant::now();
             let techniques: Vec<Technique> = variants.iter().map(|v| v.technique).collect();
             let rows = evaluate_fractions(r, name, &techniques)?;
             for (t, f) in techniques.iter().zip(rows) {
                 error.insert(*t, f);
             }
+            self.note("errors against the reference", t);
         }
+        let counting = Instant::now();
         // One frame first: the casters' uploads land in it, not in a variant's counts.
         r.render()?;
         let base = r.settings;
@@ -191,7 +208,9 @@ impl Runner {
             r.settings.toggles = v.toggles;
             r.settings.index_format = v.index_format;
         };
-        // Counting frames (not timed).
+        // Counting frames, not timed: also the warm-up round (every variant's buffers sized and
+        // first-use costs paid before any timed frame), whose wall time sets how many timed
+        // rounds fit the budget (a counting frame costs a little more than a timed one).
         let mut counted = Vec::with_capacity(variants.len());
         for v in &variants {
             apply(r, v);
@@ -199,6 +218,9 @@ impl Runner {
             counted.push(r.render()?.stats);
             r.settings.counters = false;
         }
+        let frames = frames_within(self.frames, counting.elapsed().as_secs_f64(), self.point_budget_s);
+        self.note("counting frames (the warm-up round)", counting);
+        let timing = Instant::now();
         // Timed frames, round-robin.
         #[derive(Default)]
         struct Acc {
@@ -211,17 +233,10 @@ impl Runner {
             plan: Vec<f64>,
         }
         let mut acc: Vec<Acc> = variants.iter().map(|_| Acc::default()).collect();
-        let mut frames = self.frames;
-        let mut frame = 0;
-        while frame <= frames {
-            let round = Instant::now();
-            for (k, v) in variants.iter().enumerate() {
+        for _ in 0..frames {
+            for (v, a) in variants.iter().zip(&mut acc) {
                 apply(r, v);
                 let f = r.render()?;
-                if frame == 0 {
-                    continue;
-                }
-                let a = &mut acc[k];
                 if let Some(g) = &f.stats.gpu_ms {
                     a.shadow.push(g.shadow);
                     a.map.push(g.shadow_map);
@@ -232,13 +247,9 @@ impl Runner {
                 }
                 a.plan.push(f.stats.cpu_ms.plan + f.stats.cpu_ms.silhouettes);
             }
-            if frame == 0 {
-                // The warm-up round's wall time sets how many timed rounds fit the budget.
-                frames = frames_within(frames, round.elapsed().as_secs_f64(), self.point_budget_s);
-            }
-            frame += 1;
         }
         r.settings = base;
+        self.note(&format!("{frames} timed rounds"), timing);
         let (w, h) = (r.config().width, r.config().height);
         let mut rows = Vec::new();
         for ((v, s), a) in variants.iter().zip(counted).zip(acc) {
@@ -249,7 +260,7 @@ impl Runner {
             };
             let shadow_map = map_size.is_some();
             let med = |x: Vec<f64>| (!x.is_empty()).then(|| median(x));
-            let q = |x: &[f64], p: f64| (!x.is_empty()).then(|| super::model::quantile(x, p));
+            let q = |x: &[f64], p: f64| (!x.is_empty()).then(|| quantile(x, p));
             let (p10, p90) = (q(&a.shadow, 0.1), q(&a.shadow, 0.9));
             // Per light, the casters it did not cull, and their meshes' triangles.
             let drawn = s.lights.iter().flat_map(|l| l.casters.iter()).filter(|c| c.case != crate::shadow::Case::Culled);
@@ -259,6 +270,14 @@ impl Runner {
             let (map_ms, lookup_ms) = match shadow_map {
                 true => (med(a.map.clone()), med(lookup)),
                 false => (None, None),
+            };
+            let lit_pixels: u64 =
+                s.lights.iter().map(|l| l.scissor.map_or(w as u64 * h as u64, |[_, _, sw, sh]| sw as u64 * sh as u64)).sum();
+            let (illum_ms, depth_ms) = (med(a.illum), med(a.depth));
+            // Work at a limit's rate over the pass's time (1 = at the limit).
+            let at = |n: u64, rate: f64, unit: f64, ms: Option<f64>| match ms {
+                Some(ms) if rate > 0.0 && ms > 0.0 => Some(n as f64 / (rate * unit) * 1e3 / ms),
+                _ => None,
             };
             let mut row = SuiteRow {
                 suite: "fill-vertex".into(),
@@ -283,8 +302,12 @@ impl Runner {
                 gpu_tlas_ms: if v.technique == Technique::RayQuery { med(a.accel) } else { None },
                 blas_build_ms: s.ray_query.as_ref().filter(|_| v.technique == Technique::RayQuery).map(|q| q.bottom_level_build_ms),
                 gpu_frame_ms: med(a.frame),
-                gpu_depth_ms: med(a.depth),
-                gpu_illuminate_ms: med(a.illum),
+                gpu_depth_ms: depth_ms,
+                gpu_illuminate_ms: illum_ms,
+                lit_pixels,
+                lighting_limit_fraction: at(lit_pixels, self.limits.lighting_gpix_s, 1e9, illum_ms),
+                gbuffer_triangles,
+                gbuffer_limit_fraction: at(gbuffer_triangles, self.limits.gbuffer_tri_mtri_s, 1e6, depth_ms),
                 stencil_fragments: c.stencil_fragments,
                 shadow_triangles: s.totals.triangles.total(),
                 shadow_sides: s.totals.triangles.sides,

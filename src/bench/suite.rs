@@ -15,17 +15,19 @@ pub use super::runner::{frames_within, MIN_FRAMES};
 
 use super::limits::{self, Limits, LimitsConfig};
 use super::methods::all_techniques;
+use super::phases::{load_average, Clock};
 use super::proof::{self, Origin};
-use super::report::{Ablation, RowLimits, SuiteReport, SuiteRow};
+use super::report::{RowLimits, SuiteReport, SuiteRow};
 use super::runner::{scene_of, Point, Runner, Variant};
-use super::sweeps::{self, PointScene, Scale, SweepPoint};
+use super::sweeps::{self, PointScene, Scale, SweepPoint, ONE_FACTOR};
+use super::toggles::{ablations, index_variants, no_depth_bounds, toggle_variants};
 use crate::error::{Error, Result};
 use crate::gpu::Context;
-use crate::render::{IndexFormat, PassToggles, Technique};
+use crate::render::Technique;
 use crate::shadow::Method;
 use std::collections::BTreeMap;
+use std::ops::Range;
 use std::path::PathBuf;
-use std::time::Instant;
 
 /// What to run (the CLI's `bench --suite` arguments).
 #[derive(Clone, Debug)]
@@ -42,10 +44,17 @@ pub struct SuiteConfig {
     pub progress: bool,
 }
 
+/// Rows in measurement order, each segment either measured for its sweep or a sweep's copy
+/// of an identical point measured before (relabelled with that sweep and x).
+struct Segment {
+    rows: Range<usize>,
+    copy_as: Option<(&'static str, f64)>,
+}
+
 /// Runs the suite on `ctx` and writes its outputs into `cfg.out`.
 pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
-    let start = Instant::now();
-    let cpu0 = process_cpu_seconds();
+    let mut clock = Clock::start();
+    let load_average_start = load_average();
     let scale = cfg.scale;
     let frames = cfg.frames.unwrap_or_else(|| scale.frames()).max(1);
     let base = scale.base_size();
@@ -60,6 +69,7 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
         &ctx,
         &LimitsConfig { width: base.0, height: base.1, reps: if scale == Scale::Full { 5 } else { 3 }, scale: lscale },
     )?;
+    clock.lap("limits", 0, 0);
     let row_limits = RowLimits {
         stencil_fill_gfrag_s: limits.stencil_fill_gfrag_s,
         small_tri_mtri_s: limits.small_tri_mtri_s,
@@ -67,10 +77,14 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
         draws_per_s: limits.draws_per_s,
         setup_tri_mtri_s: limits.setup_tri_mtri_s,
         clip_tri_mtri_s: limits.clip_tri_mtri_s,
+        lighting_gpix_s: limits.lighting_gpix_s,
+        gbuffer_tri_mtri_s: limits.gbuffer_tri_mtri_s,
     };
     // Multiview cube faces where the renderer trusts the device's multiview (gpu::quirks).
     let multiview = ctx.features.multiview && crate::gpu::quirks::multiview_defect(&ctx.info).is_none();
     let techniques = all_techniques(&scale.shadow_map_sizes(), ctx.features.ray_query, multiview, ctx.features.mesh_shader);
+    let named_techniques = all_techniques(&scale.named_shadow_map_sizes(), ctx.features.ray_query, multiview, ctx.features.mesh_shader);
+    let not_measured = not_measured(&ctx);
     let points = sweeps::points(scale);
     // The tiny suite (tests) leaves the 435k-triangle vertex scene out.
     let named: &[&str] = if scale == Scale::Tiny { &["bench/fill", "default"] } else { &["bench/fill", "bench/vertex"] };
@@ -87,12 +101,12 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
     // The named scenes also read each shadow map with gathers (the same picture; the lookup's
     // cost side by side with the nine taps').
     let gathers: Vec<Variant> = scale
-        .shadow_map_sizes()
+        .named_shadow_map_sizes()
         .into_iter()
         .map(|size| Variant::of(Technique::ShadowMap { size, pcf: crate::render::Pcf::Gather, cube: Default::default() }))
         .collect();
-    let units = (named.len() + points.len() - caps_points) * techniques.len()
-        + named.len() * gathers.len()
+    let units = (points.len() - caps_points) * techniques.len()
+        + named.len() * (named_techniques.len() + gathers.len())
         + caps_points * caps.len()
         + (ablation_scenes.len() + 1) * toggle_variants.len()
         + index_variants.len();
@@ -114,66 +128,103 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
         frames_in_flight: cfg.frames_in_flight,
         bar,
         skipped: Vec::new(),
-        start,
+        start: std::time::Instant::now(),
         point_budget_s: if cfg.frames.is_some() { f64::INFINITY } else { scale.point_budget_s() },
     };
     let mut rows: Vec<SuiteRow> = Vec::new();
     let mut origins: Vec<Origin> = Vec::new();
+    let mut segments: Vec<Segment> = Vec::new();
     // Each point's rows, and how each was measured (for its bound's proof).
-    let mut keep = |measured: Vec<(SuiteRow, Variant)>, scene: &PointScene, size: (u32, u32)| {
+    let mut keep = |rows: &mut Vec<SuiteRow>,
+                    segments: &mut Vec<Segment>,
+                    measured: Vec<(SuiteRow, Variant)>,
+                    scene: &PointScene,
+                    size: (u32, u32)| {
+        let first = rows.len();
         for (row, variant) in measured {
             rows.push(row);
             origins.push(Origin { scene: scene.clone(), size, variant });
         }
+        segments.push(Segment { rows: first..rows.len(), copy_as: None });
     };
     let all: Vec<Variant> = techniques.iter().map(|&t| Variant::of(t)).collect();
-    let named_all: Vec<Variant> = all.iter().chain(&gathers).cloned().collect();
+    let named_all: Vec<Variant> = named_techniques.iter().map(|&t| Variant::of(t)).chain(gathers.iter().cloned()).collect();
     // The named scenes, with their error (the Pareto chart).
     for &n in named {
         run.bar.set_message(format!("scenes {n}"));
         let scene = crate::scene::load(n)?;
-        keep(run.point(Point { sweep: "scenes", x: 0.0, name: n }, scene, base, &named_all, true)?, &PointScene::Named(n.into()), base);
+        let measured = run.point(Point { sweep: "scenes", x: 0.0, name: n }, scene, base, &named_all, true)?;
+        keep(&mut rows, &mut segments, measured, &PointScene::Named(n.into()), base);
     }
+    clock.lap("scenes", named.len(), 0);
+    // Every technique's points, measured once: a one-factor point identical to one measured
+    // before (the same scene at the same size, every technique) takes its rows.
+    let mut measured_points: Vec<(PointScene, (u32, u32), Range<usize>)> = Vec::new();
     for p in &points {
         let SweepPoint { sweep, x, scene: source, size } = p;
-        let (scene, name) = scene_of(source)?;
-        run.bar.set_message(format!("{sweep} {name} {}x{}", size.0, size.1));
         let variants = if *sweep == "caps" { &caps } else { &all };
-        keep(run.point(Point { sweep, x: *x, name: &name }, scene, *size, variants, false)?, source, *size);
+        let earlier = measured_points.iter().find(|(s, z, _)| s == source && z == size).map(|m| m.2.clone());
+        match earlier.filter(|_| ONE_FACTOR.contains(sweep)) {
+            Some(range) => {
+                run.bar.inc(range.len() as u64);
+                segments.push(Segment { rows: range, copy_as: Some((sweep, *x)) });
+                clock.lap(sweep, 0, 1);
+            }
+            None => {
+                let (scene, name) = scene_of(source)?;
+                run.bar.set_message(format!("{sweep} {name} {}x{}", size.0, size.1));
+                let first = rows.len();
+                let measured = run.point(Point { sweep, x: *x, name: &name }, scene, *size, variants, false)?;
+                keep(&mut rows, &mut segments, measured, source, *size);
+                if variants == &all {
+                    measured_points.push((source.clone(), *size, first..rows.len()));
+                }
+                clock.lap(sweep, 1, 0);
+            }
+        }
     }
     // Ablations: McGuire with each optimisation off; index formats on the vertex scene.
     for &n in ablation_scenes {
         run.bar.set_message(format!("ablation {n}"));
         let scene = crate::scene::load(n)?;
-        keep(
-            run.point(Point { sweep: "ablation", x: 0.0, name: n }, scene, base, &toggle_variants, false)?,
-            &PointScene::Named(n.into()),
-            base,
-        );
+        let measured = run.point(Point { sweep: "ablation", x: 0.0, name: n }, scene, base, &toggle_variants, false)?;
+        keep(&mut rows, &mut segments, measured, &PointScene::Named(n.into()), base);
     }
     // Lights with a range, casters beyond some of them: what scissor and culling are for.
     let ranged = super::scenes::SweepScene::ranged();
-    keep(
-        run.point(Point { sweep: "ablation", x: 0.0, name: &ranged.name() }, ranged.build(), base, &toggle_variants, false)?,
-        &PointScene::Param(ranged),
-        base,
-    );
+    let measured = run.point(Point { sweep: "ablation", x: 0.0, name: &ranged.name() }, ranged.build(), base, &toggle_variants, false)?;
+    keep(&mut rows, &mut segments, measured, &PointScene::Param(ranged), base);
     run.bar.set_message("ablation index formats");
-    keep(
-        run.point(Point { sweep: "ablation", x: 0.0, name: index_scene }, crate::scene::load(index_scene)?, base, &index_variants, false)?,
-        &PointScene::Named(index_scene.into()),
-        base,
-    );
+    let measured =
+        run.point(Point { sweep: "ablation", x: 0.0, name: index_scene }, crate::scene::load(index_scene)?, base, &index_variants, false)?;
+    keep(&mut rows, &mut segments, measured, &PointScene::Named(index_scene.into()), base);
+    clock.lap("ablation", ablation_scenes.len() + 2, 0);
     let model = super::model::fit(&mut rows, limit_costs(&limits));
     for r in &mut rows {
         sweeps::classify(r, row_limits);
     }
-    // Every claimed bound put to the test, on the same device, before the context goes.
+    clock.lap("model", 0, 0);
+    // Every candidate bound put to the test, on the same device, before the context goes.
     let proof_frames = cfg.frames.map_or(scale.proof_frames(), |f| f.max(3));
     let bound_proofs = proof::prove(&mut run, &mut rows, &origins, &model, proof_frames)?;
+    clock.lap("proofs", bound_proofs.points, 0);
     run.bar.finish_and_clear();
     let ctx = run.ctx.take().ok_or_else(|| Error::Other("context lost".into()))?;
     ctx.check_validation()?;
+    // The rows in measurement order, the shared points' copies relabelled in their places.
+    let rows: Vec<SuiteRow> = segments
+        .iter()
+        .flat_map(|seg| {
+            seg.rows.clone().map(|i| {
+                let mut r = rows[i].clone();
+                if let Some((sweep, x)) = seg.copy_as {
+                    r.measured_in = std::mem::replace(&mut r.sweep, sweep.to_string());
+                    r.x = x;
+                }
+                r
+            })
+        })
+        .collect::<Vec<_>>();
     let crossovers = sweeps::crossovers(&rows);
     let mut ablations = ablations(&rows);
     if !ctx.features.depth_bounds {
@@ -194,14 +245,26 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
         ablations,
         plots: Vec::new(),
         cpu_seconds: None,
-        load_average: load_average(),
+        load_average: None,
+        load_average_start,
         skipped: run.skipped,
         bound_proofs,
+        phases: Vec::new(),
+        techniques: techniques.iter().map(|&t| super::classic::technique_label(t)).collect(),
+        named_techniques: named_techniques
+            .iter()
+            .chain(gathers.iter().map(|v| &v.technique))
+            .map(|&t| super::classic::technique_label(t))
+            .collect(),
+        not_measured,
     };
     std::fs::create_dir_all(&cfg.out).map_err(|e| Error::io(cfg.out.display().to_string(), e))?;
     report.plots = super::plots::write_all(&report, &cfg.out)?;
-    report.seconds = start.elapsed().as_secs_f64();
-    report.cpu_seconds = process_cpu_seconds().map(|c| c - cpu0.unwrap_or(0.0));
+    clock.lap("plots", 0, 0);
+    report.phases = clock.phases.clone();
+    report.seconds = clock.seconds();
+    report.cpu_seconds = clock.cpu_seconds();
+    report.load_average = load_average();
     report.write(&cfg.out)?;
     Ok(report)
 }
@@ -220,95 +283,21 @@ fn limit_costs(limits: &Limits) -> BTreeMap<String, f64> {
     .collect()
 }
 
-/// The depth-bounds ablation of `scene`, skipped: the device has no `depthBounds`.
-fn no_depth_bounds(scene: &str) -> Ablation {
-    Ablation {
-        what: "depth-bounds".into(),
-        scene: scene.into(),
-        variant: "depth-bounds-off".into(),
-        baseline: "all-on".into(),
-        time_ratio: None,
-        fragment_ratio: None,
-        triangle_ratio: None,
-        byte_ratio: None,
-        skipped: "the device has no depthBounds feature (the pass never uses it here)".into(),
+/// The techniques this device cannot run, and why (the report says they were not measured).
+fn not_measured(ctx: &Context) -> BTreeMap<String, String> {
+    let mut out = BTreeMap::new();
+    let version = format!("{} {}", ctx.info.driver, ctx.info.driver_info);
+    if !ctx.features.mesh_shader {
+        out.insert(
+            "mesh".to_string(),
+            format!("{version} has no VK_EXT_mesh_shader (meshShader, Vulkan 1.2 or newer); Mesa lavapipe 25.0.7 has it (`scripts/drivers.sh install 25.0.7`)"),
+        );
     }
-}
-
-fn toggle_variants(ctx: &Context) -> Vec<Variant> {
-    let m = Technique::Volumes(Method::McGuire);
-    let on = PassToggles::default();
-    let mut v = vec![
-        Variant { label: "all-on".into(), ..Variant::of(m) },
-        Variant { label: "scissor-off".into(), toggles: PassToggles { scissor: false, ..on }, ..Variant::of(m) },
-        Variant { label: "culling-off".into(), toggles: PassToggles { culling: false, ..on }, ..Variant::of(m) },
-    ];
-    if ctx.features.depth_bounds {
-        v.push(Variant { label: "depth-bounds-off".into(), toggles: PassToggles { depth_bounds: false, ..on }, ..Variant::of(m) });
-    }
-    v
-}
-
-fn index_variants() -> Vec<Variant> {
-    let m = Technique::Volumes(Method::McGuire);
-    [IndexFormat::U8, IndexFormat::U16, IndexFormat::U32, IndexFormat::Naive]
-        .into_iter()
-        .map(|f| Variant { label: format!("index-{}", f.name()), index_format: f, ..Variant::of(m) })
-        .collect()
-}
-
-/// The constant factors as ratios: toggles against `all-on`, the other methods' triangles and
-/// time against McGuire's on the named scenes, index formats against u16.
-fn ablations(rows: &[SuiteRow]) -> Vec<Ablation> {
-    let ratio = |a: Option<f64>, b: Option<f64>| match (a, b) {
-        (Some(a), Some(b)) if b > 0.0 => Some(a / b),
-        _ => None,
-    };
-    let make = |what: &str, v: &SuiteRow, b: &SuiteRow, vl: &str, bl: &str| Ablation {
-        what: what.into(),
-        scene: v.scene.clone(),
-        variant: vl.into(),
-        baseline: bl.into(),
-        time_ratio: ratio(v.gpu_shadow_ms, b.gpu_shadow_ms),
-        fragment_ratio: ratio(v.stencil_fragments.map(|x| x as f64), b.stencil_fragments.map(|x| x as f64)),
-        triangle_ratio: ratio(Some(v.shadow_triangles as f64), Some(b.shadow_triangles as f64)),
-        byte_ratio: ratio(Some(v.bytes as f64), Some(b.bytes as f64)),
-        skipped: String::new(),
-    };
-    let mut out = Vec::new();
-    let abl: Vec<&SuiteRow> = rows.iter().filter(|r| r.sweep == "ablation").collect();
-    for b in abl.iter().filter(|r| r.variant == "all-on") {
-        for v in abl.iter().filter(|r| r.scene == b.scene && r.variant.ends_with("-off")) {
-            out.push(make(v.variant.trim_end_matches("-off"), v, b, &v.variant, "all-on"));
-        }
-    }
-    for b in abl.iter().filter(|r| r.variant == "index-u16") {
-        for v in abl.iter().filter(|r| r.scene == b.scene && r.variant.starts_with("index-") && r.variant != "index-u16") {
-            out.push(make("index-format", v, b, &v.variant, "index-u16"));
-        }
-    }
-    let scenes: Vec<&SuiteRow> = rows.iter().filter(|r| r.sweep == "scenes").collect();
-    for b in scenes.iter().filter(|r| r.method == "mcguire") {
-        for v in scenes.iter().filter(|r| r.scene == b.scene && matches!(r.method.as_str(), "lengyel" | "everitt-kilgard" | "zfail")) {
-            out.push(make("method", v, b, &v.method, "mcguire"));
-        }
+    if !ctx.features.ray_query {
+        out.insert(
+            "rayquery".to_string(),
+            format!("{version} has no VK_KHR_ray_query with acceleration structures; Mesa lavapipe 25.0.7 has them"),
+        );
     }
     out
-}
-
-/// This process's CPU time (user + system, all threads: lavapipe's rasteriser threads too),
-/// seconds; Linux only (`/proc/self/stat`, 100 ticks a second).
-fn process_cpu_seconds() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
-    // Fields after the command name (which may hold spaces) in parentheses.
-    let rest = &stat[stat.rfind(')')? + 2..];
-    let f: Vec<&str> = rest.split_whitespace().collect();
-    let (utime, stime): (f64, f64) = (f.get(11)?.parse().ok()?, f.get(12)?.parse().ok()?);
-    Some((utime + stime) / 100.0)
-}
-
-/// The machine's 1-minute load average at the end of the run (other work competing for the
-/// CPU slows lavapipe); Linux only.
-fn load_average() -> Option<f64> {
-    std::fs::read_to_string("/proc/loadavg").ok()?.split_whitespace().next()?.parse().ok()
 }

@@ -4,8 +4,8 @@
 use super::report::{Crossover, RowLimits, SuiteRow};
 use super::scenes::SweepScene;
 
-/// How many points: the full suite, `--quick` (about 10 minutes on lavapipe on 2 cores), or
-/// the tiny one the tests run (two points a sweep, small targets).
+/// How many points: the full suite, `--quick` (under 6 minutes on lavapipe on 2 quiet cores),
+/// or the tiny one the tests run (two points a sweep, small targets).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Scale {
     /// Every point.
@@ -73,8 +73,16 @@ impl Scale {
             Scale::Tiny => f64::INFINITY,
         }
     }
-    /// Shadow-map sizes every point runs.
+    /// Shadow-map sizes every sweep point runs (the quick suite's sweeps: the smallest only,
+    /// a big map with multiview faces costing as much as five volume methods there).
     pub fn shadow_map_sizes(self) -> Vec<u32> {
+        match self {
+            Scale::Full => vec![512, 1024, 2048, 4096],
+            Scale::Quick | Scale::Tiny => vec![512],
+        }
+    }
+    /// Shadow-map sizes the named scenes run (with their error: the Pareto chart).
+    pub fn named_shadow_map_sizes(self) -> Vec<u32> {
         match self {
             Scale::Full => vec![512, 1024, 2048, 4096],
             Scale::Quick => vec![512, 2048],
@@ -100,8 +108,10 @@ pub fn one_factor_grid(scale: Scale) -> (u32, u64, u32) {
     }
 }
 
-/// The one-factor sweeps' points (see [`ONE_FACTOR`]), around one centre point shared by all
-/// three (measured once in each: a repeat).
+/// The one-factor sweeps' points (see [`ONE_FACTOR`]), around one centre point the three
+/// share (the full and quick suites; two in the tiny one), measured once: the suite takes its
+/// rows for the sweeps after the first. The casters sweep's far end is the plain grid, the
+/// `casters` sweep's point of that size (taken from it too).
 fn one_factor_points(scale: Scale) -> Vec<SweepPoint> {
     let base = scale.base_size();
     let (spheres, per, groups) = one_factor_grid(scale);
@@ -111,7 +121,7 @@ fn one_factor_points(scale: Scale) -> Vec<SweepPoint> {
     let (casters, tess, heights): (Vec<u32>, Vec<u64>, Vec<f32>) = match scale {
         Scale::Full => (vec![1, 4, 16, 64, 256], vec![128, 256, 512, 1024, 2048], vec![0.5, 1.0, 1.5, 4.0, 16.0]),
         Scale::Quick => (vec![1, 16, 256], vec![128, 512, 1024], vec![0.5, 1.5, 8.0]),
-        Scale::Tiny => (vec![1, 16], vec![32, 128], vec![0.5, 4.0]),
+        Scale::Tiny => (vec![1, 16], vec![32, 64], vec![1.5, 4.0]),
     };
     let point = |sweep: &'static str, x: f64, p: SweepScene| SweepPoint { sweep, x, scene: PointScene::Param(p), size: base };
     let mut out = Vec::new();
@@ -153,7 +163,7 @@ pub fn points(scale: Scale) -> Vec<SweepPoint> {
         let p = SweepScene { triangles: t as u64, ..d };
         out.push(param("tessellation", p.built_triangles() as f64, p));
     }
-    for l in pick(&[1.0, 4.0, 16.0, 64.0, 256.0], &[1.0, 8.0, 32.0], &[1.0, 4.0]) {
+    for l in pick(&[1.0, 4.0, 16.0, 64.0, 256.0], &[1.0, 4.0, 8.0], &[1.0, 4.0]) {
         out.push(param("lights", l, SweepScene { lights: l as u32, ..d }));
     }
     for h in pick(&[0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0], &[0.25, 2.0, 16.0], &[0.25, 4.0]) {
@@ -431,6 +441,20 @@ mod tests {
         let tess: Vec<f64> = full.iter().filter(|p| p.sweep == "tessellation").map(|p| p.x).collect();
         assert!(tess[0] < 1.5e3 && *tess.last().unwrap() > 1.5e6, "{tess:?}");
         assert!(shadow_map_fits(4096, 1) && !shadow_map_fits(4096, 256) && shadow_map_fits(512, 256));
+    }
+
+    #[test]
+    fn the_one_factor_sweeps_share_their_centre() {
+        for scale in [Scale::Tiny, Scale::Quick, Scale::Full] {
+            let all = points(scale);
+            // Every one-factor point but the first of each scene repeats one listed before it.
+            let shared = all
+                .iter()
+                .enumerate()
+                .filter(|(i, p)| ONE_FACTOR.contains(&p.sweep) && all[..*i].iter().any(|q| q.scene == p.scene && q.size == p.size))
+                .count();
+            assert!(shared >= if scale == Scale::Tiny { 1 } else { 3 }, "{scale:?}: {shared} shared");
+        }
     }
 
     #[test]

@@ -62,7 +62,7 @@ pub(crate) struct BenchArgs {
     /// sweeps, bounds, crossovers, ablations, plots); writes into --out.
     #[arg(long, value_enum)]
     suite: Option<SuiteArg>,
-    /// With --suite: fewer points and frames (about 10 minutes on lavapipe on 2 cores, the one-factor sweeps and the bounds' ablations included).
+    /// With --suite: fewer points and frames (under 6 minutes on lavapipe on 2 quiet cores, the one-factor sweeps and the bounds' ablations included).
     #[arg(long)]
     quick: bool,
     /// With --suite: output directory for bench.json, bench.csv, the plots and bench.md.
