@@ -46,8 +46,12 @@ pub struct BenchRow {
     pub frames_in_flight: usize,
     /// Shadow-volume triangles drawn in one frame (all lights, sides + caps).
     pub shadow_triangles: u64,
-    /// Index and vertex bytes uploaded for the shadow volumes in one frame.
+    /// Index and vertex bytes the shadow volumes' draws read in one frame (uploaded by the
+    /// CPU for the CPU-planned methods, written by the GPU for `compute`; 0 for `mesh`).
     pub shadow_bytes: u64,
+    /// Geometry bytes the CPU wrote for the frame (`Totals::bytes_sent`: the streams plus any
+    /// caster uploads; 0 for static casters under a GPU-driven technique).
+    pub bytes_sent: u64,
     /// Worst light's mismatches outside a 1-pixel band / compared pixels.
     pub error_fraction: f64,
     /// (caster, light) pairs per case in one frame: `[culled, z-pass, z-fail, z-fail + light cap]`.
@@ -409,6 +413,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 frames_in_flight: r.config().frames_in_flight,
                 shadow_triangles: s.totals.triangles.total(),
                 shadow_bytes: s.totals.index_bytes + s.totals.vertex_bytes,
+                bytes_sent: s.totals.bytes_sent,
                 error_fraction: err.fraction,
                 cases: [c.culled, c.zpass, c.zfail, c.zfail_light_cap],
                 volume_draws: s.totals.draws,
@@ -461,12 +466,12 @@ impl BenchReport {
             "Device: {} ({}), {}x{}. Medians; wall ms = one frame at a time (latency), fps = throughput with frames in flight; error = mismatched pixels outside a 1-pixel band vs the CPU reference (worst light).\n\n",
             self.device, self.driver, self.width, self.height
         );
-        s += "| scene | method | counter | GPU frame ms | GPU shadow ms | map / lookup ms | BLAS build / refit / TLAS ms | wall ms | fps | plan ms | shadow tris | draws | bytes | error | cases c/1/2/3 |\n";
-        s += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        s += "| scene | method | counter | GPU frame ms | GPU shadow ms | map / lookup ms | BLAS build / refit / TLAS ms | wall ms | fps | plan ms | shadow tris | draws | bytes read | bytes sent | error | cases c/1/2/3 |\n";
+        s += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
         let f = |v: Option<f64>| v.map(|x| format!("{x:.2}")).unwrap_or_else(|| "—".into());
         for r in &self.rows {
             s += &format!(
-                "| {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.1} | {:.3} | {} | {} | {} | {:.4}% | {}/{}/{}/{} |\n",
+                "| {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.1} | {:.3} | {} | {} | {} | {} | {:.4}% | {}/{}/{}/{} |\n",
                 r.scene,
                 r.method,
                 r.counter,
@@ -486,6 +491,7 @@ impl BenchReport {
                 r.shadow_triangles,
                 r.volume_draws,
                 r.shadow_bytes,
+                r.bytes_sent,
                 r.error_fraction * 100.0,
                 r.cases[0],
                 r.cases[1],
