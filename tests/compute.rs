@@ -64,67 +64,24 @@ fn renderer(ctx: umbrage::gpu::Context, scene: umbrage::scene::Scene) -> Rendere
     Renderer::new(ctx, scene, opts).unwrap()
 }
 
-/// Every hard case (bad input among them: light_in_face_plane, light_at_vertex,
-/// light_inside_caster, zero_area, slivers, near_coplanar, far_coordinates, open_casters) and
-/// every built-in scene.
+/// Every hard case and built-in scene with casters ([`common::hard_and_builtin_scenes`]).
 #[test]
 fn compute_equals_mcguire_on_every_hard_case_and_builtin_scene() {
     let Some(mut ctx) = common::context() else { return };
-    let mut names: Vec<&str> = umbrage::scene::builtin_names().into_iter().filter(|n| n.starts_with("hard/")).collect();
-    names.extend(["default", "stairs", "cubes", "spheres"]);
-    for name in names {
+    for name in common::hard_and_builtin_scenes() {
         let mut r = renderer(ctx, umbrage::scene::load(name).unwrap());
         compare(&mut r, name);
         ctx = r.into_context();
     }
 }
 
-/// A mirrored caster (negative scale), a caster of several chunks (> 32768 vertices), a
-/// directional light and a spot light, light inside a caster's bounds: the same counts; static
-/// casters send no geometry after their first frame; frames in flight stay validation clean.
-const MIXED: &str = r#"
-ambient = [0.05, 0.05, 0.05]
-[camera]
-eye = [0.0, 5.0, 9.0]
-target = [0.0, 0.5, 0.0]
-[[light]]
-kind = "point"
-position = [0.3, 6.0, 0.4]
-[[light]]
-kind = "directional"
-direction = [-0.3, -1.0, -0.2]
-[[light]]
-kind = "point"
-position = [2.6, 0.9, 0.2]
-[[mesh]]
-name = "floor"
-shape = "plane"
-size = [30.0, 30.0]
-casts_shadow = false
-[[mesh]]
-name = "mirrored"
-shape = "box"
-size = [1.0, 1.0, 1.0]
-translate = [-2.0, 1.0, 0.0]
-scale = [-1.0, 1.0, 1.0]
-[[mesh]]
-name = "dense"
-shape = "sphere"
-radius = 0.8
-segments = 300
-rings = 150
-translate = [0.5, 1.5, 0.0]
-[[mesh]]
-name = "hollow"
-shape = "box"
-size = [2.0, 2.0, 2.0]
-translate = [2.6, 1.0, 0.0]
-"#;
-
+/// The mixed scene ([`common::MIXED`]: a mirrored caster, a caster of several chunks, a
+/// directional light, a light inside a caster's bounds): the same counts; static casters send
+/// no geometry after their first frame; frames in flight stay validation clean.
 #[test]
 fn compute_mirrored_chunked_directional_and_static_bytes() {
     let Some(ctx) = common::context() else { return };
-    let scene = umbrage::scene::load_str(MIXED, "mixed", std::path::Path::new(".")).unwrap();
+    let scene = common::mixed_scene();
     let mut r = renderer(ctx, scene);
     assert!(r.casters().iter().any(|c| c.chunks.len() > 1), "the dense sphere spans several chunks");
     assert!(r.casters().iter().any(|c| c.mirrored));
@@ -225,14 +182,12 @@ fn compute_draw_ways_are_bit_identical() {
             ctx.info.name
         );
     }
-    let mut names: Vec<&str> = umbrage::scene::builtin_names().into_iter().filter(|n| n.starts_with("hard/")).collect();
-    names.extend(["default", "stairs", "cubes", "spheres"]);
-    for name in names {
+    for name in common::hard_and_builtin_scenes() {
         let mut r = renderer(ctx, umbrage::scene::load(name).unwrap());
         compare_draw_ways(&mut r, name, &ways);
         ctx = r.into_context();
     }
-    let scene = umbrage::scene::load_str(MIXED, "mixed", std::path::Path::new(".")).unwrap();
+    let scene = common::mixed_scene();
     let mut r = renderer(ctx, scene);
     compare_draw_ways(&mut r, "mixed", &ways);
     // the merged draws with frames in flight: validation (synchronisation included) clean
@@ -260,7 +215,7 @@ fn swiftshader_draw_ways() {
         compare_draw_ways(&mut r, name, &ways);
         ctx = r.into_context();
     }
-    let scene = umbrage::scene::load_str(MIXED, "mixed", std::path::Path::new(".")).unwrap();
+    let scene = common::mixed_scene();
     let mut r = renderer(ctx, scene);
     compare_draw_ways(&mut r, "mixed", &ways);
 }

@@ -154,3 +154,59 @@ pub fn rerun_on_swiftshader(test: &str, env: &[(&str, &str)]) -> bool {
     run_child(test, true, env, &vars, "SwiftShader");
     true
 }
+
+/// The scenes the GPU-driven methods are compared with McGuire on: every `hard/` case (bad
+/// input among them: light_in_face_plane, light_at_vertex, light_inside_caster, zero_area,
+/// slivers, near_coplanar, far_coordinates, open_casters) and the built-in scenes with casters.
+pub fn hard_and_builtin_scenes() -> Vec<&'static str> {
+    let mut names: Vec<&str> = umbrage::scene::builtin_names().into_iter().filter(|n| n.starts_with("hard/")).collect();
+    names.extend(["default", "stairs", "cubes", "spheres"]);
+    names
+}
+
+/// A mirrored caster (negative scale), a caster of several chunks (> 32768 vertices), a
+/// directional light and point lights, one inside a caster's bounds: the mixed scene the
+/// GPU-driven methods' tests share ([`mixed_scene`]).
+pub const MIXED: &str = r#"
+ambient = [0.05, 0.05, 0.05]
+[camera]
+eye = [0.0, 5.0, 9.0]
+target = [0.0, 0.5, 0.0]
+[[light]]
+kind = "point"
+position = [0.3, 6.0, 0.4]
+[[light]]
+kind = "directional"
+direction = [-0.3, -1.0, -0.2]
+[[light]]
+kind = "point"
+position = [2.6, 0.9, 0.2]
+[[mesh]]
+name = "floor"
+shape = "plane"
+size = [30.0, 30.0]
+casts_shadow = false
+[[mesh]]
+name = "mirrored"
+shape = "box"
+size = [1.0, 1.0, 1.0]
+translate = [-2.0, 1.0, 0.0]
+scale = [-1.0, 1.0, 1.0]
+[[mesh]]
+name = "dense"
+shape = "sphere"
+radius = 0.8
+segments = 300
+rings = 150
+translate = [0.5, 1.5, 0.0]
+[[mesh]]
+name = "hollow"
+shape = "box"
+size = [2.0, 2.0, 2.0]
+translate = [2.6, 1.0, 0.0]
+"#;
+
+/// [`MIXED`], loaded.
+pub fn mixed_scene() -> umbrage::scene::Scene {
+    umbrage::scene::load_str(MIXED, "mixed", std::path::Path::new(".")).unwrap()
+}
