@@ -325,6 +325,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
             let ray = technique == Technique::RayQuery;
             let rays = s.ray_query.as_ref().filter(|_| ray);
             let compute = technique == Technique::Compute && !a.silhouettes.is_empty();
+            eprintln!("PROFILE {} {:?} sil min {:.3} shadow min {:.3} median {:.3} plan {:.3}", name, technique, a.silhouettes.iter().cloned().fold(f64::MAX, f64::min), a.shadow.iter().cloned().fold(f64::MAX, f64::min), median(a.shadow.clone()), median(a.plan.clone())); // ABLATION
             let silhouettes_ms = compute.then(|| median(a.silhouettes));
             let read_bytes = compute.then_some(s.totals.silhouette_read_bytes);
             let fraction = match (silhouettes_ms, read_bytes, read_gib_s) {

@@ -328,36 +328,18 @@ impl CasterTable {
         for (i, m) in meshes {
             let elements = mesh_elements(&m);
             let base = self.arena.allocate(elements);
-            // the meshlets' firsts, absolute in their tables
-            let meshlets: Vec<[u32; 4]> = m.meshlets.iter().map(|&[ft, tc, fe, ec]| [ft + base[5], tc, fe + base[6], ec]).collect();
-            let bytes: [&[u8]; super::compute::arena::N] = [
-                bytemuck::cast_slice(&m.planes),
-                bytemuck::cast_slice(&m.tris),
-                bytemuck::cast_slice(&m.positions),
-                bytemuck::cast_slice(&m.edges),
-                bytemuck::cast_slice(&meshlets),
-                bytemuck::cast_slice(&m.meshlet_tris),
-                bytemuck::cast_slice(&m.meshlet_edges),
-            ];
+            let bytes = m.table_bytes(&base);
             for k in 0..super::compute::arena::N {
                 let offset = base[k] as u64 * ELEMENT_BYTES[k];
-                if let Err(e) = self.staged_into(dev, &format!("compute {}", TABLES[k]), bytes[k], tables[k], offset) {
+                if let Err(e) = self.staged_into(dev, &format!("compute {}", TABLES[k]), &bytes[k], tables[k], offset) {
                     // the ranges stay allocated, unused; the copies already staged are harmless
                     self.arena.free(elements);
                     return Err(e);
                 }
             }
-            let c = &self.cpu[i];
-            self.live[i].compute = Some(ComputeStatic {
-                base,
-                elements,
-                triangles: m.tris.len() as u32,
-                edge_count: m.edges.len() as u32,
-                chunk_edges: m.chunk_edges,
-                chunk_tris: c.chunks.iter().map(|ch| ch.local_tris.len() as u32).collect(),
-                part_meshlets: m.part_meshlets,
-                apex_base: m.apex_base,
-            });
+            drop(bytes);
+            let placed: ComputeStatic = m.placed(&self.cpu[i], base, elements);
+            self.live[i].compute = Some(placed);
         }
         Ok(())
     }

@@ -1,6 +1,7 @@
-//! The compute pass's static tables of every caster, in one pass-wide arena: seven storage
-//! buffers (face planes, triangles, welded positions and the parts' apexes, edges; and for
-//! mesh-shader extrusion the meshlets, their triangles and their owned edges) that one
+//! The compute pass's static tables of every caster, in one pass-wide arena: nine storage
+//! buffers (face planes, triangles, welded positions and the parts' apexes, edges; for
+//! mesh-shader extrusion the meshlets, their triangles and their owned edges; the facing
+//! stage's block bounds and the `find` stage's word-pair groups) that one
 //! descriptor set binds, so one dispatch per stage (or one mesh draw per caster part) serves
 //! every (light, caster) pair of a frame.
 //!
@@ -21,12 +22,17 @@ use ash::vk;
 use gpu_allocator::MemoryLocation;
 
 /// The tables, in binding order.
-pub(crate) const TABLES: [&str; N] = ["planes", "triangles", "positions", "edges", "meshlets", "meshlet triangles", "meshlet edges"];
+pub(crate) const TABLES: [&str; N] =
+    ["planes", "triangles", "positions", "edges", "meshlets", "meshlet triangles", "meshlet edges", "block bounds", "word pairs"];
 /// The number of tables.
-pub(crate) const N: usize = 7;
+pub(crate) const N: usize = 9;
+/// The facing stage's block bounds (three `vec4<f32>` per 64 slots).
+pub(crate) const BLOCKS: usize = 7;
+/// The `find` stage's word-pair groups.
+pub(crate) const GROUPS: usize = 8;
 /// Bytes of one element of each table (`vec4<f32>`, `Tri`, `vec4<f32>`, `vec4<u32>`,
-/// `vec4<u32>`, `u32`, `vec4<u32>`).
-pub(crate) const ELEMENT_BYTES: [u64; N] = [16, 32, 16, 16, 16, 4, 16];
+/// `vec4<u32>`, `u32`, `vec4<u32>`, `vec4<f32>`, `vec4<u32>`).
+pub(crate) const ELEMENT_BYTES: [u64; N] = [16, 32, 16, 16, 16, 4, 16, 16, 16];
 /// The smallest table, in elements.
 const MIN_ELEMENTS: u64 = 1024;
 
@@ -47,6 +53,8 @@ pub(crate) fn mesh_elements(m: &ComputeMesh) -> [u64; N] {
         m.meshlets.len() as u64,
         m.meshlet_tris.len() as u64,
         m.meshlet_edges.len() as u64,
+        m.blocks.len() as u64,
+        m.groups.len() as u64,
     ]
 }
 
