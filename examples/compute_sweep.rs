@@ -9,7 +9,10 @@
 //! shadow triangles, GPU shadow ms (the determination, compute dispatches included), and the
 //! geometry bytes the CPU sent. On a device with mesh shaders (`VK_EXT_mesh_shader`: Mesa
 //! lavapipe 25.0.7, `eval "$(scripts/drivers.sh env 25.0.7)"`) `mesh` (mesh-shader extrusion)
-//! joins the table. `SWEEP_QUICK=1`: the 10k and 100k spheres only, both views.
+//! joins the table, with its task stage's cull (`mesh`) and without it (`mesh (no task)`,
+//! `PassToggles::mesh_task` off: every meshlet's mesh workgroup runs), and the mesh
+//! workgroups that ran against the meshlets the draws covered. `SWEEP_QUICK=1`: the 10k and
+//! 100k spheres only, both views.
 use umbrage::render::{RenderOptions, Renderer, Technique};
 use umbrage::shadow::Method;
 
@@ -50,11 +53,18 @@ fn main() -> umbrage::Result<()> {
     let mut ctx = umbrage::gpu::Context::new()?;
     println!("device: {}, 320x240, medians of {frames} frames\n", ctx.info.name);
     println!(
-        "| view | triangles | method | CPU ms (plan + record) | of which silhouettes | shadow triangles | GPU shadow ms | of which GPU silhouettes | bytes sent |"
+        "| view | triangles | method | CPU ms (plan + record) | of which silhouettes | shadow triangles | GPU shadow ms | of which GPU silhouettes | bytes sent | mesh workgroups run / meshlets |"
     );
-    println!("|---|---:|---|---:|---:|---:|---:|---:|---:|");
+    println!("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|");
     let quick = std::env::var_os("SWEEP_QUICK").is_some();
-    let mesh = ctx.features.mesh_shader.then_some(Technique::Mesh);
+    // (label, technique, the task stage's cull)
+    let mut variants = vec![("mcguire", Technique::Volumes(Method::McGuire), true), ("compute", Technique::Compute, true)];
+    if ctx.features.mesh_shader {
+        variants.push(("mesh", Technique::Mesh, true));
+        if ctx.features.task_shader {
+            variants.push(("mesh (no task)", Technique::Mesh, false));
+        }
+    }
     let views = [("outside (z-pass)", [0.0f32, 4.0, 9.0]), ("in the shadow (z-fail, fan cap)", [0.2, 0.3, 0.4])];
     let sizes = [(32u32, 17u32), (100, 51), (317, 159), (1000, 501)];
     for (view, eye) in &views {
@@ -65,10 +75,12 @@ fn main() -> umbrage::Result<()> {
             let tris = s.meshes[1].mesh.triangles.len();
             let opts = RenderOptions { width: 320, height: 240, ..Default::default() };
             let mut r = Renderer::new(ctx, s, opts)?;
-            for t in [Technique::Volumes(Method::McGuire), Technique::Compute].into_iter().chain(mesh) {
+            for &(label, t, task) in &variants {
                 r.settings.technique = t;
-                r.render()?; // warm-up: uploads, static tables
+                r.settings.toggles.mesh_task = task;
+                r.render()?; // warm-up: uploads, static tables, pipelines
                 let (mut cpu, mut sil, mut gpu, mut gsil, mut bytes, mut st) = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), 0, 0);
+                let mut groups = (0, 0);
                 for _ in 0..frames {
                     let f = r.render()?;
                     cpu.push(f.stats.cpu_ms.plan + f.stats.cpu_ms.record);
@@ -77,10 +89,11 @@ fn main() -> umbrage::Result<()> {
                     gsil.push(f.stats.gpu_ms.as_ref().map_or(f64::NAN, |g| g.silhouettes));
                     bytes = f.stats.totals.bytes_sent;
                     st = f.stats.totals.triangles.total();
+                    groups = (f.stats.totals.mesh_workgroups, f.stats.totals.mesh_meshlets);
                 }
+                let groups = if t == Technique::Mesh { format!("{} / {}", groups.0, groups.1) } else { "-".into() };
                 println!(
-                    "| {view} | {tris} | {} | {:.3} | {:.3} | {st} | {:.2} | {:.2} | {bytes} |",
-                    t.name(),
+                    "| {view} | {tris} | {label} | {:.3} | {:.3} | {st} | {:.2} | {:.2} | {bytes} | {groups} |",
                     median(cpu),
                     median(sil),
                     median(gpu),

@@ -1,7 +1,9 @@
 #!/usr/bin/env python3
 """The scenes of docs/gpu-driven.md: 256 UV spheres of 512 triangles over a floor, as 256
 casters (casters256.toml) and merged into one OBJ caster (merged256.toml + merged256.obj: the
-same triangles), and one 490,000-triangle sphere (big.toml).
+same triangles), the same triangles grouped into 4, 16 and 64 OBJ casters (casters4.toml ..
+casters64.toml: the casters sweep at fixed triangles, fixed coverage), and one
+490,000-triangle sphere (big.toml).
 
     scripts/gpu-driven-scenes.py target/gpu-driven
     umbrage bench --scene target/gpu-driven/casters256.toml --scene target/gpu-driven/merged256.toml \\
@@ -72,6 +74,20 @@ def main():
         f.writelines(f"v {v[0]:g} {v[1]:g} {v[2]:g}\n" for v in vs)
         f.writelines(f"f {t[0] + 1} {t[1] + 1} {t[2] + 1}\n" for t in fs)
     open(os.path.join(out, "merged256.toml"), "w").write('name = "merged256"\n' + HEADER + '\n[[mesh]]\nname = "spheres"\nobj = "merged256.obj"\n')
+    # The casters sweep: the 256 spheres in n groups of 256 / n, one OBJ caster a group.
+    for n in (4, 16, 64):
+        per = 256 // n
+        toml = [f'name = "casters{n}"', HEADER]
+        for g in range(n):
+            gv, gf = [], []
+            for c in centres()[g * per:(g + 1) * per]:
+                uv_sphere(c, 0.5, 32, 9, gv, gf)
+            name = f"casters{n}_{g}.obj"
+            with open(os.path.join(out, name), "w") as f:
+                f.writelines(f"v {v[0]:g} {v[1]:g} {v[2]:g}\n" for v in gv)
+                f.writelines(f"f {t[0] + 1} {t[1] + 1} {t[2] + 1}\n" for t in gf)
+            toml += ["[[mesh]]", f'name = "g{g}"', f'obj = "{name}"', ""]
+        open(os.path.join(out, f"casters{n}.toml"), "w").write("\n".join(toml))
     big = HEADER.replace("[0.0, 14.0, 22.0]", "[0.0, 4.0, 6.0]").replace("[0.5, 10.0, 0.3]", "[0.5, 5.0, 0.3]").replace("[60.0, 60.0]", "[30.0, 30.0]")
     open(os.path.join(out, "big.toml"), "w").write('name = "big"\n' + big + '\n[[mesh]]\nname = "ball"\nshape = "sphere"\nradius = 1.0\nsegments = 700\nrings = 351\ntranslate = [0.0, 1.2, 0.0]\n')
     print(f"{len(fs)} merged triangles; scenes in {out}")

@@ -5,6 +5,15 @@
 // `facing` and `exact` stages (`shaders/silhouette.wgsl`) wrote for this light, bit for bit
 // the CPU's.
 //
+// With `taskShader` (and `PassToggles::mesh_task`), a task stage (`cull`, a meshlet a thread,
+// 64 a workgroup) runs first and launches the mesh workgroups (`extrude_culled`) of only the
+// meshlets that emit something: a meshlet whose normal cone and bounding sphere prove that
+// every triangle it reads faces the light strictly the same way (`geom::cone::same_facing`,
+// conservative) has no silhouette edge, and its faces are all of one facing; the others are
+// decided from the facing bits themselves (an owned edge whose two bits differ, a triangle of
+// the wanted facing). So the same meshlets emit the same triangles as without the task stage
+// (`extrude`, every meshlet a workgroup): the cull only drops workgroups that emit nothing.
+//
 // What a draw emits (`pc.flags`, mode in bits 0..2), with exactly the CPU's triangles and
 // windings (`shadow::plan::emit`):
 // * MODE_SIDES, one owned edge a thread: an edge whose two triangles' bits differ is a
@@ -27,7 +36,8 @@
 // 64 triangles x 3 vertices / 1 triangle: 255 vertices, 153 triangles.
 //
 // Statistics: the workgroup's side, dark-cap and light-cap triangles and silhouette edges
-// are summed in workgroup atomics, then added once to the draw's four counters.
+// are summed in workgroup atomics, then added once to the draw's counters; then the meshlets
+// the draw covered and the mesh workgroups that ran (words 4 and 5).
 enable wgpu_mesh_shader;
 
 struct Push {
@@ -58,10 +68,21 @@ struct Tri {
     l: vec4<u32>,
 }
 
+// One row of the meshlet table (`pass::mesh::meshlet_rows`, `shadow::meshlet::MeshletBounds`).
+struct Meshlet {
+    // (first triangle, triangles, first edge, edges), absolute in the two tables below
+    range: vec4<u32>,
+    // a sphere about every vertex of its triangles and its owned edges' triangles: centre, radius
+    sphere: vec4<f32>,
+    // the normal cones (axis, cosine of the half-angle) of its owned edges' triangles and of
+    // its own triangles (cos 0: decides nothing)
+    sides: vec4<f32>,
+    faces: vec4<f32>,
+}
+
 @group(0) @binding(0) var<storage, read> positions: array<vec4<f32>>;
 @group(0) @binding(1) var<storage, read> tris: array<Tri>;
-// (first triangle, triangles, first edge, edges), absolute in the two tables below
-@group(0) @binding(2) var<storage, read> meshlets: array<vec4<u32>>;
+@group(0) @binding(2) var<storage, read> meshlets: array<Meshlet>;
 // welded triangle ids (relative to the caster's first triangle)
 @group(0) @binding(3) var<storage, read> meshlet_tris: array<u32>;
 // (t0, t1, c0 | c1 << 8, 0): t0 walks a -> b from corner c0, t1 walks b -> a from corner c1
@@ -77,6 +98,14 @@ const MODE_LIGHT: u32 = 2u;
 const F_DIRECTIONAL: u32 = 4u;
 const F_FAN: u32 = 8u;
 const F_WANT: u32 = 16u;
+
+// Meshlets one task workgroup decides (a thread each).
+const TASK_GROUP: u32 = 64u;
+// `geom::cone::TEST_MARGIN`: 2^-16.
+const TEST_MARGIN: f32 = 1.52587890625e-5;
+// The counters' words: the meshlets the draws covered, the mesh workgroups that ran.
+const C_MESHLETS: u32 = 4u;
+const C_RAN: u32 = 5u;
 
 const MAX_VERTICES: u32 = 255u;
 const MAX_PRIMITIVES: u32 = 153u;
@@ -100,6 +129,16 @@ var<workgroup> mesh_out: MeshOutput;
 // Output slots taken so far, and the workgroup's statistics (sides, dark, light, edges).
 var<workgroup> taken: array<atomic<u32>, 2>;
 var<workgroup> tally: array<atomic<u32>, 4>;
+
+// The task stage's launch list: the meshlets (relative to `pc.meshlet_base`) whose mesh
+// workgroups run, in order.
+struct Payload {
+    ids: array<u32, 64>,
+}
+var<task_payload> payload: Payload;
+// The task workgroup's verdicts (1: the meshlet emits something) and how many it launches.
+var<workgroup> keep: array<u32, 64>;
+var<workgroup> kept: u32;
 
 fn facing(t: u32) -> bool {
     return ((facing_bits[pc.fac_base + (t >> 5u)] >> (t & 31u)) & 1u) != 0u;
@@ -207,9 +246,50 @@ fn face(t: u32, mode: u32) {
     }
 }
 
-@mesh(mesh_out)
-@workgroup_size(64)
-fn extrude(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+// Whether every triangle the cone `cone` and the sphere `sphere` bound faces the light
+// strictly the same way (`geom::cone::same_facing`, the same f32 arithmetic; its margin covers
+// this evaluation's rounding). NaN or infinity anywhere: false.
+fn same_facing(cone: vec4<f32>, sphere: vec4<f32>) -> bool {
+    let l = pc.light;
+    let k = select(0.0, 1.0, l.w != 0.0);
+    let v = l.xyz - sphere.xyz * k;
+    let s = dot(cone.xyz, v);
+    let q = length(cross(cone.xyz, v));
+    let sn = sqrt(max(1.0 - cone.w * cone.w, 0.0)) * (1.0 + 1.0 / 1048576.0);
+    let m = k * sphere.w + TEST_MARGIN * (length(l.xyz) + k * (length(sphere.xyz) + sphere.w));
+    return cone.w * s - sn * q > m || cone.w * s + sn * q < -m;
+}
+
+// Whether meshlet `m` emits anything in this draw: exactly the mesh stage's decision (the cone
+// only skips reading the bits where it proves the answer).
+fn emits(m: Meshlet) -> bool {
+    if ((pc.flags & 3u) == MODE_SIDES) {
+        if (m.range.w == 0u || same_facing(m.sides, m.sphere)) {
+            return false;
+        }
+        for (var i = 0u; i < m.range.w; i = i + 1u) {
+            let e = meshlet_edges[m.range.z + i];
+            if (facing(e.x) != facing(e.y)) {
+                return true;
+            }
+        }
+        return false;
+    }
+    let want = (pc.flags & F_WANT) != 0u;
+    if (same_facing(m.faces, m.sphere)) {
+        // every triangle faces one way: the first one's bit is all of theirs
+        return facing(meshlet_tris[m.range.x]) == want;
+    }
+    for (var i = 0u; i < m.range.y; i = i + 1u) {
+        if (facing(meshlet_tris[m.range.x + i]) == want) {
+            return true;
+        }
+    }
+    return false;
+}
+
+// The workgroup of meshlet `index` (absolute in the meshlet table).
+fn extrude_meshlet(index: u32, lid: u32) {
     if (lid < 2u) {
         atomicStore(&taken[lid], 0u);
     }
@@ -217,7 +297,7 @@ fn extrude(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index
         atomicStore(&tally[lid], 0u);
     }
     workgroupBarrier();
-    let m = meshlets[pc.meshlet_base + wg.x];
+    let m = meshlets[index].range;
     let mode = pc.flags & 3u;
     if (mode == MODE_SIDES) {
         if (lid < m.w) {
@@ -237,4 +317,54 @@ fn extrude(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index
             }
         }
     }
+}
+
+// Without a task stage: every meshlet of the draw a workgroup.
+@mesh(mesh_out)
+@workgroup_size(64)
+fn extrude(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    extrude_meshlet(pc.meshlet_base + wg.x, lid);
+    if (lid == 0u) {
+        atomicAdd(&counts[pc.stat + C_MESHLETS], 1u);
+        atomicAdd(&counts[pc.stat + C_RAN], 1u);
+    }
+}
+
+// The task stage: TASK_GROUP meshlets a workgroup, a thread each; launches the mesh
+// workgroups of those that emit something, in order.
+@task
+@payload(payload)
+@workgroup_size(64)
+fn cull(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) -> @builtin(mesh_task_size) vec3<u32> {
+    let first = wg.x * TASK_GROUP;
+    var k = 0u;
+    if (first + lid < pc.meshlets && emits(meshlets[pc.meshlet_base + first + lid])) {
+        k = 1u;
+    }
+    keep[lid] = k;
+    workgroupBarrier();
+    if (lid == 0u) {
+        var n = 0u;
+        for (var j = 0u; j < TASK_GROUP; j = j + 1u) {
+            if (keep[j] != 0u) {
+                payload.ids[n] = first + j;
+                n = n + 1u;
+            }
+        }
+        kept = n;
+        atomicAdd(&counts[pc.stat + C_MESHLETS], min(pc.meshlets - first, TASK_GROUP));
+        if (n != 0u) {
+            atomicAdd(&counts[pc.stat + C_RAN], n);
+        }
+    }
+    let n = workgroupUniformLoad(&kept);
+    return vec3<u32>(n, 1u, 1u);
+}
+
+// After the task stage: the launched meshlets, one workgroup each.
+@mesh(mesh_out)
+@payload(payload)
+@workgroup_size(64)
+fn extrude_culled(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) lid: u32) {
+    extrude_meshlet(pc.meshlet_base + payload.ids[wg.x], lid);
 }

@@ -43,6 +43,7 @@ pub fn read_gpuinfo(text: &str) -> Result<DeviceCaps> {
         geometry_shader: feature(&["VkPhysicalDeviceFeatures"], "geometryShader"),
         sample_rate_shading: feature(&["VkPhysicalDeviceFeatures"], "sampleRateShading"),
         multi_draw_indirect: feature(&["VkPhysicalDeviceFeatures"], "multiDrawIndirect"),
+        draw_indirect_first_instance: feature(&["VkPhysicalDeviceFeatures"], "drawIndirectFirstInstance"),
         multiview: feature(&["VkPhysicalDeviceVulkan11Features", "VkPhysicalDeviceMultiviewFeaturesKHR"], "multiview"),
         draw_indirect_count: feature(&["VkPhysicalDeviceVulkan12Features"], "drawIndirectCount"),
         buffer_device_address: feature(

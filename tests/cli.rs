@@ -1,5 +1,7 @@
 //! The command line as a user meets it: bad input gives a clear message and a non-zero exit,
 //! never a panic; good input writes what it says.
+mod common;
+
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
@@ -127,6 +129,8 @@ fn bench_accepts_every_render_method() {
         "96x64",
         "--shadow-map-size",
         "256",
+        "--compute-draws",
+        "auto,per-chunk",
         "--json",
         json.to_str().unwrap(),
     ]);
@@ -134,7 +138,11 @@ fn bench_accepts_every_render_method() {
     let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     let rows = v["rows"].as_array().unwrap();
     let methods: Vec<&str> = rows.iter().map(|r| r["method"].as_str().unwrap()).collect();
-    assert_eq!(methods, ["edgequad", "mcguire", "compute", "shadowmap-256"], "auto is mcguire, listed once");
+    assert_eq!(methods, ["edgequad", "mcguire", "compute", "compute-per-chunk", "shadowmap-256"], "auto is mcguire, listed once");
+    // The compute path's volume draw calls: merged (one per light and pipeline) where the
+    // device has the indirect-draw features, else as many as per chunk; the same shadow.
+    let draws = |m: &str| rows.iter().find(|r| r["method"] == m).and_then(|r| r["volume_draws"].as_u64()).unwrap();
+    assert!(draws("compute") > 0 && draws("compute") <= draws("compute-per-chunk") && draws("mcguire") > 0, "{v}");
     // The compute silhouettes are timed on their own and put against the compute read rate
     // measured in the same run.
     let rate = v["compute_read_gib_s"].as_f64().unwrap();
@@ -164,7 +172,7 @@ fn bench_accepts_every_render_method() {
     }
     for r in rows {
         let silhouettes = r["gpu_silhouettes_ms"].as_f64();
-        if r["method"] == "compute" {
+        if r["method"].as_str().is_some_and(|m| m.starts_with("compute")) {
             let (ms, bytes, fraction) =
                 (silhouettes.unwrap(), r["silhouette_read_bytes"].as_u64().unwrap(), r["silhouette_limit_fraction"].as_f64().unwrap());
             assert!(ms > 0.0 && ms < r["gpu_shadow_ms"].as_f64().unwrap() && bytes > 0, "{r}");
@@ -350,4 +358,31 @@ fn the_pipeline_cache_file_round_trips_and_ignores_foreign_data() {
     }
     assert!(render("off").status.success());
     let _ = std::fs::remove_dir_all(&d);
+}
+
+/// `--method mesh` on a device without `VK_EXT_mesh_shader` (Mesa lavapipe 22.3.6): a clear
+/// error naming the extension and how to get a driver that has it, from the command line and
+/// as the library's `Error::Unsupported`.
+#[test]
+fn mesh_without_the_extension_names_it_and_the_driver_script() {
+    use umbrage::pass::{Capabilities, PassSettings, Technique};
+    let s = PassSettings { technique: Technique::Mesh, ..Default::default() };
+    let e = s.check(&Capabilities::default()).unwrap_err();
+    assert!(matches!(e, umbrage::Error::Unsupported(_)), "{e:?}");
+    let text = e.to_string();
+    assert!(text.contains("VK_EXT_mesh_shader") && text.contains("scripts/drivers.sh install 25.0.7"), "{text}");
+    let Some(env) = common::driver_env("22.3.6") else {
+        let why = "Mesa lavapipe 22.3.6 is not installed (scripts/drivers.sh install 22.3.6)";
+        assert!(std::env::var_os("CI").is_none(), "CI needs {why}");
+        eprintln!("SKIPPED: {why}");
+        return;
+    };
+    let d = tmp("mesh");
+    let mut c = Command::new(env!("CARGO_BIN_EXE_umbrage"));
+    c.args(["render", "--method", "mesh", "--size", "64x48", "--out", d.join("mesh.png").to_str().unwrap()]).env("UMBRAGE_VALIDATION", "1");
+    common::apply_driver_env(&mut c, &env);
+    let out = c.output().unwrap();
+    fails_with(&out, "VK_EXT_mesh_shader");
+    fails_with(&out, "scripts/drivers.sh install 25.0.7");
+    assert!(!d.join("mesh.png").exists(), "nothing is written");
 }

@@ -378,3 +378,56 @@ fn expectations_fail_on_any_change() {
     assert_eq!(stdout.matches("NEW FAILURE").count(), d24.len(), "{stdout}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The environment of `scripts/drivers.sh env VERSION`, or `None` (loudly; a failure under
+/// `CI`) when that driver is not installed.
+fn driver_or_skip(version: &str) -> Option<Vec<(String, Option<String>)>> {
+    let env = common::driver_env(version);
+    if env.is_none() {
+        let why = format!("Mesa lavapipe {version} is not installed (scripts/drivers.sh install {version})");
+        assert!(std::env::var_os("CI").is_none(), "CI needs {why}");
+        eprintln!("SKIPPED: {why}");
+    }
+    env
+}
+
+/// `umbrage conform --filter mesh.` on driver `version`: its exit status and the cases.
+fn mesh_family_on(version: &str) -> Option<(Option<i32>, Vec<serde_json::Value>)> {
+    let env = driver_or_skip(version)?;
+    let dir = tmp(&format!("mesh-{version}"));
+    let mut c = umbrage();
+    c.args(["conform", "--filter", "mesh.", "--out"]).arg(&dir);
+    common::apply_driver_env(&mut c, &env);
+    let out = c.output().unwrap();
+    println!("{}", String::from_utf8_lossy(&out.stdout));
+    let cases = json(&dir)["cases"].as_array().unwrap().clone();
+    let _ = std::fs::remove_dir_all(&dir);
+    Some((out.status.code(), cases))
+}
+
+/// The mesh-shader family passes on Mesa lavapipe 25.0.7, which has `VK_EXT_mesh_shader` with
+/// task shaders.
+#[test]
+fn mesh_family_passes_on_lavapipe_25() {
+    let Some((code, cases)) = mesh_family_on("25.0.7") else { return };
+    assert_eq!(code, Some(0), "{cases:?}");
+    assert_eq!(cases.len(), conform::mesh::NAMES.len());
+    for c in &cases {
+        assert_eq!(c["status"], "pass", "{}: {}", c["name"], c["message"]);
+        assert_eq!(c["group"], "mesh");
+    }
+}
+
+/// Without `VK_EXT_mesh_shader` (Mesa lavapipe 22.3.6) every mesh case is reported skipped as
+/// unsupported — never passed, never failed — naming the extension and the driver script.
+#[test]
+fn mesh_family_is_unsupported_without_the_extension() {
+    let Some((code, cases)) = mesh_family_on("22.3.6") else { return };
+    assert_eq!(code, Some(0), "{cases:?}");
+    assert_eq!(cases.len(), conform::mesh::NAMES.len());
+    for c in &cases {
+        assert_eq!(c["status"], "skipped", "{}", c["name"]);
+        let m = c["message"].as_str().unwrap();
+        assert!(m.starts_with("unsupported: VK_EXT_mesh_shader") && m.contains("scripts/drivers.sh install 25.0.7"), "{m}");
+    }
+}

@@ -15,7 +15,8 @@ use umbrage::error::Misuse;
 use umbrage::geom::{Light, LightKind, Mesh, Sphere};
 use umbrage::gpu::Context;
 use umbrage::pass::{
-    Counter, DepthMode, IndexFormat, PassSettings, ShadowPass, ShadowPassDesc, ShadowView, Technique, MAX_CONE_DEG, MAX_TARGET_SIZE,
+    ComputeDraws, Counter, DepthMode, IndexFormat, PassSettings, ShadowPass, ShadowPassDesc, ShadowView, Technique, MAX_CONE_DEG,
+    MAX_TARGET_SIZE,
 };
 use umbrage::scene::shapes;
 use umbrage::shadow::Method;
@@ -408,6 +409,20 @@ fn rows(ctx: &Context) -> Vec<Row> {
         expect: Expect::Unsupported("indexTypeUint8"),
         accepted: settings_probes(&[IndexFormat::Auto, IndexFormat::U16], |s, v| s.index_format = v),
         refused: settings_probes(&[IndexFormat::U8], |s, v| s.index_format = v),
+    });
+    // (the harness's pass enables none of the indirect-draw features)
+    let compute_draws = |s: &mut PassSettings, v: ComputeDraws| {
+        s.technique = Technique::Compute;
+        s.toggles.compute_draws = v;
+    };
+    rows.push(Row {
+        input,
+        field: "PassToggles::compute_draws",
+        range: "`Auto`, `PerChunk`; with `Technique::Compute`, `PerRecord` where the host enabled `drawIndirectFirstInstance`, \
+                `Multi` with `multiDrawIndirect` too, `Count` with Vulkan 1.2's `drawIndirectCount` too",
+        expect: Expect::Unsupported("drawIndirectFirstInstance"),
+        accepted: settings_probes(&[ComputeDraws::Auto, ComputeDraws::PerChunk], compute_draws),
+        refused: settings_probes(&[ComputeDraws::PerRecord, ComputeDraws::Multi, ComputeDraws::Count], compute_draws),
     });
     let cube = shapes::cuboid(Vec3::ONE);
     let with_pos = |i: usize, p: Vec3| {

@@ -46,8 +46,8 @@ use umbrage::geom::{Light, Mesh, Sphere};
 use umbrage::gpu::resources::{cleared_depth_stencil, memory_barrier, transition};
 use umbrage::gpu::{Buffer, Context, Image};
 use umbrage::pass::{
-    CasterId, DepthStencilTarget, PassSettings, PreparedFrame, RenderPassTarget, ShadowPass, ShadowPassDesc, ShadowView, SphereId,
-    TargetModel, Technique,
+    CasterId, ComputeDraws, DepthStencilTarget, EnabledFeatures, PassSettings, PassToggles, PreparedFrame, RenderPassTarget, ShadowPass,
+    ShadowPassDesc, ShadowView, SphereId, TargetModel, Technique,
 };
 use umbrage::scene::shapes;
 use umbrage::shadow::Method;
@@ -316,6 +316,14 @@ fn new_pass(ctx: &Context, frames_in_flight: usize, render_pass: Option<RenderPa
         frames_in_flight,
         target: render_pass.map_or(TargetModel::DynamicRendering, TargetModel::RenderPass),
         transmit_format: render_pass.is_none().then_some(vk::Format::R16G16B16A16_SFLOAT),
+        // the compute path's merged draws where the device has them (Step::SetMethod picks
+        // each way of recording them in turn)
+        features: EnabledFeatures {
+            draw_indirect_first_instance: ctx.features.draw_indirect_first_instance,
+            multi_draw_indirect: ctx.features.multi_draw_indirect,
+            draw_indirect_count: ctx.features.draw_indirect_count,
+            ..Default::default()
+        },
         ..Default::default()
     };
     ShadowPass::new(&ctx.instance, ctx.physical, &ctx.device, (*ctx.allocator).clone(), &desc).unwrap()
@@ -482,6 +490,8 @@ struct Sut {
     /// (the host waits for the slot's fence then, and the comparison reads its stencil).
     in_flight: Vec<Option<InFlight>>,
     submitted: usize,
+    /// Times `Technique::Compute` was set (each time the next way of recording its draws).
+    compute_ways: usize,
 }
 
 impl Sut {
@@ -587,7 +597,7 @@ impl StateMachineTest for Sequences {
             new_pass(&h.ctx, model.frames_in_flight, rp)
         });
         let in_flight = (0..model.frames_in_flight).map(|_| None).collect();
-        Sut { pass, target: model.target, casters: vec![], spheres: vec![], transparent: vec![], in_flight, submitted: 0 }
+        Sut { pass, target: model.target, casters: vec![], spheres: vec![], transparent: vec![], in_flight, submitted: 0, compute_ways: 0 }
     }
 
     fn apply(mut sut: Sut, model: &Model, step: Step) -> Sut {
@@ -619,7 +629,17 @@ impl StateMachineTest for Sequences {
                 }
             }
             Step::RemoveTransparent(i) => sut.pass.remove_caster(sut.transparent.remove(i)).unwrap(),
-            Step::SetMethod(m) => sut.pass.set_settings(PassSettings { technique: technique(m), ..Default::default() }).unwrap(),
+            Step::SetMethod(m) => {
+                // Compute: each time the next way of recording its volume draws the pass can
+                // use (merged or per chunk: the same stencil every way).
+                const WAYS: [ComputeDraws; 5] =
+                    [ComputeDraws::Auto, ComputeDraws::PerChunk, ComputeDraws::PerRecord, ComputeDraws::Multi, ComputeDraws::Count];
+                let way = WAYS[sut.compute_ways % WAYS.len()];
+                sut.compute_ways += m.is_none() as usize;
+                let way = if sut.pass.capabilities().compute_draws(way).is_ok() { way } else { ComputeDraws::Auto };
+                let toggles = PassToggles { compute_draws: way, ..Default::default() };
+                sut.pass.set_settings(PassSettings { technique: technique(m), toggles, ..Default::default() }).unwrap()
+            }
             Step::Prepare(slot, fate) => {
                 // As a host: before preparing a slot again, wait for its previous frame (here
                 // also compared); the other slots' frames stay in flight.

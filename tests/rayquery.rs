@@ -150,6 +150,8 @@ fn the_classic_bench_times_builds_refits_and_top_levels() {
         counters: vec![umbrage::render::Counter::Stencil],
         frames: 2,
         opts: RenderOptions { width: 160, height: 120, ..Default::default() },
+        compute_draws: Vec::new(),
+        mesh_task: Vec::new(),
     };
     let report = umbrage::bench::run(ctx, &cfg, |_| {}).unwrap();
     let rays = report.rows.iter().find(|r| r.method == "rayquery").expect("a rayquery row");

@@ -423,6 +423,12 @@ impl Host {
             // This host's G-buffer is depth only: no positions and normals for rays.
             ray_query: false,
             mesh_shader: false,
+            // A host that enables none of the indirect-draw features: the compute path's
+            // volumes are drawn one chunk at a time with push constants.
+            draw_indirect_first_instance: false,
+            multi_draw_indirect: false,
+            draw_indirect_count: false,
+            task_shader: false,
         };
         let device = create_device(&host.instance, &picked, dynamic)?;
         host.device = Some(device.clone());

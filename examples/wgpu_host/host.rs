@@ -256,6 +256,10 @@ impl Host {
                 index_type_uint8: host.gpu.index_type_uint8,
                 ray_query: false,
                 mesh_shader: false,
+                draw_indirect_first_instance: false,
+                multi_draw_indirect: false,
+                draw_indirect_count: false,
+                task_shader: false,
             },
             ..Default::default()
         };

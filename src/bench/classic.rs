@@ -6,7 +6,7 @@
 use crate::accuracy::evaluate;
 use crate::error::{Error, Result};
 use crate::gpu::Context;
-use crate::render::{Counter, RenderOptions, Renderer, Technique};
+use crate::render::{ComputeDraws, Counter, RenderOptions, Renderer, Technique};
 use serde::Serialize;
 
 /// One (scene, method, counter) measurement: medians over the measured frames.
@@ -51,6 +51,10 @@ pub struct BenchRow {
     pub error_fraction: f64,
     /// (caster, light) pairs per case in one frame: `[culled, z-pass, z-fail, z-fail + light cap]`.
     pub cases: [u64; 4],
+    /// Volume draw calls the frame's determinations record, all lights (`totals.draws` in
+    /// `--stats`): one per chunk and case, or for `compute`'s merged draws one per light and
+    /// pipeline (`count`, `multi`).
+    pub volume_draws: u64,
     /// Ray query: median GPU time of the frame's top-level build, ms (`None` otherwise).
     pub gpu_tlas_ms: Option<f64>,
     /// Ray query: GPU time of the frame that built the bottom levels (its acceleration span:
@@ -188,6 +192,13 @@ pub struct BenchConfig {
     pub counters: Vec<Counter>,
     /// Frames measured per variant (at least 1), round-robin over the variants.
     pub frames: usize,
+    /// `compute` runs once per way of recording its volume draws here (rows `compute` for
+    /// [`ComputeDraws::Auto`], `compute-<way>` for the others); empty: `Auto` only.
+    pub compute_draws: Vec<ComputeDraws>,
+    /// [`Technique::Mesh`]'s task stage ([`crate::pass::PassToggles::mesh_task`]): a row per
+    /// value, `mesh` (on) and `mesh-notask` (off: every meshlet's mesh workgroup runs), side
+    /// by side; empty: on only.
+    pub mesh_task: Vec<bool>,
     /// Renderer options for everything else (size, depth mode, ...).
     pub opts: RenderOptions,
 }
@@ -211,6 +222,42 @@ pub fn technique_label(t: Technique) -> String {
         t => t.name().to_string(),
     }
 }
+
+/// One row's settings: its technique and counter, and the compute and mesh techniques' own.
+#[derive(Clone, Copy, Debug)]
+struct Variant {
+    technique: Technique,
+    counter: Counter,
+    /// [`crate::pass::PassToggles::compute_draws`] (only `Auto` for the other techniques).
+    draws: ComputeDraws,
+    /// [`crate::pass::PassToggles::mesh_task`] (only `true` for the other techniques).
+    task: bool,
+}
+
+impl Variant {
+    /// Sets the renderer up to draw this variant.
+    fn apply(&self, r: &mut Renderer) {
+        r.settings.technique = self.technique;
+        r.settings.counter = self.counter;
+        r.settings.toggles.compute_draws = self.draws;
+        r.settings.toggles.mesh_task = self.task;
+    }
+
+    /// The row's `method`: [`technique_label`], then `-<way>` for a compute way other than
+    /// `Auto`, or [`NOTASK_SUFFIX`] for a mesh row without its task stage.
+    fn label(&self) -> String {
+        let base = technique_label(self.technique);
+        match (self.draws, self.task) {
+            (ComputeDraws::Auto, true) => base,
+            (ComputeDraws::Auto, false) => format!("{base}{NOTASK_SUFFIX}"),
+            (w, _) => format!("{base}-{}", w.name()),
+        }
+    }
+}
+
+/// What a `mesh` row's label has appended when its task stage was off
+/// ([`BenchConfig::mesh_task`]).
+const NOTASK_SUFFIX: &str = "-notask";
 
 /// What [`technique_label`] appends for a shadow map whose cube faces are multiview views.
 const MULTIVIEW_SUFFIX: &str = "-multiview";
@@ -257,22 +304,36 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         let scene = crate::scene::load(name)?;
         let c = ctx.take().ok_or_else(|| Error::Other("context lost".into()))?;
         let mut r = Renderer::new(c, scene, cfg.opts.clone())?;
-        // (technique, counter) variants, and their error against the reference.
-        let mut variants: Vec<(Technique, Counter)> = Vec::new();
+        // The variants (technique, counter, compute draws, mesh task stage), and their error
+        // against the reference.
+        let ways: &[ComputeDraws] = if cfg.compute_draws.is_empty() { &[ComputeDraws::Auto] } else { &cfg.compute_draws };
+        let tasks: &[bool] = if cfg.mesh_task.is_empty() { &[true] } else { &cfg.mesh_task };
+        let mut variants: Vec<Variant> = Vec::new();
         for &counter in &cfg.counters {
-            variants.extend(cfg.techniques.iter().filter(|t| !matches!(t, Technique::ShadowMap { .. })).map(|&t| (t, counter)));
+            for &technique in cfg.techniques.iter().filter(|t| !matches!(t, Technique::ShadowMap { .. })) {
+                let one = Variant { technique, counter, draws: ComputeDraws::Auto, task: true };
+                match technique {
+                    Technique::Compute => variants.extend(ways.iter().map(|&draws| Variant { draws, ..one })),
+                    Technique::Mesh => variants.extend(tasks.iter().map(|&task| Variant { task, ..one })),
+                    _ => variants.push(one),
+                }
+            }
         }
         // Shadow maps do not draw analytic sphere casters (the renderer refuses them): left out.
         let spheres = r.scene().spheres.iter().any(|s| s.casts_shadow);
-        variants
-            .extend(cfg.techniques.iter().filter(|t| matches!(t, Technique::ShadowMap { .. }) && !spheres).map(|&t| (t, Counter::Float)));
+        variants.extend(cfg.techniques.iter().filter(|t| matches!(t, Technique::ShadowMap { .. }) && !spheres).map(|&technique| Variant {
+            technique,
+            counter: Counter::Float,
+            draws: ComputeDraws::Auto,
+            task: true,
+        }));
         let sc = r.scene();
         let gbuffer_triangles = sc.meshes.iter().filter(|m| m.opacity >= 1.0).map(|m| m.mesh.triangles.len() as u64).sum::<u64>()
             + 12 * sc.spheres.len() as u64;
         let mut errors = Vec::new();
-        for &(technique, counter) in &variants {
-            r.settings.counter = counter;
-            errors.extend(evaluate(&mut r, name, &[technique], 1)?);
+        for v in &variants {
+            v.apply(&mut r);
+            errors.extend(evaluate(&mut r, name, &[v.technique], 1)?);
         }
         // Round-robin over variants, frame by frame, so that drift (thermal, other load) hits
         // every variant alike: the ratios are measured side by side.
@@ -291,9 +352,8 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         }
         let mut acc: Vec<Acc> = variants.iter().map(|_| Acc::default()).collect();
         for frame in 0..=cfg.frames {
-            for (k, &(technique, counter)) in variants.iter().enumerate() {
-                r.settings.technique = technique;
-                r.settings.counter = counter;
+            for (k, v) in variants.iter().enumerate() {
+                v.apply(&mut r);
                 let f = r.render()?;
                 if frame == 0 {
                     continue; // warm-up: buffers sized, caches hot
@@ -313,9 +373,9 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 a.last = Some(f.stats);
             }
         }
-        for ((&(technique, counter), err), a) in variants.iter().zip(&errors).zip(acc) {
-            r.settings.technique = technique;
-            r.settings.counter = counter;
+        for ((v, err), a) in variants.iter().zip(&errors).zip(acc) {
+            v.apply(&mut r);
+            let Variant { technique, counter, .. } = *v;
             let throughput = r.throughput(cfg.frames.max(2))?;
             let s = a.last.ok_or_else(|| Error::Other("no frame".into()))?;
             let c = &s.totals.cases;
@@ -325,7 +385,6 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
             let ray = technique == Technique::RayQuery;
             let rays = s.ray_query.as_ref().filter(|_| ray);
             let compute = technique == Technique::Compute && !a.silhouettes.is_empty();
-            eprintln!("PROFILE {} {:?} sil min {:.3} shadow min {:.3} median {:.3} plan {:.3}", name, technique, a.silhouettes.iter().cloned().fold(f64::MAX, f64::min), a.shadow.iter().cloned().fold(f64::MAX, f64::min), median(a.shadow.clone()), median(a.plan.clone())); // ABLATION
             let silhouettes_ms = compute.then(|| median(a.silhouettes));
             let read_bytes = compute.then_some(s.totals.silhouette_read_bytes);
             let fraction = match (silhouettes_ms, read_bytes, read_gib_s) {
@@ -342,7 +401,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
             };
             let row = BenchRow {
                 scene: name.clone(),
-                method: technique_label(technique),
+                method: v.label(),
                 counter: counter.name().to_string(),
                 index_format: s.index_format.name().to_string(),
                 frames: cfg.frames,
@@ -359,6 +418,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 shadow_bytes: s.totals.index_bytes + s.totals.vertex_bytes,
                 error_fraction: err.fraction,
                 cases: [c.culled, c.zpass, c.zfail, c.zfail_light_cap],
+                volume_draws: s.totals.draws,
                 gpu_tlas_ms: (ray && !a.accel.is_empty()).then(|| median(a.accel)),
                 blas_build_ms: rays.map(|q| q.bottom_level_build_ms),
                 blas_bytes: rays.map(|q| q.bottom_level_bytes),
@@ -408,12 +468,12 @@ impl BenchReport {
             "Device: {} ({}), {}x{}. Medians; wall ms = one frame at a time (latency), fps = throughput with frames in flight; error = mismatched pixels outside a 1-pixel band vs the CPU reference (worst light).\n\n",
             self.device, self.driver, self.width, self.height
         );
-        s += "| scene | method | counter | GPU frame ms | GPU shadow ms | map / lookup ms | BLAS build / refit / TLAS ms | wall ms | fps | plan ms | shadow tris | bytes | error | cases c/1/2/3 |\n";
-        s += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+        s += "| scene | method | counter | GPU frame ms | GPU shadow ms | map / lookup ms | BLAS build / refit / TLAS ms | wall ms | fps | plan ms | shadow tris | draws | bytes | error | cases c/1/2/3 |\n";
+        s += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
         let f = |v: Option<f64>| v.map(|x| format!("{x:.2}")).unwrap_or_else(|| "—".into());
         for r in &self.rows {
             s += &format!(
-                "| {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.1} | {:.3} | {} | {} | {:.4}% | {}/{}/{}/{} |\n",
+                "| {} | {} | {} | {} | {} | {} | {} | {:.2} | {:.1} | {:.3} | {} | {} | {} | {:.4}% | {}/{}/{}/{} |\n",
                 r.scene,
                 r.method,
                 r.counter,
@@ -431,6 +491,7 @@ impl BenchReport {
                 r.throughput_fps,
                 r.cpu_plan_ms,
                 r.shadow_triangles,
+                r.volume_draws,
                 r.shadow_bytes,
                 r.error_fraction * 100.0,
                 r.cases[0],

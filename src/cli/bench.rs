@@ -42,6 +42,15 @@ pub(crate) struct BenchArgs {
     /// (atlas, multiview): one row each (`shadowmap-2048`, `shadowmap-2048-multiview`).
     #[arg(long, value_enum, value_delimiter = ',', default_value = "atlas")]
     cube: Vec<umbrage::render::CubeFaces>,
+    /// Comma-separated ways to record the compute technique's volume draws (auto, count,
+    /// multi, per-record, per-chunk): one row each (`compute`, `compute-per-chunk`, ...), side
+    /// by side; a way the device lacks fails the run.
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "auto")]
+    compute_draws: Vec<umbrage::render::ComputeDraws>,
+    /// Comma-separated task-stage settings for the mesh technique (on, off): one row each
+    /// (`mesh`, `mesh-notask`: no task stage, every meshlet's mesh workgroup runs).
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "on")]
+    mesh_task: Vec<OnOff>,
     /// Write the report as JSON.
     #[arg(long)]
     json: Option<PathBuf>,
@@ -64,6 +73,15 @@ pub(crate) struct BenchArgs {
     tiny: bool,
     #[command(flatten)]
     soak: SoakArgs,
+}
+
+/// A setting switched on or off.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+enum OnOff {
+    /// On.
+    On,
+    /// Off.
+    Off,
 }
 
 /// `bench --suite`.
@@ -97,7 +115,13 @@ pub(crate) fn bench_command(a: BenchArgs) -> Result<ExitCode> {
         frames_in_flight: a.frames_in_flight,
         ..Default::default()
     };
-    bench(a.scenes, (techniques, a.methods.is_empty()), a.counters, a.frames, opts, a.json.as_deref(), a.markdown.as_deref())
+    let listed = Listed {
+        techniques,
+        default_list: a.methods.is_empty(),
+        compute_draws: a.compute_draws,
+        mesh_task: a.mesh_task.iter().map(|&t| t == OnOff::On).collect(),
+    };
+    bench(a.scenes, listed, a.counters, a.frames, opts, a.json.as_deref(), a.markdown.as_deref())
 }
 
 /// `bench --suite fill-vertex`: runs the suite, writes its outputs, prints the Markdown.
@@ -216,9 +240,20 @@ fn bench_techniques(
     out
 }
 
+/// The rows `bench` runs: the techniques, and the variants of the compute and mesh ones.
+struct Listed {
+    techniques: Vec<Technique>,
+    /// No `--methods` given: the device's mesh and ray-query techniques are added.
+    default_list: bool,
+    /// `--compute-draws`.
+    compute_draws: Vec<umbrage::render::ComputeDraws>,
+    /// `--mesh-task`, on as `true`.
+    mesh_task: Vec<bool>,
+}
+
 fn bench(
     scenes: Vec<String>,
-    (techniques, default_list): (Vec<Technique>, bool),
+    Listed { techniques, default_list, compute_draws, mesh_task }: Listed,
     counters: Vec<Counter>,
     frames: usize,
     opts: RenderOptions,
@@ -234,7 +269,7 @@ fn bench(
     if default_list && ctx.features.ray_query {
         techniques.push(Technique::RayQuery);
     }
-    let cfg = umbrage::bench::BenchConfig { scenes, techniques, counters, frames, opts };
+    let cfg = umbrage::bench::BenchConfig { scenes, techniques, counters, frames, opts, compute_draws, mesh_task };
     let report = umbrage::bench::run(ctx, &cfg, |r| {
         eprintln!(
             "{:<14} {:<16} {:<8} gpu {:>8} ms  shadow {:>8} ms  {:>7.1} fps  {:>8} tris  error {:.4}%",

@@ -61,6 +61,10 @@ fn pass_groups(ctx: &Context, out: &mut Vec<Group>) {
         index_type_uint8: f.index_type_uint8,
         ray_query: f.ray_query,
         mesh_shader: f.mesh_shader,
+        draw_indirect_first_instance: f.draw_indirect_first_instance,
+        multi_draw_indirect: f.multi_draw_indirect,
+        draw_indirect_count: f.draw_indirect_count,
+        task_shader: f.task_shader,
     };
     let mut modes = vec![sp::DepthMode::Infinite];
     if f.depth_clamp {

@@ -383,7 +383,7 @@ fn prepare_draw(
 /// # Safety
 /// `cb` is recording outside a rendering instance; `img` is in TRANSFER_SRC_OPTIMAL and the
 /// buffers hold 4 bytes (depth) and 1 byte (stencil) per texel.
-unsafe fn copy_aspects(ctx: &Context, cb: vk::CommandBuffer, img: &Image, (depth, stencil): (vk::Buffer, vk::Buffer)) {
+pub(crate) unsafe fn copy_aspects(ctx: &Context, cb: vk::CommandBuffer, img: &Image, (depth, stencil): (vk::Buffer, vk::Buffer)) {
     let region = |aspect| aspect_copy(aspect, img.extent, 0);
     let src = vk::ImageLayout::TRANSFER_SRC_OPTIMAL;
     // SAFETY: the caller's contract.

@@ -11,6 +11,7 @@
 
 use super::cases::{Config, FORMATS};
 use super::suite::{self, CaseOutcome, ConfigRun, Report, SuiteOptions};
+pub use super::units::Unit;
 use super::{CheckResult, Status};
 use crate::error::{Error, Result};
 use crate::gpu::Context;
@@ -29,53 +30,6 @@ pub struct Isolation {
     pub jobs: usize,
     /// Where the children write their results (created if missing).
     pub scratch: PathBuf,
-}
-
-/// One unit of the suite, as named on the child's command line.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Unit {
-    /// One configuration's submission (`d24s8.render_pass.static_state`).
-    Config(Config),
-    /// The `legacy.*` single-configuration checks, but multiview.
-    Legacy,
-    /// `legacy.multiview_cube_faces` on its own (a multiview crash costs no other check).
-    Multiview,
-    /// The `pipeline.hard_cases.*` renders against the CPU reference, of the hard scenes whose
-    /// index is `shard` modulo `shards` (split so that `--jobs` children share them).
-    Pipeline {
-        /// This unit's share.
-        shard: usize,
-        /// How many units share the scenes (at least 1).
-        shards: usize,
-    },
-}
-
-impl Unit {
-    /// The name a child is given: the configuration's name, `legacy`, `multiview` or `pipeline`.
-    pub fn name(&self) -> String {
-        match self {
-            Unit::Config(c) => c.name(),
-            Unit::Legacy => "legacy".into(),
-            Unit::Multiview => "multiview".into(),
-            Unit::Pipeline { shards: 1, .. } => "pipeline".into(),
-            Unit::Pipeline { shard, shards } => format!("pipeline.{shard}of{shards}"),
-        }
-    }
-
-    /// Parses [`Unit::name`].
-    pub fn parse(s: &str) -> Option<Unit> {
-        match s {
-            "legacy" => Some(Unit::Legacy),
-            "multiview" => Some(Unit::Multiview),
-            "pipeline" => Some(Unit::Pipeline { shard: 0, shards: 1 }),
-            _ if s.starts_with("pipeline.") => {
-                let (k, n) = s["pipeline.".len()..].split_once("of")?;
-                let (shard, shards) = (k.parse().ok()?, n.parse().ok()?);
-                (shard < shards).then_some(Unit::Pipeline { shard, shards })
-            }
-            _ => Config::all(&FORMATS).into_iter().find(|c| c.name() == s).map(Unit::Config),
-        }
-    }
 }
 
 /// What a child sends back.
@@ -101,6 +55,11 @@ pub fn run_unit(ctx: &Context, unit: Unit, new_context: &dyn Fn() -> Result<Cont
             let names = if unit == Unit::Legacy { super::units::legacy_unit() } else { super::units::MULTIVIEW.to_vec() };
             let mut cases = Vec::new();
             let legacy = suite::run_legacy(ctx, new_context, opts, &names, &mut cases);
+            ChildResult { cases, config: None, legacy }
+        }
+        Unit::Mesh => {
+            let mut cases = Vec::new();
+            let legacy = suite::run_mesh(ctx, opts, &mut cases);
             ChildResult { cases, config: None, legacy }
         }
         Unit::Pipeline { shard, shards } => {
@@ -164,7 +123,7 @@ pub fn run_suite_isolated(ctx: &Context, opts: &SuiteOptions, iso: &Isolation, a
         }
     }
     let shards = iso.jobs.max(1);
-    let units = [Unit::Legacy, Unit::Multiview].into_iter().chain((0..shards).map(|shard| Unit::Pipeline { shard, shards }));
+    let units = [Unit::Legacy, Unit::Multiview, Unit::Mesh].into_iter().chain((0..shards).map(|shard| Unit::Pipeline { shard, shards }));
     for unit in units {
         let names = suite::unit_case_names(unit, &opts.filter);
         if names.is_empty() {
@@ -253,6 +212,7 @@ pub fn run_suite_isolated(ctx: &Context, opts: &SuiteOptions, iso: &Isolation, a
 fn unit_group(unit: Unit) -> &'static str {
     match unit {
         Unit::Pipeline { .. } => "pipeline",
+        Unit::Mesh => "mesh",
         _ => "legacy",
     }
 }

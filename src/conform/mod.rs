@@ -13,7 +13,9 @@
 //!   submission), and each tile is compared exactly with a CPU model of the spec.
 //! - **The single-configuration checks** ([`checks`], named `legacy.*` and
 //!   `pipeline.hard_cases.*`): the original nine checks, the last of which runs the whole
-//!   shadow pipeline on every `hard/*` scene and method against the CPU reference.
+//!   shadow pipeline on every `hard/*` scene and method against the CPU reference; the
+//!   `commands.*` checks; and the mesh-shader family ([`mesh`], `mesh.*`: what
+//!   `--method mesh` relies on of `VK_EXT_mesh_shader`, reported unsupported without it).
 //!
 //! Outputs: `conform.json`, `conform.md`, JUnit XML (`--junit`), and for every failure the
 //! expected, actual and difference images. See docs/conform/cts-mapping.md.
@@ -36,7 +38,8 @@
 //! A check also fails when the validation layers reported an error during it.
 //!
 //! The command line runs every unit (a configuration's submission, the legacy checks, the
-//! multiview check, the pipeline checks) in a child process ([`isolate`]), judges a run against a driver's
+//! multiview check, the mesh-shader checks, the pipeline checks) in a child process
+//! ([`isolate`]), judges a run against a driver's
 //! expected failures ([`expect`]), and puts several runs side by side ([`matrix`]). Any
 //! Vulkan 1.0 device runs the classic render pass with static state; what needs 1.3 is skipped
 //! with the reason.
@@ -53,7 +56,9 @@ pub mod images;
 pub mod isolate;
 pub mod junit;
 pub mod matrix;
+pub mod mesh;
 pub mod model;
+mod outcome;
 pub mod raster;
 pub mod report;
 pub mod suite;

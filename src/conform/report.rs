@@ -32,8 +32,15 @@ pub fn markdown(r: &Report) -> String {
     let f = &r.features;
     let _ = writeln!(
         s,
-        "- features: depthClamp {}, depthBounds {}, VK_EXT_depth_range_unrestricted {}, occlusionQueryPrecise {}, indexTypeUint8 {}",
-        f.depth_clamp, f.depth_bounds, f.depth_range_unrestricted, f.occlusion_query_precise, f.index_type_uint8
+        "- features: depthClamp {}, depthBounds {}, VK_EXT_depth_range_unrestricted {}, occlusionQueryPrecise {}, indexTypeUint8 {}, \
+         meshShader {}, taskShader {}",
+        f.depth_clamp,
+        f.depth_bounds,
+        f.depth_range_unrestricted,
+        f.occlusion_query_precise,
+        f.index_type_uint8,
+        f.mesh_shader,
+        f.task_shader
     );
     let fmts: Vec<String> =
         r.formats.iter().map(|x| format!("{} {}", x.format, if x.usable { "usable" } else { "**not supported**" })).collect();
@@ -109,7 +116,7 @@ pub fn markdown(r: &Report) -> String {
         let _ = writeln!(s, "| `{}` | {} | {bug} |", c.name, c.status.name());
     }
 
-    let legacy: Vec<_> = r.cases.iter().filter(|c| ["legacy", "commands", "pipeline"].contains(&c.group.as_str())).collect();
+    let legacy: Vec<_> = r.cases.iter().filter(|c| ["legacy", "commands", "mesh", "pipeline"].contains(&c.group.as_str())).collect();
     if !legacy.is_empty() {
         s.push_str("\n## Single-configuration checks\n\n| case | result | details |\n|---|---|---|\n");
         for c in legacy {

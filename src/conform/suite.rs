@@ -3,127 +3,18 @@
 //! single-configuration end-to-end checks (`legacy.*`, `pipeline.hard_cases.*`).
 
 use super::batch::{self, TileResult};
-use super::cases::{self, Bug, Case, Config, RenderModel, Req, StateModel, FORMATS};
+use super::cases::{self, Case, Config, RenderModel, Req, StateModel, FORMATS};
 use super::model::{self, DepthExp, Expected};
 use super::{images, CheckResult, Status};
 use crate::error::Result;
 use crate::gpu::{Context, DeviceInfo, Features};
 use ash::vk;
-use std::path::PathBuf;
 use std::time::Instant;
 
-use super::units::{pipeline_shard_names, COMMANDS, LEGACY};
-pub use super::units::{run_legacy, run_pipeline};
-
-/// Options of a suite run.
-#[derive(Clone, Debug)]
-pub struct SuiteOptions {
-    /// Case-name patterns; a case runs when any matches (empty: every case). A pattern with
-    /// `*` is a glob over the whole name, otherwise a substring.
-    pub filter: Vec<String>,
-    /// Size of the `pipeline.hard_cases.*` renders.
-    pub pipeline_size: (u32, u32),
-    /// Where failure images go (`<dir>/failures/<case>/`); `None`: not written.
-    pub image_dir: Option<PathBuf>,
-    /// Test seam: the expectation applies [`model::broken`]`(op)` wherever it should apply `op`
-    /// (`UMBRAGE_CONFORM_BREAK=<op>` on the command line), so the cases that exercise `op`
-    /// must fail — and only those.
-    #[doc(hidden)]
-    pub break_op: Option<vk::StencilOp>,
-}
-
-impl Default for SuiteOptions {
-    fn default() -> Self {
-        SuiteOptions { filter: Vec::new(), pipeline_size: (160, 120), image_dir: None, break_op: None }
-    }
-}
-
-/// Whether `name` matches `pattern` (glob with `*` and `?` when it has either, else substring).
-pub fn matches(pattern: &str, name: &str) -> bool {
-    if !pattern.contains(['*', '?']) {
-        return name.contains(pattern);
-    }
-    fn glob(p: &[u8], s: &[u8]) -> bool {
-        match (p.first(), s.first()) {
-            (None, None) => true,
-            (Some(b'*'), _) => glob(&p[1..], s) || (!s.is_empty() && glob(p, &s[1..])),
-            (Some(b'?'), Some(_)) => glob(&p[1..], &s[1..]),
-            (Some(a), Some(b)) if a == b => glob(&p[1..], &s[1..]),
-            _ => false,
-        }
-    }
-    glob(pattern.as_bytes(), name.as_bytes())
-}
-
-pub(crate) fn selected(filter: &[String], name: &str) -> bool {
-    filter.is_empty() || filter.iter().any(|p| matches(p, name))
-}
-
-/// One query draw's count.
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
-pub struct QueryOutcome {
-    /// Smallest count the model allows.
-    pub expected_min: u64,
-    /// Largest count the model allows.
-    pub expected_max: u64,
-    /// What the device counted.
-    pub actual: u64,
-}
-
-/// The result of one case.
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
-pub struct CaseOutcome {
-    /// The full dotted name.
-    pub name: String,
-    /// `stencil`, `depth`, `raster`, `zoo`, `legacy` or `pipeline`.
-    pub group: String,
-    /// The configuration (`d24s8.dynamic_rendering.static_state`); `None` for the legacy and
-    /// pipeline checks (the renderer's format, dynamic rendering, static state).
-    pub config: Option<String>,
-    /// Pass, fail or skipped.
-    pub status: Status,
-    /// Pass: what held; fail: what differed; skipped: the missing feature.
-    pub message: String,
-    /// What the case checks.
-    pub what: String,
-    /// The bug a zoo case reproduces (not sent back by an isolated child: the parent has it).
-    #[serde(skip_serializing_if = "Option::is_none", skip_deserializing)]
-    pub bug: Option<Bug>,
-    /// Seconds: the configuration's submission time shared equally among its cases.
-    pub seconds: f64,
-    /// Pixels whose stencil was judged.
-    pub judged_pixels: u64,
-    /// Judged pixels whose stencil differed.
-    pub stencil_mismatches: u64,
-    /// Judged pixels whose depth differed.
-    pub depth_mismatches: u64,
-    /// Occlusion-query counts.
-    #[serde(skip_serializing_if = "Vec::is_empty", default)]
-    pub queries: Vec<QueryOutcome>,
-    /// Failure images written (expected, actual, diff).
-    #[serde(skip_serializing_if = "Vec::is_empty", default)]
-    pub images: Vec<String>,
-}
-
-impl CaseOutcome {
-    pub(crate) fn new(name: String, group: &str, config: Option<String>, what: String) -> CaseOutcome {
-        CaseOutcome {
-            name,
-            group: group.into(),
-            config,
-            status: Status::Pass,
-            message: String::new(),
-            what,
-            bug: None,
-            seconds: 0.0,
-            judged_pixels: 0,
-            stencil_mismatches: 0,
-            depth_mismatches: 0,
-            queries: Vec::new(),
-            images: Vec::new(),
-        }
-    }
-}
+pub(crate) use super::outcome::selected;
+pub use super::outcome::{matches, CaseOutcome, QueryOutcome, SuiteOptions};
+use super::units::{pipeline_shard_names, Unit, COMMANDS, LEGACY, MESH};
+pub use super::units::{run_legacy, run_mesh, run_pipeline};
 
 /// Whether a depth-stencil format was usable.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -168,7 +59,8 @@ pub struct Report {
     pub configs: Vec<ConfigRun>,
     /// Every selected case, in name order of generation.
     pub cases: Vec<CaseOutcome>,
-    /// The legacy single-configuration checks' full results (numbers), when selected.
+    /// The single-configuration checks' full results (numbers: `legacy.*`, `commands.*`,
+    /// `mesh.*`, the pipeline check), when selected.
     pub legacy: Vec<CheckResult>,
     /// Wall time of the whole run.
     pub seconds: f64,
@@ -191,12 +83,13 @@ impl Report {
 }
 
 /// The selected case names of the legacy or pipeline unit (empty for a configuration unit).
-pub fn unit_case_names(unit: super::isolate::Unit, filter: &[String]) -> Vec<String> {
+pub fn unit_case_names(unit: Unit, filter: &[String]) -> Vec<String> {
     let all = match unit {
-        super::isolate::Unit::Legacy => super::units::legacy_unit().into_iter().map(super::units::full_name).collect(),
-        super::isolate::Unit::Multiview => super::units::MULTIVIEW.iter().map(|n| format!("legacy.{n}")).collect(),
-        super::isolate::Unit::Pipeline { shard, shards } => pipeline_shard_names((shard, shards)),
-        super::isolate::Unit::Config(_) => Vec::new(),
+        Unit::Legacy => super::units::legacy_unit().into_iter().map(super::units::full_name).collect(),
+        Unit::Multiview => super::units::MULTIVIEW.iter().map(|n| format!("legacy.{n}")).collect(),
+        Unit::Mesh => MESH.iter().map(|n| format!("mesh.{n}")).collect(),
+        Unit::Pipeline { shard, shards } => pipeline_shard_names((shard, shards)),
+        Unit::Config(_) => Vec::new(),
     };
     all.into_iter().filter(|n| selected(filter, n)).collect()
 }
@@ -206,6 +99,7 @@ pub fn all_names() -> Vec<String> {
     let mut v: Vec<String> = cases::all(&Config::all(&FORMATS)).into_iter().map(|c| c.name).collect();
     v.extend(LEGACY.iter().map(|n| format!("legacy.{n}")));
     v.extend(COMMANDS.iter().map(|n| format!("commands.{n}")));
+    v.extend(MESH.iter().map(|n| format!("mesh.{n}")));
     v.extend(pipeline_shard_names((0, 1)));
     v
 }
@@ -435,6 +329,7 @@ pub fn run_suite(ctx: &Context, new_context: &dyn Fn() -> Result<Context>, opts:
     }
     let every: Vec<&str> = LEGACY.iter().chain(COMMANDS.iter()).copied().collect();
     let mut legacy = run_legacy(ctx, new_context, opts, &every, &mut outcomes);
+    legacy.extend(run_mesh(ctx, opts, &mut outcomes));
     legacy.extend(run_pipeline(ctx, new_context, opts, (0, 1), &mut outcomes));
     Report {
         device: ctx.info.clone(),

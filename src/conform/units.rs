@@ -1,8 +1,10 @@
-//! The suite's single-configuration units: the `legacy.*` checks (split into the `legacy` unit
-//! and the `multiview` unit, which crash isolation runs apart) and the `pipeline.hard_cases.*`
-//! renders against the CPU reference.
+//! The suite's units ([`Unit`]: what crash isolation runs in one child) and the
+//! single-configuration ones: the `legacy.*` checks (split into the `legacy` unit and the
+//! `multiview` unit, which crash isolation runs apart), the `mesh.*` family (a unit of its own)
+//! and the `pipeline.hard_cases.*` renders against the CPU reference.
 
-use super::suite::{selected, CaseOutcome, SuiteOptions};
+use super::cases::{Config, FORMATS};
+use super::outcome::{selected, CaseOutcome, SuiteOptions};
 use super::{CheckResult, Status};
 use crate::error::Result;
 use crate::gpu::Context;
@@ -21,8 +23,64 @@ pub(crate) const LEGACY: [&str; 10] = [
     super::checks::MULTIVIEW_CUBE_FACES,
 ];
 
+/// One unit of the suite, as named on the child's command line.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Unit {
+    /// One configuration's submission (`d24s8.render_pass.static_state`).
+    Config(Config),
+    /// The `legacy.*` single-configuration checks, but multiview.
+    Legacy,
+    /// `legacy.multiview_cube_faces` on its own (a multiview crash costs no other check).
+    Multiview,
+    /// The `mesh.*` family on its own (mesh shaders are young in drivers: a crash there costs
+    /// no other check).
+    Mesh,
+    /// The `pipeline.hard_cases.*` renders against the CPU reference, of the hard scenes whose
+    /// index is `shard` modulo `shards` (split so that `--jobs` children share them).
+    Pipeline {
+        /// This unit's share.
+        shard: usize,
+        /// How many units share the scenes (at least 1).
+        shards: usize,
+    },
+}
+
+impl Unit {
+    /// The name a child is given: the configuration's name, `legacy`, `multiview`, `mesh` or
+    /// `pipeline`.
+    pub fn name(&self) -> String {
+        match self {
+            Unit::Config(c) => c.name(),
+            Unit::Legacy => "legacy".into(),
+            Unit::Multiview => "multiview".into(),
+            Unit::Mesh => "mesh".into(),
+            Unit::Pipeline { shards: 1, .. } => "pipeline".into(),
+            Unit::Pipeline { shard, shards } => format!("pipeline.{shard}of{shards}"),
+        }
+    }
+
+    /// Parses [`Unit::name`].
+    pub fn parse(s: &str) -> Option<Unit> {
+        match s {
+            "legacy" => Some(Unit::Legacy),
+            "multiview" => Some(Unit::Multiview),
+            "mesh" => Some(Unit::Mesh),
+            "pipeline" => Some(Unit::Pipeline { shard: 0, shards: 1 }),
+            _ if s.starts_with("pipeline.") => {
+                let (k, n) = s["pipeline.".len()..].split_once("of")?;
+                let (shard, shards) = (k.parse().ok()?, n.parse().ok()?);
+                (shard < shards).then_some(Unit::Pipeline { shard, shards })
+            }
+            _ => Config::all(&FORMATS).into_iter().find(|c| c.name() == s).map(Unit::Config),
+        }
+    }
+}
+
 /// The `commands.*` checks (run in the `legacy` unit): what umbrage records besides draws.
-pub(crate) const COMMANDS: [&str; 11] = super::checks::commands::NAMES;
+pub(crate) const COMMANDS: [&str; 13] = super::checks::commands::NAMES;
+
+/// The `mesh.*` checks (the `mesh` unit): the mesh-shader family.
+pub(crate) const MESH: [&str; 4] = super::mesh::NAMES;
 
 /// A single-configuration check's case name: `commands.<name>` or `legacy.<name>`.
 pub(crate) fn full_name(name: &str) -> String {
@@ -71,7 +129,7 @@ pub fn run_legacy(
     type Run<'a> = Box<dyn Fn() -> Result<CheckResult> + 'a>;
     let on_ctx = |f: Check| -> Run<'_> { Box::new(move || f(ctx)) };
     use super::checks::commands;
-    let unit: [(&str, Run<'_>); 21] = [
+    let unit: [(&str, Run<'_>); 23] = [
         (LEGACY[0], on_ctx(super::checks::w0_vertices_and_infinity)),
         (LEGACY[1], on_ctx(super::checks::depth_clamp)),
         (LEGACY[2], on_ctx(super::checks::watertight_fan)),
@@ -94,6 +152,8 @@ pub fn run_legacy(
         (COMMANDS[8], on_ctx(commands::fill_buffer)),
         (COMMANDS[9], on_ctx(commands::dispatch)),
         (COMMANDS[10], on_ctx(commands::dispatch_indirect)),
+        (COMMANDS[11], on_ctx(commands::multi_draw_indirect)),
+        (COMMANDS[12], on_ctx(commands::draw_indirect_count)),
     ];
     let mut results = Vec::new();
     for (name, f) in unit {
@@ -119,6 +179,39 @@ pub fn run_legacy(
         }
         let t0 = Instant::now();
         let mut r = f().unwrap_or_else(|e| CheckResult::error(name, &e));
+        super::with_validation(&mut r, ctx.take_validation_errors());
+        o.status = r.status;
+        o.message = r.summary.clone();
+        o.seconds = t0.elapsed().as_secs_f64();
+        out.push(o);
+        results.push(r);
+    }
+    results
+}
+
+/// The selected `mesh.*` checks (outcomes into `out`, full results returned): each skipped as
+/// unsupported, with the reason, where the device lacks what it needs.
+pub fn run_mesh(ctx: &Context, opts: &SuiteOptions, out: &mut Vec<CaseOutcome>) -> Vec<CheckResult> {
+    type Check = fn(&Context) -> Result<CheckResult>;
+    use super::mesh;
+    let checks: [(&str, Check); 4] =
+        [(MESH[0], mesh::w0_vertices), (MESH[1], mesh::watertight_meshlets), (MESH[2], mesh::group_counts), (MESH[3], mesh::task_payload)];
+    let mut results = Vec::new();
+    for (name, f) in checks {
+        let full = format!("mesh.{name}");
+        if !selected(&opts.filter, &full) {
+            continue;
+        }
+        let mut o = CaseOutcome::new(full, "mesh", None, format!("mesh-shader check `{name}` (VK_EXT_mesh_shader, the renderer's format)"));
+        if let Some(why) = mesh::unsupported(ctx, name) {
+            o.status = Status::Skipped;
+            o.message = why;
+            out.push(o);
+            continue;
+        }
+        let t0 = Instant::now();
+        let _ = ctx.take_validation_errors();
+        let mut r = f(ctx).unwrap_or_else(|e| CheckResult::error(name, &e));
         super::with_validation(&mut r, ctx.take_validation_errors());
         o.status = r.status;
         o.message = r.summary.clone();

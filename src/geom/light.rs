@@ -109,7 +109,7 @@ pub struct Light {
     pub cone_deg: f32,
     /// `Some` for an area light ([`crate::geom::area`]): `kind` is then [`LightKind::Point`]
     /// and `position` the centre; the renderer splits it into point-light samples.
-    pub area: Option<super::area::AreaLight>,
+    pub area: Option<super::area_shape::AreaLight>,
 }
 
 impl Light {

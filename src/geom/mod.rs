@@ -4,8 +4,10 @@
 pub mod mesh;
 pub use mesh::{Aabb, Mesh};
 pub mod area;
+mod area_shape;
 pub use area::{AreaLight, AreaShape};
 pub mod bounds;
+pub mod cone;
 pub mod edgescan;
 pub mod light;
 pub use order::TriangleOrder;

@@ -59,6 +59,8 @@ pub struct FeatureSet {
     pub sample_rate_shading: bool,
     /// `multiDrawIndirect` (Vulkan 1.0).
     pub multi_draw_indirect: bool,
+    /// `drawIndirectFirstInstance` (Vulkan 1.0).
+    pub draw_indirect_first_instance: bool,
     /// `multiview` (`VkPhysicalDeviceVulkan11Features`, or `VK_KHR_multiview`'s structure).
     pub multiview: bool,
     /// `drawIndirectCount` (`VkPhysicalDeviceVulkan12Features`).
@@ -220,6 +222,7 @@ impl DeviceCaps {
             geometry_shader: t(base.geometry_shader),
             sample_rate_shading: t(base.sample_rate_shading),
             multi_draw_indirect: t(base.multi_draw_indirect),
+            draw_indirect_first_instance: t(base.draw_indirect_first_instance),
             multiview: t(f11.multiview),
             draw_indirect_count: t(f12.draw_indirect_count),
             buffer_device_address: t(f12.buffer_device_address),
@@ -378,6 +381,9 @@ pub fn choose(caps: &DeviceCaps, minimum: Minimum) -> Result<Choice> {
         multiview: v12 && f.multiview,
         mesh_shader,
         task_shader: mesh_shader && f.task_shader,
+        multi_draw_indirect: f.multi_draw_indirect,
+        draw_indirect_first_instance: f.draw_indirect_first_instance,
+        draw_indirect_count: v12 && f.draw_indirect_count,
         sample_rate_shading: f.sample_rate_shading,
         standard_sample_locations: l.standard_sample_locations == vk::TRUE,
         storage_buffer_storage_class: v11 || storage_buffer_ext,
@@ -470,6 +476,15 @@ pub struct Features {
     /// `taskShader` of `VK_EXT_mesh_shader` is present and enabled too (only with
     /// [`mesh_shader`](Self::mesh_shader)).
     pub task_shader: bool,
+    /// `multiDrawIndirect` is supported and enabled: indirect draws of more than one record
+    /// per call (the compute path's merged volume draws).
+    pub multi_draw_indirect: bool,
+    /// `drawIndirectFirstInstance` is supported and enabled: indirect records with a non-zero
+    /// `firstInstance` (the merged draws' per-caster transforms are selected by it).
+    pub draw_indirect_first_instance: bool,
+    /// `drawIndirectCount` (Vulkan 1.2 core) is supported and enabled:
+    /// `vkCmdDrawIndexedIndirectCount` (the merged draws' count comes from the GPU).
+    pub draw_indirect_count: bool,
     /// `sampleRateShading` is supported and enabled: the renderer's multisampled frame
     /// (`--msaa N`) shades its G-buffer and lighting per sample.
     pub sample_rate_shading: bool,

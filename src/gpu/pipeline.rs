@@ -89,6 +89,9 @@ pub struct PipelineDesc<'a> {
     /// mesh entry point replace the vertex stage (`vertex`, the vertex input and the input
     /// assembly are then ignored). `None` (the default): a vertex pipeline.
     pub mesh: Option<(&'a [u8], &'a std::ffi::CStr)>,
+    /// With [`PipelineDesc::mesh`]: a task entry point of the same module (`taskShader`
+    /// enabled), run before the mesh stage. `None` (the default): no task stage.
+    pub task: Option<&'a std::ffi::CStr>,
 }
 
 impl<'a> PipelineDesc<'a> {
@@ -121,6 +124,7 @@ impl<'a> PipelineDesc<'a> {
             render_pass: None,
             view_mask: 0,
             mesh: None,
+            task: None,
         }
     }
 }
@@ -155,6 +159,9 @@ pub fn create(ctx: &impl GpuDevice, d: &PipelineDesc) -> Result<vk::Pipeline> {
         }
     };
     let mut stages = vec![vk::PipelineShaderStageCreateInfo::default().stage(first_stage).module(vs).name(first_entry)];
+    if let (Some(task), Some(_)) = (d.task, d.mesh) {
+        stages.push(vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::TASK_EXT).module(vs).name(task));
+    }
     if let Some(fs) = fs {
         stages.push(vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::FRAGMENT).module(fs).name(d.fragment_entry));
     }
@@ -308,6 +315,9 @@ fn label(d: &PipelineDesc) -> String {
         Some((module, entry)) => format!("{}:{}", super::creation::shader_name(module), entry.to_string_lossy()),
         None => super::creation::shader_name(d.vertex),
     };
+    if let (Some(task), Some(_)) = (d.task, d.mesh) {
+        s += &format!(" (task {})", task.to_string_lossy());
+    }
     if let Some(f) = d.fragment {
         s += &format!(" + {}", super::creation::shader_name(f));
         if d.fragment_entry != c"main" {

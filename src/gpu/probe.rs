@@ -52,14 +52,17 @@ pub(super) fn open_device(
         .depth_bounds(features.depth_bounds)
         .pipeline_statistics_query(features.pipeline_statistics_query)
         .occlusion_query_precise(features.occlusion_query_precise)
-        .sample_rate_shading(features.sample_rate_shading);
+        .sample_rate_shading(features.sample_rate_shading)
+        .multi_draw_indirect(features.multi_draw_indirect)
+        .draw_indirect_first_instance(features.draw_indirect_first_instance);
     let mut e13 = vk::PhysicalDeviceVulkan13Features::default()
         .dynamic_rendering(features.dynamic_rendering)
         .synchronization2(features.synchronization2);
     let mut e_u8 = vk::PhysicalDeviceIndexTypeUint8FeaturesEXT::default().index_type_uint8(true);
     let mut e_as = vk::PhysicalDeviceAccelerationStructureFeaturesKHR::default().acceleration_structure(true);
     let mut e_rq = vk::PhysicalDeviceRayQueryFeaturesKHR::default().ray_query(true);
-    let mut e12 = vk::PhysicalDeviceVulkan12Features::default().buffer_device_address(true);
+    let mut e12 =
+        vk::PhysicalDeviceVulkan12Features::default().buffer_device_address(ray_query).draw_indirect_count(features.draw_indirect_count);
     let mut e11 = vk::PhysicalDeviceVulkan11Features::default().multiview(true);
     let mut e_mesh = vk::PhysicalDeviceMeshShaderFeaturesEXT::default().mesh_shader(true).task_shader(features.task_shader);
     let mut dev_exts: Vec<_> = extensions.iter().map(|e| e.as_ptr()).collect();
@@ -83,7 +86,11 @@ pub(super) fn open_device(
         dinfo = dinfo.push_next(&mut e11);
     }
     if ray_query {
-        dinfo = dinfo.push_next(&mut e_as).push_next(&mut e_rq).push_next(&mut e12);
+        dinfo = dinfo.push_next(&mut e_as).push_next(&mut e_rq);
+    }
+    // Vulkan 1.2's features: bufferDeviceAddress (ray query), drawIndirectCount.
+    if ray_query || features.draw_indirect_count {
+        dinfo = dinfo.push_next(&mut e12);
     }
     if mesh_shader {
         dinfo = dinfo.push_next(&mut e_mesh);

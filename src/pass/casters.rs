@@ -3,7 +3,7 @@
 //! release once every frame in flight that could use a buffer has retired.
 
 use super::compute::arena::{add_elements, mesh_elements, ComputeArena, ELEMENT_BYTES, TABLES};
-use super::compute::{ComputeMesh, ComputeStatic};
+use super::compute::{dual_length, ComputeMesh, ComputeStatic};
 use super::device::PassDevice;
 use crate::error::{Error, Misuse, Result};
 use crate::geom::Mesh;
@@ -93,14 +93,6 @@ pub(crate) struct CasterTable {
     graves: Vec<Grave>,
     /// The compute pass's static tables of every caster that has them.
     pub arena: ComputeArena,
-}
-
-/// The dual-length vertex data of a chunk: every vertex with w = 1, then again with w = 0.
-fn dual_length(vertices: &[Vec3]) -> Vec<[f32; 4]> {
-    let mut data: Vec<[f32; 4]> = Vec::with_capacity(vertices.len() * 2);
-    data.extend(vertices.iter().map(|v| [v.x, v.y, v.z, 1.0]));
-    data.extend(vertices.iter().map(|v| [v.x, v.y, v.z, 0.0]));
-    data
 }
 
 impl CasterTable {

@@ -204,7 +204,52 @@ pub struct EnabledFeatures {
     /// `VK_EXT_mesh_shader` with `meshShader` (Vulkan 1.2 or newer):
     /// [`Technique::Mesh`].
     pub mesh_shader: bool,
+    /// `VkPhysicalDeviceFeatures::drawIndirectFirstInstance`: [`Technique::Compute`]'s volume
+    /// draws read each caster's transform through the draw's `firstInstance`, with no push
+    /// constants or buffer binds per caster ([`ComputeDraws`]). Without it: one draw per chunk
+    /// with the caster's push constants.
+    pub draw_indirect_first_instance: bool,
+    /// `VkPhysicalDeviceFeatures::multiDrawIndirect`: with `draw_indirect_first_instance`, one
+    /// indirect draw per light and pipeline ([`ComputeDraws::Multi`]).
+    pub multi_draw_indirect: bool,
+    /// Vulkan 1.2's `drawIndirectCount` (`VkPhysicalDeviceVulkan12Features`): with the two
+    /// above, the draw count comes from the GPU (`vkCmdDrawIndexedIndirectCount`,
+    /// [`ComputeDraws::Count`]).
+    pub draw_indirect_count: bool,
+    /// `taskShader` of `VK_EXT_mesh_shader` (with [`mesh_shader`](Self::mesh_shader)):
+    /// [`Technique::Mesh`] culls the meshlets that would emit nothing in a task stage
+    /// ([`PassToggles::mesh_task`]); without it every meshlet's mesh workgroup runs.
+    pub task_shader: bool,
 }
+
+named_enum!(
+    /// How [`Technique::Compute`]'s volume draws are recorded (the GPU writes one
+    /// `VkDrawIndexedIndirectCommand` per chunk and case; the counts are the same whichever
+    /// way they are drawn). Every way but `PerChunk` reads each caster's transform and
+    /// object-space light as per-instance vertex attributes selected by the record's
+    /// `firstInstance`, and the chunks' vertices from one pass-wide buffer at the record's
+    /// `vertexOffset`, so a light's draws need no push constants or buffer binds per caster.
+    ComputeDraws, "compute draws", {
+        /// The best the device and the host's [`EnabledFeatures`] allow: `Count`, else
+        /// `Multi`, else `PerRecord`, else `PerChunk`.
+        #[default]
+        Auto => "auto",
+        /// One `vkCmdDrawIndexedIndirectCount` per light and pipeline, its count written by
+        /// the GPU (the non-empty records, compacted): `drawIndirectCount`,
+        /// `multiDrawIndirect` and `drawIndirectFirstInstance`.
+        Count => "count",
+        /// One multi-draw `vkCmdDrawIndexedIndirect` per light and pipeline over the
+        /// compacted records (the unused tail empty): `multiDrawIndirect` and
+        /// `drawIndirectFirstInstance`.
+        Multi => "multi",
+        /// One `vkCmdDrawIndexedIndirect` per record, without push constants or binds per
+        /// caster: `drawIndirectFirstInstance`.
+        PerRecord => "per-record",
+        /// One `vkCmdDrawIndexedIndirect` per chunk record with the caster's push constants
+        /// and its chunk's own vertex buffer: what every device can do.
+        PerChunk => "per-chunk",
+    }
+);
 
 /// What a [`ShadowPass`](super::ShadowPass) is created for. Everything here is fixed for the
 /// pass's lifetime (pipelines and ring slots are built from it); per-frame choices are in
@@ -338,11 +383,28 @@ pub struct PassToggles {
     /// on lavapipe (1.1-1.3x, docs/raytrace.md): the rays cost the same, and the per-light
     /// resolve passes cost more than the G-buffer reads they save.
     pub ray_batch: bool,
+    /// How [`Technique::Compute`]'s volume draws are recorded ([`ComputeDraws::Auto`]: the
+    /// best the device allows); the same stencil every way. A way the pass cannot use is
+    /// refused by [`PassSettings::check`] for `Technique::Compute` frames.
+    pub compute_draws: ComputeDraws,
+    /// [`Technique::Mesh`] on a pass with [`Capabilities::task_shader`]: a task stage launches
+    /// the mesh workgroups of only the meshlets that emit something, decided by each
+    /// meshlet's normal cone and bounding sphere where they prove it and by the facing bits
+    /// otherwise (off: every meshlet's mesh workgroup runs, as without task shaders). The same
+    /// triangles either way.
+    pub mesh_task: bool,
 }
 
 impl Default for PassToggles {
     fn default() -> Self {
-        PassToggles { scissor: true, depth_bounds: true, culling: true, ray_batch: false }
+        PassToggles {
+            scissor: true,
+            depth_bounds: true,
+            culling: true,
+            ray_batch: false,
+            compute_draws: ComputeDraws::Auto,
+            mesh_task: true,
+        }
     }
 }
 
@@ -362,6 +424,45 @@ pub struct Capabilities {
     pub r32f_blend: bool,
     /// Mesh shaders enabled and present ([`EnabledFeatures::mesh_shader`]).
     pub mesh_shader: bool,
+    /// `drawIndirectFirstInstance` enabled and present.
+    pub draw_indirect_first_instance: bool,
+    /// `multiDrawIndirect` enabled and present.
+    pub multi_draw_indirect: bool,
+    /// `drawIndirectCount` (Vulkan 1.2) enabled and present.
+    pub draw_indirect_count: bool,
+    /// Task shaders too ([`EnabledFeatures::task_shader`]).
+    pub task_shader: bool,
+}
+
+impl Capabilities {
+    /// The way [`Technique::Compute`]'s volume draws are recorded for `want`: `Auto` resolved
+    /// to the best these capabilities allow, a forced way kept, or the error naming what it
+    /// needs ([`Error::Unsupported`]).
+    pub fn compute_draws(&self, want: ComputeDraws) -> Result<ComputeDraws> {
+        let first = self.draw_indirect_first_instance;
+        let multi = first && self.multi_draw_indirect;
+        let count = multi && self.draw_indirect_count;
+        let (ok, needs) = match want {
+            ComputeDraws::Auto => {
+                return Ok(match (count, multi, first) {
+                    (true, _, _) => ComputeDraws::Count,
+                    (_, true, _) => ComputeDraws::Multi,
+                    (_, _, true) => ComputeDraws::PerRecord,
+                    _ => ComputeDraws::PerChunk,
+                })
+            }
+            ComputeDraws::Count => (count, "drawIndirectCount (Vulkan 1.2), multiDrawIndirect and drawIndirectFirstInstance"),
+            ComputeDraws::Multi => (multi, "multiDrawIndirect and drawIndirectFirstInstance"),
+            ComputeDraws::PerRecord => (first, "drawIndirectFirstInstance"),
+            ComputeDraws::PerChunk => (true, ""),
+        };
+        match ok {
+            true => Ok(want),
+            false => Err(Error::Unsupported(format!(
+                "ComputeDraws::{want:?} needs {needs}, present and enabled by the host (EnabledFeatures); use ComputeDraws::Auto"
+            ))),
+        }
+    }
 }
 
 /// Refuses a depth-stencil format without a depth aspect or without 8 stencil bits.
@@ -401,6 +502,9 @@ impl PassSettings {
         }
         if self.technique == Technique::Mesh && !caps.mesh_shader {
             return Err(mesh_missing());
+        }
+        if self.technique == Technique::Compute {
+            caps.compute_draws(self.toggles.compute_draws)?;
         }
         if self.index_format == IndexFormat::U8 && !caps.index_type_uint8 {
             return Err(Error::Unsupported(

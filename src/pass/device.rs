@@ -19,6 +19,8 @@ pub(crate) struct PassDevice {
     /// The device's `maxStorageBufferRange` (the compute pass's tables and lists are bound
     /// whole, each at most this long).
     pub max_storage_range: u64,
+    /// The device's `maxDrawIndirectCount` (the merged draws split a longer list).
+    pub max_draw_indirect_count: u32,
 }
 
 impl GpuDevice for PassDevice {
@@ -88,6 +90,10 @@ pub(super) fn capabilities(caps: &DeviceCaps, desc: &ShadowPassDesc) -> Result<C
         r32f_blend: caps.format_features(COUNT_FORMAT).contains(vk::FormatFeatureFlags::COLOR_ATTACHMENT_BLEND)
             && desc.target == TargetModel::DynamicRendering,
         mesh_shader: desc.features.mesh_shader && mesh_shader,
+        draw_indirect_first_instance: desc.features.draw_indirect_first_instance && f.draw_indirect_first_instance,
+        multi_draw_indirect: desc.features.multi_draw_indirect && f.multi_draw_indirect,
+        draw_indirect_count: desc.features.draw_indirect_count && api >= vk::API_VERSION_1_2 && f.draw_indirect_count,
+        task_shader: desc.features.mesh_shader && mesh_shader && desc.features.task_shader && f.task_shader,
     })
 }
 

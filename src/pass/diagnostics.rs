@@ -110,20 +110,36 @@ impl Diagnostics for ShadowPass {
         let Some(pipe) = self.pipes.overlay else {
             return Err(Misuse::NotConfigured { call: "cmd_draw_volume_overlay", needs: "ShadowPassDesc::debug_color_format" }.into());
         };
-        // SAFETY: the caller's contract.
-        unsafe { self.dev.device.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipe) };
+        let mut bound = vk::Pipeline::null();
         for lf in &frame.lights {
             for c in lf.casters.iter().filter(|c| c.case != Case::Culled) {
-                // (mesh draws have no vertex pipeline: the overlay leaves Technique::Mesh's out)
-                for dr in c.draws.iter().filter(|dr| !dr.light_cap && dr.mesh.is_none()) {
+                for dr in c.draws.iter().filter(|dr| !dr.light_cap) {
                     let color = match dr.case {
                         Case::Culled => continue,
                         Case::ZPass => [0.2f32, 0.4, 1.0, 0.12],
                         Case::ZFail => [1.0, 0.3, 0.2, 0.12],
                         Case::ZFailLightCap => [0.1, 1.0, 0.2, 0.12],
                     };
-                    // SAFETY: as above.
+                    if let Some(md) = &dr.mesh {
+                        // Technique::Mesh: the mesh pipelines' overlay, the same colours
+                        let Some(mesh_pipe) = self.mesh_set(frame)?.overlay else {
+                            return Err(Misuse::NotConfigured {
+                                call: "cmd_draw_volume_overlay",
+                                needs: "ShadowPassDesc::debug_color_format",
+                            }
+                            .into());
+                        };
+                        // SAFETY: the caller's contract.
+                        unsafe { self.record_mesh(cb, frame, mesh_pipe, c, md, color)? };
+                        bound = mesh_pipe;
+                        continue;
+                    }
+                    // SAFETY: the caller's contract.
                     unsafe {
+                        if bound != pipe {
+                            self.dev.device.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipe);
+                            bound = pipe;
+                        }
                         self.push(cb, c, color);
                         self.record_draw(cb, frame, dr);
                     }

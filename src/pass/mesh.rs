@@ -12,26 +12,56 @@
 //! facing bits and the per-draw counters are the frame's.
 //!
 //! A draw covers at most [`MAX_TASKS`] meshlets (every device's `maxMeshWorkGroupCount[0]`):
-//! larger parts take several draws.
+//! larger parts take several draws. With `taskShader` a task stage culls the meshlets that
+//! would emit nothing (`shaders/extrude.wgsl`, [`super::mesh_pipes`]): a draw then dispatches
+//! one task workgroup per [`TASK_GROUP`] meshlets.
 
-use super::device::PassDevice;
-use super::pipelines::{mirror, COUNT_FORMAT};
 use super::push::VolumePush;
-use crate::error::{Error, Result};
-use crate::gpu::descriptors::pipeline_layout;
-use crate::gpu::pipeline::{self, Blend, PipelineDesc};
-use crate::gpu::{shaders, GpuDevice};
-use crate::shadow::Case;
-use ash::vk;
 use bytemuck::{Pod, Zeroable};
 
 /// Most meshlets (workgroups) one draw dispatches: Vulkan's minimum `maxMeshWorkGroupCount[0]`.
 pub(crate) const MAX_TASKS: u32 = 65535;
+/// Meshlets one task workgroup decides (`TASK_GROUP` of `shaders/extrude.wgsl`).
+pub(crate) const TASK_GROUP: u32 = 64;
 /// Storage-buffer bindings of the mesh set: positions, triangles, meshlets, meshlet triangles,
 /// meshlet edges (the arena's), facing bits and the draws' counters (the frame's).
 pub(crate) const MESH_BINDINGS: u32 = 7;
-/// Words of one draw's counters: sides, dark cap, light cap, silhouette edges.
-pub(crate) const COUNT_WORDS: usize = 4;
+/// Words of one draw's counters: sides, dark cap, light cap, silhouette edges, then the
+/// meshlets the draws covered and the mesh workgroups that ran (fewer where the task stage
+/// culled).
+pub(crate) const COUNT_WORDS: usize = 6;
+/// Words of one row of the arena's meshlet table (`struct Meshlet` of `shaders/extrude.wgsl`):
+/// its ranges, its bounding sphere, its sides' and faces' normal cones.
+pub(crate) const MESHLET_WORDS: usize = 16;
+
+/// The meshlet table's rows of `ml`: `(first triangle, triangles, first edge, edges)` (the
+/// firsts relative to the caster's ranges of the meshlet triangle and edge tables; see
+/// [`placed`]), the sphere `(centre, radius)`, the sides' cone `(axis, cos)` and the faces'
+/// cone, as f32 bits.
+pub(crate) fn meshlet_rows(ml: &crate::shadow::meshlet::Meshlets) -> Vec<[u32; MESHLET_WORDS]> {
+    ml.meshlets
+        .iter()
+        .zip(&ml.bounds)
+        .map(|(m, b)| {
+            let (c, s, f) = (b.sphere.center, b.sides.axis, b.faces.axis);
+            let floats = [c.x, c.y, c.z, b.sphere.radius, s.x, s.y, s.z, b.sides.cos, f.x, f.y, f.z, b.faces.cos];
+            let mut row = [0u32; MESHLET_WORDS];
+            row[..4].copy_from_slice(&[m.first_triangle, m.triangle_count, m.first_edge, m.edge_count]);
+            for (w, x) in row[4..].iter_mut().zip(floats) {
+                *w = x.to_bits();
+            }
+            row
+        })
+        .collect()
+}
+
+/// A meshlet row with its firsts made absolute: the caster's first meshlet triangle
+/// (`tris`) and first meshlet edge (`edges`) in the arena.
+pub(crate) fn placed(mut row: [u32; MESHLET_WORDS], tris: u32, edges: u32) -> [u32; MESHLET_WORDS] {
+    row[0] += tris;
+    row[2] += edges;
+    row
+}
 
 /// What a draw emits (`pc.flags` of `shaders/extrude.wgsl`).
 pub(crate) mod flags {
@@ -105,150 +135,6 @@ impl MeshDraw {
     }
 }
 
-/// The mesh pipelines: as the volume pipelines ([`super::pipelines`]), with `extrude.wgsl`'s
-/// mesh stage in place of `shadow.vert`.
-pub(crate) struct MeshPipes {
-    /// `VK_EXT_mesh_shader`'s commands.
-    pub loader: ash::ext::mesh_shader::Device,
-    pub set_layout: vk::DescriptorSetLayout,
-    pub layout: vk::PipelineLayout,
-    /// Stencil counting: z-pass, z-fail, z-fail light caps (depth NEVER).
-    pub stencil: [vk::Pipeline; 3],
-    /// The counting variant (depth and stencil tests pass, nothing written).
-    pub raster: vk::Pipeline,
-    /// The float counter's z-pass, z-fail and caps (where R32F blends).
-    pub count: Option<[vk::Pipeline; 3]>,
-}
-
-impl MeshPipes {
-    /// Creates the pipelines for the pass's `desc` (its depth-stencil format, samples, depth
-    /// direction and mode, target model), with depth clamp and depth bounds as the volume
-    /// pipelines have them.
-    pub fn new(
-        instance: &ash::Instance,
-        dev: &PassDevice,
-        desc: &super::ShadowPassDesc,
-        (depth_clamp, depth_bounds, r32f_blend): (bool, bool, bool),
-    ) -> Result<MeshPipes> {
-        let d = dev.device();
-        let bindings: Vec<_> = (0..MESH_BINDINGS)
-            .map(|i| {
-                vk::DescriptorSetLayoutBinding::default()
-                    .binding(i)
-                    .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                    .descriptor_count(1)
-                    .stage_flags(vk::ShaderStageFlags::MESH_EXT)
-            })
-            .collect();
-        // SAFETY: creation on a valid device from locals; destroyed in `destroy` (or below on error).
-        let set_layout = unsafe { d.create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None) }
-            .map_err(Error::vk("vkCreateDescriptorSetLayout"))?;
-        let mut me = MeshPipes {
-            loader: ash::ext::mesh_shader::Device::new(instance, d),
-            set_layout,
-            layout: vk::PipelineLayout::null(),
-            stencil: [vk::Pipeline::null(); 3],
-            raster: vk::Pipeline::null(),
-            count: None,
-        };
-        match me.create(dev, desc, (depth_clamp, depth_bounds, r32f_blend)) {
-            Ok(()) => Ok(me),
-            Err(e) => {
-                // SAFETY: nothing created here was used yet.
-                unsafe { me.destroy(d) };
-                Err(e)
-            }
-        }
-    }
-
-    fn create(
-        &mut self,
-        dev: &PassDevice,
-        desc: &super::ShadowPassDesc,
-        (depth_clamp, depth_bounds, r32f_blend): (bool, bool, bool),
-    ) -> Result<()> {
-        use super::desc::{sample_flags, DepthDirection, DepthMode, TargetModel};
-        use vk::StencilOp as S;
-        let stages = vk::ShaderStageFlags::MESH_EXT | vk::ShaderStageFlags::FRAGMENT;
-        self.layout = pipeline_layout(dev, &[self.set_layout], MeshPush::SIZE, stages)?;
-        let reverse = desc.depth_direction == DepthDirection::Reverse;
-        let render_pass = match desc.target {
-            TargetModel::RenderPass(rp) => Some((rp.render_pass, rp.subpass, rp.color_attachments)),
-            _ => None,
-        };
-        let create = |p: &PipelineDesc| -> Result<vk::Pipeline> {
-            let mut p = p.clone();
-            if reverse {
-                p.depth_compare = mirror(p.depth_compare);
-            }
-            p.samples = sample_flags(desc.samples);
-            p.render_pass = render_pass;
-            pipeline::create(dev, &p)
-        };
-        let mut s = PipelineDesc::new(shaders::SHADOW_VERT, self.layout, desc.depth_stencil_format);
-        s.mesh = Some((shaders::EXTRUDE_WGSL, c"extrude"));
-        s.depth_test = true;
-        s.depth_compare = vk::CompareOp::LESS;
-        s.depth_clamp = depth_clamp && desc.depth_mode == DepthMode::Clamp;
-        s.depth_bounds = depth_bounds;
-        s.stencil = Some((pipeline::stencil_ops(S::INCREMENT_AND_WRAP, S::KEEP), pipeline::stencil_ops(S::DECREMENT_AND_WRAP, S::KEEP)));
-        self.stencil[0] = create(&s)?;
-        s.stencil = Some((pipeline::stencil_ops(S::KEEP, S::DECREMENT_AND_WRAP), pipeline::stencil_ops(S::KEEP, S::INCREMENT_AND_WRAP)));
-        self.stencil[1] = create(&s)?;
-        s.depth_compare = vk::CompareOp::NEVER;
-        self.stencil[2] = create(&s)?;
-        let keep = vk::StencilOpState { write_mask: 0, ..pipeline::stencil_ops(S::KEEP, S::KEEP) };
-        let mut r = s.clone();
-        r.depth_compare = vk::CompareOp::ALWAYS;
-        r.stencil = Some((keep, keep));
-        self.raster = create(&r)?;
-        if r32f_blend && render_pass.is_none() {
-            let fmt = [COUNT_FORMAT];
-            let mut c = s.clone();
-            c.fragment = Some(shaders::COUNT_FRAG);
-            c.color_formats = &fmt;
-            c.blend = Blend::Additive;
-            c.stencil = None;
-            let mut count = [vk::Pipeline::null(); 3];
-            for (k, cmp) in [vk::CompareOp::LESS, vk::CompareOp::GREATER_OR_EQUAL, vk::CompareOp::ALWAYS].into_iter().enumerate() {
-                c.depth_compare = cmp;
-                match create(&c) {
-                    Ok(p) => count[k] = p,
-                    Err(e) => {
-                        // SAFETY: the pipelines were just created and never used.
-                        unsafe { count.iter().for_each(|&p| dev.device().destroy_pipeline(p, None)) };
-                        return Err(e);
-                    }
-                }
-            }
-            self.count = Some(count);
-        }
-        Ok(())
-    }
-
-    /// The stencil pipeline of a draw of `case` (`light_cap`: the light cap's).
-    pub fn stencil_for(&self, case: Case, light_cap: bool) -> vk::Pipeline {
-        match (case == Case::ZPass, light_cap) {
-            (true, _) => self.stencil[0],
-            (false, false) => self.stencil[1],
-            (false, true) => self.stencil[2],
-        }
-    }
-
-    /// # Safety
-    /// No pending command buffer uses the pipelines.
-    pub unsafe fn destroy(&mut self, d: &ash::Device) {
-        // SAFETY: the caller's contract; null handles are ignored.
-        unsafe {
-            for p in self.stencil.into_iter().chain([self.raster]).chain(self.count.into_iter().flatten()) {
-                d.destroy_pipeline(p, None);
-            }
-            d.destroy_pipeline_layout(self.layout, None);
-            d.destroy_descriptor_set_layout(self.set_layout, None);
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -262,5 +148,30 @@ mod tests {
         // the output budget the shader declares is the meshlets' (and within 256 / 256)
         use crate::shadow::meshlet::{MESHLET_OUTPUT_PRIMITIVES, MESHLET_OUTPUT_VERTICES};
         assert_eq!((MESHLET_OUTPUT_VERTICES, MESHLET_OUTPUT_PRIMITIVES), (255, 153));
+    }
+
+    /// A meshlet row is `struct Meshlet` of `shaders/extrude.wgsl` (64 bytes, the arena's
+    /// element), its bounds as f32 bits, its firsts made absolute by `placed`.
+    #[test]
+    fn meshlet_rows_match_the_wgsl_struct() {
+        use crate::geom::testmesh::uv_sphere;
+        use crate::shadow::meshlet::Meshlets;
+        assert_eq!(MESHLET_WORDS as u64 * 4, crate::pass::compute::arena::ELEMENT_BYTES[4]);
+        let c = crate::shadow::Caster::new("s", &uv_sphere(1.0, 32, 16), glam::Mat4::IDENTITY).unwrap();
+        let ml = Meshlets::build(&c);
+        let rows = meshlet_rows(&ml);
+        assert_eq!(rows.len(), ml.meshlets.len());
+        for ((row, m), b) in rows.iter().zip(&ml.meshlets).zip(&ml.bounds) {
+            assert_eq!(row[..4], [m.first_triangle, m.triangle_count, m.first_edge, m.edge_count]);
+            let f = |k: usize| f32::from_bits(row[k]);
+            assert_eq!([f(4), f(5), f(6), f(7)], [b.sphere.center.x, b.sphere.center.y, b.sphere.center.z, b.sphere.radius]);
+            assert_eq!([f(8), f(9), f(10), f(11)], [b.sides.axis.x, b.sides.axis.y, b.sides.axis.z, b.sides.cos]);
+            assert_eq!([f(12), f(13), f(14), f(15)], [b.faces.axis.x, b.faces.axis.y, b.faces.axis.z, b.faces.cos]);
+            let p = placed(*row, 100, 1000);
+            assert_eq!((p[0], p[1], p[2], p[3]), (row[0] + 100, row[1], row[2] + 1000, row[3]));
+            assert_eq!(p[4..], row[4..]);
+        }
+        // a sphere of 512 triangles: most meshlets have cones that decide
+        assert!(ml.bounds.iter().filter(|b| b.sides.decides() && b.faces.decides()).count() * 2 > ml.bounds.len());
     }
 }

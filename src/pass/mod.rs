@@ -94,6 +94,7 @@ mod draw;
 mod eye;
 mod frame;
 mod mesh;
+mod mesh_pipes;
 mod pack;
 mod pipelines;
 mod planar;
@@ -109,8 +110,8 @@ mod volumes;
 
 pub use casters::CasterId;
 pub use desc::{
-    reverse_z, Capabilities, Counter, CubeFaces, DepthDirection, DepthMode, EnabledFeatures, IndexFormat, PassSettings, PassToggles, Pcf,
-    RenderPassTarget, ShadowPassDesc, TargetModel, Technique,
+    reverse_z, Capabilities, ComputeDraws, Counter, CubeFaces, DepthDirection, DepthMode, EnabledFeatures, IndexFormat, PassSettings,
+    PassToggles, Pcf, RenderPassTarget, ShadowPassDesc, TargetModel, Technique,
 };
 pub use draw::LightFrame;
 pub use frame::{PreparedFrame, MAX_CONE_DEG};
@@ -165,8 +166,11 @@ pub struct ShadowPass {
     serial: u64,
     planar_receiver: glam::DVec4,
     compute_pipes: Option<compute::ComputePipes>,
+    /// [`Technique::Compute`]'s merged draws' pipelines (with the compute pipelines, where the
+    /// pass has `drawIndirectFirstInstance`).
+    merged_pipes: Option<compute::draws_record::DrawPipes>,
     /// [`Technique::Mesh`]'s pipelines (made with its first frame or `create_pipelines`).
-    mesh_pipes: Option<mesh::MeshPipes>,
+    mesh_pipes: Option<mesh_pipes::MeshPipes>,
     /// Analytic sphere casters, in draw order (after the mesh casters).
     spheres: Vec<spheres::SphereCaster>,
     next_sphere: u64,
@@ -236,6 +240,7 @@ impl ShadowPass {
             allocator,
             pipeline_cache: desc.pipeline_cache,
             max_storage_range: device_caps.limits.max_storage_buffer_range as u64,
+            max_draw_indirect_count: device_caps.limits.max_draw_indirect_count.max(1),
         };
         let pipes = Pipelines::new(&dev, desc, caps.depth_clamp, caps.depth_bounds, caps.r32f_blend)?;
         let id = NEXT_PASS_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -253,6 +258,7 @@ impl ShadowPass {
             serial: 0,
             planar_receiver: glam::DVec4::Y,
             compute_pipes: None,
+            merged_pipes: None,
             mesh_pipes: None,
             spheres: Vec::new(),
             next_sphere: 0,
@@ -326,8 +332,10 @@ impl ShadowPass {
 
     /// Creates now the pipelines that the first frame of `technique` would otherwise create
     /// (the GPU silhouettes' compute pipelines of [`Technique::Compute`], and with them the
-    /// mesh pipelines of [`Technique::Mesh`]; the other techniques' are made with the pass), so
-    /// that frame does not wait for the driver's shader compiler. Idempotent.
+    /// mesh pipelines of [`Technique::Mesh`]: with the task stage or without it, as the
+    /// current [`PassToggles::mesh_task`] and [`Capabilities::task_shader`] choose; the other
+    /// techniques' are made with the pass), so that frame does not wait for the driver's
+    /// shader compiler. Idempotent.
     ///
     /// Errors: [`Technique::Mesh`] on a pass without [`Capabilities::mesh_shader`]
     /// ([`Error::Unsupported`]), or the driver's.
@@ -339,12 +347,34 @@ impl ShadowPass {
         if gpu && self.compute_pipes.is_none() {
             self.compute_pipes = Some(compute::ComputePipes::new(&self.dev)?);
         }
-        if technique == Technique::Mesh && self.mesh_pipes.is_none() {
+        if technique == Technique::Compute && self.caps.draw_indirect_first_instance && self.merged_pipes.is_none() {
             let c = &self.caps;
-            self.mesh_pipes =
-                Some(mesh::MeshPipes::new(&self.instance, &self.dev, &self.desc, (c.depth_clamp, c.depth_bounds, c.r32f_blend))?);
+            let caps = (c.depth_clamp, c.depth_bounds, c.r32f_blend);
+            self.merged_pipes = Some(compute::draws_record::DrawPipes::new(&self.dev, &self.desc, self.pipes.layout, caps)?);
+        }
+        if technique == Technique::Mesh {
+            let c = &self.caps;
+            if self.mesh_pipes.is_none() {
+                let features = (c.depth_clamp, c.depth_bounds, c.r32f_blend);
+                self.mesh_pipes = Some(mesh_pipes::MeshPipes::new(&self.instance, &self.dev, features, c.task_shader)?);
+            }
+            let culled = c.task_shader && self.settings.toggles.mesh_task;
+            if let Some(m) = self.mesh_pipes.as_mut() {
+                m.ensure(&self.dev, &self.desc, culled)?;
+            }
         }
         Ok(())
+    }
+
+    /// The pipeline stages the mesh draws read and write in: the mesh stage, and the task
+    /// stage where the pass has task shaders (none without mesh shaders).
+    fn mesh_stages(&self) -> ash::vk::PipelineStageFlags2 {
+        use ash::vk::PipelineStageFlags2 as S;
+        match (self.caps.mesh_shader, self.caps.task_shader) {
+            (false, _) => S::NONE,
+            (true, false) => S::MESH_SHADER_EXT,
+            (true, true) => S::MESH_SHADER_EXT | S::TASK_SHADER_EXT,
+        }
     }
 
     fn all_slots(&self) -> u64 {
@@ -446,7 +476,14 @@ impl ShadowPass {
         let stream = self.write_stream(slot, &packed.stream)?;
         // The compute pass's records and descriptor sets count as recording work too.
         let compute = match packed.compute {
-            Some(cf) => Some(self.prepare_compute(slot, cf)?),
+            Some(cf) => {
+                // (mesh frames draw with mesh tasks: no indirect records to merge)
+                let draws = match self.settings.technique {
+                    Technique::Compute => self.caps.compute_draws(self.settings.toggles.compute_draws)?,
+                    _ => ComputeDraws::PerChunk,
+                };
+                Some(self.prepare_compute(slot, cf, (lights.len(), draws))?)
+            }
             None => None,
         };
         let ray_frame = match rays {
@@ -462,6 +499,9 @@ impl ShadowPass {
         totals.bytes_sent += upload_bytes;
         if let Some(cf) = &compute {
             totals.silhouette_read_bytes = 16 * (cf.exact_capacity + cf.sil_capacity);
+            if let Some(m) = &cf.merged {
+                totals.draws = totals.draws - m.per_chunk_calls + m.calls;
+            }
         }
         let warnings = overflow_warnings(&self.casters, &packed.lights, self.settings.counter);
         let serial = self.serial;
@@ -494,6 +534,10 @@ impl Drop for ShadowPass {
         if let Some(mut c) = self.compute_pipes.take() {
             // SAFETY: as above.
             unsafe { c.destroy(&self.dev.device) };
+        }
+        if let Some(mut m) = self.merged_pipes.take() {
+            // SAFETY: as above.
+            unsafe { m.destroy(&self.dev.device) };
         }
         if let Some(mut m) = self.mesh_pipes.take() {
             // SAFETY: as above.

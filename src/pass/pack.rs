@@ -96,7 +96,7 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
                 let at = crate::pass::compute::frame::CasterAt { light: li, stat: cstats.len() };
                 if cp.parts.iter().any(|p| p.path == VolumePath::Compute && p.case != Case::Culled) {
                     let buffers: Vec<vk::Buffer> = gpu.chunks.iter().map(|b| b.raw).collect();
-                    cf.add_caster(at, caster, st, cp, &buffers, &mut draws);
+                    cf.add_caster(at, caster, st, cp, (&buffers, mvps[cp.caster]), &mut draws);
                     fmt_used = UsedIndexFormat::U16;
                 }
                 if cp.parts.iter().any(|p| p.path == VolumePath::Mesh && p.case != Case::Culled) {

@@ -106,39 +106,23 @@ impl Pipelines {
     ) -> Result<Pipelines> {
         // Every table below is written for forward depth; reverse-Z mirrors the compares and
         // the depth bias. Samples and the target model apply to every pipeline.
-        let reverse = desc.depth_direction == DepthDirection::Reverse;
-        let samples = sample_flags(desc.samples);
         let render_pass = match desc.target {
             TargetModel::RenderPass(rp) => Some((rp.render_pass, rp.subpass, rp.color_attachments)),
             _ => None,
         };
         let mut create = |d: &PipelineDesc| -> Result<vk::Pipeline> {
-            let mut d = d.clone();
-            if reverse {
-                d.depth_compare = mirror(d.depth_compare);
-                d.depth_bias = d.depth_bias.map(|(c, s)| (-c, -s));
-            }
-            d.samples = samples;
-            d.render_pass = render_pass;
-            let p = pipeline::create(dev, &d)?;
+            let p = create_volume_pipeline(dev, desc, d)?;
             made.push(p);
             Ok(p)
         };
         use vk::StencilOp as S;
         let df = desc.depth_stencil_format;
-        let mut s = PipelineDesc::new(shaders::SHADOW_VERT, layout, df);
-        s.vertex_stride = 16;
-        s.attributes = &[(0, vk::Format::R32G32B32A32_SFLOAT, 0)];
-        s.depth_test = true;
-        s.depth_compare = vk::CompareOp::LESS;
-        s.depth_clamp = depth_clamp;
-        s.depth_bounds = depth_bounds;
-        s.stencil = Some((pipeline::stencil_ops(S::INCREMENT_AND_WRAP, S::KEEP), pipeline::stencil_ops(S::DECREMENT_AND_WRAP, S::KEEP)));
-        let zpass = create(&s)?;
-        s.stencil = Some((pipeline::stencil_ops(S::KEEP, S::DECREMENT_AND_WRAP), pipeline::stencil_ops(S::KEEP, S::INCREMENT_AND_WRAP)));
-        let zfail = create(&s)?;
-        s.depth_compare = vk::CompareOp::NEVER;
-        let zfail_cap = create(&s)?;
+        let v = volume_states(shaders::SHADOW_VERT, (0, &[]), layout, df, depth_clamp, depth_bounds);
+        let zpass = create(&v.stencil[0])?;
+        let zfail = create(&v.stencil[1])?;
+        let zfail_cap = create(&v.stencil[2])?;
+        // the light cap's state: the edge quads' and the float counter's derive from it
+        let s = v.stencil[2].clone();
 
         let eq_attrs = [(0, vk::Format::R32G32B32_SFLOAT, 0), (1, vk::Format::R32G32B32A32_SFLOAT, 12)];
         let mut e = s.clone();
@@ -150,12 +134,8 @@ impl Pipelines {
         e.depth_compare = vk::CompareOp::LESS;
         let eq_sides = create(&e)?;
         let stencil = StencilPipes { zpass, zfail, zfail_cap, eq_faces, eq_sides };
-        // The counting variant: ALWAYS, write masks 0 (depth bounds kept: they cull fill).
-        let keep = vk::StencilOpState { write_mask: 0, ..pipeline::stencil_ops(S::KEEP, S::KEEP) };
-        let mut r = s.clone();
-        r.depth_compare = vk::CompareOp::ALWAYS;
-        r.stencil = Some((keep, keep));
-        let raster_volume = create(&r)?;
+        let keep = v.raster.stencil.map(|(k, _)| k).unwrap_or_default();
+        let raster_volume = create(&v.raster)?;
         let mut re = e.clone();
         re.depth_compare = vk::CompareOp::ALWAYS;
         re.stencil = Some((keep, keep));
@@ -171,7 +151,7 @@ impl Pipelines {
         // their own rendering instances: dynamic rendering only (refused at creation otherwise).
         let dynamic = render_pass.is_none();
         let count = match r32f_blend && dynamic {
-            true => Some(count_pipes(&mut create, &c, &eq_attrs)?),
+            true => Some(count_pipes(&mut create, &v.count, &c, &eq_attrs)?),
             false => None,
         };
 
@@ -255,20 +235,95 @@ impl Pipelines {
     }
 }
 
+/// Creates the pipeline `d` as the pass makes its volume pipelines: compares and depth bias
+/// mirrored for reverse-Z, at the desc's sample count, inside its render pass when it has one.
+pub(crate) fn create_volume_pipeline(dev: &impl GpuDevice, desc: &ShadowPassDesc, d: &PipelineDesc) -> Result<vk::Pipeline> {
+    let mut d = d.clone();
+    if desc.depth_direction == DepthDirection::Reverse {
+        d.depth_compare = mirror(d.depth_compare);
+        d.depth_bias = d.depth_bias.map(|(c, s)| (-c, -s));
+    }
+    d.samples = sample_flags(desc.samples);
+    d.render_pass = match desc.target {
+        TargetModel::RenderPass(rp) => Some((rp.render_pass, rp.subpass, rp.color_attachments)),
+        _ => None,
+    };
+    pipeline::create(dev, &d)
+}
+
+/// The formats of the float counter's one colour attachment.
+const COUNT_FORMATS: [vk::Format; 1] = [COUNT_FORMAT];
+
+/// The fixed-function states of the volumes' pipelines, for a vertex shader (`shadow.vert`
+/// or its TABLE variant) reading `(x, y, z, w)` from binding 0 and `instance` (binding 1's
+/// stride and attributes; stride 0: none).
+pub(crate) struct VolumeStates<'a> {
+    /// Stencil counting: z-pass, z-fail, light caps (depth NEVER).
+    pub stencil: [PipelineDesc<'a>; 3],
+    /// The counting variant: depth and stencil always pass, nothing written.
+    pub raster: PipelineDesc<'a>,
+    /// The float counter: z-pass (LESS), z-fail (GREATER_OR_EQUAL), light caps (ALWAYS).
+    pub count: [PipelineDesc<'a>; 3],
+}
+
+/// The states of [`VolumeStates`] (forward depth; [`create_volume_pipeline`] mirrors them).
+pub(crate) fn volume_states<'a>(
+    vertex: &'a [u8],
+    (instance_stride, instance_attributes): (u32, &'a [(u32, vk::Format, u32)]),
+    layout: vk::PipelineLayout,
+    depth_format: vk::Format,
+    depth_clamp: bool,
+    depth_bounds: bool,
+) -> VolumeStates<'a> {
+    use vk::StencilOp as S;
+    let mut s = PipelineDesc::new(vertex, layout, depth_format);
+    s.vertex_stride = 16;
+    s.attributes = &[(0, vk::Format::R32G32B32A32_SFLOAT, 0)];
+    s.instance_stride = instance_stride;
+    s.instance_attributes = instance_attributes;
+    s.depth_test = true;
+    s.depth_compare = vk::CompareOp::LESS;
+    s.depth_clamp = depth_clamp;
+    s.depth_bounds = depth_bounds;
+    s.stencil = Some((pipeline::stencil_ops(S::INCREMENT_AND_WRAP, S::KEEP), pipeline::stencil_ops(S::DECREMENT_AND_WRAP, S::KEEP)));
+    let zpass = s.clone();
+    s.stencil = Some((pipeline::stencil_ops(S::KEEP, S::DECREMENT_AND_WRAP), pipeline::stencil_ops(S::KEEP, S::INCREMENT_AND_WRAP)));
+    let zfail = s.clone();
+    s.depth_compare = vk::CompareOp::NEVER;
+    let cap = s.clone();
+    // The counting variant: ALWAYS, write masks 0 (depth bounds kept: they cull fill).
+    let keep = vk::StencilOpState { write_mask: 0, ..pipeline::stencil_ops(S::KEEP, S::KEEP) };
+    let mut r = s.clone();
+    r.depth_compare = vk::CompareOp::ALWAYS;
+    r.stencil = Some((keep, keep));
+    let mut c = s.clone();
+    c.fragment = Some(shaders::COUNT_FRAG);
+    c.color_formats = &COUNT_FORMATS;
+    c.blend = Blend::Additive;
+    c.stencil = None;
+    let count = [vk::CompareOp::LESS, vk::CompareOp::GREATER_OR_EQUAL, vk::CompareOp::ALWAYS].map(|op| {
+        let mut d = c.clone();
+        d.depth_compare = op;
+        d
+    });
+    VolumeStates { stencil: [zpass, zfail, cap], raster: r, count }
+}
+
 /// Makes a pipeline from a description (and keeps it for destruction).
 type Create<'c> = dyn FnMut(&PipelineDesc) -> Result<vk::Pipeline> + 'c;
 
-/// The float counter's pipelines from the counting description `c` (additive R32F, no stencil):
-/// z-pass, z-fail and caps, and the edge quads' faces and sides (`eq_attrs`: their vertex
-/// attributes).
-fn count_pipes(create: &mut Create, c: &PipelineDesc, eq_attrs: &[(u32, vk::Format, u32)]) -> Result<CountPipes> {
-    let mut c = c.clone();
-    c.depth_compare = vk::CompareOp::LESS;
-    let zpass = create(&c)?;
-    c.depth_compare = vk::CompareOp::GREATER_OR_EQUAL;
-    let zfail = create(&c)?;
-    c.depth_compare = vk::CompareOp::ALWAYS;
-    let cap = create(&c)?;
+/// The float counter's pipelines: z-pass, z-fail and caps (`volume`, from [`volume_states`]),
+/// and from the counting description `c` (additive R32F, no stencil) the edge quads' faces and
+/// sides (`eq_attrs`: their vertex attributes).
+fn count_pipes(
+    create: &mut Create,
+    volume: &[PipelineDesc; 3],
+    c: &PipelineDesc,
+    eq_attrs: &[(u32, vk::Format, u32)],
+) -> Result<CountPipes> {
+    let zpass = create(&volume[0])?;
+    let zfail = create(&volume[1])?;
+    let cap = create(&volume[2])?;
     let mut ec = c.clone();
     ec.vertex = shaders::EDGEQUAD_VERT;
     ec.vertex_stride = 32;

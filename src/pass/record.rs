@@ -171,7 +171,7 @@ impl ShadowPass {
         crate::gpu::resources::memory_barrier(
             &self.dev,
             cb,
-            (S::VERTEX_INPUT | S::COMPUTE_SHADER | if self.caps.mesh_shader { S::MESH_SHADER_EXT } else { S::NONE }, A::NONE),
+            (S::VERTEX_INPUT | S::COMPUTE_SHADER | self.mesh_stages(), A::NONE),
             (S::TRANSFER, A::TRANSFER_WRITE),
         );
         // SAFETY: the caller's contract; the staging and destination buffers live until the
@@ -182,7 +182,7 @@ impl ShadowPass {
             }
         }
         // (the mesh draws of Technique::Mesh read the compute arena's tables directly)
-        let mesh = if self.caps.mesh_shader { S::MESH_SHADER_EXT } else { S::NONE };
+        let mesh = self.mesh_stages();
         crate::gpu::resources::memory_barrier(
             &self.dev,
             cb,

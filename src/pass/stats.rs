@@ -187,6 +187,14 @@ pub struct Totals {
     /// an edge, per light and caster); 0 for the other techniques. With `gpu_ms.silhouettes`,
     /// the pass's read rate.
     pub silhouette_read_bytes: u64,
+    /// [`Technique::Mesh`](super::Technique::Mesh): the meshlets its draws covered (a part's
+    /// meshlets once per draw: sides, dark cap, light cap), read back after the frame; 0 for
+    /// the other techniques.
+    pub mesh_meshlets: u64,
+    /// [`Technique::Mesh`](super::Technique::Mesh): the mesh workgroups that ran: as many as
+    /// [`mesh_meshlets`](Self::mesh_meshlets) without a task stage, only the meshlets that
+    /// emit something with it ([`PassToggles::mesh_task`](super::PassToggles::mesh_task)).
+    pub mesh_workgroups: u64,
 }
 
 #[derive(Clone, Debug, Default)]

@@ -63,6 +63,11 @@ impl ShadowPass {
             }
             _ => {}
         }
+        // Technique::Compute's merged draws: the light's GPU-silhouette volumes in one draw
+        // call per pipeline (src/pass/compute/draws.rs); their chunk draws are skipped below.
+        // SAFETY: the caller's contract; `kind` was checked above.
+        unsafe { self.record_merged(cb, frame, light, kind)? };
+        let merged = frame.compute.as_ref().is_some_and(|cf| cf.merged.is_some());
         let mut bound = vk::Pipeline::null();
         for c in lf.casters.iter().filter(|c| c.case != Case::Culled) {
             let wanted = match kind {
@@ -114,6 +119,9 @@ impl ShadowPass {
                     }
                     continue;
                 }
+                if dr.indirect && merged {
+                    continue;
+                }
                 let planar = frame.settings.technique == super::desc::Technique::Planar;
                 let Some(pipe) = self.pipeline_for(kind, count, dr.case, dr.light_cap, planar) else { continue };
                 // Parts of one caster may take different cases: the sign follows the draw's.
@@ -136,9 +144,9 @@ impl ShadowPass {
     }
 
     /// Records one mesh draw of [`Technique::Mesh`](super::desc::Technique::Mesh) for `kind`
-    /// (its pipeline, the frame's mesh set, its push block, `vkCmdDrawMeshTasksEXT`); returns
-    /// whether anything was bound (a kind the mesh path has no pipeline for draws nothing:
-    /// the light-intensity map's casters are never on it).
+    /// (its pipeline, then [`record_mesh`](Self::record_mesh)); returns whether anything was
+    /// bound (a kind the mesh path has no pipeline for draws nothing: the light-intensity
+    /// map's casters are never on it).
     ///
     /// # Safety
     /// As [`cmd_draw_volumes`](Self::cmd_draw_volumes); `dr` and `md` are a draw of `c`, of
@@ -152,14 +160,12 @@ impl ShadowPass {
         dr: &super::draw::Draw,
         md: &super::mesh::MeshDraw,
     ) -> Result<bool> {
-        let (Some(mp), Some(cf)) = (self.mesh_pipes.as_ref(), frame.compute.as_ref()) else {
-            return Err(Misuse::NotConfigured { call: "cmd_draw_volumes (mesh draws)", needs: "Technique::Mesh's pipelines" }.into());
-        };
+        let set = self.mesh_set(frame)?;
         let zpass = dr.case == Case::ZPass;
         let pipe = match kind {
-            VolumeKind::Stencil => mp.stencil_for(dr.case, dr.light_cap),
-            VolumeKind::Rasterised => mp.raster,
-            VolumeKind::Float => match mp.count {
+            VolumeKind::Stencil => set.stencil_for(dr.case, dr.light_cap),
+            VolumeKind::Rasterised => set.raster,
+            VolumeKind::Float => match set.count {
                 Some(p) => {
                     p[if zpass {
                         0
@@ -171,30 +177,61 @@ impl ShadowPass {
                 }
                 None => return Ok(false),
             },
-            VolumeKind::FloatDepthTested => match mp.count {
+            VolumeKind::FloatDepthTested => match set.count {
                 Some(p) => p[if zpass { 0 } else { 1 }],
                 None => return Ok(false),
             },
             VolumeKind::Transmit { .. } => return Ok(false),
         };
         let sign = if zpass { 1.0 } else { -1.0 };
-        let volume = VolumePush::new(c.mvp, c.light_object, [sign, 0.0, 0.0, 0.0]);
-        let push = md.push(&volume);
+        // SAFETY: forwarded contract.
+        unsafe { self.record_mesh(cb, frame, pipe, c, md, [sign, 0.0, 0.0, 0.0])? };
+        Ok(true)
+    }
+
+    /// The mesh pipelines `frame` draws with: the culled set (task stage first) where the pass
+    /// has task shaders and the frame's [`PassToggles::mesh_task`](super::PassToggles::mesh_task) is on, else the plain one.
+    pub(super) fn mesh_set(&self, frame: &PreparedFrame) -> Result<&super::mesh_pipes::MeshPipeSet> {
+        let culled = self.caps.task_shader && frame.settings.toggles.mesh_task;
+        self.mesh_pipes
+            .as_ref()
+            .and_then(|mp| mp.set(culled))
+            .ok_or_else(|| Misuse::NotConfigured { call: "cmd_draw_volumes (mesh draws)", needs: "Technique::Mesh's pipelines" }.into())
+    }
+
+    /// Binds `pipe` (a mesh pipeline of the frame's set) and the frame's mesh set, pushes the
+    /// caster's block with `color` and draws `md`'s meshlets (`vkCmdDrawMeshTasksEXT`: with
+    /// the task stage, one task workgroup per [`TASK_GROUP`](super::mesh::TASK_GROUP)
+    /// meshlets).
+    ///
+    /// # Safety
+    /// As [`cmd_draw_volumes`](Self::cmd_draw_volumes) (or inside the overlay's rendering
+    /// instance); `md` is a mesh draw of `c`, of `frame`.
+    pub(super) unsafe fn record_mesh(
+        &self,
+        cb: vk::CommandBuffer,
+        frame: &PreparedFrame,
+        pipe: vk::Pipeline,
+        c: &super::draw::CasterDraw,
+        md: &super::mesh::MeshDraw,
+        color: [f32; 4],
+    ) -> Result<()> {
+        let culled = self.caps.task_shader && frame.settings.toggles.mesh_task;
+        let (Some(mp), Some(cf)) = (self.mesh_pipes.as_ref(), frame.compute.as_ref()) else {
+            return Err(Misuse::NotConfigured { call: "cmd_draw_volumes (mesh draws)", needs: "Technique::Mesh's pipelines" }.into());
+        };
+        let push = md.push(&VolumePush::new(c.mvp, c.light_object, color));
+        let groups = if culled { md.meshlets.div_ceil(super::mesh::TASK_GROUP) } else { md.meshlets };
         let d = &self.dev.device;
-        // SAFETY: the caller's contract; the push block matches the mesh layout's range.
+        // SAFETY: the caller's contract; the push block matches the mesh layout's range; the
+        // frame's mesh set and the arena's tables live until the slot is prepared again.
         unsafe {
             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipe);
             d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, mp.layout, 0, &[cf.mesh_set], &[]);
-            d.cmd_push_constants(
-                cb,
-                mp.layout,
-                vk::ShaderStageFlags::MESH_EXT | vk::ShaderStageFlags::FRAGMENT,
-                0,
-                bytemuck::bytes_of(&push),
-            );
-            mp.loader.cmd_draw_mesh_tasks(cb, md.meshlets, 1, 1);
+            d.cmd_push_constants(cb, mp.layout, mp.stages, 0, bytemuck::bytes_of(&push));
+            mp.loader.cmd_draw_mesh_tasks(cb, groups, 1, 1);
         }
-        Ok(true)
+        Ok(())
     }
 
     /// Which pipeline counts a draw.
@@ -280,7 +317,9 @@ impl ShadowPass {
         unsafe {
             if dr.indirect {
                 let Some(cf) = frame.compute.as_ref() else { return };
-                d.cmd_bind_vertex_buffers(cb, 0, &[dr.vertices], &[0]);
+                // with the merged draws the records address the arena's vertex table
+                let vertices = cf.merged.as_ref().map_or(dr.vertices, |m| m.handles.vertices);
+                d.cmd_bind_vertex_buffers(cb, 0, &[vertices], &[0]);
                 d.cmd_bind_index_buffer(cb, cf.out_buffer, 0, vk::IndexType::UINT16);
                 d.cmd_draw_indexed_indirect(cb, cf.records_buffer, dr.offset, 1, 20);
                 return;

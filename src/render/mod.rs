@@ -37,8 +37,8 @@ pub use counters::PassCounters;
 pub use frame::{largest_device_heap, FrameTicket, MemoryEstimate, NewError, Renderer, Throughput};
 pub use frame_output::{standard_sample_locations, FrameOutput, SampleOutput};
 pub use options::{
-    Counter, CubeFaces, DepthMode, FrameSettings, IndexFormat, PassToggles, Pcf, RenderConfig, RenderOptions, Shading, Technique,
-    TransmitMode, View,
+    ComputeDraws, Counter, CubeFaces, DepthMode, FrameSettings, IndexFormat, PassToggles, Pcf, RenderConfig, RenderOptions, Shading,
+    Technique, TransmitMode, View,
 };
 pub use passes::debug::stencil_heatmap;
 pub use stats::Stats;

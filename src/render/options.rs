@@ -2,7 +2,7 @@
 
 use crate::error::{Error, Result};
 use crate::named_enum::named_enum;
-pub use crate::pass::{Counter, CubeFaces, DepthMode, IndexFormat, PassToggles, Pcf, Technique};
+pub use crate::pass::{ComputeDraws, Counter, CubeFaces, DepthMode, IndexFormat, PassToggles, Pcf, Technique};
 use ash::vk;
 
 named_enum!(

@@ -1,10 +1,11 @@
 //! Meshlets for mesh-shader extrusion ([`Technique::Mesh`](crate::pass::Technique::Mesh)):
 //! built once per caster, for each of its closed manifold parts.
 //!
-//! A meshlet is a patch of at most [`MAX_MESHLET_TRIANGLES`] edge-connected triangles of one
-//! part, and the edges it **owns**: every manifold edge of the part is owned by exactly one
-//! meshlet, the one its first triangle (in the build's breadth-first order) went to, so it is
-//! one of the meshlets holding a triangle of the edge. A mesh-shader workgroup draws one
+//! A meshlet is a patch of at most [`MAX_MESHLET_TRIANGLES`] triangles of one part, grown
+//! breadth-first from a seed over edge adjacency (compact, so that a silhouette crosses few of
+//! them and the task stage can drop the rest), and the edges it **owns**: every manifold edge
+//! of the part is owned by exactly one meshlet, the one its first triangle (in the build's
+//! order) went to, so it is one of the meshlets holding a triangle of the edge. A mesh-shader workgroup draws one
 //! meshlet: the side quad (and fan dark-cap triangle) of each owned edge whose two triangles'
 //! facing bits differ, or the face caps of its triangles. Since the facing bits are one per
 //! triangle, read by every meshlet alike, two meshlets sharing an edge agree on it bit for bit,
@@ -19,9 +20,18 @@
 //!
 //! Parts that are not closed 2-manifolds (open, non-manifold, inconsistently oriented) get no
 //! meshlets: they keep the CPU's multiplicity path (Kim et al. 2008), part by part.
+//!
+//! Each meshlet also carries its [`MeshletBounds`], what the task stage culls it with: a
+//! sphere about every vertex it reads and two normal cones ([`crate::geom::cone`]), one of the
+//! triangles of its owned edges (both of each edge's, the neighbour's too: if they all face
+//! the light strictly the same way, no owned edge is a silhouette edge and its sides emit
+//! nothing) and one of its own triangles (if they all face one way, only one of the face caps
+//! can have any of them).
 
 use super::caster::{Caster, CasterKind};
+use crate::geom::cone::{Bound, FacingCone};
 use crate::geom::topology::ManifoldEdge;
+use glam::Vec3;
 use std::collections::VecDeque;
 use std::ops::Range;
 
@@ -71,6 +81,34 @@ pub struct Meshlets {
     /// For each part of the caster ([`Caster::parts`]), its meshlets' range in
     /// [`meshlets`](Self::meshlets): empty for the parts on the multiplicity path.
     pub parts: Vec<Range<u32>>,
+    /// Per meshlet, what the task stage culls it with.
+    pub bounds: Vec<MeshletBounds>,
+}
+
+/// A meshlet's culling bounds (conservative: see [`crate::geom::cone`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MeshletBounds {
+    /// A sphere about every vertex of its triangles and of its owned edges' triangles.
+    pub sphere: Bound,
+    /// The normal cone of its owned edges' triangles (both of each edge).
+    pub sides: FacingCone,
+    /// The normal cone of its own triangles.
+    pub faces: FacingCone,
+}
+
+impl MeshletBounds {
+    /// The bounds of meshlet `m` of `out`, from the caster's welded mesh.
+    fn of(caster: &Caster, out: &Meshlets, m: &Meshlet) -> MeshletBounds {
+        let mesh = caster.mesh();
+        let tri = |t: u32| mesh.triangles[t as usize].map(|v| mesh.positions[v as usize]);
+        let own: Vec<[Vec3; 3]> = out.triangles[m.triangles()].iter().map(|&t| tri(t)).collect();
+        let sides: Vec<[Vec3; 3]> = out.edges[m.edges()].iter().flat_map(|e| [tri(e.t0), tri(e.t1)]).collect();
+        MeshletBounds {
+            sphere: Bound::of(own.iter().chain(&sides).flatten().copied()),
+            sides: FacingCone::of(&sides),
+            faces: FacingCone::of(&own),
+        }
+    }
 }
 
 impl Meshlets {
@@ -84,7 +122,7 @@ impl Meshlets {
         let n = caster.triangle_count;
         let mut assigned = vec![UNASSIGNED; n];
         let mut tri_edges: Vec<[u32; 3]> = vec![[NO_EDGE; 3]; n];
-        let mut queued = vec![false; n];
+        let mut queued = vec![0u32; n];
         for part in &caster.parts {
             let start = out.meshlets.len() as u32;
             if part.kind == CasterKind::Manifold && !whole_multiplicity {
@@ -93,6 +131,7 @@ impl Meshlets {
             }
             out.parts.push(start..out.meshlets.len() as u32);
         }
+        out.bounds = out.meshlets.iter().map(|m| MeshletBounds::of(caster, &out, m)).collect();
         out
     }
 }
@@ -102,16 +141,18 @@ const NO_EDGE: u32 = u32::MAX;
 
 /// Per welded triangle, shared by the parts (each part touches only its own triangles): the
 /// meshlet it went to (`UNASSIGNED` before), its edges (indices into its part's edge list),
-/// whether the breadth-first walk reached it.
+/// the last meshlet whose walk queued it (its index + 1; 0: none).
 struct Scratch<'a> {
     assigned: &'a mut [u32],
     tri_edges: &'a mut [[u32; 3]],
-    queued: &'a mut [bool],
+    queued: &'a mut [u32],
 }
 
-/// Greedy meshlets of one closed manifold part: triangles in breadth-first order over edge
-/// adjacency (restarting at the part's next unvisited triangle), a new meshlet whenever the
-/// next triangle would exceed either limit. A triangle's edges whose other triangle is not
+/// Greedy meshlets of one closed manifold part. Each meshlet grows breadth-first over edge
+/// adjacency from its first triangle until the next triangle would exceed either limit; that
+/// triangle starts the next meshlet, and the rest of the full meshlet's frontier seeds the
+/// ones after it (a stack above the part's triangles in order, so each meshlet starts beside
+/// the last one and the patches stay compact). A triangle's edges whose other triangle is not
 /// assigned yet become its meshlet's (each edge is thus owned once, by the meshlet of the
 /// first of its two triangles).
 fn build_part(part: &super::caster::Part, scratch: Scratch, out: &mut Meshlets) {
@@ -125,42 +166,45 @@ fn build_part(part: &super::caster::Part, scratch: Scratch, out: &mut Meshlets) 
         }
     }
     let other = |e: &ManifoldEdge, t: u32| if e.t0 == t { e.t1 } else { e.t0 };
-    let mut current = Meshlet { first_triangle: out.triangles.len() as u32, first_edge: out.edges.len() as u32, ..Meshlet::default() };
-    let mut queue = VecDeque::new();
-    for &seed in &part.triangles {
-        if queued[seed as usize] {
+    let fresh =
+        |out: &Meshlets| Meshlet { first_triangle: out.triangles.len() as u32, first_edge: out.edges.len() as u32, ..Meshlet::default() };
+    let mut current = fresh(out);
+    // the next seed is the stack's top: the part's triangles in order below the frontiers of
+    // the meshlets already full
+    let mut seeds: Vec<u32> = part.triangles.iter().rev().copied().collect();
+    let mut walk = VecDeque::new();
+    while let Some(t) = walk.pop_front().or_else(|| seeds.pop()) {
+        if assigned[t as usize] != UNASSIGNED {
             continue;
         }
-        queued[seed as usize] = true;
-        queue.push_back(seed);
-        while let Some(t) = queue.pop_front() {
-            let new_edges: Vec<u32> = tri_edges[t as usize]
-                .iter()
-                .filter(|&&i| i != NO_EDGE && assigned[other(&edges[i as usize], t) as usize] == UNASSIGNED)
-                .copied()
-                .collect();
-            if current.triangle_count as usize + 1 > MAX_MESHLET_TRIANGLES
-                || current.edge_count as usize + new_edges.len() > MAX_MESHLET_EDGES
-            {
-                out.meshlets.push(current);
-                current = Meshlet { first_triangle: out.triangles.len() as u32, first_edge: out.edges.len() as u32, ..Meshlet::default() };
+        let new_edges: Vec<u32> = tri_edges[t as usize]
+            .iter()
+            .filter(|&&i| i != NO_EDGE && assigned[other(&edges[i as usize], t) as usize] == UNASSIGNED)
+            .copied()
+            .collect();
+        if current.triangle_count as usize + 1 > MAX_MESHLET_TRIANGLES || current.edge_count as usize + new_edges.len() > MAX_MESHLET_EDGES
+        {
+            out.meshlets.push(current);
+            current = fresh(out);
+            // the full meshlet's frontier seeds the next ones; `t` starts this one
+            seeds.extend(walk.drain(..).rev());
+        }
+        let id = out.meshlets.len() as u32;
+        assigned[t as usize] = id;
+        out.triangles.push(t);
+        current.triangle_count += 1;
+        for &i in &new_edges {
+            out.edges.push(edges[i as usize]);
+        }
+        current.edge_count += new_edges.len() as u32;
+        for &i in &tri_edges[t as usize] {
+            if i == NO_EDGE {
+                continue;
             }
-            assigned[t as usize] = out.meshlets.len() as u32;
-            out.triangles.push(t);
-            current.triangle_count += 1;
-            for &i in &new_edges {
-                out.edges.push(edges[i as usize]);
-            }
-            current.edge_count += new_edges.len() as u32;
-            for &i in &tri_edges[t as usize] {
-                if i == NO_EDGE {
-                    continue;
-                }
-                let u = other(&edges[i as usize], t);
-                if !queued[u as usize] {
-                    queued[u as usize] = true;
-                    queue.push_back(u);
-                }
+            let u = other(&edges[i as usize], t);
+            if assigned[u as usize] == UNASSIGNED && queued[u as usize] != id + 1 {
+                queued[u as usize] = id + 1;
+                walk.push_back(u);
             }
         }
     }
@@ -225,6 +269,50 @@ mod tests {
         }
         assert_eq!(owned.len(), expected);
         assert_eq!(m.edges.len(), expected);
+        check_bounds(c, m);
+    }
+
+    /// The bounds contain what they claim: every vertex the meshlet reads is in its sphere,
+    /// and for lights about the caster (point, near and inside, directional) a cone that
+    /// decides is right for every triangle it covers (the exact predicate).
+    fn check_bounds(c: &Caster, m: &Meshlets) {
+        use crate::geom::cone::same_facing;
+        use crate::geom::predicates::facing_exact;
+        use glam::Vec4;
+        assert_eq!(m.bounds.len(), m.meshlets.len());
+        let mesh = c.mesh();
+        let tri = |t: u32| mesh.triangles[t as usize].map(|v| mesh.positions[v as usize]);
+        let lights = [
+            Vec4::new(3.0, 7.0, 2.0, 1.0),
+            Vec4::new(0.1, 0.2, 0.05, 1.0),
+            Vec4::new(-20.0, 1.0, 4.0, 1.0),
+            Vec4::new(0.3, -1.0, 0.2, 0.0),
+            Vec4::new(0.0, 0.0, 1.0, 0.0),
+        ];
+        let mut decided = 0;
+        for (ml, b) in m.meshlets.iter().zip(&m.bounds) {
+            let own: Vec<u32> = m.triangles[ml.triangles()].to_vec();
+            let sides: Vec<u32> = m.edges[ml.edges()].iter().flat_map(|e| [e.t0, e.t1]).collect();
+            for &t in own.iter().chain(&sides) {
+                for p in tri(t) {
+                    assert!((p.as_dvec3() - b.sphere.center.as_dvec3()).length() <= b.sphere.radius as f64);
+                }
+            }
+            for l in lights {
+                for (cone, set) in [(b.sides, &sides), (b.faces, &own)] {
+                    if let Some(front) = same_facing(cone, b.sphere, l) {
+                        decided += 1;
+                        for &t in set.iter() {
+                            let [p0, p1, p2] = tri(t);
+                            let strict = if front { facing_exact(p0, p1, p2, l) } else { facing_exact(p0, p2, p1, l) };
+                            assert!(strict, "triangle {t} against {l}: the cone said {front}");
+                        }
+                    }
+                }
+            }
+        }
+        // on a fine mesh the cones decide most meshlets for lights away from it
+        assert!(decided > 0 || m.meshlets.len() < 4, "no meshlet decided");
     }
 
     #[test]

@@ -21,8 +21,7 @@
 //!   as such, pipeline statistics in flag-bit order, timestamps in order.
 //! - `scissor`: `vkCmdSetScissor` per draw, including a scissor past the image and an empty one.
 //! - `indirect`: `vkCmdDrawIndexedIndirect` one record at a time at non-zero offsets, with
-//!   `firstIndex`, `vertexOffset` and an `instanceCount` of 0, as `ShadowPass`'s compute path
-//!   draws its volumes.
+//!   `firstIndex`, `vertexOffset` and an `instanceCount` of 0 (the compute path's per chunk).
 //! - `fill_buffer`: `vkCmdFillBuffer` at offsets, over an earlier fill, and `VK_WHOLE_SIZE` to
 //!   the last whole word of a buffer whose size is not a multiple of 4: every byte.
 //! - `dispatch`: `vkCmdDispatch` with the 2D group counts `--method compute` splits a large
@@ -30,6 +29,7 @@
 //!   builtins, storage-buffer atomics exact; group counts of 0 dispatch nothing.
 //! - `dispatch_indirect`: `vkCmdDispatchIndirect` of a command at a non-zero offset that an
 //!   earlier dispatch grew with `atomicMax`: exactly its groups; a command with x = 0 nothing.
+//! - `multi_draw_indirect`, `draw_indirect_count`: the compute path's merged draws (`multidraw.rs`).
 
 use super::rect;
 use crate::conform::harness::{self, DrawCall, Draws, Indices, PipeSpec};
@@ -42,7 +42,7 @@ use gpu_allocator::MemoryLocation;
 use serde_json::json;
 
 /// The checks' names (cases `commands.<name>`), in run order.
-pub const NAMES: [&str; 11] = [
+pub const NAMES: [&str; 13] = [
     "clears",
     "copy_aspects",
     "layouts",
@@ -54,6 +54,8 @@ pub const NAMES: [&str; 11] = [
     "fill_buffer",
     "dispatch",
     "dispatch_indirect",
+    "multi_draw_indirect",
+    "draw_indirect_count",
 ];
 
 fn vkerr(call: &'static str) -> impl Fn(vk::Result) -> Error {
@@ -591,6 +593,8 @@ pub fn layouts(ctx: &Context) -> Result<CheckResult> {
 mod copies;
 mod dispatch;
 mod draws;
+mod multidraw;
 pub use copies::{blit_copy_color, buffers};
 pub use dispatch::{dispatch, dispatch_indirect, fill_buffer};
 pub use draws::{indirect, queries, scissor};
+pub use multidraw::{draw_indirect_count, multi_draw_indirect};

@@ -3,7 +3,9 @@
 //! mesh-shader extrusion the meshlets, their triangles and their owned edges; the facing
 //! stage's block bounds and the `find` stage's word-pair groups) that one
 //! descriptor set binds, so one dispatch per stage (or one mesh draw per caster part) serves
-//! every (light, caster) pair of a frame.
+//! every (light, caster) pair of a frame; and a tenth, the chunks' dual-length vertices
+//! (a vertex buffer), so the merged volume draws address every chunk by its record's
+//! `vertexOffset` ([`super::draws`]).
 //!
 //! A caster's tables are bump-allocated at the end of each table and filled by staged copies
 //! (pending uploads: they ride with every frame until one that recorded them retires, like the
@@ -22,17 +24,30 @@ use ash::vk;
 use gpu_allocator::MemoryLocation;
 
 /// The tables, in binding order.
-pub(crate) const TABLES: [&str; N] =
-    ["planes", "triangles", "positions", "edges", "meshlets", "meshlet triangles", "meshlet edges", "block bounds", "word pairs"];
+pub(crate) const TABLES: [&str; N] = [
+    "planes",
+    "triangles",
+    "positions",
+    "edges",
+    "meshlets",
+    "meshlet triangles",
+    "meshlet edges",
+    "volume vertices",
+    "block bounds",
+    "word pairs",
+];
 /// The number of tables.
-pub(crate) const N: usize = 9;
+pub(crate) const N: usize = 10;
+/// The chunks' dual-length vertices (a vertex buffer, not bound to the compute set).
+pub(crate) const VERTICES: usize = 7;
 /// The facing stage's block bounds (three `vec4<f32>` per 64 slots).
-pub(crate) const BLOCKS: usize = 7;
+pub(crate) const BLOCKS: usize = 8;
 /// The `find` stage's word-pair groups.
-pub(crate) const GROUPS: usize = 8;
+pub(crate) const GROUPS: usize = 9;
 /// Bytes of one element of each table (`vec4<f32>`, `Tri`, `vec4<f32>`, `vec4<u32>`,
-/// `vec4<u32>`, `u32`, `vec4<u32>`, `vec4<f32>`, `vec4<u32>`).
-pub(crate) const ELEMENT_BYTES: [u64; N] = [16, 32, 16, 16, 16, 4, 16, 16, 16];
+/// `Meshlet` of `shaders/extrude.wgsl` (16 words), `u32`, `vec4<u32>`, `vec4<f32>`,
+/// `vec4<f32>`, `vec4<u32>`).
+pub(crate) const ELEMENT_BYTES: [u64; N] = [16, 32, 16, 16, 64, 4, 16, 16, 16, 16];
 /// The smallest table, in elements.
 const MIN_ELEMENTS: u64 = 1024;
 
@@ -53,6 +68,7 @@ pub(crate) fn mesh_elements(m: &ComputeMesh) -> [u64; N] {
         m.meshlets.len() as u64,
         m.meshlet_tris.len() as u64,
         m.meshlet_edges.len() as u64,
+        m.vertices.len() as u64,
         m.blocks.len() as u64,
         m.groups.len() as u64,
     ]
@@ -115,7 +131,10 @@ impl ComputeArena {
         }
         let mut made: Vec<Buffer> = Vec::with_capacity(N);
         for k in 0..N {
-            let usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
+            let mut usage = vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST;
+            if k == VERTICES {
+                usage |= vk::BufferUsageFlags::VERTEX_BUFFER;
+            }
             match Buffer::new(dev, &format!("compute arena: {}", TABLES[k]), capacity[k] * ELEMENT_BYTES[k], usage, MemoryLocation::GpuOnly)
             {
                 Ok(b) => made.push(b),

@@ -120,6 +120,13 @@ pub(crate) struct ComputeFrame {
     /// The mesh draws' descriptor set and counters (filled by `prepare`).
     pub mesh_set: vk::DescriptorSet,
     pub counts_buffer: vk::Buffer,
+    /// The merged draws ([`super::draws`]): per (light, caster) pair with compute parts its
+    /// transform and object-space light (the per-instance attributes `firstInstance` selects),
+    /// every enabled chunk record, and their layout (filled by `prepare`; `None`: one draw per
+    /// chunk with push constants).
+    pub xforms: Vec<super::draws::Xform>,
+    pub chunk_records: Vec<super::draws::ChunkRecord>,
+    pub merged: Option<super::draws::Merged>,
 }
 
 impl Default for ComputeFrame {
@@ -147,6 +154,9 @@ impl Default for ComputeFrame {
             counts_words: 0,
             mesh_set: vk::DescriptorSet::null(),
             counts_buffer: vk::Buffer::null(),
+            xforms: Vec::new(),
+            chunk_records: Vec::new(),
+            merged: None,
         }
     }
 }
@@ -175,17 +185,19 @@ impl ComputeFrame {
 
     /// Lays out a caster's job and chunk records for light `at.light` from its plan `cp` (the
     /// parts the planner left to the GPU: path `"compute"`), and appends the chunks' indirect
-    /// draws to `draws`.
+    /// draws to `draws`; `mvp` (object to clip) is the caster's transform for the merged draws.
     pub fn add_caster(
         &mut self,
         at: CasterAt,
         caster: &Caster,
         st: &ComputeStatic,
         cp: &CasterPlan,
-        chunk_buffers: &[vk::Buffer],
+        (chunk_buffers, mvp): (&[vk::Buffer], glam::Mat4),
         draws: &mut Vec<Draw>,
     ) {
         let CasterAt { light: li, stat } = at;
+        let xform = self.xforms.len() as u32;
+        self.xforms.push(super::draws::Xform::new(mvp, cp.light_object));
         let rec_base = self.records.len();
         self.records.resize(rec_base + RECORD_WORDS * caster.chunks.len(), 0);
         let l_obj = glam::Vec4::from_array(cp.light_object);
@@ -238,6 +250,14 @@ impl ComputeFrame {
                 r[rec::CAP_CAP] = cap as u32;
                 self.out_indices += cap.div_ceil(2) * 2;
                 self.metas.push(RecordMeta { word: w, light: li, caster: stat, part: pp_index });
+                self.chunk_records.push(super::draws::ChunkRecord {
+                    word: w,
+                    light: li,
+                    xform,
+                    vertex_base: st.chunk_vertex_base[chunk],
+                    zpass: pp.case == Case::ZPass,
+                    cap: light_cap,
+                });
                 let offset = (w * 4) as u64;
                 let draw = |cap_draw: bool, offset: u64| Draw {
                     vertices: chunk_buffers[chunk],
@@ -407,6 +427,7 @@ impl ComputeFrame {
         for m in &self.mesh_metas {
             let r = words.get(m.word..m.word + COUNT_WORDS).ok_or_else(|| Error::Internal("mesh counters short".into()))?;
             add_counts(lights, totals, m, [r[0] as u64, r[1] as u64, r[2] as u64, r[3] as u64], 0, UsedIndexFormat::None);
+            (totals.mesh_meshlets, totals.mesh_workgroups) = (totals.mesh_meshlets + r[4] as u64, totals.mesh_workgroups + r[5] as u64);
         }
         Ok(())
     }

@@ -34,6 +34,8 @@
 //! for the same light and caster.
 
 pub(crate) mod arena;
+pub(crate) mod draws;
+pub(crate) mod draws_record;
 pub(crate) mod frame;
 mod prepare;
 pub(crate) mod record;
@@ -79,6 +81,17 @@ pub(crate) mod rec {
     pub const VOL_CAP: usize = 15;
     pub const CAP_CAP: usize = 16;
     pub const OVERFLOW: usize = 17;
+    /// The volume and light-cap commands' `vertexOffset` and `firstInstance` (written by the
+    /// CPU for the merged draws: the chunk's first vertex in the arena, the pair's transform).
+    pub const VOL_VERTEX_OFFSET: usize = 3;
+    pub const VOL_FIRST_INSTANCE: usize = 4;
+    pub const CAP_VERTEX_OFFSET: usize = 8;
+    pub const CAP_FIRST_INSTANCE: usize = 9;
+    /// The merged draws' lists the two commands go to (`shaders/compact_draws.wgsl`): the
+    /// word offset of the list's count, or [`NO_LIST`].
+    pub const VOL_LIST: usize = 18;
+    pub const CAP_LIST: usize = 19;
+    pub const NO_LIST: u32 = u32::MAX;
     pub const F_ENABLED: u32 = 1;
     pub const F_BACK: u32 = 2;
     pub const F_DIRECTIONAL: u32 = 4;
@@ -129,8 +142,9 @@ pub(crate) struct ComputeMesh {
     pub chunk_edges: Vec<u32>,
     /// Mesh-shader extrusion: the meshlets of the closed manifold parts
     /// ([`Meshlets`]), `(first triangle, triangles, first edge, edges)`, the firsts relative
-    /// to the caster's ranges of the two tables below (made absolute when placed in the arena).
-    pub meshlets: Vec<[u32; 4]>,
+    /// to the caster's ranges of the two tables below (made absolute when placed in the arena),
+    /// then their culling bounds (`crate::pass::mesh::meshlet_rows`).
+    pub meshlets: Vec<[u32; crate::pass::mesh::MESHLET_WORDS]>,
     /// The meshlets' triangles (their slots in the scan order, as the facing bits have them).
     pub meshlet_tris: Vec<u32>,
     /// The meshlets' owned edges, `(s0, s1, c0 | c1 << 8, 0)` (the slots of `t0` and `t1`).
@@ -140,6 +154,19 @@ pub(crate) struct ComputeMesh {
     /// The index of part 0's apex in `positions` (part `p`'s is `apex_base + p`): the welded
     /// positions come first.
     pub apex_base: u32,
+    /// Every chunk's dual-length vertices (n with w = 1, then n with w = 0), chunk after chunk:
+    /// the merged volume draws' vertex arena.
+    pub vertices: Vec<[f32; 4]>,
+    /// Per chunk, its first vertex in `vertices`.
+    pub chunk_vertices: Vec<u32>,
+}
+
+/// The dual-length vertex data of a chunk: every vertex with w = 1, then again with w = 0.
+pub(crate) fn dual_length(vertices: &[glam::Vec3]) -> Vec<[f32; 4]> {
+    let mut data: Vec<[f32; 4]> = Vec::with_capacity(vertices.len() * 2);
+    data.extend(vertices.iter().map(|v| [v.x, v.y, v.z, 1.0]));
+    data.extend(vertices.iter().map(|v| [v.x, v.y, v.z, 0.0]));
+    data
 }
 
 impl ComputeMesh {
@@ -152,7 +179,12 @@ impl ComputeMesh {
         let order = caster.planes.order();
         let slot = |t: u32| order.slot(t);
         let planes = caster.planes.planes_scan();
-        let blocks = caster.planes.gpu_blocks(mesh).iter().flat_map(|b| [[b[0], b[1], b[2], b[3]], [b[4], b[5], b[6], b[7]], [b[8], b[9], b[10], b[11]]]).collect();
+        let blocks = caster
+            .planes
+            .gpu_blocks(mesh)
+            .iter()
+            .flat_map(|b| [[b[0], b[1], b[2], b[3]], [b[4], b[5], b[6], b[7]], [b[8], b[9], b[10], b[11]]])
+            .collect();
         let tris = (0..mesh.triangles.len() as u32)
             .map(|s| {
                 let t = order.triangle(s) as usize;
@@ -183,8 +215,14 @@ impl ComputeMesh {
             }
         }
         let tables::WordPairs { edges, groups } = tables::word_pairs(edges);
+        let mut vertices = Vec::new();
+        let mut chunk_vertices = Vec::with_capacity(caster.chunks.len());
+        for ch in &caster.chunks {
+            chunk_vertices.push(vertices.len() as u32);
+            vertices.extend(dual_length(&ch.vertices));
+        }
         let ml = Meshlets::build(caster);
-        let meshlets = ml.meshlets.iter().map(|m| [m.first_triangle, m.triangle_count, m.first_edge, m.edge_count]).collect();
+        let meshlets = crate::pass::mesh::meshlet_rows(&ml);
         let meshlet_edges = ml.edges.iter().map(|e| [slot(e.t0), slot(e.t1), e.c0 as u32 | (e.c1 as u32) << 8, 0]).collect();
         ComputeMesh {
             planes,
@@ -199,15 +237,16 @@ impl ComputeMesh {
             meshlet_edges,
             part_meshlets: ml.parts,
             apex_base,
+            vertices,
+            chunk_vertices,
         }
     }
-}
 
-impl ComputeMesh {
     /// The bytes of each arena table, placed at `base` (the meshlets' firsts made absolute).
     pub fn table_bytes(&self, base: &[u32; arena::N]) -> [std::borrow::Cow<'_, [u8]>; arena::N] {
         use std::borrow::Cow;
-        let meshlets: Vec<[u32; 4]> = self.meshlets.iter().map(|&[ft, tc, fe, ec]| [ft + base[5], tc, fe + base[6], ec]).collect();
+        let meshlets: Vec<[u32; crate::pass::mesh::MESHLET_WORDS]> =
+            self.meshlets.iter().map(|&row| crate::pass::mesh::placed(row, base[5], base[6])).collect();
         [
             Cow::Borrowed(bytemuck::cast_slice(&self.planes)),
             Cow::Borrowed(bytemuck::cast_slice(&self.tris)),
@@ -216,6 +255,7 @@ impl ComputeMesh {
             Cow::Owned(bytemuck::cast_slice(&meshlets).to_vec()),
             Cow::Borrowed(bytemuck::cast_slice(&self.meshlet_tris)),
             Cow::Borrowed(bytemuck::cast_slice(&self.meshlet_edges)),
+            Cow::Borrowed(bytemuck::cast_slice(&self.vertices)),
             Cow::Borrowed(bytemuck::cast_slice(&self.blocks)),
             Cow::Borrowed(bytemuck::cast_slice(&self.groups)),
         ]
@@ -233,6 +273,7 @@ impl ComputeMesh {
             chunk_tris: caster.chunks.iter().map(|ch| ch.local_tris.len() as u32).collect(),
             part_meshlets: self.part_meshlets,
             apex_base: self.apex_base,
+            chunk_vertex_base: self.chunk_vertices.iter().map(|&v| v + base[arena::VERTICES]).collect(),
         }
     }
 }
@@ -255,6 +296,9 @@ pub(crate) struct ComputeStatic {
     pub part_meshlets: Vec<std::ops::Range<u32>>,
     /// Part `p`'s apex is position `apex_base + p` (relative to `base[2]`).
     pub apex_base: u32,
+    /// Per chunk, its first vertex in the arena's vertex table (absolute: the merged draws'
+    /// `vertexOffset`).
+    pub chunk_vertex_base: Vec<u32>,
 }
 
 /// The compute pipelines (one per stage: facing bits, exact facing, silhouette edges with
@@ -364,6 +408,10 @@ pub(crate) struct SlotCompute {
     /// [`Technique::Mesh`](crate::pass::Technique::Mesh): the mesh draws' counters (host
     /// visible: read back for stats).
     pub counts: Option<Buffer>,
+    /// The merged draws ([`draws`]): per (light, caster) pair its transform and light (host
+    /// visible, per-instance vertex attributes), and the per-light lists of compacted commands.
+    pub xforms: Option<Buffer>,
+    pub draw_lists: Option<Buffer>,
     pub pool: vk::DescriptorPool,
     pub pool_sets: u32,
 }
@@ -415,7 +463,16 @@ impl SlotCompute {
     }
 
     pub fn destroy(&mut self, dev: &PassDevice) {
-        for b in [&mut self.records, &mut self.out, &mut self.facing, &mut self.jobs, &mut self.lists, &mut self.counts] {
+        for b in [
+            &mut self.records,
+            &mut self.out,
+            &mut self.facing,
+            &mut self.jobs,
+            &mut self.lists,
+            &mut self.counts,
+            &mut self.xforms,
+            &mut self.draw_lists,
+        ] {
             if let Some(mut b) = b.take() {
                 b.destroy(dev);
             }

@@ -9,9 +9,22 @@ use ash::vk;
 use gpu_allocator::MemoryLocation;
 
 impl ShadowPass {
-    /// Sizes the slot's compute buffers for `cf`, writes its jobs and records and the frame's
-    /// one descriptor set. The slot's previous frame has retired.
-    pub(crate) fn prepare_compute(&mut self, slot: usize, mut cf: ComputeFrame) -> Result<ComputeFrame> {
+    /// Sizes the slot's compute buffers for `cf`, lays out its merged draws for `lights` lights
+    /// in `draws` (resolved: not `Auto`), writes its jobs and records and the frame's
+    /// descriptor sets. The slot's previous frame has retired.
+    pub(crate) fn prepare_compute(
+        &mut self,
+        slot: usize,
+        mut cf: ComputeFrame,
+        (lights, draws): (usize, crate::pass::ComputeDraws),
+    ) -> Result<ComputeFrame> {
+        let draws = if cf.mesh { crate::pass::ComputeDraws::PerChunk } else { draws };
+        cf.merged = super::draws::plan(&mut cf.records, &cf.chunk_records, lights, draws, self.dev.max_draw_indirect_count);
+        let merged_layout = match (&cf.merged, self.merged_pipes.as_ref()) {
+            (None, _) => vk::DescriptorSetLayout::null(),
+            (Some(_), Some(p)) => p.set_layout,
+            (Some(_), None) => return Err(Error::Internal("merged draws without their pipelines".into())),
+        };
         let Some(pipes) = self.compute_pipes.as_ref() else {
             return Err(
                 Misuse::NotConfigured { call: "Technique::Compute", needs: "a device with compute silhouettes (Capabilities)" }.into()
@@ -78,7 +91,7 @@ impl ShadowPass {
             SlotCompute::ensure(dev, &mut sc.counts, &format!("mesh counters {slot}"), counts_range, usage, MemoryLocation::GpuToCpu)?;
         }
         let counts_raw = sc.counts.as_ref().map(|b| b.raw).unwrap_or_default();
-        sc.reset_pool(dev, 2)?;
+        sc.reset_pool(dev, 3)?;
         cf.set = vk::DescriptorSet::null();
         cf.mesh_set = vk::DescriptorSet::null();
         if !cf.jobs.is_empty() {
@@ -141,6 +154,15 @@ impl ShadowPass {
                 unsafe { d.update_descriptor_sets(&writes, &[]) };
                 cf.mesh_set = sets[0];
             }
+        }
+        if let Some(m) = cf.merged.as_mut().filter(|_| !cf.jobs.is_empty()) {
+            let b = super::draws_record::MergedBuffers {
+                xforms: &cf.xforms,
+                records: (records_raw, ranges[0]),
+                vertices: arena[super::arena::VERTICES],
+                set_layout: merged_layout,
+            };
+            super::draws_record::prepare_merged(dev, sc, slot, m, b)?;
         }
         cf.counts_buffer = counts_raw;
         cf.records_buffer = records_raw;

@@ -7,8 +7,11 @@
 //!    caster uploads -> compute reads and writes;
 //! 2. between the stages (facing | exact | find and caps): compute writes -> compute reads
 //!    and atomics, and the indirect dispatch read of the exact list's size;
-//! 3. the compute writes -> indirect-command reads, index reads, and host reads (the counts
-//!    `--stats` reads back after the fence).
+//! 3. with the merged draws' compaction ([`super::draws`]): the `find` and `caps` stages'
+//!    writes -> its reads;
+//! 4. the compute writes -> indirect-command reads, index reads, and host reads (the counts
+//!    `--stats` reads back after the fence): the one barrier between the compute and the
+//!    draws.
 
 use super::super::ShadowPass;
 use super::{rec, LANES};
@@ -16,7 +19,7 @@ use crate::pass::PreparedFrame;
 use ash::vk;
 
 /// Most workgroups of one dispatch dimension (every device has at least this many).
-const MAX_GROUPS: u32 = 65535;
+pub(crate) const MAX_GROUPS: u32 = 65535;
 
 /// A global memory barrier, recorded as Vulkan 1.0 (the pass needs no synchronization2).
 fn barrier(
@@ -35,7 +38,9 @@ impl ShadowPass {
     /// blocks where their bound decides them, else the plane filter), the exact test of what
     /// it left undecided, the possible silhouette edges with their sides (skipping whole
     /// word-pair groups of uniform blocks) and the face caps, writing 16-bit indices and the
-    /// indirect draw counts; then a barrier to the indirect draws and index reads. Nothing for other
+    /// indirect draw counts (and with the merged draws' lists of
+    /// [`PassToggles::compute_draws`](crate::pass::PassToggles::compute_draws), a fifth: their
+    /// compaction); then one barrier to the indirect draws and index reads. Nothing for other
     /// techniques. Idempotent per frame; also recorded by the first `cmd_determine` /
     /// `cmd_count_float` / `cmd_light_intensity` of the frame when the host did not call it
     /// (hosts drawing with [`cmd_draw_volumes`](Self::cmd_draw_volumes) inside their own
@@ -64,7 +69,7 @@ impl ShadowPass {
         let rw = A::SHADER_READ | A::SHADER_WRITE;
         // Mesh frames: the mesh draws read the facing bits and write their counters (a
         // previous frame's mesh draws may still read the bits this frame rewrites).
-        let mesh = if self.caps.mesh_shader { S::MESH_SHADER_EXT } else { S::NONE };
+        let mesh = self.mesh_stages();
         // compute writes -> the next stage's reads, atomics and indirect dispatch
         let to_next = |this: &Self| {
             barrier(
@@ -84,8 +89,6 @@ impl ShadowPass {
             (S::COMPUTE_SHADER | S::TRANSFER, rw | A::TRANSFER_WRITE),
         );
         let [facing, exact, find, caps] = cp.stages;
-        let skip: u32 = std::env::var("UMBRAGE_SIL_SKIP").ok().and_then(|v| v.parse().ok()).unwrap_or(0); // ABLATION
-        let on = |bit: u32| skip & bit == 0; // ABLATION
         let push = cf.push();
         let records = cf.records_buffer;
         // SAFETY: the caller's contract; the pipelines, the set and its buffers live until the
@@ -97,13 +100,22 @@ impl ShadowPass {
                 // last barrier orders them)
                 d.cmd_fill_buffer(cb, cf.counts_buffer, 0, (cf.counts_words * 4).max(4), 0);
             }
+            // the merged draws' lists start empty (counts 0, every command empty)
+            if let Some(m) = &cf.merged {
+                self.cmd_clear_draw_lists(cb, m);
+            }
+        }
+        // (the merged draws read the cleared tail of their lists as empty commands)
+        barrier(&self.dev, cb, (S::TRANSFER, A::TRANSFER_WRITE), (S::COMPUTE_SHADER | S::DRAW_INDIRECT, rw | A::INDIRECT_COMMAND_READ));
+        // SAFETY: as above.
+        unsafe {
             d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::COMPUTE, cp.layout, 0, &[cf.set], &[]);
             d.cmd_push_constants(cb, cp.layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::bytes_of(&push));
             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, facing);
-            if on(1) { dispatch_groups(d, cb, cf.groups[0].div_ceil(LANES)); }
+            dispatch_groups(d, cb, cf.groups[0].div_ceil(LANES));
             to_next(self);
             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, exact);
-            if on(2) { d.cmd_dispatch_indirect(cb, records, (rec::H_EXACT_X * 4) as u64); }
+            d.cmd_dispatch_indirect(cb, records, (rec::H_EXACT_X * 4) as u64);
         }
         if cf.mesh {
             // The facing bits are all the mesh draws need; the counters' fill too.
@@ -111,7 +123,7 @@ impl ShadowPass {
                 &self.dev,
                 cb,
                 (S::COMPUTE_SHADER | S::TRANSFER, A::SHADER_WRITE | A::TRANSFER_WRITE),
-                (S::MESH_SHADER_EXT | S::HOST, A::SHADER_READ | A::SHADER_WRITE | A::HOST_READ),
+                (mesh | S::HOST, A::SHADER_READ | A::SHADER_WRITE | A::HOST_READ),
             );
             return Ok(());
         }
@@ -119,11 +131,17 @@ impl ShadowPass {
         unsafe {
             to_next(self);
             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, find);
-            if on(4) { dispatch_groups(d, cb, cf.groups[1].div_ceil(LANES)); }
+            dispatch_groups(d, cb, cf.groups[1].div_ceil(LANES));
             if cf.groups[2] > 0 {
                 d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, caps);
                 dispatch_groups(d, cb, cf.groups[2]);
             }
+        }
+        // The merged draws: every non-empty command into its light and pipeline's list.
+        if let Some(m) = cf.merged.as_ref().filter(|m| m.compacts()) {
+            to_next(self);
+            // SAFETY: as above; the lists were cleared above, the records' counts are final.
+            unsafe { self.cmd_compact_draws(cb, m)? };
         }
         barrier(
             &self.dev,

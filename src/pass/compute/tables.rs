@@ -34,7 +34,7 @@ pub(crate) fn word_pairs(edges: impl IntoIterator<Item = (u32, u32, u32)>) -> Wo
         .into_iter()
         .map(|(s0, s1, corners)| {
             let (lo, hi) = (s0.min(s1), s0.max(s1));
-            ((lo / block, hi / block), [s0, s1, corners, lo % block | (hi % block) << 8])
+            ((lo / block, hi / block), [s0, s1, corners, (lo % block) | ((hi % block) << 8)])
         })
         .collect();
     keyed.sort_by_key(|k| k.0);
@@ -75,7 +75,7 @@ mod tests {
             for e in &w.edges[first as usize..(first + count) as usize] {
                 let (lo, hi) = (e[0].min(e[1]), e[0].max(e[1]));
                 assert_eq!((lo / 64, hi / 64), (a, b));
-                assert_eq!(e[3], lo % 64 | (hi % 64) << 8);
+                assert_eq!(e[3], (lo % 64) | ((hi % 64) << 8));
             }
             next = first + count;
         }
@@ -110,7 +110,8 @@ mod tests {
         let order = c.planes.order();
         assert!(!order.is_identity());
         let m = ComputeMesh::new(&c);
-        let input: Vec<(u32, u32, u32)> = c.topology.manifold_edges.iter().map(|e| (order.slot(e.t0), order.slot(e.t1), e.c0 as u32 | (e.c1 as u32) << 8)).collect();
+        let input: Vec<(u32, u32, u32)> =
+            c.topology.manifold_edges.iter().map(|e| (order.slot(e.t0), order.slot(e.t1), e.c0 as u32 | (e.c1 as u32) << 8)).collect();
         check(&input, &WordPairs { edges: m.edges.clone(), groups: m.groups.clone() });
         // the triangles, planes and blocks by slot
         for (s, row) in m.tris.iter().enumerate() {
