@@ -191,7 +191,7 @@ mod tests {
     use super::super::exact_bit;
     use super::*;
     use crate::geom::order::TriangleOrder;
-    use crate::geom::testmesh::{shuffled, uv_sphere};
+    use crate::geom::testmesh::{shuffled, torus, uv_sphere};
     use glam::Vec3;
 
     /// The exact sign of `Σ terms` (each an f64 value, the sum not rounded): Shewchuk's
@@ -354,5 +354,95 @@ mod tests {
         }
         assert!(tried > 0);
         assert!(broken > 0, "without the allowance no light near the threshold broke the invariant ({tried} tried)");
+    }
+
+    /// A small xorshift generator for the randomised lights.
+    fn next(x: &mut u64) -> f32 {
+        *x ^= *x << 13;
+        *x ^= *x >> 7;
+        *x ^= *x << 17;
+        (*x >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+    }
+
+    /// Every block the f32 test decides agrees with every slot's exact facing (and clears the
+    /// filter's bound), for lights grazing a flat patch far from the origin (point lights a
+    /// hair above, on and below its plane, directional lights nearly parallel to it), for a
+    /// torus near the filter's range (2^60), and for a sphere with degenerate triangles
+    /// scattered through its blocks (those blocks are never decided; the others still are).
+    #[test]
+    fn gpu_blocks_agree_near_grazing_far_and_degenerate() {
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        // a flat 16 x 16 grid (512 triangles, 8 blocks) on z = z0, far from the origin
+        let (x0, y0, z0) = (1.0e5f32, -2.0e5f32, 3.0e4f32);
+        let mut positions = Vec::new();
+        for i in 0..17 {
+            for j in 0..17 {
+                positions.push(Vec3::new(x0 + i as f32 * 0.25, y0 + j as f32 * 0.25, z0));
+            }
+        }
+        let mut triangles = Vec::new();
+        for i in 0..16u32 {
+            for j in 0..16u32 {
+                let v = i * 17 + j;
+                triangles.push([v, v + 17, v + 1]);
+                triangles.push([v + 1, v + 17, v + 18]);
+            }
+        }
+        let flat = Mesh::new(positions, triangles);
+        let planes = FacePlanes::new(&flat);
+        let mut decided = 0;
+        for k in 0..200 {
+            let (dx, dy) = (next(&mut x) * 1.0e4, next(&mut x) * 1.0e4);
+            let dz = [0.0, 1.0e-6, -1.0e-6, 1.0e-3, -1.0e-3, 0.5, -0.5, 64.0][k % 8] * (1.0 + next(&mut x).abs());
+            let l = Vec4::new(x0 + 2.0 + dx, y0 + 2.0 + dy, z0 + dz, 1.0);
+            decided += [false, true].map(|flip| check(&planes, &flat, l, flip)).iter().sum::<usize>();
+            let d = Vec4::new(next(&mut x), next(&mut x), dz * 1.0e-3, 0.0);
+            decided += [false, true].map(|flip| check(&planes, &flat, d, flip)).iter().sum::<usize>();
+        }
+        assert!(decided > 0, "no grazing light decided a block of the flat patch");
+
+        // a torus at 10^17 (inside the filter's range), in the spatial order
+        let mut far = shuffled(&torus(4.0e14, 1.0e14, 64, 32));
+        let off = Vec3::new(1.0e17, -7.0e16, 3.0e16);
+        for p in &mut far.positions {
+            *p += off;
+        }
+        let all: Vec<u32> = (0..far.triangles.len() as u32).collect();
+        let planes = FacePlanes::with_order(&far, TriangleOrder::spatial(&far, &[&all]));
+        let mut decided = 0;
+        for _ in 0..40 {
+            let v = Vec3::new(next(&mut x), next(&mut x), next(&mut x));
+            for scale in [1.0e14f32, 5.0e14, 1.0e16] {
+                let l = (off + v * scale).extend(1.0);
+                decided += [false, true].map(|flip| check(&planes, &far, l, flip)).iter().sum::<usize>();
+            }
+            decided += check(&planes, &far, v.extend(0.0), false);
+        }
+        assert!(decided > 0, "no block of the far torus decided");
+
+        // a sphere with every 37th triangle collapsed (zero area) or a sliver
+        let mut m = uv_sphere(2.0, 96, 48);
+        for t in (5..m.triangles.len()).step_by(37) {
+            let [a, b, _] = m.triangles[t];
+            m.triangles[t] = if t % 2 == 0 { [a, a, b] } else { [a, b, b] };
+        }
+        let all: Vec<u32> = (0..m.triangles.len() as u32).collect();
+        let planes = FacePlanes::with_order(&m, TriangleOrder::spatial(&m, &[&all]));
+        let blocks = planes.gpu_blocks(&m);
+        let mut decided = 0;
+        for _ in 0..60 {
+            let v = Vec3::new(next(&mut x), next(&mut x), next(&mut x)).normalize_or(Vec3::X);
+            for r in [2.0f32, 2.0001, 2.5, 40.0] {
+                decided += [false, true].map(|flip| check(&planes, &m, (v * r).extend(1.0), flip)).iter().sum::<usize>();
+            }
+        }
+        for (b, block) in blocks.iter().enumerate() {
+            let degenerate = (b * GPU_BLOCK..planes.len().min(b * GPU_BLOCK + GPU_BLOCK)).any(|s| {
+                let [a, b, c] = m.triangles[planes.tri(s)];
+                a == b || b == c || a == c
+            });
+            assert!(!degenerate || block[11] == 0.0, "block {b} holds a degenerate triangle and is decidable");
+        }
+        assert!(decided > 0 && blocks.iter().any(|b| b[11] == 1.0));
     }
 }
