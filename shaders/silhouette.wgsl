@@ -1,60 +1,31 @@
 // GPU possible silhouettes (`--method compute`): every (light, caster) pair of the frame in
 // one dispatch per stage, whatever the number of casters.
 //
-// The casters' static tables live in one pass-wide arena (planes, triangles, positions,
-// edges, block bounds, word-pair groups: one storage buffer each); the frame's job table
-// gives each (light, caster) pair its object-space light, filter, arena offsets, chunk
-// records and facing bits, and the first invocation (facing, find) or workgroup (caps) it
-// owns in each stage (a prefix over the jobs: an invocation finds its job by a binary
-// search of ceil(log2(jobs)) steps).
+// The casters' static tables live in one pass-wide arena; the frame's job table gives each
+// (light, caster) pair its light, filter, offsets, records and facing bits, and its first
+// invocation (facing, find) or workgroup (caps) in each stage: an invocation finds its job by
+// a binary search of ceil(log2(jobs)) steps.
 //
-// Every triangle table is in the caster's scan order (`geom::TriangleOrder::spatial`, the
-// CPU's): slot s is a triangle, 64 consecutive slots a compact patch of the surface (a
-// block), and the facing bits are by slot. Edges name their triangles' slots. Stages
-// (`cmd_compute_silhouettes`):
-//
-// 1. `facing`, an invocation per 64-slot block of a job: first the block's bound
-//    (`decide_block`, `geom::planes::gpu` on the CPU: its centre plane, spread and an
-//    allowance for this f32 evaluation, derived there) decides the whole block with one test
-//    where the light is far from all its planes; otherwise each slot's facing bit exactly as
-//    the CPU's `FacePlanes::facing_packed` decides it: the f32 plane value is trusted only
-//    beyond the CPU's proven error bound (`bound`, per caster and light). The invocation
-//    writes its two words whole (no clearing fill). Every slot the filter cannot decide
-//    (grazing light, degenerate triangles) goes to the frame's exact list, whose indirect
-//    dispatch size the same atomics keep up to date.
-// 2. `exact` (indirect, over the exact list): the EXACT sign of orient3d of the triangle's f32
-//    vertices, evaluated as a sum of 48 (point light) or 24 (directional) products of three
-//    f32 values in a fixed-point accumulator of 12-bit limbs (no rounding at all). The bits are
-//    therefore the CPU's, bit for bit, and every edge is derived from one bit per triangle:
-//    the volume is closed by construction. (Its own stage: in the filter's, its code made
-//    lavapipe ten times slower on every triangle.)
-// 3. `find`, an invocation per word-pair group of a job (`pass::compute::tables`: at most 32
-//    edges whose two slots lie in the same two blocks): a group whose two blocks are uniform
-//    and equal (both all ones or both all zeros) holds no silhouette edge and is skipped
-//    without reading its edges; in the others an edge whose two bits differ is a possible
-//    silhouette edge, and its side quad (one triangle for a directional light) and, for
-//    McGuire's fan dark cap, its fan triangle are written straight away (`side`), into the
-//    chunk of the light-facing triangle (front formulation) or of the other one (back
-//    formulation, the light inside the part's bounds), with the same winding as the CPU's
-//    `shadow::plan::emit`. Loops, not branches, carry the per-edge and per-side work: on
-//    lavapipe a branch's code costs every lane whether it is taken or not, but a loop ends
-//    when no lane has an iteration left. (Before, the edges went to a list and a fourth,
-//    indirect stage wrote their sides: on lavapipe the list's atomics, the reloads and the
-//    extra dispatch cost more than the lanes idle in this loop.)
-//    `caps`, in the same barrier interval, a workgroup per GROUP triangles of the jobs whose
-//    chunks need face caps (dark cap of front or back faces, light cap): the caps.
-//
-// Output: 16-bit indices into the chunk's dual-length vertex buffer (index i < n: (p, 1),
-// i + n: (p, 0)), packed two to a u32 word. A chunk's region is allocated with an atomic add
-// on its VkDrawIndexedIndirectCommand::indexCount; a word shared by two allocations is written
-// with atomicAnd/atomicOr on disjoint halves (order independent), a word owned whole with
-// atomicStore. Regions are sized on the CPU for the worst case of the chunk's case; a write
-// past the region is not made and flags the record's overflow word instead (never silent).
+// Every triangle table is in the caster's scan order (`geom::TriangleOrder::spatial`): slot s
+// is a triangle, 64 consecutive slots a compact patch (a block); facing bits and edges are by
+// slot. Stages (`cmd_compute_silhouettes`; docs/compute.md has the details and the reasons):
+// 1. `facing`, an invocation per block: `decide_block` (its f32 bound, `geom::planes::gpu`)
+//    decides the block whole where it can; else each slot's plane filter with the CPU's error
+//    bound; the undecided slots go to the exact list. Both words written whole.
+// 2. `exact` (indirect, over the list): the exact sign of orient3d, summed without rounding in
+//    a fixed-point accumulator: the bits are the CPU's, and the volume is closed.
+// 3. `find`, an invocation per word-pair group (`pass::compute::tables`): a group of two
+//    uniform, equal blocks is skipped; in the others an edge whose two bits differ writes its
+//    side (and fan triangle) with the CPU's winding (`side`); `caps`, in the same barrier
+//    interval, writes the face caps. Loops, not branches, carry per-slot, per-edge and
+//    per-side work: on lavapipe a branch costs every lane, a loop ends when no lane is left.
+// Output: 16-bit indices into the chunk's dual-length vertex buffer (i < n: (p, 1), i + n:
+// (p, 0)), two to a u32 word, in regions allocated by an atomic add on the chunk's indexCount
+// and sized on the CPU for the worst case; a write past one flags the record (never silent).
 
 struct Push {
     jobs: u32,
-    // Invocations of the `facing` (blocks) and `find` (word-pair groups) stages, workgroups of
-    // the `caps` stage (the sums over the jobs).
+    // Invocations of `facing` (blocks) and `find` (word-pair groups), workgroups of `caps`.
     blocks: u32,
     word_pairs: u32,
     cap_groups: u32,
@@ -65,12 +36,10 @@ struct Push {
     _pad2: u32,
 }
 
-// One (light, caster) pair (`pass::compute::frame::GpuJob`), in rows of four words: a
-// stage loads the rows it needs whole (lavapipe loads each load instruction lane by lane, so
-// one vec4 load costs about what one scalar load costs).
+// One (light, caster) pair (`pass::compute::frame::GpuJob`), in rows of four words (on
+// lavapipe one vec4 load costs about what one scalar load costs).
 struct Job {
-    // The light in the caster's object space (w = 1 point, w = 0 directional), f32 as the
-    // CPU planner has it.
+    // The light in the caster's object space (w = 1 point, w = 0 directional).
     light: vec4<f32>,
     // The plane filter's light (negated for mirroring transforms).
     filt: vec4<f32>,
@@ -158,7 +127,6 @@ const STAGE_FACING: u32 = 0u;
 const STAGE_FIND: u32 = 1u;
 const STAGE_CAPS: u32 = 2u;
 
-
 // ---- jobs ----
 
 // (One field read, not the whole job: this runs log2(jobs) times per invocation.)
@@ -198,7 +166,6 @@ fn group_index(wg: vec3<u32>, nwg: vec3<u32>) -> u32 {
 fn lane_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
     return gid.x + gid.y * nwg.x * LANES;
 }
-
 
 // Appends `entry` to the exact list; the `exact` stage's indirect dispatch command grows to
 // cover it (64 entries a workgroup; the stage strides beyond 65535 workgroups).
@@ -308,13 +275,9 @@ fn acc_sign() -> i32 {
     return 0;
 }
 
-
-// Exact facing: point light: det[p0 - L, p1 - L, p2 - L] < 0; directional:
-// det[p1 - p0, p2 - p0, d] > 0 (`geom::predicates::facing_exact`). The determinant is the
-// sum over the six permutations (i, j, k) of its rows' components, each a product of three
-// differences expanded into its terms: point light, rows (x0 - x1) (y0 - y1) (z0 - z1) with
-// x = (p0, L), y = (p1, L), z = (p2, L): 8 terms; directional, x = (p1, p0), y = (p2, p0),
-// z = d: 4 terms. One loop over the 48 (or 24) terms, so `add3` is inlined once.
+// Exact facing (`geom::predicates::facing_exact`): point light det[p0 - L, p1 - L, p2 - L] < 0,
+// directional det[p1 - p0, p2 - p0, d] > 0; the six permutations' products of differences
+// expanded into 48 (24) terms of three f32 values, one loop so `add3` is inlined once.
 fn facing_exact(job: Job, t: u32) -> bool {
     let tri = tris[job.bases.y + t];
     var i1 = tri.g.y;
@@ -405,10 +368,8 @@ fn emit(r: u32, cap: bool, idx: array<u32, 9>, count: u32) {
 
 // ---- stages ----
 
-// The block test (`geom::planes::decide_gpu_block`, the same f32 operations in the same
-// order): 1 when every slot of the block faces the filter light `l` (w = ±1 or 0) with
-// filter bound `e`, -1 when none does, 0 when the block is left to the per-slot filter. The
-// allowance covers this f32 evaluation (`geom/planes/gpu.rs` derives it).
+// The block test (`geom::planes::gpu`'s mirror, same f32 operations and order, its allowance
+// derived there): 1 every slot faces `l` (w = ±1 or 0, filter bound `e`), -1 none, 0 undecided.
 fn decide_block(k: u32, l: vec4<f32>, e: f32) -> i32 {
     let cd = blocks[k];
     let nd = blocks[k + 1u];
@@ -425,9 +386,7 @@ fn decide_block(k: u32, l: vec4<f32>, e: f32) -> i32 {
     return select(0, select(select(0, -1, centre < -margin), 1, centre > margin), ok);
 }
 
-// Stage 1: the facing bits of one 64-slot block of one job an invocation (see the top). The
-// job's fields are read one by one: loading the whole job per invocation cost lavapipe more
-// than the planes themselves.
+// Stage 1: one 64-slot block of one job an invocation (the job's fields read one by one).
 @compute @workgroup_size(LANES)
 fn facing(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let g = lane_index(gid, nwg);
@@ -489,8 +448,7 @@ fn facing(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups
     }
 }
 
-// Stage 2: the exact test for the listed triangles (indirect: as many workgroups as the list
-// needs, striding beyond the dispatch limit).
+// Stage 2: the exact test of the listed slots (indirect; strides past the dispatch limit).
 @compute @workgroup_size(64)
 fn exact(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let stride = nwg.x * 64u;
@@ -504,8 +462,7 @@ fn exact(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups)
     }
 }
 
-// Stage 3a: possible silhouette edges and their sides, one word-pair group of one job an
-// invocation (see the top).
+// Stage 3a: silhouette edges and their sides, one word-pair group of one job an invocation.
 @compute @workgroup_size(LANES)
 fn find(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let g = lane_index(gid, nwg);
@@ -544,8 +501,7 @@ fn find(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) 
     }
 }
 
-// Stage 3b: triangle t's face caps (dark cap of front or back faces, light cap) for the
-// chunks whose case needs them; GROUP triangles of one job with caps a workgroup.
+// Stage 3b: the face caps of the chunks that need them, GROUP slots of one job a workgroup.
 @compute @workgroup_size(GROUP)
 fn caps(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>,
         @builtin(local_invocation_index) lid: u32) {
@@ -589,13 +545,7 @@ fn caps(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3
 }
 
 fn corner(l: vec4<u32>, k: u32) -> u32 {
-    if (k == 0u) {
-        return l.x;
-    }
-    if (k == 1u) {
-        return l.y;
-    }
-    return l.z;
+    return select(select(l.z, l.y, k == 1u), l.x, k == 0u);
 }
 
 // The side (and fan triangle) of silhouette edge `i` of job `j`: one emission of 3, 6 or 9
