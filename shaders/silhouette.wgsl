@@ -1,88 +1,65 @@
 // GPU possible silhouettes (`--method compute`): every (light, caster) pair of the frame in
 // one dispatch per stage, whatever the number of casters.
 //
-// The casters' static tables live in one pass-wide arena (planes, triangles, positions,
-// edges: one storage buffer each); the frame's job table gives each (light, caster) pair its
-// object-space light, filter, arena offsets, chunk records and facing bits, and the first
-// workgroup it owns in each stage (a prefix over the jobs: a workgroup finds its job by a
-// binary search, uniform across the workgroup). Stages (`cmd_compute_silhouettes`):
+// The casters' static tables live in one pass-wide arena; the frame's job table gives each
+// (light, caster) pair its light, filter, offsets, records and facing bits, and its first
+// invocation (facing, find) or workgroup (caps) in each stage: an invocation finds its job by
+// a binary search of ceil(log2(jobs)) steps.
 //
-// 1. `facing`, a workgroup per GROUP triangles of a job: the facing bit, exactly as the
-//    CPU's `FacePlanes::facing_packed` decides it: the f32 plane value is trusted only beyond
-//    the CPU's proven error bound (`bound`, computed on the CPU per caster and light). A
-//    light-facing triangle sets its bit (the words were cleared by a fill). Every triangle the
-//    filter cannot decide (grazing light, degenerate triangles) goes to the frame's exact
-//    list, whose indirect dispatch size the same atomics keep up to date.
-// 2. `exact` (indirect, over the exact list): the EXACT sign of orient3d of the triangle's f32
-//    vertices, evaluated as a sum of 48 (point light) or 24 (directional) products of three
-//    f32 values in a fixed-point accumulator of 12-bit limbs (no rounding at all). The bits are
-//    therefore the CPU's, bit for bit, and every edge is derived from one bit per triangle:
-//    the volume is closed by construction. (Its own stage: in the filter's, its code made
-//    lavapipe ten times slower on every triangle.)
-// 3. `find`, a workgroup per GROUP manifold edges of a job: an edge whose two triangles' bits
-//    differ is a possible silhouette edge, appended to the frame's silhouette list (an atomic
-//    per silhouette edge: O(sqrt(n)) of n). Nothing else happens per edge: on lavapipe a
-//    branch's code costs every lane whether it is taken or not, and the emitting code in this
-//    stage made it 190 ms instead of 13 at 490k triangles. (A workgroup aggregation of the
-//    appends, with two workgroup barriers, measured no faster there: 25-27 ms either way.)
-//    `caps`, in the same barrier interval, a workgroup per GROUP triangles of the jobs whose
-//    chunks need face caps (dark cap of front or back faces, light cap): the caps.
-// 4. `emit` (indirect, over the silhouette list): each edge's side quad (one triangle for a
-//    directional light) and, for McGuire's fan dark cap, its fan triangle, into the chunk of
-//    the light-facing triangle (front formulation) or of the other one (back formulation, the
-//    light inside the part's bounds), with the same winding as the CPU's `shadow::plan::emit`.
-//
-// Output: 16-bit indices into the chunk's dual-length vertex buffer (index i < n: (p, 1),
-// i + n: (p, 0)), packed two to a u32 word. A chunk's region is allocated with an atomic add
-// on its VkDrawIndexedIndirectCommand::indexCount; a word shared by two allocations is written
-// with atomicAnd/atomicOr on disjoint halves (order independent), a word owned whole with
-// atomicStore. Regions are sized on the CPU for the worst case of the chunk's case; a write
-// past the region is not made and flags the record's overflow word instead (never silent).
+// Every triangle table is in the caster's scan order (`geom::TriangleOrder::spatial`): slot s
+// is a triangle, 64 consecutive slots a compact patch (a block); facing bits and edges are by
+// slot. Stages (`cmd_compute_silhouettes`; docs/compute.md has the details and the reasons):
+// 1. `facing`, an invocation per block: `decide_block` (its f32 bound, `geom::planes::gpu`)
+//    decides the block whole where it can; else each slot's plane filter with the CPU's error
+//    bound; the undecided slots go to the exact list. Both words written whole.
+// 2. `exact` (indirect, over the list): the exact sign of orient3d, summed without rounding in
+//    a fixed-point accumulator: the bits are the CPU's, and the volume is closed.
+// 3. `find`, an invocation per word-pair group (`pass::compute::tables`): a group of two
+//    uniform, equal blocks is skipped; in the others an edge whose two bits differ writes its
+//    side (and fan triangle) with the CPU's winding (`side`); `caps`, in the same barrier
+//    interval, writes the face caps. Loops, not branches, carry per-slot, per-edge and
+//    per-side work: on lavapipe a branch costs every lane, a loop ends when no lane is left.
+// Output: 16-bit indices into the chunk's dual-length vertex buffer (i < n: (p, 1), i + n:
+// (p, 0)), two to a u32 word, in regions allocated by an atomic add on the chunk's indexCount
+// and sized on the CPU for the worst case; a write past one flags the record (never silent).
 
 struct Push {
     jobs: u32,
-    // Workgroups of the `facing`, `find` and `caps` stages (the sums over the jobs).
-    facing_groups: u32,
-    find_groups: u32,
+    // Invocations of `facing` (blocks) and `find` (word-pair groups), workgroups of `caps`.
+    blocks: u32,
+    word_pairs: u32,
     cap_groups: u32,
-    // Entry offset of the silhouette list in `lists` (the exact list starts at 0).
-    sil_base: u32,
     // Steps of the binary search over the jobs: ceil(log2(jobs)).
     steps: u32,
-    _pad1: u32,
-    _pad2: u32,
-}
-
-// One (light, caster) pair (`pass::compute::frame::GpuJob`).
-struct Job {
-    // The light in the caster's object space (w = 1 point, w = 0 directional), f32 as the
-    // CPU planner has it.
-    light: vec4<f32>,
-    // The plane filter's light (negated for mirroring transforms).
-    filt: vec4<f32>,
-    // The filter's error bound (+inf: every triangle exact).
-    bound: f32,
-    // 1: mirroring transform (triangle corners 1 and 2 swapped for the exact test).
-    flip: u32,
-    tris: u32,
-    edges: u32,
-    // The caster's first element in each arena table.
-    plane_base: u32,
-    tri_base: u32,
-    pos_base: u32,
-    edge_base: u32,
-    // Word offset of the pair's chunk records.
-    rec_base: u32,
-    // Word offset of the pair's facing bits (a bit per triangle, whole workgroups).
-    fac_base: u32,
-    // The pair's first workgroup in the `facing`, `find` and `caps` stages.
-    g_facing: u32,
-    g_find: u32,
-    g_caps: u32,
     _pad0: u32,
     _pad1: u32,
     _pad2: u32,
 }
+
+// One (light, caster) pair (`pass::compute::frame::GpuJob`), in rows of four words (on
+// lavapipe one vec4 load costs about what one scalar load costs).
+struct Job {
+    // The light in the caster's object space (w = 1 point, w = 0 directional).
+    light: vec4<f32>,
+    // The plane filter's light (negated for mirroring transforms).
+    filt: vec4<f32>,
+    // x: the filter's error bound (f32 bits; +inf: every triangle exact); y: J_FLIP (mirroring
+    // transform: triangle corners 1 and 2 swapped for the exact test) | J_BLOCKS (the job has
+    // a filter, so the block test may decide); z: triangles; w: edges.
+    head: vec4<u32>,
+    // The caster's first element in the plane, triangle, position and edge tables.
+    bases: vec4<u32>,
+    // x: word offset of the pair's chunk records; y: word offset of its facing bits (a bit per
+    // slot, two words a block); z, w: its first invocation in the `facing` (blocks) and `find`
+    // (word-pair groups) stages.
+    offsets: vec4<u32>,
+    // x: its first workgroup in the `caps` stage; y, z: the caster's first element in the
+    // block-bound and word-pair tables; w: its word-pair groups.
+    more: vec4<u32>,
+}
+
+const J_FLIP: u32 = 1u;
+const J_BLOCKS: u32 = 2u;
 
 struct Tri {
     // welded vertex ids (positions, relative to the caster's first)
@@ -99,16 +76,19 @@ struct Tri {
 @group(0) @binding(5) var<storage, read_write> facing_bits: array<atomic<u32>>;
 @group(0) @binding(6) var<storage, read_write> records: array<atomic<u32>>;
 @group(0) @binding(7) var<storage, read_write> out_words: array<atomic<u32>>;
+// The exact list: (job, slot).
 @group(0) @binding(8) var<storage, read_write> lists: array<vec2<u32>>;
+// Per 64-slot block, three vec4s (`geom::planes::GpuBlock`): (c, D'), (N, Δd), (Δ, ok).
+@group(0) @binding(9) var<storage, read> blocks: array<vec4<f32>>;
+// Word-pair groups (a, b, first edge, edges): `pass::compute::tables::WordPairs`.
+@group(0) @binding(10) var<storage, read> word_pairs: array<vec4<u32>>;
 
 var<immediate> pc: Push;
 
-// The frame's header at the start of `records` (`pass::compute::rec::H_*`): the two lists'
-// lengths and their indirect dispatch commands (x, y, z).
+// The frame's header at the start of `records` (`pass::compute::rec::H_*`): the exact list's
+// length and its indirect dispatch command (x, y, z).
 const H_EXACT: u32 = 0u;
 const H_EXACT_X: u32 = 1u;
-const H_SIL: u32 = 4u;
-const H_SIL_X: u32 = 5u;
 const MAX_GROUPS: u32 = 65535u;
 
 // Chunk record layout (u32 words, RECORD_WORDS a chunk): the volume's indirect command
@@ -136,28 +116,32 @@ const DC_FAN: u32 = 1u;
 const DC_FRONT: u32 = 2u;
 const DC_BACK: u32 = 3u;
 
-// Triangles (facing, caps) or edges (find) of one job a workgroup (`pass::compute::GROUP`).
+// Triangles of one job a workgroup of the `caps` stage (`pass::compute::GROUP`).
 const GROUP: u32 = 256u;
+// Invocations a workgroup of the `facing` and `find` stages (`pass::compute::LANES`).
+const LANES: u32 = 64u;
+// The allowance of the block test (`geom::planes::gpu::ALLOWANCE`): 2^-18.
+const ALLOWANCE: f32 = 3.814697265625e-6;
 
 const STAGE_FACING: u32 = 0u;
 const STAGE_FIND: u32 = 1u;
 const STAGE_CAPS: u32 = 2u;
-
 
 // ---- jobs ----
 
 // (One field read, not the whole job: this runs log2(jobs) times per invocation.)
 fn first_group(j: u32, stage: u32) -> u32 {
     if (stage == STAGE_FACING) {
-        return jobs[j].g_facing;
+        return jobs[j].offsets.z;
     }
     if (stage == STAGE_FIND) {
-        return jobs[j].g_find;
+        return jobs[j].offsets.w;
     }
-    return jobs[j].g_caps;
+    return jobs[j].more.x;
 }
 
-// The job owning workgroup `w` of `stage`: the last job whose first group is at most `w`
+// The job owning workgroup (caps) or invocation (facing, find) `w` of `stage`: the last job
+// whose first group is at most `w`
 // (jobs with no group in the stage share the next one's first group and are passed over).
 // `pc.steps` = ceil(log2(jobs)) steps, no early exit: uniform control flow.
 fn job_of(w: u32, stage: u32) -> u32 {
@@ -178,22 +162,17 @@ fn group_index(wg: vec3<u32>, nwg: vec3<u32>) -> u32 {
     return wg.x + wg.y * nwg.x;
 }
 
-fn facing_bit(job: Job, t: u32) -> bool {
-    return ((atomicLoad(&facing_bits[job.fac_base + (t >> 5u)]) >> (t & 31u)) & 1u) != 0u;
+// The linear invocation index of a LANES-wide stage dispatched likewise.
+fn lane_index(gid: vec3<u32>, nwg: vec3<u32>) -> u32 {
+    return gid.x + gid.y * nwg.x * LANES;
 }
 
-// Appends to a list whose indirect dispatch command is at `x_word`: its x grows to cover
-// entry `k` (64 entries a workgroup; the stage strides beyond 65535 workgroups).
-fn grow_dispatch(x_word: u32, end: u32) {
-    atomicMax(&records[x_word], min((end + 63u) / 64u, MAX_GROUPS));
-}
-
-// Appends `entry` to the list whose length is header word `count_word`, its entries from
-// `base` in `lists`, its dispatch command's x at `x_word`.
-fn append(count_word: u32, x_word: u32, base: u32, entry: vec2<u32>) {
-    let k = atomicAdd(&records[count_word], 1u);
-    lists[base + k] = entry;
-    grow_dispatch(x_word, k + 1u);
+// Appends `entry` to the exact list; the `exact` stage's indirect dispatch command grows to
+// cover it (64 entries a workgroup; the stage strides beyond 65535 workgroups).
+fn append_exact(entry: vec2<u32>) {
+    let k = atomicAdd(&records[H_EXACT], 1u);
+    lists[k] = entry;
+    atomicMax(&records[H_EXACT_X], min((k + 64u) / 64u, MAX_GROUPS));
 }
 
 // ---- exact orient3d: fixed-point sum of products of three f32 values ----
@@ -296,24 +275,20 @@ fn acc_sign() -> i32 {
     return 0;
 }
 
-
-// Exact facing: point light: det[p0 - L, p1 - L, p2 - L] < 0; directional:
-// det[p1 - p0, p2 - p0, d] > 0 (`geom::predicates::facing_exact`). The determinant is the
-// sum over the six permutations (i, j, k) of its rows' components, each a product of three
-// differences expanded into its terms: point light, rows (x0 - x1) (y0 - y1) (z0 - z1) with
-// x = (p0, L), y = (p1, L), z = (p2, L): 8 terms; directional, x = (p1, p0), y = (p2, p0),
-// z = d: 4 terms. One loop over the 48 (or 24) terms, so `add3` is inlined once.
+// Exact facing (`geom::predicates::facing_exact`): point light det[p0 - L, p1 - L, p2 - L] < 0,
+// directional det[p1 - p0, p2 - p0, d] > 0; the six permutations' products of differences
+// expanded into 48 (24) terms of three f32 values, one loop so `add3` is inlined once.
 fn facing_exact(job: Job, t: u32) -> bool {
-    let tri = tris[job.tri_base + t];
+    let tri = tris[job.bases.y + t];
     var i1 = tri.g.y;
     var i2 = tri.g.z;
-    if (job.flip != 0u) {
+    if ((job.head.y & J_FLIP) != 0u) {
         i1 = tri.g.z;
         i2 = tri.g.y;
     }
-    let p0 = positions[job.pos_base + tri.g.x].xyz;
-    let p1 = positions[job.pos_base + i1].xyz;
-    let p2 = positions[job.pos_base + i2].xyz;
+    let p0 = positions[job.bases.z + tri.g.x].xyz;
+    let p1 = positions[job.bases.z + i1].xyz;
+    let p2 = positions[job.bases.z + i2].xyz;
     let l = job.light.xyz;
     let point = job.light.w != 0.0;
     let x0 = select(p1, p0, point);
@@ -393,32 +368,87 @@ fn emit(r: u32, cap: bool, idx: array<u32, 9>, count: u32) {
 
 // ---- stages ----
 
-// Stage 1: the plane filter, GROUP triangles of one job a workgroup (the facing words were
-// cleared by the frame's fill). The job's fields are read one by one: loading the whole job
-// per invocation cost lavapipe more than the planes themselves.
-@compute @workgroup_size(GROUP)
-fn facing(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>,
-          @builtin(local_invocation_index) lid: u32) {
-    let w = group_index(wg, nwg);
-    let j = job_of(w, STAGE_FACING);
-    let t = (w - jobs[j].g_facing) * GROUP + lid;
-    if (w < pc.facing_groups && t < jobs[j].tris) {
-        let pl = planes[jobs[j].plane_base + t];
-        let f = jobs[j].filt;
-        let bound = jobs[j].bound;
-        // the CPU's order: ((nx lx + ny ly) + nz lz) + d lw
-        let v = ((pl.x * f.x + pl.y * f.y) + pl.z * f.z) + pl.w * f.w;
-        if (v > bound) {
-            atomicOr(&facing_bits[jobs[j].fac_base + (t >> 5u)], 1u << (t & 31u));
-        } else if (!(v < -bound)) {
+// The block test (`geom::planes::gpu`'s mirror, same f32 operations and order, its allowance
+// derived there): 1 every slot faces `l` (w = ±1 or 0, filter bound `e`), -1 none, 0 undecided.
+fn decide_block(k: u32, l: vec4<f32>, e: f32) -> i32 {
+    let cd = blocks[k];
+    let nd = blocks[k + 1u];
+    let sp = blocks[k + 2u];
+    let w = l.w;
+    let q = vec3<f32>(l.x - cd.x * w, l.y - cd.y * w, l.z - cd.z * w);
+    let aq = abs(q);
+    let centre = ((nd.x * q.x + nd.y * q.y) + nd.z * q.z) + cd.w * w;
+    let spread = ((sp.x * aq.x + sp.y * aq.y) + sp.z * aq.z) + nd.w * abs(w);
+    let mag = ((abs(nd.x) * aq.x + abs(nd.y) * aq.y) + abs(nd.z) * aq.z) + abs(cd.w) * abs(w);
+    let t = spread + e;
+    let margin = t + (t + mag) * ALLOWANCE;
+    let ok = sp.w == 1.0;
+    return select(0, select(select(0, -1, centre < -margin), 1, centre > margin), ok);
+}
+
+// Stage 1: one 64-slot block of one job an invocation (the job's fields read one by one).
+@compute @workgroup_size(LANES)
+fn facing(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let g = lane_index(gid, nwg);
+    let j = job_of(g, STAGE_FACING);
+    let head = jobs[j].head;
+    let bases = jobs[j].bases;
+    let offsets = jobs[j].offsets;
+    let more = jobs[j].more;
+    let f = jobs[j].filt;
+    let b = g - offsets.z;
+    let tris = head.z;
+    if (g < pc.blocks && b * 64u < tris) {
+        let n = min(tris - b * 64u, 64u);
+        let bound = bitcast<f32>(head.x);
+        var decided = 0;
+        if ((head.y & J_BLOCKS) != 0u) {
+            decided = decide_block(more.y + 3u * b, f, bound);
+        }
+        // the slots' valid bits in the block's two words
+        let valid_lo = select(0xffffffffu, (1u << min(n, 31u)) - 1u, n < 32u);
+        let valid_hi = select(0u, select(0xffffffffu, (1u << (n - 32u)) - 1u, n < 64u), n > 32u);
+        var lo = select(0u, valid_lo, decided > 0);
+        var hi = select(0u, valid_hi, decided > 0);
+        var unsure_lo = 0u;
+        var unsure_hi = 0u;
+        // undecided block: each slot's plane (a loop, so blocks decided whole cost nothing
+        // here once every lane's block is decided)
+        let count = select(n, 0u, decided != 0);
+        let base = bases.x + b * 64u;
+        for (var k = 0u; k < count; k = k + 1u) {
+            let pl = planes[base + k];
+            // the CPU's order: ((nx lx + ny ly) + nz lz) + d lw
+            let v = ((pl.x * f.x + pl.y * f.y) + pl.z * f.z) + pl.w * f.w;
+            let bit = 1u << (k & 31u);
+            let up = select(0u, bit, v > bound);
             // undecided (|v| <= bound, or NaN): the exact test decides
-            append(H_EXACT, H_EXACT_X, 0u, vec2<u32>(j, t));
+            let unsure = select(0u, bit, !(v > bound) && !(v < -bound));
+            let low = k < 32u;
+            lo = lo | select(0u, up, low);
+            hi = hi | select(up, 0u, low);
+            unsure_lo = unsure_lo | select(0u, unsure, low);
+            unsure_hi = unsure_hi | select(unsure, 0u, low);
+        }
+        let w = offsets.y + 2u * b;
+        atomicStore(&facing_bits[w], lo);
+        atomicStore(&facing_bits[w + 1u], hi);
+        // the undecided slots to the exact list (no iteration in most blocks)
+        var unsure = vec2<u32>(unsure_lo, unsure_hi);
+        loop {
+            if (unsure.x == 0u && unsure.y == 0u) {
+                break;
+            }
+            let low = unsure.x != 0u;
+            let word = select(unsure.y, unsure.x, low);
+            let k = firstTrailingBit(word) + select(32u, 0u, low);
+            append_exact(vec2<u32>(j, b * 64u + k));
+            unsure = select(vec2<u32>(unsure.x, unsure.y & (unsure.y - 1u)), vec2<u32>(unsure.x & (unsure.x - 1u), unsure.y), low);
         }
     }
 }
 
-// Stage 2: the exact test for the listed triangles (indirect: as many workgroups as the list
-// needs, striding beyond the dispatch limit).
+// Stage 2: the exact test of the listed slots (indirect; strides past the dispatch limit).
 @compute @workgroup_size(64)
 fn exact(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
     let stride = nwg.x * 64u;
@@ -427,44 +457,65 @@ fn exact(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups)
         let e = lists[k];
         let job = jobs[e.x];
         if (facing_exact(job, e.y)) {
-            atomicOr(&facing_bits[job.fac_base + (e.y >> 5u)], 1u << (e.y & 31u));
+            atomicOr(&facing_bits[job.offsets.y + (e.y >> 5u)], 1u << (e.y & 31u));
         }
     }
 }
 
-// Stage 3a: possible silhouette edges, GROUP edges of one job a workgroup, appended to the
-// silhouette list (an atomic per silhouette edge: they are few).
-@compute @workgroup_size(GROUP)
-fn find(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>,
-        @builtin(local_invocation_index) lid: u32) {
-    let w = group_index(wg, nwg);
-    let j = job_of(w, STAGE_FIND);
-    let i = (w - jobs[j].g_find) * GROUP + lid;
-    if (w < pc.find_groups && i < jobs[j].edges) {
-        let e = edge_table[jobs[j].edge_base + i];
-        let fac = jobs[j].fac_base;
-        let b0 = (atomicLoad(&facing_bits[fac + (e.x >> 5u)]) >> (e.x & 31u)) & 1u;
-        let b1 = (atomicLoad(&facing_bits[fac + (e.y >> 5u)]) >> (e.y & 31u)) & 1u;
-        if (b0 != b1) {
-            append(H_SIL, H_SIL_X, pc.sil_base, vec2<u32>(j, i));
+// Stage 3a: silhouette edges and their sides, one word-pair group of one job an invocation.
+@compute @workgroup_size(LANES)
+fn find(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
+    let g = lane_index(gid, nwg);
+    let j = job_of(g, STAGE_FIND);
+    let offsets = jobs[j].offsets;
+    let more = jobs[j].more;
+    let i = g - offsets.w;
+    if (g < pc.word_pairs && i < more.w) {
+        let h = word_pairs[more.z + i];
+        let fac = offsets.y;
+        let a0 = atomicLoad(&facing_bits[fac + 2u * h.x]);
+        let a1 = atomicLoad(&facing_bits[fac + 2u * h.x + 1u]);
+        let b0 = atomicLoad(&facing_bits[fac + 2u * h.y]);
+        let b1 = atomicLoad(&facing_bits[fac + 2u * h.y + 1u]);
+        // both blocks all ones or both all zeros: no edge of the group is on the silhouette
+        let uniform = (a0 & a1 & b0 & b1) == 0xffffffffu || (a0 | a1 | b0 | b1) == 0u;
+        let count = select(h.w, 0u, uniform);
+        let first = jobs[j].bases.w + h.z;
+        var sil = 0u;
+        for (var k = 0u; k < count; k = k + 1u) {
+            // the two slots' bit positions in blocks a and b
+            let p = edge_table[first + k].w;
+            let pa = p & 63u;
+            let pb = (p >> 8u) & 63u;
+            let fa = select(a0, a1, pa >= 32u) >> (pa & 31u);
+            let fb = select(b0, b1, pb >= 32u) >> (pb & 31u);
+            sil = sil | (((fa ^ fb) & 1u) << k);
+        }
+        loop {
+            if (sil == 0u) {
+                break;
+            }
+            side(j, h.z + firstTrailingBit(sil));
+            sil = sil & (sil - 1u);
         }
     }
 }
 
-// Stage 3b: triangle t's face caps (dark cap of front or back faces, light cap) for the
-// chunks whose case needs them; GROUP triangles of one job with caps a workgroup.
+// Stage 3b: the face caps of the chunks that need them, GROUP slots of one job a workgroup.
 @compute @workgroup_size(GROUP)
 fn caps(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>,
         @builtin(local_invocation_index) lid: u32) {
     let w = group_index(wg, nwg);
-    let job = jobs[job_of(w, STAGE_CAPS)];
-    let t = (w - job.g_caps) * GROUP + lid;
-    if (w >= pc.cap_groups || t >= job.tris) {
+    // the job's fields one by one (each load is per lane on lavapipe)
+    let j = job_of(w, STAGE_CAPS);
+    let t = (w - jobs[j].more.x) * GROUP + lid;
+    if (w >= pc.cap_groups || t >= jobs[j].head.z) {
         return;
     }
-    let f = facing_bit(job, t);
-    let tri = tris[job.tri_base + t];
-    let r = job.rec_base + tri.l.w * RECORD_WORDS;
+    let offsets = jobs[j].offsets;
+    let f = ((atomicLoad(&facing_bits[offsets.y + (t >> 5u)]) >> (t & 31u)) & 1u) != 0u;
+    let tri = tris[jobs[j].bases.y + t];
+    let r = offsets.x + tri.l.w * RECORD_WORDS;
     let flags = atomicLoad(&records[r + R_FLAGS]);
     if ((flags & F_ENABLED) == 0u) {
         return;
@@ -494,78 +545,54 @@ fn caps(@builtin(workgroup_id) wg: vec3<u32>, @builtin(num_workgroups) nwg: vec3
 }
 
 fn corner(l: vec4<u32>, k: u32) -> u32 {
-    if (k == 0u) {
-        return l.x;
-    }
-    if (k == 1u) {
-        return l.y;
-    }
-    return l.z;
+    return select(select(l.z, l.y, k == 1u), l.x, k == 0u);
 }
 
-// The side (and fan triangle) of silhouette edge `i` of job `j`.
+// The side (and fan triangle) of silhouette edge `i` of job `j`: one emission of 3, 6 or 9
+// indices (selected, not branched: llvmpipe pays every branch's emission on every lane).
 fn side(j: u32, i: u32) {
-    let job = jobs[j];
-    let e = edge_table[job.edge_base + i];
-    let f0 = facing_bit(job, e.x);
+    let bases = jobs[j].bases;
+    let offsets = jobs[j].offsets;
+    let tri_base = bases.y;
+    let rec_base = offsets.x;
+    let fac = offsets.y;
+    let e = edge_table[bases.w + i].xyz;
+    let f0 = ((atomicLoad(&facing_bits[fac + (e.x >> 5u)]) >> (e.x & 31u)) & 1u) != 0u;
     // lit: the light-facing triangle and the corner where a -> b starts in it
-    var lit = e.x;
-    var lit_c = e.z & 0xffu;
-    var unlit = e.y;
-    var unlit_c = (e.z >> 8u) & 0xffu;
-    if (!f0) {
-        lit = e.y;
-        lit_c = (e.z >> 8u) & 0xffu;
-        unlit = e.x;
-        unlit_c = e.z & 0xffu;
-    }
+    let c0 = e.z & 0xffu;
+    let c1 = (e.z >> 8u) & 0xffu;
+    let lit = select(e.y, e.x, f0);
+    let lit_c = select(c1, c0, f0);
+    let unlit = select(e.x, e.y, f0);
+    let unlit_c = select(c0, c1, f0);
     // which chunk's record decides: the lit triangle's (front) or the unlit one's (back)
-    let lit_tri = tris[job.tri_base + lit];
-    let r_lit = job.rec_base + lit_tri.l.w * RECORD_WORDS;
-    let back = (atomicLoad(&records[r_lit + R_FLAGS]) & F_BACK) != 0u;
-    var tri = lit_tri;
+    let lit_l = tris[tri_base + lit].l;
+    let back = (atomicLoad(&records[rec_base + lit_l.w * RECORD_WORDS + R_FLAGS]) & F_BACK) != 0u;
+    var l = lit_l;
     var k = lit_c;
     if (back) {
-        tri = tris[job.tri_base + unlit];
+        l = tris[tri_base + unlit].l;
         k = unlit_c;
     }
-    let r = job.rec_base + tri.l.w * RECORD_WORDS;
+    let r = rec_base + l.w * RECORD_WORDS;
     let flags = atomicLoad(&records[r + R_FLAGS]);
-    if ((flags & F_ENABLED) == 0u) {
-        return;
-    }
-    let n = atomicLoad(&records[r + R_N]);
-    var a = corner(tri.l, k);
-    var b = corner(tri.l, (k + 1u) % 3u);
-    if (back) {
-        let s = a;
-        a = b;
-        b = s;
-    }
-    atomicAdd(&records[r + R_EDGES], 1u);
-    if ((flags & F_DIRECTIONAL) != 0u) {
-        emit(r, false, array<u32, 9>(b, a, a + n, 0u, 0u, 0u, 0u, 0u, 0u), 3u);
-        atomicAdd(&records[r + R_SIDES], 1u);
-        return;
-    }
-    let dc = (flags >> 3u) & 3u;
-    if (dc == DC_FAN) {
+    if ((flags & F_ENABLED) != 0u) {
+        let n = atomicLoad(&records[r + R_N]);
+        let ca = corner(l, k);
+        let cb = corner(l, (k + 1u) % 3u);
+        let a = select(ca, cb, back);
+        let b = select(cb, ca, back);
+        let directional = (flags & F_DIRECTIONAL) != 0u;
+        let fan = !directional && ((flags >> 3u) & 3u) == DC_FAN;
+        // directional (b, a, a∞); point (b, a, a∞), (b, a∞, b∞); McGuire's fan also
+        // (apex∞, b∞, a∞)
+        let count = select(select(6u, 9u, fan), 3u, directional);
         let apex = n - 1u;
-        emit(r, false, array<u32, 9>(b, a, a + n, b, a + n, b + n, apex + n, b + n, a + n), 9u);
-        atomicAdd(&records[r + R_DARK], 1u);
-    } else {
-        emit(r, false, array<u32, 9>(b, a, a + n, b, a + n, b + n, 0u, 0u, 0u), 6u);
-    }
-    atomicAdd(&records[r + R_SIDES], 2u);
-}
-
-// Stage 4: the listed silhouette edges' sides (indirect, striding beyond the dispatch limit).
-@compute @workgroup_size(64)
-fn sides(@builtin(global_invocation_id) gid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>) {
-    let stride = nwg.x * 64u;
-    let count = atomicLoad(&records[H_SIL]);
-    for (var k = gid.x; k < count; k = k + stride) {
-        let e = lists[pc.sil_base + k];
-        side(e.x, e.y);
+        emit(r, false, array<u32, 9>(b, a, a + n, b, a + n, b + n, apex + n, b + n, a + n), count);
+        atomicAdd(&records[r + R_EDGES], 1u);
+        atomicAdd(&records[r + R_SIDES], select(2u, 1u, directional));
+        if (fan) {
+            atomicAdd(&records[r + R_DARK], 1u);
+        }
     }
 }

@@ -527,5 +527,8 @@ fn block64_w(nx: &[f32], ny: &[f32], nz: &[f32], d: &[f32], l: Vec4, e: f32, dw:
     (bits, !sure)
 }
 
+mod gpu;
+pub(crate) use gpu::GPU_BLOCK;
+
 #[cfg(test)]
 mod tests;

@@ -1,8 +1,9 @@
-//! The compute pass's static tables of every caster, in one pass-wide arena: seven storage
-//! buffers (face planes, triangles, welded positions and the parts' apexes, edges; and for
-//! mesh-shader extrusion the meshlets, their triangles and their owned edges) that one
+//! The compute pass's static tables of every caster, in one pass-wide arena: nine storage
+//! buffers (face planes, triangles, welded positions and the parts' apexes, edges; for
+//! mesh-shader extrusion the meshlets, their triangles and their owned edges; the facing
+//! stage's block bounds and the `find` stage's word-pair groups) that one
 //! descriptor set binds, so one dispatch per stage (or one mesh draw per caster part) serves
-//! every (light, caster) pair of a frame; and an eighth, the chunks' dual-length vertices
+//! every (light, caster) pair of a frame; and a tenth, the chunks' dual-length vertices
 //! (a vertex buffer), so the merged volume draws address every chunk by its record's
 //! `vertexOffset` ([`super::draws`]).
 //!
@@ -23,15 +24,30 @@ use ash::vk;
 use gpu_allocator::MemoryLocation;
 
 /// The tables, in binding order.
-pub(crate) const TABLES: [&str; N] =
-    ["planes", "triangles", "positions", "edges", "meshlets", "meshlet triangles", "meshlet edges", "volume vertices"];
+pub(crate) const TABLES: [&str; N] = [
+    "planes",
+    "triangles",
+    "positions",
+    "edges",
+    "meshlets",
+    "meshlet triangles",
+    "meshlet edges",
+    "volume vertices",
+    "block bounds",
+    "word pairs",
+];
 /// The number of tables.
-pub(crate) const N: usize = 8;
+pub(crate) const N: usize = 10;
 /// The chunks' dual-length vertices (a vertex buffer, not bound to the compute set).
 pub(crate) const VERTICES: usize = 7;
+/// The facing stage's block bounds (three `vec4<f32>` per 64 slots).
+pub(crate) const BLOCKS: usize = 8;
+/// The `find` stage's word-pair groups.
+pub(crate) const GROUPS: usize = 9;
 /// Bytes of one element of each table (`vec4<f32>`, `Tri`, `vec4<f32>`, `vec4<u32>`,
-/// `Meshlet` of `shaders/extrude.wgsl` (16 words), `u32`, `vec4<u32>`, `vec4<f32>`).
-pub(crate) const ELEMENT_BYTES: [u64; N] = [16, 32, 16, 16, 64, 4, 16, 16];
+/// `Meshlet` of `shaders/extrude.wgsl` (16 words), `u32`, `vec4<u32>`, `vec4<f32>`,
+/// `vec4<f32>`, `vec4<u32>`).
+pub(crate) const ELEMENT_BYTES: [u64; N] = [16, 32, 16, 16, 64, 4, 16, 16, 16, 16];
 /// The smallest table, in elements.
 const MIN_ELEMENTS: u64 = 1024;
 
@@ -53,6 +69,8 @@ pub(crate) fn mesh_elements(m: &ComputeMesh) -> [u64; N] {
         m.meshlet_tris.len() as u64,
         m.meshlet_edges.len() as u64,
         m.vertices.len() as u64,
+        m.blocks.len() as u64,
+        m.groups.len() as u64,
     ]
 }
 

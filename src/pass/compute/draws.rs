@@ -10,7 +10,7 @@
 //! attributes): no push constants and no vertex-buffer binds per caster. Then, by
 //! [`ComputeDraws`]:
 //!
-//! * `Count` and `Multi`: a sixth compute stage (`shaders/compact_draws.wgsl`) copies every
+//! * `Count` and `Multi`: a further compute stage (`shaders/compact_draws.wgsl`, after `find` and `caps`) copies every
 //!   non-empty command into its light and pipeline's list ([`List`]: a count word, then the
 //!   commands); `Count` draws each list with one `vkCmdDrawIndexedIndirectCount` (the GPU's
 //!   count), `Multi` with one multi-draw `vkCmdDrawIndexedIndirect` over the whole list (its

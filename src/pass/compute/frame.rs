@@ -31,8 +31,9 @@ pub(crate) struct GpuJob {
     pub filt: [f32; 4],
     /// The filter's error bound (+inf: every triangle to the exact test).
     pub bound: f32,
-    /// 1: mirroring transform.
-    pub flip: u32,
+    /// Bit 0 ([`J_FLIP`]): mirroring transform; bit 1 ([`J_BLOCKS`]): the facing stage may
+    /// decide whole blocks (the job has a filter).
+    pub flags: u32,
     pub tris: u32,
     pub edges: u32,
     /// The caster's first element in each arena table.
@@ -44,16 +45,30 @@ pub(crate) struct GpuJob {
     pub rec_base: u32,
     /// Word offset of the pair's facing bits (a bit per triangle, whole workgroups).
     pub fac_base: u32,
-    /// The pair's first workgroup in the `facing`, `find` and `caps` stages.
+    /// The pair's first invocation in the `facing` stage (one per 64-slot block) and the
+    /// `find` stage (one per word-pair group), and its first workgroup in the `caps` stage.
     pub g_facing: u32,
     pub g_find: u32,
     pub g_caps: u32,
-    pub pad: [u32; 3],
+    /// The caster's first element in the block-bound and word-pair tables, and its groups.
+    pub block_base: u32,
+    pub group_base: u32,
+    pub groups: u32,
 }
+
+/// [`GpuJob::flags`]: a mirroring transform (corners 1 and 2 swapped for the exact test).
+pub(crate) const J_FLIP: u32 = 1;
+/// [`GpuJob::flags`]: the facing stage may decide whole blocks (the job has a filter).
+pub(crate) const J_BLOCKS: u32 = 2;
 
 /// Workgroups of `n` items, [`GROUP`] a workgroup.
 fn groups_of(n: u32) -> u32 {
     n.div_ceil(GROUP)
+}
+
+/// 64-slot blocks of `n` triangles (an invocation of the `facing` stage each).
+fn blocks_of(n: u32) -> u32 {
+    n.div_ceil(crate::geom::planes::GPU_BLOCK as u32)
 }
 
 /// Where a chunk record's counts go in the stats.
@@ -81,18 +96,17 @@ pub(crate) struct ComputeFrame {
     pub out_indices: u64,
     /// Facing words.
     pub facing_words: u64,
-    /// Workgroups of the `facing`, `find` and `caps` stages.
+    /// Invocations of the `facing` (blocks) and `find` (word-pair groups) stages, workgroups
+    /// of the `caps` stage.
     pub groups: [u32; 3],
-    /// Room for the exact list (every job's triangles) and the silhouette list (every job's
-    /// edges), in entries.
+    /// Room for the exact list (every job's triangles), in entries.
     pub exact_capacity: u64,
+    /// Every job's edges (what a full scan of the edge table would read).
     pub sil_capacity: u64,
     /// The frame's descriptor set (filled by `prepare`).
     pub set: vk::DescriptorSet,
     pub records_buffer: vk::Buffer,
     pub out_buffer: vk::Buffer,
-    /// The facing bits (cleared before the `facing` stage sets the light-facing ones).
-    pub facing_buffer: vk::Buffer,
     pub recorded: Cell<bool>,
     pub read_back: Cell<bool>,
     /// Mesh-shader extrusion ([`Technique::Mesh`](crate::pass::Technique::Mesh)): only the
@@ -119,10 +133,8 @@ impl Default for ComputeFrame {
     fn default() -> Self {
         let mut records = vec![0u32; HEADER_WORDS];
         // the lists' dispatch commands: x grows with the lists, y = z = 1
-        for w in [rec::H_EXACT_X, rec::H_SIL_X] {
-            records[w + 1] = 1;
-            records[w + 2] = 1;
-        }
+        records[rec::H_EXACT_X + 1] = 1;
+        records[rec::H_EXACT_X + 2] = 1;
         ComputeFrame {
             jobs: Vec::new(),
             records,
@@ -135,7 +147,6 @@ impl Default for ComputeFrame {
             set: vk::DescriptorSet::null(),
             records_buffer: vk::Buffer::null(),
             out_buffer: vk::Buffer::null(),
-            facing_buffer: vk::Buffer::null(),
             recorded: Cell::new(false),
             read_back: Cell::new(false),
             mesh: false,
@@ -164,12 +175,11 @@ impl ComputeFrame {
     pub fn push(&self) -> SilhouettePush {
         SilhouettePush {
             jobs: self.jobs.len() as u32,
-            facing_groups: self.groups[0],
-            find_groups: self.groups[1],
+            blocks: self.groups[0],
+            word_pairs: self.groups[1],
             cap_groups: self.groups[2],
-            sil_base: self.exact_capacity as u32,
             steps: self.jobs.len().next_power_of_two().trailing_zeros(),
-            pad: [0; 2],
+            pad: [0; 3],
         }
     }
 
@@ -276,13 +286,14 @@ impl ComputeFrame {
             Some((lf, e)) => (if caster.mirrored { -lf } else { lf }, e),
             None => (glam::Vec4::ZERO, f32::INFINITY),
         };
-        let tri_groups = groups_of(st.triangles);
+        let blocks = blocks_of(st.triangles);
         let fac_base = self.facing_words as u32;
+        let filter = if bound.is_finite() { J_BLOCKS } else { 0 };
         let job = GpuJob {
             light: cp.light_object,
             filt: filt.to_array(),
             bound,
-            flip: caster.mirrored as u32,
+            flags: if caster.mirrored { J_FLIP } else { 0 } | filter,
             tris: st.triangles,
             edges: st.edge_count,
             plane_base: st.base[0],
@@ -294,14 +305,17 @@ impl ComputeFrame {
             g_facing: self.groups[0],
             g_find: self.groups[1],
             g_caps: self.groups[2],
-            pad: [0; 3],
+            block_base: st.base[super::arena::BLOCKS],
+            group_base: st.base[super::arena::GROUPS],
+            groups: st.group_count,
         };
-        self.groups[0] += tri_groups;
-        self.groups[1] += groups_of(st.edge_count);
+        self.groups[0] += blocks;
+        self.groups[1] += st.group_count;
         if caps {
-            self.groups[2] += tri_groups;
+            self.groups[2] += groups_of(st.triangles);
         }
-        self.facing_words += (tri_groups * (GROUP / 32)) as u64;
+        // two words a block, every word written by the `facing` stage
+        self.facing_words += 2 * blocks as u64;
         self.exact_capacity += st.triangles as u64;
         self.sil_capacity += st.edge_count as u64;
         self.jobs.push(job);
@@ -319,7 +333,9 @@ impl ComputeFrame {
         // the `find` and `caps` stages do not run for mesh frames
         if let Some(j) = self.jobs.last_mut() {
             j.edges = 0;
+            j.groups = 0;
         }
+        self.groups[1] -= st.group_count;
         self.sil_capacity -= st.edge_count as u64;
         let directional = cp.light_object[3] == 0.0;
         for (pp_index, pp) in cp.parts.iter().enumerate() {
@@ -377,13 +393,13 @@ impl ComputeFrame {
         if self.read_back.replace(true) {
             return Ok(());
         }
-        // The lists can never outgrow their room (each entry is one triangle or edge of one
-        // job); a count beyond it would mean entries were written out of bounds.
-        let (exact, sil) = (words.get(rec::H_EXACT).copied().unwrap_or(0), words.get(rec::H_SIL).copied().unwrap_or(0));
-        if exact as u64 > self.exact_capacity || sil as u64 > self.sil_capacity {
+        // The exact list can never outgrow its room (each entry is one triangle of one job); a
+        // count beyond it would mean entries were written out of bounds.
+        let exact = words.get(rec::H_EXACT).copied().unwrap_or(0);
+        if exact as u64 > self.exact_capacity {
             return Err(Error::Internal(format!(
-                "compute silhouettes: the lists overflowed ({exact} of {} exact triangles, {sil} of {} silhouette edges)",
-                self.exact_capacity, self.sil_capacity
+                "compute silhouettes: the exact list overflowed ({exact} of {} triangles)",
+                self.exact_capacity
             )));
         }
         for m in &self.metas {

@@ -2,26 +2,36 @@
 //! per-caster tables the compute pass reads (in one pass-wide [`arena`]), its pipelines, and
 //! the per-slot buffers it writes.
 //!
-//! Per caster, uploaded once (and again only when a deforming caster moves its vertices):
-//! * the object-space f32 plane of every triangle ([`FacePlanes::planes_xyzd`]), the filter of
-//!   the CPU's facing test;
-//! * per triangle its three welded vertex ids, chunk-local corners and chunk, and the welded
-//!   positions: the exact fallback of the facing test and the indices the caps are made of;
-//! * the edge table: every edge of the closed manifold parts, `(t0, t1, c0 | c1 << 8)`.
+//! Per caster, uploaded once (and again only when a deforming caster moves its vertices),
+//! every triangle table in the planes' scan order ([`FacePlanes::order`]: slot `s` holds
+//! triangle `order().triangle(s)`, 64 consecutive slots a compact patch of the surface; the
+//! facing bits are by slot):
+//! * the object-space f32 plane of every slot ([`FacePlanes::planes_xyzd`]'s planes, by slot),
+//!   the filter of the CPU's facing test, and per 64-slot block the bound that decides the
+//!   whole block with one test (`geom::planes::gpu`);
+//! * per slot its triangle's three welded vertex ids, chunk-local corners and chunk, and the
+//!   welded positions: the exact fallback of the facing test and the indices the caps are made
+//!   of;
+//! * the edge table: every edge of the closed manifold parts, `(s0, s1, c0 | c1 << 8, pa | pb
+//!   << 8)`, filed by the pair of blocks its two slots lie in ([`tables::WordPairs`]).
 //!
 //! Per frame the CPU writes one job per (light, caster) pair ([`frame::GpuJob`]: the light,
-//! the arena offsets, the first workgroup of the pair in each stage) and one small record per
-//! chunk (`RECORD_WORDS` words: the chunk's two `VkDrawIndexedIndirectCommand`s, with zero
-//! counts and the first index of the chunk's region, its case parameters and its capacities);
-//! the shader (`shaders/silhouette.wgsl`) does the rest, in five dispatches per frame whatever
-//! the number of casters and lights. See [`frame`] for the layout and [`record`] for the
-//! commands and barriers.
+//! the arena offsets, the first invocation or workgroup of the pair in each stage) and one
+//! small record per chunk (`RECORD_WORDS` words: the chunk's two
+//! `VkDrawIndexedIndirectCommand`s, with zero counts and the first index of the chunk's
+//! region, its case parameters and its capacities); the shader (`shaders/silhouette.wgsl`)
+//! does the rest, in four dispatches per frame whatever the number of casters and lights. See
+//! [`frame`] for the layout and [`record`] for the commands and barriers. Everything observable
+//! (plans, stats, the chunks' indices) keeps the caller's triangle order: the shader writes
+//! each triangle's chunk-local corners, and the counts do not depend on the order.
 //!
-//! Facing is bit for bit the CPU's ([`FacePlanes::facing_packed`]): the same f32 plane filter
-//! with the CPU's error bound (Vulkan's f32 add and multiply are correctly rounded, and the
-//! bound covers flushed denormals), and where it cannot decide, the exact sign of orient3d of
-//! the f32 vertices, summed without rounding in a fixed-point accumulator. So the GPU's
-//! triangle counts equal the CPU planner's for the same light and caster.
+//! Facing is bit for bit the CPU's ([`FacePlanes::facing_packed`]): a block decided whole only
+//! where its bound proves every slot's plane value beyond the filter's error bound (f32
+//! evaluation included), else the same f32 plane filter with the CPU's error bound (Vulkan's
+//! f32 add and multiply are correctly rounded, and the bound covers flushed denormals), and
+//! where it cannot decide, the exact sign of orient3d of the f32 vertices, summed without
+//! rounding in a fixed-point accumulator. So the GPU's triangle counts equal the CPU planner's
+//! for the same light and caster.
 
 pub(crate) mod arena;
 pub(crate) mod draws;
@@ -29,6 +39,7 @@ pub(crate) mod draws_record;
 pub(crate) mod frame;
 mod prepare;
 pub(crate) mod record;
+pub(crate) mod tables;
 
 use super::device::PassDevice;
 use crate::error::{Error, Result};
@@ -40,22 +51,22 @@ use ash::vk;
 use bytemuck::{Pod, Zeroable};
 use gpu_allocator::MemoryLocation;
 
-/// Triangles (or edges) of one job a workgroup of the `facing`, `find` and `caps` stages
-/// (`GROUP` in `shaders/silhouette.wgsl`).
+/// Triangles of one job a workgroup of the `caps` stage (`GROUP` in
+/// `shaders/silhouette.wgsl`).
 pub(crate) const GROUP: u32 = 256;
+/// Invocations a workgroup of the `facing` (a 64-slot block each) and `find` (a word-pair
+/// group each) stages (`LANES` in `shaders/silhouette.wgsl`).
+pub(crate) const LANES: u32 = 64;
 /// Words of one chunk record (see `shaders/silhouette.wgsl`).
 pub(crate) const RECORD_WORDS: usize = 20;
-/// Words of the frame's header at the start of the records: the exact and silhouette lists'
-/// lengths and their `VkDispatchIndirectCommand`s.
+/// Words of the frame's header at the start of the records: the exact list's length and its
+/// `VkDispatchIndirectCommand` (the rest unused).
 pub(crate) const HEADER_WORDS: usize = 16;
 /// Record word offsets.
 pub(crate) mod rec {
     /// Header: the exact list's length, then its dispatch command (x, y, z).
     pub const H_EXACT: usize = 0;
     pub const H_EXACT_X: usize = 1;
-    /// Header: the silhouette list's length, then its dispatch command (x, y, z).
-    pub const H_SIL: usize = 4;
-    pub const H_SIL_X: usize = 5;
     pub const VOL_COUNT: usize = 0;
     pub const VOL_INSTANCES: usize = 1;
     pub const VOL_FIRST: usize = 2;
@@ -95,15 +106,14 @@ pub(crate) mod rec {
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub(crate) struct SilhouettePush {
     pub jobs: u32,
-    /// Workgroups of the `facing`, `find` and `caps` stages.
-    pub facing_groups: u32,
-    pub find_groups: u32,
+    /// Invocations of the `facing` stage (64-slot blocks) and of the `find` stage (word-pair
+    /// groups), workgroups of the `caps` stage.
+    pub blocks: u32,
+    pub word_pairs: u32,
     pub cap_groups: u32,
-    /// Entry offset of the silhouette list in the lists buffer (the exact list starts at 0).
-    pub sil_base: u32,
     /// Steps of the shader's binary search over the jobs: ceil(log2(jobs)).
     pub steps: u32,
-    pub pad: [u32; 2],
+    pub pad: [u32; 3],
 }
 
 impl SilhouettePush {
@@ -113,14 +123,21 @@ impl SilhouettePush {
 /// A caster's static tables for the compute pass, on the CPU.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct ComputeMesh {
-    /// Per triangle, `(nx, ny, nz, d)`.
+    /// Per slot of the scan order ([`FacePlanes::order`](crate::geom::planes::FacePlanes::order)),
+    /// its triangle's `(nx, ny, nz, d)`.
     pub planes: Vec<[f32; 4]>,
-    /// Per triangle: welded ids `g0 g1 g2 _`, local corners `l0 l1 l2 chunk`.
+    /// Per slot: its triangle's welded ids `g0 g1 g2 _`, local corners `l0 l1 l2 chunk`.
     pub tris: Vec<[u32; 8]>,
     /// Welded positions (w unused).
     pub positions: Vec<[f32; 4]>,
-    /// Edges of the closed manifold parts: `(t0, t1, c0 | c1 << 8, 0)`.
+    /// Edges of the closed manifold parts: `(s0, s1, c0 | c1 << 8, pa | pb << 8)`, the slots
+    /// of `t0` and `t1`, word-pair group after group ([`tables::WordPairs`]).
     pub edges: Vec<[u32; 4]>,
+    /// Per 64 slots, the block bound of the `facing` stage (three `vec4<f32>` a block:
+    /// `geom::planes::gpu::GpuBlock`).
+    pub blocks: Vec<[f32; 4]>,
+    /// The edges' word-pair groups `(a, b, first, count)` ([`tables::WordPairs`]).
+    pub groups: Vec<[u32; 4]>,
     /// Per chunk: edges of the table with a triangle in the chunk (the side capacity).
     pub chunk_edges: Vec<u32>,
     /// Mesh-shader extrusion: the meshlets of the closed manifold parts
@@ -128,9 +145,9 @@ pub(crate) struct ComputeMesh {
     /// to the caster's ranges of the two tables below (made absolute when placed in the arena),
     /// then their culling bounds (`crate::pass::mesh::meshlet_rows`).
     pub meshlets: Vec<[u32; crate::pass::mesh::MESHLET_WORDS]>,
-    /// The meshlets' welded triangle ids.
+    /// The meshlets' triangles (their slots in the scan order, as the facing bits have them).
     pub meshlet_tris: Vec<u32>,
-    /// The meshlets' owned edges, `(t0, t1, c0 | c1 << 8, 0)`.
+    /// The meshlets' owned edges, `(s0, s1, c0 | c1 << 8, 0)` (the slots of `t0` and `t1`).
     pub meshlet_edges: Vec<[u32; 4]>,
     /// Per part, its meshlets (relative to the caster's first).
     pub part_meshlets: Vec<std::ops::Range<u32>>,
@@ -157,14 +174,23 @@ impl ComputeMesh {
     /// the others keep the CPU's multiplicity path).
     pub fn new(caster: &Caster) -> ComputeMesh {
         let mesh = caster.mesh();
-        let planes = caster.planes.planes_xyzd();
-        let tris = mesh
-            .triangles
+        // Every triangle table in the planes' scan order (slot s holds triangle
+        // order.triangle(s)): the facing bits, blocks and word pairs follow the terminator.
+        let order = caster.planes.order();
+        let slot = |t: u32| order.slot(t);
+        let planes = caster.planes.planes_scan();
+        let blocks = caster
+            .planes
+            .gpu_blocks(mesh)
             .iter()
-            .zip(&caster.tri_chunk)
-            .map(|(t, &(ci, li))| {
+            .flat_map(|b| [[b[0], b[1], b[2], b[3]], [b[4], b[5], b[6], b[7]], [b[8], b[9], b[10], b[11]]])
+            .collect();
+        let tris = (0..mesh.triangles.len() as u32)
+            .map(|s| {
+                let t = order.triangle(s) as usize;
+                let (tri, (ci, li)) = (mesh.triangles[t], caster.tri_chunk[t]);
                 let l = caster.chunks[ci as usize].local_tris[li as usize];
-                [t[0], t[1], t[2], 0, l[0] as u32, l[1] as u32, l[2] as u32, ci]
+                [tri[0], tri[1], tri[2], 0, l[0] as u32, l[1] as u32, l[2] as u32, ci]
             })
             .collect();
         let mut positions: Vec<[f32; 4]> = mesh.positions.iter().map(|p| [p.x, p.y, p.z, 1.0]).collect();
@@ -180,7 +206,7 @@ impl ComputeMesh {
         let whole_multiplicity = caster.kind != CasterKind::Manifold && caster.parts.len() == 1;
         for part in caster.parts.iter().filter(|p| p.kind == CasterKind::Manifold && !whole_multiplicity) {
             for e in part.scan.edges() {
-                edges.push([e.t0, e.t1, e.c0 as u32 | (e.c1 as u32) << 8, 0]);
+                edges.push((slot(e.t0), slot(e.t1), e.c0 as u32 | (e.c1 as u32) << 8));
                 let (c0, c1) = (caster.tri_chunk[e.t0 as usize].0, caster.tri_chunk[e.t1 as usize].0);
                 chunk_edges[c0 as usize] += 1;
                 if c1 != c0 {
@@ -188,6 +214,7 @@ impl ComputeMesh {
                 }
             }
         }
+        let tables::WordPairs { edges, groups } = tables::word_pairs(edges);
         let mut vertices = Vec::new();
         let mut chunk_vertices = Vec::with_capacity(caster.chunks.len());
         for ch in &caster.chunks {
@@ -196,15 +223,17 @@ impl ComputeMesh {
         }
         let ml = Meshlets::build(caster);
         let meshlets = crate::pass::mesh::meshlet_rows(&ml);
-        let meshlet_edges = ml.edges.iter().map(|e| [e.t0, e.t1, e.c0 as u32 | (e.c1 as u32) << 8, 0]).collect();
+        let meshlet_edges = ml.edges.iter().map(|e| [slot(e.t0), slot(e.t1), e.c0 as u32 | (e.c1 as u32) << 8, 0]).collect();
         ComputeMesh {
             planes,
             tris,
             positions,
             edges,
+            blocks,
+            groups,
             chunk_edges,
             meshlets,
-            meshlet_tris: ml.triangles,
+            meshlet_tris: ml.triangles.iter().map(|&t| slot(t)).collect(),
             meshlet_edges,
             part_meshlets: ml.parts,
             apex_base,
@@ -227,6 +256,8 @@ impl ComputeMesh {
             Cow::Borrowed(bytemuck::cast_slice(&self.meshlet_tris)),
             Cow::Borrowed(bytemuck::cast_slice(&self.meshlet_edges)),
             Cow::Borrowed(bytemuck::cast_slice(&self.vertices)),
+            Cow::Borrowed(bytemuck::cast_slice(&self.blocks)),
+            Cow::Borrowed(bytemuck::cast_slice(&self.groups)),
         ]
     }
 
@@ -237,6 +268,7 @@ impl ComputeMesh {
             elements,
             triangles: self.tris.len() as u32,
             edge_count: self.edges.len() as u32,
+            group_count: self.groups.len() as u32,
             chunk_edges: self.chunk_edges,
             chunk_tris: caster.chunks.iter().map(|ch| ch.local_tris.len() as u32).collect(),
             part_meshlets: self.part_meshlets,
@@ -255,6 +287,8 @@ pub(crate) struct ComputeStatic {
     pub elements: [u64; arena::N],
     pub triangles: u32,
     pub edge_count: u32,
+    /// Word-pair groups of its edges ([`tables::WordPairs`]).
+    pub group_count: u32,
     pub chunk_edges: Vec<u32>,
     /// Triangles per chunk.
     pub chunk_tris: Vec<u32>,
@@ -267,21 +301,22 @@ pub(crate) struct ComputeStatic {
     pub chunk_vertex_base: Vec<u32>,
 }
 
-/// The compute pipelines (one per stage: facing filter, exact facing, silhouette edges, face
-/// caps, sides) and their layout.
+/// The compute pipelines (one per stage: facing bits, exact facing, silhouette edges with
+/// their sides, face caps) and their layout.
 pub(crate) struct ComputePipes {
     pub set_layout: vk::DescriptorSetLayout,
     pub layout: vk::PipelineLayout,
-    /// In stage order: `facing`, `exact`, `find`, `caps`, `sides`.
-    pub stages: [vk::Pipeline; 5],
+    /// In stage order: `facing`, `exact`, `find`, `caps`.
+    pub stages: [vk::Pipeline; 4],
 }
 
 /// The entry points of `shaders/silhouette.wgsl`, in [`ComputePipes::stages`] order.
-const ENTRIES: [&std::ffi::CStr; 5] = [c"facing", c"exact", c"find", c"caps", c"sides"];
+const ENTRIES: [&std::ffi::CStr; 4] = [c"facing", c"exact", c"find", c"caps"];
 
 /// Storage-buffer bindings of the set: 0..4 the arena's tables, 4 the jobs, 5 facing bits,
-/// 6 the header and chunk records, 7 the output indices, 8 the exact and silhouette lists.
-pub(crate) const BINDINGS: u32 = 9;
+/// 6 the header and chunk records, 7 the output indices, 8 the exact list,
+/// 9 and 10 the arena's block bounds and word-pair groups.
+pub(crate) const BINDINGS: u32 = 11;
 
 impl ComputePipes {
     pub fn new(dev: &PassDevice) -> Result<ComputePipes> {
@@ -298,7 +333,7 @@ impl ComputePipes {
         // SAFETY: creation on a valid device from locals; destroyed in `destroy` (or below on error).
         let set_layout = unsafe { d.create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None) }
             .map_err(Error::vk("vkCreateDescriptorSetLayout"))?;
-        let mut me = ComputePipes { set_layout, layout: vk::PipelineLayout::null(), stages: [vk::Pipeline::null(); 5] };
+        let mut me = ComputePipes { set_layout, layout: vk::PipelineLayout::null(), stages: [vk::Pipeline::null(); 4] };
         match me.create(dev) {
             Ok(()) => Ok(me),
             Err(e) => {
@@ -364,11 +399,11 @@ pub(crate) struct SlotCompute {
     pub records: Option<Buffer>,
     /// Output indices (u16, two a word), every light's regions.
     pub out: Option<Buffer>,
-    /// Facing bits, two words per 64 triangles of each job.
+    /// Facing bits, two words per 64-slot block of each job.
     pub facing: Option<Buffer>,
     /// The frame's jobs (host visible).
     pub jobs: Option<Buffer>,
-    /// The exact and silhouette lists (`(job, triangle or edge)` pairs).
+    /// The exact list (`(job, slot)` pairs).
     pub lists: Option<Buffer>,
     /// [`Technique::Mesh`](crate::pass::Technique::Mesh): the mesh draws' counters (host
     /// visible: read back for stats).
@@ -467,16 +502,17 @@ mod tests {
         // every edge counted once per chunk it touches
         let touching: u32 = m.chunk_edges.iter().sum();
         assert!(touching as usize >= m.edges.len() && (touching as usize) < 2 * m.edges.len());
-        for (t, row) in m.tris.iter().enumerate() {
-            let (ci, li) = c.tri_chunk[t];
+        let order = c.planes.order();
+        for (s, row) in m.tris.iter().enumerate() {
+            let (ci, li) = c.tri_chunk[order.triangle(s as u32) as usize];
             assert_eq!(row[7], ci);
             let lt = c.chunks[ci as usize].local_tris[li as usize];
             assert_eq!([row[4], row[5], row[6]], lt.map(|x| x as u32));
         }
-        // corners: the edge a -> b starts at corner c0 of t0
+        // corners: the edge a -> b starts at corner c0 of t0 (the table holds their slots)
         for e in &m.edges {
-            let (t0, c0) = (e[0] as usize, (e[2] & 0xff) as usize);
-            let (t1, c1) = (e[1] as usize, (e[2] >> 8) as usize);
+            let (t0, c0) = (order.triangle(e[0]) as usize, (e[2] & 0xff) as usize);
+            let (t1, c1) = (order.triangle(e[1]) as usize, (e[2] >> 8) as usize);
             let (a, b) = (c.mesh().triangles[t0][c0], c.mesh().triangles[t0][(c0 + 1) % 3]);
             assert_eq!((c.mesh().triangles[t1][c1], c.mesh().triangles[t1][(c1 + 1) % 3]), (b, a));
         }
@@ -491,12 +527,14 @@ mod tests {
     fn push_and_job_match_the_wgsl_blocks() {
         use super::frame::GpuJob;
         assert_eq!(SilhouettePush::SIZE, 32);
-        assert_eq!(std::mem::offset_of!(SilhouettePush, sil_base), 16);
+        assert_eq!(std::mem::offset_of!(SilhouettePush, steps), 16);
         assert_eq!(std::mem::size_of::<GpuJob>(), 96);
         assert_eq!(std::mem::offset_of!(GpuJob, bound), 32);
         assert_eq!(std::mem::offset_of!(GpuJob, plane_base), 48);
         assert_eq!(std::mem::offset_of!(GpuJob, rec_base), 64);
         assert_eq!(std::mem::offset_of!(GpuJob, g_facing), 72);
         assert_eq!(std::mem::offset_of!(GpuJob, g_caps), 80);
+        assert_eq!(std::mem::offset_of!(GpuJob, block_base), 84);
+        assert_eq!(std::mem::offset_of!(GpuJob, groups), 92);
     }
 }

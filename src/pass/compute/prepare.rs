@@ -47,7 +47,7 @@ impl ShadowPass {
             ("indices", cf.out_indices * 2),
             ("facing bits", cf.facing_words * 4),
             ("jobs", (cf.jobs.len() * std::mem::size_of::<GpuJob>()) as u64),
-            ("lists", (cf.exact_capacity + cf.sil_capacity) * 8),
+            ("lists", cf.exact_capacity * 8),
         ];
         for (name, bytes) in sizes {
             if bytes > dev.max_storage_range {
@@ -77,7 +77,7 @@ impl ShadowPass {
         records.write(0, bytemuck::cast_slice(&cf.records))?;
         jobs.write(0, bytemuck::cast_slice(&cf.jobs))?;
         let slot_buffers = [records.raw, out.raw, facing.raw, jobs.raw, lists.raw];
-        let (records_raw, out_raw, facing_raw) = (records.raw, out.raw, facing.raw);
+        let (records_raw, out_raw) = (records.raw, out.raw);
         let counts_range = (cf.counts_words * 4).max(16);
         if mesh_layout.is_some() {
             if counts_range > dev.max_storage_range {
@@ -103,11 +103,24 @@ impl ShadowPass {
             }
             .map_err(Error::vk("vkAllocateDescriptorSets"))?;
             let set = sets[0];
-            // binding order: the arena's four tables, jobs, facing, records, indices, lists
+            // binding order: the arena's four tables, jobs, facing, records, indices, lists, the
+            // arena's block bounds and word pairs
             let whole = |buffer| [vk::DescriptorBufferInfo { buffer, offset: 0, range: vk::WHOLE_SIZE }];
             let ranged = |k: usize| [vk::DescriptorBufferInfo { buffer: slot_buffers[k], offset: 0, range: ranges[k] }];
-            let infos: [[vk::DescriptorBufferInfo; 1]; BINDINGS as usize] =
-                [whole(arena[0]), whole(arena[1]), whole(arena[2]), whole(arena[3]), ranged(3), ranged(2), ranged(0), ranged(1), ranged(4)];
+            let (blocks, groups) = (arena[super::arena::BLOCKS], arena[super::arena::GROUPS]);
+            let infos: [[vk::DescriptorBufferInfo; 1]; BINDINGS as usize] = [
+                whole(arena[0]),
+                whole(arena[1]),
+                whole(arena[2]),
+                whole(arena[3]),
+                ranged(3),
+                ranged(2),
+                ranged(0),
+                ranged(1),
+                ranged(4),
+                whole(blocks),
+                whole(groups),
+            ];
             if arena.contains(&vk::Buffer::null()) {
                 return Err(Error::Internal("compute silhouettes: jobs without the arena".into()));
             }
@@ -154,7 +167,6 @@ impl ShadowPass {
         cf.counts_buffer = counts_raw;
         cf.records_buffer = records_raw;
         cf.out_buffer = out_raw;
-        cf.facing_buffer = facing_raw;
         Ok(cf)
     }
 

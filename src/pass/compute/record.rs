@@ -5,15 +5,16 @@
 //! Barriers (global memory barriers):
 //! 1. earlier indirect, index and compute accesses (a previous frame on the queue) and the
 //!    caster uploads -> compute reads and writes;
-//! 2. between the stages (facing | exact | find and caps | sides): compute writes -> compute
-//!    reads and atomics, and the indirect dispatch reads of the lists' sizes;
-//! 3. with the merged draws' compaction ([`super::draws`]): the sides' writes -> its reads;
+//! 2. between the stages (facing | exact | find and caps): compute writes -> compute reads
+//!    and atomics, and the indirect dispatch read of the exact list's size;
+//! 3. with the merged draws' compaction ([`super::draws`]): the `find` and `caps` stages'
+//!    writes -> its reads;
 //! 4. the compute writes -> indirect-command reads, index reads, and host reads (the counts
 //!    `--stats` reads back after the fence): the one barrier between the compute and the
 //!    draws.
 
 use super::super::ShadowPass;
-use super::rec;
+use super::{rec, LANES};
 use crate::pass::PreparedFrame;
 use ash::vk;
 
@@ -32,12 +33,13 @@ fn barrier(
 
 impl ShadowPass {
     /// Records the GPU possible silhouettes of every light of `frame`
-    /// ([`Technique::Compute`](crate::pass::Technique::Compute)): five dispatches for every
-    /// (light, caster) pair at once, whatever their number: the facing filter, the exact test
-    /// of what it left undecided, the possible silhouette edges (compacted into a list) and the
-    /// face caps, then the listed edges' sides, writing 16-bit indices and the indirect draw
-    /// counts (and with the merged draws' lists of
-    /// [`PassToggles::compute_draws`](crate::pass::PassToggles::compute_draws), a sixth: their
+    /// ([`Technique::Compute`](crate::pass::Technique::Compute)): four dispatches for every
+    /// (light, caster) pair at once, whatever their number: the facing bits (whole 64-triangle
+    /// blocks where their bound decides them, else the plane filter), the exact test of what
+    /// it left undecided, the possible silhouette edges with their sides (skipping whole
+    /// word-pair groups of uniform blocks) and the face caps, writing 16-bit indices and the
+    /// indirect draw counts (and with the merged draws' lists of
+    /// [`PassToggles::compute_draws`](crate::pass::PassToggles::compute_draws), a fifth: their
     /// compaction); then one barrier to the indirect draws and index reads. Nothing for other
     /// techniques. Idempotent per frame; also recorded by the first `cmd_determine` /
     /// `cmd_count_float` / `cmd_light_intensity` of the frame when the host did not call it
@@ -86,16 +88,16 @@ impl ShadowPass {
             ),
             (S::COMPUTE_SHADER | S::TRANSFER, rw | A::TRANSFER_WRITE),
         );
-        let [facing, exact, find, caps, sides] = cp.stages;
+        let [facing, exact, find, caps] = cp.stages;
         let push = cf.push();
         let records = cf.records_buffer;
         // SAFETY: the caller's contract; the pipelines, the set and its buffers live until the
         // slot is prepared again; the set binds the frame's buffers and the arena's tables.
-        // The facing bits start cleared: the `facing` stage sets the light-facing ones.
+        // (The facing bits need no clearing: the `facing` stage writes every word whole.)
         unsafe {
-            d.cmd_fill_buffer(cb, cf.facing_buffer, 0, (cf.facing_words * 4).max(4), 0);
             if cf.mesh {
-                // the mesh draws' counters start at zero
+                // the mesh draws' counters start at zero (read by the mesh draws only: the
+                // last barrier orders them)
                 d.cmd_fill_buffer(cb, cf.counts_buffer, 0, (cf.counts_words * 4).max(4), 0);
             }
             // the merged draws' lists start empty (counts 0, every command empty)
@@ -110,7 +112,7 @@ impl ShadowPass {
             d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::COMPUTE, cp.layout, 0, &[cf.set], &[]);
             d.cmd_push_constants(cb, cp.layout, vk::ShaderStageFlags::COMPUTE, 0, bytemuck::bytes_of(&push));
             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, facing);
-            dispatch_groups(d, cb, cf.groups[0]);
+            dispatch_groups(d, cb, cf.groups[0].div_ceil(LANES));
             to_next(self);
             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, exact);
             d.cmd_dispatch_indirect(cb, records, (rec::H_EXACT_X * 4) as u64);
@@ -129,14 +131,11 @@ impl ShadowPass {
         unsafe {
             to_next(self);
             d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, find);
-            dispatch_groups(d, cb, cf.groups[1]);
+            dispatch_groups(d, cb, cf.groups[1].div_ceil(LANES));
             if cf.groups[2] > 0 {
                 d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, caps);
                 dispatch_groups(d, cb, cf.groups[2]);
             }
-            to_next(self);
-            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::COMPUTE, sides);
-            d.cmd_dispatch_indirect(cb, records, (rec::H_SIL_X * 4) as u64);
         }
         // The merged draws: every non-empty command into its light and pipeline's list.
         if let Some(m) = cf.merged.as_ref().filter(|m| m.compacts()) {
