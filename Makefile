@@ -12,11 +12,13 @@ deps:
 	@./scripts/drivers.sh install 25.0.7 >/dev/null || echo "warning: Mesa lavapipe 25.0.7 not installed (scripts/drivers.sh install 25.0.7): no --method rayquery here" >&2
 
 # What the tests and the conformance runs need as well (off Debian: the validation layer too),
-# lavapipe 25.0.7, which tests/rayquery.rs runs on when the system's driver has no ray query,
-# and SwiftShader, which tests/hard_cases.rs, the quick matrix and the minimal example run on.
+# lavapipe 25.0.7, which tests/rayquery.rs and tests/mesh.rs run on when the system's driver has
+# no ray query or mesh shaders, lavapipe 22.3.6, a known driver without mesh shaders for
+# tests/cli.rs (and the quick matrix's), and SwiftShader, which tests/hard_cases.rs, the quick
+# matrix and the minimal example run on.
 deps-tests:
 	@./scripts/deps.sh --tests
-	./scripts/drivers.sh install 25.0.7 swiftshader
+	./scripts/drivers.sh install 22.3.6 25.0.7 swiftshader
 
 # Three Mesa lavapipe versions (Vulkan 1.0, 1.3, 1.4) and SwiftShader in .drivers/, beside the
 # system's; select one with eval "$$(scripts/drivers.sh env 25.0.7)" (scripts/drivers.sh --help).

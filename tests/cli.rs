@@ -303,7 +303,7 @@ fn info_pipelines_creates_and_times_every_pipeline() {
     assert!(text.contains("all created"), "{text}");
     for what in [
         "silhouette.wgsl:exact",
-        "silhouette.wgsl:sides",
+        "silhouette.wgsl:find",
         "shadow.vert depth LESS stencil",
         "fullscreen.vert + illuminate.frag",
         "render-pass",
