@@ -272,45 +272,68 @@ impl FacePlanes {
         }
     }
 
+    /// Triangle `t`'s stored plane in f64: its normal and offset.
+    fn plane64(&self, t: usize) -> ([f64; 3], f64) {
+        ([self.nx[t] as f64, self.ny[t] as f64, self.nz[t] as f64], self.d[t] as f64)
+    }
+
+    /// The mean of the first corners of triangles `ts` (a block's centre point), in f64;
+    /// `None` where a triangle has no corners in `mesh`.
+    fn block_centre(&self, mesh: &Mesh, ts: std::ops::Range<usize>) -> Option<[f64; 3]> {
+        let k = ts.len() as f64;
+        let mut c = [0.0f64; 3];
+        for t in ts {
+            let [p0, ..] = corners(mesh, self.tri(t))?;
+            for (ci, pi) in c.iter_mut().zip(p0.to_array()) {
+                *ci += pi as f64 / k;
+            }
+        }
+        Some(c)
+    }
+
+    /// Triangle `t`'s plane offset about the centre `c` (`|c|_inf` = `cinf`),
+    /// `d + n · c`, and a bound on its f64 rounding (four roundings of terms at most
+    /// `|d| + |n|_1 |c|_inf`).
+    fn offset(&self, t: usize, c: [f64; 3], cinf: f64) -> (f64, f64) {
+        let (n, d) = self.plane64(t);
+        let v = d + n[0] * c[0] + n[1] * c[1] + n[2] * c[2];
+        (v, 4.0 * (d.abs() + (n[0].abs() + n[1].abs() + n[2].abs()) * cinf) * 2f64.powi(-53))
+    }
+
+    /// The spreads of triangles `ts` about a centre normal `nm` and offset `dm` (offsets
+    /// taken about `c`): per normal component the largest `|n_i - nm_i|`, and the largest
+    /// `|offset - dm|` plus its rounding bound. Not yet rounded up.
+    fn block_spreads(&self, ts: std::ops::Range<usize>, c: [f64; 3], cinf: f64, nm: [f64; 3], dm: f64) -> ([f64; 3], f64) {
+        let (mut spread, mut spread_d) = ([0.0f64; 3], 0.0f64);
+        for t in ts {
+            let (n, _) = self.plane64(t);
+            for i in 0..3 {
+                spread[i] = spread[i].max((n[i] - nm[i]).abs());
+            }
+            let (v, err) = self.offset(t, c, cinf);
+            spread_d = spread_d.max((v - dm).abs() + err);
+        }
+        (spread, spread_d)
+    }
+
     /// The [`BlockBound`] of triangles `ts` (one block).
     fn block_bound(&self, mesh: &Mesh, ts: std::ops::Range<usize>, always_exact: &[bool]) -> BlockBound {
         if ts.is_empty() || always_exact[ts.clone()].iter().any(|&x| x) {
             return BlockBound::default();
         }
         let k = ts.len() as f64;
-        let plane = |t: usize| ([self.nx[t] as f64, self.ny[t] as f64, self.nz[t] as f64], self.d[t] as f64);
-        let mut c = [0.0f64; 3];
-        for t in ts.clone() {
-            let Some([p0, ..]) = corners(mesh, self.tri(t)) else { return BlockBound::default() };
-            for (ci, pi) in c.iter_mut().zip(p0.to_array()) {
-                *ci += pi as f64 / k;
-            }
-        }
+        let Some(c) = self.block_centre(mesh, ts.clone()) else { return BlockBound::default() };
         let cinf = c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-        let offset = |t: usize| {
-            let (n, d) = plane(t);
-            let v = d + n[0] * c[0] + n[1] * c[1] + n[2] * c[2];
-            // four roundings of terms at most |d| + |n|_1 |c|_inf
-            let err = 4.0 * (d.abs() + (n[0].abs() + n[1].abs() + n[2].abs()) * cinf) * 2f64.powi(-53);
-            (v, err)
-        };
-        let (mut nm, mut dm) = ([0.0f64; 3], 0.0f64);
+        let mut nm = [0.0f64; 3];
+        let mut dm = 0.0f64;
         for t in ts.clone() {
-            let (n, _) = plane(t);
+            let (n, _) = self.plane64(t);
             for i in 0..3 {
                 nm[i] += n[i] / k;
             }
-            dm += offset(t).0 / k;
+            dm += self.offset(t, c, cinf).0 / k;
         }
-        let (mut spread, mut spread_d) = ([0.0f64; 3], 0.0f64);
-        for t in ts {
-            let (n, _) = plane(t);
-            for i in 0..3 {
-                spread[i] = spread[i].max((n[i] - nm[i]).abs());
-            }
-            let (v, err) = offset(t);
-            spread_d = spread_d.max((v - dm).abs() + err);
-        }
+        let (spread, spread_d) = self.block_spreads(ts, c, cinf, nm, dm);
         // round the spreads up past their own f64 rounding
         let up = 1.0 + 2f64.powi(-40);
         let spread = spread.map(|x| x * up);

@@ -44,7 +44,7 @@
 //! `planes::tests::gpu_blocks_*` check that a decided block's every `V_t` (evaluated exactly)
 //! clears `e`, and that without the allowance a light near the threshold breaks it.
 
-use super::{corners, FacePlanes};
+use super::FacePlanes;
 use crate::geom::mesh::Mesh;
 #[cfg(test)]
 use glam::Vec4;
@@ -89,23 +89,16 @@ impl FacePlanes {
 
     fn gpu_block(&self, mesh: &Mesh, ts: std::ops::Range<usize>) -> GpuBlock {
         let none = [0.0; 12];
-        let plane = |s: usize| ([self.nx[s] as f64, self.ny[s] as f64, self.nz[s] as f64], self.d[s] as f64);
         // a zero plane is an always-exact slot (a real plane has |n|_1 = 1)
-        if self.all_exact || ts.is_empty() || ts.clone().any(|s| plane(s).0 == [0.0; 3]) {
+        if self.all_exact || ts.is_empty() || ts.clone().any(|s| self.plane64(s).0 == [0.0; 3]) {
             return none;
         }
         let k = ts.len() as f64;
-        let mut c = [0.0f64; 3];
-        for s in ts.clone() {
-            let Some([p0, ..]) = corners(mesh, self.tri(s)) else { return none };
-            for (ci, pi) in c.iter_mut().zip(p0.to_array()) {
-                *ci += pi as f64 / k;
-            }
-        }
+        let Some(c) = self.block_centre(mesh, ts.clone()) else { return none };
         let c = c.map(|x| x as f32 as f64);
         let mut nm = [0.0f64; 3];
         for s in ts.clone() {
-            let (n, _) = plane(s);
+            let (n, _) = self.plane64(s);
             for i in 0..3 {
                 nm[i] += n[i] / k;
             }
@@ -113,21 +106,8 @@ impl FacePlanes {
         let nm = nm.map(|x| x as f32 as f64);
         let cinf = c.iter().fold(0.0f64, |a, x| a.max(x.abs()));
         // d'_s = d̃_s + ñ_s · c: products of f32 values are exact in f64, three additions round
-        let offset = |s: usize| {
-            let (n, d) = plane(s);
-            let v = d + n[0] * c[0] + n[1] * c[1] + n[2] * c[2];
-            (v, 4.0 * (d.abs() + (n[0].abs() + n[1].abs() + n[2].abs()) * cinf) * 2f64.powi(-53))
-        };
-        let dm = (ts.clone().map(|s| offset(s).0).sum::<f64>() / k) as f32 as f64;
-        let (mut spread, mut spread_d) = ([0.0f64; 3], 0.0f64);
-        for s in ts {
-            let (n, _) = plane(s);
-            for i in 0..3 {
-                spread[i] = spread[i].max((n[i] - nm[i]).abs());
-            }
-            let (v, err) = offset(s);
-            spread_d = spread_d.max((v - dm).abs() + err);
-        }
+        let dm = (ts.clone().map(|s| self.offset(s, c, cinf).0).sum::<f64>() / k) as f32 as f64;
+        let (spread, spread_d) = self.block_spreads(ts, c, cinf, nm, dm);
         // past the f64 roundings of the differences, then up to f32
         let up = 1.0 + 2f64.powi(-50);
         let spread = spread.map(|x| up32(x * up));
