@@ -155,6 +155,7 @@ fn tiny_suite(tag: &str, driver: &[(String, Option<String>)]) -> serde_json::Val
         assert!(rows.iter().any(|r| r["sweep"] == s), "no {s} rows");
     }
     one_factor_sweeps(rows);
+    sides_and_ray_steps(rows);
     identifiability(&v["model"]);
     bound_proofs(&v);
     let methods: Vec<&str> = rows.iter().filter(|r| r["sweep"] == "tessellation").filter_map(|r| r["method"].as_str()).collect();
@@ -209,6 +210,44 @@ fn tiny_suite(tag: &str, driver: &[(String, Option<String>)]) -> serde_json::Val
 }
 
 /// The one-factor sweeps (issue #38): each moves one count while the others stay.
+/// The model's sliver and ray-step counts: sides to infinity are the volumes' own sides (none
+/// for planar projection, shadow maps and ray query); edge quads take those of the McGuire
+/// volumes of the same frame (every other quad of theirs is degenerate), ray query their
+/// stencil fragments.
+fn sides_and_ray_steps(rows: &[serde_json::Value]) {
+    let u = |r: &serde_json::Value, k: &str| r[k].as_u64().unwrap_or_else(|| panic!("{k}: {}", r[k]));
+    let twin = |r: &serde_json::Value| {
+        rows.iter().find(|m| {
+            m["method"] == "mcguire" && ["sweep", "x", "scene", "variant", "width", "height", "lights"].iter().all(|k| m[*k] == r[*k])
+        })
+    };
+    let (mut quads, mut rays) = (0, 0);
+    for r in rows {
+        let method = r["method"].as_str().unwrap();
+        let what = format!("{} {} {method}", r["sweep"], r["scene"]);
+        match method {
+            "planar" | "rayquery" => assert_eq!(u(r, "infinite_sides"), 0, "{what}"),
+            m if m.starts_with("shadowmap") => assert_eq!(u(r, "infinite_sides"), 0, "{what}"),
+            "edgequad" => {
+                if let Some(m) = twin(r) {
+                    assert_eq!(u(r, "infinite_sides"), u(m, "shadow_sides"), "{what}: not the McGuire silhouette's sides");
+                    quads += 1;
+                }
+            }
+            _ => assert_eq!(u(r, "infinite_sides"), u(r, "shadow_sides"), "{what}"),
+        }
+        if method == "rayquery" {
+            let m = twin(r).unwrap_or_else(|| panic!("{what}: no McGuire row beside it"));
+            assert_eq!(r["volume_fragments"], m["stencil_fragments"], "{what}: not the McGuire volumes' fragments");
+            rays += 1;
+        } else {
+            assert!(r["volume_fragments"].is_null(), "{what}: volume fragments outside ray query");
+        }
+    }
+    assert!(quads > 0, "no edge-quad row beside a McGuire one");
+    assert!(rays == 0 || rows.iter().any(|r| r["method"] == "rayquery" && r["volume_fragments"].as_u64().unwrap_or(0) > 0));
+}
+
 fn one_factor_sweeps(rows: &[serde_json::Value]) {
     let of = |sweep: &str, method: &str| -> Vec<&serde_json::Value> {
         rows.iter().filter(|r| r["sweep"] == sweep && r["method"] == method).collect()

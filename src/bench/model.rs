@@ -5,8 +5,9 @@
 //! gpu_shadow_ms ≈ 1e-6 · Σ c_k · count_k   (c_k in ns per unit, c_k ≥ 0)
 //! ```
 //!
-//! over [`TERMS`] (fragments, per-pixel light passes, shadow-map lookups (taps or gathers) and texels, rays,
-//! triangles submitted and set up, clipped triangles, vertices shaded, caster triangles bound, compute
+//! over [`TERMS`] (fragments, per-pixel light passes, shadow-map lookups (taps or gathers) and texels, rays
+//! and their steps through the casters' volumes, triangles submitted and set up, clipped triangles, sides
+//! running to infinity across the screen, vertices shaded, caster triangles bound, compute
 //! silhouette and mesh-shader triangles read, draws, caster passes per technique family, lights and a
 //! constant), fitted by non-negative least squares on the suite's own rows, in relative error
 //! (each row weighted by 1 / its time, so a 0.3 ms row counts as much as a 300 ms one). It is
@@ -48,9 +49,19 @@ pub const TERMS: &[(&str, Group, &str)] = &[
     ("gather_pixels", Group::Fill, "lights x frame pixels of the shadow-map PCF lookup, four gathers (shadow maps with --pcf gather)"),
     ("map_texels", Group::Fill, "shadow-map texels cleared and rendered (faces x size^2, per light)"),
     ("rays", Group::Fill, "ray-query rays (lights x frame pixels, ray query only)"),
+    (
+        "ray_steps",
+        Group::Fill,
+        "ray query: the McGuire volumes' stencil fragments at the same frame (rays through casters' shadow volumes) x log2 of the caster triangles (the BVH's depth)",
+    ),
     ("input_triangles", Group::Vertex, "input-assembly primitives (pipeline statistics): every triangle submitted, culled or not"),
     ("setup_triangles", Group::Vertex, "primitives out of clipping (pipeline statistics): what reaches setup"),
     ("clipped_triangles", Group::Vertex, "volume triangles with a vertex at infinity (sides and dark caps): always clipped"),
+    (
+        "infinite_sides",
+        Group::Vertex,
+        "volume sides running to infinity that cover screen area (the silhouette's; edge quads: the McGuire plan's): slivers binned across the screen",
+    ),
     ("vertices", Group::Vertex, "vertex-shader invocations (pipeline statistics)"),
     (
         "bound_triangles",
@@ -183,9 +194,11 @@ pub fn features(r: &SuiteRow) -> Option<Vec<f64>> {
         only(gather, pixels),
         r.map_texels as f64,
         only(ray, pixels),
+        only(ray, r.volume_fragments.unwrap_or(0) as f64 * (r.triangles.max(2) as f64).log2()),
         r.primitives? as f64,
         r.clipped_primitives? as f64,
         r.clipped_triangles as f64,
+        r.infinite_sides as f64,
         r.vertex_invocations? as f64,
         only(planned, r.bound_triangles as f64),
         only(r.method == "compute", r.triangles as f64 * lights),
@@ -389,6 +402,29 @@ mod tests {
         };
         assert_eq!(features(&r).map(|f| f.len()), Some(TERMS.len()));
         assert_eq!(features(&SuiteRow::default()), None, "untimed rows are not modelled");
+    }
+
+    #[test]
+    fn sides_and_ray_steps_count_where_they_belong() {
+        let names: Vec<&str> = TERMS.iter().map(|(n, _, _)| *n).collect();
+        let at = |n: &str| names.iter().position(|x| *x == n).unwrap();
+        let row = |method: &str| SuiteRow {
+            method: method.into(),
+            gpu_shadow_ms: Some(1.0),
+            primitives: Some(1),
+            clipped_primitives: Some(1),
+            vertex_invocations: Some(3),
+            triangles: 1024,
+            infinite_sides: 40,
+            volume_fragments: Some(1000),
+            ..Default::default()
+        };
+        let ray = features(&row("rayquery")).unwrap();
+        // 1000 fragments through volumes, a BVH over 1024 triangles: 10 levels.
+        assert_eq!(ray[at("ray_steps")], 10_000.0);
+        let volumes = features(&row("mcguire")).unwrap();
+        assert_eq!(volumes[at("ray_steps")], 0.0, "ray steps outside ray query");
+        assert_eq!(volumes[at("infinite_sides")], 40.0);
     }
 
     #[test]

@@ -170,6 +170,16 @@ pub struct SuiteRow {
     /// `gbuffer_triangles` at the measured G-buffer geometry limit
     /// ([`RowLimits::gbuffer_tri_mtri_s`]) over `gpu_depth_ms` (1 = at the limit).
     pub gbuffer_limit_fraction: Option<f64>,
+    /// Volume side triangles running to infinity that cover screen area: long slivers the
+    /// rasteriser bins across the screen. The silhouette's sides (`shadow_sides`) for the
+    /// CPU-planned, compute and mesh volumes; for edge quads, the sides of the McGuire plan of
+    /// the same frame (every other quad of theirs is degenerate); 0 for planar projection,
+    /// shadow maps and ray query.
+    pub infinite_sides: u64,
+    /// Ray query only: the stencil fragments of the McGuire volumes of the same frame (the
+    /// rays that pass through casters' shadow volumes, and how many of them), what the
+    /// model's `ray_steps` term weighs by the casters' BVH depth. `None` on other rows.
+    pub volume_fragments: Option<u64>,
 }
 
 /// A row's fill, vertex and draw shares from identified terms only.
@@ -282,6 +292,8 @@ pub const CSV_COLUMNS: &[&str] = &[
     "lighting_limit_fraction",
     "gbuffer_triangles",
     "gbuffer_limit_fraction",
+    "infinite_sides",
+    "volume_fragments",
 ];
 
 fn opt<T: ToString>(v: Option<T>) -> String {
@@ -369,6 +381,8 @@ impl SuiteRow {
             opt(r.lighting_limit_fraction),
             r.gbuffer_triangles.to_string(),
             opt(r.gbuffer_limit_fraction),
+            r.infinite_sides.to_string(),
+            opt(r.volume_fragments),
         ]
         .iter()
         .map(|f| if f.contains(',') { format!("\"{f}\"") } else { f.clone() })

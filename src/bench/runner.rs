@@ -218,6 +218,24 @@ impl Runner {
             counted.push(r.render()?.stats);
             r.settings.counters = false;
         }
+        // Edge quads and ray query draw no silhouette sides of their own to count: the McGuire
+        // volumes of the same frame give their rows the sides that cover screen area and the
+        // fragments rays pass through (one more counting frame, with the first variant's
+        // toggles).
+        let mcguire = Technique::Volumes(crate::shadow::Method::McGuire);
+        let twin = match variants.iter().find(|v| matches!(v.technique, Technique::EdgeQuads | Technique::RayQuery)) {
+            Some(v) => match counted.iter().zip(&variants).find(|(_, w)| w.technique == mcguire && w.toggles == v.toggles) {
+                Some((s, _)) => Some(s.clone()),
+                None => {
+                    apply(r, &Variant { technique: mcguire, ..(*v).clone() });
+                    r.settings.counters = true;
+                    let s = r.render()?.stats;
+                    r.settings.counters = false;
+                    Some(s)
+                }
+            },
+            None => None,
+        };
         let frames = frames_within(self.frames, counting.elapsed().as_secs_f64(), self.point_budget_s);
         self.note("counting frames (the warm-up round)", counting);
         let timing = Instant::now();
@@ -318,6 +336,15 @@ impl Runner {
                 map_texels: map_size.map_or(0, |n| n * n * map_faces),
                 caster_passes,
                 bound_triangles,
+                infinite_sides: match v.technique {
+                    Technique::Planar | Technique::ShadowMap { .. } | Technique::RayQuery => 0,
+                    Technique::EdgeQuads => twin.as_ref().map_or(0, |t| t.totals.triangles.sides),
+                    _ => s.totals.triangles.sides,
+                },
+                volume_fragments: match v.technique {
+                    Technique::RayQuery => twin.as_ref().and_then(|t| t.counters.as_ref()).and_then(|c| c.stencil_fragments),
+                    _ => None,
+                },
                 draws: s.totals.draws,
                 cpu_plan_ms: median(a.plan),
                 bytes: s.totals.bytes_sent,

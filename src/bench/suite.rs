@@ -275,6 +275,7 @@ fn limit_costs(limits: &Limits) -> BTreeMap<String, f64> {
         ("fragments", 1.0 / limits.stencil_fill_gfrag_s),
         ("setup_triangles", 1e3 / limits.setup_tri_mtri_s),
         ("clipped_triangles", 1e3 / limits.clip_tri_mtri_s),
+        ("infinite_sides", 1e3 / limits.sliver_tri_mtri_s),
         ("draws", 1e9 / limits.draws_per_s),
     ]
     .iter()

@@ -52,7 +52,7 @@ impl Scale {
     pub fn frames(self) -> usize {
         match self {
             Scale::Full => 11,
-            Scale::Quick => 9,
+            Scale::Quick => 7,
             Scale::Tiny => 1,
         }
     }
@@ -61,7 +61,7 @@ impl Scale {
     pub fn proof_frames(self) -> usize {
         match self {
             Scale::Full => 9,
-            Scale::Quick | Scale::Tiny => 5,
+            Scale::Quick | Scale::Tiny => 4,
         }
     }
     /// Wall seconds a point's timed rounds may take before its frames are cut (to no fewer
