@@ -164,6 +164,19 @@ fn compare_draw_ways(r: &mut Renderer, name: &str, ways: &[ComputeDraws]) {
     }
 }
 
+/// [`compare_draw_ways`] on each named scene, then on the mixed scene, whose renderer it
+/// returns.
+fn draw_ways_on(mut ctx: umbrage::gpu::Context, names: &[&str], ways: &[ComputeDraws]) -> Renderer {
+    for name in names {
+        let mut r = renderer(ctx, umbrage::scene::load(name).unwrap());
+        compare_draw_ways(&mut r, name, ways);
+        ctx = r.into_context();
+    }
+    let mut r = renderer(ctx, common::mixed_scene());
+    compare_draw_ways(&mut r, "mixed", ways);
+    r
+}
+
 /// Every way of recording the compute path's volume draws (issue #37: one
 /// `vkCmdDrawIndexedIndirectCount` per light and pipeline, one multi-draw, one draw per record,
 /// one draw per chunk with push constants) gives the same stencil and float counts, bit for
@@ -172,7 +185,7 @@ fn compare_draw_ways(r: &mut Renderer, name: &str, ways: &[ComputeDraws]) {
 /// lavapipe (22.3.6) every way is there; under CI a missing one fails.
 #[test]
 fn compute_draw_ways_are_bit_identical() {
-    let Some(mut ctx) = common::context() else { return };
+    let Some(ctx) = common::context() else { return };
     let ways = draw_ways(&ctx.features);
     if std::env::var_os("CI").is_some() {
         assert_eq!(
@@ -182,14 +195,7 @@ fn compute_draw_ways_are_bit_identical() {
             ctx.info.name
         );
     }
-    for name in common::hard_and_builtin_scenes() {
-        let mut r = renderer(ctx, umbrage::scene::load(name).unwrap());
-        compare_draw_ways(&mut r, name, &ways);
-        ctx = r.into_context();
-    }
-    let scene = common::mixed_scene();
-    let mut r = renderer(ctx, scene);
-    compare_draw_ways(&mut r, "mixed", &ways);
+    let mut r = draw_ways_on(ctx, &common::hard_and_builtin_scenes(), &ways);
     // the merged draws with frames in flight: validation (synchronisation included) clean
     r.settings.toggles.compute_draws = ComputeDraws::Auto;
     r.settings.technique = Technique::Compute;
@@ -206,16 +212,9 @@ fn compute_draw_ways_on_swiftshader() {
 #[test]
 #[ignore = "a helper: compute_draw_ways_on_swiftshader runs it on SwiftShader"]
 fn swiftshader_draw_ways() {
-    let Some(mut ctx) = common::context() else { return };
+    let Some(ctx) = common::context() else { return };
     let ways = draw_ways(&ctx.features);
     eprintln!("{}: ways {ways:?}", ctx.info.name);
     assert!(ways.len() >= 2, "{}: no merged way at all", ctx.info.name);
-    for name in ["default", "hard/open_casters", "hard/light_inside_caster"] {
-        let mut r = renderer(ctx, umbrage::scene::load(name).unwrap());
-        compare_draw_ways(&mut r, name, &ways);
-        ctx = r.into_context();
-    }
-    let scene = common::mixed_scene();
-    let mut r = renderer(ctx, scene);
-    compare_draw_ways(&mut r, "mixed", &ways);
+    draw_ways_on(ctx, &["default", "hard/open_casters", "hard/light_inside_caster"], &ways);
 }

@@ -9,7 +9,7 @@
 
 use super::saturate::time_gpu;
 use crate::error::{Error, Result};
-use crate::gpu::descriptors::pipeline_layout;
+use crate::gpu::descriptors::{pipeline_layout, storage_set_layout};
 use crate::gpu::{pipeline, shaders, Buffer, Context};
 use ash::vk;
 use bytemuck::{Pod, Zeroable};
@@ -69,18 +69,8 @@ fn measure_with(ctx: &Context, reps: usize, max_planes: u64, made: &mut Made) ->
     }
     let d = &ctx.device;
     let max_planes = max_planes.max(1 << 16).min(ctx.limits.max_storage_buffer_range as u64 / 16);
-    let bindings: Vec<_> = (0..2)
-        .map(|i| {
-            vk::DescriptorSetLayoutBinding::default()
-                .binding(i)
-                .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                .descriptor_count(1)
-                .stage_flags(vk::ShaderStageFlags::COMPUTE)
-        })
-        .collect();
-    // SAFETY: creation on a valid device; destroyed by `measure`.
-    made.set_layout = unsafe { d.create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None) }
-        .map_err(Error::vk("vkCreateDescriptorSetLayout"))?;
+    // destroyed by `measure`
+    made.set_layout = storage_set_layout(ctx, 2, vk::ShaderStageFlags::COMPUTE)?;
     made.layout = pipeline_layout(ctx, &[made.set_layout], std::mem::size_of::<Push>() as u32, vk::ShaderStageFlags::COMPUTE)?;
     let module = pipeline::shader_module(ctx, shaders::COMPUTE_READ_WGSL)?;
     let stage = vk::PipelineShaderStageCreateInfo::default().stage(vk::ShaderStageFlags::COMPUTE).module(module).name(c"stream");

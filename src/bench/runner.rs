@@ -211,28 +211,27 @@ impl Runner {
         // Counting frames, not timed: also the warm-up round (every variant's buffers sized and
         // first-use costs paid before any timed frame), whose wall time sets how many timed
         // rounds fit the budget (a counting frame costs a little more than a timed one).
-        let mut counted = Vec::with_capacity(variants.len());
-        for v in &variants {
+        let count = |r: &mut Renderer, v: &Variant| -> Result<_> {
             apply(r, v);
             r.settings.counters = true;
-            counted.push(r.render()?.stats);
+            let stats = r.render()?.stats;
             r.settings.counters = false;
+            Ok(stats)
+        };
+        let mut counted = Vec::with_capacity(variants.len());
+        for v in &variants {
+            counted.push(count(r, v)?);
         }
         // Edge quads and ray query draw no silhouette sides of their own to count: the McGuire
         // volumes of the same frame give their rows the sides that cover screen area and the
-        // fragments rays pass through (one more counting frame, with the first variant's
-        // toggles).
+        // fragments rays pass through, `(sides, fragments)` (one more counting frame, with the
+        // first such variant's toggles, where no McGuire variant has them).
         let mcguire = Technique::Volumes(crate::shadow::Method::McGuire);
+        let of = |s: &crate::render::Stats| (s.totals.triangles.sides, s.counters.as_ref().and_then(|c| c.stencil_fragments));
         let twin = match variants.iter().find(|v| matches!(v.technique, Technique::EdgeQuads | Technique::RayQuery)) {
             Some(v) => match counted.iter().zip(&variants).find(|(_, w)| w.technique == mcguire && w.toggles == v.toggles) {
-                Some((s, _)) => Some(s.clone()),
-                None => {
-                    apply(r, &Variant { technique: mcguire, ..(*v).clone() });
-                    r.settings.counters = true;
-                    let s = r.render()?.stats;
-                    r.settings.counters = false;
-                    Some(s)
-                }
+                Some((s, _)) => Some(of(s)),
+                None => Some(of(&count(r, &Variant { technique: mcguire, ..(*v).clone() })?)),
             },
             None => None,
         };
@@ -338,11 +337,11 @@ impl Runner {
                 bound_triangles,
                 infinite_sides: match v.technique {
                     Technique::Planar | Technique::ShadowMap { .. } | Technique::RayQuery => 0,
-                    Technique::EdgeQuads => twin.as_ref().map_or(0, |t| t.totals.triangles.sides),
+                    Technique::EdgeQuads => twin.map_or(0, |t| t.0),
                     _ => s.totals.triangles.sides,
                 },
                 volume_fragments: match v.technique {
-                    Technique::RayQuery => twin.as_ref().and_then(|t| t.counters.as_ref()).and_then(|c| c.stencil_fragments),
+                    Technique::RayQuery => twin.and_then(|t| t.1),
                     _ => None,
                 },
                 draws: s.totals.draws,

@@ -386,21 +386,7 @@ mod tests {
             #[test]
             fn near_coplanar_grids(scale in prop_oneof![Just(1.0f32), Just(1e4), Just(1e-4), Just(3e6)], off in point(), tilt in -1e-6f32..1e-6, lz in -1e-5f32..1e-5) {
                 // a fan of almost coplanar triangles, lights on and very near their plane
-                let mut positions = Vec::new();
-                for i in 0..9 {
-                    for j in 0..9 {
-                        positions.push(off + Vec3::new(i as f32, j as f32, (i * j) as f32 * tilt) * scale);
-                    }
-                }
-                let mut triangles = Vec::new();
-                for i in 0..8u32 {
-                    for j in 0..8u32 {
-                        let v = i * 9 + j;
-                        triangles.push([v, v + 9, v + 1]);
-                        triangles.push([v + 1, v + 9, v + 10]);
-                    }
-                }
-                let m = Mesh { positions, triangles };
+                let m = crate::geom::testmesh::grid(9, 9, |i, j| off + Vec3::new(i as f32, j as f32, (i * j) as f32 * tilt) * scale);
                 for l in [(off + Vec3::new(3.0, 4.0, lz) * scale).extend(1.0), off.extend(1.0), Vec3::new(1.0, 2.0, lz).extend(0.0), (off * 2.0).extend(1.0)] {
                     check_planes(&m, l);
                 }

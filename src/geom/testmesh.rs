@@ -1,10 +1,25 @@
-//! Closed, CCW-outward test meshes (cube, UV sphere, torus) for tests and benchmarks: compiled
+//! Closed, CCW-outward test meshes (cube, UV sphere, torus) and an open grid for tests and benchmarks: compiled
 //! into the crate's own unit tests only (`#[cfg(test)]`), and included by path into the
 //! integration tests and benchmarks that need them (their parent module brings `Mesh` into
 //! scope), so they are not part of the library.
 
 use super::Mesh;
 use glam::Vec3;
+
+/// A grid of `rows x cols` vertices at `at(i, j)` (row `i`, column `j`), two triangles a cell,
+/// CCW seen from +z where `at` keeps the grid's orientation: an open sheet, not closed.
+pub fn grid(rows: u32, cols: u32, at: impl Fn(u32, u32) -> Vec3) -> Mesh {
+    let positions = (0..rows).flat_map(|i| (0..cols).map(move |j| (i, j))).map(|(i, j)| at(i, j)).collect();
+    let mut triangles = Vec::new();
+    for i in 0..rows.saturating_sub(1) {
+        for j in 0..cols.saturating_sub(1) {
+            let v = i * cols + j;
+            triangles.push([v, v + cols, v + 1]);
+            triangles.push([v + 1, v + cols, v + cols + 1]);
+        }
+    }
+    Mesh { positions, triangles }
+}
 
 /// Axis-aligned cube of half-size `h` around `c`: 8 vertices, 12 triangles.
 pub fn cube(c: Vec3, h: f32) -> Mesh {

@@ -164,6 +164,23 @@ pub fn pipeline_layout(
     unsafe { ctx.device().create_pipeline_layout(&info, None) }.map_err(vkerr("vkCreatePipelineLayout"))
 }
 
+/// A layout of `count` storage-buffer bindings 0, 1, 2, ..., one descriptor each, visible to
+/// `stages` (the compute and mesh passes' tables). The caller destroys it.
+pub fn storage_set_layout(ctx: &impl GpuDevice, count: u32, stages: vk::ShaderStageFlags) -> Result<vk::DescriptorSetLayout> {
+    let bindings: Vec<_> = (0..count)
+        .map(|i| {
+            vk::DescriptorSetLayoutBinding::default()
+                .binding(i)
+                .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
+                .descriptor_count(1)
+                .stage_flags(stages)
+        })
+        .collect();
+    // SAFETY: valid device; the create info points at locals alive for the call.
+    unsafe { ctx.device().create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None) }
+        .map_err(vkerr("vkCreateDescriptorSetLayout"))
+}
+
 /// One write per entry of `infos` into `set`'s storage-buffer bindings 0, 1, 2, ... (binding
 /// `k` gets `infos[k]`).
 pub fn storage_buffer_writes(set: vk::DescriptorSet, infos: &[[vk::DescriptorBufferInfo; 1]]) -> Vec<vk::WriteDescriptorSet<'_>> {

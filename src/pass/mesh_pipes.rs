@@ -10,7 +10,7 @@ use super::device::PassDevice;
 use super::mesh::{MeshPush, MESH_BINDINGS};
 use super::pipelines::{mirror, COUNT_FORMAT};
 use crate::error::{Error, Result};
-use crate::gpu::descriptors::pipeline_layout;
+use crate::gpu::descriptors::{pipeline_layout, storage_set_layout};
 use crate::gpu::pipeline::{self, Blend, PipelineDesc};
 use crate::gpu::{shaders, GpuDevice};
 use crate::shadow::Case;
@@ -76,18 +76,8 @@ impl MeshPipes {
         if task {
             stages |= vk::ShaderStageFlags::TASK_EXT;
         }
-        let bindings: Vec<_> = (0..MESH_BINDINGS)
-            .map(|i| {
-                vk::DescriptorSetLayoutBinding::default()
-                    .binding(i)
-                    .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                    .descriptor_count(1)
-                    .stage_flags(stages)
-            })
-            .collect();
-        // SAFETY: creation on a valid device from locals; destroyed in `destroy` (or below on error).
-        let set_layout = unsafe { d.create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None) }
-            .map_err(Error::vk("vkCreateDescriptorSetLayout"))?;
+        // destroyed in `destroy` (or below on error)
+        let set_layout = storage_set_layout(dev, MESH_BINDINGS, stages)?;
         let stages = stages | vk::ShaderStageFlags::FRAGMENT;
         let layout = match pipeline_layout(dev, &[set_layout], MeshPush::SIZE, stages) {
             Ok(l) => l,

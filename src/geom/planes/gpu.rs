@@ -171,7 +171,7 @@ mod tests {
     use super::super::exact_bit;
     use super::*;
     use crate::geom::order::TriangleOrder;
-    use crate::geom::testmesh::{shuffled, torus, uv_sphere};
+    use crate::geom::testmesh::{grid, shuffled, torus, uv_sphere};
     use glam::Vec3;
 
     /// The exact sign of `Σ terms` (each an f64 value, the sum not rounded): Shewchuk's
@@ -277,22 +277,10 @@ mod tests {
     #[test]
     fn gpu_blocks_need_the_allowance() {
         let (x0, y0) = (100_000.0f32, 5_000.0f32);
-        let mut positions = Vec::new();
-        for i in 0..5 {
-            for j in 0..9 {
-                let (x, y) = (x0 + i as f32 * 0.5, y0 + j as f32 * 0.5);
-                positions.push(Vec3::new(x, y, 2.0 * x - y));
-            }
-        }
-        let mut triangles = Vec::new();
-        for i in 0..4u32 {
-            for j in 0..8u32 {
-                let v = i * 9 + j;
-                triangles.push([v, v + 9, v + 1]);
-                triangles.push([v + 1, v + 9, v + 10]);
-            }
-        }
-        let m = Mesh { positions, triangles };
+        let m = grid(5, 9, |i, j| {
+            let (x, y) = (x0 + i as f32 * 0.5, y0 + j as f32 * 0.5);
+            Vec3::new(x, y, 2.0 * x - y)
+        });
         let planes = FacePlanes::new(&m);
         let block = planes.gpu_blocks(&m)[0];
         assert_eq!(block[11], 1.0);

@@ -1,7 +1,7 @@
 //! `FacePlanes` against the exact predicate: block bounds, super-blocks and scan orders.
 
 use super::*;
-use crate::geom::testmesh::uv_sphere;
+use crate::geom::testmesh::{grid, uv_sphere};
 use proptest::prelude::*;
 
 impl FacePlanes {
@@ -109,21 +109,7 @@ proptest! {
         // 8 blocks of exactly coplanar (or tilted by h) triangles: their spread is zero,
         // so the block test decides them from lights barely off the plane; it must never
         // disagree with the exact predicate
-        let mut positions = Vec::new();
-        for i in 0..17 {
-            for j in 0..17 {
-                positions.push(Vec3::new(i as f32, j as f32, z + (i as f32) * h) * big);
-            }
-        }
-        let mut triangles = Vec::new();
-        for i in 0..16u32 {
-            for j in 0..16u32 {
-                let v = i * 17 + j;
-                triangles.push([v, v + 17, v + 1]);
-                triangles.push([v + 1, v + 17, v + 18]);
-            }
-        }
-        let m = Mesh { positions, triangles };
+        let m = grid(17, 17, |i, j| Vec3::new(i as f32, j as f32, z + (i as f32) * h) * big);
         let planes = FacePlanes::new(&m);
         let mut bits = Vec::new();
         for lz in [0.0f32, 1e-7, -1e-7, 1e-4, 3.0] {

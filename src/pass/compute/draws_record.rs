@@ -5,7 +5,7 @@
 use super::draws::{pieces, Merged, Xform, COMMAND_BYTES, COMPACT_GROUP, LIST_HEADER, SIGN};
 use super::{SlotCompute, HEADER_WORDS};
 use crate::error::{Error, Misuse, Result};
-use crate::gpu::descriptors::pipeline_layout;
+use crate::gpu::descriptors::{pipeline_layout, storage_set_layout};
 use crate::gpu::{pipeline, shaders};
 use crate::pass::desc::{ComputeDraws, DepthMode, ShadowPassDesc, TargetModel};
 use crate::pass::device::PassDevice;
@@ -98,19 +98,8 @@ impl DrawPipes {
             self.count = Some(count);
         }
         let d = &dev.device;
-        let bindings: Vec<_> = (0..2)
-            .map(|i| {
-                vk::DescriptorSetLayoutBinding::default()
-                    .binding(i)
-                    .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                    .descriptor_count(1)
-                    .stage_flags(vk::ShaderStageFlags::COMPUTE)
-            })
-            .collect();
-        // SAFETY: creation on a valid device from locals; destroyed in `destroy`.
-        self.set_layout =
-            unsafe { d.create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None) }
-                .map_err(Error::vk("vkCreateDescriptorSetLayout"))?;
+        // destroyed in `destroy`
+        self.set_layout = storage_set_layout(dev, 2, vk::ShaderStageFlags::COMPUTE)?;
         let push = std::mem::size_of::<CompactPush>() as u32;
         self.layout = pipeline_layout(dev, &[self.set_layout], push, vk::ShaderStageFlags::COMPUTE)?;
         let module = pipeline::shader_module(dev, shaders::COMPACT_DRAWS_WGSL)?;

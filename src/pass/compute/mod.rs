@@ -43,7 +43,7 @@ pub(crate) mod tables;
 
 use super::device::PassDevice;
 use crate::error::{Error, Result};
-use crate::gpu::descriptors::pipeline_layout;
+use crate::gpu::descriptors::{pipeline_layout, storage_set_layout};
 use crate::gpu::{pipeline, shaders, Buffer, GpuDevice};
 use crate::shadow::meshlet::Meshlets;
 use crate::shadow::{Caster, CasterKind};
@@ -321,18 +321,8 @@ pub(crate) const BINDINGS: u32 = 11;
 impl ComputePipes {
     pub fn new(dev: &PassDevice) -> Result<ComputePipes> {
         let d = dev.device();
-        let bindings: Vec<_> = (0..BINDINGS)
-            .map(|i| {
-                vk::DescriptorSetLayoutBinding::default()
-                    .binding(i)
-                    .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                    .descriptor_count(1)
-                    .stage_flags(vk::ShaderStageFlags::COMPUTE)
-            })
-            .collect();
-        // SAFETY: creation on a valid device from locals; destroyed in `destroy` (or below on error).
-        let set_layout = unsafe { d.create_descriptor_set_layout(&vk::DescriptorSetLayoutCreateInfo::default().bindings(&bindings), None) }
-            .map_err(Error::vk("vkCreateDescriptorSetLayout"))?;
+        // destroyed in `destroy` (or below on error)
+        let set_layout = storage_set_layout(dev, BINDINGS, vk::ShaderStageFlags::COMPUTE)?;
         let mut me = ComputePipes { set_layout, layout: vk::PipelineLayout::null(), stages: [vk::Pipeline::null(); 4] };
         match me.create(dev) {
             Ok(()) => Ok(me),

@@ -139,17 +139,7 @@ impl ShadowPass {
                 let counts = [vk::DescriptorBufferInfo { buffer: counts_raw, offset: 0, range: counts_range }];
                 let infos: [[vk::DescriptorBufferInfo; 1]; crate::pass::mesh::MESH_BINDINGS as usize] =
                     [whole(arena[2]), whole(arena[1]), whole(arena[4]), whole(arena[5]), whole(arena[6]), ranged(2), counts];
-                let writes: Vec<vk::WriteDescriptorSet> = infos
-                    .iter()
-                    .enumerate()
-                    .map(|(b, info)| {
-                        vk::WriteDescriptorSet::default()
-                            .dst_set(sets[0])
-                            .dst_binding(b as u32)
-                            .descriptor_type(vk::DescriptorType::STORAGE_BUFFER)
-                            .buffer_info(info)
-                    })
-                    .collect();
+                let writes = crate::gpu::descriptors::storage_buffer_writes(sets[0], &infos);
                 // SAFETY: as above.
                 unsafe { d.update_descriptor_sets(&writes, &[]) };
                 cf.mesh_set = sets[0];
