@@ -4,7 +4,7 @@
 mod common;
 use glam::{EulerRot, Mat4, Quat, Vec2, Vec3};
 use proptest::prelude::*;
-use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
+use proptest::test_runner::{Config, TestRunner};
 use std::cell::RefCell;
 use umbrage::accuracy::{evaluate, THRESHOLD};
 use umbrage::render::{RenderOptions, Renderer};
@@ -133,28 +133,15 @@ fn check(ctx: &RefCell<Option<umbrage::gpu::Context>>, case: &Case, drawn: &std:
     Ok(())
 }
 
-/// The property's random source: a fixed seed by default, so that CI is reproducible (a case
-/// it finds is kept in [`regressions`]); `UMBRAGE_PROPTEST_SEED=<u64>` replays a run and
-/// `UMBRAGE_PROPTEST_SEED=random` explores, with `UMBRAGE_PROPTEST_CASES` cases (24 by default).
+/// The property's runner: a fixed seed by default, so that CI is reproducible (a case it
+/// finds is kept in [`regressions`]); `UMBRAGE_PROPTEST_SEED=<u64>` replays a run and
+/// `UMBRAGE_PROPTEST_SEED=random` explores ([`common::proptest_seed`]), with
+/// `UMBRAGE_PROPTEST_CASES` cases (24 by default).
 fn runner() -> (TestRunner, String) {
     let cases = std::env::var("UMBRAGE_PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(24);
     let config = Config { cases, failure_persistence: None, ..Config::default() };
-    let seed = match std::env::var("UMBRAGE_PROPTEST_SEED").as_deref() {
-        Ok("random") => rand_seed(),
-        Ok(v) => v.parse().expect("UMBRAGE_PROPTEST_SEED: a u64 or `random`"),
-        Err(_) => 0x2026_1203,
-    };
-    let mut bytes = [0u8; 32];
-    bytes[..8].copy_from_slice(&seed.to_le_bytes());
-    let rng = TestRng::from_seed(RngAlgorithm::ChaCha, &bytes);
-    (TestRunner::new_with_rng(config, rng), format!("UMBRAGE_PROPTEST_SEED={seed}, {cases} cases"))
-}
-
-fn rand_seed() -> u64 {
-    use std::hash::{BuildHasher, Hasher};
-    let mut h = std::collections::hash_map::RandomState::new().build_hasher();
-    h.write_u128(std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_nanos()).unwrap_or(0));
-    h.finish()
+    let seed = common::proptest_seed("proptest_gpu", 0x2026_1203);
+    (TestRunner::new_with_rng(config, common::seeded_rng(seed)), format!("UMBRAGE_PROPTEST_SEED={seed}, {cases} cases"))
 }
 
 #[test]

@@ -210,3 +210,34 @@ translate = [2.6, 1.0, 0.0]
 pub fn mixed_scene() -> umbrage::scene::Scene {
     umbrage::scene::load_str(MIXED, "mixed", std::path::Path::new(".")).unwrap()
 }
+
+/// The seed of a GPU property test's random source: `default` (so that CI is reproducible),
+/// `UMBRAGE_PROPTEST_SEED=<u64>` to replay a run, or `UMBRAGE_PROPTEST_SEED=random` to
+/// explore. The seed is written straight to the process's stderr, past the test harness's
+/// capture, so that a run the driver aborts (a crash loses the captured output) still names
+/// the seed that replays it.
+pub fn proptest_seed(test: &str, default: u64) -> u64 {
+    use std::io::Write;
+    let seed = match std::env::var("UMBRAGE_PROPTEST_SEED").as_deref() {
+        Ok("random") => random_seed(),
+        Ok(v) => v.parse().expect("UMBRAGE_PROPTEST_SEED: a u64 or `random`"),
+        Err(_) => default,
+    };
+    let _ = writeln!(std::io::stderr().lock(), "{test}: UMBRAGE_PROPTEST_SEED={seed}");
+    seed
+}
+
+/// A ChaCha test RNG from `seed`.
+pub fn seeded_rng(seed: u64) -> proptest::test_runner::TestRng {
+    use proptest::test_runner::{RngAlgorithm, TestRng};
+    let mut bytes = [0u8; 32];
+    bytes[..8].copy_from_slice(&seed.to_le_bytes());
+    TestRng::from_seed(RngAlgorithm::ChaCha, &bytes)
+}
+
+fn random_seed() -> u64 {
+    use std::hash::{BuildHasher, Hasher};
+    let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+    h.write_u128(std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_nanos()).unwrap_or(0));
+    h.finish()
+}
