@@ -502,14 +502,21 @@ impl Sut {
     /// pass's holding the casters of the model it was prepared from (later calls must not
     /// have reached it).
     fn retire(&mut self, slot: usize) {
-        let Some(InFlight { model, .. }) = self.in_flight.get_mut(slot).and_then(Option::take) else { return };
+        if self.in_flight.get(slot).is_none_or(Option::is_none) {
+            return;
+        }
+        // The entry stays until the fence has signalled: a panic before that leaves it for
+        // `Drop` to wait on (the pass must not be dropped under the frame).
+        let fence = with_harness(|h| {
+            let fence = h.slots[slot].fence;
+            // SAFETY: the fence was submitted with the slot's frame.
+            unsafe { h.ctx.device.wait_for_fences(&[fence], true, u64::MAX) }.unwrap();
+            fence
+        });
+        let Some(InFlight { model, .. }) = self.in_flight[slot].take() else { return };
         let (got, want) = with_harness(|h| {
-            let s = &h.slots[slot];
-            // SAFETY: the fence was submitted with the slot's frame; reset once signalled.
-            unsafe {
-                h.ctx.device.wait_for_fences(&[s.fence], true, u64::MAX).unwrap();
-                h.ctx.device.reset_fences(&[s.fence]).unwrap();
-            }
+            // SAFETY: signalled above: its frame has completed.
+            unsafe { h.ctx.device.reset_fences(&[fence]) }.unwrap();
             let got = stencil(&h.slots[slot].target);
             (got, reference_stencil(h, &model))
         });
