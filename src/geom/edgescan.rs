@@ -17,11 +17,13 @@
 //!   order) holds no silhouette edge and is skipped whole; the others test each edge's two
 //!   bits in the two words already loaded, with no further memory access.
 //!
-//! Per light, the scan first finds the **runs** of equal uniform words (all ones or all zeros)
-//! over the words it touches: a class skips every word whose reach (the word and the words `δ`
-//! slots on) lies in one run, a run at a time, and a facing word whose word pairs all end
-//! inside its run skips them all at once. In a spatial order the work is then about the words
-//! the light's terminator crosses, not the mesh's size.
+//! Per light, the scan first lists the **breaks** among the facing words it touches: the
+//! words that are mixed (neither all ones nor all zeros) or differ from the word before.
+//! Between two breaks every word is the same uniform word, and no edge with both slots there
+//! is on the silhouette: a class visits only the words whose reach (the word and the words `δ`
+//! slots on) holds a break, and a facing word's word pairs are skipped up to the first break
+//! after it. In a spatial order the work is then about the words the light's terminator
+//! crosses, not the mesh's size.
 //!
 //! Both paths test exactly the same two bits of every edge, so the result is the plain scan's,
 //! edge for edge, and its edges keep the caller's triangle ids.
@@ -60,15 +62,12 @@ pub struct EdgeScan {
 }
 
 /// The word pairs `pairs[start .. end]` (`start` the previous `LoWord`'s `end`) have their
-/// `lo` slots in facing word `w`, and their `hi` words at most `max_hi`; those before
-/// `far` have their `hi` word less than 64 words on, bit `hi - w` of `near`.
+/// `lo` slots in facing word `w`, and their `hi` words at most `max_hi`.
 #[derive(Clone, Copy, Debug, Default)]
 struct LoWord {
     w: u32,
     max_hi: u32,
     end: u32,
-    far: u32,
-    near: u64,
 }
 
 /// The residual edges with their `lo` slot in the facing word of their [`LoWord`] and their
@@ -202,7 +201,6 @@ impl EdgeScan {
         // residual edges by word pair (stable: the given order inside a pair)
         residual.sort_by_key(|&(_, lo, hi, _)| (lo / 64, hi / 64));
         for by_lo in residual.chunk_by(|x, y| x.1 / 64 == y.1 / 64) {
-            let first_offset = scan.offsets.len();
             for run in by_lo.chunk_by(|x, y| x.2 / 64 == y.2 / 64) {
                 for &(e, lo, hi, is_t0) in run {
                     scan.offsets.push([(lo % 64) as u8 | (u8::from(is_t0) << 7), (hi % 64) as u8]);
@@ -212,9 +210,7 @@ impl EdgeScan {
             }
             let w = by_lo[0].1 / 64;
             let max_hi = by_lo.iter().map(|x| x.2 / 64).max().unwrap_or(0);
-            let far = scan.pairs.partition_point(|p| p.end as usize <= first_offset || p.hi < w + 64) as u32;
-            let near = by_lo.iter().filter(|x| x.2 / 64 < w + 64).fold(0u64, |m, x| m | 1 << (x.2 / 64 - w));
-            scan.lo_words.push(LoWord { w, max_hi, end: scan.pairs.len() as u32, far, near });
+            scan.lo_words.push(LoWord { w, max_hi, end: scan.pairs.len() as u32 });
         }
         // the words read: each class's own and shifted words, each pair's two words
         let mut words = (usize::MAX, 0usize);
@@ -258,41 +254,47 @@ impl EdgeScan {
     ///
     /// [`possible_silhouette`]: super::silhouette::possible_silhouette
     pub fn scan_into(&self, bits: &[u64], out: &mut Vec<SilhouetteEdge>) {
-        RUNS.with_borrow_mut(|runs| {
-            let runs = Runs::new(bits, self.words, runs);
+        BREAKS.with_borrow_mut(|breaks| {
+            find_breaks(bits, self.words, breaks);
             for c in &self.classes {
-                self.scan_class(c, bits, &runs, out);
+                self.scan_class(c, bits, breaks, out);
             }
-            self.scan_pairs(bits, &runs, out);
+            self.scan_pairs(bits, breaks, out);
         })
     }
 
-    fn scan_pairs(&self, bits: &[u64], runs: &Runs, out: &mut Vec<SilhouetteEdge>) {
+    fn scan_pairs(&self, bits: &[u64], breaks: &[u32], out: &mut Vec<SilhouetteEdge>) {
         let rest = &self.edges[self.rest..];
         let word = |w: u32| bits.get(w as usize).copied().unwrap_or(0);
         let mut first_pair = 0usize;
+        // the first break after the current word (the lo words increase)
+        let mut next = 0usize;
         for l in &self.lo_words {
             let pairs = first_pair..l.end as usize;
             first_pair = l.end as usize;
-            // every pair of the word ends inside its run: nothing on the silhouette
-            if runs.end(l.w as usize) > l.max_hi as usize {
-                continue;
+            while breaks[next] <= l.w {
+                next += 1;
             }
             let a = word(l.w);
-            // every near pair's hi word is uniform and equal to the uniform lo word: only the
-            // far pairs are left
-            let pairs = if runs.same_as(l.w as usize, a, l.near) { l.far as usize..pairs.end } else { pairs };
+            // a uniform word, and every word up to the next break equal to it: the pairs whose
+            // hi word lies before that break hold no silhouette edge
+            let clear_below = if a.wrapping_add(1) > 1 { 0 } else { breaks[next] };
+            if clear_below > l.max_hi {
+                continue;
+            }
             let mut start = if pairs.start == 0 { 0 } else { self.pairs[pairs.start - 1].end as usize };
             for p in &self.pairs[pairs] {
                 let end = p.end as usize;
-                let b = word(p.hi);
                 // both words all ones or both all zeros: no edge of the pair is on the silhouette
-                if a != b || a.wrapping_add(1) > 1 {
-                    for (o, e) in self.offsets[start..end].iter().zip(&rest[start..end]) {
-                        let fl = (a >> (o[0] & 63)) & 1;
-                        let fh = (b >> (o[1] & 63)) & 1;
-                        if fl != fh {
-                            out.push(oriented(e, (fl != 0) == (o[0] >= 128)));
+                if p.hi >= clear_below {
+                    let b = word(p.hi);
+                    if a != b || a.wrapping_add(1) > 1 {
+                        for (o, e) in self.offsets[start..end].iter().zip(&rest[start..end]) {
+                            let fl = (a >> (o[0] & 63)) & 1;
+                            let fh = (b >> (o[1] & 63)) & 1;
+                            if fl != fh {
+                                out.push(oriented(e, (fl != 0) == (o[0] >= 128)));
+                            }
                         }
                     }
                 }
@@ -301,122 +303,64 @@ impl EdgeScan {
         }
     }
 
-    fn scan_class(&self, c: &DeltaClass, bits: &[u64], runs: &Runs, out: &mut Vec<SilhouetteEdge>) {
+    fn scan_class(&self, c: &DeltaClass, bits: &[u64], breaks: &[u32], out: &mut Vec<SilhouetteEdge>) {
         let edges = &self.edges[c.first..];
-        // the words `w .. w + reach` are read for the class's word `w`
+        // the words `w ..= w + reach` are read for the class's word `w`: it can hold a
+        // silhouette edge only when a break lies among them
         let reach = (c.delta as usize).div_ceil(64);
-        let mut i = 0;
-        while i < c.masks.len() {
-            let w = c.first_word + i;
-            let end = runs.end(w);
-            if end > w + reach {
-                // the word and its shifted words lie in one uniform run, and so do those of the
-                // next words up to the run's end: no edge of theirs is on the silhouette
-                i = end - reach - c.first_word;
-                continue;
+        let (lo, hi) = (c.first_word, c.first_word + c.masks.len());
+        let mut done = lo;
+        let from = breaks.partition_point(|&b| (b as usize) < lo);
+        for &b in &breaks[from..] {
+            let b = b as usize;
+            if b >= hi + reach {
+                break;
             }
-            let m = c.masks[i];
-            let f = bits.get(w).copied().unwrap_or(0);
-            let mut s = (f ^ shifted(bits, w, c.delta)) & m;
-            while s != 0 {
-                let k = s.trailing_zeros();
-                s &= s - 1;
-                let rank = c.ranks[i] + (m & ((1u64 << k) - 1)).count_ones();
-                let e = &edges[rank as usize];
-                // `f`'s bit k is slot lo's
-                let lo_lit = (f >> k) & 1 != 0;
-                let lo_is_t0 = (c.lo_t0[i] >> k) & 1 != 0;
-                out.push(oriented(e, lo_lit == lo_is_t0));
+            for w in b.saturating_sub(reach).max(done)..(b + 1).min(hi) {
+                let i = w - lo;
+                let m = c.masks[i];
+                if m == 0 {
+                    continue;
+                }
+                let f = bits.get(w).copied().unwrap_or(0);
+                let mut s = (f ^ shifted(bits, w, c.delta)) & m;
+                while s != 0 {
+                    let k = s.trailing_zeros();
+                    s &= s - 1;
+                    let rank = c.ranks[i] + (m & ((1u64 << k) - 1)).count_ones();
+                    let e = &edges[rank as usize];
+                    // `f`'s bit k is slot lo's
+                    let lo_lit = (f >> k) & 1 != 0;
+                    let lo_is_t0 = (c.lo_t0[i] >> k) & 1 != 0;
+                    out.push(oriented(e, lo_lit == lo_is_t0));
+                }
             }
-            i += 1;
+            done = done.max((b + 1).min(hi));
         }
     }
 }
 
-/// The runs of equal uniform facing words over the words `first .. first + end.len()`:
-/// `end[w - first]` is the end (exclusive) of the run of words equal to word `w` from `w` on
-/// when `w` is all ones or all zeros, else `w` (words past the bits are zeros; outside the
-/// range every word is its own, empty, run).
-///
-/// Also the sets of all-ones and all-zeros words over the same range, one bit a word
-/// (`ones`, `zeros`: bit `w - first`).
-struct Runs<'a> {
-    first: usize,
-    end: &'a [u32],
-    ones: &'a [u64],
-    zeros: &'a [u64],
-}
-
-/// [`Runs`]' tables.
-#[derive(Default)]
-struct RunScratch {
-    end: Vec<u32>,
-    ones: Vec<u64>,
-    zeros: Vec<u64>,
-}
-
-impl<'a> Runs<'a> {
-    fn new(bits: &[u64], (first, last): (usize, usize), scratch: &'a mut RunScratch) -> Runs<'a> {
-        let RunScratch { end: scratch, ones, zeros } = scratch;
-        let sets = (last - first).div_ceil(64) + 1;
-        for v in [&mut *ones, &mut *zeros] {
-            v.clear();
-            v.resize(sets, 0);
+/// The breaks among facing words `first .. last` into `breaks` (increasing, then `u32::MAX`):
+/// every word that is neither all ones nor all zeros, and every other word that differs from
+/// the word before it (from `first + 1` on; words past the bits are zeros). Between two breaks
+/// all words are one uniform word.
+fn find_breaks(bits: &[u64], (first, last): (usize, usize), breaks: &mut Vec<u32>) {
+    breaks.clear();
+    let word = |w: usize| bits.get(w).copied().unwrap_or(0);
+    let mut prev = word(first);
+    for w in first..last {
+        let a = word(w);
+        if a != prev || a.wrapping_add(1) > 1 {
+            breaks.push(w as u32);
         }
-        scratch.clear();
-        scratch.resize(last - first, 0);
-        let word = |w: usize| bits.get(w).copied().unwrap_or(0);
-        let mut next = (u64::MAX / 3, last as u32); // (word w + 1, its run end): none yet
-        for w in (first..last).rev() {
-            let a = word(w);
-            let e = if a.wrapping_add(1) > 1 {
-                w as u32
-            } else if next.0 == a {
-                next.1
-            } else {
-                w as u32 + 1
-            };
-            scratch[w - first] = e;
-            next = (a, e);
-            let i = w - first;
-            ones[i / 64] |= u64::from(a == u64::MAX) << (i % 64);
-            zeros[i / 64] |= u64::from(a == 0) << (i % 64);
-        }
-        Runs { first, end: scratch, ones, zeros }
+        prev = a;
     }
-
-    /// True when word `w` (its bits `a`) is all ones or all zeros and so is every word
-    /// `w + k` for bit `k` of `near`, with the same bits (words outside the range count as
-    /// mixed).
-    #[inline]
-    fn same_as(&self, w: usize, a: u64, near: u64) -> bool {
-        let set = if a == u64::MAX {
-            self.ones
-        } else if a == 0 {
-            self.zeros
-        } else {
-            return false;
-        };
-        let Some(i) = w.checked_sub(self.first) else { return false };
-        let (q, r) = (i / 64, i % 64);
-        let lo = set.get(q).copied().unwrap_or(0) >> r;
-        let window = if r == 0 { lo } else { lo | (set.get(q + 1).copied().unwrap_or(0) << (64 - r)) };
-        window & near == near
-    }
-
-    /// The end of word `w`'s run (`w` when it has none).
-    #[inline]
-    fn end(&self, w: usize) -> usize {
-        match w.checked_sub(self.first).and_then(|i| self.end.get(i)) {
-            Some(&e) => e as usize,
-            None => w,
-        }
-    }
+    breaks.push(u32::MAX);
 }
 
 thread_local! {
-    /// [`Runs`]' table, kept per thread across calls.
-    static RUNS: std::cell::RefCell<RunScratch> = std::cell::RefCell::new(RunScratch::default());
+    /// [`find_breaks`]' list, kept per thread across calls.
+    static BREAKS: std::cell::RefCell<Vec<u32>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 #[cfg(test)]

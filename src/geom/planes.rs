@@ -104,31 +104,62 @@ struct BlockBound {
     decidable: bool,
 }
 
+/// The filter light's values every block test uses, computed once per light.
+#[derive(Clone, Copy, Debug)]
+struct Probe {
+    p: [f64; 3],
+    w: f64,
+    pinf: f64,
+    e: f64,
+}
+
+impl Probe {
+    /// For the filter light `l` (`w` = ±1 or 0) and error bound `e`.
+    fn new(l: Vec4, e: f64) -> Probe {
+        let p = [l.x as f64, l.y as f64, l.z as f64];
+        Probe { p, w: l.w as f64, pinf: p[0].abs().max(p[1].abs()).max(p[2].abs()), e }
+    }
+}
+
 impl BlockBound {
     /// The block's facing for the filter light `l` (`w` = ±1 or 0) with error bound `e`:
     /// `Some(true)` when every triangle faces it, `Some(false)` when none does.
-    #[inline]
+    #[cfg(test)]
     fn decide(&self, l: Vec4, e: f64) -> Option<bool> {
-        if !self.decidable {
-            return None;
+        match self.test(&Probe::new(l, e)) {
+            (true, _) => Some(true),
+            (_, true) => Some(false),
+            _ => None,
         }
-        let (p, w) = ([l.x as f64, l.y as f64, l.z as f64], l.w as f64);
+    }
+
+    /// Without branches: (every triangle faces the probe's light, none does); at most one
+    /// is true, neither for a block that is not decidable.
+    #[inline(always)]
+    fn test(&self, probe: &Probe) -> (bool, bool) {
+        let (p, w) = (probe.p, probe.w);
         let q = [p[0] - self.c[0] * w, p[1] - self.c[1] * w, p[2] - self.c[2] * w];
         let centre = self.n[0] * q[0] + self.n[1] * q[1] + self.n[2] * q[2] + self.d * w;
         let spread = self.spread[0] * q[0].abs() + self.spread[1] * q[1].abs() + self.spread[2] * q[2].abs() + self.spread_d * w.abs();
-        let pinf = p[0].abs().max(p[1].abs()).max(p[2].abs());
         // a dozen f64 operations on terms bounded by these magnitudes: 2^-40 of them is far
         // above their rounding
-        let slack = ((self.scale[0] * (pinf + self.scale[1])) + self.scale[2]) * 2f64.powi(-40);
-        let margin = spread + slack + e;
-        if centre > margin {
-            Some(true)
-        } else if centre < -margin {
-            Some(false)
-        } else {
-            None
-        }
+        let slack = ((self.scale[0] * (probe.pinf + self.scale[1])) + self.scale[2]) * 2f64.powi(-40);
+        let margin = spread + slack + probe.e;
+        (self.decidable & (centre > margin), self.decidable & (centre < -margin))
     }
+}
+
+/// [`BlockBound::test`] of up to 64 consecutive bounds at once: bit `i` of the first mask is
+/// set when `bounds[i]` decides its block facing, of the second when not facing.
+#[inline]
+fn test_blocks(bounds: &[BlockBound], probe: &Probe) -> (u64, u64) {
+    let (mut ones, mut zeros) = (0u64, 0u64);
+    for (i, b) in bounds.iter().take(64).enumerate() {
+        let (all, none) = b.test(probe);
+        ones |= u64::from(all) << i;
+        zeros |= u64::from(none) << i;
+    }
+    (ones, zeros)
 }
 
 fn corners(mesh: &Mesh, t: usize) -> Option<[Vec3; 3]> {
@@ -470,37 +501,50 @@ impl FacePlanes {
             .zip(self.nz[a..b].chunks_exact(64))
             .zip(self.d[a..b].chunks_exact(64));
         let (words, last) = (n.div_ceil(64), first + out.len());
-        // words before `decided.0` belong to a super-block decided `decided.1`
-        let mut decided = (0usize, false);
-        for (i, (o, (((nx, ny), nz), d))) in out.iter_mut().zip(blocks).enumerate() {
-            let (base, w) = (a + i * 64, first + i);
-            let valid = if base + 64 <= n { u64::MAX } else { (1u64 << (n - base)) - 1 };
-            if w < decided.0 {
-                *o = if decided.1 { valid } else { 0 };
+        let probe = Probe::new(lf, e as f64);
+        let size = SUPER_BLOCKS[0];
+        let valid = |w: usize| if (w + 1) * 64 <= n { u64::MAX } else { (1u64 << (n - w * 64)) - 1 };
+        let mut blocks = blocks;
+        let mut w = first;
+        while w < last {
+            // the super-block of word `w`, where all its words are this call's
+            let s = w / size;
+            let end = ((s + 1) * size).min(words).min(last);
+            let whole = s * size >= first && ((s + 1) * size).min(words) <= last;
+            let sup = match self.supers[0].get(s) {
+                Some(b) if whole => b.test(&probe),
+                _ => (false, false),
+            };
+            if sup.0 || sup.1 {
+                for v in w..end {
+                    out[v - first] = if sup.0 { valid(v) } else { 0 };
+                }
+                blocks.nth(end - w - 1);
+                w = end;
                 continue;
             }
-            let sup = SUPER_BLOCKS.iter().zip(&self.supers).find_map(|(&size, bounds)| {
-                let end = (w + size).min(words);
-                (w % size == 0 && end <= last).then(|| bounds.get(w / size).and_then(|b| b.decide(lf, e as f64)).map(|all| (end, all)))?
-            });
-            if let Some(d) = sup {
-                decided = d;
-                *o = if d.1 { valid } else { 0 };
-                continue;
+            // its blocks' bounds, all at once
+            let (ones, zeros) = test_blocks(self.blocks.get(w..end).unwrap_or(&[]), &probe);
+            for k in 0..end - w {
+                let v = w + k;
+                let Some((((nx, ny), nz), d)) = blocks.next() else { break };
+                out[v - first] = if (ones >> k) & 1 != 0 {
+                    valid(v)
+                } else if (zeros >> k) & 1 != 0 {
+                    0
+                } else {
+                    let (bits, unsure) = block64(nx, ny, nz, d, lf, e);
+                    let mut word = bits & valid(v);
+                    let mut u = unsure & valid(v);
+                    while u != 0 {
+                        let k = u.trailing_zeros() as usize;
+                        u &= u - 1;
+                        word = (word & !(1 << k)) | (u64::from(exact_bit(mesh, self.tri(v * 64 + k), l, flip)) << k);
+                    }
+                    word
+                };
             }
-            if let Some(all) = self.blocks.get(w).and_then(|b| b.decide(lf, e as f64)) {
-                *o = if all { valid } else { 0 };
-                continue;
-            }
-            let (bits, unsure) = block64(nx, ny, nz, d, lf, e);
-            let mut w = bits & valid;
-            let mut u = unsure & valid;
-            while u != 0 {
-                let k = u.trailing_zeros() as usize;
-                u &= u - 1;
-                w = (w & !(1 << k)) | (u64::from(exact_bit(mesh, self.tri(base + k), l, flip)) << k);
-            }
-            *o = w;
+            w = end;
         }
     }
 }
