@@ -346,14 +346,25 @@ impl EdgeScan {
 /// all words are one uniform word.
 fn find_breaks(bits: &[u64], (first, last): (usize, usize), breaks: &mut Vec<u32>) {
     breaks.clear();
-    let word = |w: usize| bits.get(w).copied().unwrap_or(0);
-    let mut prev = word(first);
-    for w in first..last {
-        let a = word(w);
-        if a != prev || a.wrapping_add(1) > 1 {
-            breaks.push(w as u32);
+    // the words inside the bits, 64 at a time into a mask (no branch per word), then the
+    // zeros past them
+    let inside = &bits[first.min(bits.len())..last.min(bits.len())];
+    let mut prev = inside.first().copied().unwrap_or(0);
+    for (c, chunk) in inside.chunks(64).enumerate() {
+        let mut m = 0u64;
+        for (k, &a) in chunk.iter().enumerate() {
+            m |= u64::from((a != prev) | (a.wrapping_add(1) > 1)) << k;
+            prev = a;
         }
-        prev = a;
+        while m != 0 {
+            let k = m.trailing_zeros() as usize;
+            m &= m - 1;
+            breaks.push((first + c * 64 + k) as u32);
+        }
+    }
+    let past = first.max(bits.len());
+    if past < last && past > first && prev != 0 {
+        breaks.push(past as u32);
     }
     breaks.push(u32::MAX);
 }
