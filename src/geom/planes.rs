@@ -122,17 +122,6 @@ impl Probe {
 }
 
 impl BlockBound {
-    /// The block's facing for the filter light `l` (`w` = ±1 or 0) with error bound `e`:
-    /// `Some(true)` when every triangle faces it, `Some(false)` when none does.
-    #[cfg(test)]
-    fn decide(&self, l: Vec4, e: f64) -> Option<bool> {
-        match self.test(&Probe::new(l, e)) {
-            (true, _) => Some(true),
-            (_, true) => Some(false),
-            _ => None,
-        }
-    }
-
     /// Without branches: (every triangle faces the probe's light, none does); at most one
     /// is true, neither for a block that is not decidable.
     #[inline(always)]

@@ -9,7 +9,7 @@ impl FacePlanes {
     fn decided_blocks(&self, l: Vec4, flip: bool) -> usize {
         let Some((lf, e)) = self.error_bound(l) else { return 0 };
         let lf = if flip { -lf } else { lf };
-        self.blocks.iter().filter(|b| b.decide(lf, e as f64).is_some()).count()
+        self.blocks.iter().filter(|b| b.test(&Probe::new(lf, e as f64)) != (false, false)).count()
     }
 }
 
