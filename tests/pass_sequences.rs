@@ -507,6 +507,9 @@ impl Sut {
         }
         // The entry stays until the fence has signalled: a panic before that leaves it for
         // `Drop` to wait on (the pass must not be dropped under the frame).
+        if injected_failure() && self.in_flight[slot].as_ref().is_some_and(|f| f.serial >= 2) {
+            panic!("{INJECTED}");
+        }
         let fence = with_harness(|h| {
             let fence = h.slots[slot].fence;
             // SAFETY: the fence was submitted with the slot's frame.
@@ -715,6 +718,14 @@ impl StateMachineTest for Sequences {
     }
 }
 
+/// The panic [`a_failing_sequence_is_reported`] injects (`PASS_SEQUENCES_INJECT_FAILURE` set):
+/// in `retire`, before the fence of the third frame submitted in a sequence is waited for.
+const INJECTED: &str = "injected failure (PASS_SEQUENCES_INJECT_FAILURE)";
+
+fn injected_failure() -> bool {
+    std::env::var_os("PASS_SEQUENCES_INJECT_FAILURE").is_some()
+}
+
 fn cases() -> u32 {
     std::env::var("PASS_SEQUENCES_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(200)
 }
@@ -798,7 +809,9 @@ fn every_call_sequence_matches_a_fresh_pass() {
     let failure_persistence =
         Some(Box::new(FileFailurePersistence::Direct(concat!(env!("CARGO_MANIFEST_DIR"), "/proptest-regressions/pass_sequences.txt")))
             as Box<dyn proptest::test_runner::FailurePersistence>);
-    let config = Config { cases: cases(), max_shrink_iters: 2000, failure_persistence, ..Config::default() };
+    // an injected failure is neither kept nor shrunk far
+    let (failure_persistence, max_shrink_iters) = if injected_failure() { (None, 20) } else { (failure_persistence, 2000) };
+    let config = Config { cases: cases(), max_shrink_iters, failure_persistence, ..Config::default() };
     let seed = common::proptest_seed("pass_sequences", 0x2026_1206);
     for fif in 1..=MAX_FRAMES_IN_FLIGHT {
         FRAMES_IN_FLIGHT.with(|f| f.set(fif));
@@ -837,4 +850,29 @@ fn every_call_sequence_matches_a_fresh_pass() {
     }
     destroy_target(&h.ctx, h.reference_target);
     h.ctx.check_validation().unwrap();
+}
+
+/// A failing sequence must come out as a test failure naming its seed and its case, never as
+/// a crash: the test re-runs itself in a child process with a failure injected while a frame
+/// is still in flight (the window in which CI once saw the process abort with `free():
+/// corrupted unsorted chunks` and no message), and checks the child's exit and output.
+#[test]
+fn a_failing_sequence_is_reported() {
+    if injected_failure() {
+        return; // the child runs only the sequences
+    }
+    let out = std::process::Command::new(std::env::current_exe().unwrap())
+        .args(["every_call_sequence_matches_a_fresh_pass", "--exact", "--nocapture", "--test-threads", "1"])
+        .env("PASS_SEQUENCES_INJECT_FAILURE", "1")
+        .env("PASS_SEQUENCES_CASES", "4")
+        .output()
+        .unwrap();
+    let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    let tail = &text[text.len().saturating_sub(3000)..];
+    // 101: the test harness's failure exit (a crash has no code, a signal instead)
+    assert_eq!(out.status.code(), Some(101), "the child did not fail cleanly ({:?}):\n{tail}", out.status);
+    for needle in ["UMBRAGE_PROPTEST_SEED=", INJECTED, "minimal failing input"] {
+        assert!(text.contains(needle), "the child's output lacks {needle:?}:\n{tail}");
+    }
+    assert!(!text.contains("Validation Error"), "a validation error in the failure path:\n{tail}");
 }
