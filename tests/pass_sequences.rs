@@ -502,12 +502,10 @@ impl Sut {
     /// pass's holding the casters of the model it was prepared from (later calls must not
     /// have reached it).
     fn retire(&mut self, slot: usize) {
-        if self.in_flight.get(slot).is_none_or(Option::is_none) {
-            return;
-        }
+        let Some(serial) = self.in_flight.get(slot).and_then(Option::as_ref).map(|f| f.serial) else { return };
         // The entry stays until the fence has signalled: a panic before that leaves it for
         // `Drop` to wait on (the pass must not be dropped under the frame).
-        if injected_failure() && self.in_flight[slot].as_ref().is_some_and(|f| f.serial >= 2) {
+        if injected_failure() && serial >= 2 {
             panic!("{INJECTED}");
         }
         let fence = with_harness(|h| {

@@ -278,27 +278,29 @@ impl EdgeScan {
             let a = word(l.w);
             // a uniform word, and every word up to the next break equal to it: the pairs whose
             // hi word lies before that break hold no silhouette edge
-            let clear_below = if a.wrapping_add(1) > 1 { 0 } else { breaks[next] };
+            let clear_below = if mixed(a) { 0 } else { breaks[next] };
             if clear_below > l.max_hi {
                 continue;
             }
             let mut start = if pairs.start == 0 { 0 } else { self.pairs[pairs.start - 1].end as usize };
             for p in &self.pairs[pairs] {
-                let end = p.end as usize;
+                let edges = start..p.end as usize;
+                start = edges.end;
+                if p.hi < clear_below {
+                    continue;
+                }
+                let b = word(p.hi);
                 // both words all ones or both all zeros: no edge of the pair is on the silhouette
-                if p.hi >= clear_below {
-                    let b = word(p.hi);
-                    if a != b || a.wrapping_add(1) > 1 {
-                        for (o, e) in self.offsets[start..end].iter().zip(&rest[start..end]) {
-                            let fl = (a >> (o[0] & 63)) & 1;
-                            let fh = (b >> (o[1] & 63)) & 1;
-                            if fl != fh {
-                                out.push(oriented(e, (fl != 0) == (o[0] >= 128)));
-                            }
-                        }
+                if a == b && !mixed(a) {
+                    continue;
+                }
+                for (o, e) in self.offsets[edges.clone()].iter().zip(&rest[edges]) {
+                    let fl = (a >> (o[0] & 63)) & 1;
+                    let fh = (b >> (o[1] & 63)) & 1;
+                    if fl != fh {
+                        out.push(oriented(e, (fl != 0) == (o[0] >= 128)));
                     }
                 }
-                start = end;
             }
         }
     }
@@ -316,7 +318,8 @@ impl EdgeScan {
             if b >= hi + reach {
                 break;
             }
-            for w in b.saturating_sub(reach).max(done)..(b + 1).min(hi) {
+            let top = (b + 1).min(hi);
+            for w in b.saturating_sub(reach).max(done)..top {
                 let i = w - lo;
                 let m = c.masks[i];
                 if m == 0 {
@@ -335,9 +338,15 @@ impl EdgeScan {
                     out.push(oriented(e, lo_lit == lo_is_t0));
                 }
             }
-            done = done.max((b + 1).min(hi));
+            done = done.max(top);
         }
     }
+}
+
+/// Whether facing word `a` is neither all ones nor all zeros.
+#[inline]
+fn mixed(a: u64) -> bool {
+    a.wrapping_add(1) > 1
 }
 
 /// The breaks among facing words `first .. last` into `breaks` (increasing, then `u32::MAX`):
@@ -353,7 +362,7 @@ fn find_breaks(bits: &[u64], (first, last): (usize, usize), breaks: &mut Vec<u32
     for (c, chunk) in inside.chunks(64).enumerate() {
         let mut m = 0u64;
         for (k, &a) in chunk.iter().enumerate() {
-            m |= u64::from((a != prev) | (a.wrapping_add(1) > 1)) << k;
+            m |= u64::from((a != prev) | mixed(a)) << k;
             prev = a;
         }
         while m != 0 {

@@ -483,55 +483,46 @@ impl FacePlanes {
         let n = self.len;
         // flip: the negated plane, i.e. the negated light (exact).
         let lf = if flip { -lf } else { lf };
-        let (a, b) = (first * 64, (first + out.len()) * 64);
-        let blocks = self.nx[a..b]
-            .chunks_exact(64)
-            .zip(self.ny[a..b].chunks_exact(64))
-            .zip(self.nz[a..b].chunks_exact(64))
-            .zip(self.d[a..b].chunks_exact(64));
         let (words, last) = (n.div_ceil(64), first + out.len());
         let probe = Probe::new(lf, e as f64);
         let size = SUPER_BLOCKS[0];
         let valid = |w: usize| if (w + 1) * 64 <= n { u64::MAX } else { (1u64 << (n - w * 64)) - 1 };
-        let mut blocks = blocks;
+        // word `w` from its 64 dot products, the exact test where they are unsure
+        let dots = |w: usize| {
+            let r = w * 64..w * 64 + 64;
+            let (bits, unsure) = block64(&self.nx[r.clone()], &self.ny[r.clone()], &self.nz[r.clone()], &self.d[r], lf, e);
+            let (mut word, mut u) = (bits & valid(w), unsure & valid(w));
+            while u != 0 {
+                let k = u.trailing_zeros() as usize;
+                u &= u - 1;
+                word = (word & !(1 << k)) | (u64::from(exact_bit(mesh, self.tri(w * 64 + k), l, flip)) << k);
+            }
+            word
+        };
         let mut w = first;
         while w < last {
-            // the super-block of word `w`, where all its words are this call's
+            // the super-block of word `w`, tested where all its words are this call's
             let s = w / size;
-            let end = ((s + 1) * size).min(words).min(last);
-            let whole = s * size >= first && ((s + 1) * size).min(words) <= last;
+            let s_end = ((s + 1) * size).min(words);
+            let end = s_end.min(last);
             let sup = match self.supers[0].get(s) {
-                Some(b) if whole => b.test(&probe),
+                Some(b) if s * size >= first && s_end <= last => b.test(&probe),
                 _ => (false, false),
             };
             if sup.0 || sup.1 {
                 for v in w..end {
                     out[v - first] = if sup.0 { valid(v) } else { 0 };
                 }
-                blocks.nth(end - w - 1);
-                w = end;
-                continue;
-            }
-            // its blocks' bounds, all at once
-            let (ones, zeros) = test_blocks(self.blocks.get(w..end).unwrap_or(&[]), &probe);
-            for k in 0..end - w {
-                let v = w + k;
-                let Some((((nx, ny), nz), d)) = blocks.next() else { break };
-                out[v - first] = if (ones >> k) & 1 != 0 {
-                    valid(v)
-                } else if (zeros >> k) & 1 != 0 {
-                    0
-                } else {
-                    let (bits, unsure) = block64(nx, ny, nz, d, lf, e);
-                    let mut word = bits & valid(v);
-                    let mut u = unsure & valid(v);
-                    while u != 0 {
-                        let k = u.trailing_zeros() as usize;
-                        u &= u - 1;
-                        word = (word & !(1 << k)) | (u64::from(exact_bit(mesh, self.tri(v * 64 + k), l, flip)) << k);
-                    }
-                    word
-                };
+            } else {
+                // its blocks' bounds, all at once
+                let (ones, zeros) = test_blocks(self.blocks.get(w..end).unwrap_or(&[]), &probe);
+                for (k, v) in (w..end).enumerate() {
+                    out[v - first] = match ((ones >> k) & 1, (zeros >> k) & 1) {
+                        (1, _) => valid(v),
+                        (_, 1) => 0,
+                        _ => dots(v),
+                    };
+                }
             }
             w = end;
         }
