@@ -11,75 +11,109 @@
 //!   row, or `2 slices + 1`, across rows). For every distance `δ` that covers enough edges, the
 //!   scan keeps one mask bit per slot `lo` with an edge to `lo + δ`; the silhouette bits of 64
 //!   such edges are then `(F[w] ^ (F >> δ)[w]) & mask[w]`: a handful of word operations.
-//! * **word pairs**: every other edge is filed under the pair of facing words its two slots
-//!   lie in, with its two bit positions (two bytes an edge). A pair whose two words are both
-//!   all ones or both all zeros (a light far from a compact patch: most pairs, in a spatial
-//!   order) holds no silhouette edge and is skipped whole; the others test each edge's two
-//!   bits in the two words already loaded, with no further memory access.
+//! * **residual edges**: every other edge is kept with its two bit positions (two bytes an
+//!   edge). A pair of facing words that are both all ones or both all zeros (a light far from
+//!   a compact patch: most pairs, in a spatial order) holds no silhouette edge and is skipped
+//!   whole; the others test each edge's two bits in the words already loaded, with no further
+//!   memory access and no branch an edge.
+//!
+//! Both kinds are **near** when an edge's two slots lie in one facing word or in a word and
+//! the next (a class with `δ < 64`), else **far**. The near edges are filed by the word of
+//! their `lo` slot, every near class's mask of a word next to the others', so one visit of a
+//! word tests all of them; the far classes keep a mask array each, and the far residual edges
+//! are filed by their pair of words.
 //!
 //! Per light, the scan first lists the **breaks** among the facing words it touches: the
 //! words that are mixed (neither all ones nor all zeros) or differ from the word before.
 //! Between two breaks every word is the same uniform word, and no edge with both slots there
-//! is on the silhouette: a class visits only the words whose reach (the word and the words `δ`
-//! slots on) holds a break, and a facing word's word pairs are skipped up to the first break
-//! after it. In a spatial order the work is then about the words the light's terminator
-//! crosses, not the mesh's size.
+//! is on the silhouette: the near edges are visited only in a break's word and the word
+//! before it, and a far class only in the words whose reach (the word and the words `δ` slots
+//! on) holds a break. In a spatial order the work is then about the words the light's
+//! terminator crosses and the far word pairs, not the mesh's size.
 //!
-//! Both paths test exactly the same two bits of every edge, so the result is the plain scan's,
-//! edge for edge, and its edges keep the caller's triangle ids.
+//! Every path tests exactly the same two bits of every edge, so the result is the plain
+//! scan's, edge for edge, and its edges keep the caller's triangle ids.
 
 use super::order::TriangleOrder;
 use super::silhouette::SilhouetteEdge;
 use super::topology::ManifoldEdge;
 
-/// At most this many distance classes (each costs a pass over its words per light).
+/// At most this many distance classes (each costs work per visited word and light).
 const MAX_CLASSES: usize = 8;
 /// A class must hold at least this many edges per facing word it spans on average: below it,
 /// its word pass costs more than the per-edge lookups it saves.
 const MIN_EDGES_PER_WORD: usize = 2;
 
 /// Manifold edges prepared for the per-light scan ([`EdgeScan::scan_into`]): distance classes
-/// scanned a facing word at a time, and the other edges filed by the pair of facing words
-/// they join, two bytes an edge. Built once per caster part; the scan reads only these, and the
-/// full edge records of the few edges on the possible silhouette.
+/// scanned a facing word at a time, and the other edges filed by the facing words they join,
+/// two bytes an edge. Built once per caster part; the scan reads only these, and the full edge
+/// records of the few edges on the possible silhouette.
 #[derive(Clone, Debug, Default)]
 pub struct EdgeScan {
-    /// Scan order: each class's edges by increasing `lo`, class after class, then the residual
-    /// edges by word pair.
+    /// Scan order: the near edges word by word, then each far class's edges by increasing
+    /// `lo`, then the far residual edges by word pair.
     edges: Vec<ManifoldEdge>,
-    classes: Vec<DeltaClass>,
-    /// `edges[rest..]` are the residual edges.
-    rest: usize,
-    /// The facing words with residual edges at their `lo` slot, increasing.
-    lo_words: Vec<LoWord>,
-    /// The residual edges' word pairs, by increasing `(lo word, hi word)`.
-    pairs: Vec<WordPair>,
-    /// Per residual edge: the bit of its `lo` slot in the pair's `lo` word, plus 128 when
-    /// that slot is `t0`'s; the bit of its `hi` slot in the `hi` word.
-    offsets: Vec<[u8; 2]>,
+    near: Near,
+    far_classes: Vec<DeltaClass>,
+    /// The far residual edges' word pairs, by increasing `(lo word, hi word)`.
+    far: Vec<WordPair>,
+    /// The far residual edges are `edges[far_start..]`.
+    far_start: usize,
+    /// Per far residual edge: the bit of its `lo` slot in its `lo` word, plus [`T0`] when that
+    /// slot is `t0`'s; the bit of its `hi` slot in its `hi` word.
+    far_offsets: Vec<[u8; 2]>,
     /// The facing words the scan reads: `words.0 .. words.1`.
     words: (usize, usize),
 }
 
-/// The word pairs `pairs[start .. end]` (`start` the previous `LoWord`'s `end`) have their
-/// `lo` slots in facing word `w`, and their `hi` words at most `max_hi`.
-#[derive(Clone, Copy, Debug, Default)]
-struct LoWord {
-    w: u32,
-    max_hi: u32,
-    end: u32,
+/// In an edge's bit positions: its `lo` slot is its `t0`'s.
+const T0: u8 = 128;
+
+/// The near edges: those of a class with `δ < 64`, and the residual edges with both slots in
+/// one facing word or in a word and the next, filed by the word of their `lo` slot.
+#[derive(Clone, Debug, Default)]
+struct Near {
+    /// The near classes' distances, each below 64.
+    deltas: Vec<u32>,
+    /// The first word with near edges.
+    first: usize,
+    /// Word `first + i`'s edges, and one past the last word (only its `base`).
+    words: Vec<NearWord>,
+    /// Bit `k` of `masks[i * deltas.len() + c]`: class `c` has an edge with `lo` slot
+    /// `64 (first + i) + k`.
+    masks: Vec<u64>,
+    /// Bit `k` of `lo_t0[..]` (indexed as `masks`): that edge's `lo` slot is its `t0`'s.
+    lo_t0: Vec<u64>,
+    /// `ranks[..]` (indexed as `masks`): the word's edges of the classes before `c`.
+    ranks: Vec<u16>,
+    /// Per near residual edge, in edge order: its bit positions, the `hi` one in the `lo`
+    /// word and the next (0 to 127), and [`T0`] as for the far ones.
+    offsets: Vec<[u8; 2]>,
 }
 
-/// The residual edges with their `lo` slot in the facing word of their [`LoWord`] and their
-/// `hi` slot in word `hi`: `edges[rest + start .. rest + end]`, `start` the previous pair's
-/// `end`.
+/// One word's near edges: `edges[base .. rest]` are its class edges, class after class, by
+/// `lo`; `edges[rest .. next]` its residual edges inside the word, `edges[next ..]` (up to the
+/// next word's `base`) those reaching into the next word. The residual edge `edges[rest + j]`
+/// has bit positions `offsets[off + j]`.
+#[derive(Clone, Copy, Debug, Default)]
+struct NearWord {
+    base: u32,
+    rest: u32,
+    next: u32,
+    off: u32,
+}
+
+/// The far residual edges with their `lo` slot in facing word `lo` and their `hi` slot in
+/// word `hi`: `edges[start .. end]`, `start` the previous pair's `end` (the first's:
+/// `far_start`).
 #[derive(Clone, Copy, Debug, Default)]
 struct WordPair {
+    lo: u32,
     hi: u32,
     end: u32,
 }
 
-/// The edges between slots `lo` and `lo + delta`.
+/// The edges between slots `lo` and `lo + delta`, a far class (`delta >= 64`).
 #[derive(Clone, Debug, Default)]
 struct DeltaClass {
     delta: u32,
@@ -97,23 +131,21 @@ struct DeltaClass {
 
 #[inline]
 fn oriented(e: &ManifoldEdge, t0_lit: bool) -> SilhouetteEdge {
-    if t0_lit {
-        SilhouetteEdge { a: e.a, b: e.b, lit: e.t0, lit_corner: e.c0, unlit: e.t1, unlit_corner: e.c1 }
-    } else {
-        SilhouetteEdge { a: e.b, b: e.a, lit: e.t1, lit_corner: e.c1, unlit: e.t0, unlit_corner: e.c0 }
-    }
+    // selects, not a branch: which triangle is lit follows the light, not a pattern
+    let (ends, tris, corners) = ([e.a, e.b], [e.t0, e.t1], [e.c0, e.c1]);
+    let (i, j) = (usize::from(!t0_lit), usize::from(t0_lit));
+    SilhouetteEdge { a: ends[i], b: ends[j], lit: tris[i], lit_corner: corners[i], unlit: tris[j], unlit_corner: corners[j] }
 }
 
 /// Word `i` of the facing bits shifted down by `delta` bits: bit `k` is the facing of
 /// slot `64 i + k + delta` (0 past the end).
 #[inline]
 fn shifted(bits: &[u64], i: usize, delta: u32) -> u64 {
-    let word = |j: usize| bits.get(j).copied().unwrap_or(0);
     let (q, r) = (i + (delta / 64) as usize, delta % 64);
     if r == 0 {
-        word(q)
+        word(bits, q)
     } else {
-        (word(q) >> r) | (word(q + 1) << (64 - r))
+        (word(bits, q) >> r) | (word(bits, q + 1) << (64 - r))
     }
 }
 
@@ -123,6 +155,13 @@ type Slotted = (ManifoldEdge, u32, u32, bool);
 fn slotted(e: ManifoldEdge, order: &TriangleOrder) -> Slotted {
     let (s0, s1) = (order.slot(e.t0), order.slot(e.t1));
     (e, s0.min(s1), s0.max(s1), s0 <= s1)
+}
+
+/// The bit positions of residual edge `x` (`hi` relative to the start of its `lo` word when
+/// `near`, else to its own word).
+fn offsets_of(&(_, lo, hi, is_t0): &Slotted, near: bool) -> [u8; 2] {
+    let hi_bit = if near { hi - lo / 64 * 64 } else { hi % 64 };
+    [(lo % 64) as u8 | if is_t0 { T0 } else { 0 }, hi_bit as u8]
 }
 
 /// The distances worth a class, most edges first: at most [`MAX_CLASSES`], each with at least
@@ -142,6 +181,34 @@ fn choose_deltas(edges: &[Slotted]) -> Vec<u32> {
     counts.into_iter().take(MAX_CLASSES).map(|(_, d)| d).collect()
 }
 
+/// Splits `edges` into the classes of `deltas` (each by increasing `lo`) and the residual:
+/// every edge goes to the class of its distance, unless that class already has an edge at its
+/// `lo` (two edges between the same two triangles).
+fn split_classes(edges: Vec<Slotted>, deltas: &[u32]) -> (Vec<Vec<Slotted>>, Vec<Slotted>) {
+    let mut members: Vec<Vec<Slotted>> = vec![Vec::new(); deltas.len()];
+    let mut residual = Vec::new();
+    for e in edges {
+        let (_, lo, hi, _) = e;
+        match deltas.iter().position(|&d| hi > lo && hi - lo == d) {
+            Some(c) => members[c].push(e),
+            None => residual.push(e),
+        }
+    }
+    for es in &mut members {
+        es.sort_by_key(|e| e.1);
+        let mut kept: Vec<Slotted> = Vec::with_capacity(es.len());
+        for &e in es.iter() {
+            if kept.last().is_some_and(|k| k.1 == e.1) {
+                residual.push(e);
+            } else {
+                kept.push(e);
+            }
+        }
+        *es = kept;
+    }
+    (members, residual)
+}
+
 impl EdgeScan {
     /// The scan over `edges` with the triangles in their own order (its
     /// [`edges`](Self::edges) are the same edges, in scan order).
@@ -156,34 +223,23 @@ impl EdgeScan {
     pub fn with_order(edges: Vec<ManifoldEdge>, order: &TriangleOrder) -> EdgeScan {
         let edges: Vec<Slotted> = edges.into_iter().map(|e| slotted(e, order)).collect();
         let deltas = choose_deltas(&edges);
-        // every edge goes to the first class of its distance, unless that class already has an
-        // edge at its `lo` (two edges between the same two triangles): then to the residual
-        let mut members: Vec<Vec<Slotted>> = vec![Vec::new(); deltas.len()];
-        let mut residual = Vec::new();
-        for e in edges {
-            let (_, lo, hi, _) = e;
-            match deltas.iter().position(|&d| hi > lo && hi - lo == d) {
-                Some(c) => members[c].push(e),
-                None => residual.push(e),
-            }
-        }
+        let (members, mut residual) = split_classes(edges, &deltas);
+        // residual edges: the near ones by word (inside the word first), then the far ones by
+        // word pair (stable: the given order inside a pair)
+        let is_near = |&(_, lo, hi, _): &Slotted| hi / 64 - lo / 64 <= 1;
+        residual.sort_by_key(|e| (!is_near(e), e.1 / 64, e.2 / 64));
+        let near_count = residual.iter().take_while(|e| is_near(e)).count();
+        let (near_rest, far_rest) = residual.split_at(near_count);
+        let (near_classes, far_classes): (Vec<_>, Vec<_>) =
+            deltas.iter().zip(members).filter(|(_, es)| !es.is_empty()).partition(|(&d, _)| d < 64);
         let mut scan = EdgeScan::default();
-        for (&delta, mut es) in deltas.iter().zip(members) {
-            es.sort_by_key(|e| e.1);
-            let mut kept: Vec<Slotted> = Vec::with_capacity(es.len());
-            for e in es {
-                if kept.last().is_some_and(|k| k.1 == e.1) {
-                    residual.push(e);
-                } else {
-                    kept.push(e);
-                }
-            }
-            let Some(last) = kept.last() else { continue };
+        scan.near = Near::build(near_classes, near_rest, &mut scan.edges);
+        for (&delta, kept) in &far_classes {
             let first_word = kept[0].1 as usize / 64;
-            let words = last.1 as usize / 64 - first_word + 1;
+            let words = kept[kept.len() - 1].1 as usize / 64 - first_word + 1;
             let mut masks = vec![0u64; words];
             let mut lo_t0 = vec![0u64; words];
-            for &(_, lo, _, is_t0) in &kept {
+            for &(_, lo, _, is_t0) in kept {
                 let lo = lo as usize;
                 masks[lo / 64 - first_word] |= 1 << (lo % 64);
                 lo_t0[lo / 64 - first_word] |= u64::from(is_t0) << (lo % 64);
@@ -194,33 +250,30 @@ impl EdgeScan {
                 ranks.push(before);
                 before += m.count_ones();
             }
-            scan.classes.push(DeltaClass { delta, first_word, masks, lo_t0, ranks, first: scan.edges.len() });
-            scan.edges.extend(kept.into_iter().map(|k| k.0));
+            scan.far_classes.push(DeltaClass { delta, first_word, masks, lo_t0, ranks, first: scan.edges.len() });
+            scan.edges.extend(kept.iter().map(|k| k.0));
         }
-        scan.rest = scan.edges.len();
-        // residual edges by word pair (stable: the given order inside a pair)
-        residual.sort_by_key(|&(_, lo, hi, _)| (lo / 64, hi / 64));
-        for by_lo in residual.chunk_by(|x, y| x.1 / 64 == y.1 / 64) {
-            for run in by_lo.chunk_by(|x, y| x.2 / 64 == y.2 / 64) {
-                for &(e, lo, hi, is_t0) in run {
-                    scan.offsets.push([(lo % 64) as u8 | (u8::from(is_t0) << 7), (hi % 64) as u8]);
-                    scan.edges.push(e);
-                }
-                scan.pairs.push(WordPair { hi: run[0].2 / 64, end: scan.offsets.len() as u32 });
+        scan.far_start = scan.edges.len();
+        for run in far_rest.chunk_by(|x, y| (x.1 / 64, x.2 / 64) == (y.1 / 64, y.2 / 64)) {
+            for e in run {
+                scan.far_offsets.push(offsets_of(e, false));
+                scan.edges.push(e.0);
             }
-            let w = by_lo[0].1 / 64;
-            let max_hi = by_lo.iter().map(|x| x.2 / 64).max().unwrap_or(0);
-            scan.lo_words.push(LoWord { w, max_hi, end: scan.pairs.len() as u32 });
+            scan.far.push(WordPair { lo: run[0].1 / 64, hi: run[0].2 / 64, end: scan.edges.len() as u32 });
         }
-        // the words read: each class's own and shifted words, each pair's two words
+        // the words read: the near words and the next, each far class's own and shifted
+        // words, each far pair's two words
         let mut words = (usize::MAX, 0usize);
-        for c in &scan.classes {
+        if let Some(n) = scan.near.words.len().checked_sub(1).filter(|&n| n > 0) {
+            words = (scan.near.first, scan.near.first + n + 1);
+        }
+        for c in &scan.far_classes {
             words.0 = words.0.min(c.first_word);
             words.1 = words.1.max(c.first_word + c.masks.len() + (c.delta as usize).div_ceil(64) + 1);
         }
-        for l in &scan.lo_words {
-            words.0 = words.0.min(l.w as usize);
-            words.1 = words.1.max(l.max_hi as usize + 1);
+        for p in &scan.far {
+            words.0 = words.0.min(p.lo as usize);
+            words.1 = words.1.max(p.hi as usize + 1);
         }
         scan.words = if words.0 < words.1 { words } else { (0, 0) };
         scan
@@ -231,19 +284,28 @@ impl EdgeScan {
         &self.edges
     }
 
-    /// Bytes one scan reads (at most): the class masks and orientation bits, the residual word
-    /// pairs and their edges' bit positions.
+    /// Bytes one scan reads (at most): the class masks and orientation bits, the near words'
+    /// records, the far word pairs, and the residual edges' bit positions.
     pub fn bytes(&self) -> usize {
-        self.classes.iter().map(|c| c.masks.len() * 16).sum::<usize>()
-            + self.lo_words.len() * std::mem::size_of::<LoWord>()
-            + self.pairs.len() * std::mem::size_of::<WordPair>()
-            + self.offsets.len() * 2
+        let n = &self.near;
+        (n.masks.len() + n.lo_t0.len()) * 8
+            + n.ranks.len() * 2
+            + n.words.len() * std::mem::size_of::<NearWord>()
+            + n.offsets.len() * 2
+            + self.far_classes.iter().map(|c| c.masks.len() * 16).sum::<usize>()
+            + self.far.len() * std::mem::size_of::<WordPair>()
+            + self.far_offsets.len() * 2
     }
 
-    /// Edges scanned a facing word at a time by a distance class (the rest are filed by
-    /// word pair).
+    /// Edges scanned a facing word at a time by a distance class (the rest are residual
+    /// edges, tested one by one where their words are not both the same uniform word).
     pub fn word_scanned_edges(&self) -> usize {
-        self.rest
+        let near: usize = self.near.masks.iter().map(|m| m.count_ones() as usize).sum();
+        near + self
+            .far_classes
+            .iter()
+            .map(|c| c.ranks.last().map_or(0, |&r| r as usize) + c.masks.last().map_or(0, |m| m.count_ones() as usize))
+            .sum::<usize>()
     }
 
     /// Appends the possible silhouette for the packed facing `bits` (in the scan's order) to
@@ -254,59 +316,94 @@ impl EdgeScan {
     ///
     /// [`possible_silhouette`]: super::silhouette::possible_silhouette
     pub fn scan_into(&self, bits: &[u64], out: &mut Vec<SilhouetteEdge>) {
-        BREAKS.with_borrow_mut(|breaks| {
+        SCRATCH.with_borrow_mut(|Scratch { breaks, dirty, hits }| {
             find_breaks(bits, self.words, breaks);
-            for c in &self.classes {
-                self.scan_class(c, bits, breaks, out);
+            let mut hits = Hits { list: hits, len: 0 };
+            self.scan_near(bits, breaks, &mut hits);
+            for c in &self.far_classes {
+                self.scan_class(c, bits, breaks, &mut hits);
             }
-            self.scan_pairs(bits, breaks, out);
+            self.scan_far(bits, dirty, &mut hits);
+            out.extend(hits.found().iter().map(|&h| oriented(&self.edges[h as u32 as usize], h >> 32 != 0)));
         })
     }
 
-    fn scan_pairs(&self, bits: &[u64], breaks: &[u32], out: &mut Vec<SilhouetteEdge>) {
-        let rest = &self.edges[self.rest..];
-        let word = |w: u32| bits.get(w as usize).copied().unwrap_or(0);
-        let mut first_pair = 0usize;
-        // the first break after the current word (the lo words increase)
-        let mut next = 0usize;
-        for l in &self.lo_words {
-            let pairs = first_pair..l.end as usize;
-            first_pair = l.end as usize;
-            while breaks[next] <= l.w {
-                next += 1;
+    /// The near edges of the words next to a break: every class's edges whose bits differ,
+    /// and the residual edges of a mixed word, or a uniform word's that reach into a next word
+    /// unlike it.
+    fn scan_near(&self, bits: &[u64], breaks: &[u32], hits: &mut Hits) {
+        let near = &self.near;
+        let classes = near.deltas.len();
+        let (lo, hi) = (near.first, near.first + near.words.len().saturating_sub(1));
+        let mut done = lo;
+        let from = breaks.partition_point(|&b| (b as usize) < lo);
+        for &b in &breaks[from..] {
+            let b = b as usize;
+            // a break at `b` concerns words `b - 1` (its next word) and `b`
+            if b > hi {
+                break;
             }
-            let a = word(l.w);
-            // a uniform word, and every word up to the next break equal to it: the pairs whose
-            // hi word lies before that break hold no silhouette edge
-            let clear_below = if mixed(a) { 0 } else { breaks[next] };
-            if clear_below > l.max_hi {
-                continue;
-            }
-            let mut start = if pairs.start == 0 { 0 } else { self.pairs[pairs.start - 1].end as usize };
-            for p in &self.pairs[pairs] {
-                let edges = start..p.end as usize;
-                start = edges.end;
-                if p.hi < clear_below {
-                    continue;
-                }
-                let b = word(p.hi);
-                // both words all ones or both all zeros: no edge of the pair is on the silhouette
-                if a == b && !mixed(a) {
-                    continue;
-                }
-                for (o, e) in self.offsets[edges.clone()].iter().zip(&rest[edges]) {
-                    let fl = (a >> (o[0] & 63)) & 1;
-                    let fh = (b >> (o[1] & 63)) & 1;
-                    if fl != fh {
-                        out.push(oriented(e, (fl != 0) == (o[0] >= 128)));
+            let top = (b + 1).min(hi);
+            for w in b.saturating_sub(1).max(done)..top {
+                let (f, g) = (word(bits, w), word(bits, w + 1));
+                let i = w - lo;
+                let (nw, end) = (near.words[i], near.words[i + 1].base);
+                hits.room((end - nw.base) as usize);
+                let at = i * classes..(i + 1) * classes;
+                let (list, mut len) = (&mut hits.list[..], hits.len);
+                for (((&delta, &m), &t0), &rank) in
+                    near.deltas.iter().zip(&near.masks[at.clone()]).zip(&near.lo_t0[at.clone()]).zip(&near.ranks[at])
+                {
+                    let mut s = (f ^ ((f >> delta) | (g << (64 - delta)))) & m;
+                    while s != 0 {
+                        let k = s.trailing_zeros();
+                        s &= s - 1;
+                        let rank = u32::from(rank) + (m & ((1u64 << k) - 1)).count_ones();
+                        // `f`'s bit k is slot lo's
+                        let t0_lit = ((f ^ t0) >> k) & 1 == 0;
+                        list[len] = entry(nw.base + rank, t0_lit);
+                        len += 1;
                     }
                 }
+                hits.len = len;
+                let start = if mixed(f) {
+                    nw.rest
+                } else if f != g {
+                    nw.next
+                } else {
+                    end
+                };
+                let off = (nw.off + start - nw.rest) as usize;
+                test_edges(start..end, &near.offsets[off..], f, [f, g], hits);
             }
+            done = done.max(top);
         }
     }
 
-    fn scan_class(&self, c: &DeltaClass, bits: &[u64], breaks: &[u32], out: &mut Vec<SilhouetteEdge>) {
-        let edges = &self.edges[c.first..];
+    /// The far residual edges of the word pairs whose two words are not the same uniform word.
+    fn scan_far(&self, bits: &[u64], dirty: &mut Vec<u32>, hits: &mut Hits) {
+        // the pairs to test, listed without a branch a pair
+        if dirty.len() < self.far.len() {
+            dirty.resize(self.far.len(), 0);
+        }
+        let mut n = 0;
+        for (i, p) in self.far.iter().enumerate() {
+            let (a, b) = (word(bits, p.lo as usize), word(bits, p.hi as usize));
+            dirty[n] = i as u32;
+            n += usize::from(a != b || mixed(a));
+        }
+        for &i in &dirty[..n] {
+            let i = i as usize;
+            let p = self.far[i];
+            let start = if i == 0 { self.far_start as u32 } else { self.far[i - 1].end };
+            let b = word(bits, p.hi as usize);
+            hits.room((p.end - start) as usize);
+            let off = start as usize - self.far_start;
+            test_edges(start..p.end, &self.far_offsets[off..], word(bits, p.lo as usize), [b, b], hits);
+        }
+    }
+
+    fn scan_class(&self, c: &DeltaClass, bits: &[u64], breaks: &[u32], hits: &mut Hits) {
         // the words `w ..= w + reach` are read for the class's word `w`: it can hold a
         // silhouette edge only when a break lies among them
         let reach = (c.delta as usize).div_ceil(64);
@@ -322,24 +419,142 @@ impl EdgeScan {
             for w in b.saturating_sub(reach).max(done)..top {
                 let i = w - lo;
                 let m = c.masks[i];
-                if m == 0 {
-                    continue;
-                }
-                let f = bits.get(w).copied().unwrap_or(0);
+                let f = word(bits, w);
                 let mut s = (f ^ shifted(bits, w, c.delta)) & m;
+                hits.room(s.count_ones() as usize);
                 while s != 0 {
                     let k = s.trailing_zeros();
                     s &= s - 1;
                     let rank = c.ranks[i] + (m & ((1u64 << k) - 1)).count_ones();
-                    let e = &edges[rank as usize];
                     // `f`'s bit k is slot lo's
-                    let lo_lit = (f >> k) & 1 != 0;
-                    let lo_is_t0 = (c.lo_t0[i] >> k) & 1 != 0;
-                    out.push(oriented(e, lo_lit == lo_is_t0));
+                    let t0_lit = ((f ^ c.lo_t0[i]) >> k) & 1 == 0;
+                    hits.push(c.first as u32 + rank, t0_lit);
                 }
             }
             done = done.max(top);
         }
+    }
+}
+
+impl Near {
+    /// The near `classes` (distance and edges by increasing `lo`) and near residual edges
+    /// (`rest`, by `lo` word, those inside the word first), their edges appended to `edges`
+    /// in scan order.
+    fn build(classes: Vec<(&u32, Vec<Slotted>)>, rest: &[Slotted], edges: &mut Vec<ManifoldEdge>) -> Near {
+        let word_of = |e: &Slotted| e.1 as usize / 64;
+        let firsts = classes.iter().map(|(_, es)| word_of(&es[0])).chain(rest.first().map(word_of));
+        let lasts = classes.iter().map(|(_, es)| word_of(&es[es.len() - 1])).chain(rest.last().map(word_of));
+        let (Some(first), Some(last)) = (firsts.min(), lasts.max()) else {
+            return Near::default();
+        };
+        let k = classes.len();
+        let words = last + 1 - first;
+        let mut near = Near {
+            deltas: classes.iter().map(|(&d, _)| d).collect(),
+            first,
+            masks: vec![0; words * k],
+            lo_t0: vec![0; words * k],
+            ranks: vec![0; words * k],
+            ..Near::default()
+        };
+        let (mut at, mut r) = (vec![0usize; k], 0usize);
+        for i in 0..words {
+            let w = first + i;
+            let base = edges.len() as u32;
+            for (c, (_, es)) in classes.iter().enumerate() {
+                near.ranks[i * k + c] = (edges.len() as u32 - base) as u16;
+                while let Some(e) = es.get(at[c]).filter(|e| word_of(e) == w) {
+                    near.masks[i * k + c] |= 1 << (e.1 % 64);
+                    near.lo_t0[i * k + c] |= u64::from(e.3) << (e.1 % 64);
+                    edges.push(e.0);
+                    at[c] += 1;
+                }
+            }
+            let (rest_at, off) = (edges.len() as u32, near.offsets.len() as u32);
+            let mut next = None;
+            while let Some(e) = rest.get(r).filter(|e| word_of(e) == w) {
+                if e.2 as usize / 64 > w && next.is_none() {
+                    next = Some(edges.len() as u32);
+                }
+                near.offsets.push(offsets_of(e, true));
+                edges.push(e.0);
+                r += 1;
+            }
+            near.words.push(NearWord { base, rest: rest_at, next: next.unwrap_or(edges.len() as u32), off });
+        }
+        near.words.push(NearWord { base: edges.len() as u32, ..NearWord::default() });
+        near
+    }
+}
+
+/// Lists the residual edges `range` (bit positions `offsets`, from the range's first) whose
+/// two bits differ, without a branch an edge: `lo` bits in `a`, `hi` bits in `b` (bit `k` in
+/// `b[k / 64]`).
+#[inline]
+fn test_edges(range: std::ops::Range<u32>, offsets: &[[u8; 2]], a: u64, b: [u64; 2], hits: &mut Hits) {
+    let (list, mut len) = (&mut hits.list[..], hits.len);
+    for (i, o) in range.zip(offsets) {
+        let fl = (a >> (o[0] & 63)) & 1;
+        let fh = (b[usize::from(o[1] >> 6 & 1)] >> (o[1] & 63)) & 1;
+        // t0 is lit when its slot's bit is set: lo's bit when lo is t0's, else hi's
+        let t0_lit = (fl != 0) == (o[0] >= T0);
+        list[len] = entry(i, t0_lit);
+        len += usize::from(fl != fh);
+    }
+    hits.len = len;
+}
+
+/// A [`Hits`] entry: edge `i`, and whether its `t0` is lit.
+#[inline]
+fn entry(i: u32, t0_lit: bool) -> u64 {
+    u64::from(i) | (u64::from(t0_lit) << 32)
+}
+
+/// Facing word `w` (0 past the bits).
+#[inline]
+fn word(bits: &[u64], w: usize) -> u64 {
+    bits.get(w).copied().unwrap_or(0)
+}
+
+/// A scan's lists, kept per thread across calls: [`find_breaks`]' breaks, the far word
+/// pairs to test, and the edges found.
+#[derive(Default)]
+struct Scratch {
+    breaks: Vec<u32>,
+    dirty: Vec<u32>,
+    hits: Vec<u64>,
+}
+
+thread_local! {
+    static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
+}
+
+/// The edges on the silhouette, as indices into the scan's edges with bit 32 set when the
+/// edge's `t0` is lit, listed without a branch an edge: every candidate is written, and kept
+/// by advancing the length.
+struct Hits<'a> {
+    list: &'a mut Vec<u64>,
+    len: usize,
+}
+
+impl Hits<'_> {
+    /// Room for `more` candidates.
+    #[inline]
+    fn room(&mut self, more: usize) {
+        if self.list.len() < self.len + more {
+            self.list.resize((self.len + more).max(2 * self.list.len()), 0);
+        }
+    }
+
+    /// Appends edge `i` with its orientation. Needs [`room`](Self::room).
+    #[inline]
+    fn push(&mut self, i: u32, t0_lit: bool) {
+        self.list[self.len] = entry(i, t0_lit);
+        self.len += 1;
+    }
+
+    fn found(&self) -> &[u64] {
+        &self.list[..self.len]
     }
 }
 
@@ -376,11 +591,6 @@ fn find_breaks(bits: &[u64], (first, last): (usize, usize), breaks: &mut Vec<u32
         breaks.push(past as u32);
     }
     breaks.push(u32::MAX);
-}
-
-thread_local! {
-    /// [`find_breaks`]' list, kept per thread across calls.
-    static BREAKS: std::cell::RefCell<Vec<u32>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 #[cfg(test)]
@@ -435,7 +645,7 @@ mod tests {
             let scan = check(t.manifold_edges.clone(), &bits);
             // rows of quads: two distances (1 inside a row, 2 slices + 1 across rows) cover all
             // but the seam and pole edges
-            assert!(scan.classes.len() >= 2, "{} classes", scan.classes.len());
+            assert!(scan.near.deltas.len() + scan.far_classes.len() >= 2, "{:?} classes", scan.near.deltas);
             assert!(
                 scan.word_scanned_edges() * 10 >= t.manifold_edges.len() * 9,
                 "{} of {}",
@@ -456,7 +666,7 @@ mod tests {
         FacePlanes::new(&t.mesh).facing_packed(&t.mesh, Vec4::new(3.0, 2.0, 1.0, 1.0), false, &mut bits);
         let scan = check(t.manifold_edges.clone(), &bits);
         assert!(scan.word_scanned_edges() * 10 < t.manifold_edges.len());
-        assert!(scan.pairs.len() * 2 > t.manifold_edges.len());
+        assert!(scan.far.len() * 2 > t.manifold_edges.len());
         // in a spatial order the same mesh's edges fall into few word pairs, most skipped whole
         let all: Vec<u32> = (0..t.mesh.triangles.len() as u32).collect();
         let order = TriangleOrder::spatial(&t.mesh, &[&all]);
@@ -464,7 +674,7 @@ mod tests {
         for l in [Vec4::new(3.0, 2.0, 1.0, 1.0), Vec4::new(0.1, 0.2, -0.3, 1.0), Vec4::new(-1.0, 0.5, 0.2, 0.0)] {
             planes.facing_packed(&t.mesh, l, false, &mut bits);
             let scan = check_in(t.manifold_edges.clone(), &bits, &order);
-            assert!(scan.pairs.len() * 8 < t.manifold_edges.len(), "{} pairs", scan.pairs.len());
+            assert!(scan.far.len() * 8 < t.manifold_edges.len(), "{} pairs", scan.far.len());
             // the same silhouette as the mesh's own order, edge set for edge set
             let mut own = Vec::new();
             FacePlanes::new(&t.mesh).facing_packed(&t.mesh, l, false, &mut own);
@@ -492,7 +702,7 @@ mod tests {
         for pattern in [0x5555_5555_5555_5555u64, 0xffff_0000_ffff_0000, 0x0123_4567_89ab_cdef] {
             let bits: Vec<u64> = (0..8).map(|i| pattern.rotate_left(i * 7)).collect();
             let scan = check(edges.clone(), &bits);
-            assert_eq!(scan.classes.len(), 2);
+            assert_eq!((scan.near.deltas.len(), scan.far_classes.len()), (0, 2));
             check(edges.clone(), &bits[..3]);
         }
     }
