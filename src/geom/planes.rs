@@ -15,6 +15,8 @@ const PLANE_RANGE: f64 = (1u64 << 60) as f64;
 const PLANE_CONDITION: f64 = 65536.0;
 /// Blocks (facing words) per super-block bound, coarse to fine.
 const SUPER_BLOCKS: [usize; 1] = [8];
+// a super-block's block bounds are tested side by side, 8 at a time (`Bounds8`)
+const _: () = assert!(SUPER_BLOCKS[0] == 8);
 /// Unit roundoff of f32.
 const U32: f64 = 1.0 / (1u64 << 24) as f64;
 
@@ -70,8 +72,8 @@ pub struct FacePlanes {
     /// Coordinates out of the filter's range: every triangle is decided exactly.
     all_exact: bool,
     /// One bound per 64-triangle block (word of facing bits): lets a light decide a whole word
-    /// without its 64 dot products (see [`BlockBound`]).
-    blocks: Vec<BlockBound>,
+    /// without its 64 dot products (see [`BlockBound`]); a super-block's 8 side by side.
+    blocks: Vec<Bounds8>,
     /// One bound per `SUPER_BLOCKS[i]` blocks for each level `i` (compact patches of 512
     /// triangles in a spatial order): a light far from all of them decides their words at once.
     supers: [Vec<BlockBound>; 1],
@@ -138,17 +140,68 @@ impl BlockBound {
     }
 }
 
-/// [`BlockBound::test`] of up to 64 consecutive bounds at once: bit `i` of the first mask is
-/// set when `bounds[i]` decides its block facing, of the second when not facing.
-#[inline]
-fn test_blocks(bounds: &[BlockBound], probe: &Probe) -> (u64, u64) {
-    let (mut ones, mut zeros) = (0u64, 0u64);
-    for (i, b) in bounds.iter().take(64).enumerate() {
-        let (all, none) = b.test(probe);
-        ones |= u64::from(all) << i;
-        zeros |= u64::from(none) << i;
+/// The bounds of one super-block's 8 blocks, field by field, so that their tests run side by
+/// side: [`test`](Self::test) does [`BlockBound::test`]'s f64 operations in the same order on
+/// each, so it takes the same decisions. A missing block (past the mesh's end) is not
+/// decidable.
+#[derive(Clone, Debug, Default)]
+struct Bounds8 {
+    c: [[f64; 8]; 3],
+    n: [[f64; 8]; 3],
+    d: [f64; 8],
+    spread: [[f64; 8]; 3],
+    spread_d: [f64; 8],
+    scale: [[f64; 8]; 3],
+    decidable: [bool; 8],
+}
+
+impl Bounds8 {
+    /// The bounds `b` (at most 8).
+    fn new(b: &[BlockBound]) -> Bounds8 {
+        let mut x = Bounds8::default();
+        for (i, b) in b.iter().take(8).enumerate() {
+            for k in 0..3 {
+                (x.c[k][i], x.n[k][i], x.spread[k][i], x.scale[k][i]) = (b.c[k], b.n[k], b.spread[k], b.scale[k]);
+            }
+            (x.d[i], x.spread_d[i], x.decidable[i]) = (b.d, b.spread_d, b.decidable);
+        }
+        x
     }
-    (ones, zeros)
+
+    /// Block `i`'s bound.
+    #[cfg(test)]
+    fn get(&self, i: usize) -> BlockBound {
+        BlockBound {
+            c: self.c.map(|v| v[i]),
+            n: self.n.map(|v| v[i]),
+            d: self.d[i],
+            spread: self.spread.map(|v| v[i]),
+            spread_d: self.spread_d[i],
+            scale: self.scale.map(|v| v[i]),
+            decidable: self.decidable[i],
+        }
+    }
+
+    /// [`BlockBound::test`] of the 8 blocks, without branches: bit `i` of the first mask is set
+    /// when block `i` faces the probe's light whole, of the second when none of it does.
+    #[inline]
+    fn test(&self, probe: &Probe) -> (u64, u64) {
+        let (p, w) = (probe.p, probe.w);
+        let (mut ones, mut zeros) = (0u64, 0u64);
+        for i in 0..8 {
+            let q = [p[0] - self.c[0][i] * w, p[1] - self.c[1][i] * w, p[2] - self.c[2][i] * w];
+            let centre = self.n[0][i] * q[0] + self.n[1][i] * q[1] + self.n[2][i] * q[2] + self.d[i] * w;
+            let spread = self.spread[0][i] * q[0].abs()
+                + self.spread[1][i] * q[1].abs()
+                + self.spread[2][i] * q[2].abs()
+                + self.spread_d[i] * w.abs();
+            let slack = ((self.scale[0][i] * (probe.pinf + self.scale[1][i])) + self.scale[2][i]) * 2f64.powi(-40);
+            let margin = spread + slack + probe.e;
+            ones |= u64::from(self.decidable[i] & (centre > margin)) << i;
+            zeros |= u64::from(self.decidable[i] & (centre < -margin)) << i;
+        }
+        (ones, zeros)
+    }
 }
 
 fn corners(mesh: &Mesh, t: usize) -> Option<[Vec3; 3]> {
@@ -284,7 +337,9 @@ impl FacePlanes {
         for t in exact_ids {
             always_exact[t] = true;
         }
-        self.blocks = (0..n.div_ceil(64)).map(|b| self.block_bound(mesh, b * 64..n.min(b * 64 + 64), &always_exact)).collect();
+        let blocks: Vec<BlockBound> =
+            (0..n.div_ceil(64)).map(|b| self.block_bound(mesh, b * 64..n.min(b * 64 + 64), &always_exact)).collect();
+        self.blocks = blocks.chunks(SUPER_BLOCKS[0]).map(Bounds8::new).collect();
         for (level, size) in SUPER_BLOCKS.iter().enumerate() {
             let step = 64 * size;
             self.supers[level] =
@@ -515,7 +570,8 @@ impl FacePlanes {
                 }
             } else {
                 // its blocks' bounds, all at once
-                let (ones, zeros) = test_blocks(self.blocks.get(w..end).unwrap_or(&[]), &probe);
+                let (ones, zeros) = self.blocks.get(s).map_or((0, 0), |b| b.test(&probe));
+                let (ones, zeros) = (ones >> (w - s * size), zeros >> (w - s * size));
                 for (k, v) in (w..end).enumerate() {
                     out[v - first] = match ((ones >> k) & 1, (zeros >> k) & 1) {
                         (1, _) => valid(v),

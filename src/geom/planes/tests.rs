@@ -9,8 +9,39 @@ impl FacePlanes {
     fn decided_blocks(&self, l: Vec4, flip: bool) -> usize {
         let Some((lf, e)) = self.error_bound(l) else { return 0 };
         let lf = if flip { -lf } else { lf };
-        self.blocks.iter().filter(|b| b.test(&Probe::new(lf, e as f64)) != (false, false)).count()
+        let probe = Probe::new(lf, e as f64);
+        self.blocks.iter().map(|b| b.test(&probe)).map(|(ones, zeros)| (ones | zeros).count_ones() as usize).sum()
     }
+}
+
+#[test]
+fn side_by_side_block_tests_take_each_blocks_decision() {
+    // the 8 tests of a super-block at once are the single tests, bit for bit
+    let mut m = uv_sphere(1.0, 90, 45);
+    m.triangles.truncate(m.triangles.len() - 100); // a last super-block with missing blocks
+    let planes = FacePlanes::new(&m);
+    let mut x = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        (x % 2001) as f32 / 500.0 - 2.0
+    };
+    let mut decided = 0;
+    for k in 0..200 {
+        let l = Vec4::new(next(), next(), next(), [0.0, 1.0, -1.0][k % 3]);
+        let Some((lf, e)) = planes.error_bound(l) else { continue };
+        let probe = Probe::new(lf, e as f64);
+        for b in &planes.blocks {
+            let (ones, zeros) = b.test(&probe);
+            for i in 0..8 {
+                let (all, none) = b.get(i).test(&probe);
+                assert_eq!((all, none), ((ones >> i) & 1 == 1, (zeros >> i) & 1 == 1));
+                decided += usize::from(all | none);
+            }
+        }
+    }
+    assert!(decided > 1000, "{decided}");
 }
 
 fn exact(m: &Mesh, l: Vec4, flip: bool) -> Vec<u64> {
@@ -44,7 +75,7 @@ fn whole_blocks_decided_and_exact() {
             }
             if off == Vec3::ZERO && l.w != 0.0 && l.y != 1.0001 {
                 let decided = planes.decided_blocks(l, false);
-                assert!(decided * 2 > planes.blocks.len(), "{decided} of {} blocks decided", planes.blocks.len());
+                assert!(decided * 2 > planes.len().div_ceil(64), "{decided} of {} blocks decided", planes.len().div_ceil(64));
             }
         }
     }
@@ -86,7 +117,11 @@ fn ordered_planes_give_the_permuted_bits() {
         }
         if l.w != 0.0 && l.y != 0.99 {
             let (a, b) = (own.decided_blocks(l, false), ordered.decided_blocks(l, false));
-            assert!(a * 10 < own.blocks.len() && b * 2 > ordered.blocks.len(), "{a} / {b} of {} blocks decided", own.blocks.len());
+            assert!(
+                a * 10 < own.len().div_ceil(64) && b * 2 > ordered.len().div_ceil(64),
+                "{a} / {b} of {} blocks decided",
+                own.len().div_ceil(64)
+            );
         }
     }
     // the GPU's planes stay in triangle order
