@@ -18,6 +18,13 @@
 //!   four plane arrays and `EdgeScan::bytes`), in the same run, so the throughput of the other
 //!   functions (the group's throughput is those bytes) can be compared to memory speed.
 //!
+//! After each size's group, **paired rounds** compare `facing+silhouette` with `streaming_sum`
+//! directly: 31 rounds, each a batch of one then a batch of the other (about 10 ms each), and
+//! the ratio of the two batch times per round. A shared or throttled host changes speed from
+//! one second to the next, which moves criterion's separate estimates apart; inside one round
+//! both see the same host. The line printed gives the median round's ratio (streaming time
+//! over facing+silhouette time: above 1 is faster than the streaming read) and its spread.
+//!
 //! The `load/1M` group times `Caster::new` on the 1M sphere, ordered and shuffled, and the
 //! reordering alone (`TriangleOrder::spatial`).
 
@@ -61,6 +68,21 @@ fn streaming_sum(p: &PlainArrays, pairs: &[[u32; 2]]) -> u64 {
     s.iter().map(|&x| x as u64).sum::<u64>().wrapping_add(t)
 }
 
+/// Paired rounds of `a` and `b` (see the module docs): per round, `a`'s batch time over `b`'s,
+/// sorted.
+fn paired_ratios(mut a: impl FnMut(), mut b: impl FnMut(), batch: u32) -> Vec<f64> {
+    let mut time = |f: &mut dyn FnMut()| {
+        let t = std::time::Instant::now();
+        for _ in 0..batch {
+            f();
+        }
+        t.elapsed().as_secs_f64()
+    };
+    let mut ratios: Vec<f64> = (0..31).map(|_| time(&mut a) / time(&mut b)).collect();
+    ratios.sort_by(f64::total_cmp);
+    ratios
+}
+
 fn bench(c: &mut Criterion) {
     let light = Vec4::new(3.0, 2.0, 1.0, 1.0);
     let threads = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
@@ -102,6 +124,28 @@ fn bench(c: &mut Criterion) {
             });
         };
         facing_silhouette(&mut g, "facing+silhouette", planes, scan, mesh);
+        // the same two functions in paired rounds (batches of about 10 ms)
+        let batch = (10_000_000 / (tris as u64 / 3).max(1)).clamp(5, 2_000) as u32;
+        let (mut bits, mut sil) = (Vec::new(), Vec::new());
+        let ratios = paired_ratios(
+            || {
+                black_box(streaming_sum(black_box(&plain), black_box(&pairs)));
+            },
+            || {
+                planes.facing_packed_auto(mesh, black_box(light), false, &mut bits);
+                sil.clear();
+                scan.scan_into(&bits, &mut sil);
+                black_box(sil.len());
+            },
+            batch,
+        );
+        println!(
+            "silhouette/{name}/paired: facing+silhouette at {:.2}x streaming_sum's speed (median of {} paired rounds of {batch}; quartiles {:.2}x-{:.2}x)",
+            ratios[ratios.len() / 2],
+            ratios.len(),
+            ratios[ratios.len() / 4],
+            ratios[3 * ratios.len() / 4]
+        );
         // the same sphere, triangles shuffled, loaded as a caster (reordered at load)
         let shuffled_mesh = shuffled(&sphere);
         let sc = Caster::new("shuffled", &shuffled_mesh, Mat4::IDENTITY).expect("shuffled caster");
