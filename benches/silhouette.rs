@@ -71,7 +71,7 @@ fn streaming_sum(p: &PlainArrays, pairs: &[[u32; 2]]) -> u64 {
 /// Paired rounds of `a` and `b` (see the module docs): per round, `a`'s batch time over `b`'s,
 /// sorted.
 fn paired_ratios(mut a: impl FnMut(), mut b: impl FnMut(), batch: u32) -> Vec<f64> {
-    let mut time = |f: &mut dyn FnMut()| {
+    let time = |f: &mut dyn FnMut()| {
         let t = std::time::Instant::now();
         for _ in 0..batch {
             f();
