@@ -346,6 +346,10 @@ impl EdgeScan {
             let top = (b + 1).min(hi);
             for w in b.saturating_sub(1).max(done)..top {
                 let (f, g) = (word(bits, w), word(bits, w + 1));
+                if f == g && !mixed(f) {
+                    // a uniform word and the same next word: no near edge of it differs
+                    continue;
+                }
                 let i = w - lo;
                 let (nw, end) = (near.words[i], near.words[i + 1].base);
                 hits.room((end - nw.base) as usize);
