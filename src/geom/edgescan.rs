@@ -43,6 +43,8 @@ const MAX_CLASSES: usize = 8;
 /// A class must hold at least this many edges per facing word it spans on average: below it,
 /// its word pass costs more than the per-edge lookups it saves.
 const MIN_EDGES_PER_WORD: usize = 2;
+/// Far word pairs tested a chunk at a time (their list of pairs to test stays small).
+const FAR_CHUNK: usize = 256;
 
 /// Manifold edges prepared for the per-light scan ([`EdgeScan::scan_into`]): distance classes
 /// scanned a facing word at a time, and the other edges filed by the facing words they join,
@@ -57,11 +59,15 @@ pub struct EdgeScan {
     far_classes: Vec<DeltaClass>,
     /// The far residual edges' word pairs, by increasing `(lo word, hi word)`.
     far: Vec<WordPair>,
-    /// The far residual edges are `edges[far_start..]`.
+    /// The far residual edges in word pairs are `edges[far_start..lone_start]`.
     far_start: usize,
-    /// Per far residual edge: the bit of its `lo` slot in its `lo` word, plus [`T0`] when that
-    /// slot is `t0`'s; the bit of its `hi` slot in its `hi` word.
+    /// Per far residual edge in a word pair: the bit of its `lo` slot in its `lo` word, plus
+    /// [`T0`] when that slot is `t0`'s; the bit of its `hi` slot in its `hi` word.
     far_offsets: Vec<[u8; 2]>,
+    /// The far residual edges alone in their word pair (a pair costs more than its one edge)
+    /// are `edges[lone_start..]`, each with its slots: `t0`'s, `t1`'s.
+    lone_start: usize,
+    lone: Vec<[u32; 2]>,
     /// The facing words the scan reads: `words.0 .. words.1`.
     words: (usize, usize),
 }
@@ -254,12 +260,22 @@ impl EdgeScan {
             scan.edges.extend(kept.iter().map(|k| k.0));
         }
         scan.far_start = scan.edges.len();
+        let mut lone = Vec::new();
         for run in far_rest.chunk_by(|x, y| (x.1 / 64, x.2 / 64) == (y.1 / 64, y.2 / 64)) {
+            if let [e] = run {
+                lone.push(e);
+                continue;
+            }
             for e in run {
                 scan.far_offsets.push(offsets_of(e, false));
                 scan.edges.push(e.0);
             }
             scan.far.push(WordPair { lo: run[0].1 / 64, hi: run[0].2 / 64, end: scan.edges.len() as u32 });
+        }
+        scan.lone_start = scan.edges.len();
+        for &&(e, lo, hi, is_t0) in &lone {
+            scan.lone.push(if is_t0 { [lo, hi] } else { [hi, lo] });
+            scan.edges.push(e);
         }
         // the words read: the near words and the next, each far class's own and shifted
         // words, each far pair's two words
@@ -274,6 +290,10 @@ impl EdgeScan {
         for p in &scan.far {
             words.0 = words.0.min(p.lo as usize);
             words.1 = words.1.max(p.hi as usize + 1);
+        }
+        for &(_, lo, hi, _) in lone {
+            words.0 = words.0.min(lo as usize / 64);
+            words.1 = words.1.max(hi as usize / 64 + 1);
         }
         scan.words = if words.0 < words.1 { words } else { (0, 0) };
         scan
@@ -295,6 +315,7 @@ impl EdgeScan {
             + self.far_classes.iter().map(|c| c.masks.len() * 16).sum::<usize>()
             + self.far.len() * std::mem::size_of::<WordPair>()
             + self.far_offsets.len() * 2
+            + self.lone.len() * 8
     }
 
     /// Edges scanned a facing word at a time by a distance class (the rest are residual
@@ -316,14 +337,15 @@ impl EdgeScan {
     ///
     /// [`possible_silhouette`]: super::silhouette::possible_silhouette
     pub fn scan_into(&self, bits: &[u64], out: &mut Vec<SilhouetteEdge>) {
-        SCRATCH.with_borrow_mut(|Scratch { breaks, dirty, hits }| {
+        SCRATCH.with_borrow_mut(|Scratch { breaks, hits }| {
             find_breaks(bits, self.words, breaks);
             let mut hits = Hits { list: hits, len: 0 };
             self.scan_near(bits, breaks, &mut hits);
             for c in &self.far_classes {
                 self.scan_class(c, bits, breaks, &mut hits);
             }
-            self.scan_far(bits, dirty, &mut hits);
+            self.scan_far(bits, &mut hits);
+            self.scan_lone(bits, &mut hits);
             out.extend(hits.found().iter().map(|&h| oriented(&self.edges[h as u32 as usize], h >> 32 != 0)));
         })
     }
@@ -385,25 +407,45 @@ impl EdgeScan {
     }
 
     /// The far residual edges of the word pairs whose two words are not the same uniform word.
-    fn scan_far(&self, bits: &[u64], dirty: &mut Vec<u32>, hits: &mut Hits) {
-        // the pairs to test, listed without a branch a pair
-        if dirty.len() < self.far.len() {
-            dirty.resize(self.far.len(), 0);
+    fn scan_far(&self, bits: &[u64], hits: &mut Hits) {
+        // a chunk of pairs at a time: first the pairs to test, listed without a branch a pair,
+        // then their edges
+        let mut dirty = [0u16; FAR_CHUNK];
+        let mut start = self.far_start as u32;
+        for (c, chunk) in self.far.chunks(FAR_CHUNK).enumerate() {
+            let mut n = 0;
+            for (i, p) in chunk.iter().enumerate() {
+                let (a, b) = (word(bits, p.lo as usize), word(bits, p.hi as usize));
+                dirty[n] = i as u16;
+                n += usize::from(a != b || mixed(a));
+            }
+            let end = chunk[chunk.len() - 1].end;
+            hits.room((end - start) as usize);
+            for &i in &dirty[..n] {
+                let i = c * FAR_CHUNK + usize::from(i);
+                let p = self.far[i];
+                let first = if i == 0 { self.far_start as u32 } else { self.far[i - 1].end };
+                let b = word(bits, p.hi as usize);
+                let off = first as usize - self.far_start;
+                test_edges(first..p.end, &self.far_offsets[off..], word(bits, p.lo as usize), [b, b], hits);
+            }
+            start = end;
         }
-        let mut n = 0;
-        for (i, p) in self.far.iter().enumerate() {
-            let (a, b) = (word(bits, p.lo as usize), word(bits, p.hi as usize));
-            dirty[n] = i as u32;
-            n += usize::from(a != b || mixed(a));
-        }
-        for &i in &dirty[..n] {
-            let i = i as usize;
-            let p = self.far[i];
-            let start = if i == 0 { self.far_start as u32 } else { self.far[i - 1].end };
-            let b = word(bits, p.hi as usize);
-            hits.room((p.end - start) as usize);
-            let off = start as usize - self.far_start;
-            test_edges(start..p.end, &self.far_offsets[off..], word(bits, p.lo as usize), [b, b], hits);
+    }
+
+    /// The far residual edges alone in their word pair, each by its two bits.
+    fn scan_lone(&self, bits: &[u64], hits: &mut Hits) {
+        let bit = |s: u32| (word(bits, s as usize / 64) >> (s % 64)) & 1;
+        for (c, chunk) in self.lone.chunks(FAR_CHUNK).enumerate() {
+            hits.room(chunk.len());
+            let (list, mut len) = (&mut hits.list[..], hits.len);
+            let first = self.lone_start + c * FAR_CHUNK;
+            for (i, &[s0, s1]) in chunk.iter().enumerate() {
+                let (f0, f1) = (bit(s0), bit(s1));
+                list[len] = entry((first + i) as u32, f0 != 0);
+                len += usize::from(f0 != f1);
+            }
+            hits.len = len;
         }
     }
 
@@ -520,12 +562,10 @@ fn word(bits: &[u64], w: usize) -> u64 {
     bits.get(w).copied().unwrap_or(0)
 }
 
-/// A scan's lists, kept per thread across calls: [`find_breaks`]' breaks, the far word
-/// pairs to test, and the edges found.
+/// A scan's lists, kept per thread across calls: [`find_breaks`]' breaks and the edges found.
 #[derive(Default)]
 struct Scratch {
     breaks: Vec<u32>,
-    dirty: Vec<u32>,
     hits: Vec<u64>,
 }
 
@@ -664,13 +704,14 @@ mod tests {
 
     #[test]
     fn shuffled_triangles_take_the_residual_path() {
-        // a fixed pseudo-random triangle order: no distance class, every edge in its own pair
+        // a fixed pseudo-random triangle order: no distance class, almost every edge alone in
+        // its word pair
         let t = Topology::build(&shuffled(&uv_sphere(1.0, 200, 101)));
         let mut bits = Vec::new();
         FacePlanes::new(&t.mesh).facing_packed(&t.mesh, Vec4::new(3.0, 2.0, 1.0, 1.0), false, &mut bits);
         let scan = check(t.manifold_edges.clone(), &bits);
         assert!(scan.word_scanned_edges() * 10 < t.manifold_edges.len());
-        assert!(scan.far.len() * 2 > t.manifold_edges.len());
+        assert!(scan.lone.len() * 2 > t.manifold_edges.len(), "{} alone", scan.lone.len());
         // in a spatial order the same mesh's edges fall into few word pairs, most skipped whole
         let all: Vec<u32> = (0..t.mesh.triangles.len() as u32).collect();
         let order = TriangleOrder::spatial(&t.mesh, &[&all]);
@@ -678,7 +719,7 @@ mod tests {
         for l in [Vec4::new(3.0, 2.0, 1.0, 1.0), Vec4::new(0.1, 0.2, -0.3, 1.0), Vec4::new(-1.0, 0.5, 0.2, 0.0)] {
             planes.facing_packed(&t.mesh, l, false, &mut bits);
             let scan = check_in(t.manifold_edges.clone(), &bits, &order);
-            assert!(scan.far.len() * 8 < t.manifold_edges.len(), "{} pairs", scan.far.len());
+            assert!((scan.far.len() + scan.lone.len()) * 8 < t.manifold_edges.len(), "{} pairs, {} alone", scan.far.len(), scan.lone.len());
             // the same silhouette as the mesh's own order, edge set for edge set
             let mut own = Vec::new();
             FacePlanes::new(&t.mesh).facing_packed(&t.mesh, l, false, &mut own);
