@@ -69,18 +69,23 @@ fn streaming_sum(p: &PlainArrays, pairs: &[[u32; 2]]) -> u64 {
 }
 
 /// Paired rounds of `a` and `b` (see the module docs): per round, `a`'s batch time over `b`'s,
-/// sorted.
-fn paired_ratios(mut a: impl FnMut(), mut b: impl FnMut(), batch: u32) -> Vec<f64> {
+/// sorted, and the median time of one call of `a` and of `b`, in seconds.
+fn paired_ratios(mut a: impl FnMut(), mut b: impl FnMut(), batch: u32) -> (Vec<f64>, f64, f64) {
     let time = |f: &mut dyn FnMut()| {
         let t = std::time::Instant::now();
         for _ in 0..batch {
             f();
         }
-        t.elapsed().as_secs_f64()
+        t.elapsed().as_secs_f64() / f64::from(batch)
     };
-    let mut ratios: Vec<f64> = (0..31).map(|_| time(&mut a) / time(&mut b)).collect();
+    let rounds: Vec<(f64, f64)> = (0..31).map(|_| (time(&mut a), time(&mut b))).collect();
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let mut ratios: Vec<f64> = rounds.iter().map(|(x, y)| x / y).collect();
     ratios.sort_by(f64::total_cmp);
-    ratios
+    (ratios, median(rounds.iter().map(|r| r.0).collect()), median(rounds.iter().map(|r| r.1).collect()))
 }
 
 fn bench(c: &mut Criterion) {
@@ -127,7 +132,7 @@ fn bench(c: &mut Criterion) {
         // the same two functions in paired rounds (batches of about 10 ms)
         let batch = (10_000_000 / (tris as u64 / 3).max(1)).clamp(5, 2_000) as u32;
         let (mut bits, mut sil) = (Vec::new(), Vec::new());
-        let ratios = paired_ratios(
+        let (ratios, t_stream, t_ours) = paired_ratios(
             || {
                 black_box(streaming_sum(black_box(&plain), black_box(&pairs)));
             },
@@ -140,11 +145,13 @@ fn bench(c: &mut Criterion) {
             batch,
         );
         println!(
-            "silhouette/{name}/paired: facing+silhouette at {:.2}x streaming_sum's speed (median of {} paired rounds of {batch}; quartiles {:.2}x-{:.2}x)",
+            "silhouette/{name}/paired: facing+silhouette at {:.2}x streaming_sum's speed (median of {} paired rounds of {batch}; quartiles {:.2}x-{:.2}x; median calls {:.2} µs against {:.2} µs)",
             ratios[ratios.len() / 2],
             ratios.len(),
             ratios[ratios.len() / 4],
-            ratios[3 * ratios.len() / 4]
+            ratios[3 * ratios.len() / 4],
+            t_ours * 1e6,
+            t_stream * 1e6
         );
         // the same sphere, triangles shuffled, loaded as a caster (reordered at load)
         let shuffled_mesh = shuffled(&sphere);

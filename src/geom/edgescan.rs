@@ -618,7 +618,12 @@ fn find_breaks(bits: &[u64], (first, last): (usize, usize), breaks: &mut Vec<u32
     // zeros past them
     let inside = &bits[first.min(bits.len())..last.min(bits.len())];
     let mut prev = inside.first().copied().unwrap_or(0);
-    for (c, chunk) in inside.chunks(64).enumerate() {
+    for (c, chunk) in inside.chunks(8).enumerate() {
+        // most runs of 8 words are one uniform word, the one before them: no break
+        let a0 = chunk[0];
+        if chunk.iter().fold(a0 ^ prev, |x, &a| x | (a ^ a0)) == 0 && !mixed(a0) {
+            continue;
+        }
         let mut m = 0u64;
         for (k, &a) in chunk.iter().enumerate() {
             m |= u64::from((a != prev) | mixed(a)) << k;
@@ -627,7 +632,7 @@ fn find_breaks(bits: &[u64], (first, last): (usize, usize), breaks: &mut Vec<u32
         while m != 0 {
             let k = m.trailing_zeros() as usize;
             m &= m - 1;
-            breaks.push((first + c * 64 + k) as u32);
+            breaks.push((first + c * 8 + k) as u32);
         }
     }
     let past = first.max(bits.len());
