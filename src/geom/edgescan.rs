@@ -85,11 +85,9 @@ struct Near {
     first: usize,
     /// Word `first + i`'s edges, and one past the last word (only its `base`).
     words: Vec<NearWord>,
-    /// Bit `k` of `masks[i * deltas.len() + c]`: class `c` has an edge with `lo` slot
-    /// `64 (first + i) + k`.
-    masks: Vec<u64>,
-    /// Bit `k` of `lo_t0[..]` (indexed as `masks`): that edge's `lo` slot is its `t0`'s.
-    lo_t0: Vec<u64>,
+    /// Bit `k` of `masks[i * deltas.len() + c][0]`: class `c` has an edge with `lo` slot
+    /// `64 (first + i) + k`; of `[1]`: that edge's `lo` slot is its `t0`'s.
+    masks: Vec<[u64; 2]>,
     /// `ranks[..]` (indexed as `masks`): the word's edges of the classes before `c`.
     ranks: Vec<u16>,
     /// Per near residual edge, in edge order: its bit positions, the `hi` one in the `lo`
@@ -308,7 +306,7 @@ impl EdgeScan {
     /// records, the far word pairs, and the residual edges' bit positions.
     pub fn bytes(&self) -> usize {
         let n = &self.near;
-        (n.masks.len() + n.lo_t0.len()) * 8
+        n.masks.len() * 16
             + n.ranks.len() * 2
             + n.words.len() * std::mem::size_of::<NearWord>()
             + n.offsets.len() * 2
@@ -321,7 +319,7 @@ impl EdgeScan {
     /// Edges scanned a facing word at a time by a distance class (the rest are residual
     /// edges, tested one by one where their words are not both the same uniform word).
     pub fn word_scanned_edges(&self) -> usize {
-        let near: usize = self.near.masks.iter().map(|m| m.count_ones() as usize).sum();
+        let near: usize = self.near.masks.iter().map(|m| m[0].count_ones() as usize).sum();
         near + self
             .far_classes
             .iter()
@@ -377,9 +375,7 @@ impl EdgeScan {
                 hits.room((end - nw.base) as usize);
                 let at = i * classes..(i + 1) * classes;
                 let (list, mut len) = (&mut hits.list[..], hits.len);
-                for (((&delta, &m), &t0), &rank) in
-                    near.deltas.iter().zip(&near.masks[at.clone()]).zip(&near.lo_t0[at.clone()]).zip(&near.ranks[at])
-                {
+                for ((&delta, &[m, t0]), &rank) in near.deltas.iter().zip(&near.masks[at.clone()]).zip(&near.ranks[at]) {
                     let mut s = (f ^ ((f >> delta) | (g << (64 - delta)))) & m;
                     while s != 0 {
                         let k = s.trailing_zeros();
@@ -498,8 +494,7 @@ impl Near {
         let mut near = Near {
             deltas: classes.iter().map(|(&d, _)| d).collect(),
             first,
-            masks: vec![0; words * k],
-            lo_t0: vec![0; words * k],
+            masks: vec![[0; 2]; words * k],
             ranks: vec![0; words * k],
             ..Near::default()
         };
@@ -510,8 +505,8 @@ impl Near {
             for (c, (_, es)) in classes.iter().enumerate() {
                 near.ranks[i * k + c] = (edges.len() as u32 - base) as u16;
                 while let Some(e) = es.get(at[c]).filter(|e| word_of(e) == w) {
-                    near.masks[i * k + c] |= 1 << (e.1 % 64);
-                    near.lo_t0[i * k + c] |= u64::from(e.3) << (e.1 % 64);
+                    near.masks[i * k + c][0] |= 1 << (e.1 % 64);
+                    near.masks[i * k + c][1] |= u64::from(e.3) << (e.1 % 64);
                     edges.push(e.0);
                     at[c] += 1;
                 }
