@@ -38,6 +38,9 @@ use super::order::TriangleOrder;
 use super::silhouette::SilhouetteEdge;
 use super::topology::ManifoldEdge;
 
+mod near;
+use near::{Near, NearWord};
+
 /// At most this many distance classes (each costs work per visited word and light).
 const MAX_CLASSES: usize = 8;
 /// A class must hold at least this many edges per facing word it spans on average: below it,
@@ -74,38 +77,6 @@ pub struct EdgeScan {
 
 /// In an edge's bit positions: its `lo` slot is its `t0`'s.
 const T0: u8 = 128;
-
-/// The near edges: those of a class with `δ < 64`, and the residual edges with both slots in
-/// one facing word or in a word and the next, filed by the word of their `lo` slot.
-#[derive(Clone, Debug, Default)]
-struct Near {
-    /// The near classes' distances, each below 64.
-    deltas: Vec<u32>,
-    /// The first word with near edges.
-    first: usize,
-    /// Word `first + i`'s edges, and one past the last word (only its `base`).
-    words: Vec<NearWord>,
-    /// Bit `k` of `masks[i * deltas.len() + c][0]`: class `c` has an edge with `lo` slot
-    /// `64 (first + i) + k`; of `[1]`: that edge's `lo` slot is its `t0`'s.
-    masks: Vec<[u64; 2]>,
-    /// `ranks[..]` (indexed as `masks`): the word's edges of the classes before `c`.
-    ranks: Vec<u16>,
-    /// Per near residual edge, in edge order: its bit positions, the `hi` one in the `lo`
-    /// word and the next (0 to 127), and [`T0`] as for the far ones.
-    offsets: Vec<[u8; 2]>,
-}
-
-/// One word's near edges: `edges[base .. rest]` are its class edges, class after class, by
-/// `lo`; `edges[rest .. next]` its residual edges inside the word, `edges[next ..]` (up to the
-/// next word's `base`) those reaching into the next word. The residual edge `edges[rest + j]`
-/// has bit positions `offsets[off + j]`.
-#[derive(Clone, Copy, Debug, Default)]
-struct NearWord {
-    base: u32,
-    rest: u32,
-    next: u32,
-    off: u32,
-}
 
 /// The far residual edges with their `lo` slot in facing word `lo` and their `hi` slot in
 /// word `hi`: `edges[start .. end]`, `start` the previous pair's `end` (the first's:
@@ -338,7 +309,7 @@ impl EdgeScan {
         SCRATCH.with_borrow_mut(|Scratch { breaks, hits }| {
             find_breaks(bits, self.words, breaks);
             let mut hits = Hits { list: hits, len: 0 };
-            self.scan_near(bits, breaks, &mut hits);
+            self.near.scan(bits, breaks, &mut hits);
             for c in &self.far_classes {
                 self.scan_class(c, bits, breaks, &mut hits);
             }
@@ -346,60 +317,6 @@ impl EdgeScan {
             self.scan_lone(bits, &mut hits);
             out.extend(hits.found().iter().map(|&h| oriented(&self.edges[h as u32 as usize], h >> 32 != 0)));
         })
-    }
-
-    /// The near edges of the words next to a break: every class's edges whose bits differ,
-    /// and the residual edges of a mixed word, or a uniform word's that reach into a next word
-    /// unlike it.
-    fn scan_near(&self, bits: &[u64], breaks: &[u32], hits: &mut Hits) {
-        let near = &self.near;
-        let classes = near.deltas.len();
-        let (lo, hi) = (near.first, near.first + near.words.len().saturating_sub(1));
-        let mut done = lo;
-        let from = breaks.partition_point(|&b| (b as usize) < lo);
-        for &b in &breaks[from..] {
-            let b = b as usize;
-            // a break at `b` concerns words `b - 1` (its next word) and `b`
-            if b > hi {
-                break;
-            }
-            let top = (b + 1).min(hi);
-            for w in b.saturating_sub(1).max(done)..top {
-                let (f, g) = (word(bits, w), word(bits, w + 1));
-                if f == g && !mixed(f) {
-                    // a uniform word and the same next word: no near edge of it differs
-                    continue;
-                }
-                let i = w - lo;
-                let (nw, end) = (near.words[i], near.words[i + 1].base);
-                hits.room((end - nw.base) as usize);
-                let at = i * classes..(i + 1) * classes;
-                let (list, mut len) = (&mut hits.list[..], hits.len);
-                for ((&delta, &[m, t0]), &rank) in near.deltas.iter().zip(&near.masks[at.clone()]).zip(&near.ranks[at]) {
-                    let mut s = (f ^ ((f >> delta) | (g << (64 - delta)))) & m;
-                    while s != 0 {
-                        let k = s.trailing_zeros();
-                        s &= s - 1;
-                        let rank = u32::from(rank) + (m & ((1u64 << k) - 1)).count_ones();
-                        // `f`'s bit k is slot lo's
-                        let t0_lit = ((f ^ t0) >> k) & 1 == 0;
-                        list[len] = entry(nw.base + rank, t0_lit);
-                        len += 1;
-                    }
-                }
-                hits.len = len;
-                let start = if mixed(f) {
-                    nw.rest
-                } else if f != g {
-                    nw.next
-                } else {
-                    end
-                };
-                let off = (nw.off + start - nw.rest) as usize;
-                test_edges(start..end, &near.offsets[off..], f, [f, g], hits);
-            }
-            done = done.max(top);
-        }
     }
 
     /// The far residual edges of the word pairs whose two words are not the same uniform word.
@@ -475,56 +392,6 @@ impl EdgeScan {
             }
             done = done.max(top);
         }
-    }
-}
-
-impl Near {
-    /// The near `classes` (distance and edges by increasing `lo`) and near residual edges
-    /// (`rest`, by `lo` word, those inside the word first), their edges appended to `edges`
-    /// in scan order.
-    fn build(classes: Vec<(&u32, Vec<Slotted>)>, rest: &[Slotted], edges: &mut Vec<ManifoldEdge>) -> Near {
-        let word_of = |e: &Slotted| e.1 as usize / 64;
-        let firsts = classes.iter().map(|(_, es)| word_of(&es[0])).chain(rest.first().map(word_of));
-        let lasts = classes.iter().map(|(_, es)| word_of(&es[es.len() - 1])).chain(rest.last().map(word_of));
-        let (Some(first), Some(last)) = (firsts.min(), lasts.max()) else {
-            return Near::default();
-        };
-        let k = classes.len();
-        let words = last + 1 - first;
-        let mut near = Near {
-            deltas: classes.iter().map(|(&d, _)| d).collect(),
-            first,
-            masks: vec![[0; 2]; words * k],
-            ranks: vec![0; words * k],
-            ..Near::default()
-        };
-        let (mut at, mut r) = (vec![0usize; k], 0usize);
-        for i in 0..words {
-            let w = first + i;
-            let base = edges.len() as u32;
-            for (c, (_, es)) in classes.iter().enumerate() {
-                near.ranks[i * k + c] = (edges.len() as u32 - base) as u16;
-                while let Some(e) = es.get(at[c]).filter(|e| word_of(e) == w) {
-                    near.masks[i * k + c][0] |= 1 << (e.1 % 64);
-                    near.masks[i * k + c][1] |= u64::from(e.3) << (e.1 % 64);
-                    edges.push(e.0);
-                    at[c] += 1;
-                }
-            }
-            let (rest_at, off) = (edges.len() as u32, near.offsets.len() as u32);
-            let mut next = None;
-            while let Some(e) = rest.get(r).filter(|e| word_of(e) == w) {
-                if e.2 as usize / 64 > w && next.is_none() {
-                    next = Some(edges.len() as u32);
-                }
-                near.offsets.push(offsets_of(e, true));
-                edges.push(e.0);
-                r += 1;
-            }
-            near.words.push(NearWord { base, rest: rest_at, next: next.unwrap_or(edges.len() as u32), off });
-        }
-        near.words.push(NearWord { base: edges.len() as u32, ..NearWord::default() });
-        near
     }
 }
 
@@ -638,152 +505,4 @@ fn find_breaks(bits: &[u64], (first, last): (usize, usize), breaks: &mut Vec<u32
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::geom::silhouette::{possible_silhouette_packed, FacePlanes};
-    use crate::geom::testmesh::{cube, shuffled, uv_sphere};
-    use crate::geom::topology::Topology;
-    use crate::geom::TriangleOrder;
-    use glam::{Vec3, Vec4};
-    use proptest::prelude::*;
-
-    fn check(edges: Vec<ManifoldEdge>, bits: &[u64]) -> EdgeScan {
-        check_in(edges, bits, &TriangleOrder::identity())
-    }
-
-    /// The plain scan over `edges` with bits looked up by slot.
-    fn plain(edges: &[ManifoldEdge], bits: &[u64], order: &TriangleOrder) -> Vec<SilhouetteEdge> {
-        let slotted: Vec<ManifoldEdge> = edges.iter().map(|e| ManifoldEdge { t0: order.slot(e.t0), t1: order.slot(e.t1), ..*e }).collect();
-        let mut out = possible_silhouette_packed(&slotted, bits);
-        for s in &mut out {
-            s.lit = order.triangle(s.lit);
-            s.unlit = order.triangle(s.unlit);
-        }
-        out
-    }
-
-    fn check_in(edges: Vec<ManifoldEdge>, bits: &[u64], order: &TriangleOrder) -> EdgeScan {
-        let scan = EdgeScan::with_order(edges.clone(), order);
-        let mut sorted_in = edges.clone();
-        let mut sorted_scan = scan.edges().to_vec();
-        let key = |e: &ManifoldEdge| (e.a, e.b, e.t0, e.t1, e.c0, e.c1);
-        sorted_in.sort_by_key(key);
-        sorted_scan.sort_by_key(key);
-        assert_eq!(sorted_in, sorted_scan, "the scan holds exactly the given edges");
-        let mut sil = Vec::new();
-        scan.scan_into(bits, &mut sil);
-        assert_eq!(sil, plain(scan.edges(), bits, order));
-        if order.is_identity() {
-            assert_eq!(sil, possible_silhouette_packed(scan.edges(), bits));
-        }
-        scan
-    }
-
-    #[test]
-    fn sphere_is_scanned_by_words() {
-        let t = Topology::build(&uv_sphere(1.0, 120, 61));
-        let planes = FacePlanes::new(&t.mesh);
-        let mut bits = Vec::new();
-        for l in [Vec4::new(3.0, 2.0, 1.0, 1.0), Vec4::new(0.1, 0.2, -0.3, 1.0), Vec4::new(-1.0, 0.5, 0.2, 0.0)] {
-            planes.facing_packed(&t.mesh, l, false, &mut bits);
-            let scan = check(t.manifold_edges.clone(), &bits);
-            // rows of quads: two distances (1 inside a row, 2 slices + 1 across rows) cover all
-            // but the seam and pole edges
-            assert!(scan.near.deltas.len() + scan.far_classes.len() >= 2, "{:?} classes", scan.near.deltas);
-            assert!(
-                scan.word_scanned_edges() * 10 >= t.manifold_edges.len() * 9,
-                "{} of {}",
-                scan.word_scanned_edges(),
-                t.manifold_edges.len()
-            );
-            for b in [&bits[..], &bits[..bits.len() / 2], &[u64::MAX][..], &[][..]] {
-                check(t.manifold_edges.clone(), b);
-            }
-        }
-    }
-
-    #[test]
-    fn shuffled_triangles_take_the_residual_path() {
-        // a fixed pseudo-random triangle order: no distance class, almost every edge alone in
-        // its word pair
-        let t = Topology::build(&shuffled(&uv_sphere(1.0, 200, 101)));
-        let mut bits = Vec::new();
-        FacePlanes::new(&t.mesh).facing_packed(&t.mesh, Vec4::new(3.0, 2.0, 1.0, 1.0), false, &mut bits);
-        let scan = check(t.manifold_edges.clone(), &bits);
-        assert!(scan.word_scanned_edges() * 10 < t.manifold_edges.len());
-        assert!(scan.lone.len() * 2 > t.manifold_edges.len(), "{} alone", scan.lone.len());
-        // in a spatial order the same mesh's edges fall into few word pairs, most skipped whole
-        let all: Vec<u32> = (0..t.mesh.triangles.len() as u32).collect();
-        let order = TriangleOrder::spatial(&t.mesh, &[&all]);
-        let planes = FacePlanes::with_order(&t.mesh, order.clone());
-        for l in [Vec4::new(3.0, 2.0, 1.0, 1.0), Vec4::new(0.1, 0.2, -0.3, 1.0), Vec4::new(-1.0, 0.5, 0.2, 0.0)] {
-            planes.facing_packed(&t.mesh, l, false, &mut bits);
-            let scan = check_in(t.manifold_edges.clone(), &bits, &order);
-            assert!((scan.far.len() + scan.lone.len()) * 8 < t.manifold_edges.len(), "{} pairs, {} alone", scan.far.len(), scan.lone.len());
-            // the same silhouette as the mesh's own order, edge set for edge set
-            let mut own = Vec::new();
-            FacePlanes::new(&t.mesh).facing_packed(&t.mesh, l, false, &mut own);
-            let mut a = plain(scan.edges(), &bits, &order);
-            let mut b = possible_silhouette_packed(&t.manifold_edges, &own);
-            let key = |e: &SilhouetteEdge| (e.a, e.b, e.lit, e.unlit);
-            a.sort_by_key(key);
-            b.sort_by_key(key);
-            assert_eq!(a, b);
-        }
-    }
-
-    #[test]
-    fn doubled_and_self_edges() {
-        // two edges between the same two triangles, an edge of a triangle with itself, and
-        // distances over 64 (shifts across words)
-        let mk = |t0: u32, t1: u32, a: u32| ManifoldEdge { a, b: a + 1, t0, c0: 0, t1, c1: 1 };
-        let mut edges = Vec::new();
-        for lo in 0..300u32 {
-            edges.push(mk(lo, lo + 70, 2 * lo));
-            edges.push(mk(lo + 128, lo, 2 * lo + 1));
-        }
-        edges.push(mk(5, 75, 9999));
-        edges.push(mk(7, 7, 10_001));
-        for pattern in [0x5555_5555_5555_5555u64, 0xffff_0000_ffff_0000, 0x0123_4567_89ab_cdef] {
-            let bits: Vec<u64> = (0..8).map(|i| pattern.rotate_left(i * 7)).collect();
-            let scan = check(edges.clone(), &bits);
-            assert_eq!((scan.near.deltas.len(), scan.far_classes.len()), (0, 2));
-            check(edges.clone(), &bits[..3]);
-        }
-    }
-
-    #[test]
-    fn cube_and_empty() {
-        let t = Topology::build(&cube(Vec3::ZERO, 1.0));
-        check(t.manifold_edges.clone(), &[0b1010_1010_1010]);
-        check(Vec::new(), &[u64::MAX]);
-        assert_eq!(EdgeScan::new(Vec::new()).bytes(), 0);
-    }
-
-    proptest! {
-        #![proptest_config(ProptestConfig::with_cases(64))]
-        #[test]
-        fn random_pairs_and_bits(
-            pairs in prop::collection::vec((0u32..700, 0u32..80), 0..600),
-            bits in prop::collection::vec(any::<u64>(), 0..13),
-        ) {
-            let edges: Vec<ManifoldEdge> = pairs
-                .iter()
-                .enumerate()
-                .map(|(i, &(t, d))| ManifoldEdge { a: i as u32, b: i as u32 + 1, t0: t, c0: 0, t1: t + d % 3 * (d / 3), c1: 2 })
-                .collect();
-            check(edges.clone(), &bits);
-            // any order: a random permutation of the triangles
-            let n = 800usize;
-            let mut perm: Vec<u32> = (0..n as u32).collect();
-            let mut x = bits.first().copied().unwrap_or(7) | 1;
-            for i in (1..n).rev() {
-                x ^= x << 13;
-                x ^= x >> 7;
-                x ^= x << 17;
-                perm.swap(i, (x % (i as u64 + 1)) as usize);
-            }
-            check_in(edges, &bits, &TriangleOrder::from_slots(perm).unwrap());
-        }
-    }
-}
+mod tests;
