@@ -21,7 +21,8 @@
 //! the next (a class with `δ < 64`), else **far**. The near edges are filed by the word of
 //! their `lo` slot, every near class's mask of a word next to the others', so one visit of a
 //! word tests all of them; the far classes keep a mask array each, and the far residual edges
-//! are filed by their pair of words.
+//! are filed by their pair of words, except an edge alone in its pair: it keeps its two slots
+//! and is tested by its two bits.
 //!
 //! Per light, the scan first lists the **breaks** among the facing words it touches: the
 //! words that are mixed (neither all ones nor all zeros) or differ from the word before.
@@ -56,7 +57,7 @@ const FAR_CHUNK: usize = 256;
 #[derive(Clone, Debug, Default)]
 pub struct EdgeScan {
     /// Scan order: the near edges word by word, then each far class's edges by increasing
-    /// `lo`, then the far residual edges by word pair.
+    /// `lo`, then the far residual edges by word pair, then the lone ones.
     edges: Vec<ManifoldEdge>,
     near: Near,
     far_classes: Vec<DeltaClass>,
