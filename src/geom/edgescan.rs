@@ -380,16 +380,9 @@ impl EdgeScan {
                 let i = w - lo;
                 let m = c.masks[i];
                 let f = word(bits, w);
-                let mut s = (f ^ shifted(bits, w, c.delta)) & m;
+                let s = (f ^ shifted(bits, w, c.delta)) & m;
                 hits.room(s.count_ones() as usize);
-                while s != 0 {
-                    let k = s.trailing_zeros();
-                    s &= s - 1;
-                    let rank = c.ranks[i] + (m & ((1u64 << k) - 1)).count_ones();
-                    // `f`'s bit k is slot lo's
-                    let t0_lit = ((f ^ c.lo_t0[i]) >> k) & 1 == 0;
-                    hits.push(c.first as u32 + rank, t0_lit);
-                }
+                hits.class_edges(s, m, f ^ c.lo_t0[i], c.first as u32 + c.ranks[i]);
             }
             done = done.max(top);
         }
@@ -453,11 +446,21 @@ impl Hits<'_> {
         }
     }
 
-    /// Appends edge `i` with its orientation. Needs [`room`](Self::room).
+    /// Appends a class's edges of one word on the silhouette: bit `k` of `s` for the edge of
+    /// mask bit `k` of `m`, which is edge `first` plus its rank in `m`; `t0` is lit where bit
+    /// `k` of `lo_vs_t0` (the word's facing bits xor the edges' `lo is t0` bits) is clear.
+    /// Needs [`room`](Self::room).
     #[inline]
-    fn push(&mut self, i: u32, t0_lit: bool) {
-        self.list[self.len] = entry(i, t0_lit);
-        self.len += 1;
+    fn class_edges(&mut self, mut s: u64, m: u64, lo_vs_t0: u64, first: u32) {
+        let (list, mut len) = (&mut self.list[..], self.len);
+        while s != 0 {
+            let k = s.trailing_zeros();
+            s &= s - 1;
+            let rank = (m & ((1u64 << k) - 1)).count_ones();
+            list[len] = entry(first + rank, (lo_vs_t0 >> k) & 1 == 0);
+            len += 1;
+        }
+        self.len = len;
     }
 
     fn found(&self) -> &[u64] {

@@ -2,7 +2,7 @@
 //! the residual edges with both slots in one facing word or in a word and the next, filed by
 //! the word of their `lo` slot, so that one visit of a word next to a break tests them all.
 
-use super::{entry, mixed, offsets_of, test_edges, word, Hits, Slotted};
+use super::{mixed, offsets_of, test_edges, word, Hits, Slotted};
 use crate::geom::topology::ManifoldEdge;
 
 /// The near edges: those of a class with `δ < 64`, and the residual edges with both slots in
@@ -112,20 +112,10 @@ impl Near {
                 let (nw, end) = (near.words[i], near.words[i + 1].base);
                 hits.room((end - nw.base) as usize);
                 let at = i * classes..(i + 1) * classes;
-                let (list, mut len) = (&mut hits.list[..], hits.len);
                 for ((&delta, &[m, t0]), &rank) in near.deltas.iter().zip(&near.masks[at.clone()]).zip(&near.ranks[at]) {
-                    let mut s = (f ^ ((f >> delta) | (g << (64 - delta)))) & m;
-                    while s != 0 {
-                        let k = s.trailing_zeros();
-                        s &= s - 1;
-                        let rank = u32::from(rank) + (m & ((1u64 << k) - 1)).count_ones();
-                        // `f`'s bit k is slot lo's
-                        let t0_lit = ((f ^ t0) >> k) & 1 == 0;
-                        list[len] = entry(nw.base + rank, t0_lit);
-                        len += 1;
-                    }
+                    let s = (f ^ ((f >> delta) | (g << (64 - delta)))) & m;
+                    hits.class_edges(s, m, f ^ t0, nw.base + u32::from(rank));
                 }
-                hits.len = len;
                 let start = if mixed(f) {
                     nw.rest
                 } else if f != g {
