@@ -86,6 +86,12 @@ obj = "{obj_path}"
     )
 }
 
+/// Scenes where SwiftShader leaves holes in z-pass volumes (docs/conform/drivers-notes.md
+/// §1e: isolated pixels and thin wedges with a lower count than lavapipe's, which is exact
+/// there), with the fraction outside the band measured on SwiftShader (Debian 12's
+/// `chromium-common` 156.0.8078.114).
+const SWIFTSHADER_HOLES: &[(&str, f64)] = &[("synthetic city", 5.0 / 46137.0)];
+
 fn check_city(ctx: umbrage::gpu::Context, name: &str, toml: &str, dir: &std::path::Path) -> umbrage::gpu::Context {
     let scene = umbrage::scene::load_str(toml, name, dir).unwrap();
     let (w, h) = (256, 192);
@@ -93,9 +99,21 @@ fn check_city(ctx: umbrage::gpu::Context, name: &str, toml: &str, dir: &std::pat
     let ratio = whole as f64 / per_part.max(1) as f64;
     eprintln!("{name}: street light: {per_part} shadow triangles with parts, {whole} as one multiplicity caster ({ratio:.1}x)");
     assert!(ratio >= 3.0, "{name}: only {ratio:.2}x fewer triangles ({per_part} vs {whole})");
+    let swiftshader = ctx.info.name.contains("SwiftShader");
     let mut r = Renderer::new(ctx, scene, RenderOptions { width: w, height: h, ..Default::default() }).unwrap();
     for row in evaluate(&mut r, name, &[Technique::Volumes(Method::McGuire)], 1).unwrap() {
-        assert!(row.passed, "{name}: {} mismatches of {} ({:.4}%)", row.mismatches, row.compared, row.fraction * 100.0);
+        let why = format!("{name}: {} mismatches of {} ({:.4}%)", row.mismatches, row.compared, row.fraction * 100.0);
+        match SWIFTSHADER_HOLES.iter().find(|(n, _)| *n == name).filter(|_| swiftshader) {
+            // held to twice its measured fraction, and failing while the defect lasts
+            Some((_, measured)) => {
+                assert!(
+                    !row.passed && row.fraction <= 2.0 * measured,
+                    "{why}: SwiftShader's holes changed: update SWIFTSHADER_HOLES and docs/conform/drivers-notes.md §1e"
+                );
+                eprintln!("{why}: SwiftShader's holes (docs/conform/drivers-notes.md §1e), as measured");
+            }
+            None => assert!(row.passed, "{why}"),
+        }
     }
     let stats = r.render().unwrap().stats;
     let city = stats.lights[0].casters.iter().find(|c| c.name == "city").unwrap();

@@ -19,7 +19,13 @@ pub struct LightCheck {
     pub kind: String,
     /// The dumped mask compared with the reference's.
     pub metrics: Metrics,
+    /// The first 32 pixels counted in `metrics.mismatches_outside_band`, as `[x, y]`, in row
+    /// order: where to look first.
+    pub mismatched: Vec<[u32; 2]>,
 }
+
+/// At most this many mismatched pixels are listed per light ([`LightCheck::mismatched`]).
+const LISTED_MISMATCHES: usize = 32;
 
 /// The result of checking a frame dump against the reference.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -78,6 +84,11 @@ impl fmt::Display for CheckReport {
                 m.ambiguous,
                 m.band_pixels
             )?;
+            if !l.mismatched.is_empty() {
+                let at: Vec<String> = l.mismatched.iter().map(|[x, y]| format!("({x}, {y})")).collect();
+                let more = if m.mismatches_outside_band as usize > at.len() { ", ..." } else { "" };
+                writeln!(f, "    mismatched at {}{more}", at.join(", "))?;
+            }
         }
         write!(f, "  worst fraction outside band: {:.6}", self.worst_fraction())
     }
@@ -180,6 +191,10 @@ pub fn check(dump: &Dump, name: &str, band: u32) -> Result<CheckReport> {
         let states: Vec<LightState> = (0..w * h).map(|i| all[i * nl + k]).collect();
         let band_mask = metrics::band_mask(&states, &geo_edges, w, h, band);
         let m = metrics::compare_states(&dump.shadow[k], &states, &band_mask);
+        let mismatched = metrics::mismatches_outside_band(&dump.shadow[k], &states, &band_mask, LISTED_MISMATCHES)
+            .into_iter()
+            .map(|i| [(i % w) as u32, (i / w) as u32])
+            .collect();
         report.lights.push(LightCheck {
             index: k,
             position: dump.lights[k].position.to_array(),
@@ -190,6 +205,7 @@ pub fn check(dump: &Dump, name: &str, band: u32) -> Result<CheckReport> {
             }
             .to_string(),
             metrics: m,
+            mismatched,
         });
     }
     Ok(report)

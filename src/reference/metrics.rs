@@ -184,6 +184,15 @@ fn classify(v: u8) -> MaskValue {
     }
 }
 
+/// The pixels whose mask value disagrees with the reference outside the band (the ones
+/// [`compare_states`] counts in `mismatches_outside_band`), in row order, at most `limit`.
+pub fn mismatches_outside_band(mask: &[u8], states: &[LightState], band: &[bool], limit: usize) -> Vec<usize> {
+    (0..states.len())
+        .filter(|&i| !band[i] && compare_states(&mask[i..=i], &states[i..=i], &[false]).mismatches_outside_band == 1)
+        .take(limit)
+        .collect()
+}
+
 /// Compares a mask with reference states given a precomputed band (all the same length).
 pub fn compare_states(mask: &[u8], states: &[LightState], band: &[bool]) -> Metrics {
     let mut m = Metrics { pixels: states.len() as u64, ..Metrics::default() };

@@ -497,6 +497,9 @@ fn reference_metrics_band() {
     assert_eq!(m.mismatches_outside_band, 3);
     assert!((m.fraction_outside_band - 3.0 / 179.0).abs() < 1e-12);
     assert!(m.band_pixels >= 6 * 9);
+    // The listed pixels are the ones counted, in row order, up to the limit.
+    assert_eq!(metrics::mismatches_outside_band(&mask, &states, &band, 10), vec![5 * w + 1, 6 * w + 18, 7 * w + 15]);
+    assert_eq!(metrics::mismatches_outside_band(&mask, &states, &band, 2), vec![5 * w + 1, 6 * w + 18]);
     // Geometric discontinuities widen the band.
     let geo: Vec<metrics::GeoSample> = (0..w * h)
         .map(|i| {
