@@ -113,11 +113,16 @@ fn scene(c: &Case) -> Scene {
     }
 }
 
+/// The fraction `zfail` may miss on SwiftShader: twice the worst measured (`hard/big_caster`,
+/// 0.058 %; `tests/hard_cases.rs`' `SLIVER_DEFECT`).
+const SWIFTSHADER_SLIVERS: f64 = 2.0 * 0.00058;
+
 /// Renders `case` with every exact volume method and checks each against the reference.
 fn check(ctx: &RefCell<Option<umbrage::gpu::Context>>, case: &Case, drawn: &std::cell::Cell<u64>) -> Result<(), TestCaseError> {
     let methods = [Method::McGuire, Method::ZFail, Method::Lengyel].map(umbrage::render::Technique::Volumes);
     let c = ctx.borrow_mut().take().expect("context");
     let mut r = Renderer::new(c, scene(case), RenderOptions { width: 128, height: 96, ..Default::default() }).expect("renderer");
+    let swiftshader = r.context().info.name.contains("SwiftShader");
     let rows = evaluate(&mut r, "proptest", &methods, 1).expect("evaluate");
     r.context().check_validation().expect("validation");
     *ctx.borrow_mut() = Some(r.into_context());
@@ -125,7 +130,12 @@ fn check(ctx: &RefCell<Option<umbrage::gpu::Context>>, case: &Case, drawn: &std:
     for row in rows {
         drawn.set(drawn.get() + row.shadow_triangles);
         prop_assert!(row.compared > 0, "nothing visible: {:?}", case);
-        if row.fraction > THRESHOLD {
+        // SwiftShader drops clipped slivers whose snapped winding flips (a driver defect,
+        // docs/conform/drivers-notes.md §1e): z-fail with both caps everywhere counts the
+        // sides' slivers behind the receivers and misses a few pixels (at most 0.058 % of a
+        // hard case); McGuire's cases and Lengyel's stay exact there.
+        let ceiling = if swiftshader && row.method == "zfail" { SWIFTSHADER_SLIVERS } else { THRESHOLD };
+        if row.fraction > ceiling {
             failures.push(format!("{} mismatches {} of {}", row.method, row.mismatches, row.compared));
         }
     }
@@ -175,6 +185,18 @@ fn regressions() {
             cam_angle: 1.8544235,
             cam_height: 2.0392418,
             cam_dist: 4.7142024,
+        },
+        // SwiftShader, 2026-12-06 (UMBRAGE_PROPTEST_SEED=539365891): `zfail` missed 1 pixel of
+        // 7,518 (the sliver defect above); McGuire and Lengyel exact, lavapipe exact.
+        Case {
+            seeds: vec![17387287035438895228],
+            offsets: vec![(-1.6173371, 1.1300724, -1.6034667)],
+            rotations: vec![(0.70888674, 1.6437795, 3.521345)],
+            light: (-2.498638, 6.92002, -1.2039063),
+            directional: false,
+            cam_angle: 5.6249504,
+            cam_height: 2.860529,
+            cam_dist: 7.6041436,
         },
     ];
     for case in &cases {
