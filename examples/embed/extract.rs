@@ -3,8 +3,9 @@
 //! every pixel into the slot's readback buffer. With one sample it is the same shader on
 //! single-sample views, so every configuration reads back the same way.
 
+use super::pipelines::shader_module;
 use super::shaders;
-use super::vulkan::{shader_module, vkerr};
+use super::vulkan::vkerr;
 use ash::vk;
 
 /// Push block of the extraction shader (six u32).

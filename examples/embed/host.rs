@@ -27,15 +27,17 @@
 //!    unprojected from the sample's depth at its standard location) checked against the CPU
 //!    reference exactly as `umbrage check` checks `umbrage render --dump`.
 //!
-//! This file holds the configuration, the scene, the setup and the teardown; `frame.rs`
-//! records, submits and reads back a frame; `extract.rs` is the per-sample readback;
-//! `shaders.rs` the WGSL; `vulkan.rs` the Vulkan plumbing. `examples/embed/main.rs` is the
+//! This file holds the configuration, the scene, instance and device; `setup.rs` the rest of
+//! the setup and the teardown; `frame.rs` records, submits and reads back a frame;
+//! `extract.rs` is the per-sample readback; `shaders.rs` the WGSL; `vulkan.rs` the Vulkan
+//! plumbing and `pipelines.rs` its pipelines and render passes. `examples/embed/main.rs` is the
 //! command line; `tests/embed.rs` includes this file and runs every configuration.
 #![allow(dead_code)]
 
 use ash::vk;
 use glam::Vec3;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
+use pipelines::{create_render_pass, RenderPassDesc};
 use std::ffi::c_void;
 use std::sync::{Arc, Mutex};
 use umbrage::pass::stats::{CpuMs, LightStats, Totals};
@@ -43,8 +45,7 @@ use umbrage::pass::{CasterId, DepthDirection, EnabledFeatures, RenderPassTarget,
 use umbrage::reference::Dump;
 use umbrage::scene::Scene;
 use vulkan::{
-    color_samples_supported, create_device, create_image, create_render_pass, create_view, debug_callback, free_buffer, lock, pick_device,
-    validation_requested, vkerr, Buf, Img, RenderPassDesc,
+    color_samples_supported, create_device, create_image, create_view, debug_callback, pick_device, validation_requested, vkerr, Buf, Img,
 };
 
 /// The default frame size.
@@ -214,6 +215,8 @@ pub fn run(config: &Config, frames: usize) -> Result<Vec<FrameResult>, String> {
 mod extract;
 #[path = "frame.rs"]
 mod frame;
+#[path = "pipelines.rs"]
+mod pipelines;
 #[path = "scenes.rs"]
 mod scenes;
 #[path = "setup.rs"]
@@ -541,71 +544,5 @@ impl Host {
 
     fn pass(&mut self) -> &mut ShadowPass {
         self.pass.as_mut().expect("the pass exists once Host::new returned")
-    }
-}
-
-impl Drop for Host {
-    /// Teardown: device idle, the pass, the host's buffers and images, the allocator (last
-    /// Arc), pipelines, render passes, pool, device, messenger, instance.
-    fn drop(&mut self) {
-        if let Some(device) = self.device.take() {
-            // SAFETY: after the wait nothing on the GPU uses any object destroyed below; each
-            // is destroyed once, children before parents, the pass before its device.
-            unsafe {
-                let _ = device.device_wait_idle();
-                drop(self.pass.take());
-                self.extract.destroy(&device);
-                device.destroy_query_pool(self.queries, None);
-                for fb in [self.passes.prepass_fb, self.passes.lighting_fb] {
-                    device.destroy_framebuffer(fb, None);
-                }
-                for v in [self.depth_view, self.stencil_view] {
-                    device.destroy_image_view(v, None);
-                }
-                if let Some(allocator) = self.allocator.take() {
-                    for m in self.meshes.drain(..) {
-                        free_buffer(&device, &allocator, m.vertices);
-                        free_buffer(&device, &allocator, m.indices);
-                    }
-                    for s in self.slots.drain(..) {
-                        free_buffer(&device, &allocator, s.readback);
-                        free_buffer(&device, &allocator, s.lit);
-                        device.destroy_fence(s.fence, None);
-                        device.free_command_buffers(self.pool, &[s.cmd]);
-                    }
-                    for img in [self.depth.take(), self.lit_target.take(), self.normal_target.take()].into_iter().flatten() {
-                        device.destroy_image_view(img.view, None);
-                        device.destroy_image(img.raw, None);
-                        if let Some(a) = img.alloc {
-                            let _ = lock(&allocator).free(a);
-                        }
-                    }
-                    // The allocator frees its memory blocks when the last Arc drops: here,
-                    // the pass's clone is gone.
-                    if let Err(a) = Arc::try_unwrap(allocator) {
-                        if let Ok(mut l) = self.log.lock() {
-                            l.push(format!("allocator still shared at teardown ({} references)", Arc::strong_count(&a)));
-                        }
-                    }
-                }
-                for p in [self.prepass, self.lighting] {
-                    device.destroy_pipeline(p, None);
-                }
-                device.destroy_pipeline_layout(self.layout, None);
-                for rp in [self.passes.prepass, self.passes.lighting] {
-                    device.destroy_render_pass(rp, None);
-                }
-                device.destroy_command_pool(self.pool, None);
-                device.destroy_device(None);
-            }
-        }
-        // SAFETY: every child of the instance is gone; the messenger goes before the instance,
-        // and the log it writes into is still alive (a field, dropped after this body).
-        unsafe {
-            if let Some((du, m)) = self.debug.take() {
-                du.destroy_debug_utils_messenger(m, None);
-            }
-            self.instance.destroy_instance(None);
-        }
     }
 }

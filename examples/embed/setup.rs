@@ -1,8 +1,9 @@
 //! The host's setup beyond instance and device: framebuffers (render-pass model), pipelines,
-//! meshes and ring slots.
+//! meshes and ring slots; and its teardown.
 
+use super::pipelines::{create_pipeline, shader_module, PipelineState, Target};
 use super::shaders;
-use super::vulkan::{create_buffer, create_pipeline, free_buffer, shader_module, upload, vkerr, PipelineState, Target};
+use super::vulkan::{create_buffer, free_buffer, lock, upload, vkerr};
 use super::{Host, Layout, MeshGpu, Slot, FRAMES_IN_FLIGHT, LIT_FORMAT, NORMAL_FORMAT};
 use ash::vk;
 use gpu_allocator::vulkan::Allocator;
@@ -186,5 +187,71 @@ impl Host {
             }
         }
         Ok(())
+    }
+}
+
+impl Drop for Host {
+    /// Teardown: device idle, the pass, the host's buffers and images, the allocator (last
+    /// Arc), pipelines, render passes, pool, device, messenger, instance.
+    fn drop(&mut self) {
+        if let Some(device) = self.device.take() {
+            // SAFETY: after the wait nothing on the GPU uses any object destroyed below; each
+            // is destroyed once, children before parents, the pass before its device.
+            unsafe {
+                let _ = device.device_wait_idle();
+                drop(self.pass.take());
+                self.extract.destroy(&device);
+                device.destroy_query_pool(self.queries, None);
+                for fb in [self.passes.prepass_fb, self.passes.lighting_fb] {
+                    device.destroy_framebuffer(fb, None);
+                }
+                for v in [self.depth_view, self.stencil_view] {
+                    device.destroy_image_view(v, None);
+                }
+                if let Some(allocator) = self.allocator.take() {
+                    for m in self.meshes.drain(..) {
+                        free_buffer(&device, &allocator, m.vertices);
+                        free_buffer(&device, &allocator, m.indices);
+                    }
+                    for s in self.slots.drain(..) {
+                        free_buffer(&device, &allocator, s.readback);
+                        free_buffer(&device, &allocator, s.lit);
+                        device.destroy_fence(s.fence, None);
+                        device.free_command_buffers(self.pool, &[s.cmd]);
+                    }
+                    for img in [self.depth.take(), self.lit_target.take(), self.normal_target.take()].into_iter().flatten() {
+                        device.destroy_image_view(img.view, None);
+                        device.destroy_image(img.raw, None);
+                        if let Some(a) = img.alloc {
+                            let _ = lock(&allocator).free(a);
+                        }
+                    }
+                    // The allocator frees its memory blocks when the last Arc drops: here,
+                    // the pass's clone is gone.
+                    if let Err(a) = Arc::try_unwrap(allocator) {
+                        if let Ok(mut l) = self.log.lock() {
+                            l.push(format!("allocator still shared at teardown ({} references)", Arc::strong_count(&a)));
+                        }
+                    }
+                }
+                for p in [self.prepass, self.lighting] {
+                    device.destroy_pipeline(p, None);
+                }
+                device.destroy_pipeline_layout(self.layout, None);
+                for rp in [self.passes.prepass, self.passes.lighting] {
+                    device.destroy_render_pass(rp, None);
+                }
+                device.destroy_command_pool(self.pool, None);
+                device.destroy_device(None);
+            }
+        }
+        // SAFETY: every child of the instance is gone; the messenger goes before the instance,
+        // and the log it writes into is still alive (a field, dropped after this body).
+        unsafe {
+            if let Some((du, m)) = self.debug.take() {
+                du.destroy_debug_utils_messenger(m, None);
+            }
+            self.instance.destroy_instance(None);
+        }
     }
 }
