@@ -59,7 +59,7 @@ doc:
 bench: deps
 	$(CARGO) bench
 
-# The fuzz generators of tests/fuzz.rs in release, FUZZ_CASES cases each (4 generators plus
+# The fuzz generators of tests/fuzz/ in release, FUZZ_CASES cases each (4 generators plus
 # 1/20 as many raw-byte OBJ files: >= 1,000,000 cases in all), the counts printed per generator.
 FUZZ_CASES ?= 250000
 fuzz: deps

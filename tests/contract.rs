@@ -532,7 +532,7 @@ fn markdown(rows: &[Row]) -> String {
          naming what is missing; `ShadowPass::capabilities_for` answers them without a device ([devices.md](devices.md)). \
          Ids of another pass or of a removed caster are `Misuse::ForeignId` / `Misuse::UnknownId`; a slot out of range \
          `Misuse::SlotOutOfRange` (tests/pass_contract.rs, tests/shadow_pass.rs).\n\n\
-         Call sequences: `tests/pass_sequences.rs` drives random sequences of every public call (casters, sphere and \
+         Call sequences: `tests/pass_sequences/` drives random sequences of every public call (casters, sphere and \
          transparent casters added, moved, deformed and removed; settings; `prepare` on any slot with the frame dropped, \
          submitted, or recorded and abandoned; invalid arguments and another pass's ids interleaved) against a reference \
          model (proptest-state-machine), and after every submitted frame compares the stencil, byte for byte, with a \

@@ -37,7 +37,7 @@ pub fn load_obj_str(text: &str, name: &str) -> Result<Mesh> {
 ///
 /// Also rejects face (and line) indices that cannot name an element, which tobj 4.0.5 turns
 /// into overflowing `usize` arithmetic (`vn * 3 + 2`, `vt * 2 + 1`: a panic in debug builds,
-/// an out-of-bounds index in release; found by tests/fuzz.rs): a positive index larger than the
+/// an out-of-bounds index in release; found by tests/fuzz/): a positive index larger than the
 /// file's line count (every element takes a line of its own), and a negative (relative) index
 /// reaching before the first `v`/`vt`/`vn` defined so far.
 fn check_vertices(text: &str, name: &str) -> Result<()> {
