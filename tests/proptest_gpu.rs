@@ -133,7 +133,8 @@ fn check(ctx: &RefCell<Option<umbrage::gpu::Context>>, case: &Case, drawn: &std:
         // SwiftShader drops clipped slivers whose snapped winding flips (a driver defect,
         // docs/conform/drivers-notes.md §1e): z-fail with both caps everywhere counts the
         // sides' slivers behind the receivers and misses a few pixels (at most 0.058 % of a
-        // hard case); McGuire's cases and Lengyel's stay exact there.
+        // hard case). McGuire's and Lengyel's cases keep the usual threshold: they were exact
+        // on every case seen here (z-pass sides can be hit too: tests/parts.rs' city).
         let ceiling = if swiftshader && row.method == "zfail" { SWIFTSHADER_SLIVERS } else { THRESHOLD };
         if row.fraction > ceiling {
             failures.push(format!("{} mismatches {} of {}", row.method, row.mismatches, row.compared));
