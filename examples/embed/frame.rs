@@ -5,7 +5,7 @@
 
 use super::extract::ExtractPush;
 use super::vulkan::{image_barrier, memory_barrier, vkerr, write_buffer};
-use super::{FrameResult, Host, InFlight, Layout, LightResult, SampleFrame, BAND, FRAMES_IN_FLIGHT};
+use super::{FrameResult, Host, InFlight, Layout, LightResult, SampleFrame, BAND, FRAMES_IN_FLIGHT, GEOMETRY_WORDS};
 use ash::vk;
 use glam::{DMat4, DVec3, DVec4, Vec3};
 use umbrage::pass::{reverse_z, DepthStencilTarget, ShadowView};
@@ -344,11 +344,11 @@ impl Host {
             .collect();
         let mut sample_frames = Vec::with_capacity(samples as usize);
         for (si, &(sx, sy)) in umbrage::render::standard_sample_locations(samples).iter().enumerate() {
-            let geometry = &words[layout.geometry(si as u32) as usize..][..4 * n];
+            let geometry = &words[layout.geometry(si as u32) as usize..][..GEOMETRY_WORDS as usize * n];
             let mut positions = Vec::with_capacity(3 * n);
             let mut normals = Vec::with_capacity(3 * n);
             let mut background = Vec::with_capacity(n);
-            for (i, g) in geometry.chunks_exact(4).enumerate() {
+            for (i, g) in geometry.chunks_exact(GEOMETRY_WORDS as usize).enumerate() {
                 let depth = f32::from_bits(g[0]);
                 let bg = depth == clear_depth;
                 background.push(bg);
@@ -357,11 +357,17 @@ impl Host {
                     normals.extend([f32::NAN; 3]);
                     continue;
                 }
-                // The sample's position: its depth unprojected at its own location.
+                // The sample's position: its depth unprojected at its own location, then put
+                // back on its triangle's plane (normal `n`, offset `d` from the eye) along the
+                // normal: the depth of a rasteriser that snaps vertices coarsely lies a little
+                // off the surface, which moves points in and out of the caster they lie on.
                 let (x, y) = ((i % w as usize) as f64 + sx, (i / w as usize) as f64 + sy);
                 let clip = DVec4::new(2.0 * x / w as f64 - 1.0, 2.0 * y / h as f64 - 1.0, depth as f64, 1.0);
                 let r = unproject * clip;
-                let p = eye + r.truncate() / r.w;
+                let [nx, ny, nz, d] = [g[1], g[2], g[3], g[4]].map(|v| f32::from_bits(v) as f64);
+                let normal = DVec3::new(nx, ny, nz);
+                let rel = r.truncate() / r.w;
+                let p = eye + rel - normal * (normal.dot(rel) - d);
                 positions.extend(p.as_vec3().to_array());
                 normals.extend([g[1], g[2], g[3]].map(f32::from_bits));
             }

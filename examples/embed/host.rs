@@ -260,19 +260,23 @@ struct Slot {
     in_flight: Option<InFlight>,
 }
 
-/// Readback layout, in 4-byte words: per sample its geometry (4 words a pixel: depth, normal),
+/// Readback layout, in 4-byte words: per sample its geometry ([`GEOMETRY_WORDS`] a pixel:
+/// depth, normal, plane offset),
 /// then per light and sample its packed stencil and lit bit (1 word a pixel).
 struct Layout {
     pixels: u32,
     samples: u32,
 }
 
+/// Words of one pixel's geometry in the readback.
+const GEOMETRY_WORDS: u32 = 5;
+
 impl Layout {
     fn geometry(&self, sample: u32) -> u32 {
-        4 * self.pixels * sample
+        GEOMETRY_WORDS * self.pixels * sample
     }
     fn packed(&self, light: usize, sample: u32) -> u32 {
-        4 * self.pixels * self.samples + self.pixels * (light as u32 * self.samples + sample)
+        GEOMETRY_WORDS * self.pixels * self.samples + self.pixels * (light as u32 * self.samples + sample)
     }
     fn bytes(&self, lights: usize) -> u64 {
         4 * self.packed(lights, 0) as u64

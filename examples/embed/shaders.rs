@@ -9,7 +9,11 @@ use naga::{back::spv, valid};
 ///
 /// `fs_normal` (pre-pass) writes the visible side's unit face normal, from the screen-space
 /// derivatives of the eye-relative position: every sample a triangle covers gets the
-/// triangle's plane normal, turned towards the eye. `fs_lit` (lighting pass) writes 1.
+/// triangle's plane normal, turned towards the eye; and, in w, the plane's offset `n · rel`
+/// (the readback puts the position unprojected from the depth back on the triangle's plane:
+/// a rasteriser that snaps vertices coarsely, like SwiftShader's 1/16 pixel, leaves depths a
+/// little off the true surface, while the interpolated position stays on it). `fs_lit`
+/// (lighting pass) writes 1.
 pub const SCENE_WGSL: &str = r#"
 struct Push { mvp: mat4x4<f32>, rel: mat4x4<f32> }
 var<immediate> pc: Push;
@@ -33,7 +37,7 @@ fn fs_normal(v: VsOut) -> @location(0) vec4<f32> {
     if dot(n, v.rel) > 0.0 {
         n = -n;
     }
-    return vec4<f32>(n, 1.0);
+    return vec4<f32>(n, dot(n, v.rel));
 }
 
 @fragment
@@ -43,8 +47,9 @@ fn fs_lit(v: VsOut) -> @location(0) vec4<f32> {
 "#;
 
 /// The readback of one sample of every pixel into a storage buffer (images with more than one
-/// sample cannot be copied to a buffer): when `geometry` is set, its depth and normal as four
-/// words at `geometry_at + 4 i` (depth's bits, then the normal); always, the light's stencil
+/// sample cannot be copied to a buffer): when `geometry` is set, its depth, normal and plane
+/// offset as five words at `geometry_at + 5 i` (depth's bits, then the normal's four
+/// components); always, the light's stencil
 /// count and lit bit (`stencil | lit << 8`) at `packed_at + i`. `MS` is replaced by
 /// `multisampled_2d` or `2d` (textureLoad's third argument is then the sample, or the level 0).
 pub const EXTRACT_WGSL: &str = r#"
@@ -67,11 +72,12 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.y * pc.width + id.x;
     if pc.geometry != 0u {
         let n = textureLoad(normal_t, p, s);
-        let g = pc.geometry_at + 4u * i;
+        let g = pc.geometry_at + 5u * i;
         words[g] = bitcast<u32>(textureLoad(depth_t, p, s));
         words[g + 1u] = bitcast<u32>(n.x);
         words[g + 2u] = bitcast<u32>(n.y);
         words[g + 3u] = bitcast<u32>(n.z);
+        words[g + 4u] = bitcast<u32>(n.w);
     }
     let lit = select(0u, 256u, textureLoad(lit_t, p, s).x > 0.5);
     words[pc.packed_at + i] = (textureLoad(stencil_t, p, s).x & 255u) | lit;
