@@ -115,7 +115,7 @@ fn scene(c: &Case) -> Scene {
 
 /// The fraction `zfail` may miss on SwiftShader: twice the worst measured (`hard/big_caster`,
 /// 0.058 %; `tests/hard_cases.rs`' `SLIVER_DEFECT`).
-const SWIFTSHADER_SLIVERS: f64 = 2.0 * 0.00058;
+const SWIFTSHADER_SLIVERS: f64 = 2.0 * common::SWIFTSHADER_BIG_CASTER_SLIVERS;
 
 /// Renders `case` with every exact volume method and checks each against the reference.
 fn check(ctx: &RefCell<Option<umbrage::gpu::Context>>, case: &Case, drawn: &std::cell::Cell<u64>) -> Result<(), TestCaseError> {

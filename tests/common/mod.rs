@@ -241,3 +241,8 @@ fn random_seed() -> u64 {
     h.write_u128(std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_nanos()).unwrap_or(0));
     h.finish()
 }
+
+/// The fraction of `hard/big_caster` that SwiftShader's sliver defect costs the z-fail methods
+/// with both caps everywhere (docs/conform/drivers-notes.md §1e), measured: the worst of the
+/// defect's cells, which `tests/hard_cases.rs` and `tests/proptest_gpu.rs` hold it to.
+pub const SWIFTSHADER_BIG_CASTER_SLIVERS: f64 = 0.00058;
