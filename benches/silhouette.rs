@@ -25,6 +25,10 @@
 //! both see the same host. The line printed gives the median round's ratio (streaming time
 //! over facing+silhouette time: above 1 is faster than the streaming read) and its spread.
 //!
+//! A second paired line per size compares the copy of the facing and the scan compiled for
+//! this CPU's x86-64 level (`umbrage::geom::cpu`; `streaming_sum` is compiled per level too)
+//! with the portable copy.
+//!
 //! The `load/1M` group times `Caster::new` on the 1M sphere, ordered and shuffled, and the
 //! reordering alone (`TriangleOrder::spatial`).
 
@@ -32,6 +36,7 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Through
 use glam::Mat4;
 use glam::Vec4;
 use std::hint::black_box;
+use umbrage::geom::cpu;
 use umbrage::geom::silhouette::{possible_silhouette_packed_into, EdgeScan, FacePlanes, SilhouetteEdge};
 use umbrage::geom::topology::Topology;
 use umbrage::geom::TriangleOrder;
@@ -54,6 +59,12 @@ struct PlainArrays {
     d: Vec<f32>,
 }
 
+/// Compiled per x86-64 level like the facing and the scan (`umbrage::geom::cpu`: the same
+/// target list), so that the comparison gives both sides the same instructions.
+#[multiversion::multiversion(targets(
+    "x86_64+avx+avx2+bmi1+bmi2+fma+lzcnt+popcnt+sse3+ssse3+sse4.1+sse4.2",
+    "x86_64+popcnt+sse3+ssse3+sse4.1+sse4.2"
+))]
 fn streaming_sum(p: &PlainArrays, pairs: &[[u32; 2]]) -> u64 {
     let mut s = [0u32; 8];
     for (((a, b), c), d) in p.a.chunks_exact(8).zip(p.b.chunks_exact(8)).zip(p.c.chunks_exact(8)).zip(p.d.chunks_exact(8)) {
@@ -152,6 +163,29 @@ fn bench(c: &mut Criterion) {
             ratios[3 * ratios.len() / 4],
             t_ours * 1e6,
             t_stream * 1e6
+        );
+        // what the CPU-specific copies of the facing and the scan buy: the best copy against
+        // the portable one, in paired rounds
+        let run = |portable: bool, (bits, sil): &mut (Vec<u64>, Vec<SilhouetteEdge>)| {
+            cpu::set_portable_only(portable);
+            planes.facing_packed_auto(mesh, black_box(light), false, bits);
+            sil.clear();
+            scan.scan_into(bits, sil);
+            black_box(sil.len());
+        };
+        let level = cpu::level();
+        let (mut portable_out, mut best_out) = ((Vec::new(), Vec::new()), (Vec::new(), Vec::new()));
+        let (ratios, t_portable, t_best) = paired_ratios(|| run(true, &mut portable_out), || run(false, &mut best_out), batch);
+        assert_eq!(portable_out, best_out, "the copies found the same silhouette");
+        cpu::set_portable_only(false);
+        println!(
+            "silhouette/{name}/cpu-level: facing+silhouette's {level} copy at {:.2}x the portable copy's speed (median of {} paired rounds of {batch}; quartiles {:.2}x-{:.2}x; median calls {:.2} µs against {:.2} µs)",
+            ratios[ratios.len() / 2],
+            ratios.len(),
+            ratios[ratios.len() / 4],
+            ratios[3 * ratios.len() / 4],
+            t_best * 1e6,
+            t_portable * 1e6
         );
         // the same sphere, triangles shuffled, loaded as a caster (reordered at load)
         let shuffled_mesh = shuffled(&sphere);

@@ -35,6 +35,7 @@
 //! Every path tests exactly the same two bits of every edge, so the result is the plain
 //! scan's, edge for edge, and its edges keep the caller's triangle ids.
 
+use super::cpu::{self, per_cpu_level};
 use super::order::TriangleOrder;
 use super::silhouette::SilhouetteEdge;
 use super::topology::ManifoldEdge;
@@ -308,19 +309,14 @@ impl EdgeScan {
     /// [`possible_silhouette`]: super::silhouette::possible_silhouette
     pub fn scan_into(&self, bits: &[u64], out: &mut Vec<SilhouetteEdge>) {
         SCRATCH.with_borrow_mut(|Scratch { breaks, hits }| {
-            find_breaks(bits, self.words, breaks);
             let mut hits = Hits { list: hits, len: 0 };
-            self.near.scan(bits, breaks, &mut hits);
-            for c in &self.far_classes {
-                self.scan_class(c, bits, breaks, &mut hits);
-            }
-            self.scan_far(bits, &mut hits);
-            self.scan_lone(bits, &mut hits);
+            scan_words(self, bits, breaks, &mut hits);
             out.extend(hits.found().iter().map(|&h| oriented(&self.edges[h as u32 as usize], h >> 32 != 0)));
         })
     }
 
     /// The far residual edges of the word pairs whose two words are not the same uniform word.
+    #[inline(always)]
     fn scan_far(&self, bits: &[u64], hits: &mut Hits) {
         // a chunk of pairs at a time: first the pairs to test, listed without a branch a pair,
         // then their edges
@@ -348,6 +344,7 @@ impl EdgeScan {
     }
 
     /// The far residual edges alone in their word pair, each by its two bits.
+    #[inline(always)]
     fn scan_lone(&self, bits: &[u64], hits: &mut Hits) {
         let bit = |s: u32| (word(bits, s as usize / 64) >> (s % 64)) & 1;
         for (c, chunk) in self.lone.chunks(FAR_CHUNK).enumerate() {
@@ -363,6 +360,7 @@ impl EdgeScan {
         }
     }
 
+    #[inline(always)]
     fn scan_class(&self, c: &DeltaClass, bits: &[u64], breaks: &[u32], hits: &mut Hits) {
         // the words `w ..= w + reach` are read for the class's word `w`: it can hold a
         // silhouette edge only when a break lies among them
@@ -389,10 +387,39 @@ impl EdgeScan {
     }
 }
 
+/// One scan's word work ([`EdgeScan::scan_into`]): the breaks, then every kind of edge, into
+/// `hits`; the best copy for this CPU ([`super::cpu`]), or the portable one.
+fn scan_words(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, hits: &mut Hits) {
+    if cpu::portable_only() {
+        scan_words_in(scan, bits, breaks, hits)
+    } else {
+        scan_words_per_level(scan, bits, breaks, hits)
+    }
+}
+
+per_cpu_level! {
+    /// [`scan_words_in`], compiled per CPU level.
+    fn scan_words_per_level(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, hits: &mut Hits) {
+        scan_words_in(scan, bits, breaks, hits)
+    }
+}
+
+/// [`scan_words`]' body; it and the parts it calls are inlined into each copy.
+#[inline(always)]
+fn scan_words_in(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, hits: &mut Hits) {
+    find_breaks(bits, scan.words, breaks);
+    scan.near.scan(bits, breaks, hits);
+    for c in &scan.far_classes {
+        scan.scan_class(c, bits, breaks, hits);
+    }
+    scan.scan_far(bits, hits);
+    scan.scan_lone(bits, hits);
+}
+
 /// Lists the residual edges `range` (bit positions `offsets`, from the range's first) whose
 /// two bits differ, without a branch an edge: `lo` bits in `a`, `hi` bits in `b` (bit `k` in
 /// `b[k / 64]`).
-#[inline]
+#[inline(always)]
 fn test_edges(range: std::ops::Range<u32>, offsets: &[[u8; 2]], a: u64, b: [u64; 2], hits: &mut Hits) {
     let (list, mut len) = (&mut hits.list[..], hits.len);
     for (i, o) in range.zip(offsets) {
@@ -450,7 +477,7 @@ impl Hits<'_> {
     /// mask bit `k` of `m`, which is edge `first` plus its rank in `m`; `t0` is lit where bit
     /// `k` of `lo_vs_t0` (the word's facing bits xor the edges' `lo is t0` bits) is clear.
     /// Needs [`room`](Self::room).
-    #[inline]
+    #[inline(always)]
     fn class_edges(&mut self, mut s: u64, m: u64, lo_vs_t0: u64, first: u32) {
         let (list, mut len) = (&mut self.list[..], self.len);
         while s != 0 {
@@ -478,6 +505,7 @@ fn mixed(a: u64) -> bool {
 /// every word that is neither all ones nor all zeros, and every other word that differs from
 /// the word before it (from `first + 1` on; words past the bits are zeros). Between two breaks
 /// all words are one uniform word.
+#[inline(always)]
 fn find_breaks(bits: &[u64], (first, last): (usize, usize), breaks: &mut Vec<u32>) {
     breaks.clear();
     // the words inside the bits, 64 at a time into a mask (no branch per word), then the

@@ -8,6 +8,7 @@ mod area_shape;
 pub use area::{AreaLight, AreaShape};
 pub mod bounds;
 pub mod cone;
+pub mod cpu;
 pub mod edgescan;
 pub mod light;
 pub use order::TriangleOrder;

@@ -1,6 +1,7 @@
 //! Object-space triangle planes for facing bits at memory speed ([`FacePlanes`]): f32 SoA
 //! planes with a proven error bound, the exact predicate only where the sign is in doubt.
 
+use super::cpu::{self, per_cpu_level};
 use super::mesh::Mesh;
 use super::order::TriangleOrder;
 use super::predicates::facing_exact;
@@ -378,7 +379,7 @@ impl FacePlanes {
             }
             return;
         };
-        self.fill_words(mesh, l, flip, (lf, e), 0, out);
+        fill_words(self, mesh, l, flip, (lf, e), 0, out);
     }
 
     /// [`facing_packed`](Self::facing_packed), on every available core (at most 8) for meshes
@@ -407,61 +408,79 @@ impl FacePlanes {
         let per = words.div_ceil(th);
         std::thread::scope(|s| {
             for (ci, o) in out.chunks_mut(per).enumerate() {
-                s.spawn(move || self.fill_words(mesh, l, flip, filter, ci * per, o));
+                s.spawn(move || fill_words(self, mesh, l, flip, filter, ci * per, o));
             }
         });
     }
+}
 
-    /// Words `first .. first + out.len()` of the packed bits, with the filter `(lf, e)` of
-    /// [`error_bound`](Self::error_bound) (`n == self.len` checked by the caller).
-    fn fill_words(&self, mesh: &Mesh, l: Vec4, flip: bool, (lf, e): (Vec4, f32), first: usize, out: &mut [u64]) {
-        let n = self.len;
-        // flip: the negated plane, i.e. the negated light (exact).
-        let lf = if flip { -lf } else { lf };
-        let (words, last) = (n.div_ceil(64), first + out.len());
-        let probe = Probe::new(lf, e as f64);
-        let size = SUPER_BLOCKS[0];
-        let valid = |w: usize| if (w + 1) * 64 <= n { u64::MAX } else { (1u64 << (n - w * 64)) - 1 };
-        // word `w` from its 64 dot products, the exact test where they are unsure
-        let dots = |w: usize| {
-            let r = w * 64..w * 64 + 64;
-            let (bits, unsure) = block64(&self.nx[r.clone()], &self.ny[r.clone()], &self.nz[r.clone()], &self.d[r], lf, e);
-            let (mut word, mut u) = (bits & valid(w), unsure & valid(w));
-            while u != 0 {
-                let k = u.trailing_zeros() as usize;
-                u &= u - 1;
-                word = (word & !(1 << k)) | (u64::from(exact_bit(mesh, self.tri(w * 64 + k), l, flip)) << k);
-            }
-            word
-        };
-        let mut w = first;
-        while w < last {
-            // the super-block of word `w`, tested where all its words are this call's
-            let s = w / size;
-            let s_end = ((s + 1) * size).min(words);
-            let end = s_end.min(last);
-            let sup = match self.supers[0].get(s) {
-                Some(b) if s * size >= first && s_end <= last => b.test(&probe),
-                _ => (false, false),
-            };
-            if sup.0 || sup.1 {
-                for v in w..end {
-                    out[v - first] = if sup.0 { valid(v) } else { 0 };
-                }
-            } else {
-                // its blocks' bounds, all at once
-                let (ones, zeros) = self.blocks.get(s).map_or((0, 0), |b| b.test(&probe));
-                let (ones, zeros) = (ones >> (w - s * size), zeros >> (w - s * size));
-                for (k, v) in (w..end).enumerate() {
-                    out[v - first] = match ((ones >> k) & 1, (zeros >> k) & 1) {
-                        (1, _) => valid(v),
-                        (_, 1) => 0,
-                        _ => dots(v),
-                    };
-                }
-            }
-            w = end;
+/// Words `first .. first + out.len()` of `planes`' packed bits, with the filter `(lf, e)` of
+/// [`FacePlanes::error_bound`] (`n == planes.len` checked by the caller); the best copy for
+/// this CPU ([`super::cpu`]), or the portable one.
+fn fill_words(planes: &FacePlanes, mesh: &Mesh, l: Vec4, flip: bool, filter: (Vec4, f32), first: usize, out: &mut [u64]) {
+    if cpu::portable_only() {
+        fill_words_in(planes, mesh, l, flip, filter, first, out)
+    } else {
+        fill_words_per_level(planes, mesh, l, flip, filter, first, out)
+    }
+}
+
+per_cpu_level! {
+    /// [`fill_words_in`], compiled per CPU level.
+    fn fill_words_per_level(planes: &FacePlanes, mesh: &Mesh, l: Vec4, flip: bool, filter: (Vec4, f32), first: usize, out: &mut [u64]) {
+        fill_words_in(planes, mesh, l, flip, filter, first, out)
+    }
+}
+
+/// [`fill_words`]' body, inlined into each copy.
+#[inline(always)]
+fn fill_words_in(planes: &FacePlanes, mesh: &Mesh, l: Vec4, flip: bool, (lf, e): (Vec4, f32), first: usize, out: &mut [u64]) {
+    let n = planes.len;
+    // flip: the negated plane, i.e. the negated light (exact).
+    let lf = if flip { -lf } else { lf };
+    let (words, last) = (n.div_ceil(64), first + out.len());
+    let probe = Probe::new(lf, e as f64);
+    let size = SUPER_BLOCKS[0];
+    let valid = |w: usize| if (w + 1) * 64 <= n { u64::MAX } else { (1u64 << (n - w * 64)) - 1 };
+    // word `w` from its 64 dot products, the exact test where they are unsure
+    let dots = |w: usize| {
+        let r = w * 64..w * 64 + 64;
+        let (bits, unsure) = block64(&planes.nx[r.clone()], &planes.ny[r.clone()], &planes.nz[r.clone()], &planes.d[r], lf, e);
+        let (mut word, mut u) = (bits & valid(w), unsure & valid(w));
+        while u != 0 {
+            let k = u.trailing_zeros() as usize;
+            u &= u - 1;
+            word = (word & !(1 << k)) | (u64::from(exact_bit(mesh, planes.tri(w * 64 + k), l, flip)) << k);
         }
+        word
+    };
+    let mut w = first;
+    while w < last {
+        // the super-block of word `w`, tested where all its words are this call's
+        let s = w / size;
+        let s_end = ((s + 1) * size).min(words);
+        let end = s_end.min(last);
+        let sup = match planes.supers[0].get(s) {
+            Some(b) if s * size >= first && s_end <= last => b.test(&probe),
+            _ => (false, false),
+        };
+        if sup.0 || sup.1 {
+            for v in w..end {
+                out[v - first] = if sup.0 { valid(v) } else { 0 };
+            }
+        } else {
+            // its blocks' bounds, all at once
+            let (ones, zeros) = planes.blocks.get(s).map_or((0, 0), |b| b.test(&probe));
+            let (ones, zeros) = (ones >> (w - s * size), zeros >> (w - s * size));
+            for (k, v) in (w..end).enumerate() {
+                out[v - first] = match ((ones >> k) & 1, (zeros >> k) & 1) {
+                    (1, _) => valid(v),
+                    (_, 1) => 0,
+                    _ => dots(v),
+                };
+            }
+        }
+        w = end;
     }
 }
 
@@ -473,7 +492,7 @@ impl FacePlanes {
 /// scalar form, and each comparison becomes one mask (`movmskps`). The filter's light has
 /// `lw = ±1` or `0`, where `d·lw` is exact (`±d`, or a zero that cannot move the value across
 /// `±e`): those three are specialised, one multiplication fewer, the same bits.
-#[inline]
+#[inline(always)]
 fn block64(nx: &[f32], ny: &[f32], nz: &[f32], d: &[f32], l: Vec4, e: f32) -> (u64, u64) {
     if l.w == 1.0 {
         block64_w(nx, ny, nz, d, l, e, |s, d| s + d)

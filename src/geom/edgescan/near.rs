@@ -89,6 +89,7 @@ impl Near {
     /// The near edges of the words next to a break: every class's edges whose bits differ,
     /// and the residual edges of a mixed word, or a uniform word's that reach into a next word
     /// unlike it.
+    #[inline(always)]
     pub(super) fn scan(&self, bits: &[u64], breaks: &[u32], hits: &mut Hits) {
         let near = self;
         let classes = near.deltas.len();

@@ -2,6 +2,7 @@
 //! and self edges, random edges, bits and permutations.
 
 use super::*;
+use crate::geom::cpu::on_each_copy;
 use crate::geom::silhouette::{possible_silhouette_packed, FacePlanes};
 use crate::geom::testmesh::{cube, shuffled, uv_sphere};
 use crate::geom::topology::Topology;
@@ -32,8 +33,11 @@ fn check_in(edges: Vec<ManifoldEdge>, bits: &[u64], order: &TriangleOrder) -> Ed
     sorted_in.sort_by_key(key);
     sorted_scan.sort_by_key(key);
     assert_eq!(sorted_in, sorted_scan, "the scan holds exactly the given edges");
-    let mut sil = Vec::new();
-    scan.scan_into(bits, &mut sil);
+    let sil = on_each_copy(|| {
+        let mut sil = Vec::new();
+        scan.scan_into(bits, &mut sil);
+        sil
+    });
     assert_eq!(sil, plain(scan.edges(), bits, order));
     if order.is_identity() {
         assert_eq!(sil, possible_silhouette_packed(scan.edges(), bits));

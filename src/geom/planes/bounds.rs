@@ -107,7 +107,7 @@ impl Bounds8 {
 
     /// [`BlockBound::test`] of the 8 blocks, without branches: bit `i` of the first mask is set
     /// when block `i` faces the probe's light whole, of the second when none of it does.
-    #[inline]
+    #[inline(always)]
     pub(super) fn test(&self, probe: &Probe) -> (u64, u64) {
         let (p, w) = (probe.p, probe.w);
         let (mut ones, mut zeros) = (0u64, 0u64);
