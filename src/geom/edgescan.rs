@@ -106,7 +106,7 @@ struct DeltaClass {
     first: usize,
 }
 
-#[inline]
+#[inline(always)]
 fn oriented(e: &ManifoldEdge, t0_lit: bool) -> SilhouetteEdge {
     // selects, not a branch: which triangle is lit follows the light, not a pattern
     let (ends, tris, corners) = ([e.a, e.b], [e.t0, e.t1], [e.c0, e.c1]);
@@ -309,9 +309,7 @@ impl EdgeScan {
     /// [`possible_silhouette`]: super::silhouette::possible_silhouette
     pub fn scan_into(&self, bits: &[u64], out: &mut Vec<SilhouetteEdge>) {
         SCRATCH.with_borrow_mut(|Scratch { breaks, hits }| {
-            let mut hits = Hits { list: hits, len: 0 };
-            scan_words(self, bits, breaks, &mut hits);
-            out.extend(hits.found().iter().map(|&h| oriented(&self.edges[h as u32 as usize], h >> 32 != 0)));
+            scan_words(self, bits, breaks, &mut Hits { list: hits, len: 0 }, out);
         })
     }
 
@@ -388,25 +386,25 @@ impl EdgeScan {
 }
 
 /// One scan's word work ([`EdgeScan::scan_into`]): the breaks, then every kind of edge, into
-/// `hits`; the best copy for this CPU ([`super::cpu`]), or the portable one.
-fn scan_words(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, hits: &mut Hits) {
+/// `hits`, and the edges found appended to `out`; the best copy for this CPU ([`super::cpu`]), or the portable one.
+fn scan_words(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, hits: &mut Hits, out: &mut Vec<SilhouetteEdge>) {
     if cpu::portable_only() {
-        scan_words_in(scan, bits, breaks, hits)
+        scan_words_in(scan, bits, breaks, hits, out)
     } else {
-        scan_words_per_level(scan, bits, breaks, hits)
+        scan_words_per_level(scan, bits, breaks, hits, out)
     }
 }
 
 per_cpu_level! {
     /// [`scan_words_in`], compiled per CPU level.
-    fn scan_words_per_level(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, hits: &mut Hits) {
-        scan_words_in(scan, bits, breaks, hits)
+    fn scan_words_per_level(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, hits: &mut Hits, out: &mut Vec<SilhouetteEdge>) {
+        scan_words_in(scan, bits, breaks, hits, out)
     }
 }
 
 /// [`scan_words`]' body; it and the parts it calls are inlined into each copy.
 #[inline(always)]
-fn scan_words_in(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, hits: &mut Hits) {
+fn scan_words_in(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, hits: &mut Hits, out: &mut Vec<SilhouetteEdge>) {
     find_breaks(bits, scan.words, breaks);
     scan.near.scan(bits, breaks, hits);
     for c in &scan.far_classes {
@@ -414,6 +412,11 @@ fn scan_words_in(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, hits: &mu
     }
     scan.scan_far(bits, hits);
     scan.scan_lone(bits, hits);
+    // the edges found, oriented (a loop, not an iterator adapter: inlined into each copy)
+    out.reserve(hits.len);
+    for &h in hits.found() {
+        out.push(oriented(&scan.edges[h as u32 as usize], h >> 32 != 0));
+    }
 }
 
 /// Lists the residual edges `range` (bit positions `offsets`, from the range's first) whose
@@ -490,6 +493,7 @@ impl Hits<'_> {
         self.len = len;
     }
 
+    #[inline(always)]
     fn found(&self) -> &[u64] {
         &self.list[..self.len]
     }

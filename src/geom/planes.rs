@@ -441,19 +441,7 @@ fn fill_words_in(planes: &FacePlanes, mesh: &Mesh, l: Vec4, flip: bool, (lf, e):
     let (words, last) = (n.div_ceil(64), first + out.len());
     let probe = Probe::new(lf, e as f64);
     let size = SUPER_BLOCKS[0];
-    let valid = |w: usize| if (w + 1) * 64 <= n { u64::MAX } else { (1u64 << (n - w * 64)) - 1 };
-    // word `w` from its 64 dot products, the exact test where they are unsure
-    let dots = |w: usize| {
-        let r = w * 64..w * 64 + 64;
-        let (bits, unsure) = block64(&planes.nx[r.clone()], &planes.ny[r.clone()], &planes.nz[r.clone()], &planes.d[r], lf, e);
-        let (mut word, mut u) = (bits & valid(w), unsure & valid(w));
-        while u != 0 {
-            let k = u.trailing_zeros() as usize;
-            u &= u - 1;
-            word = (word & !(1 << k)) | (u64::from(exact_bit(mesh, planes.tri(w * 64 + k), l, flip)) << k);
-        }
-        word
-    };
+    let valid = |w: usize| valid_bits(n, w);
     let mut w = first;
     while w < last {
         // the super-block of word `w`, tested where all its words are this call's
@@ -476,12 +464,39 @@ fn fill_words_in(planes: &FacePlanes, mesh: &Mesh, l: Vec4, flip: bool, (lf, e):
                 out[v - first] = match ((ones >> k) & 1, (zeros >> k) & 1) {
                     (1, _) => valid(v),
                     (_, 1) => 0,
-                    _ => dots(v),
+                    _ => dot_word(planes, mesh, (l, lf, e), flip, v),
                 };
             }
         }
         w = end;
     }
+}
+
+/// The bits of word `w` that are triangles (of `n`).
+#[inline(always)]
+fn valid_bits(n: usize, w: usize) -> u64 {
+    if (w + 1) * 64 <= n {
+        u64::MAX
+    } else {
+        (1u64 << (n - w * 64)) - 1
+    }
+}
+
+/// Facing word `w` of `planes` from its 64 dot products with the filter's light `lf` and
+/// bound `e`, the exact test (light `l`) where they are unsure. Not a closure: it is inlined
+/// into each CPU level's copy of [`fill_words`].
+#[inline(always)]
+fn dot_word(planes: &FacePlanes, mesh: &Mesh, (l, lf, e): (Vec4, Vec4, f32), flip: bool, w: usize) -> u64 {
+    let r = w * 64..w * 64 + 64;
+    let (bits, unsure) = block64(&planes.nx[r.clone()], &planes.ny[r.clone()], &planes.nz[r.clone()], &planes.d[r], lf, e);
+    let valid = valid_bits(planes.len, w);
+    let (mut word, mut u) = (bits & valid, unsure & valid);
+    while u != 0 {
+        let k = u.trailing_zeros() as usize;
+        u &= u - 1;
+        word = (word & !(1 << k)) | (u64::from(exact_bit(mesh, planes.tri(w * 64 + k), l, flip)) << k);
+    }
+    word
 }
 
 /// Facing and "unsure" bits of 64 planes: bit k of the first word is set when plane k's value
