@@ -324,8 +324,10 @@ impl EdgeScan {
             let mut n = 0;
             for (i, p) in chunk.iter().enumerate() {
                 let (a, b) = (word(bits, p.lo as usize), word(bits, p.hi as usize));
-                dirty[n] = i as u16;
-                n += usize::from(a != b || mixed(a));
+                // (`n <= i < FAR_CHUNK`: the mask only spares the bounds check)
+                dirty[n % FAR_CHUNK] = i as u16;
+                // not the same uniform word: `a` mixed (`a + 1` above 1) or `b` unlike it
+                n += usize::from(((a ^ b) | (a.wrapping_add(1) >> 1)) != 0);
             }
             let end = chunk[chunk.len() - 1].end;
             hits.room((end - start) as usize);

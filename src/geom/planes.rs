@@ -367,10 +367,10 @@ impl FacePlanes {
     pub fn facing_packed(&self, mesh: &Mesh, l: Vec4, flip: bool, out: &mut Vec<u64>) {
         let n = mesh.triangles.len();
         let words = n.div_ceil(64);
-        out.clear();
-        out.resize(words, 0);
         let filter = if n == self.len { self.error_bound(l) } else { None };
         let Some((lf, e)) = filter else {
+            out.clear();
+            out.resize(words, 0);
             let same = n == self.len;
             for t in 0..n {
                 if exact_bit(mesh, if same { self.tri(t) } else { t }, l, flip) {
@@ -379,6 +379,8 @@ impl FacePlanes {
             }
             return;
         };
+        // (every word is written: no need to clear them first)
+        out.resize(words, 0);
         fill_words(self, mesh, l, flip, (lf, e), 0, out);
     }
 
@@ -403,7 +405,7 @@ impl FacePlanes {
         let Some(filter) = filter.filter(|_| th > 1) else {
             return self.facing_packed(mesh, l, flip, out);
         };
-        out.clear();
+        // (the threads write every word)
         out.resize(words, 0);
         let per = words.div_ceil(th);
         std::thread::scope(|s| {
@@ -452,21 +454,26 @@ fn fill_words_in(planes: &FacePlanes, mesh: &Mesh, l: Vec4, flip: bool, (lf, e):
             Some(b) if s * size >= first && s_end <= last => b.test(&probe),
             _ => (false, false),
         };
+        let ours = &mut out[w - first..end - first];
         if sup.0 || sup.1 {
-            for v in w..end {
-                out[v - first] = if sup.0 { valid(v) } else { 0 };
-            }
+            ours.fill(if sup.0 { u64::MAX } else { 0 });
         } else {
-            // its blocks' bounds, all at once
+            // its blocks' bounds, all at once: the decided words, then the others' dot products
             let (ones, zeros) = planes.blocks.get(s).map_or((0, 0), |b| b.test(&probe));
             let (ones, zeros) = (ones >> (w - s * size), zeros >> (w - s * size));
-            for (k, v) in (w..end).enumerate() {
-                out[v - first] = match ((ones >> k) & 1, (zeros >> k) & 1) {
-                    (1, _) => valid(v),
-                    (_, 1) => 0,
-                    _ => dot_word(planes, mesh, (l, lf, e), flip, v),
-                };
+            for (k, o) in ours.iter_mut().enumerate() {
+                *o = 0u64.wrapping_sub((ones >> k) & 1);
             }
+            let mut undecided = !(ones | zeros) & ((1 << ours.len()) - 1);
+            while undecided != 0 {
+                let k = undecided.trailing_zeros() as usize;
+                undecided &= undecided - 1;
+                ours[k] = dot_word(planes, mesh, (l, lf, e), flip, w + k);
+            }
+        }
+        // the last word's bits past the triangles stay clear
+        if end == words {
+            out[end - 1 - first] &= valid(end - 1);
         }
         w = end;
     }
