@@ -353,8 +353,8 @@ impl EdgeScan {
             let first = self.lone_start + c * FAR_CHUNK;
             for (i, &[s0, s1]) in chunk.iter().enumerate() {
                 let (f0, f1) = (bit(s0), bit(s1));
-                list[len] = entry((first + i) as u32, f0 != 0);
-                len += usize::from(f0 != f1);
+                list[len] = entry((first + i) as u32, f0);
+                len += ((f0 ^ f1) & 1) as usize;
             }
             hits.len = len;
         }
@@ -428,20 +428,23 @@ fn scan_words_in(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, hits: &mu
 fn test_edges(range: std::ops::Range<u32>, offsets: &[[u8; 2]], a: u64, b: [u64; 2], hits: &mut Hits) {
     let (list, mut len) = (&mut hits.list[..], hits.len);
     for (i, o) in range.zip(offsets) {
-        let fl = (a >> (o[0] & 63)) & 1;
-        let fh = (b[usize::from(o[1] >> 6 & 1)] >> (o[1] & 63)) & 1;
-        // t0 is lit when its slot's bit is set: lo's bit when lo is t0's, else hi's
-        let t0_lit = (fl != 0) == (o[0] >= T0);
+        let (o0, o1) = (u64::from(o[0]), u64::from(o[1]));
+        // the two bits in bit 0 (integer operations only: no flags to materialise)
+        let fl = a >> (o0 & 63);
+        let fh = b[(o1 >> 6 & 1) as usize] >> (o1 & 63);
+        // t0 is lit when its slot's bit is set: lo's bit when lo is t0's (`T0`), else hi's
+        const _: () = assert!(T0 == 1 << 7);
+        let t0_lit = fl ^ (o0 >> 7) ^ 1;
         list[len] = entry(i, t0_lit);
-        len += usize::from(fl != fh);
+        len += ((fl ^ fh) & 1) as usize;
     }
     hits.len = len;
 }
 
-/// A [`Hits`] entry: edge `i`, and whether its `t0` is lit.
-#[inline]
-fn entry(i: u32, t0_lit: bool) -> u64 {
-    u64::from(i) | (u64::from(t0_lit) << 32)
+/// A [`Hits`] entry: edge `i`, and whether its `t0` is lit (bit 0 of `t0_lit`).
+#[inline(always)]
+fn entry(i: u32, t0_lit: u64) -> u64 {
+    u64::from(i) | ((t0_lit & 1) << 32)
 }
 
 /// Facing word `w` (0 past the bits).
@@ -489,7 +492,7 @@ impl Hits<'_> {
             let k = s.trailing_zeros();
             s &= s - 1;
             let rank = (m & ((1u64 << k) - 1)).count_ones();
-            list[len] = entry(first + rank, (lo_vs_t0 >> k) & 1 == 0);
+            list[len] = entry(first + rank, !(lo_vs_t0 >> k));
             len += 1;
         }
         self.len = len;
