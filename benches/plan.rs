@@ -2,7 +2,10 @@
 //! selection, facing bits, possible silhouettes and index emission, for every method, as
 //! `umbrage bench` runs it once per frame and light; `streaming_sum` beside them reads the
 //! bytes the planner must at least touch (every caster's positions and triangles) as a plain
-//! streaming sum, so its time can be held against memory speed in the same run.
+//! streaming sum, so its time can be held against memory speed in the same run. After the
+//! group, paired rounds (as in `benches/silhouette.rs`) compare `mcguire` with the streaming
+//! sum, and its CPU level's copies of the facing and the edge scan (`umbrage::geom::cpu`) with
+//! the portable ones.
 //!
 //! `plan/buildings` (only when `target/assets/buildings.obj` is there: `scripts/fetch-assets.sh`)
 //! plans the OpenFOAM city block (400k triangles, 26 parts) for its two lights, as the file
@@ -11,12 +14,27 @@
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::hint::black_box;
+use umbrage::geom::cpu;
 use umbrage::geom::silhouette::{EdgeScan, FacePlanes};
 use umbrage::geom::Mesh;
 use umbrage::shadow::{plan_light, Caster, Method, PlanInput};
+#[path = "common/paired.rs"]
+mod paired;
+use paired::{paired_line, paired_ratios};
 #[path = "../src/geom/testmesh.rs"]
 #[allow(dead_code)]
 mod testmesh;
+
+/// The streaming sum of the casters' bytes; compiled per x86-64 level like the facing and the
+/// scan (`umbrage::geom::cpu`: the same target list), so that both sides get the same
+/// instructions.
+#[multiversion::multiversion(targets(
+    "x86_64+avx+avx2+bmi1+bmi2+fma+lzcnt+popcnt+sse3+ssse3+sse4.1+sse4.2",
+    "x86_64+popcnt+sse3+ssse3+sse4.1+sse4.2"
+))]
+fn plain_sum(plain: &[u32]) -> u64 {
+    plain.iter().fold(0u64, |a, &x| a.wrapping_add(x as u64))
+}
 
 /// `caster` with its silhouette structures in the mesh's own triangle order (no reordering).
 fn in_caller_order(caster: &Caster) -> Caster {
@@ -101,12 +119,30 @@ fn bench(c: &mut Criterion) {
             p.chain(m.mesh.triangles.iter().flat_map(|t| t.iter().copied()).collect::<Vec<_>>())
         })
         .collect();
-    g.bench_function("streaming_sum", |b| b.iter(|| black_box(black_box(&plain).iter().fold(0u64, |a, &x| a.wrapping_add(x as u64)))));
+    g.bench_function("streaming_sum", |b| b.iter(|| black_box(plain_sum(black_box(&plain)))));
     for method in [Method::McGuire, Method::ZFail, Method::ZPass] {
         let input = PlanInput { camera: cam, width: w, height: h, view_proj: vp, light, method };
         g.bench_function(method.name(), |b| b.iter(|| black_box(plan_light(black_box(&input), &casters).casters.len())));
     }
     g.finish();
+    // `mcguire` in paired rounds (batches of about 10 ms): against the streaming sum, and its
+    // CPU level's copies of the facing and the scan against the portable ones
+    let input = PlanInput { camera: cam, width: w, height: h, view_proj: vp, light, method: Method::McGuire };
+    let plan = |portable: bool| {
+        cpu::set_portable_only(portable);
+        black_box(plan_light(black_box(&input), &casters).casters.len());
+    };
+    let stream = || {
+        black_box(plain_sum(black_box(&plain)));
+    };
+    let batch = 30;
+    println!(
+        "{}",
+        paired_line("plan/bench-vertex/paired: mcguire", "streaming_sum's", paired_ratios(stream, || plan(false), batch), batch)
+    );
+    let what = format!("plan/bench-vertex/cpu-level: mcguire with the {} copies", cpu::level());
+    println!("{}", paired_line(&what, "the portable copies'", paired_ratios(|| plan(true), || plan(false), batch), batch));
+    cpu::set_portable_only(false);
 }
 
 criterion_group!(benches, bench, buildings);

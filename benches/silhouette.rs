@@ -41,6 +41,9 @@ use umbrage::geom::silhouette::{possible_silhouette_packed_into, EdgeScan, FaceP
 use umbrage::geom::topology::Topology;
 use umbrage::geom::TriangleOrder;
 use umbrage::shadow::Caster;
+#[path = "common/paired.rs"]
+mod paired;
+use paired::{paired_line, paired_ratios};
 #[path = "../src/geom/testmesh.rs"]
 #[allow(dead_code)]
 mod testmesh;
@@ -77,26 +80,6 @@ fn streaming_sum(p: &PlainArrays, pairs: &[[u32; 2]]) -> u64 {
         t = t.wrapping_add((e[0] ^ e[1]) as u64);
     }
     s.iter().map(|&x| x as u64).sum::<u64>().wrapping_add(t)
-}
-
-/// Paired rounds of `a` and `b` (see the module docs): per round, `a`'s batch time over `b`'s,
-/// sorted, and the median time of one call of `a` and of `b`, in seconds.
-fn paired_ratios(mut a: impl FnMut(), mut b: impl FnMut(), batch: u32) -> (Vec<f64>, f64, f64) {
-    let time = |f: &mut dyn FnMut()| {
-        let t = std::time::Instant::now();
-        for _ in 0..batch {
-            f();
-        }
-        t.elapsed().as_secs_f64() / f64::from(batch)
-    };
-    let rounds: Vec<(f64, f64)> = (0..31).map(|_| (time(&mut a), time(&mut b))).collect();
-    let median = |mut v: Vec<f64>| {
-        v.sort_by(f64::total_cmp);
-        v[v.len() / 2]
-    };
-    let mut ratios: Vec<f64> = rounds.iter().map(|(x, y)| x / y).collect();
-    ratios.sort_by(f64::total_cmp);
-    (ratios, median(rounds.iter().map(|r| r.0).collect()), median(rounds.iter().map(|r| r.1).collect()))
 }
 
 fn bench(c: &mut Criterion) {
@@ -143,7 +126,7 @@ fn bench(c: &mut Criterion) {
         // the same two functions in paired rounds (batches of about 10 ms)
         let batch = (10_000_000 / (tris as u64 / 3).max(1)).clamp(5, 2_000) as u32;
         let (mut bits, mut sil) = (Vec::new(), Vec::new());
-        let (ratios, t_stream, t_ours) = paired_ratios(
+        let paired = paired_ratios(
             || {
                 black_box(streaming_sum(black_box(&plain), black_box(&pairs)));
             },
@@ -155,15 +138,7 @@ fn bench(c: &mut Criterion) {
             },
             batch,
         );
-        println!(
-            "silhouette/{name}/paired: facing+silhouette at {:.2}x streaming_sum's speed (median of {} paired rounds of {batch}; quartiles {:.2}x-{:.2}x; median calls {:.2} µs against {:.2} µs)",
-            ratios[ratios.len() / 2],
-            ratios.len(),
-            ratios[ratios.len() / 4],
-            ratios[3 * ratios.len() / 4],
-            t_ours * 1e6,
-            t_stream * 1e6
-        );
+        println!("{}", paired_line(&format!("silhouette/{name}/paired: facing+silhouette"), "streaming_sum's", paired, batch));
         // what the CPU-specific copies of the facing and the scan buy: the best copy against
         // the portable one, in paired rounds
         let run = |portable: bool, (bits, sil): &mut (Vec<u64>, Vec<SilhouetteEdge>)| {
@@ -175,18 +150,11 @@ fn bench(c: &mut Criterion) {
         };
         let level = cpu::level();
         let (mut portable_out, mut best_out) = ((Vec::new(), Vec::new()), (Vec::new(), Vec::new()));
-        let (ratios, t_portable, t_best) = paired_ratios(|| run(true, &mut portable_out), || run(false, &mut best_out), batch);
+        let paired = paired_ratios(|| run(true, &mut portable_out), || run(false, &mut best_out), batch);
         assert_eq!(portable_out, best_out, "the copies found the same silhouette");
         cpu::set_portable_only(false);
-        println!(
-            "silhouette/{name}/cpu-level: facing+silhouette's {level} copy at {:.2}x the portable copy's speed (median of {} paired rounds of {batch}; quartiles {:.2}x-{:.2}x; median calls {:.2} µs against {:.2} µs)",
-            ratios[ratios.len() / 2],
-            ratios.len(),
-            ratios[ratios.len() / 4],
-            ratios[3 * ratios.len() / 4],
-            t_best * 1e6,
-            t_portable * 1e6
-        );
+        let what = format!("silhouette/{name}/cpu-level: facing+silhouette's {level} copy");
+        println!("{}", paired_line(&what, "the portable copy's", paired, batch));
         // the same sphere, triangles shuffled, loaded as a caster (reordered at load)
         let shuffled_mesh = shuffled(&sphere);
         let sc = Caster::new("shuffled", &shuffled_mesh, Mat4::IDENTITY).expect("shuffled caster");
