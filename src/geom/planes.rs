@@ -509,7 +509,8 @@ fn dot_word(planes: &FacePlanes, mesh: &Mesh, (l, lf, e): (Vec4, Vec4, f32), fli
 /// Facing and "unsure" bits of 64 planes: bit k of the first word is set when plane k's value
 /// exceeds `e`, of the second when its magnitude does not (NaN included).
 ///
-/// Four planes at a time in glam's `Vec4` (SSE2 on x86_64, safe): the value is
+/// Four planes at a time in glam's `Vec4` (SSE2 on x86_64, VEX-encoded in the x86-64-v3 copy;
+/// safe): the value is
 /// `((nx·lx + ny·ly) + nz·lz) + d·lw` in f32, the same operations in the same order as the
 /// scalar form, and each comparison becomes one mask (`movmskps`). The filter's light has
 /// `lw = ±1` or `0`, where `d·lw` is exact (`±d`, or a zero that cannot move the value across
