@@ -32,6 +32,23 @@ const STENCIL_DIFF_BOUND: usize = 8;
 /// 1 of 512,000 on `hard/eye_in_volume`, with either target model.
 const REVERSE_Z_DIFF_BOUND: usize = 16;
 
+/// SwiftShader stores multisampled depth at its sample locations mirrored in x
+/// (docs/conform/drivers-notes.md §1f, a driver defect): with several samples, the positions
+/// the host unprojects from the depth buffer are not the points its stencil counted, and a few
+/// pixels near shadow edges disagree with the reference outside the band. At most this many a
+/// light and sample are allowed there (twice the most measured: 3 of ~43,600, chromium-common
+/// 156.0.8078.129, every configuration of the embedded scene); 1 sample must stay exact.
+const SWIFTSHADER_MSAA_MISMATCHES: u64 = 6;
+
+/// The mismatches allowed per light and sample on `device` at `samples` samples.
+fn allowed_mismatches(device: &str, samples: u32) -> u64 {
+    if device.contains("SwiftShader") && samples > 1 {
+        SWIFTSHADER_MSAA_MISMATCHES
+    } else {
+        0
+    }
+}
+
 /// Runs `config` for 3 frames (both ring slots, the box moving) and checks every sample.
 fn run_checked(config: &Config, scene: Option<&str>) -> Option<Vec<FrameResult>> {
     let config = Config { scene: scene.map(str::to_string), ..config.clone() };
@@ -46,6 +63,8 @@ fn run_checked(config: &Config, scene: Option<&str>) -> Option<Vec<FrameResult>>
         Err(e) => panic!("{name}: {e}"),
     };
     assert_eq!(frames.len(), 3, "{name}");
+    let allowed = allowed_mismatches(&frames[0].device, config.samples);
+    let mut residue = 0;
     for (f, r) in frames.iter().enumerate() {
         assert_eq!(r.frame, f, "{name}: frames come back in order");
         assert_eq!(r.slot, f % host::FRAMES_IN_FLIGHT);
@@ -54,12 +73,25 @@ fn run_checked(config: &Config, scene: Option<&str>) -> Option<Vec<FrameResult>>
             for s in 0..config.samples as usize {
                 assert!(l.compared[s] > 10_000, "{name} frame {f} light {li} sample {s}: only {} pixels compared", l.compared[s]);
                 assert!(l.shadowed[s] > 100, "{name} frame {f} light {li} sample {s}: no shadow");
-                assert_eq!(l.mismatches[s], 0, "{name} frame {f} light {li} sample {s}: mismatches outside the band");
+                assert!(
+                    l.mismatches[s] <= allowed,
+                    "{name} frame {f} light {li} sample {s}: {} mismatches outside the band (allowed {allowed})",
+                    l.mismatches[s]
+                );
+                residue += l.mismatches[s];
             }
             for (value, what) in [(0, "unlit"), (128, "background"), (255, "lit")] {
                 assert!(l.mask.contains(&value), "{name} frame {f} light {li}: no {what} pixel");
             }
         }
+    }
+    if allowed > 0 {
+        eprintln!("{name}: {residue} mismatches outside the band over 3 frames ({}: drivers-notes §1f)", frames[0].device);
+        // measured 13 on the embedded scene in every configuration (0 on hard/eye_in_volume)
+        assert!(
+            scene.is_some() || residue > 0,
+            "{name}: SwiftShader's multisampled depth residue is gone: remove SWIFTSHADER_MSAA_MISMATCHES and update drivers-notes §1f"
+        );
     }
     // The samples are distinct points: their masks differ somewhere (edges).
     if config.samples > 1 {
@@ -179,7 +211,12 @@ fn dumps_hold_every_sample() {
             eprintln!("SKIPPED (no Vulkan device, CI not set)");
             return;
         }
-        assert!(out.status.success(), "{samples} samples: the example failed:\n{stderr}");
+        // the device, from the example's per-frame line "frame 0 (slot 0, <device>, ...)"
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        let device = stdout.lines().find_map(|l| l.strip_prefix("frame 0 (slot 0, ")).unwrap_or("");
+        let allowed = allowed_mismatches(device, samples);
+        let only_mismatches = stderr.lines().filter(|l| !l.trim().is_empty()).all(|l| l.contains("mismatched pixels outside the band"));
+        assert!(out.status.success() || (allowed > 0 && only_mismatches), "{samples} samples: the example failed:\n{stderr}");
         assert!(png.is_file(), "no PNG");
         let dumps: Vec<std::path::PathBuf> = if samples == 1 {
             vec![dir.join("dump")]
@@ -191,7 +228,13 @@ fn dumps_hold_every_sample() {
             let report = umbrage::reference::check_dump(d, host::BAND).unwrap_or_else(|e| panic!("{}: {e}", d.display()));
             for l in &report.lights {
                 assert!(l.metrics.compared > 5_000, "{}: light {}: {} compared", d.display(), l.index, l.metrics.compared);
-                assert_eq!(l.metrics.mismatches_outside_band, 0, "{}: light {}", d.display(), l.index);
+                assert!(
+                    l.metrics.mismatches_outside_band <= allowed,
+                    "{}: light {}: {} mismatches",
+                    d.display(),
+                    l.index,
+                    l.metrics.mismatches_outside_band
+                );
             }
             for f in ["stencil_0.png", "color.png", "world.obj", "positions.f32", "normals.f32"] {
                 assert!(d.join(f).is_file(), "{}: no {f}", d.display());
