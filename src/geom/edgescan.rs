@@ -388,7 +388,8 @@ impl EdgeScan {
 }
 
 /// One scan's word work ([`EdgeScan::scan_into`]): the breaks, then every kind of edge, into
-/// `hits`, and the edges found appended to `out`; the best copy for this CPU ([`super::cpu`]), or the portable one.
+/// `hits`, and the edges found appended to `out`; the best copy for this CPU
+/// ([`super::cpu`]), or the portable one.
 fn scan_words(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, hits: &mut Hits, out: &mut Vec<SilhouetteEdge>) {
     if cpu::portable_only() {
         scan_words_in(scan, bits, breaks, hits, out)
