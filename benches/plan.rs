@@ -18,6 +18,9 @@ use umbrage::geom::cpu;
 use umbrage::geom::silhouette::{EdgeScan, FacePlanes};
 use umbrage::geom::Mesh;
 use umbrage::shadow::{plan_light, Caster, Method, PlanInput};
+#[macro_use]
+#[path = "common/levels.rs"]
+mod levels;
 #[path = "common/paired.rs"]
 mod paired;
 use paired::{paired_line, paired_ratios};
@@ -25,15 +28,13 @@ use paired::{paired_line, paired_ratios};
 #[allow(dead_code)]
 mod testmesh;
 
-/// The streaming sum of the casters' bytes; compiled per x86-64 level like the facing and the
-/// scan (`umbrage::geom::cpu`: the same target list), so that both sides get the same
-/// instructions.
-#[multiversion::multiversion(targets(
-    "x86_64+avx+avx2+bmi1+bmi2+fma+lzcnt+popcnt+sse3+ssse3+sse4.1+sse4.2",
-    "x86_64+popcnt+sse3+ssse3+sse4.1+sse4.2"
-))]
-fn plain_sum(plain: &[u32]) -> u64 {
-    plain.iter().fold(0u64, |a, &x| a.wrapping_add(x as u64))
+per_cpu_level! {
+    /// The streaming sum of the casters' bytes; compiled per x86-64 level like the facing and the
+    /// scan (`umbrage::geom::cpu`: the same target list), so that both sides get the same
+    /// instructions.
+    fn plain_sum(plain: &[u32]) -> u64 {
+        plain.iter().fold(0u64, |a, &x| a.wrapping_add(x as u64))
+    }
 }
 
 /// `caster` with its silhouette structures in the mesh's own triangle order (no reordering).

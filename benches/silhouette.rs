@@ -41,6 +41,9 @@ use umbrage::geom::silhouette::{possible_silhouette_packed_into, EdgeScan, FaceP
 use umbrage::geom::topology::Topology;
 use umbrage::geom::TriangleOrder;
 use umbrage::shadow::Caster;
+#[macro_use]
+#[path = "common/levels.rs"]
+mod levels;
 #[path = "common/paired.rs"]
 mod paired;
 use paired::{paired_line, paired_ratios};
@@ -62,24 +65,22 @@ struct PlainArrays {
     d: Vec<f32>,
 }
 
-/// Compiled per x86-64 level like the facing and the scan (`umbrage::geom::cpu`: the same
-/// target list), so that the comparison gives both sides the same instructions.
-#[multiversion::multiversion(targets(
-    "x86_64+avx+avx2+bmi1+bmi2+fma+lzcnt+popcnt+sse3+ssse3+sse4.1+sse4.2",
-    "x86_64+popcnt+sse3+ssse3+sse4.1+sse4.2"
-))]
-fn streaming_sum(p: &PlainArrays, pairs: &[[u32; 2]]) -> u64 {
-    let mut s = [0u32; 8];
-    for (((a, b), c), d) in p.a.chunks_exact(8).zip(p.b.chunks_exact(8)).zip(p.c.chunks_exact(8)).zip(p.d.chunks_exact(8)) {
-        for k in 0..8 {
-            s[k] = s[k].wrapping_add(a[k].to_bits() ^ b[k].to_bits() ^ c[k].to_bits() ^ d[k].to_bits());
+per_cpu_level! {
+    /// Compiled per x86-64 level like the facing and the scan (`umbrage::geom::cpu`: the same
+    /// target list), so that the comparison gives both sides the same instructions.
+    fn streaming_sum(p: &PlainArrays, pairs: &[[u32; 2]]) -> u64 {
+        let mut s = [0u32; 8];
+        for (((a, b), c), d) in p.a.chunks_exact(8).zip(p.b.chunks_exact(8)).zip(p.c.chunks_exact(8)).zip(p.d.chunks_exact(8)) {
+            for k in 0..8 {
+                s[k] = s[k].wrapping_add(a[k].to_bits() ^ b[k].to_bits() ^ c[k].to_bits() ^ d[k].to_bits());
+            }
         }
+        let mut t = 0u64;
+        for e in pairs {
+            t = t.wrapping_add((e[0] ^ e[1]) as u64);
+        }
+        s.iter().map(|&x| x as u64).sum::<u64>().wrapping_add(t)
     }
-    let mut t = 0u64;
-    for e in pairs {
-        t = t.wrapping_add((e[0] ^ e[1]) as u64);
-    }
-    s.iter().map(|&x| x as u64).sum::<u64>().wrapping_add(t)
 }
 
 fn bench(c: &mut Criterion) {
