@@ -48,8 +48,42 @@ const MAX_CLASSES: usize = 8;
 /// A class must hold at least this many edges per facing word it spans on average: below it,
 /// its word pass costs more than the per-edge lookups it saves.
 const MIN_EDGES_PER_WORD: usize = 2;
-/// Far word pairs tested a chunk at a time (their list of pairs to test stays small).
+/// Lone far edges tested a chunk at a time.
 const FAR_CHUNK: usize = 256;
+/// Residual edges are tested this many at a time ([`test_edges`]); their bit positions are
+/// padded to a whole block.
+const TEST_BLOCK: usize = 8;
+/// Far word pairs are tested by their words' codes ([`fill_codes`]) when every word index is
+/// below this (facing bits of up to 4,194,304 triangles), else by the words themselves.
+const WORD_CODES: usize = 1 << 16;
+
+/// Whether [`EdgeScan::scan_far`] must test the words themselves (tests of the path taken
+/// past [`WORD_CODES`]).
+#[cfg(test)]
+fn words_only() -> bool {
+    tests::WORDS_ONLY.with(std::cell::Cell::get)
+}
+
+#[cfg(not(test))]
+#[inline(always)]
+fn words_only() -> bool {
+    false
+}
+
+/// A code per facing word: its index is a `u16`, so its reads need no bounds check.
+type WordCodes = [u8; WORD_CODES];
+
+/// The codes of facing words `words` (below [`WORD_CODES`]): `1` for all zeros, `2` for all
+/// ones, `0` for a mixed word. Two words are the same uniform word when their codes share a
+/// bit: a word pair holds no silhouette edge when `codes[lo] & codes[hi] != 0`.
+#[inline(always)]
+fn fill_codes(bits: &[u64], words: std::ops::Range<usize>, codes: &mut WordCodes) {
+    let inside = words.start.min(bits.len())..words.end.min(bits.len());
+    for (c, &a) in codes[inside.clone()].iter_mut().zip(&bits[inside.clone()]) {
+        *c = u8::from(a == 0) | u8::from(a == u64::MAX) << 1;
+    }
+    codes[inside.end.max(words.start)..words.end].fill(1);
+}
 
 /// Manifold edges prepared for the per-light scan ([`EdgeScan::scan_into`]): distance classes
 /// scanned a facing word at a time, and the other edges filed by the facing words they join,
@@ -62,12 +96,21 @@ pub struct EdgeScan {
     edges: Vec<ManifoldEdge>,
     near: Near,
     far_classes: Vec<DeltaClass>,
-    /// The far residual edges' word pairs, by increasing `(lo word, hi word)`.
-    far: Vec<WordPair>,
+    /// The far residual edges' word pairs, by increasing `(lo word, hi word)`: pair `i` has its
+    /// edges' `lo` slots in facing word `far_lo[i]`, their `hi` slots in word `far_hi[i]`, and
+    /// its edges are `edges[start .. far_end[i]]`, `start` the previous pair's end (the
+    /// first's: `far_start`). Three arrays, not one of structs: the per-light test of every
+    /// pair reads only the first two.
+    far_lo: Vec<u32>,
+    far_hi: Vec<u32>,
+    far_end: Vec<u32>,
+    /// One past the last word of any far pair.
+    far_top: usize,
     /// The far residual edges in word pairs are `edges[far_start..lone_start]`.
     far_start: usize,
     /// Per far residual edge in a word pair: the bit of its `lo` slot in its `lo` word, plus
-    /// [`T0`] when that slot is `t0`'s; the bit of its `hi` slot in its `hi` word.
+    /// [`T0`] when that slot is `t0`'s; the bit of its `hi` slot in its `hi` word; then a
+    /// [`TEST_BLOCK`]'s padding.
     far_offsets: Vec<[u8; 2]>,
     /// The far residual edges alone in their word pair (a pair costs more than its one edge)
     /// are `edges[lone_start..]`, each with its slots: `t0`'s, `t1`'s.
@@ -79,16 +122,6 @@ pub struct EdgeScan {
 
 /// In an edge's bit positions: its `lo` slot is its `t0`'s.
 const T0: u8 = 128;
-
-/// The far residual edges with their `lo` slot in facing word `lo` and their `hi` slot in
-/// word `hi`: `edges[start .. end]`, `start` the previous pair's `end` (the first's:
-/// `far_start`).
-#[derive(Clone, Copy, Debug, Default)]
-struct WordPair {
-    lo: u32,
-    hi: u32,
-    end: u32,
-}
 
 /// The edges between slots `lo` and `lo + delta`, a far class (`delta >= 64`).
 #[derive(Clone, Debug, Default)]
@@ -241,7 +274,13 @@ impl EdgeScan {
                 scan.far_offsets.push(offsets_of(e, false));
                 scan.edges.push(e.0);
             }
-            scan.far.push(WordPair { lo: run[0].1 / 64, hi: run[0].2 / 64, end: scan.edges.len() as u32 });
+            scan.far_lo.push(run[0].1 / 64);
+            scan.far_hi.push(run[0].2 / 64);
+            scan.far_top = scan.far_top.max(run[0].2 as usize / 64 + 1);
+            scan.far_end.push(scan.edges.len() as u32);
+        }
+        if !scan.far_offsets.is_empty() {
+            scan.far_offsets.resize(scan.far_offsets.len() + TEST_BLOCK - 1, [0; 2]);
         }
         scan.lone_start = scan.edges.len();
         for &&(e, lo, hi, is_t0) in &lone {
@@ -258,9 +297,9 @@ impl EdgeScan {
             words.0 = words.0.min(c.first_word);
             words.1 = words.1.max(c.first_word + c.masks.len() + (c.delta as usize).div_ceil(64) + 1);
         }
-        for p in &scan.far {
-            words.0 = words.0.min(p.lo as usize);
-            words.1 = words.1.max(p.hi as usize + 1);
+        for (&lo, &hi) in scan.far_lo.iter().zip(&scan.far_hi) {
+            words.0 = words.0.min(lo as usize);
+            words.1 = words.1.max(hi as usize + 1);
         }
         for &(_, lo, hi, _) in lone {
             words.0 = words.0.min(lo as usize / 64);
@@ -284,7 +323,7 @@ impl EdgeScan {
             + n.words.len() * std::mem::size_of::<NearWord>()
             + n.offsets.len() * 2
             + self.far_classes.iter().map(|c| c.masks.len() * 16).sum::<usize>()
-            + self.far.len() * std::mem::size_of::<WordPair>()
+            + self.far_lo.len() * 3 * std::mem::size_of::<u32>()
             + self.far_offsets.len() * 2
             + self.lone.len() * 8
     }
@@ -308,38 +347,43 @@ impl EdgeScan {
     ///
     /// [`possible_silhouette`]: super::silhouette::possible_silhouette
     pub fn scan_into(&self, bits: &[u64], out: &mut Vec<SilhouetteEdge>) {
-        SCRATCH.with_borrow_mut(|Scratch { breaks, hits }| {
-            scan_words(self, bits, breaks, &mut Hits { list: hits, len: 0 }, out);
+        SCRATCH.with_borrow_mut(|Scratch { breaks, codes, hits }| {
+            let codes = codes.get_or_insert_with(|| Box::new([0; WORD_CODES]));
+            scan_words(self, bits, breaks, codes, &mut Hits { list: hits, len: 0 }, out);
         })
     }
 
     /// The far residual edges of the word pairs whose two words are not the same uniform word.
     #[inline(always)]
-    fn scan_far(&self, bits: &[u64], hits: &mut Hits) {
-        // a chunk of pairs at a time: first the pairs to test, listed without a branch a pair,
-        // then their edges
-        let mut dirty = [0u16; FAR_CHUNK];
-        let mut start = self.far_start as u32;
-        for (c, chunk) in self.far.chunks(FAR_CHUNK).enumerate() {
-            let mut n = 0;
-            for (i, p) in chunk.iter().enumerate() {
-                let (a, b) = (word(bits, p.lo as usize), word(bits, p.hi as usize));
-                // (`n <= i < FAR_CHUNK`: the mask only spares the bounds check)
-                dirty[n % FAR_CHUNK] = i as u16;
-                // not the same uniform word: `a` mixed (`a + 1` above 1) or `b` unlike it
-                n += usize::from(((a ^ b) | (a.wrapping_add(1) >> 1)) != 0);
+    fn scan_far(&self, bits: &[u64], codes: &mut WordCodes, hits: &mut Hits) {
+        // 64 pairs at a time: first their test, one bit a pair into a mask (no branch a pair),
+        // then the edges of the pairs it marks
+        let fast = self.far_top <= WORD_CODES && !words_only();
+        if fast {
+            fill_codes(bits, self.far_lo.first().map_or(0, |&w| w as usize)..self.far_top, codes);
+        }
+        for (c, (los, his)) in self.far_lo.chunks(64).zip(self.far_hi.chunks(64)).enumerate() {
+            let mut m = 0u64;
+            if fast {
+                // (every word index is below 2^16: no bounds check)
+                for (k, (&lo, &hi)) in los.iter().zip(his).enumerate() {
+                    m |= u64::from(codes[lo as u16 as usize] & codes[hi as u16 as usize] == 0) << k;
+                }
+            } else {
+                for (k, (&lo, &hi)) in los.iter().zip(his).enumerate() {
+                    let (a, b) = (word(bits, lo as usize), word(bits, hi as usize));
+                    m |= u64::from(((a ^ b) | (a.wrapping_add(1) >> 1)) != 0) << k;
+                }
             }
-            let end = chunk[chunk.len() - 1].end;
-            hits.room((end - start) as usize);
-            for &i in &dirty[..n] {
-                let i = c * FAR_CHUNK + usize::from(i);
-                let p = self.far[i];
-                let first = if i == 0 { self.far_start as u32 } else { self.far[i - 1].end };
-                let b = word(bits, p.hi as usize);
+            while m != 0 {
+                let i = c * 64 + m.trailing_zeros() as usize;
+                m &= m - 1;
+                let first = if i == 0 { self.far_start as u32 } else { self.far_end[i - 1] };
+                let end = self.far_end[i];
+                let b = word(bits, self.far_hi[i] as usize);
                 let off = first as usize - self.far_start;
-                test_edges(first..p.end, &self.far_offsets[off..], word(bits, p.lo as usize), [b, b], hits);
+                test_edges(first..end, &self.far_offsets[off..], word(bits, self.far_lo[i] as usize), [b, b], hits);
             }
-            start = end;
         }
     }
 
@@ -390,30 +434,37 @@ impl EdgeScan {
 /// One scan's word work ([`EdgeScan::scan_into`]): the breaks, then every kind of edge, into
 /// `hits`, and the edges found appended to `out`; the best copy for this CPU
 /// ([`super::cpu`]), or the portable one.
-fn scan_words(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, hits: &mut Hits, out: &mut Vec<SilhouetteEdge>) {
+fn scan_words(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, codes: &mut WordCodes, hits: &mut Hits, out: &mut Vec<SilhouetteEdge>) {
     if cpu::portable_only() {
-        scan_words_in(scan, bits, breaks, hits, out)
+        scan_words_in(scan, bits, breaks, codes, hits, out)
     } else {
-        scan_words_per_level(scan, bits, breaks, hits, out)
+        scan_words_per_level(scan, bits, breaks, codes, hits, out)
     }
 }
 
 per_cpu_level! {
     /// [`scan_words_in`], compiled per CPU level.
-    fn scan_words_per_level(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, hits: &mut Hits, out: &mut Vec<SilhouetteEdge>) {
-        scan_words_in(scan, bits, breaks, hits, out)
+    fn scan_words_per_level(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, codes: &mut WordCodes, hits: &mut Hits, out: &mut Vec<SilhouetteEdge>) {
+        scan_words_in(scan, bits, breaks, codes, hits, out)
     }
 }
 
 /// [`scan_words`]' body; it and the parts it calls are inlined into each copy.
 #[inline(always)]
-fn scan_words_in(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, hits: &mut Hits, out: &mut Vec<SilhouetteEdge>) {
+fn scan_words_in(
+    scan: &EdgeScan,
+    bits: &[u64],
+    breaks: &mut Vec<u32>,
+    codes: &mut WordCodes,
+    hits: &mut Hits,
+    out: &mut Vec<SilhouetteEdge>,
+) {
     find_breaks(bits, scan.words, breaks);
     scan.near.scan(bits, breaks, hits);
     for c in &scan.far_classes {
         scan.scan_class(c, bits, breaks, hits);
     }
-    scan.scan_far(bits, hits);
+    scan.scan_far(bits, codes, hits);
     scan.scan_lone(bits, hits);
     // the edges found, oriented (a loop, not an iterator adapter: inlined into each copy)
     out.reserve(hits.len);
@@ -422,24 +473,45 @@ fn scan_words_in(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, hits: &mu
     }
 }
 
-/// Lists the residual edges `range` (bit positions `offsets`, from the range's first) whose
-/// two bits differ, without a branch an edge: `lo` bits in `a`, `hi` bits in `b` (bit `k` in
-/// `b[k / 64]`).
+/// Lists the residual edges `range` (bit positions `offsets`, from the range's first, padded
+/// to a whole [`TEST_BLOCK`]) whose two bits differ: `lo` bits in `a`, `hi` bits in `b` (bit
+/// `k` in `b[k / 64]`). A block of edges at a time, without a branch or a store an edge:
+/// their tests into a mask, then the few edges it marks (needs no [`Hits::room`]). The
+/// blocks' fixed length spares the branch mispredicted at the end of a short loop of varying
+/// length (a word's or a word pair's edges: 5 or 6 on average).
 #[inline(always)]
 fn test_edges(range: std::ops::Range<u32>, offsets: &[[u8; 2]], a: u64, b: [u64; 2], hits: &mut Hits) {
-    let (list, mut len) = (&mut hits.list[..], hits.len);
-    for (i, o) in range.zip(offsets) {
-        let (o0, o1) = (u64::from(o[0]), u64::from(o[1]));
-        // the two bits in bit 0 (integer operations only: no flags to materialise)
-        let fl = a >> (o0 & 63);
-        let fh = b[(o1 >> 6 & 1) as usize] >> (o1 & 63);
-        // t0 is lit when its slot's bit is set: lo's bit when lo is t0's (`T0`), else hi's
-        const _: () = assert!(T0 == 1 << 7);
-        let t0_lit = fl ^ (o0 >> 7) ^ 1;
-        list[len] = entry(i, t0_lit);
-        len += ((fl ^ fh) & 1) as usize;
+    let n = (range.end - range.start) as usize;
+    for (c, block) in offsets[..n.next_multiple_of(TEST_BLOCK)].chunks_exact(TEST_BLOCK).enumerate() {
+        let mut m = 0u64;
+        for (k, o) in block.iter().enumerate() {
+            let (o0, o1) = (u64::from(o[0]), u64::from(o[1]));
+            // the two bits in bit 0 (integer operations only: no flags to materialise)
+            let fl = a >> (o0 & 63);
+            let fh = b[(o1 >> 6 & 1) as usize] >> (o1 & 63);
+            m |= ((fl ^ fh) & 1) << k;
+        }
+        // (the padding past the range's last edge)
+        m &= (1 << (n - c * TEST_BLOCK).min(TEST_BLOCK)) - 1;
+        if m == 0 {
+            continue;
+        }
+        hits.room(m.count_ones() as usize);
+        let (list, mut len) = (&mut hits.list[..], hits.len);
+        let first = range.start + (c * TEST_BLOCK) as u32;
+        while m != 0 {
+            let k = m.trailing_zeros();
+            m &= m - 1;
+            let o0 = u64::from(block[k as usize][0]);
+            // t0 is lit when its slot's bit is set: lo's bit when lo is t0's (`T0`), else hi's
+            // (which differs from lo's)
+            const _: () = assert!(T0 == 1 << 7);
+            let t0_lit = (a >> (o0 & 63)) ^ (o0 >> 7) ^ 1;
+            list[len] = entry(first + k, t0_lit);
+            len += 1;
+        }
+        hits.len = len;
     }
-    hits.len = len;
 }
 
 /// A [`Hits`] entry: edge `i`, and whether its `t0` is lit (bit 0 of `t0_lit`).
@@ -458,6 +530,8 @@ fn word(bits: &[u64], w: usize) -> u64 {
 #[derive(Default)]
 struct Scratch {
     breaks: Vec<u32>,
+    /// [`fill_codes`]' codes (allocated on the thread's first scan).
+    codes: Option<Box<WordCodes>>,
     hits: Vec<u64>,
 }
 

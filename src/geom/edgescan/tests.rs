@@ -10,6 +10,11 @@ use crate::geom::TriangleOrder;
 use glam::{Vec3, Vec4};
 use proptest::prelude::*;
 
+thread_local! {
+    /// Far word pairs tested by their words, not by the words' codes (as past `WORD_CODES`).
+    pub(super) static WORDS_ONLY: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
+
 fn check(edges: Vec<ManifoldEdge>, bits: &[u64]) -> EdgeScan {
     check_in(edges, bits, &TriangleOrder::identity())
 }
@@ -39,6 +44,12 @@ fn check_in(edges: Vec<ManifoldEdge>, bits: &[u64], order: &TriangleOrder) -> Ed
         sil
     });
     assert_eq!(sil, plain(scan.edges(), bits, order));
+    // the far word pairs tested by their words (meshes past 2^16 words): the same edges
+    WORDS_ONLY.set(true);
+    let mut by_words = Vec::new();
+    scan.scan_into(bits, &mut by_words);
+    WORDS_ONLY.set(false);
+    assert_eq!(sil, by_words, "far pairs tested by their words");
     if order.is_identity() {
         assert_eq!(sil, possible_silhouette_packed(scan.edges(), bits));
     }
@@ -85,7 +96,12 @@ fn shuffled_triangles_take_the_residual_path() {
     for l in [Vec4::new(3.0, 2.0, 1.0, 1.0), Vec4::new(0.1, 0.2, -0.3, 1.0), Vec4::new(-1.0, 0.5, 0.2, 0.0)] {
         planes.facing_packed(&t.mesh, l, false, &mut bits);
         let scan = check_in(t.manifold_edges.clone(), &bits, &order);
-        assert!((scan.far.len() + scan.lone.len()) * 8 < t.manifold_edges.len(), "{} pairs, {} alone", scan.far.len(), scan.lone.len());
+        assert!(
+            (scan.far_lo.len() + scan.lone.len()) * 8 < t.manifold_edges.len(),
+            "{} pairs, {} alone",
+            scan.far_lo.len(),
+            scan.lone.len()
+        );
         // the same silhouette as the mesh's own order, edge set for edge set
         let mut own = Vec::new();
         FacePlanes::new(&t.mesh).facing_packed(&t.mesh, l, false, &mut own);
