@@ -486,10 +486,9 @@ fn test_edges(range: std::ops::Range<u32>, offsets: &[[u8; 2]], a: u64, b: [u64;
         let mut m = 0u64;
         for (k, o) in block.iter().enumerate() {
             let (o0, o1) = (u64::from(o[0]), u64::from(o[1]));
-            // the two bits in bit 0 (integer operations only: no flags to materialise)
-            let fl = a >> (o0 & 63);
-            let fh = b[(o1 >> 6 & 1) as usize] >> (o1 & 63);
-            m |= ((fl ^ fh) & 1) << k;
+            // the two bits in bit 0 (selects and shifts only: the block's lanes side by side)
+            let hw = if o1 & 64 != 0 { b[1] } else { b[0] };
+            m |= (((a >> (o0 & 63)) ^ (hw >> (o1 & 63))) & 1) << k;
         }
         // (the padding past the range's last edge)
         m &= (1 << (n - c * TEST_BLOCK).min(TEST_BLOCK)) - 1;
