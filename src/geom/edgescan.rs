@@ -525,7 +525,8 @@ fn word(bits: &[u64], w: usize) -> u64 {
     bits.get(w).copied().unwrap_or(0)
 }
 
-/// A scan's lists, kept per thread across calls: [`find_breaks`]' breaks and the edges found.
+/// A scan's lists, kept per thread across calls: [`find_breaks`]' breaks, the far pairs' word
+/// codes (64 KiB) and the edges found.
 #[derive(Default)]
 struct Scratch {
     breaks: Vec<u32>,
