@@ -265,9 +265,10 @@ impl EdgeScan {
             words.0 = words.0.min(c.first_word);
             words.1 = words.1.max(c.first_word + c.masks.len() + (c.delta as usize).div_ceil(64) + 1);
         }
-        for (&lo, &hi) in scan.far_lo.iter().zip(&scan.far_hi) {
+        // (the pairs are by increasing `lo` word)
+        if let Some(&lo) = scan.far_lo.first() {
             words.0 = words.0.min(lo as usize);
-            words.1 = words.1.max(hi as usize + 1);
+            words.1 = words.1.max(scan.far_top);
         }
         for &(_, lo, hi, _) in lone {
             words.0 = words.0.min(lo as usize / 64);
