@@ -9,6 +9,7 @@ use super::silhouette::PLANES_PARALLEL_THRESHOLD;
 use glam::{Vec3, Vec4};
 
 mod bounds;
+mod dots;
 use bounds::{BlockBound, Bounds8, Probe};
 
 /// Largest coordinate magnitude (mesh or light) the f32 plane filter accepts: beyond it the
@@ -421,22 +422,52 @@ impl FacePlanes {
 /// this CPU ([`super::cpu`]), or the portable one.
 fn fill_words(planes: &FacePlanes, mesh: &Mesh, l: Vec4, flip: bool, filter: (Vec4, f32), first: usize, out: &mut [u64]) {
     if cpu::portable_only() {
-        fill_words_in(planes, mesh, l, flip, filter, first, out)
+        fill_words_in(planes, mesh, l, flip, filter, first, out, dots::block64)
     } else {
         fill_words_per_level(planes, mesh, l, flip, filter, first, out)
     }
 }
 
 per_cpu_level! {
-    /// [`fill_words_in`], compiled per CPU level.
+    /// [`fill_words_in`], compiled per CPU level; the copies with AVX take their dot products
+    /// eight planes a vector ([`dots::block64_avx`]), the others four.
     fn fill_words_per_level(planes: &FacePlanes, mesh: &Mesh, l: Vec4, flip: bool, filter: (Vec4, f32), first: usize, out: &mut [u64]) {
-        fill_words_in(planes, mesh, l, flip, filter, first, out)
+        // (a closure written here has this copy's target features, so it may call the AVX
+        // function; the macro is defined for the copies that have AVX only)
+        #[multiversion::target::target_cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+        macro_rules! dots {
+            () => {
+                |nx: &[f32], ny: &[f32], nz: &[f32], d: &[f32], l: Vec4, e: f32| dots::block64_avx(nx, ny, nz, d, l, e)
+            };
+        }
+        #[multiversion::target::target_cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
+        macro_rules! dots {
+            () => {
+                dots::block64
+            };
+        }
+        fill_words_in(planes, mesh, l, flip, filter, first, out, dots!())
     }
 }
 
-/// [`fill_words`]' body, inlined into each copy.
+/// The dot products of one facing word: `(facing, unsure)` bits of 64 planes
+/// (`nx, ny, nz, d`) for the filter light and bound ([`dots::block64`]).
+trait Dots: Fn(&[f32], &[f32], &[f32], &[f32], Vec4, f32) -> (u64, u64) + Copy {}
+impl<F: Fn(&[f32], &[f32], &[f32], &[f32], Vec4, f32) -> (u64, u64) + Copy> Dots for F {}
+
+/// [`fill_words`]' body, inlined into each copy, with that copy's dot products.
 #[inline(always)]
-fn fill_words_in(planes: &FacePlanes, mesh: &Mesh, l: Vec4, flip: bool, (lf, e): (Vec4, f32), first: usize, out: &mut [u64]) {
+#[allow(clippy::too_many_arguments)]
+fn fill_words_in(
+    planes: &FacePlanes,
+    mesh: &Mesh,
+    l: Vec4,
+    flip: bool,
+    (lf, e): (Vec4, f32),
+    first: usize,
+    out: &mut [u64],
+    dots: impl Dots,
+) {
     let n = planes.len;
     // flip: the negated plane, i.e. the negated light (exact).
     let lf = if flip { -lf } else { lf };
@@ -468,7 +499,7 @@ fn fill_words_in(planes: &FacePlanes, mesh: &Mesh, l: Vec4, flip: bool, (lf, e):
             while undecided != 0 {
                 let k = undecided.trailing_zeros() as usize;
                 undecided &= undecided - 1;
-                ours[k] = dot_word(planes, mesh, (l, lf, e), flip, w + k);
+                ours[k] = dot_word(planes, mesh, (l, lf, e), flip, w + k, dots);
             }
         }
         // the last word's bits past the triangles stay clear
@@ -493,9 +524,9 @@ fn valid_bits(n: usize, w: usize) -> u64 {
 /// bound `e`, the exact test (light `l`) where they are unsure. Not a closure: it is inlined
 /// into each CPU level's copy of [`fill_words`].
 #[inline(always)]
-fn dot_word(planes: &FacePlanes, mesh: &Mesh, (l, lf, e): (Vec4, Vec4, f32), flip: bool, w: usize) -> u64 {
+fn dot_word(planes: &FacePlanes, mesh: &Mesh, (l, lf, e): (Vec4, Vec4, f32), flip: bool, w: usize, dots: impl Dots) -> u64 {
     let r = w * 64..w * 64 + 64;
-    let (bits, unsure) = block64(&planes.nx[r.clone()], &planes.ny[r.clone()], &planes.nz[r.clone()], &planes.d[r], lf, e);
+    let (bits, unsure) = dots(&planes.nx[r.clone()], &planes.ny[r.clone()], &planes.nz[r.clone()], &planes.d[r], lf, e);
     let valid = valid_bits(planes.len, w);
     let (mut word, mut u) = (bits & valid, unsure & valid);
     while u != 0 {
@@ -504,52 +535,6 @@ fn dot_word(planes: &FacePlanes, mesh: &Mesh, (l, lf, e): (Vec4, Vec4, f32), fli
         word = (word & !(1 << k)) | (u64::from(exact_bit(mesh, planes.tri(w * 64 + k), l, flip)) << k);
     }
     word
-}
-
-/// Facing and "unsure" bits of 64 planes: bit k of the first word is set when plane k's value
-/// exceeds `e`, of the second when its magnitude does not (NaN included).
-///
-/// Four planes at a time in glam's `Vec4` (SSE2 on x86_64, VEX-encoded in the x86-64-v3 copy;
-/// safe): the value is
-/// `((nx·lx + ny·ly) + nz·lz) + d·lw` in f32, the same operations in the same order as the
-/// scalar form, and each comparison becomes one mask (`movmskps`). The filter's light has
-/// `lw = ±1` or `0`, where `d·lw` is exact (`±d`, or a zero that cannot move the value across
-/// `±e`): those three are specialised, one multiplication fewer, the same bits.
-#[inline(always)]
-fn block64(nx: &[f32], ny: &[f32], nz: &[f32], d: &[f32], l: Vec4, e: f32) -> (u64, u64) {
-    if l.w == 1.0 {
-        block64_w(nx, ny, nz, d, l, e, |s, d| s + d)
-    } else if l.w == -1.0 {
-        block64_w(nx, ny, nz, d, l, e, |s, d| s - d)
-    } else if l.w == 0.0 {
-        block64_w(nx, ny, nz, d, l, e, |s, _| s)
-    } else {
-        let lw = Vec4::splat(l.w);
-        block64_w(nx, ny, nz, d, l, e, |s, d| s + d * lw)
-    }
-}
-
-/// [`block64`] with the `d` term `dw(xyz sum, d)`; 16 planes an iteration (four masks merged
-/// at constant shifts).
-#[inline(always)]
-fn block64_w(nx: &[f32], ny: &[f32], nz: &[f32], d: &[f32], l: Vec4, e: f32, dw: impl Fn(Vec4, Vec4) -> Vec4) -> (u64, u64) {
-    let (nx, ny, nz, d) = (&nx[..64], &ny[..64], &nz[..64], &d[..64]);
-    let (lx, ly, lz, ev, nev) = (Vec4::splat(l.x), Vec4::splat(l.y), Vec4::splat(l.z), Vec4::splat(e), Vec4::splat(-e));
-    let (mut bits, mut sure) = (0u64, 0u64);
-    for (q, (((x, y), z), w)) in nx.chunks_exact(16).zip(ny.chunks_exact(16)).zip(nz.chunks_exact(16)).zip(d.chunks_exact(16)).enumerate() {
-        let (mut b16, mut s16) = (0u32, 0u32);
-        for j in 0..4 {
-            let r = j * 4..j * 4 + 4;
-            let xyz = Vec4::from_slice(&x[r.clone()]) * lx + Vec4::from_slice(&y[r.clone()]) * ly + Vec4::from_slice(&z[r.clone()]) * lz;
-            let v = dw(xyz, Vec4::from_slice(&w[r]));
-            let (gt, lt) = (v.cmpgt(ev), v.cmplt(nev));
-            b16 |= gt.bitmask() << (j * 4);
-            s16 |= (gt | lt).bitmask() << (j * 4);
-        }
-        bits |= u64::from(b16) << (q * 16);
-        sure |= u64::from(s16) << (q * 16);
-    }
-    (bits, !sure)
 }
 
 mod gpu;
