@@ -48,19 +48,27 @@ pub fn shadow_volume_outside_frustum(caster_world_box: &Aabb, light_h: Vec4, fru
         return true;
     }
     let l = light_h.as_dvec4();
-    let mut pts: Vec<DVec4> = caster_world_box.corners().iter().map(|c| c.as_dvec3().extend(1.0)).collect();
-    if l.w != 0.0 {
+    // the box's corners, then the directions they extrude in (on the stack: once per caster
+    // and light)
+    let corners = caster_world_box.corners();
+    let mut pts = [DVec4::ZERO; 16];
+    for (p, c) in pts.iter_mut().zip(&corners) {
+        *p = c.as_dvec3().extend(1.0);
+    }
+    let n = if l.w != 0.0 {
         let lp = l.truncate() / l.w;
         if caster_world_box.contains(lp.as_vec3()) || box_contains_d(caster_world_box, lp) {
             return false;
         }
-        for c in caster_world_box.corners() {
-            pts.push((c.as_dvec3() - lp).extend(0.0));
+        for (p, c) in pts[8..].iter_mut().zip(&corners) {
+            *p = (c.as_dvec3() - lp).extend(0.0);
         }
+        16
     } else {
-        pts.push((-l.truncate()).extend(0.0));
-    }
-    frustum.all_outside_one_plane(&pts)
+        pts[8] = (-l.truncate()).extend(0.0);
+        9
+    };
+    frustum.all_outside_one_plane(&pts[..n])
 }
 
 fn box_contains_d(b: &Aabb, p: DVec3) -> bool {

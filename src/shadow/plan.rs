@@ -129,6 +129,17 @@ fn emit_with<F: FacingSet + ?Sized>(
     let mut vol: Vec<Vec<u16>> = vec![Vec::new(); nch];
     let mut cap: Vec<Vec<u16>> = vec![Vec::new(); nch];
     let (mut sides, mut dark, mut light) = (0, 0, 0);
+    // each chunk's side (and fan) indices reserved at once: a pass over the edges' chunks
+    // costs less than growing the lists edge by edge (reallocations were 7 % of a plan)
+    let edge_indices = if e.directional { 3 } else { 6 } + if !e.directional && e.dark_cap == DarkCap::Fan { 3 } else { 0 };
+    let mut per_chunk = vec![0usize; nch];
+    for s in sil {
+        let tri = if e.formulation == Formulation::Back { s.unlit } else { s.lit };
+        per_chunk[caster.tri_chunk[tri as usize].0 as usize] += edge_indices;
+    }
+    for (v, &n) in vol.iter_mut().zip(&per_chunk) {
+        v.reserve_exact(n);
+    }
     for s in sil {
         // a->b as in the lit triangle; the back formulation uses the unlit triangle's chunk
         let (tri, corner, rev) = match e.formulation {
