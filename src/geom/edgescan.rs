@@ -40,8 +40,10 @@ use super::order::TriangleOrder;
 use super::silhouette::SilhouetteEdge;
 use super::topology::ManifoldEdge;
 
+mod blocks;
 mod far;
 mod near;
+use blocks::{test_edges, BlockMask};
 use far::{WordCodes, WORD_CODES};
 use near::{Near, NearWord};
 
@@ -354,16 +356,31 @@ impl EdgeScan {
 /// ([`super::cpu`]), or the portable one.
 fn scan_words(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, codes: &mut WordCodes, hits: &mut Hits, out: &mut Vec<SilhouetteEdge>) {
     if cpu::portable_only() {
-        scan_words_in(scan, bits, breaks, codes, hits, out)
+        scan_words_in(scan, bits, breaks, codes, hits, out, blocks::block_mask)
     } else {
         scan_words_per_level(scan, bits, breaks, codes, hits, out)
     }
 }
 
 per_cpu_level! {
-    /// [`scan_words_in`], compiled per CPU level.
+    /// [`scan_words_in`], compiled per CPU level; the copies with SSSE3 test the residual
+    /// edges' blocks with byte shuffles ([`blocks::block_mask_ssse3`]), the others bit by bit.
     fn scan_words_per_level(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, codes: &mut WordCodes, hits: &mut Hits, out: &mut Vec<SilhouetteEdge>) {
-        scan_words_in(scan, bits, breaks, codes, hits, out)
+        // (a closure written here has this copy's target features, so it may call the SSSE3
+        // function; the macro is defined for the copies that have SSSE3 only)
+        #[multiversion::target::target_cfg(all(target_arch = "x86_64", target_feature = "ssse3"))]
+        macro_rules! block_mask {
+            () => {
+                |block: &[[u8; 2]; TEST_BLOCK], a: u64, b: [u64; 2]| blocks::block_mask_ssse3(block, a, b)
+            };
+        }
+        #[multiversion::target::target_cfg(not(all(target_arch = "x86_64", target_feature = "ssse3")))]
+        macro_rules! block_mask {
+            () => {
+                blocks::block_mask
+            };
+        }
+        scan_words_in(scan, bits, breaks, codes, hits, out, block_mask!())
     }
 }
 
@@ -376,58 +393,19 @@ fn scan_words_in(
     codes: &mut WordCodes,
     hits: &mut Hits,
     out: &mut Vec<SilhouetteEdge>,
+    block_mask: impl BlockMask,
 ) {
     find_breaks(bits, scan.words, breaks);
-    scan.near.scan(bits, breaks, hits);
+    scan.near.scan(bits, breaks, hits, block_mask);
     for c in &scan.far_classes {
         scan.scan_class(c, bits, breaks, hits);
     }
-    scan.scan_far(bits, codes, hits);
+    scan.scan_far(bits, codes, hits, block_mask);
     scan.scan_lone(bits, hits);
     // the edges found, oriented (a loop, not an iterator adapter: inlined into each copy)
     out.reserve(hits.len);
     for &h in hits.found() {
         out.push(oriented(&scan.edges[h as u32 as usize], h >> 32 != 0));
-    }
-}
-
-/// Lists the residual edges `range` (bit positions `offsets`, from the range's first, padded
-/// to a whole [`TEST_BLOCK`]) whose two bits differ: `lo` bits in `a`, `hi` bits in `b` (bit
-/// `k` in `b[k / 64]`). A block of edges at a time, without a branch or a store an edge:
-/// their tests into a mask, then the few edges it marks (needs no [`Hits::room`]). The
-/// blocks' fixed length spares the branch mispredicted at the end of a short loop of varying
-/// length (a word's or a word pair's edges: 5 or 6 on average).
-#[inline(always)]
-fn test_edges(range: std::ops::Range<u32>, offsets: &[[u8; 2]], a: u64, b: [u64; 2], hits: &mut Hits) {
-    let n = (range.end - range.start) as usize;
-    for (c, block) in offsets[..n.next_multiple_of(TEST_BLOCK)].chunks_exact(TEST_BLOCK).enumerate() {
-        let mut m = 0u64;
-        for (k, o) in block.iter().enumerate() {
-            let (o0, o1) = (u64::from(o[0]), u64::from(o[1]));
-            // the two bits in bit 0 (selects and shifts only: the block's lanes side by side)
-            let hw = if o1 & 64 != 0 { b[1] } else { b[0] };
-            m |= (((a >> (o0 & 63)) ^ (hw >> (o1 & 63))) & 1) << k;
-        }
-        // (the padding past the range's last edge)
-        m &= (1 << (n - c * TEST_BLOCK).min(TEST_BLOCK)) - 1;
-        if m == 0 {
-            continue;
-        }
-        hits.room(m.count_ones() as usize);
-        let (list, mut len) = (&mut hits.list[..], hits.len);
-        let first = range.start + (c * TEST_BLOCK) as u32;
-        while m != 0 {
-            let k = m.trailing_zeros();
-            m &= m - 1;
-            let o0 = u64::from(block[k as usize][0]);
-            // t0 is lit when its slot's bit is set: lo's bit when lo is t0's (`T0`), else hi's
-            // (which differs from lo's)
-            const _: () = assert!(T0 == 1 << 7);
-            let t0_lit = (a >> (o0 & 63)) ^ (o0 >> 7) ^ 1;
-            list[len] = entry(first + k, t0_lit);
-            len += 1;
-        }
-        hits.len = len;
     }
 }
 

@@ -2,7 +2,7 @@
 //! tested a pair at a time through per-word codes, and those alone in their pair, tested by
 //! their two bits.
 
-use super::{entry, test_edges, word, EdgeScan, Hits};
+use super::{entry, test_edges, word, BlockMask, EdgeScan, Hits};
 
 /// Lone far edges tested a chunk at a time.
 const FAR_CHUNK: usize = 256;
@@ -41,7 +41,7 @@ fn fill_codes(bits: &[u64], words: std::ops::Range<usize>, codes: &mut WordCodes
 impl EdgeScan {
     /// The far residual edges of the word pairs whose two words are not the same uniform word.
     #[inline(always)]
-    pub(super) fn scan_far(&self, bits: &[u64], codes: &mut WordCodes, hits: &mut Hits) {
+    pub(super) fn scan_far(&self, bits: &[u64], codes: &mut WordCodes, hits: &mut Hits, block_mask: impl BlockMask) {
         // 64 pairs at a time: first their test, one bit a pair into a mask (no branch a pair),
         // then the edges of the pairs it marks
         let fast = self.far_top <= WORD_CODES && !words_only();
@@ -68,7 +68,7 @@ impl EdgeScan {
                 let end = self.far_end[i];
                 let b = word(bits, self.far_hi[i] as usize);
                 let off = first as usize - self.far_start;
-                test_edges(first..end, &self.far_offsets[off..], word(bits, self.far_lo[i] as usize), [b, b], hits);
+                test_edges(first..end, &self.far_offsets[off..], word(bits, self.far_lo[i] as usize), [b, b], hits, block_mask);
             }
         }
     }

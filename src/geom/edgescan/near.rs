@@ -2,7 +2,7 @@
 //! the residual edges with both slots in one facing word or in a word and the next, filed by
 //! the word of their `lo` slot, so that one visit of a word next to a break tests them all.
 
-use super::{mixed, offsets_of, test_edges, word, Hits, Slotted, TEST_BLOCK};
+use super::{mixed, offsets_of, test_edges, word, BlockMask, Hits, Slotted, TEST_BLOCK};
 use crate::geom::topology::ManifoldEdge;
 
 /// The near edges: those of a class with `δ < 64`, and the residual edges with both slots in
@@ -94,7 +94,7 @@ impl Near {
     /// and the residual edges of a mixed word, or a uniform word's that reach into a next word
     /// unlike it.
     #[inline(always)]
-    pub(super) fn scan(&self, bits: &[u64], breaks: &[u32], hits: &mut Hits) {
+    pub(super) fn scan(&self, bits: &[u64], breaks: &[u32], hits: &mut Hits, block_mask: impl BlockMask) {
         let near = self;
         let classes = near.deltas.len();
         let (lo, hi) = (near.first, near.first + near.words.len().saturating_sub(1));
@@ -129,7 +129,7 @@ impl Near {
                     end
                 };
                 let off = (nw.off + start - nw.rest) as usize;
-                test_edges(start..end, &near.offsets[off..], f, [f, g], hits);
+                test_edges(start..end, &near.offsets[off..], f, [f, g], hits, block_mask);
             }
             done = done.max(top);
         }
