@@ -3,8 +3,12 @@
 //! ([`EdgeScan::scan_into`](super::edgescan::EdgeScan::scan_into)) are compiled once for the
 //! portable target (x86-64's baseline: SSE2, no `popcnt`) and again for two x86-64 levels,
 //! and the best copy this CPU runs is picked at run time (the `multiversion` crate: no
-//! `unsafe` here, and the binary stays portable). Every copy is the same source, gives the
-//! same bits, and is tested against the portable one ([`set_portable_only`]).
+//! `unsafe` here, and the binary stays portable). Every copy is the same source, except two
+//! kernels written with `std::arch` value intrinsics for the copies that have the features
+//! (the facing's dot products 8 planes a vector with AVX, the scan's residual edges by SSSE3
+//! byte shuffles; safe code: `#[target_feature]` functions called from the copies compiled
+//! with those features). Every copy gives the same bits, and is tested against the portable
+//! one ([`set_portable_only`]).
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
