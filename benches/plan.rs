@@ -10,7 +10,8 @@
 //! `plan/buildings` (only when `target/assets/buildings.obj` is there: `scripts/fetch-assets.sh`)
 //! plans the OpenFOAM city block (400k triangles, 26 parts) for its two lights, as the file
 //! orders its triangles and shuffled, each as loaded (`Caster::new`: the silhouette structures
-//! in the load-time spatial order) and scanning in the mesh's own triangle order (no reordering).
+//! in the load-time spatial order) and scanning in the mesh's own triangle order (no reordering,
+//! and no per-edge tags: the planner reads a silhouette edge's chunk and ends from the chunk tables).
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::hint::black_box;

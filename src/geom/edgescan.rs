@@ -88,6 +88,24 @@ pub struct EdgeScan {
     lone: Vec<[u32; 2]>,
     /// The facing words the scan reads: `words.0 .. words.1`.
     words: (usize, usize),
+    /// [`EdgeScan::with_tags`]' value per edge, in scan order (or none).
+    tags: Vec<u64>,
+}
+
+/// One edge of a light's possible silhouette, as [`EdgeScan::scan_hits_into`] lists it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ScanHit(u64);
+
+impl ScanHit {
+    /// Its index in [`EdgeScan::edges`] (and [`EdgeScan::tags`]).
+    pub fn edge(self) -> usize {
+        self.0 as u32 as usize
+    }
+
+    /// Whether its `t0` faces the light (then it runs `a -> b` in its light-facing triangle).
+    pub fn t0_lit(self) -> bool {
+        self.0 >> 32 != 0
+    }
 }
 
 /// In an edge's bit positions: its `lo` slot is its `t0`'s.
@@ -109,8 +127,9 @@ struct DeltaClass {
     first: usize,
 }
 
+/// `e` as a [`SilhouetteEdge`], oriented as in its light-facing triangle (`t0` when `t0_lit`).
 #[inline(always)]
-fn oriented(e: &ManifoldEdge, t0_lit: bool) -> SilhouetteEdge {
+pub(crate) fn oriented(e: &ManifoldEdge, t0_lit: bool) -> SilhouetteEdge {
     // selects, not a branch: which triangle is lit follows the light, not a pattern
     let (ends, tris, corners) = ([e.a, e.b], [e.t0, e.t1], [e.c0, e.c1]);
     let (i, j) = (usize::from(!t0_lit), usize::from(t0_lit));
@@ -318,10 +337,45 @@ impl EdgeScan {
     ///
     /// [`possible_silhouette`]: super::silhouette::possible_silhouette
     pub fn scan_into(&self, bits: &[u64], out: &mut Vec<SilhouetteEdge>) {
+        self.with_hits(bits, |hits| {
+            out.reserve(hits.len());
+            for &h in hits {
+                out.push(oriented(&self.edges[h as u32 as usize], h >> 32 != 0));
+            }
+        })
+    }
+
+    /// [`scan_into`](Self::scan_into)'s edges as [`ScanHit`]s, appended to `out` in the same
+    /// order: each edge's index in [`edges`](Self::edges) (and [`tags`](Self::tags)) and which
+    /// of its triangles faces the light, without reading the edge records.
+    pub fn scan_hits_into(&self, bits: &[u64], out: &mut Vec<ScanHit>) {
+        self.with_hits(bits, |hits| out.extend(hits.iter().map(|&h| ScanHit(h))))
+    }
+
+    /// The scan's [`Hits`] entries for `bits`, to `f`.
+    fn with_hits(&self, bits: &[u64], f: impl FnOnce(&[u64])) {
         SCRATCH.with_borrow_mut(|Scratch { breaks, codes, hits }| {
             let codes = codes.get_or_insert_with(|| Box::new([0; WORD_CODES]));
-            scan_words(self, bits, breaks, codes, &mut Hits { list: hits, len: 0 }, out);
+            let mut found = Hits { list: hits, len: 0 };
+            scan_words(self, bits, breaks, codes, &mut found);
+            f(found.found())
         })
+    }
+
+    /// The scan with a value per edge, `tag(edge)`, kept in scan order beside the edges
+    /// ([`tags`](Self::tags)): what a caller would otherwise look up for each silhouette edge
+    /// in tables of its own (the shadow planner keeps an edge's chunk and chunk-local ends, so
+    /// that a light's silhouette reads them in the scan's order, next to one another). Replaces
+    /// earlier tags. The scan itself never reads them.
+    pub fn with_tags(mut self, tag: impl FnMut(&ManifoldEdge) -> u64) -> EdgeScan {
+        self.tags = self.edges.iter().map(tag).collect();
+        self
+    }
+
+    /// The tags of [`with_tags`](Self::with_tags), one per edge of [`edges`](Self::edges);
+    /// empty for a scan without.
+    pub fn tags(&self) -> &[u64] {
+        &self.tags
     }
 
     #[inline(always)]
@@ -354,18 +408,18 @@ impl EdgeScan {
 /// One scan's word work ([`EdgeScan::scan_into`]): the breaks, then every kind of edge, into
 /// `hits`, and the edges found appended to `out`; the best copy for this CPU
 /// ([`super::cpu`]), or the portable one.
-fn scan_words(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, codes: &mut WordCodes, hits: &mut Hits, out: &mut Vec<SilhouetteEdge>) {
+fn scan_words(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, codes: &mut WordCodes, hits: &mut Hits) {
     if cpu::portable_only() {
-        scan_words_in(scan, bits, breaks, codes, hits, out, blocks::block_mask)
+        scan_words_in(scan, bits, breaks, codes, hits, blocks::block_mask)
     } else {
-        scan_words_per_level(scan, bits, breaks, codes, hits, out)
+        scan_words_per_level(scan, bits, breaks, codes, hits)
     }
 }
 
 per_cpu_level! {
     /// [`scan_words_in`], compiled per CPU level; the copies with SSSE3 test the residual
     /// edges' blocks with byte shuffles ([`blocks::block_mask_ssse3`]), the others bit by bit.
-    fn scan_words_per_level(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, codes: &mut WordCodes, hits: &mut Hits, out: &mut Vec<SilhouetteEdge>) {
+    fn scan_words_per_level(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, codes: &mut WordCodes, hits: &mut Hits) {
         // (a closure written here has this copy's target features, so it may call the SSSE3
         // function; the macro is defined for the copies that have SSSE3 only)
         #[multiversion::target::target_cfg(all(target_arch = "x86_64", target_feature = "ssse3"))]
@@ -380,21 +434,13 @@ per_cpu_level! {
                 blocks::block_mask
             };
         }
-        scan_words_in(scan, bits, breaks, codes, hits, out, block_mask!())
+        scan_words_in(scan, bits, breaks, codes, hits, block_mask!())
     }
 }
 
 /// [`scan_words`]' body; it and the parts it calls are inlined into each copy.
 #[inline(always)]
-fn scan_words_in(
-    scan: &EdgeScan,
-    bits: &[u64],
-    breaks: &mut Vec<u32>,
-    codes: &mut WordCodes,
-    hits: &mut Hits,
-    out: &mut Vec<SilhouetteEdge>,
-    block_mask: impl BlockMask,
-) {
+fn scan_words_in(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, codes: &mut WordCodes, hits: &mut Hits, block_mask: impl BlockMask) {
     find_breaks(bits, scan.words, breaks);
     scan.near.scan(bits, breaks, hits, block_mask);
     for c in &scan.far_classes {
@@ -402,11 +448,6 @@ fn scan_words_in(
     }
     scan.scan_far(bits, codes, hits, block_mask);
     scan.scan_lone(bits, hits);
-    // the edges found, oriented (a loop, not an iterator adapter: inlined into each copy)
-    out.reserve(hits.len);
-    for &h in hits.found() {
-        out.push(oriented(&scan.edges[h as u32 as usize], h >> 32 != 0));
-    }
 }
 
 /// A [`Hits`] entry: edge `i`, and whether its `t0` is lit (bit 0 of `t0_lit`).

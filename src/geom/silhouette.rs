@@ -143,7 +143,7 @@ pub fn possible_silhouette_packed(edges: &[ManifoldEdge], bits: &[u64]) -> Vec<S
     out
 }
 
-pub use super::edgescan::EdgeScan;
+pub use super::edgescan::{EdgeScan, ScanHit};
 
 /// [`possible_silhouette_packed`] appending to `out` (reuse the allocation across frames).
 pub fn possible_silhouette_packed_into(edges: &[ManifoldEdge], bits: &[u64], out: &mut Vec<SilhouetteEdge>) {

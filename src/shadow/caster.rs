@@ -91,7 +91,10 @@ pub struct Part {
     pub edges: Vec<u32>,
     /// The part's manifold edges, ready for the per-light possible-silhouette scan of facing
     /// bits in the caster's scan order ([`Caster::planes`]); its edges and output keep the
-    /// welded triangle ids.
+    /// welded triangle ids. Each edge is tagged ([`EdgeScan::tags`], 8 bytes an edge) with its
+    /// chunk and chunk-local ends, which the planner reads for a light's silhouette edges next
+    /// to the scan's own data instead of in the chunk tables; a scan without tags (one built
+    /// anew) is planned the same, from the tables.
     pub scan: EdgeScan,
 }
 
@@ -386,11 +389,29 @@ fn build_parts(topo: &Topology, limit: usize, whole: bool, order: Option<Triangl
             chunks: first..chunks.len(),
             object_bounds: bounds,
             edges: pedges,
-            scan: EdgeScan::with_order(pman, &order),
+            scan: EdgeScan::with_order(pman, &order).with_tags(|e| side_tag(e, &chunks, &tri_chunk)),
         });
     }
     (parts, chunks, tri_chunk, order)
 }
+
+/// A manifold edge's [`EdgeScan`] tag for the planner (`plan::hit_ends`): its chunk (bits 0-31)
+/// and the chunk-local indices of its ends `a` (bits 32-47) and `b` (48-63), the same in both
+/// its triangles when they share a chunk; [`SIDE_TAG_SPLIT`] for an edge between two chunks.
+fn side_tag(e: &crate::geom::topology::ManifoldEdge, chunks: &[Chunk], tri_chunk: &[(u32, u32)]) -> u64 {
+    let ((c0, l0), (c1, _)) = (tri_chunk[e.t0 as usize], tri_chunk[e.t1 as usize]);
+    if c0 != c1 {
+        return SIDE_TAG_SPLIT;
+    }
+    // t0 runs a -> b from its corner c0
+    let lt = chunks[c0 as usize].local_tris[l0 as usize];
+    let (a, b) = (lt[e.c0 as usize % 3], lt[(e.c0 as usize + 1) % 3]);
+    u64::from(c0) | u64::from(a) << 32 | u64::from(b) << 48
+}
+
+/// [`side_tag`] of an edge whose triangles lie in different chunks (read from the chunks'
+/// tables instead).
+pub(crate) const SIDE_TAG_SPLIT: u64 = u64::MAX;
 
 /// Where [`build_chunks`] writes: the chunks, each triangle's (chunk, index in it), and the
 /// per-vertex scratch shared across calls (the chunk a vertex was last added to, its local

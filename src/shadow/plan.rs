@@ -39,10 +39,11 @@
 //! back-to-back pairs), go to `light_cap` (NEVER, z-fail cases only); the caps of all other
 //! triangles go to `volume` (depth LESS) in z-pass and in the z-fail-with-light-cap case.
 
-use super::caster::{Caster, CasterKind};
+use super::caster::{Caster, CasterKind, SIDE_TAG_SPLIT};
 
 use crate::geom::bounds::{box_distance, light_depth_bounds, light_scissor, shadow_volume_outside_frustum, Frustum, OcclusionPyramid};
-use crate::geom::silhouette::{packed_bit, SilhouetteEdge};
+use crate::geom::edgescan::oriented;
+use crate::geom::silhouette::{packed_bit, EdgeScan, ScanHit, SilhouetteEdge};
 use crate::geom::Aabb;
 use crate::geom::LightKind;
 use glam::Vec4;
@@ -112,15 +113,59 @@ pub fn emit(caster: &Caster, facing: &[bool], sil: &[SilhouetteEdge], e: Emit) -
     } else {
         Case::ZPass
     };
-    emit_with(caster, 0..caster.chunks.len(), facing, sil, e, case)
+    let ends: Vec<SideEnds> = sil.iter().map(|s| side_ends(caster, s, e.formulation)).collect();
+    emit_with(caster, 0..caster.chunks.len(), facing, &ends, e, case)
 }
 
-/// [`emit`] for the part whose chunks are `range` (`sil` from that part's edges).
+/// A silhouette edge's side as the volume draws it: a chunk and the chunk-local ends `a -> b`
+/// of the edge in the light-facing triangle's winding (front formulation), or in the other
+/// triangle's, reversed (back): the same two ends in a closed manifold part, each from its own
+/// triangle's chunk.
+#[derive(Clone, Copy, Debug)]
+struct SideEnds {
+    chunk: u32,
+    a: u16,
+    b: u16,
+}
+
+/// [`SideEnds`] of `s`, from the caster's chunk tables.
+fn side_ends(caster: &Caster, s: &SilhouetteEdge, formulation: Formulation) -> SideEnds {
+    let (tri, corner, rev) = match formulation {
+        Formulation::Front => (s.lit, s.lit_corner, false),
+        Formulation::Back => (s.unlit, s.unlit_corner, true),
+        Formulation::TwoSided => unreachable!("multiplicity casters use emit_multiplicity"),
+    };
+    let (ci, li) = caster.tri_chunk[tri as usize];
+    let lt = caster.chunks[ci as usize].local_tris[li as usize];
+    let k = corner as usize % 3;
+    let (a, b) = (lt[k], lt[(k + 1) % 3]);
+    let (a, b) = if rev { (b, a) } else { (a, b) };
+    SideEnds { chunk: ci, a, b }
+}
+
+/// [`SideEnds`] of the scan's hit `h`, from the edge's tag (its chunk and ends, next to the
+/// scan's other per-edge data: no lookup in the chunk tables, whose rows for a light's
+/// silhouette lie scattered over the caster) or, for an edge between two chunks or a scan
+/// without tags, from the chunk tables.
+fn hit_ends(caster: &Caster, scan: &EdgeScan, h: ScanHit, formulation: Formulation) -> SideEnds {
+    match scan.tags().get(h.edge()) {
+        Some(&tag) if tag != SIDE_TAG_SPLIT && formulation != Formulation::TwoSided => {
+            let (ea, eb) = ((tag >> 32) as u16, (tag >> 48) as u16);
+            // t0 runs a -> b; either formulation draws the edge as the lit triangle runs it
+            let (a, b) = if h.t0_lit() { (ea, eb) } else { (eb, ea) };
+            SideEnds { chunk: tag as u32, a, b }
+        }
+        _ => side_ends(caster, &oriented(&scan.edges()[h.edge()], h.t0_lit()), formulation),
+    }
+}
+
+/// [`emit`] for the part whose chunks are `range` (`ends`: its silhouette edges' sides, in
+/// `e.formulation`).
 fn emit_with<F: FacingSet + ?Sized>(
     caster: &Caster,
     range: std::ops::Range<usize>,
     facing: &F,
-    sil: &[SilhouetteEdge],
+    ends: &[SideEnds],
     e: Emit,
     case: Case,
 ) -> (Vec<ChunkDraw>, usize, usize, usize) {
@@ -131,32 +176,18 @@ fn emit_with<F: FacingSet + ?Sized>(
     let (mut sides, mut dark, mut light) = (0, 0, 0);
     // each chunk's side (and fan) indices reserved at once: a pass over the edges' chunks
     // costs less than growing the lists edge by edge (reallocations were 7 % of a plan)
-    let edge_indices = if e.directional { 3 } else { 6 } + if !e.directional && e.dark_cap == DarkCap::Fan { 3 } else { 0 };
+    let fan = !e.directional && e.dark_cap == DarkCap::Fan;
+    let edge_indices = if e.directional { 3 } else { 6 } + if fan { 3 } else { 0 };
     let mut per_chunk = vec![0usize; nch];
-    for s in sil {
-        let tri = if e.formulation == Formulation::Back { s.unlit } else { s.lit };
-        per_chunk[caster.tri_chunk[tri as usize].0 as usize] += edge_indices;
+    for s in ends {
+        per_chunk[s.chunk as usize] += edge_indices;
     }
     for (v, &n) in vol.iter_mut().zip(&per_chunk) {
         v.reserve_exact(n);
     }
-    for s in sil {
-        // a->b as in the lit triangle; the back formulation uses the unlit triangle's chunk
-        let (tri, corner, rev) = match e.formulation {
-            Formulation::Front => (s.lit, s.lit_corner, false),
-            Formulation::Back => (s.unlit, s.unlit_corner, true),
-            Formulation::TwoSided => unreachable!("multiplicity casters use emit_multiplicity"),
-        };
-        let (ci, li) = caster.tri_chunk[tri as usize];
-        let ch = &caster.chunks[ci as usize];
-        let n = ch.n() as u16;
-        let lt = ch.local_tris[li as usize];
-        let k = corner as usize;
-        let (mut a, mut b) = (lt[k], lt[(k + 1) % 3]);
-        if rev {
-            std::mem::swap(&mut a, &mut b);
-        }
-        let v = &mut vol[ci as usize];
+    for &SideEnds { chunk, a, b } in ends {
+        let n = caster.chunks[chunk as usize].n() as u16;
+        let v = &mut vol[chunk as usize];
         if e.directional {
             v.extend_from_slice(&[b, a, a + n]);
             sides += 1;
@@ -168,15 +199,12 @@ fn emit_with<F: FacingSet + ?Sized>(
     if !e.directional {
         match e.dark_cap {
             DarkCap::Fan => {
+                // (the front formulation's ends: the light-facing triangle's)
                 assert_eq!(e.formulation, Formulation::Front, "the fan dark cap needs the front formulation");
-                for s in sil {
-                    let (ci, li) = caster.tri_chunk[s.lit as usize];
-                    let ch = &caster.chunks[ci as usize];
+                for &SideEnds { chunk, a, b } in ends {
+                    let ch = &caster.chunks[chunk as usize];
                     let n = ch.n() as u16;
-                    let lt = ch.local_tris[li as usize];
-                    let k = s.lit_corner as usize;
-                    let (a, b) = (lt[k], lt[(k + 1) % 3]);
-                    vol[ci as usize].extend_from_slice(&[ch.apex() + n, b + n, a + n]);
+                    vol[chunk as usize].extend_from_slice(&[ch.apex() + n, b + n, a + n]);
                     dark += 1;
                 }
             }
@@ -293,7 +321,7 @@ fn plan_part(
     job: PartJob,
     l_obj: Vec4,
     (bits, tri_bits): (&[u64], &[u64]),
-    sil: &mut Vec<SilhouetteEdge>,
+    (hits, ends): (&mut Vec<ScanHit>, &mut Vec<SideEnds>),
 ) -> (PartPlan, Vec<ChunkDraw>) {
     let PartJob { part: pi, multiplicity, case } = job;
     let part = &caster.parts[pi];
@@ -338,17 +366,19 @@ fn plan_part(
         };
         return (pp, draws);
     }
-    sil.clear();
-    part.scan.scan_into(bits, sil);
+    hits.clear();
+    part.scan.scan_hits_into(bits, hits);
     let e = manifold_emit(input.method, part, case, l_obj);
     let (formulation, dark_cap_kind) = (e.formulation, e.dark_cap);
-    let (draws, sides, dark_cap, light_cap) = emit_with(caster, part.chunks.clone(), &facing, sil, e, case);
+    ends.clear();
+    ends.extend(hits.iter().map(|&h| hit_ends(caster, &part.scan, h, formulation)));
+    let (draws, sides, dark_cap, light_cap) = emit_with(caster, part.chunks.clone(), &facing, ends, e, case);
     let pp = PartPlan {
         part: pi,
         case,
         path: VolumePath::Manifold,
-        silhouette_edges: sil.len(),
-        multiplicity_max: u32::from(!sil.is_empty()),
+        silhouette_edges: hits.len(),
+        multiplicity_max: u32::from(!hits.is_empty()),
         sides,
         dark_cap,
         light_cap,
@@ -390,7 +420,7 @@ pub fn plan_light_with(input: &PlanInput, casters: &[Caster], opts: &PlanOptions
     let mut plans = Vec::with_capacity(casters.len());
     let mut bits = Vec::new();
     let mut tri_bits = Vec::new();
-    let mut sil = Vec::new();
+    let (mut hits, mut ends) = (Vec::new(), Vec::new());
     for (ci, caster) in casters.iter().enumerate() {
         let wb = caster.world_bounds();
         let l_obj = avoid_vertex(caster, object_light(caster, light_h));
@@ -482,7 +512,8 @@ pub fn plan_light_with(input: &PlanInput, casters: &[Caster], opts: &PlanOptions
             } else {
                 &[]
             };
-            let (pp, draws) = plan_part(input, caster, PartJob { part: pi, multiplicity, case }, l_obj, (&bits, tb), &mut sil);
+            let (pp, draws) =
+                plan_part(input, caster, PartJob { part: pi, multiplicity, case }, l_obj, (&bits, tb), (&mut hits, &mut ends));
             cp.silhouette_edges += pp.silhouette_edges;
             cp.multiplicity_max = cp.multiplicity_max.max(pp.multiplicity_max);
             cp.sides += pp.sides;
