@@ -26,6 +26,29 @@ macro_rules! per_cpu_level {
 }
 pub(crate) use per_cpu_level;
 
+/// Inside an item of [`per_cpu_level!`]: `$fast` in the copies compiled with the x86-64
+/// feature `$feature`, `$portable` in the others. A closure given as `$fast` has its copy's
+/// target features, so it may call a `#[target_feature]` function of that feature as safe
+/// code; the other copies never see it.
+macro_rules! by_feature {
+    ($feature:literal, $fast:expr, $portable:expr) => {{
+        #[multiversion::target::target_cfg(all(target_arch = "x86_64", target_feature = $feature))]
+        macro_rules! pick {
+            () => {
+                $fast
+            };
+        }
+        #[multiversion::target::target_cfg(not(all(target_arch = "x86_64", target_feature = $feature)))]
+        macro_rules! pick {
+            () => {
+                $portable
+            };
+        }
+        pick!()
+    }};
+}
+pub(crate) use by_feature;
+
 static PORTABLE_ONLY: AtomicBool = AtomicBool::new(false);
 
 /// Runs only the portable copies from now on (`true`), in every thread, or the best ones

@@ -43,7 +43,7 @@ use super::topology::ManifoldEdge;
 mod blocks;
 mod far;
 mod near;
-use blocks::{test_edges, BlockMask};
+use blocks::{pad_to_blocks, test_edges, BlockMask};
 use far::{WordCodes, WORD_CODES};
 use near::{Near, NearWord};
 
@@ -268,9 +268,7 @@ impl EdgeScan {
             scan.far_top = scan.far_top.max(run[0].2 as usize / 64 + 1);
             scan.far_end.push(scan.edges.len() as u32);
         }
-        if !scan.far_offsets.is_empty() {
-            scan.far_offsets.resize(scan.far_offsets.len() + TEST_BLOCK - 1, [0; 2]);
-        }
+        pad_to_blocks(&mut scan.far_offsets);
         scan.lone_start = scan.edges.len();
         for &&(e, lo, hi, is_t0) in &lone {
             scan.lone.push(if is_t0 { [lo, hi] } else { [hi, lo] });
@@ -337,12 +335,7 @@ impl EdgeScan {
     ///
     /// [`possible_silhouette`]: super::silhouette::possible_silhouette
     pub fn scan_into(&self, bits: &[u64], out: &mut Vec<SilhouetteEdge>) {
-        self.with_hits(bits, |hits| {
-            out.reserve(hits.len());
-            for &h in hits {
-                out.push(oriented(&self.edges[h as u32 as usize], h >> 32 != 0));
-            }
-        })
+        self.with_hits(bits, |hits| out.extend(hits.iter().map(|&h| oriented(&self.edges[h as u32 as usize], h >> 32 != 0))))
     }
 
     /// [`scan_into`](Self::scan_into)'s edges as [`ScanHit`]s, appended to `out` in the same
@@ -420,21 +413,12 @@ per_cpu_level! {
     /// [`scan_words_in`], compiled per CPU level; the copies with SSSE3 test the residual
     /// edges' blocks with byte shuffles ([`blocks::block_mask_ssse3`]), the others bit by bit.
     fn scan_words_per_level(scan: &EdgeScan, bits: &[u64], breaks: &mut Vec<u32>, codes: &mut WordCodes, hits: &mut Hits) {
-        // (a closure written here has this copy's target features, so it may call the SSSE3
-        // function; the macro is defined for the copies that have SSSE3 only)
-        #[multiversion::target::target_cfg(all(target_arch = "x86_64", target_feature = "ssse3"))]
-        macro_rules! block_mask {
-            () => {
-                |block: &[[u8; 2]; TEST_BLOCK], a: u64, b: [u64; 2]| blocks::block_mask_ssse3(block, a, b)
-            };
-        }
-        #[multiversion::target::target_cfg(not(all(target_arch = "x86_64", target_feature = "ssse3")))]
-        macro_rules! block_mask {
-            () => {
-                blocks::block_mask
-            };
-        }
-        scan_words_in(scan, bits, breaks, codes, hits, block_mask!())
+        let block_mask = cpu::by_feature!(
+            "ssse3",
+            |block: &[[u8; 2]; TEST_BLOCK], a: u64, b: [u64; 2]| blocks::block_mask_ssse3(block, a, b),
+            blocks::block_mask
+        );
+        scan_words_in(scan, bits, breaks, codes, hits, block_mask)
     }
 }
 

@@ -432,21 +432,12 @@ per_cpu_level! {
     /// [`fill_words_in`], compiled per CPU level; the copies with AVX take their dot products
     /// eight planes a vector ([`dots::block64_avx`]), the others four.
     fn fill_words_per_level(planes: &FacePlanes, mesh: &Mesh, l: Vec4, flip: bool, filter: (Vec4, f32), first: usize, out: &mut [u64]) {
-        // (a closure written here has this copy's target features, so it may call the AVX
-        // function; the macro is defined for the copies that have AVX only)
-        #[multiversion::target::target_cfg(all(target_arch = "x86_64", target_feature = "avx"))]
-        macro_rules! dots {
-            () => {
-                |nx: &[f32], ny: &[f32], nz: &[f32], d: &[f32], l: Vec4, e: f32| dots::block64_avx(nx, ny, nz, d, l, e)
-            };
-        }
-        #[multiversion::target::target_cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
-        macro_rules! dots {
-            () => {
-                dots::block64
-            };
-        }
-        fill_words_in(planes, mesh, l, flip, filter, first, out, dots!())
+        let dots = cpu::by_feature!(
+            "avx",
+            |nx: &[f32], ny: &[f32], nz: &[f32], d: &[f32], l: Vec4, e: f32| dots::block64_avx(nx, ny, nz, d, l, e),
+            dots::block64
+        );
+        fill_words_in(planes, mesh, l, flip, filter, first, out, dots)
     }
 }
 

@@ -62,6 +62,14 @@ pub(super) fn block_mask_ssse3(block: &[[u8; 2]; TEST_BLOCK], a: u64, b: [u64; 2
     u64::from((lo_clear ^ hi_clear) & 0xff)
 }
 
+/// Pads residual edges' bit positions `offsets` (when any) so that [`test_edges`] may read a
+/// whole block past the last edge.
+pub(super) fn pad_to_blocks(offsets: &mut Vec<[u8; 2]>) {
+    if !offsets.is_empty() {
+        offsets.resize(offsets.len() + TEST_BLOCK - 1, [0; 2]);
+    }
+}
+
 /// Lists the residual edges `range` (bit positions `offsets`, from the range's first, padded
 /// to a whole [`TEST_BLOCK`]) whose two bits differ: `lo` bits in `a`, `hi` bits in `b` (bit
 /// `k` in `b[k / 64]`). A block of edges at a time, without a branch or a store an edge:

@@ -2,7 +2,7 @@
 //! tested a pair at a time through per-word codes, and those alone in their pair, tested by
 //! their two bits.
 
-use super::{entry, test_edges, word, BlockMask, EdgeScan, Hits};
+use super::{entry, mixed, test_edges, word, BlockMask, EdgeScan, Hits};
 
 /// Lone far edges tested a chunk at a time.
 const FAR_CHUNK: usize = 256;
@@ -58,7 +58,8 @@ impl EdgeScan {
             } else {
                 for (k, (&lo, &hi)) in los.iter().zip(his).enumerate() {
                     let (a, b) = (word(bits, lo as usize), word(bits, hi as usize));
-                    m |= u64::from(((a ^ b) | (a.wrapping_add(1) >> 1)) != 0) << k;
+                    // not the same uniform word
+                    m |= u64::from((a != b) | mixed(a)) << k;
                 }
             }
             while m != 0 {

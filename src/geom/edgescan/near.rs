@@ -2,7 +2,7 @@
 //! the residual edges with both slots in one facing word or in a word and the next, filed by
 //! the word of their `lo` slot, so that one visit of a word next to a break tests them all.
 
-use super::{mixed, offsets_of, test_edges, word, BlockMask, Hits, Slotted, TEST_BLOCK};
+use super::{mixed, offsets_of, pad_to_blocks, test_edges, word, BlockMask, Hits, Slotted};
 use crate::geom::topology::ManifoldEdge;
 
 /// The near edges: those of a class with `δ < 64`, and the residual edges with both slots in
@@ -22,7 +22,7 @@ pub(super) struct Near {
     pub(super) ranks: Vec<u16>,
     /// Per near residual edge, in edge order: its bit positions, the `hi` one in the `lo`
     /// word and the next (0 to 127), and [`T0`](super::T0) as for the far ones; then a
-    /// [`TEST_BLOCK`]'s padding.
+    /// [`TEST_BLOCK`](super::TEST_BLOCK)'s padding.
     pub(super) offsets: Vec<[u8; 2]>,
 }
 
@@ -84,9 +84,7 @@ impl Near {
             near.words.push(NearWord { base, rest: rest_at, next: next.unwrap_or(edges.len() as u32), off });
         }
         near.words.push(NearWord { base: edges.len() as u32, ..NearWord::default() });
-        if !near.offsets.is_empty() {
-            near.offsets.resize(near.offsets.len() + TEST_BLOCK - 1, [0; 2]);
-        }
+        pad_to_blocks(&mut near.offsets);
         near
     }
 
