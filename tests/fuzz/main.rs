@@ -171,7 +171,7 @@ fn fuzz_obj() {
     println!("fuzz obj: {loaded} of {} loaded (the rest got an error)", cases());
     // The generator makes valid files about a quarter of the time (274 of 1,000 at the default
     // seed): a loader that rejected everything would pass every check above. Mutation, run
-    // once: `load_obj` returning an error for every input fails here.
+    // once: `load_obj_str` (under `load_obj`) returning an error for every input fails here.
     assert!(loaded * 10 >= cases(), "only {loaded} of {} OBJ inputs loaded: is the loader rejecting everything?", cases());
     // raw bytes (not UTF-8) through the file loader, a few per run
     let dir = tmp_dir();
