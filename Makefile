@@ -43,6 +43,7 @@ test: deps-tests lint
 	$(CARGO) build --lib --no-default-features
 	UMBRAGE_VALIDATION=1 $(CARGO) run --example minimal --no-default-features
 	eval "$$(./scripts/drivers.sh env swiftshader)" && UMBRAGE_VALIDATION=1 $(CARGO) run --example minimal --no-default-features
+	./scripts/capi-test.sh
 	$(MAKE) doc
 
 # Formatting and lints (Cargo.toml's [lints]: every unsafe block and unsafe fn documented),

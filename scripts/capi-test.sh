@@ -105,7 +105,7 @@ step "hosts under ASan and UBSan" sanitize
 step "make capi again (plain hosts)" ./scripts/capi-build.sh
 valgrind_run() {
     command -v valgrind >/dev/null || { echo "valgrind not installed (apt-get install valgrind)"; return 1; }
-    UMBRAGE_VALIDATION=0 valgrind --error-exitcode=99 --leak-check=full --errors-for-leak-kinds=definite \
+    UMBRAGE_VALIDATION=0 valgrind --error-exitcode=99 --keep-debuginfo=yes --leak-check=full --errors-for-leak-kinds=definite \
         --suppressions=scripts/valgrind-driver.supp \
         "$prefix/bin/umbrage-c-host" --scene default --size 64x40 --frames 2 --dump target/capi-out/valgrind
 }

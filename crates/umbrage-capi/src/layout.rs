@@ -20,20 +20,121 @@ macro_rules! pin {
 mod lp64 {
     use super::*;
     pin!(UmbrageRenderPassTarget, 32, sType = 0, pNext = 8, renderPass = 16, subpass = 24, colorAttachmentCount = 28);
-    pin!(UmbragePassCreateInfo, 112, sType = 0, pNext = 8, abiVersion = 16, depthStencilFormat = 20, samples = 24, framesInFlight = 28, depthDirection = 32, depthMode = 36, enabledFeatures = 40, settings = 44, transmitFormat = 84, pipelineCache = 88, pfnWarning = 96, pWarningUserData = 104);
+    pin!(
+        UmbragePassCreateInfo,
+        112,
+        sType = 0,
+        pNext = 8,
+        abiVersion = 16,
+        depthStencilFormat = 20,
+        samples = 24,
+        framesInFlight = 28,
+        depthDirection = 32,
+        depthMode = 36,
+        enabledFeatures = 40,
+        settings = 44,
+        transmitFormat = 84,
+        pipelineCache = 88,
+        pfnWarning = 96,
+        pWarningUserData = 104
+    );
     pin!(UmbrageVulkanDevice, 40, pfnGetInstanceProcAddr = 0, pfnGetDeviceProcAddr = 8, instance = 16, physicalDevice = 24, device = 32);
-    pin!(UmbragePassSettings, 40, technique = 0, method = 4, counter = 8, indexFormat = 12, computeDraws = 16, disableScissor = 20, disableDepthBounds = 24, disableCulling = 28, disableMeshTask = 32, rayBatch = 36);
-    pin!(UmbrageCapabilities, 40, rayQuery = 0, depthClamp = 4, depthBounds = 8, indexTypeUint8 = 12, r32fBlend = 16, meshShader = 20, drawIndirectFirstInstance = 24, multiDrawIndirect = 28, drawIndirectCount = 32, taskShader = 36);
+    pin!(
+        UmbragePassSettings,
+        40,
+        technique = 0,
+        method = 4,
+        counter = 8,
+        indexFormat = 12,
+        computeDraws = 16,
+        disableScissor = 20,
+        disableDepthBounds = 24,
+        disableCulling = 28,
+        disableMeshTask = 32,
+        rayBatch = 36
+    );
+    pin!(
+        UmbrageCapabilities,
+        40,
+        rayQuery = 0,
+        depthClamp = 4,
+        depthBounds = 8,
+        indexTypeUint8 = 12,
+        r32fBlend = 16,
+        meshShader = 20,
+        drawIndirectFirstInstance = 24,
+        multiDrawIndirect = 28,
+        drawIndirectCount = 32,
+        taskShader = 36
+    );
     pin!(UmbrageFormatFeatures, 12, format = 0, optimalTilingFeatures = 4, sampleCounts = 8);
-    pin!(UmbrageDeviceDescription, 64, sType = 0, pNext = 8, apiVersion = 16, deviceFeatures = 20, ppExtensionNames = 24, extensionCount = 32, pFormats = 40, formatCount = 48, pLimits = 56);
-    pin!(UmbrageCasterInfo, 200, sType = 0, pNext = 8, pName = 16, pPositions = 24, vertexCount = 32, pIndices = 40, indexCount = 48, indexType = 52, transform = 56, transparent = 184, transmittance = 188);
+    pin!(
+        UmbrageDeviceDescription,
+        64,
+        sType = 0,
+        pNext = 8,
+        apiVersion = 16,
+        deviceFeatures = 20,
+        ppExtensionNames = 24,
+        extensionCount = 32,
+        pFormats = 40,
+        formatCount = 48,
+        pLimits = 56
+    );
+    pin!(
+        UmbrageCasterInfo,
+        200,
+        sType = 0,
+        pNext = 8,
+        pName = 16,
+        pPositions = 24,
+        vertexCount = 32,
+        pIndices = 40,
+        indexCount = 48,
+        indexType = 52,
+        transform = 56,
+        transparent = 184,
+        transmittance = 188
+    );
     pin!(UmbrageSphereInfo, 64, sType = 0, pNext = 8, pName = 16, center = 24, radius = 48, segments = 56);
     pin!(UmbrageLight, 36, kind = 0, position = 4, direction = 16, coneDeg = 28, radius = 32);
     pin!(UmbrageView, 184, sType = 0, pNext = 8, eye = 16, view = 40, projection = 104, width = 168, height = 172, culled = 176);
     pin!(UmbrageFrame, 24, pass = 0, serial = 8, slot = 16, lights = 20);
     pin!(UmbrageDepthStencilTarget, 48, sType = 0, pNext = 8, image = 16, view = 24, extent = 32, layout = 40, finalLayout = 44);
-    pin!(UmbrageLightInfo, 56, sType = 0, pNext = 8, scissor = 16, hasDepthBounds = 32, minDepthBounds = 36, maxDepthBounds = 40, casterCount = 44, triangles = 48);
-    pin!(UmbrageFrameStats, 136, sType = 0, pNext = 8, sideTriangles = 16, darkCapTriangles = 24, lightCapTriangles = 32, indexBytes = 40, vertexBytes = 48, bytesSent = 56, draws = 64, casesCulled = 72, casesZPass = 80, casesZFail = 88, casesZFailLightCap = 96, cpuSilhouettesMs = 104, cpuPlanMs = 112, cpuRecordMs = 120, warningCount = 128, pendingUploads = 132);
+    pin!(
+        UmbrageLightInfo,
+        56,
+        sType = 0,
+        pNext = 8,
+        scissor = 16,
+        hasDepthBounds = 32,
+        minDepthBounds = 36,
+        maxDepthBounds = 40,
+        casterCount = 44,
+        triangles = 48
+    );
+    pin!(
+        UmbrageFrameStats,
+        136,
+        sType = 0,
+        pNext = 8,
+        sideTriangles = 16,
+        darkCapTriangles = 24,
+        lightCapTriangles = 32,
+        indexBytes = 40,
+        vertexBytes = 48,
+        bytesSent = 56,
+        draws = 64,
+        casesCulled = 72,
+        casesZPass = 80,
+        casesZFail = 88,
+        casesZFailLightCap = 96,
+        cpuSilhouettesMs = 104,
+        cpuPlanMs = 112,
+        cpuRecordMs = 120,
+        warningCount = 128,
+        pendingUploads = 132
+    );
     pin!(UmbrageRayQueryInputs, 40, sType = 0, pNext = 8, position = 16, normal = 24, surfaceOffset = 32);
 }
 

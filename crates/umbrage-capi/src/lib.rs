@@ -254,7 +254,11 @@ pub unsafe extern "C" fn umbrage_pass_set_ray_query_inputs(pass: UmbragePass, in
 
 /// Adds a caster (opaque, or transparent with `transparent`); `*out` gets its id.
 #[no_mangle]
-pub unsafe extern "C" fn umbrage_pass_add_caster(pass: UmbragePass, info: *const UmbrageCasterInfo, out: *mut UmbrageCasterId) -> UmbrageResult {
+pub unsafe extern "C" fn umbrage_pass_add_caster(
+    pass: UmbragePass,
+    info: *const UmbrageCasterInfo,
+    out: *mut UmbrageCasterId,
+) -> UmbrageResult {
     with_pass(pass, |s| {
         // SAFETY: non-NULL checked; readable by the header's contract.
         let info = unsafe { &*non_null(info, "info")? };
@@ -280,7 +284,11 @@ pub unsafe extern "C" fn umbrage_pass_add_caster(pass: UmbragePass, info: *const
 
 /// Moves a caster (object -> world, column-major `double[16]`) from the next prepare on.
 #[no_mangle]
-pub unsafe extern "C" fn umbrage_pass_set_caster_transform(pass: UmbragePass, caster: UmbrageCasterId, transform: *const f64) -> UmbrageResult {
+pub unsafe extern "C" fn umbrage_pass_set_caster_transform(
+    pass: UmbragePass,
+    caster: UmbrageCasterId,
+    transform: *const f64,
+) -> UmbrageResult {
     with_pass(pass, |s| {
         // SAFETY: non-NULL checked; 16 readable doubles by the header's contract.
         let m = unsafe { *non_null(transform, "transform")?.cast::<[f64; 16]>() };
@@ -326,7 +334,11 @@ pub extern "C" fn umbrage_pass_remove_caster(pass: UmbragePass, caster: UmbrageC
 
 /// Adds an analytic sphere caster; `*out` gets its id.
 #[no_mangle]
-pub unsafe extern "C" fn umbrage_pass_add_sphere(pass: UmbragePass, info: *const UmbrageSphereInfo, out: *mut UmbrageSphereId) -> UmbrageResult {
+pub unsafe extern "C" fn umbrage_pass_add_sphere(
+    pass: UmbragePass,
+    info: *const UmbrageSphereInfo,
+    out: *mut UmbrageSphereId,
+) -> UmbrageResult {
     with_pass(pass, |s| {
         // SAFETY: non-NULL checked; readable by the header's contract.
         let info = unsafe { &*non_null(info, "info")? };
@@ -347,7 +359,12 @@ pub unsafe extern "C" fn umbrage_pass_add_sphere(pass: UmbragePass, info: *const
 
 /// Moves or resizes a sphere caster.
 #[no_mangle]
-pub unsafe extern "C" fn umbrage_pass_set_sphere(pass: UmbragePass, sphere: UmbrageSphereId, center: *const f64, radius: f64) -> UmbrageResult {
+pub unsafe extern "C" fn umbrage_pass_set_sphere(
+    pass: UmbragePass,
+    sphere: UmbrageSphereId,
+    center: *const f64,
+    radius: f64,
+) -> UmbrageResult {
     with_pass(pass, |s| {
         // SAFETY: non-NULL checked; 3 readable doubles by the header's contract.
         let c = unsafe { *non_null(center, "center")?.cast::<[f64; 3]>() };
@@ -465,7 +482,12 @@ pub unsafe extern "C" fn umbrage_frame_get_stats(pass: UmbragePass, frame: Umbra
 /// What the host's lighting pass needs for light `light` of the frame: its scissor and depth
 /// bounds (set them with `umbrage_cmd_light_state`, or read them here).
 #[no_mangle]
-pub unsafe extern "C" fn umbrage_frame_get_light(pass: UmbragePass, frame: UmbrageFrame, light: u32, out: *mut UmbrageLightInfo) -> UmbrageResult {
+pub unsafe extern "C" fn umbrage_frame_get_light(
+    pass: UmbragePass,
+    frame: UmbrageFrame,
+    light: u32,
+    out: *mut UmbrageLightInfo,
+) -> UmbrageResult {
     with_pass(pass, |s| {
         let out = non_null(out, "out")? as *mut UmbrageLightInfo;
         // SAFETY: non-NULL; the host set sType.
@@ -507,7 +529,11 @@ pub unsafe extern "C" fn umbrage_cmd_upload(pass: UmbragePass, command_buffer: V
 /// Records what the frame needs before the host's rendering begins (uploads, the compute
 /// technique's silhouettes, the ray-query structures). Required first in the render-pass model.
 #[no_mangle]
-pub unsafe extern "C" fn umbrage_cmd_before_rendering(pass: UmbragePass, command_buffer: VkCommandBuffer, frame: UmbrageFrame) -> UmbrageResult {
+pub unsafe extern "C" fn umbrage_cmd_before_rendering(
+    pass: UmbragePass,
+    command_buffer: VkCommandBuffer,
+    frame: UmbrageFrame,
+) -> UmbrageResult {
     with_pass(pass, |s| {
         let f = s.frame(&frame)?;
         // SAFETY: the header's contract (the Rust `cmd_before_rendering`'s).

@@ -111,7 +111,10 @@ impl State {
             return Err(engine::Error::from(Misuse::ForeignFrame).into());
         }
         let slots = self.frames.len();
-        let held = self.frames.get(f.slot as usize).ok_or(CError::from(engine::Error::from(Misuse::SlotOutOfRange { slot: f.slot as usize, slots })))?;
+        let held = self
+            .frames
+            .get(f.slot as usize)
+            .ok_or(CError::from(engine::Error::from(Misuse::SlotOutOfRange { slot: f.slot as usize, slots })))?;
         match held {
             Some(p) if p.serial() == f.serial => Ok(p),
             Some(p) => Err(engine::Error::from(Misuse::StaleFrame { slot: f.slot as usize, serial: f.serial, current: p.serial() }).into()),

@@ -45,7 +45,6 @@ pub type RawGetInstanceProcAddr = usize;
 /// `PFN_vkGetDeviceProcAddr` in the header, as [`RawGetInstanceProcAddr`].
 pub type RawGetDeviceProcAddr = usize;
 
-
 // The enums as C passes them: 32-bit values, checked before they become Rust enums (a value
 // out of range is an error, never undefined behaviour). The header names each by its enum
 // (cbindgen.toml renames them).
