@@ -79,9 +79,9 @@ host() { # name, extra args...
     rm -rf "$dir"
     "$prefix/bin/umbrage-c-host" --scene default --size 320x200 --dump "$dir" --out "$dir.png" "$@" || return 1
     if [ -d "$dir/sample_0" ]; then
-        for s in "$dir"/sample_*; do ./target/debug/umbrage check "$s" || return 1; done
+        for s in "$dir"/sample_*; do ./target/debug/umbrage check --threshold 0 "$s" || return 1; done
     else
-        ./target/debug/umbrage check "$dir"
+        ./target/debug/umbrage check --threshold 0 "$dir"
     fi
 }
 for msaa in 1 4; do

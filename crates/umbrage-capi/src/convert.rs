@@ -15,6 +15,7 @@ use glam::{DMat4, DVec3, Mat4, Vec3};
 use std::ffi::{c_char, c_void, CStr};
 
 /// The ABI this library implements: `(major << 16) | minor`.
+#[allow(clippy::identity_op)]
 pub(crate) const ABI: u32 = (0 << 16) | 1;
 
 /// Refuses a NULL pointer argument.

@@ -26,6 +26,7 @@ use types::*;
 
 /// The ABI version the header declares: `(major << 16) | minor`. A host passes it in
 /// `UmbragePassCreateInfo::abiVersion`; while the major is 0 the minor must match exactly.
+#[allow(clippy::identity_op)]
 pub const UMBRAGE_ABI_VERSION: u32 = (0 << 16) | 1;
 
 const _: () = assert!(UMBRAGE_ABI_VERSION == convert::ABI);
@@ -122,14 +123,16 @@ pub unsafe extern "C" fn umbrage_pass_create(
         }
         // SAFETY: a non-zero address the host gave as its vkGetInstanceProcAddr (a function
         // pointer and usize have one size on every target Rust's Vulkan bindings support).
-        let gipa: ash::vk::PFN_vkGetInstanceProcAddr = unsafe { std::mem::transmute::<usize, _>(vulkan.pfnGetInstanceProcAddr) };
+        let gipa: ash::vk::PFN_vkGetInstanceProcAddr =
+            unsafe { std::mem::transmute::<usize, ash::vk::PFN_vkGetInstanceProcAddr>(vulkan.pfnGetInstanceProcAddr) };
         let static_fn = ash::StaticFn { get_instance_proc_addr: gipa };
         // SAFETY: the host's live instance and its loader.
         let instance = unsafe { ash::Instance::load(&static_fn, vulkan.instance) };
         let mut instance_fn = instance.fp_v1_0().clone();
         if vulkan.pfnGetDeviceProcAddr != 0 {
             // SAFETY: as above, the host's vkGetDeviceProcAddr.
-            instance_fn.get_device_proc_addr = unsafe { std::mem::transmute::<usize, _>(vulkan.pfnGetDeviceProcAddr) };
+            instance_fn.get_device_proc_addr =
+                unsafe { std::mem::transmute::<usize, ash::vk::PFN_vkGetDeviceProcAddr>(vulkan.pfnGetDeviceProcAddr) };
         }
         // SAFETY: the host's live device, created on `physicalDevice` of `instance`.
         let device = unsafe { ash::Device::load(&instance_fn, vulkan.device) };
