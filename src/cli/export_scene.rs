@@ -29,7 +29,10 @@ pub fn export_scene(spec: &str, out: &Path) -> Result<()> {
     let _ = writeln!(s, "camera {} {} {} {} {}", v(c.eye), v(c.target), v(c.up), c.fov_y_deg, c.near);
     for (i, l) in scene.lights.iter().enumerate() {
         if l.area.is_some() {
-            return Err(Error::input(spec, format!("light {i} is an area light: the scene export has point, spot and directional lights only")));
+            return Err(Error::input(
+                spec,
+                format!("light {i} is an area light: the scene export has point, spot and directional lights only"),
+            ));
         }
         let kind = match l.kind {
             LightKind::Point => "point",

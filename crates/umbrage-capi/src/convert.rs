@@ -356,7 +356,7 @@ pub unsafe fn mesh(info: &UmbrageCasterInfo) -> Result<engine::geom::Mesh, CErro
     if ni > 0 {
         non_null(info.pIndices, "UmbrageCasterInfo::pIndices")?;
     }
-    if ni % 3 != 0 {
+    if !ni.is_multiple_of(3) {
         return Err(CError::argument("UmbrageCasterInfo::indexCount", format!("{ni} is not a multiple of 3")));
     }
     let positions: Vec<Vec3> = if nv == 0 {
