@@ -25,8 +25,10 @@ done
 ./scripts/capi-tools.sh
 cargo_features=()
 [ -n "$features" ] && cargo_features=(--features "$features")
-# The dev profile (opt-level 2, Cargo.toml): one build of the engine shared with the tests.
-cargo cinstall -p umbrage-capi --profile dev --prefix "$prefix" --libdir lib "${cargo_features[@]}"
+# The dev profile (opt-level 2, Cargo.toml), in a target directory of its own: cargo-c builds
+# with --target and its own flags, and sharing target/ would rebuild the host-side build
+# dependencies of every other build each time.
+CARGO_TARGET_DIR="$PWD/target/capi-build" cargo cinstall -p umbrage-capi --profile dev --prefix "$prefix" --libdir lib "${cargo_features[@]}"
 
 # The scenes, in the flat format C reads (`umbrage export-scene`).
 mkdir -p "$prefix/share/umbrage/scenes"
