@@ -32,7 +32,7 @@ CARGO_TARGET_DIR="$PWD/target/capi-build" cargo cinstall -p umbrage-capi --profi
 
 # The scenes, in the flat format C reads (`umbrage export-scene`).
 mkdir -p "$prefix/share/umbrage/scenes"
-cargo build --quiet --bin umbrage --no-default-features --features cli
+cargo build --quiet -p umbrage-cli --bin umbrage
 for s in default; do
     ./target/debug/umbrage export-scene "$s" "$prefix/share/umbrage/scenes/$s.scene"
 done
