@@ -3,7 +3,7 @@
 export PATH := $(HOME)/.cargo/bin:$(PATH)
 CARGO ?= cargo
 
-.PHONY: deps deps-tests drivers lint run view test docs-unchanged bench conform conform-docs conform-matrix doc clean fuzz
+.PHONY: capi capi-test deps deps-tests drivers lint run view test docs-unchanged bench conform conform-docs conform-matrix doc clean fuzz
 
 # The loader, a driver and the tools; then Mesa lavapipe 25.0.7 in .drivers/ (ray query,
 # Vulkan 1.4) beside the system's driver, for `--method rayquery` (a warning if it cannot be had).
@@ -45,6 +45,7 @@ test: deps-tests lint
 	$(CARGO) build -p umbrage --lib
 	UMBRAGE_VALIDATION=1 $(CARGO) run -p umbrage-minimal --example minimal
 	eval "$$(./scripts/drivers.sh env swiftshader)" && UMBRAGE_VALIDATION=1 $(CARGO) run -p umbrage-minimal --example minimal
+	./scripts/capi-test.sh
 	$(MAKE) doc
 
 # What the test run decides (accuracy cells, transmittance errors, fragment counts, the coverage
@@ -59,6 +60,17 @@ docs-unchanged:
 lint:
 	$(CARGO) fmt --all --check
 	$(CARGO) clippy --workspace --all-targets -- -D warnings
+
+# The C ABI (docs/c-api.md): cargo-c installs it into target/capi/ (header, libumbrage.so and .a,
+# umbrage.pc); the C and C++ hosts are built against that install with pkg-config:
+# target/capi/bin/umbrage-c-host and umbrage-cpp-host. SANITIZE=1: both with ASan and UBSan.
+capi:
+	./scripts/capi-build.sh $(if $(SANITIZE),--sanitize)
+
+# The C ABI's tests: header drift and compilers, exported symbols, the contract from C, the C
+# host against `umbrage check`, ASan/UBSan and valgrind (scripts/capi-test.sh).
+capi-test:
+	./scripts/capi-test.sh
 
 doc:
 	RUSTDOCFLAGS="-D warnings" $(CARGO) doc --workspace --no-deps

@@ -117,6 +117,11 @@ else
     xvfb xauth xdotool libxkbcommon-x11-0 libxcursor1 libxrandr2 libxi6 libx11-xcb1; do
     have_pkg "$p" || need+=("$p")
   done
+  # make test's C ABI checks: the Vulkan headers the C hosts include, clang beside gcc for the
+  # header's language-standard matrix, pkg-config for the installed umbrage.pc, valgrind.
+  if [ $tests = 1 ]; then
+    for p in libvulkan-dev clang pkg-config valgrind; do have_pkg "$p" || need+=("$p"); done
+  fi
   if ! command -v cc >/dev/null 2>&1 || ! command -v c++ >/dev/null 2>&1; then need+=(build-essential); fi  # meshopt builds C++
   if ! command -v curl >/dev/null 2>&1 && ! command -v cargo >/dev/null 2>&1; then need+=(curl ca-certificates); fi
 

@@ -11,6 +11,9 @@ use umbrage_render::{Counter, DepthMode, IndexFormat, RenderOptions, Renderer, T
 mod bench_cli;
 #[path = "cli/pipelines.rs"]
 mod pipelines_cli;
+// `umbrage export-scene`: a scene in the flat text format the C host reads.
+#[path = "cli/export_scene.rs"]
+mod export_scene_cli;
 
 #[derive(Parser)]
 #[command(name = "umbrage", version, about = "Exact hard shadows with stencil shadow volumes on Vulkan, measured against a CPU reference")]
@@ -220,6 +223,14 @@ enum Command {
     /// Speed against error: every method on each scene, side by side on this device; with
     /// `--suite fill-vertex`, the fill-rate vs vertex-rate suite against the device's limits.
     Bench(bench_cli::BenchArgs),
+    /// Write a scene (built-in name or TOML file) in the flat text format C hosts read
+    /// (docs/c-api.md).
+    ExportScene {
+        /// Built-in scene name or scene file.
+        scene: String,
+        /// Output file.
+        out: PathBuf,
+    },
     /// Compare a frame dump with the exact CPU reference.
     Check {
         dir: PathBuf,
@@ -340,6 +351,7 @@ fn main() -> ExitCode {
         Command::Info { pipelines: true, .. } => info_pipelines(),
         Command::Info { json, scene, .. } => info(json, scene.as_deref()),
         Command::Check { dir, band, threshold } => check(&dir, band, threshold),
+        Command::ExportScene { scene, out } => export_scene_cli::export_scene(&scene, &out).map(|()| ExitCode::SUCCESS),
         Command::Bench(args) => bench_cli::bench_command(args),
         Command::Conform { out, filter, list, junit, device, no_isolate, timeout, jobs, expect, child, child_result } => {
             umbrage_conform::run(umbrage_conform::RunArgs {

@@ -1,0 +1,116 @@
+#!/usr/bin/env bash
+# The C ABI's tests (issue 53), as `make capi-test` and `make test` run them:
+#  1. the header regenerated with the pinned cbindgen equals the committed one, and compiles as
+#     C99/C11/C17/C++11/C++17/C++20 with gcc and clang (scripts/capi-header-check.sh);
+#  2. the Rust side's unit tests (result codes one to one, panics caught, messages);
+#  3. make capi: the install (header, libumbrage.so with its soname, .a, umbrage.pc) and the hosts
+#     built against it; only umbrage_* symbols exported; no Vulkan loader linked;
+#  4. the contract from C against a test build (--features test-panic, its own prefix);
+#  5. the C host exact against `umbrage check` on the default scene: 1 and 4 samples, forward and
+#     reverse-Z, dynamic rendering and a render pass, validation on; the C++ host;
+#  6. the hosts under ASan/UBSan (make capi SANITIZE=1), then the C host once under valgrind
+#     (scripts/valgrind-driver.supp for the driver's own allocations).
+# Prints "N passed, M failed" at the end; exits non-zero on any failure. A missing Vulkan device
+# fails (the checks are not skipped).
+set -uo pipefail
+cd "$(dirname "$0")/.."
+export PATH="$HOME/.cargo/bin:$PATH"
+export UMBRAGE_VALIDATION=1
+passed=0
+failed=0
+step() { # name, command...
+    local name=$1
+    shift
+    echo "=== capi-test: $name"
+    if "$@"; then
+        passed=$((passed + 1))
+        echo "--- ok: $name"
+    else
+        failed=$((failed + 1))
+        echo "--- FAILED: $name"
+    fi
+}
+
+step "pinned cbindgen and cargo-c installed" ./scripts/capi-tools.sh
+step "header up to date, compiled in every language standard" ./scripts/capi-header-check.sh
+step "Rust unit tests (codes, panics, messages, layouts)" cargo test --quiet -p umbrage-capi --lib
+step "make capi (install and hosts)" ./scripts/capi-build.sh
+
+prefix=target/capi
+symbols() {
+    local bad
+    bad=$(nm -D --defined-only "$prefix/lib/libumbrage.so" | awk '$2 ~ /[TDBRVWiu]/ {print $3}' | grep -v '^umbrage_' || true)
+    if [ -n "$bad" ]; then
+        echo "exported symbols other than umbrage_*:"
+        echo "$bad" | head
+        return 1
+    fi
+    if nm -D --undefined-only "$prefix/lib/libumbrage.so" | grep -q ' vk[A-Z]'; then
+        echo "libumbrage.so imports Vulkan symbols: it must load them from the host's vkGetInstanceProcAddr"
+        return 1
+    fi
+    if readelf -d "$prefix/lib/libumbrage.so" | grep -q 'libvulkan'; then
+        echo "libumbrage.so links the Vulkan loader"
+        return 1
+    fi
+    readelf -d "$prefix/lib/libumbrage.so" | grep -q 'SONAME.*libumbrage\.so\.0\.1' || { echo "no versioned soname"; return 1; }
+    for f in include/umbrage/umbrage.h lib/libumbrage.a lib/pkgconfig/umbrage.pc; do
+        [ -f "$prefix/$f" ] || { echo "missing $prefix/$f"; return 1; }
+    done
+    PKG_CONFIG_PATH="$prefix/lib/pkgconfig" pkg-config --cflags --libs umbrage
+    echo "$(nm -D --defined-only "$prefix/lib/libumbrage.so" | grep -c ' umbrage_') umbrage_* symbols exported, nothing else"
+}
+step "install layout, soname, exported symbols, no loader" symbols
+
+contract() {
+    local p=target/capi-test
+    ./scripts/capi-build.sh --prefix "$PWD/$p" --features test-panic >/dev/null || return 1
+    local cflags libs
+    cflags=$(PKG_CONFIG_PATH="$p/lib/pkgconfig" pkg-config --cflags umbrage)
+    libs="$(PKG_CONFIG_PATH="$p/lib/pkgconfig" pkg-config --libs umbrage) -Wl,-rpath,$PWD/$p/lib"
+    cc -std=c99 -DUMBRAGE_TEST_PANIC -Wall -Wextra -Wpedantic -Werror -Wno-missing-field-initializers $cflags \
+        tests/capi/contract.c -o "$p/bin/contract" $libs -lvulkan -lm || return 1
+    "$p/bin/contract"
+}
+step "the contract from C (test-panic build)" contract
+
+host() { # name, extra args...
+    local dir=target/capi-out/$1
+    shift
+    rm -rf "$dir"
+    "$prefix/bin/umbrage-c-host" --scene default --size 320x200 --dump "$dir" --out "$dir.png" "$@" || return 1
+    if [ -d "$dir/sample_0" ]; then
+        for s in "$dir"/sample_*; do ./target/debug/umbrage check --threshold 0 "$s" || return 1; done
+    else
+        ./target/debug/umbrage check --threshold 0 "$dir"
+    fi
+}
+for msaa in 1 4; do
+    for z in "" --reverse-z; do
+        for model in "" --render-pass; do
+            name="c-host-${msaa}x${z:+-reverse-z}${model:+-render-pass}"
+            step "$name exact against umbrage check" host "$name" --msaa "$msaa" $z $model
+        done
+    done
+done
+step "C++ host (RAII wrapper)" "$prefix/bin/umbrage-cpp-host" --scene default
+
+sanitize() {
+    ./scripts/capi-build.sh --sanitize >/dev/null || return 1
+    # the driver's own leaks are not ours: leak checks stay on, the ASan runtime reports them
+    ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 host c-host-asan --msaa 4 || return 1
+    ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=halt_on_error=1 "$prefix/bin/umbrage-cpp-host" --scene default
+}
+step "hosts under ASan and UBSan" sanitize
+# Back to the plain hosts for valgrind (ASan's runtime and valgrind do not mix).
+step "make capi again (plain hosts)" ./scripts/capi-build.sh
+valgrind_run() {
+    command -v valgrind >/dev/null || { echo "valgrind not installed (apt-get install valgrind)"; return 1; }
+    UMBRAGE_VALIDATION=0 valgrind --error-exitcode=99 --keep-debuginfo=yes --leak-check=full --errors-for-leak-kinds=definite \
+        --suppressions=scripts/valgrind-driver.supp \
+        "$prefix/bin/umbrage-c-host" --scene default --size 64x40 --frames 2 --dump target/capi-out/valgrind
+}
+step "C host under valgrind (no definite leaks beyond the driver's)" valgrind_run
+
+echo "capi-test: $passed passed, $failed failed"
+[ "$failed" = 0 ]
