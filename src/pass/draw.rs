@@ -12,7 +12,10 @@ use glam::{Mat4, Vec3, Vec4};
 pub(crate) struct Draw {
     /// The chunk's dual-length vertex buffer.
     pub vertices: vk::Buffer,
-    /// Byte offset of the indices (or naive vertices) in the frame's stream.
+    /// The kept buffer the indices (or naive vertices) are in ([`super::keep`]); `None`: the
+    /// frame's stream.
+    pub kept: Option<vk::Buffer>,
+    /// Byte offset of the indices (or naive vertices) in the frame's stream (or kept buffer).
     pub offset: u64,
     pub count: u32,
     pub format: IndexFormat,

@@ -195,12 +195,27 @@ pub struct Totals {
     /// [`mesh_meshlets`](Self::mesh_meshlets) without a task stage, only the meshlets that
     /// emit something with it ([`PassToggles::mesh_task`](super::PassToggles::mesh_task)).
     pub mesh_workgroups: u64,
+    /// Light–caster pairs drawn this frame (not culled; analytic spheres not counted):
+    /// `pairs_kept + pairs_replanned`.
+    pub pairs_total: u64,
+    /// Pairs planned this frame (every drawn pair without [`PassSettings::keep`](super::PassSettings::keep)).
+    pub pairs_replanned: u64,
+    /// Pairs drawn from index lists kept from an earlier frame (no planning, 0 bytes sent).
+    pub pairs_kept: u64,
+    /// Bytes of index lists kept across frames, resident after this frame.
+    pub kept_bytes: u64,
+    /// Kept pairs dropped this frame: evicted past the budget, or their caster moved, changed
+    /// or went.
+    pub kept_evictions: u64,
 }
 
 #[derive(Clone, Debug, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 /// CPU time of a frame by stage, ms.
 pub struct CpuMs {
+    /// With [`PassSettings::keep`](super::PassSettings::keep): culling, the cases and the
+    /// kept lists' look-ups (without it this work is inside `plan`).
+    pub cull: f64,
     /// Facing bits and possible silhouettes.
     pub silhouettes: f64,
     /// Culling, cases and index emission.
