@@ -15,6 +15,12 @@
 //! whose case changes is planned for its new case, and both lists stay kept. A light's range
 //! and cone only cull: a spot light turning keeps its pairs.
 //!
+//! **What moves is not kept.** A pair whose light or caster moved since the previous frame
+//! (the light of the same index in the previous frame's list; a caster whose pose changed) is
+//! planned into the frame's stream, as without keeping, and kept once both stand still: a
+//! moving light or character costs what it costs without keeping, and no buffer is made for
+//! lists drawn once.
+//!
 //! **Memory.** Each kept pair has its own host-visible index buffer, written once when it is
 //! planned (those are the frame's only bytes sent for it). Over
 //! [`ShadowPassDesc::keep_budget_bytes`](super::ShadowPassDesc::keep_budget_bytes), the least
@@ -46,9 +52,9 @@ use std::time::Instant;
 /// The default [`ShadowPassDesc::keep_budget_bytes`](super::ShadowPassDesc::keep_budget_bytes): 64 MiB.
 pub const DEFAULT_KEEP_BUDGET: u64 = 64 << 20;
 
-/// Below this many pairs to plan, a frame plans them on the calling thread (starting threads
-/// costs more than the work).
-const PARALLEL_MIN_PAIRS: usize = 8;
+/// Below this many caster triangles to plan, a frame plans them on the calling thread
+/// (starting a thread costs tens of microseconds: about the planning of 50k triangles).
+const PARALLEL_MIN_TRIANGLES: usize = 100_000;
 
 /// What a kept pair's lists are keyed by (see the module docs).
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
@@ -126,6 +132,8 @@ pub(crate) struct Kept {
     grid: grid::Grid,
     /// The casters the grid was built for, with their poses.
     grid_casters: Vec<(CasterId, u64)>,
+    /// The previous frame's lights' keys, in its order.
+    prev_lights: Vec<[u32; 4]>,
 }
 
 /// What one frame's keeping reads.
@@ -151,6 +159,9 @@ struct Miss {
     caster: usize,
     key: Key,
     l_obj: Vec4,
+    /// Neither the light nor the caster moved since the previous frame (a pair that moves is
+    /// drawn from the stream: keeping it would cost a buffer used once).
+    keep: bool,
 }
 
 /// A pair planned this frame: its plan, and its lists serialised from offset 0.
@@ -205,11 +216,17 @@ impl Kept {
     }
 
     /// Drops the kept pairs of casters removed or changed since the last frame, and keeps the
-    /// spatial index up to date. Returns the pairs dropped.
-    fn follow_casters(&mut self, table: &CasterTable, all_slots: u64) -> u64 {
+    /// spatial index up to date. Returns the pairs dropped, and per caster whether it moved
+    /// since the last frame.
+    fn follow_casters(&mut self, table: &CasterTable, all_slots: u64) -> (u64, Vec<bool>) {
         let now: Vec<(CasterId, u64)> = table.live.iter().map(|g| (g.id, g.pose)).collect();
         let mut evicted = 0;
+        let mut moved = vec![false; now.len()];
         if now != self.grid_casters {
+            let before: HashMap<CasterId, u64> = self.grid_casters.iter().copied().collect();
+            for (m, (id, pose)) in moved.iter_mut().zip(&now) {
+                *m = before.get(id).is_some_and(|p| p != pose);
+            }
             let live: HashMap<CasterId, u64> = now.iter().copied().collect();
             let stale: Vec<Key> = self.entries.keys().filter(|k| live.get(&k.caster) != Some(&k.pose)).cloned().collect();
             for k in stale {
@@ -234,7 +251,7 @@ impl Kept {
             let bounds: Vec<_> = table.cpu.iter().map(|c| c.world_bounds()).collect();
             self.grid.rebuild(&bounds);
         }
-        evicted
+        (evicted, moved)
     }
 
     /// Evicts the least recently drawn pairs not drawn by this frame until `need` more bytes
@@ -263,7 +280,9 @@ impl Kept {
     pub fn plan_frame(&mut self, dev: &PassDevice, table: &CasterTable, input: &KeepInput) -> Result<(Vec<KeptLight>, KeepStats)> {
         let t0 = Instant::now();
         self.frame += 1;
-        let mut stats = KeepStats { active: true, evictions: self.follow_casters(table, input.all_slots), ..KeepStats::default() };
+        let (evictions, caster_moved) = self.follow_casters(table, input.all_slots);
+        let mut stats = KeepStats { active: true, evictions, ..KeepStats::default() };
+        let light_keys: Vec<[u32; 4]> = input.lights.iter().map(|l| l.homogeneous().to_array().map(f32::to_bits)).collect();
         let opts = PlanOptions { edge_quads: false, case_per_part: true, gpu_silhouettes: false, no_culling: input.no_culling };
         let n = table.cpu.len();
         let mut lights: Vec<KeptLight> = Vec::with_capacity(input.lights.len());
@@ -286,7 +305,9 @@ impl Kept {
                 (LightKind::Directional, _, _) | (_, None, _) | (_, _, true) => None,
                 (_, Some(r), false) => self.grid.query(Some((light.position - Vec3::splat(r), light.position + Vec3::splat(r)))),
             };
-            let light_bits = ctx.light_h().to_array().map(f32::to_bits);
+            let light_bits = light_keys[li];
+            // moved since the previous frame (the light of the same index): not kept until it stands still
+            let light_moved = self.prev_lights.get(li).is_some_and(|p| *p != light_bits);
             let mut casters = Vec::with_capacity(n);
             let mut draws: Vec<Option<ChunkDraws>> = Vec::with_capacity(n);
             for (ci, caster) in table.cpu.iter().enumerate() {
@@ -320,7 +341,7 @@ impl Kept {
                     }
                     None => {
                         let m = *first_miss.entry(key.clone()).or_insert_with(|| {
-                            misses.push(Miss { light: li, caster: ci, key, l_obj });
+                            misses.push(Miss { light: li, caster: ci, key, l_obj, keep: !light_moved && !caster_moved[ci] });
                             misses.len() - 1
                         });
                         pending.push((li, casters.len(), m));
@@ -353,14 +374,26 @@ impl Kept {
             Planned { plan, bytes, draws }
         };
         let threads = input.threads.max(1).min(misses.len().max(1));
-        let planned: Vec<Planned> = if threads <= 1 || misses.len() < PARALLEL_MIN_PAIRS {
+        let work: Vec<usize> = misses.iter().map(|m| table.cpu[m.caster].triangle_count.max(1)).collect();
+        let total: usize = work.iter().sum();
+        let planned: Vec<Planned> = if threads <= 1 || total < PARALLEL_MIN_TRIANGLES {
             let mut scratch = PlanScratch::default();
             misses.iter().map(|m| job(m, &mut scratch)).collect()
         } else {
-            let per = misses.len().div_ceil(threads);
+            // contiguous runs of about equal triangle counts, one a thread
+            let mut parts: Vec<&[Miss]> = Vec::with_capacity(threads);
+            let (mut start, mut acc) = (0, 0);
+            for (i, w) in work.iter().enumerate() {
+                acc += w;
+                if acc * threads >= total * (parts.len() + 1) && parts.len() + 1 < threads {
+                    parts.push(&misses[start..=i]);
+                    start = i + 1;
+                }
+            }
+            parts.push(&misses[start..]);
             std::thread::scope(|s| {
-                let workers: Vec<_> = misses
-                    .chunks(per)
+                let workers: Vec<_> = parts
+                    .into_iter()
                     .map(|part| {
                         let job = &job;
                         s.spawn(move || {
@@ -381,7 +414,7 @@ impl Kept {
         for (m, p) in misses.into_iter().zip(planned) {
             let Planned { mut plan, bytes, mut draws } = p;
             let size = (bytes.len() as u64).max(16);
-            if !self.make_room(size, input.budget, input.all_slots, &mut stats.evictions) {
+            if !m.keep || !self.make_room(size, input.budget, input.all_slots, &mut stats.evictions) {
                 kept.push(None);
                 plans.push(plan);
                 continue;
@@ -425,6 +458,7 @@ impl Kept {
         }
         stats.plan_ms = t1.elapsed().as_secs_f64() * 1e3;
         stats.kept_bytes = self.bytes;
+        self.prev_lights = light_keys;
         Ok((lights, stats))
     }
 }
