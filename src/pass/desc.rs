@@ -376,7 +376,12 @@ pub struct PassSettings {
     /// from the lists): a pair whose light, caster and case did not change is drawn from the
     /// lists kept on the GPU, with no planning and 0 bytes sent. The same stencil either
     /// way. Off: every pair is planned from scratch every frame (and what was kept is
-    /// dropped). The budget is [`ShadowPassDesc::keep_budget_bytes`].
+    /// dropped). The budget is [`ShadowPassDesc::keep_budget_bytes`]. With it, a light of
+    /// bounded range meets only the casters a spatial index over their bounds finds in its
+    /// range (the others are culled unvisited), and a light's lists
+    /// ([`LightStats::casters`](super::stats::LightStats::casters), [`LightFrame::plan`](super::LightFrame::plan))
+    /// hold only the casters it draws: a frame costs the pairs that touch, not every light
+    /// times every caster.
     pub keep: bool,
 }
 

@@ -115,11 +115,15 @@ pub(crate) struct KeepStats {
     pub plan_ms: f64,
 }
 
-/// A light of a kept frame: its plan (the kept pairs' plans without index lists) and, per
-/// caster of the plan, the draws of a kept pair (`None`: culled, or drawn from the stream).
+/// A light of a kept frame: its plan (the kept pairs' plans without index lists; only the
+/// casters the light draws) and, per caster of the plan, the
+/// draws of a kept pair (`None`: culled, or drawn from the stream).
 pub(crate) struct KeptLight {
     pub plan: LightPlan,
     pub draws: Vec<Option<ChunkDraws>>,
+    /// Casters culled for the light (beyond its range by the spatial index, or by the
+    /// planner's tests): not in `plan`.
+    pub omitted: u64,
 }
 
 /// The pass's kept plans.
@@ -284,7 +288,7 @@ impl Kept {
         let mut stats = KeepStats { active: true, evictions, ..KeepStats::default() };
         let light_keys: Vec<[u32; 4]> = input.lights.iter().map(|l| l.homogeneous().to_array().map(f32::to_bits)).collect();
         let opts = PlanOptions { edge_quads: false, case_per_part: true, gpu_silhouettes: false, no_culling: input.no_culling };
-        let n = table.cpu.len();
+        let bounds: Vec<crate::geom::Aabb> = table.cpu.iter().map(|c| c.world_bounds()).collect();
         let mut lights: Vec<KeptLight> = Vec::with_capacity(input.lights.len());
         let mut misses: Vec<Miss> = Vec::new();
         // the first miss of each key this frame (two equal lights plan a pair once)
@@ -308,19 +312,18 @@ impl Kept {
             let light_bits = light_keys[li];
             // moved since the previous frame (the light of the same index): not kept until it stands still
             let light_moved = self.prev_lights.get(li).is_some_and(|p| *p != light_bits);
-            let mut casters = Vec::with_capacity(n);
-            let mut draws: Vec<Option<ChunkDraws>> = Vec::with_capacity(n);
+            let mut casters = Vec::new();
+            let mut draws: Vec<Option<ChunkDraws>> = Vec::new();
+            let mut omitted = 0;
             for (ci, caster) in table.cpu.iter().enumerate() {
                 if !self.grid.hit(q, ci) {
-                    // beyond the light's range: culled (its light_object is never drawn)
-                    casters.push(shadow::culled_caster_plan(ci, caster, Vec4::ZERO));
-                    draws.push(None);
+                    // beyond the light's range: culled, and left out of the light's lists
+                    omitted += 1;
                     continue;
                 }
-                let l_obj = shadow::avoid_vertex(caster, shadow::object_light(caster, ctx.light_h()));
-                let Some(cases) = ctx.caster_cases(&pi, &opts, caster) else {
-                    casters.push(shadow::culled_caster_plan(ci, caster, l_obj));
-                    draws.push(None);
+                let Some(cases) = ctx.caster_cases(&pi, &opts, caster, bounds[ci]) else {
+                    // culled (range, cone or view): left out too
+                    omitted += 1;
                     continue;
                 };
                 let g = &table.live[ci];
@@ -340,6 +343,7 @@ impl Kept {
                         stats.pairs_kept += 1;
                     }
                     None => {
+                        let l_obj = shadow::avoid_vertex(caster, shadow::object_light(caster, ctx.light_h()));
                         let m = *first_miss.entry(key.clone()).or_insert_with(|| {
                             misses.push(Miss { light: li, caster: ci, key, l_obj, keep: !light_moved && !caster_moved[ci] });
                             misses.len() - 1
@@ -351,7 +355,7 @@ impl Kept {
                 }
             }
             let (scissor, depth_bounds) = ctx.screen_bounds(&pi);
-            lights.push(KeptLight { plan: LightPlan { scissor, depth_bounds, casters, silhouette_ms: 0.0, plan_ms: 0.0 }, draws });
+            lights.push(KeptLight { plan: LightPlan { scissor, depth_bounds, casters, silhouette_ms: 0.0, plan_ms: 0.0 }, draws, omitted });
         }
         stats.cull_ms = t0.elapsed().as_secs_f64() * 1e3;
 

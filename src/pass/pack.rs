@@ -71,7 +71,11 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput, kept: Option<Vec<supe
     for (li, light) in input.lights.iter().enumerate() {
         // Each part (connected component) of a caster gets its own case; every draw carries it.
         let (mut plan, mut kept_draws) = match kept.as_mut().and_then(|k| k.next()) {
-            Some(k) => (k.plan, k.draws),
+            Some(k) => {
+                // the casters out of the light's range, left out of its lists
+                totals.cases.culled += k.omitted;
+                (k.plan, k.draws)
+            }
             None => {
                 let plan = shadow::plan_light_with(
                     &PlanInput { camera: &camera, width: view.width, height: view.height, view_proj, light, method },

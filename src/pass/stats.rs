@@ -142,7 +142,10 @@ pub struct LightStats {
     pub scissor: Option<[u32; 4]>,
     /// The light's depth bounds `[min, max]` when the device tests them.
     pub depth_bounds: Option<[f32; 2]>,
-    /// One entry per caster.
+    /// One entry per caster, in draw order; with [`PassSettings::keep`](super::PassSettings::keep)
+    /// only the casters the light draws (the culled ones are counted in [`Cases::culled`]; a
+    /// bounded light's casters out of range, found with a spatial index, are not even
+    /// visited).
     pub casters: Vec<CasterStats>,
     /// `zpass-clear`: the number of drawn volumes containing the eye (the stencil starts there).
     pub eye_volumes: Option<i32>,

@@ -498,8 +498,8 @@ impl LightContext {
     /// it is culled whole, else each part's case (culled parts `Case::Culled`), exactly as
     /// [`plan_light_with`] decides them. The rest of its plan ([`plan_caster`]) depends only on
     /// the light, the caster and these cases.
-    pub fn caster_cases(&self, input: &PlanInput, opts: &PlanOptions, caster: &Caster) -> Option<Vec<Case>> {
-        let wb = caster.world_bounds();
+    /// `wb` is the caster's [`world_bounds`](Caster::world_bounds).
+    pub fn caster_cases(&self, input: &PlanInput, opts: &PlanOptions, caster: &Caster, wb: Aabb) -> Option<Vec<Case>> {
         if self.culls(input, opts, &wb) {
             return None;
         }
