@@ -2,8 +2,8 @@
 //! kept across frames (`PassSettings::keep`) and without, while the camera walks, casters
 //! move or lights move. The numbers of `docs/frame-cost.md` come from here.
 //!
-//! Scenes: `bench/vertex` (36 casters, ~435k triangles, with its lights or `--lights N` made
-//! around it) and `level`, a level made in code: a grid of rooms (walls, pillars, crates and a
+//! Scenes: `vertex` (`bench/vertex`: 36 casters, ~435k triangles), any other built-in scene
+//! or scene file (each with its lights or `--lights N` made around it), and `level`, a level made in code: a grid of rooms (walls, pillars, crates and a
 //! character each; 1,088 casters at the default 8 x 8 rooms) with two bounded point or spot
 //! lights a room (128), the camera walking from room to room.
 //!
@@ -11,9 +11,9 @@
 //! [--rooms N] [--modes off,keep,keep1]`. Every frame's `prepare` is timed whole (wall clock)
 //! and split as the pass reports it (`cpu_ms`: cull, plan, record); medians over the frames
 //! after the first two (the first plans every pair: it is reported on its own as `cold`), of
-//! the calling thread's CPU time (`/proc/thread-self/schedstat`: what other processes run
+//! the calling thread's CPU time (`CLOCK_THREAD_CPUTIME_ID`: what other processes run
 //! meanwhile does not count, but with planning threads their share is not in it) and of the
-//! wall clock.
+//! wall clock. Linux, 64-bit.
 //! Each mode runs in its own pass, one after the other, on the calling thread (the keep
 //! modes' planning on `plan_threads` threads: `keep` every core, `keep1` one).
 
@@ -37,8 +37,10 @@ struct World {
     walk: Box<dyn Fn(usize) -> (Vec3, Vec3)>,
 }
 
-fn vertex(lights: Option<usize>) -> World {
-    let scene = umbrage::scene::load("bench/vertex").expect("bench/vertex loads");
+/// A built-in scene (or scene file) with its casters and lights (or `lights` made around it),
+/// the camera orbiting its target.
+fn scene_world(name: &str, lights: Option<usize>) -> World {
+    let scene = umbrage::scene::load(name).unwrap_or_else(|e| panic!("{name}: {e}"));
     let casters: Vec<(String, Mesh, DMat4)> =
         scene.meshes.iter().filter(|m| m.casts_shadow).map(|m| (m.name.clone(), m.mesh.clone(), m.transform.as_dmat4())).collect();
     let cam = scene.camera.clone();
@@ -152,13 +154,32 @@ struct Row {
     cold_ms: f64,
 }
 
-/// This thread's CPU time so far, ns (Linux: `/proc/thread-self/schedstat`; 0 elsewhere): what
-/// `prepare` costs the calling thread, whatever else the machine runs meanwhile.
+/// `struct timespec` of 64-bit Linux.
+#[repr(C)]
+struct Timespec {
+    tv_sec: i64,
+    tv_nsec: i64,
+}
+
+extern "C" {
+    /// POSIX `clock_gettime` (libc).
+    fn clock_gettime(clock: i32, tp: *mut Timespec) -> i32;
+}
+
+/// Linux's `CLOCK_THREAD_CPUTIME_ID`.
+const CLOCK_THREAD_CPUTIME_ID: i32 = 3;
+
+/// This thread's CPU time so far, ns: what `prepare` costs the calling thread, whatever else
+/// the machine runs meanwhile (0 where the clock fails).
 fn thread_cpu_ns() -> u64 {
-    std::fs::read_to_string("/proc/thread-self/schedstat")
-        .ok()
-        .and_then(|s| s.split_whitespace().next().and_then(|v| v.parse().ok()))
-        .unwrap_or(0)
+    let mut t = Timespec { tv_sec: 0, tv_nsec: 0 };
+    // SAFETY: `t` is a valid, writable timespec of this target's layout (64-bit Linux).
+    let r = unsafe { clock_gettime(CLOCK_THREAD_CPUTIME_ID, &mut t) };
+    if r == 0 {
+        t.tv_sec as u64 * 1_000_000_000 + t.tv_nsec as u64
+    } else {
+        0
+    }
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -260,7 +281,8 @@ fn main() {
     let scene = args.first().filter(|a| !a.starts_with("--")).cloned().unwrap_or_else(|| "vertex".into());
     let world = match scene.as_str() {
         "level" => level(rooms),
-        _ => vertex(lights),
+        "vertex" => scene_world("bench/vertex", lights),
+        name => scene_world(name, lights),
     };
     let ctx = umbrage::gpu::Context::new().expect("a Vulkan device");
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());

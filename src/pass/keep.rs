@@ -168,11 +168,11 @@ struct Miss {
     keep: bool,
 }
 
-/// A pair planned this frame: its plan, and its lists serialised from offset 0.
+/// A pair planned this frame: its plan, and its lists serialised from offset 0 (a pair to
+/// keep).
 struct Planned {
     plan: CasterPlan,
-    bytes: Vec<u8>,
-    draws: ChunkDraws,
+    lists: Option<(Vec<u8>, ChunkDraws)>,
 }
 
 impl Kept {
@@ -373,9 +373,13 @@ impl Kept {
             };
             let caster = &table.cpu[m.caster];
             let plan = shadow::plan_caster(&pi, &opts, (m.caster, caster), m.l_obj, &m.key.cases, scratch);
-            let mut bytes = Vec::new();
-            let draws = write_chunks(&mut bytes, (input.format, input.u8_ok), caster, &handles[m.caster], &plan);
-            Planned { plan, bytes, draws }
+            // (a pair that moves goes to the stream: `pack` writes it there)
+            let lists = m.keep.then(|| {
+                let mut bytes = Vec::new();
+                let draws = write_chunks(&mut bytes, (input.format, input.u8_ok), caster, &handles[m.caster], &plan);
+                (bytes, draws)
+            });
+            Planned { plan, lists }
         };
         let threads = input.threads.max(1).min(misses.len().max(1));
         let work: Vec<usize> = misses.iter().map(|m| table.cpu[m.caster].triangle_count.max(1)).collect();
@@ -416,9 +420,14 @@ impl Kept {
         let mut kept: Vec<Option<ChunkDraws>> = Vec::with_capacity(planned.len());
         let mut plans: Vec<CasterPlan> = Vec::with_capacity(planned.len());
         for (m, p) in misses.into_iter().zip(planned) {
-            let Planned { mut plan, bytes, mut draws } = p;
+            let Planned { mut plan, lists } = p;
+            let Some((bytes, mut draws)) = lists else {
+                kept.push(None);
+                plans.push(plan);
+                continue;
+            };
             let size = (bytes.len() as u64).max(16);
-            if !m.keep || !self.make_room(size, input.budget, input.all_slots, &mut stats.evictions) {
+            if !self.make_room(size, input.budget, input.all_slots, &mut stats.evictions) {
                 kept.push(None);
                 plans.push(plan);
                 continue;
@@ -453,12 +462,22 @@ impl Kept {
             };
             self.entries.insert(m.key, e);
         }
+        // (a plan drawn by one light is moved, not copied: its index lists may be long)
+        let mut uses = vec![0usize; plans.len()];
+        for &(_, _, m) in &pending {
+            uses[m] += 1;
+        }
+        let mut plans: Vec<Option<CasterPlan>> = plans.into_iter().map(Some).collect();
         for (li, k, m) in pending {
             let l = &mut lights[li];
-            let mut plan = plans[m].clone();
+            uses[m] -= 1;
+            let mut plan = match uses[m] {
+                0 => plans[m].take().unwrap_or_else(|| l.plan.casters[k].clone()),
+                _ => plans[m].clone().unwrap_or_else(|| l.plan.casters[k].clone()),
+            };
             plan.caster = l.plan.casters[k].caster;
             l.plan.casters[k] = plan;
-            l.draws[k] = kept[m].clone();
+            l.draws[k] = if uses[m] == 0 { kept[m].take() } else { kept[m].clone() };
         }
         stats.plan_ms = t1.elapsed().as_secs_f64() * 1e3;
         stats.kept_bytes = self.bytes;
