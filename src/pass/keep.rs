@@ -65,8 +65,77 @@ struct Key {
     pose: u64,
     method: Method,
     format: IndexFormat,
-    cases: Vec<Case>,
+    cases: CasesKey,
 }
+
+/// The parts' cases of a key: two bits a part up to 32 parts (no allocation for a look-up),
+/// else the list.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+enum CasesKey {
+    Packed { parts: u8, bits: u64 },
+    Long(Vec<Case>),
+}
+
+impl CasesKey {
+    fn new(cases: &[Case]) -> CasesKey {
+        if cases.len() > 32 {
+            return CasesKey::Long(cases.to_vec());
+        }
+        let bits = cases.iter().enumerate().fold(0u64, |b, (i, c)| {
+            let v = match c {
+                Case::Culled => 0u64,
+                Case::ZPass => 1,
+                Case::ZFail => 2,
+                Case::ZFailLightCap => 3,
+            };
+            b | v << (2 * i)
+        });
+        CasesKey::Packed { parts: cases.len() as u8, bits }
+    }
+}
+
+/// A multiply-rotate hasher (as rustc's FxHash) for the keys and the grid's cells: a look-up a
+/// drawn pair, every frame, where SipHash's resistance to chosen keys buys nothing.
+#[derive(Default, Clone, Copy)]
+pub(crate) struct Fx(u64);
+
+impl std::hash::Hasher for Fx {
+    #[inline]
+    fn write(&mut self, bytes: &[u8]) {
+        for c in bytes.chunks(8) {
+            let mut w = [0u8; 8];
+            w[..c.len()].copy_from_slice(c);
+            self.write_u64(u64::from_le_bytes(w));
+        }
+    }
+    #[inline]
+    fn write_u64(&mut self, v: u64) {
+        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+    #[inline]
+    fn write_u32(&mut self, v: u32) {
+        self.write_u64(v as u64);
+    }
+    #[inline]
+    fn write_u8(&mut self, v: u8) {
+        self.write_u64(v as u64);
+    }
+    #[inline]
+    fn write_usize(&mut self, v: usize) {
+        self.write_u64(v as u64);
+    }
+    #[inline]
+    fn write_isize(&mut self, v: isize) {
+        self.write_u64(v as u64);
+    }
+    #[inline]
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+/// [`Fx`]'s builder.
+pub(crate) type FxBuild = std::hash::BuildHasherDefault<Fx>;
 
 /// One kept pair.
 struct Entry {
@@ -129,7 +198,7 @@ pub(crate) struct KeptLight {
 /// The pass's kept plans.
 #[derive(Default)]
 pub(crate) struct Kept {
-    entries: HashMap<Key, Entry>,
+    entries: HashMap<Key, Entry, FxBuild>,
     bytes: u64,
     graves: Vec<Grave>,
     frame: u64,
@@ -162,6 +231,8 @@ struct Miss {
     light: usize,
     caster: usize,
     key: Key,
+    /// The parts' cases (the key holds them packed).
+    cases: Vec<Case>,
     l_obj: Vec4,
     /// Neither the light nor the caster moved since the previous frame (a pair that moves is
     /// drawn from the stream: keeping it would cost a buffer used once).
@@ -289,10 +360,11 @@ impl Kept {
         let light_keys: Vec<[u32; 4]> = input.lights.iter().map(|l| l.homogeneous().to_array().map(f32::to_bits)).collect();
         let opts = PlanOptions { edge_quads: false, case_per_part: true, gpu_silhouettes: false, no_culling: input.no_culling };
         let bounds: Vec<crate::geom::Aabb> = table.cpu.iter().map(|c| c.world_bounds()).collect();
+        let mut cases: Vec<Case> = Vec::new();
         let mut lights: Vec<KeptLight> = Vec::with_capacity(input.lights.len());
         let mut misses: Vec<Miss> = Vec::new();
         // the first miss of each key this frame (two equal lights plan a pair once)
-        let mut first_miss: HashMap<Key, usize> = HashMap::new();
+        let mut first_miss: HashMap<Key, usize, FxBuild> = HashMap::default();
         // per light and caster: the miss index of a pair planned this frame
         let mut pending: Vec<(usize, usize, usize)> = Vec::new();
         for (li, light) in input.lights.iter().enumerate() {
@@ -321,13 +393,20 @@ impl Kept {
                     omitted += 1;
                     continue;
                 }
-                let Some(cases) = ctx.caster_cases(&pi, &opts, caster, bounds[ci]) else {
+                if !ctx.caster_cases_into(&pi, &opts, caster, bounds[ci], &mut cases) {
                     // culled (range, cone or view): left out too
                     omitted += 1;
                     continue;
-                };
+                }
                 let g = &table.live[ci];
-                let key = Key { light: light_bits, caster: g.id, pose: g.pose, method: input.method, format: input.format, cases };
+                let key = Key {
+                    light: light_bits,
+                    caster: g.id,
+                    pose: g.pose,
+                    method: input.method,
+                    format: input.format,
+                    cases: CasesKey::new(&cases),
+                };
                 match self.entries.get_mut(&key) {
                     Some(e) => {
                         e.last_used = self.frame;
@@ -345,7 +424,14 @@ impl Kept {
                     None => {
                         let l_obj = shadow::avoid_vertex(caster, shadow::object_light(caster, ctx.light_h()));
                         let m = *first_miss.entry(key.clone()).or_insert_with(|| {
-                            misses.push(Miss { light: li, caster: ci, key, l_obj, keep: !light_moved && !caster_moved[ci] });
+                            misses.push(Miss {
+                                light: li,
+                                caster: ci,
+                                key,
+                                cases: cases.clone(),
+                                l_obj,
+                                keep: !light_moved && !caster_moved[ci],
+                            });
                             misses.len() - 1
                         });
                         pending.push((li, casters.len(), m));
@@ -372,7 +458,7 @@ impl Kept {
                 method: input.method,
             };
             let caster = &table.cpu[m.caster];
-            let plan = shadow::plan_caster(&pi, &opts, (m.caster, caster), m.l_obj, &m.key.cases, scratch);
+            let plan = shadow::plan_caster(&pi, &opts, (m.caster, caster), m.l_obj, &m.cases, scratch);
             // (a pair that moves goes to the stream: `pack` writes it there)
             let lists = m.keep.then(|| {
                 let mut bytes = Vec::new();

@@ -500,13 +500,26 @@ impl LightContext {
     /// the light, the caster and these cases.
     /// `wb` is the caster's [`world_bounds`](Caster::world_bounds).
     pub fn caster_cases(&self, input: &PlanInput, opts: &PlanOptions, caster: &Caster, wb: Aabb) -> Option<Vec<Case>> {
+        let mut cases = Vec::new();
+        self.caster_cases_into(input, opts, caster, wb, &mut cases).then_some(cases)
+    }
+
+    /// [`caster_cases`](Self::caster_cases) into `cases` (cleared first, left empty when the
+    /// caster is culled whole); whether it is drawn.
+    pub fn caster_cases_into(&self, input: &PlanInput, opts: &PlanOptions, caster: &Caster, wb: Aabb, cases: &mut Vec<Case>) -> bool {
+        cases.clear();
         if self.culls(input, opts, &wb) {
-            return None;
+            return false;
         }
-        let cases = part_cases(caster, wb, opts.case_per_part, &|b| self.culls(input, opts, b), |b| {
-            select_case(input.method, &self.pyramid, &self.frustum, b)
-        });
-        (!cases.iter().all(|&c| c == Case::Culled)).then_some(cases)
+        part_cases_into(
+            caster,
+            wb,
+            opts.case_per_part,
+            &|b| self.culls(input, opts, b),
+            |b| select_case(input.method, &self.pyramid, &self.frustum, b),
+            cases,
+        );
+        cases.iter().any(|&c| c != Case::Culled)
     }
 }
 
@@ -632,19 +645,30 @@ fn part_cases(
     culls: &dyn Fn(&Aabb) -> bool,
     select: impl Fn(&Aabb) -> Case,
 ) -> Vec<Case> {
+    let mut cases = Vec::with_capacity(caster.parts.len());
+    part_cases_into(caster, world_bounds, case_per_part, culls, select, &mut cases);
+    cases
+}
+
+/// [`part_cases`] into `cases` (cleared first).
+fn part_cases_into(
+    caster: &Caster,
+    world_bounds: Aabb,
+    case_per_part: bool,
+    culls: &dyn Fn(&Aabb) -> bool,
+    select: impl Fn(&Aabb) -> Case,
+    cases: &mut Vec<Case>,
+) {
     let single = caster.parts.len() == 1;
-    let mut cases: Vec<Case> = caster
-        .parts
-        .iter()
-        .map(|p| {
-            let pb = if single { world_bounds } else { p.object_bounds.transformed(&caster.transform) };
-            if !single && culls(&pb) {
-                Case::Culled
-            } else {
-                select(&pb)
-            }
-        })
-        .collect();
+    cases.clear();
+    cases.extend(caster.parts.iter().map(|p| {
+        let pb = if single { world_bounds } else { p.object_bounds.transformed(&caster.transform) };
+        if !single && culls(&pb) {
+            Case::Culled
+        } else {
+            select(&pb)
+        }
+    }));
     if !case_per_part {
         let mut live = cases.iter().copied().filter(|&c| c != Case::Culled);
         if let Some(first) = live.next() {
@@ -654,7 +678,6 @@ fn part_cases(
             }
         }
     }
-    cases
 }
 
 impl PartPlan {
