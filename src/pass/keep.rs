@@ -361,6 +361,9 @@ impl Kept {
         let opts = PlanOptions { edge_quads: false, case_per_part: true, gpu_silhouettes: false, no_culling: input.no_culling };
         let bounds: Vec<crate::geom::Aabb> = table.cpu.iter().map(|c| c.world_bounds()).collect();
         let mut cases: Vec<Case> = Vec::new();
+        let n = table.cpu.len();
+        let mut candidates: Vec<u32> = Vec::new();
+        let all: Vec<u32> = (0..n as u32).collect();
         let mut lights: Vec<KeptLight> = Vec::with_capacity(input.lights.len());
         let mut misses: Vec<Miss> = Vec::new();
         // the first miss of each key this frame (two equal lights plan a pair once)
@@ -377,22 +380,23 @@ impl Kept {
                 method: input.method,
             };
             let ctx = LightContext::new(&pi);
-            let q = match (light.kind, light.radius, input.no_culling) {
+            let reach = match (light.kind, light.radius, input.no_culling) {
                 (LightKind::Directional, _, _) | (_, None, _) | (_, _, true) => None,
-                (_, Some(r), false) => self.grid.query(Some((light.position - Vec3::splat(r), light.position + Vec3::splat(r)))),
+                (_, Some(r), false) => Some((light.position - Vec3::splat(r), light.position + Vec3::splat(r))),
             };
+            // the casters in the light's range (ascending: draw order), or every caster
+            let some = self.grid.query_into(reach, &mut candidates);
+            let omitted_unvisited = if some { (n - candidates.len()) as u64 } else { 0 };
+            let visit: &[u32] = if some { &candidates } else { &all };
             let light_bits = light_keys[li];
             // moved since the previous frame (the light of the same index): not kept until it stands still
             let light_moved = self.prev_lights.get(li).is_some_and(|p| *p != light_bits);
             let mut casters = Vec::new();
             let mut draws: Vec<Option<ChunkDraws>> = Vec::new();
-            let mut omitted = 0;
-            for (ci, caster) in table.cpu.iter().enumerate() {
-                if !self.grid.hit(q, ci) {
-                    // beyond the light's range: culled, and left out of the light's lists
-                    omitted += 1;
-                    continue;
-                }
+            // beyond the light's range: culled, not even visited, left out of the light's lists
+            let mut omitted = omitted_unvisited;
+            for &ci in visit {
+                let (ci, caster) = (ci as usize, &table.cpu[ci as usize]);
                 if !ctx.caster_cases_into(&pi, &opts, caster, bounds[ci], &mut cases) {
                     // culled (range, cone or view): left out too
                     omitted += 1;

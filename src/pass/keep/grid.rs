@@ -108,37 +108,54 @@ impl Grid {
 
     /// Marks the casters whose boxes may touch the box `min..max` (`None`: every caster) and
     /// returns the stamp they carry; [`Grid::hit`] then tells each one.
+    #[cfg(test)]
     pub fn query(&mut self, bounds: Option<(Vec3, Vec3)>) -> Option<u64> {
-        let (min, max) = bounds?;
+        let mut out = Vec::new();
+        self.query_into(bounds, &mut out).then_some(self.query)
+    }
+
+    /// The casters whose boxes may touch the box `min..max`, in ascending order, into `out`;
+    /// `false` (and `out` empty) where the query returns every caster (no bounds, or a box
+    /// over more cells than [`MAX_QUERY_CELLS`]).
+    pub fn query_into(&mut self, bounds: Option<(Vec3, Vec3)>, out: &mut Vec<u32>) -> bool {
+        out.clear();
+        let Some((min, max)) = bounds else { return false };
         if !(min.is_finite() && max.is_finite()) {
-            return None;
+            return false;
         }
         let margin = (max - min).abs() * 1e-4 + Vec3::splat(self.cell * 1e-3);
         let r = cell_range(&Aabb { min: min - margin, max: max + margin }, self.cell);
         if volume(r) > MAX_QUERY_CELLS {
-            return None;
+            return false;
         }
         self.query += 1;
         let q = self.query;
+        let mut mark = |c: u32, stamp: &mut [u64]| {
+            if stamp[c as usize] != q {
+                stamp[c as usize] = q;
+                out.push(c);
+            }
+        };
         for x in r.0.x..=r.1.x {
             for y in r.0.y..=r.1.y {
                 for z in r.0.z..=r.1.z {
                     if let Some(v) = self.cells.get(&IVec3::new(x, y, z)) {
                         for &c in v {
-                            self.stamp[c as usize] = q;
+                            mark(c, &mut self.stamp);
                         }
                     }
                 }
             }
         }
         for &c in &self.big {
-            self.stamp[c as usize] = q;
+            mark(c, &mut self.stamp);
         }
-        Some(q)
+        out.sort_unstable();
+        true
     }
 
     /// Whether caster `i` was returned by the query of stamp `q` (`None`: every caster).
-    #[inline]
+    #[cfg(test)]
     pub fn hit(&self, q: Option<u64>, i: usize) -> bool {
         q.is_none_or(|q| self.stamp[i] == q)
     }
