@@ -21,7 +21,7 @@ use glam::{DMat4, DVec3, Vec3};
 use std::time::Instant;
 use umbrage::geom::{Camera, Light, LightKind, Mesh};
 use umbrage::pass::{PassSettings, ShadowPass, ShadowPassDesc, ShadowView, Technique};
-use umbrage::scene::shapes;
+use umbrage_scene::shapes;
 use umbrage::shadow::Method;
 
 const W: u32 = 1280;
@@ -40,7 +40,7 @@ struct World {
 /// A built-in scene (or scene file) with its casters and lights (or `lights` made around it),
 /// the camera orbiting its target.
 fn scene_world(name: &str, lights: Option<usize>) -> World {
-    let scene = umbrage::scene::load(name).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let scene = umbrage_scene::load(name).unwrap_or_else(|e| panic!("{name}: {e}"));
     let casters: Vec<(String, Mesh, DMat4)> =
         scene.meshes.iter().filter(|m| m.casts_shadow).map(|m| (m.name.clone(), m.mesh.clone(), m.transform.as_dmat4())).collect();
     let cam = scene.camera.clone();

@@ -118,9 +118,7 @@ pub use draw::LightFrame;
 pub use frame::{PreparedFrame, MAX_CONE_DEG};
 pub use keep::DEFAULT_KEEP_BUDGET;
 pub use pipelines::COUNT_FORMAT;
-#[cfg(feature = "cli")]
-pub(crate) use rays::light_rel;
-pub use rays::{RayCounts, RayQueryFrame, RayQueryInputs};
+pub use rays::{light_rel, RayCounts, RayQueryFrame, RayQueryInputs};
 pub use record::{lit_stencil_state, VolumeKind};
 pub use spheres::{SphereId, SphereInfo};
 pub use target::DepthStencilTarget;
