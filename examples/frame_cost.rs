@@ -21,8 +21,8 @@ use glam::{DMat4, DVec3, Vec3};
 use std::time::Instant;
 use umbrage::geom::{Camera, Light, LightKind, Mesh};
 use umbrage::pass::{PassSettings, ShadowPass, ShadowPassDesc, ShadowView, Technique};
-use umbrage_scene::shapes;
 use umbrage::shadow::Method;
+use umbrage_scene::shapes;
 
 const W: u32 = 1280;
 const H: u32 = 720;

@@ -8,8 +8,8 @@ use ash::vk;
 use glam::{DMat4, DVec3, Vec3};
 use umbrage::geom::{Camera, Light, LightKind};
 use umbrage::pass::{PassSettings, PreparedFrame, ShadowPass, ShadowPassDesc, ShadowView, Technique};
-use umbrage_scene::shapes;
 use umbrage::shadow::Method;
+use umbrage_scene::shapes;
 
 fn pass(ctx: &umbrage::gpu::Context, desc: ShadowPassDesc) -> ShadowPass {
     let desc = ShadowPassDesc { depth_stencil_format: ctx.depth_format, frames_in_flight: 1, ..desc };

@@ -35,7 +35,7 @@ pub(super) fn pass_settings(s: &FrameSettings) -> PassSettings {
         counter: s.counter,
         index_format: s.index_format,
         toggles: s.toggles,
-        ..PassSettings::default()
+        keep: s.keep,
     }
 }
 
