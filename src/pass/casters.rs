@@ -69,6 +69,8 @@ pub(crate) struct GpuCaster {
     pub compute: Option<ComputeStatic>,
     /// Bumped by every `update_positions` (the ray-query bottom levels follow it).
     pub version: u64,
+    /// Bumped by every `set_transform` and `update_positions` (the kept plans follow it).
+    pub pose: u64,
 }
 
 /// Buffers waiting for the frames in flight that may use them to retire: bit `s` of `mask`
@@ -176,7 +178,7 @@ impl CasterTable {
         self.slots.push((0, Some(self.live.len())));
         let shells = shell_count(caster.mesh());
         self.cpu.push(caster);
-        self.live.push(GpuCaster { id, transform, shells, chunks, edge_quads: None, compute: None, version: 0 });
+        self.live.push(GpuCaster { id, transform, shells, chunks, edge_quads: None, compute: None, version: 0, pose: 0 });
         Ok(id)
     }
 
@@ -245,6 +247,7 @@ impl CasterTable {
         let chunks = self.upload_chunks(dev, &caster)?;
         let entry = &mut self.live[i];
         entry.version += 1;
+        entry.pose += 1;
         let mut old: Vec<Buffer> = std::mem::replace(&mut entry.chunks, chunks);
         if let Some(eq) = entry.edge_quads.take() {
             old.push(eq.vertices);
@@ -538,6 +541,7 @@ impl super::ShadowPass {
         check_transform(&self.casters.cpu[i].name, &transform)?;
         self.casters.cpu[i].set_transform(transform.as_mat4());
         self.casters.live[i].transform = transform;
+        self.casters.live[i].pose += 1;
         Ok(())
     }
 

@@ -285,6 +285,13 @@ pub struct ShadowPassDesc {
     /// destroys it. A driver whose compiler is slow (SwiftShader) then compiles each pipeline
     /// once per cache, not once per pass.
     pub pipeline_cache: vk::PipelineCache,
+    /// The most bytes of index lists kept across frames ([`PassSettings::keep`]); past it
+    /// the least recently drawn pairs are evicted. Default 64 MiB; 0 keeps nothing.
+    pub keep_budget_bytes: u64,
+    /// Threads that plan a frame's changed pairs (with [`PassSettings::keep`]): 0 (the
+    /// default) uses every core (`std::thread::available_parallelism`), 1 plans on the
+    /// calling thread.
+    pub plan_threads: usize,
 }
 
 impl ShadowPassDesc {
@@ -342,12 +349,14 @@ impl Default for ShadowPassDesc {
             transmit_format: None,
             debug_color_format: None,
             pipeline_cache: vk::PipelineCache::null(),
+            keep_budget_bytes: super::keep::DEFAULT_KEEP_BUDGET,
+            plan_threads: 0,
         }
     }
 }
 
 /// What may change from one frame to the next.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PassSettings {
     /// Volumes with a case rule, or edge quads.
     pub technique: Technique,
@@ -360,6 +369,31 @@ pub struct PassSettings {
     /// The paper's constant-factor optimisations, each of which can be switched off to
     /// measure what it saves (all on by default).
     pub toggles: PassToggles,
+    /// Keep each light–caster pair's plan and index lists across frames (on by default) with
+    /// the CPU-planned techniques ([`Technique::Volumes`], but not
+    /// [`Method::ZPassClear`](crate::shadow::Method::ZPassClear), whose clear value counts
+    /// from the lists): a pair whose light, caster and case did not change is drawn from the
+    /// lists kept on the GPU, with no planning and 0 bytes sent. The same stencil either
+    /// way. Off: every pair is planned from scratch every frame (and what was kept is
+    /// dropped). The budget is [`ShadowPassDesc::keep_budget_bytes`]. With it, a light of
+    /// bounded range meets only the casters a spatial index over their bounds finds in its
+    /// range (the others are culled unvisited), and a light's lists
+    /// ([`LightStats::casters`](super::stats::LightStats::casters), [`LightFrame::plan`](super::LightFrame::plan))
+    /// hold only the casters it draws: a frame costs the pairs that touch, not every light
+    /// times every caster.
+    pub keep: bool,
+}
+
+impl Default for PassSettings {
+    fn default() -> Self {
+        PassSettings {
+            technique: Technique::default(),
+            counter: Counter::default(),
+            index_format: IndexFormat::default(),
+            toggles: PassToggles::default(),
+            keep: true,
+        }
+    }
 }
 
 /// The per-light optimisations McGuire et al. claim constant factors for; switching one off

@@ -12,7 +12,10 @@ use glam::{Mat4, Vec3, Vec4};
 pub(crate) struct Draw {
     /// The chunk's dual-length vertex buffer.
     pub vertices: vk::Buffer,
-    /// Byte offset of the indices (or naive vertices) in the frame's stream.
+    /// The kept buffer the indices (or naive vertices) are in ([`super::keep`]); `None`: the
+    /// frame's stream.
+    pub kept: Option<vk::Buffer>,
+    /// Byte offset of the indices (or naive vertices) in the frame's stream (or kept buffer).
     pub offset: u64,
     pub count: u32,
     pub format: IndexFormat,
@@ -60,7 +63,9 @@ pub struct LightFrame {
     pub depth_bounds: Option<(f32, f32)>,
     /// What `--stats` reports for this light.
     pub stats: LightStats,
-    /// The plan as the planner made it (cases, silhouettes, counts per caster).
+    /// The plan as the planner made it (cases, silhouettes, counts per caster). With
+    /// [`PassSettings::keep`](super::PassSettings::keep): the casters the light draws only,
+    /// and a kept pair's plan without its index lists (they are on the GPU).
     pub plan: LightPlan,
     /// The value the determination clears the counter to inside the scissor: 0, or with
     /// [`Method::ZPassClear`](crate::shadow::Method) the number of volumes containing the eye.

@@ -93,6 +93,7 @@ pub mod diagnostics;
 mod draw;
 mod eye;
 mod frame;
+mod keep;
 mod mesh;
 mod mesh_pipes;
 mod pack;
@@ -115,6 +116,7 @@ pub use desc::{
 };
 pub use draw::LightFrame;
 pub use frame::{PreparedFrame, MAX_CONE_DEG};
+pub use keep::DEFAULT_KEEP_BUDGET;
 pub use pipelines::COUNT_FORMAT;
 pub use rays::{light_rel, RayCounts, RayQueryFrame, RayQueryInputs};
 pub use record::{lit_stencil_state, VolumeKind};
@@ -180,6 +182,8 @@ pub struct ShadowPass {
     rays: Option<rays::Rays>,
     /// The G-buffer the rays read ([`ShadowPass::set_ray_query_inputs`]).
     ray_inputs: Option<RayQueryInputs>,
+    /// The plans kept across frames ([`PassSettings::keep`]).
+    kept: keep::Kept,
 }
 
 /// The id of the next pass created.
@@ -264,6 +268,7 @@ impl ShadowPass {
             instance: instance.clone(),
             rays: None,
             ray_inputs: None,
+            kept: keep::Kept::default(),
         })
     }
 
@@ -439,6 +444,7 @@ impl ShadowPass {
             b.destroy(&self.dev);
         }
         self.casters.slot_retired(&self.dev, slot);
+        self.kept.slot_retired(&self.dev, slot);
         if let Some(r) = &mut self.rays {
             r.slot_retired(&self.dev, slot);
         }
@@ -456,6 +462,7 @@ impl ShadowPass {
         let (uploads, upload_bytes) = self.casters.carry_uploads(slot, recorded.load(Ordering::Acquire));
         let uploads_recorded = self.slots[slot].recorded.clone();
 
+        let (kept, keep_stats) = self.plan_kept(view, lights, casters)?;
         let packed = pack(
             &self.casters,
             &PackInput {
@@ -469,6 +476,7 @@ impl ShadowPass {
                 planar_receiver: self.planar_receiver,
                 spheres: &self.spheres,
             },
+            kept,
         );
         let record_start = Instant::now();
         let stream = self.write_stream(slot, &packed.stream)?;
@@ -495,6 +503,20 @@ impl ShadowPass {
         cpu.record = record_start.elapsed().as_secs_f64() * 1e3;
         let mut totals = packed.totals;
         totals.bytes_sent += upload_bytes;
+        totals.pairs_total =
+            packed.lights.iter().map(|l| l.plan.casters.iter().filter(|c| c.case != crate::shadow::Case::Culled).count() as u64).sum();
+        totals.pairs_replanned = totals.pairs_total;
+        totals.kept_bytes = self.kept.bytes();
+        if let Some(k) = keep_stats {
+            if k.active {
+                totals.pairs_kept = k.pairs_kept;
+                totals.pairs_replanned = k.pairs_replanned;
+                cpu.cull = k.cull_ms;
+                cpu.plan += k.plan_ms;
+            }
+            totals.kept_evictions = k.evictions;
+            totals.bytes_sent += k.bytes_written;
+        }
         if let Some(cf) = &compute {
             totals.silhouette_read_bytes = 16 * (cf.exact_capacity + cf.sil_capacity);
             if let Some(m) = &cf.merged {
@@ -524,6 +546,51 @@ impl ShadowPass {
     }
 }
 
+impl ShadowPass {
+    /// The frame's kept plans ([`PassSettings::keep`]) where the settings keep, with what the
+    /// keeping did; `None` where the frame plans from scratch (a technique that plans on the
+    /// GPU or not at all, `Method::ZPassClear`, keeping off, a zero budget, a culled frame).
+    fn plan_kept(
+        &mut self,
+        view: &ShadowView,
+        lights: &[Light],
+        casters: bool,
+    ) -> Result<(Option<Vec<keep::KeptLight>>, Option<keep::KeepStats>)> {
+        let all_slots = self.all_slots();
+        let method = match self.settings.technique {
+            Technique::Volumes(m) if m != crate::shadow::Method::ZPassClear => Some(m),
+            _ => None,
+        };
+        if !self.settings.keep || self.desc.keep_budget_bytes == 0 {
+            let evicted = self.kept.clear(all_slots);
+            return Ok((None, (evicted > 0).then(|| keep::KeepStats { evictions: evicted, ..Default::default() })));
+        }
+        let Some(method) = method.filter(|_| casters) else { return Ok((None, None)) };
+        let fwd = view.forward(self.desc.depth_direction);
+        let camera = crate::geom::Camera { eye: view.eye.as_vec3(), ..crate::geom::Camera::default() };
+        let threads = match self.desc.plan_threads {
+            0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+            n => n,
+        };
+        let input = keep::KeepInput {
+            camera: &camera,
+            width: view.width,
+            height: view.height,
+            view_proj: fwd.world_view_proj(),
+            lights,
+            method,
+            format: self.settings.index_format,
+            u8_ok: self.caps.index_type_uint8,
+            no_culling: !self.settings.toggles.culling,
+            budget: self.desc.keep_budget_bytes,
+            threads,
+            all_slots,
+        };
+        let (l, s) = self.kept.plan_frame(&self.dev, &self.casters, &input)?;
+        Ok((Some(l), Some(s)))
+    }
+}
+
 impl Drop for ShadowPass {
     fn drop(&mut self) {
         // SAFETY: the embedding contract (module docs): the host drops the pass only after
@@ -542,6 +609,7 @@ impl Drop for ShadowPass {
             unsafe { m.destroy(&self.dev.device) };
         }
         self.casters.destroy(&self.dev);
+        self.kept.destroy(&self.dev);
         if let Some(mut r) = self.rays.take() {
             r.destroy(&self.dev);
         }

@@ -42,7 +42,10 @@ pub(crate) struct PackInput<'a> {
 }
 
 /// Plans every light and packs the index streams (or naive vertices) into one byte stream.
-pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
+/// With `kept` (the frame's kept plans, [`super::keep`]), each light's plan comes from there
+/// and the kept pairs' draws read their own buffers; the rest is written into the stream.
+pub(crate) fn pack(table: &CasterTable, input: &PackInput, kept: Option<Vec<super::keep::KeptLight>>) -> Packed {
+    let mut kept = kept.map(|k| k.into_iter());
     let view = input.view;
     // The volumes are drawn with the host's projection; the planner (near plane, frustum,
     // scissor, depth bounds) works on its forward equivalent.
@@ -60,17 +63,28 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
     let full = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: vk::Extent2D { width: view.width, height: view.height } };
 
     let mut stream: Vec<u8> = Vec::new();
+    // the lists' bytes of pairs drawn from their kept buffers (not in the stream)
+    let mut from_kept = 0u64;
     let mut totals = Totals::default();
     let mut cpu = CpuMs::default();
     let mut lights = Vec::with_capacity(input.lights.len());
     for (li, light) in input.lights.iter().enumerate() {
         // Each part (connected component) of a caster gets its own case; every draw carries it.
-        let plan = shadow::plan_light_with(
-            &PlanInput { camera: &camera, width: view.width, height: view.height, view_proj, light, method },
-            if input.casters { &table.cpu } else { &[] },
-            &PlanOptions { edge_quads, case_per_part: true, gpu_silhouettes, no_culling: !input.settings.toggles.culling },
-        );
-        let mut plan = plan;
+        let (mut plan, mut kept_draws) = match kept.as_mut().and_then(|k| k.next()) {
+            Some(k) => {
+                // the casters out of the light's range, left out of its lists
+                totals.cases.culled += k.omitted;
+                (k.plan, k.draws)
+            }
+            None => {
+                let plan = shadow::plan_light_with(
+                    &PlanInput { camera: &camera, width: view.width, height: view.height, view_proj, light, method },
+                    if input.casters { &table.cpu } else { &[] },
+                    &PlanOptions { edge_quads, case_per_part: true, gpu_silhouettes, no_culling: !input.settings.toggles.culling },
+                );
+                (plan, Vec::new())
+            }
+        };
         if mesh {
             // the parts left to the GPU are drawn by mesh draws
             for cp in &mut plan.casters {
@@ -88,10 +102,20 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
         cpu.plan += (plan.plan_ms - plan.silhouette_ms).max(0.0);
         let mut casters = Vec::with_capacity(plan.casters.len());
         let mut cstats = Vec::with_capacity(plan.casters.len());
-        for cp in &plan.casters {
+        for (k, cp) in plan.casters.iter().enumerate() {
             let caster = &table.cpu[cp.caster];
             let gpu = &table.live[cp.caster];
-            let ChunkDraws { mut draws, index_bytes, vertex_bytes, mut fmt_used } = write_chunks(&mut stream, input, caster, gpu, cp);
+            let chunk_draws = match kept_draws.get_mut(k).and_then(Option::take) {
+                Some(d) => {
+                    from_kept += d.index_bytes + d.vertex_bytes;
+                    d
+                }
+                None => {
+                    let handles: Vec<vk::Buffer> = gpu.chunks.iter().map(|b| b.raw).collect();
+                    write_chunks(&mut stream, (input.settings.index_format, input.u8_ok), caster, &handles, cp)
+                }
+            };
+            let ChunkDraws { mut draws, index_bytes, vertex_bytes, mut fmt_used } = chunk_draws;
             if let (Some(cf), Some(st)) = (compute.as_mut(), gpu.compute.as_ref()) {
                 let at = crate::pass::compute::frame::CasterAt { light: li, stat: cstats.len() };
                 if cp.parts.iter().any(|p| p.path == VolumePath::Compute && p.case != Case::Culled) {
@@ -183,26 +207,29 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput) -> Packed {
         lights.push(LightFrame { scissor, depth_bounds, stats, plan, counter_clear, casters });
     }
     align(&mut stream, 16);
-    totals.bytes_sent = totals.index_bytes + totals.vertex_bytes;
+    // what the stream carries (kept pairs' lists were sent when they were planned)
+    totals.bytes_sent = totals.index_bytes + totals.vertex_bytes - from_kept;
     Packed { stream, lights, totals, cpu, compute }
 }
 
 /// One caster's index lists (or naive vertices) for one light, written into the stream.
-struct ChunkDraws {
-    draws: Vec<Draw>,
-    index_bytes: u64,
-    vertex_bytes: u64,
+#[derive(Clone)]
+pub(crate) struct ChunkDraws {
+    pub draws: Vec<Draw>,
+    pub index_bytes: u64,
+    pub vertex_bytes: u64,
     /// The index format used (`none` when nothing was drawn).
-    fmt_used: UsedIndexFormat,
+    pub fmt_used: UsedIndexFormat,
 }
 
 /// Writes caster `cp`'s chunk draws (volume and light-cap lists) into `stream`, each aligned
-/// to 16 bytes in the format the settings and the device allow.
-fn write_chunks(
+/// to 16 bytes in the format the settings (`format`) and the device (`u8_ok`) allow;
+/// `chunks`: the caster's chunks' vertex buffers.
+pub(crate) fn write_chunks(
     stream: &mut Vec<u8>,
-    input: &PackInput,
+    (format, u8_ok): (IndexFormat, bool),
     caster: &shadow::Caster,
-    gpu: &super::casters::GpuCaster,
+    chunks: &[vk::Buffer],
     cp: &shadow::CasterPlan,
 ) -> ChunkDraws {
     let mut draws = Vec::new();
@@ -216,8 +243,8 @@ fn write_chunks(
             if indices.is_empty() {
                 continue;
             }
-            let fmt = match input.settings.index_format {
-                IndexFormat::Auto | IndexFormat::U8 if input.u8_ok && 2 * n <= 256 => IndexFormat::U8,
+            let fmt = match format {
+                IndexFormat::Auto | IndexFormat::U8 if u8_ok && 2 * n <= 256 => IndexFormat::U8,
                 IndexFormat::Auto | IndexFormat::U8 => IndexFormat::U16,
                 f => f,
             };
@@ -245,7 +272,8 @@ fn write_chunks(
                 index_bytes += bytes;
             }
             draws.push(Draw {
-                vertices: gpu.chunks[cd.chunk].raw,
+                vertices: chunks[cd.chunk],
+                kept: None,
                 offset,
                 count: indices.len() as u32,
                 format: fmt,

@@ -104,6 +104,7 @@ fn stream_tris(stream: &mut Vec<u8>, tris: &[[DVec4; 3]], case: Case, light_cap:
     }
     Draw {
         vertices: vk::Buffer::null(),
+        kept: None,
         offset,
         count: 3 * tris.len() as u32,
         format: IndexFormat::Naive,

@@ -142,7 +142,10 @@ pub struct LightStats {
     pub scissor: Option<[u32; 4]>,
     /// The light's depth bounds `[min, max]` when the device tests them.
     pub depth_bounds: Option<[f32; 2]>,
-    /// One entry per caster.
+    /// One entry per caster, in draw order; with [`PassSettings::keep`](super::PassSettings::keep)
+    /// only the casters the light draws (the culled ones are counted in [`Cases::culled`]; a
+    /// bounded light's casters out of range, found with a spatial index, are not even
+    /// visited).
     pub casters: Vec<CasterStats>,
     /// `zpass-clear`: the number of drawn volumes containing the eye (the stencil starts there).
     pub eye_volumes: Option<i32>,
@@ -195,12 +198,27 @@ pub struct Totals {
     /// [`mesh_meshlets`](Self::mesh_meshlets) without a task stage, only the meshlets that
     /// emit something with it ([`PassToggles::mesh_task`](super::PassToggles::mesh_task)).
     pub mesh_workgroups: u64,
+    /// Light–caster pairs drawn this frame (not culled; analytic spheres not counted):
+    /// `pairs_kept + pairs_replanned`.
+    pub pairs_total: u64,
+    /// Pairs planned this frame (every drawn pair without [`PassSettings::keep`](super::PassSettings::keep)).
+    pub pairs_replanned: u64,
+    /// Pairs drawn from index lists kept from an earlier frame (no planning, 0 bytes sent).
+    pub pairs_kept: u64,
+    /// Bytes of index lists kept across frames, resident after this frame.
+    pub kept_bytes: u64,
+    /// Kept pairs dropped this frame: evicted past the budget, or their caster moved, changed
+    /// or went.
+    pub kept_evictions: u64,
 }
 
 #[derive(Clone, Debug, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 /// CPU time of a frame by stage, ms.
 pub struct CpuMs {
+    /// With [`PassSettings::keep`](super::PassSettings::keep): culling, the cases and the
+    /// kept lists' look-ups (without it this work is inside `plan`).
+    pub cull: f64,
     /// Facing bits and possible silhouettes.
     pub silhouettes: f64,
     /// Culling, cases and index emission.

@@ -308,7 +308,7 @@ impl ShadowPass {
     /// writes [`cmd_compute_silhouettes`](Self::cmd_compute_silhouettes) made visible).
     pub(super) unsafe fn record_draw(&self, cb: vk::CommandBuffer, frame: &PreparedFrame, dr: &Draw) {
         let d = &self.dev.device;
-        let stream = frame.stream;
+        let stream = dr.kept.unwrap_or(frame.stream);
         if dr.mesh.is_some() {
             // mesh draws are recorded by `record_mesh_draw`, never from a vertex pipeline
             return;

@@ -9,6 +9,6 @@ pub mod plan;
 
 pub use caster::{Caster, CasterKind, Chunk, Part, TRANSMITTANCE_FLOOR};
 pub use plan::{
-    plan_light, plan_light_opts, plan_light_with, Case, CasterPlan, ChunkDraw, DarkCap, LightPlan, Method, PartPlan, PlanInput,
-    PlanOptions, VolumePath,
+    avoid_vertex, culled_caster_plan, object_light, plan_caster, plan_light, plan_light_opts, plan_light_with, Case, CasterPlan, ChunkDraw,
+    DarkCap, LightContext, LightPlan, Method, PartPlan, PlanInput, PlanOptions, PlanScratch, VolumePath,
 };

@@ -411,40 +411,14 @@ pub fn plan_light_opts(input: &PlanInput, casters: &[Caster], edge_quads: bool) 
 /// multiplicity path.
 pub fn plan_light_with(input: &PlanInput, casters: &[Caster], opts: &PlanOptions) -> LightPlan {
     let t0 = Instant::now();
-    let light = input.light;
-    let light_h = light.homogeneous();
-    let directional = light.kind == LightKind::Directional;
-    let frustum = Frustum::from_view_proj(input.view_proj, false);
-    let pyramid = OcclusionPyramid::new(light_h, input.view_proj);
-    let mut sil_time = 0.0f64;
+    let ctx = LightContext::new(input);
+    let mut scratch = PlanScratch::default();
     let mut plans = Vec::with_capacity(casters.len());
-    let mut bits = Vec::new();
-    let mut tri_bits = Vec::new();
-    let (mut hits, mut ends) = (Vec::new(), Vec::new());
     for (ci, caster) in casters.iter().enumerate() {
         let wb = caster.world_bounds();
-        let l_obj = avoid_vertex(caster, object_light(caster, light_h));
-        let culled_plan = |case| CasterPlan {
-            caster: ci,
-            case,
-            path: caster.kind.path(),
-            silhouette_edges: 0,
-            multiplicity_max: 0,
-            sides: 0,
-            dark_cap: 0,
-            light_cap: 0,
-            chunks: Vec::new(),
-            dark_cap_kind: DarkCap::None,
-            formulation: Formulation::Front,
-            light_object: l_obj.to_array(),
-            parts: Vec::new(),
-        };
-        let culls = |b: &Aabb| {
-            let out_of_radius = !directional && light.radius.is_some_and(|r| box_distance(b, light.position) > r);
-            !opts.no_culling && (out_of_radius || spot_culls(light, b) || shadow_volume_outside_frustum(b, light_h, &frustum))
-        };
-        if culls(&wb) {
-            plans.push(culled_plan(Case::Culled));
+        let l_obj = avoid_vertex(caster, object_light(caster, ctx.light_h));
+        if ctx.culls(input, opts, &wb) {
+            plans.push(culled_caster_plan(ci, caster, l_obj));
             continue;
         }
         if opts.edge_quads && caster.kind == CasterKind::Manifold && caster.transmittance.is_none() {
@@ -453,89 +427,212 @@ pub fn plan_light_with(input: &PlanInput, casters: &[Caster], opts: &PlanOptions
                 path: VolumePath::EdgeQuad,
                 sides: 2 * caster.topology.manifold_edges.len(),
                 light_cap: caster.triangle_count,
-                ..culled_plan(Case::ZFailLightCap)
+                ..culled_caster_plan(ci, caster, l_obj)
             });
             continue;
         }
-        // A caster marked multiplicity as a whole (one part) keeps that path.
-        let whole_multiplicity = caster.kind != CasterKind::Manifold && caster.parts.len() == 1;
-        let cases = part_cases(caster, wb, opts.case_per_part, &culls, |b| select_case(input.method, &pyramid, &frustum, b));
-        let mut cp = culled_plan(Case::Culled);
+        let cases = part_cases(caster, wb, opts.case_per_part, &|b| ctx.culls(input, opts, b), |b| {
+            select_case(input.method, &ctx.pyramid, &ctx.frustum, b)
+        });
         if cases.iter().all(|&c| c == Case::Culled) {
-            plans.push(cp);
+            plans.push(culled_caster_plan(ci, caster, l_obj));
             continue;
         }
-        // GPU silhouettes: closed manifold parts of opaque casters are left to the compute
-        // pass; the CPU computes facing bits only when a part on the multiplicity path is drawn.
-        let gpu = opts.gpu_silhouettes && caster.transmittance.is_none() && !whole_multiplicity;
-        let on_gpu = |pi: usize| gpu && caster.parts[pi].kind == CasterKind::Manifold;
-        if !cases.iter().enumerate().all(|(pi, &c)| c == Case::Culled || on_gpu(pi)) {
-            let ts = Instant::now();
-            caster.planes.facing_packed_auto(caster.mesh(), l_obj, caster.mirrored, &mut bits);
-            sil_time += ts.elapsed().as_secs_f64() * 1e3;
+        plans.push(plan_caster(input, opts, (ci, caster), l_obj, &cases, &mut scratch));
+    }
+    let (scissor, depth_bounds) = light_screen_bounds(input, ctx.directional);
+    LightPlan { scissor, depth_bounds, casters: plans, silhouette_ms: scratch.silhouette_ms, plan_ms: t0.elapsed().as_secs_f64() * 1e3 }
+}
+
+/// A light's scissor and depth bounds (none for a directional light).
+fn light_screen_bounds(input: &PlanInput, directional: bool) -> (Option<[u32; 4]>, Option<(f32, f32)>) {
+    if directional {
+        (None, None)
+    } else {
+        (light_scissor(input.light, input.view_proj, input.width, input.height), light_depth_bounds(input.light, input.view_proj))
+    }
+}
+
+/// What planning one light needs once, whatever the caster: the light in homogeneous
+/// coordinates, the view frustum and the occlusion pyramid (the view-dependent half of a
+/// plan: culling and the case).
+pub struct LightContext {
+    light_h: Vec4,
+    directional: bool,
+    frustum: Frustum,
+    pyramid: OcclusionPyramid,
+}
+
+impl LightContext {
+    /// The context of `input`'s light and view.
+    pub fn new(input: &PlanInput) -> LightContext {
+        let light_h = input.light.homogeneous();
+        LightContext {
+            light_h,
+            directional: input.light.kind == LightKind::Directional,
+            frustum: Frustum::from_view_proj(input.view_proj, false),
+            pyramid: OcclusionPyramid::new(light_h, input.view_proj),
         }
-        if gpu && caster.kind == CasterKind::Manifold {
-            cp.path = VolumePath::Compute;
+    }
+
+    /// The light in homogeneous world coordinates (w = 0 for a directional light).
+    pub fn light_h(&self) -> Vec4 {
+        self.light_h
+    }
+
+    /// Whether a caster (or part) of world box `b` casts nothing into the view: beyond the
+    /// light's range or cone, or its volume outside the frustum (never with `no_culling`).
+    fn culls(&self, input: &PlanInput, opts: &PlanOptions, b: &Aabb) -> bool {
+        let light = input.light;
+        let out_of_radius = !self.directional && light.radius.is_some_and(|r| box_distance(b, light.position) > r);
+        !opts.no_culling && (out_of_radius || spot_culls(light, b) || shadow_volume_outside_frustum(b, self.light_h, &self.frustum))
+    }
+
+    /// The screen half of the light's plan: its scissor and depth bounds, as
+    /// [`plan_light_with`] reports them.
+    pub fn screen_bounds(&self, input: &PlanInput) -> (Option<[u32; 4]>, Option<(f32, f32)>) {
+        light_screen_bounds(input, self.directional)
+    }
+
+    /// The view-dependent half of planning `caster` (not on the edge-quad path): `None` when
+    /// it is culled whole, else each part's case (culled parts `Case::Culled`), exactly as
+    /// [`plan_light_with`] decides them. The rest of its plan ([`plan_caster`]) depends only on
+    /// the light, the caster and these cases.
+    /// `wb` is the caster's [`world_bounds`](Caster::world_bounds).
+    pub fn caster_cases(&self, input: &PlanInput, opts: &PlanOptions, caster: &Caster, wb: Aabb) -> Option<Vec<Case>> {
+        let mut cases = Vec::new();
+        self.caster_cases_into(input, opts, caster, wb, &mut cases).then_some(cases)
+    }
+
+    /// [`caster_cases`](Self::caster_cases) into `cases` (cleared first, left empty when the
+    /// caster is culled whole); whether it is drawn.
+    pub fn caster_cases_into(&self, input: &PlanInput, opts: &PlanOptions, caster: &Caster, wb: Aabb, cases: &mut Vec<Case>) -> bool {
+        cases.clear();
+        if self.culls(input, opts, &wb) {
+            return false;
         }
-        let mut best = 0u8;
-        let mut tri_bits_for = None;
-        for (pi, &case) in cases.iter().enumerate() {
-            let part = &caster.parts[pi];
-            let multiplicity = whole_multiplicity || part.kind != CasterKind::Manifold;
-            if case != Case::Culled && on_gpu(pi) {
-                let e = manifold_emit(input.method, part, case, l_obj);
-                cp.parts.push(PartPlan::undrawn(pi, case, VolumePath::Compute, e.dark_cap, e.formulation));
-                if case_rank(case) > best {
-                    best = case_rank(case);
-                    cp.case = case;
-                    cp.dark_cap_kind = e.dark_cap;
-                    cp.formulation = e.formulation;
-                }
-                continue;
-            }
-            if case == Case::Culled {
-                let path = if multiplicity { VolumePath::Multiplicity } else { VolumePath::Manifold };
-                cp.parts.push(PartPlan::undrawn(pi, case, path, DarkCap::None, Formulation::Front));
-                continue;
-            }
-            let permuted = !caster.planes.order().is_identity();
-            if permuted && tri_bits_for != Some(ci) && (multiplicity || needs_triangles(manifold_emit(input.method, part, case, l_obj))) {
-                // walking triangles: the bits in welded order once, not a permutation lookup each
-                caster.planes.unpermute(&bits, &mut tri_bits);
-                tri_bits_for = Some(ci);
-            }
-            // (a part that walks no triangle reads no bit of `tb`)
-            let tb: &[u64] = if !permuted {
-                &bits
-            } else if tri_bits_for == Some(ci) {
-                &tri_bits
-            } else {
-                &[]
-            };
-            let (pp, draws) =
-                plan_part(input, caster, PartJob { part: pi, multiplicity, case }, l_obj, (&bits, tb), (&mut hits, &mut ends));
-            cp.silhouette_edges += pp.silhouette_edges;
-            cp.multiplicity_max = cp.multiplicity_max.max(pp.multiplicity_max);
-            cp.sides += pp.sides;
-            cp.dark_cap += pp.dark_cap;
-            cp.light_cap += pp.light_cap;
+        part_cases_into(
+            caster,
+            wb,
+            opts.case_per_part,
+            &|b| self.culls(input, opts, b),
+            |b| select_case(input.method, &self.pyramid, &self.frustum, b),
+            cases,
+        );
+        cases.iter().any(|&c| c != Case::Culled)
+    }
+}
+
+/// The plan of a caster culled whole for a light (`l_obj`: the light in its object space).
+pub fn culled_caster_plan(ci: usize, caster: &Caster, l_obj: Vec4) -> CasterPlan {
+    CasterPlan {
+        caster: ci,
+        case: Case::Culled,
+        path: caster.kind.path(),
+        silhouette_edges: 0,
+        multiplicity_max: 0,
+        sides: 0,
+        dark_cap: 0,
+        light_cap: 0,
+        chunks: Vec::new(),
+        dark_cap_kind: DarkCap::None,
+        formulation: Formulation::Front,
+        light_object: l_obj.to_array(),
+        parts: Vec::new(),
+    }
+}
+
+/// The buffers [`plan_caster`] reuses from one caster to the next, and the time it spent on
+/// facing bits.
+#[derive(Default)]
+pub struct PlanScratch {
+    bits: Vec<u64>,
+    tri_bits: Vec<u64>,
+    hits: Vec<ScanHit>,
+    ends: Vec<SideEnds>,
+    /// Milliseconds spent computing facing bits so far.
+    pub silhouette_ms: f64,
+}
+
+/// Plans caster `ci` (not culled whole: `cases` from [`LightContext::caster_cases`]) for the
+/// light whose object-space position is `l_obj` ([`avoid_vertex`] of [`object_light`]): its
+/// facing, possible silhouettes, caps and index lists. What it returns depends on the light,
+/// the caster, the method and `cases` only, never on the view otherwise.
+pub fn plan_caster(
+    input: &PlanInput,
+    opts: &PlanOptions,
+    (ci, caster): (usize, &Caster),
+    l_obj: Vec4,
+    cases: &[Case],
+    scratch: &mut PlanScratch,
+) -> CasterPlan {
+    let PlanScratch { bits, tri_bits, hits, ends, silhouette_ms } = scratch;
+    // A caster marked multiplicity as a whole (one part) keeps that path.
+    let whole_multiplicity = caster.kind != CasterKind::Manifold && caster.parts.len() == 1;
+    let mut cp = culled_caster_plan(ci, caster, l_obj);
+    // GPU silhouettes: closed manifold parts of opaque casters are left to the compute
+    // pass; the CPU computes facing bits only when a part on the multiplicity path is drawn.
+    let gpu = opts.gpu_silhouettes && caster.transmittance.is_none() && !whole_multiplicity;
+    let on_gpu = |pi: usize| gpu && caster.parts[pi].kind == CasterKind::Manifold;
+    if !cases.iter().enumerate().all(|(pi, &c)| c == Case::Culled || on_gpu(pi)) {
+        let ts = Instant::now();
+        caster.planes.facing_packed_auto(caster.mesh(), l_obj, caster.mirrored, bits);
+        *silhouette_ms += ts.elapsed().as_secs_f64() * 1e3;
+    }
+    if gpu && caster.kind == CasterKind::Manifold {
+        cp.path = VolumePath::Compute;
+    }
+    let mut best = 0u8;
+    let mut tri_bits_done = false;
+    for (pi, &case) in cases.iter().enumerate() {
+        let part = &caster.parts[pi];
+        let multiplicity = whole_multiplicity || part.kind != CasterKind::Manifold;
+        if case != Case::Culled && on_gpu(pi) {
+            let e = manifold_emit(input.method, part, case, l_obj);
+            cp.parts.push(PartPlan::undrawn(pi, case, VolumePath::Compute, e.dark_cap, e.formulation));
             if case_rank(case) > best {
                 best = case_rank(case);
                 cp.case = case;
-                cp.dark_cap_kind = pp.dark_cap_kind;
-                cp.formulation = pp.formulation;
+                cp.dark_cap_kind = e.dark_cap;
+                cp.formulation = e.formulation;
             }
-            cp.chunks.extend(draws);
-            cp.parts.push(pp);
+            continue;
         }
-        plans.push(cp);
+        if case == Case::Culled {
+            let path = if multiplicity { VolumePath::Multiplicity } else { VolumePath::Manifold };
+            cp.parts.push(PartPlan::undrawn(pi, case, path, DarkCap::None, Formulation::Front));
+            continue;
+        }
+        let permuted = !caster.planes.order().is_identity();
+        if permuted && !tri_bits_done && (multiplicity || needs_triangles(manifold_emit(input.method, part, case, l_obj))) {
+            // walking triangles: the bits in welded order once, not a permutation lookup each
+            caster.planes.unpermute(bits, tri_bits);
+            tri_bits_done = true;
+        }
+        // (a part that walks no triangle reads no bit of `tb`)
+        let tb: &[u64] = if !permuted {
+            bits
+        } else if tri_bits_done {
+            tri_bits
+        } else {
+            &[]
+        };
+        let (pp, draws) = plan_part(input, caster, PartJob { part: pi, multiplicity, case }, l_obj, (bits, tb), (hits, ends));
+        cp.silhouette_edges += pp.silhouette_edges;
+        cp.multiplicity_max = cp.multiplicity_max.max(pp.multiplicity_max);
+        cp.sides += pp.sides;
+        cp.dark_cap += pp.dark_cap;
+        cp.light_cap += pp.light_cap;
+        if case_rank(case) > best {
+            best = case_rank(case);
+            cp.case = case;
+            cp.dark_cap_kind = pp.dark_cap_kind;
+            cp.formulation = pp.formulation;
+        }
+        cp.chunks.extend(draws);
+        cp.parts.push(pp);
     }
-    let (scissor, depth_bounds) = if directional {
-        (None, None)
-    } else {
-        (light_scissor(light, input.view_proj, input.width, input.height), light_depth_bounds(light, input.view_proj))
-    };
-    LightPlan { scissor, depth_bounds, casters: plans, silhouette_ms: sil_time, plan_ms: t0.elapsed().as_secs_f64() * 1e3 }
+    cp
 }
 
 /// Each part's case: culled by its own bounds (a caster of several parts), or the case its
@@ -548,19 +645,30 @@ fn part_cases(
     culls: &dyn Fn(&Aabb) -> bool,
     select: impl Fn(&Aabb) -> Case,
 ) -> Vec<Case> {
+    let mut cases = Vec::with_capacity(caster.parts.len());
+    part_cases_into(caster, world_bounds, case_per_part, culls, select, &mut cases);
+    cases
+}
+
+/// [`part_cases`] into `cases` (cleared first).
+fn part_cases_into(
+    caster: &Caster,
+    world_bounds: Aabb,
+    case_per_part: bool,
+    culls: &dyn Fn(&Aabb) -> bool,
+    select: impl Fn(&Aabb) -> Case,
+    cases: &mut Vec<Case>,
+) {
     let single = caster.parts.len() == 1;
-    let mut cases: Vec<Case> = caster
-        .parts
-        .iter()
-        .map(|p| {
-            let pb = if single { world_bounds } else { p.object_bounds.transformed(&caster.transform) };
-            if !single && culls(&pb) {
-                Case::Culled
-            } else {
-                select(&pb)
-            }
-        })
-        .collect();
+    cases.clear();
+    cases.extend(caster.parts.iter().map(|p| {
+        let pb = if single { world_bounds } else { p.object_bounds.transformed(&caster.transform) };
+        if !single && culls(&pb) {
+            Case::Culled
+        } else {
+            select(&pb)
+        }
+    }));
     if !case_per_part {
         let mut live = cases.iter().copied().filter(|&c| c != Case::Culled);
         if let Some(first) = live.next() {
@@ -570,7 +678,6 @@ fn part_cases(
             }
         }
     }
-    cases
 }
 
 impl PartPlan {

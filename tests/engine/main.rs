@@ -14,6 +14,7 @@ mod devices;
 mod embed;
 mod gpu_smoke;
 mod hard_cases;
+mod keep;
 mod mesh;
 mod minimal;
 mod motion;

@@ -2,7 +2,7 @@
 //! slots and targets, the comparison passes, and the recording of a frame's determination.
 
 use crate::model::{deformed, sphere_of, Model, Target};
-use crate::{light, meshes, transform, view, H, RECEIVER_DEPTH, W};
+use crate::{light_of, meshes, transform, view_of, H, RECEIVER_DEPTH, W};
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 use std::cell::RefCell;
@@ -196,7 +196,7 @@ pub(crate) fn reference_stencil(h: &mut Harness, model: &Model) -> Vec<u8> {
     let i = h.reference.iter().position(|(f, _)| *f == fif).unwrap();
     let (_, mut pass) = h.reference.swap_remove(i);
     let fresh = new_pass_state(&mut pass, model);
-    let frame = pass.prepare(0, &view(), &[light()]).unwrap();
+    let frame = pass.prepare(0, &view_of(model.eye), &[light_of(model.light)]).unwrap();
     h.ctx.one_shot(|cb| record(h, &h.reference_target, cb, &pass, &frame, Target::DynamicRendering)).unwrap();
     let stencil = stencil(&h.reference_target);
     drop(frame);
@@ -213,7 +213,8 @@ pub(crate) fn reference_stencil(h: &mut Harness, model: &Model) -> Vec<u8> {
 /// Adds the model's casters and spheres to `pass` (whose own are removed after use).
 fn new_pass_state(pass: &mut ShadowPass, model: &Model) -> (Vec<CasterId>, Vec<SphereId>) {
     let meshes = meshes();
-    pass.set_settings(PassSettings { technique: Technique::Volumes(model.method), ..Default::default() }).unwrap();
+    // from scratch: nothing kept
+    pass.set_settings(PassSettings { technique: Technique::Volumes(model.method), keep: false, ..Default::default() }).unwrap();
     let casters = model
         .casters
         .iter()

@@ -50,7 +50,7 @@ use model::{Reference, FRAMES_IN_FLIGHT};
 use proptest::test_runner::{Config, FileFailurePersistence};
 use proptest_state_machine::{ReferenceStateMachine, StateMachineTest};
 use sut::Sequences;
-use umbrage::geom::{Light, Mesh, Sphere};
+use umbrage::geom::{Light, LightKind, Mesh, Sphere};
 use umbrage::pass::ShadowView;
 use umbrage_scene::shapes;
 
@@ -69,8 +69,35 @@ fn transform(pos: [i8; 3], turn: u8) -> DMat4 {
     DMat4::from_translation(p) * DMat4::from_rotation_y(turn as f64 * 0.4)
 }
 
+/// The cameras a sequence moves between ([`model::Step::MoveCamera`]): the first looks at the
+/// casters from outside their volumes; the others from the side, low, and from among the
+/// casters (inside volumes: the z-fail cases).
+const EYES: [[f32; 3]; 4] = [[0.0, 4.0, 8.0], [5.0, 2.5, 5.0], [-6.0, 1.5, 3.0], [0.5, 0.6, 1.5]];
+
+/// The lights a sequence moves between ([`model::Step::MoveLight`]): unbounded, bounded
+/// point lights (the spatial index's queries), a spot light and a directional light.
+fn light_of(k: u8) -> Light {
+    match k % 5 {
+        0 => Light::point(Vec3::new(1.0, 8.0, 2.0)),
+        1 => Light { radius: Some(7.0), ..Light::point(Vec3::new(2.0, 5.0, -1.0)) },
+        2 => Light { radius: Some(3.0), ..Light::point(Vec3::new(-1.5, 3.0, 0.5)) },
+        3 => Light {
+            kind: LightKind::Spot,
+            radius: Some(14.0),
+            direction: Vec3::new(0.0, -1.0, -0.2),
+            cone_deg: 80.0,
+            ..Light::point(Vec3::new(0.0, 7.0, 2.0))
+        },
+        _ => Light { kind: LightKind::Directional, direction: Vec3::new(0.3, -1.0, 0.2), ..Light::point(Vec3::ZERO) },
+    }
+}
+
 fn view() -> ShadowView {
-    let eye = Vec3::new(0.0, 4.0, 8.0);
+    view_of(0)
+}
+
+fn view_of(k: u8) -> ShadowView {
+    let eye = Vec3::from(EYES[k as usize % EYES.len()]);
     ShadowView {
         eye: eye.as_dvec3(),
         view: glam::camera::rh::view::look_at_mat4(Vec3::ZERO, -eye, Vec3::Y),
@@ -81,7 +108,7 @@ fn view() -> ShadowView {
 }
 
 fn light() -> Light {
-    Light::point(Vec3::new(1.0, 8.0, 2.0))
+    light_of(0)
 }
 
 /// The panic [`a_failing_sequence_is_reported`] injects (`PASS_SEQUENCES_INJECT_FAILURE` set):

@@ -42,6 +42,12 @@ pub(crate) struct Model {
     pub(crate) spheres: Vec<ModelSphere>,
     pub(crate) transparent: Vec<ModelCaster>,
     pub(crate) method: Method,
+    /// The light ([`crate::light_of`]) and camera ([`crate::view_of`]) of the next frames.
+    pub(crate) light: u8,
+    pub(crate) eye: u8,
+    /// [`PassSettings::keep`](umbrage::pass::PassSettings::keep) of the system under test
+    /// (the reference plans from scratch: the pictures must not depend on it).
+    pub(crate) keep: bool,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -66,6 +72,12 @@ pub(crate) enum Step {
     /// A volume method, or `None`: `Technique::Compute` (McGuire's cases with the GPU's
     /// possible silhouettes; its stencil is McGuire's byte for byte).
     SetMethod(Option<Method>),
+    /// Moves the light (index into [`crate::light_of`]'s lights).
+    MoveLight(u8),
+    /// Moves the camera (index into [`crate::EYES`]).
+    MoveCamera(u8),
+    /// Turns keeping plans across frames on or off.
+    SetKeep(bool),
     Prepare(usize, FrameFate),
     /// A call with an invalid argument, or another pass's id: refused, nothing changes.
     Invalid(u8),
@@ -112,6 +124,9 @@ impl ReferenceStateMachine for Reference {
                 spheres: vec![],
                 transparent: vec![],
                 method: Method::McGuire,
+                light: 0,
+                eye: 0,
+                keep: true,
             })
             .boxed()
     }
@@ -130,6 +145,9 @@ impl ReferenceStateMachine for Reference {
             1 => caster().prop_map(Step::AddTransparent),
             1 => any(nt).prop_map(Step::RemoveTransparent),
             1 => (0usize..METHODS.len()).prop_map(|m| Step::SetMethod(METHODS[m])),
+            2 => (0u8..5).prop_map(Step::MoveLight),
+            2 => (0u8..4).prop_map(Step::MoveCamera),
+            1 => prop_oneof![3 => Just(true), 1 => Just(false)].prop_map(Step::SetKeep),
             6 => (0..slots + 1, prop_oneof![1 => Just(FrameFate::Dropped), 3 => Just(FrameFate::Submitted), 1 => Just(FrameFate::Abandoned)])
                 .prop_map(|(s, f)| Step::Prepare(s, f)),
             2 => (0u8..8).prop_map(Step::Invalid),
@@ -169,6 +187,9 @@ impl ReferenceStateMachine for Reference {
                 state.transparent.remove(*i);
             }
             Step::SetMethod(m) => state.method = m.unwrap_or(Method::McGuire),
+            Step::MoveLight(k) => state.light = *k,
+            Step::MoveCamera(k) => state.eye = *k,
+            Step::SetKeep(k) => state.keep = *k,
             Step::Prepare(..) | Step::Invalid(_) => {}
         }
         state

@@ -3,7 +3,7 @@
 
 use crate::harness::{count, new_pass, record, reference_stencil, stencil, with_harness, HARNESS};
 use crate::model::{deformed, sphere_of, technique, FrameFate, Model, Reference, Step, Target};
-use crate::{injected_failure, light, meshes, transform, view, INJECTED};
+use crate::{injected_failure, light, light_of, meshes, transform, view, view_of, INJECTED};
 use ash::vk;
 use glam::{DMat4, DVec3, Vec3};
 use proptest_state_machine::StateMachineTest;
@@ -185,13 +185,19 @@ impl StateMachineTest for Sequences {
                 sut.compute_ways += m.is_none() as usize;
                 let way = if sut.pass.capabilities().compute_draws(way).is_ok() { way } else { ComputeDraws::Auto };
                 let toggles = PassToggles { compute_draws: way, ..Default::default() };
-                sut.pass.set_settings(PassSettings { technique: technique(m), toggles, ..Default::default() }).unwrap()
+                sut.pass.set_settings(PassSettings { technique: technique(m), toggles, keep: model.keep, ..Default::default() }).unwrap()
+            }
+            // the next prepare takes them
+            Step::MoveLight(_) | Step::MoveCamera(_) => {}
+            Step::SetKeep(keep) => {
+                let s = sut.pass.settings();
+                sut.pass.set_settings(PassSettings { keep, ..s }).unwrap()
             }
             Step::Prepare(slot, fate) => {
                 // As a host: before preparing a slot again, wait for its previous frame (here
                 // also compared); the other slots' frames stay in flight.
                 sut.retire(slot);
-                let r = sut.pass.prepare(slot, &view(), &[light()]);
+                let r = sut.pass.prepare(slot, &view_of(model.eye), &[light_of(model.light)]);
                 if slot >= model.frames_in_flight {
                     assert!(r.is_err(), "slot {slot} of {} was accepted", model.frames_in_flight);
                     return sut;

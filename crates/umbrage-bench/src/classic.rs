@@ -101,6 +101,19 @@ pub struct BenchRow {
     /// ([`BenchReport::gbuffer_fill_gpix_s`]) over `gpu_gbuffer_ms`: the pass's fill against its
     /// limit where the scene covers the target once (more overdraw: more; background: less).
     pub gbuffer_fill_fraction: Option<f64>,
+    /// Median CPU time of culling, the cases and the kept plans' look-ups, ms (with
+    /// `PassSettings::keep`; 0 without it: that work is then inside `cpu_plan_ms`).
+    pub cpu_cull_ms: f64,
+    /// Median CPU time of writing the frame's stream and the pass's records, ms.
+    pub cpu_record_ms: f64,
+    /// Median light–caster pairs drawn a frame.
+    pub pairs_total: u64,
+    /// Median pairs planned a frame (all drawn pairs without keeping).
+    pub pairs_replanned: u64,
+    /// Median pairs drawn from plans kept across frames.
+    pub pairs_kept: u64,
+    /// Median bytes of index lists kept across frames.
+    pub kept_bytes: u64,
 }
 
 /// Frames [`refit_ms`] times.
@@ -345,6 +358,10 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
             silhouettes: Vec<f64>,
             wall: Vec<f64>,
             plan: Vec<f64>,
+            cull: Vec<f64>,
+            record: Vec<f64>,
+            bytes: Vec<f64>,
+            pairs: [Vec<f64>; 4],
             last: Option<umbrage_render::Stats>,
         }
         let mut acc: Vec<Acc> = variants.iter().map(|_| Acc::default()).collect();
@@ -367,6 +384,13 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 }
                 a.wall.push(f.stats.wall_ms);
                 a.plan.push(f.stats.cpu_ms.plan + f.stats.cpu_ms.silhouettes);
+                a.cull.push(f.stats.cpu_ms.cull);
+                a.record.push(f.stats.cpu_ms.record);
+                let t = &f.stats.totals;
+                a.bytes.push(t.bytes_sent as f64);
+                for (v, n) in a.pairs.iter_mut().zip([t.pairs_total, t.pairs_replanned, t.pairs_kept, t.kept_bytes]) {
+                    v.push(n as f64);
+                }
                 a.last = Some(f.stats);
             }
         }
@@ -396,6 +420,8 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 (Some(rate), Some(ms)) if rate > 0.0 && ms > 0.0 => Some(n as f64 / (rate * unit) * 1e3 / ms),
                 _ => None,
             };
+            let [pairs_total, pairs_replanned, pairs_kept, kept_bytes] = a.pairs.map(|v| median(v) as u64);
+            let (cpu_cull_ms, cpu_record_ms) = (median(a.cull), median(a.record));
             let row = BenchRow {
                 scene: name.clone(),
                 method: v.label(),
@@ -413,7 +439,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 frames_in_flight: r.config().frames_in_flight,
                 shadow_triangles: s.totals.triangles.total(),
                 shadow_bytes: s.totals.index_bytes + s.totals.vertex_bytes,
-                bytes_sent: s.totals.bytes_sent,
+                bytes_sent: median(a.bytes) as u64,
                 error_fraction: err.fraction,
                 cases: [c.culled, c.zpass, c.zfail, c.zfail_light_cap],
                 volume_draws: s.totals.draws,
@@ -431,6 +457,12 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 lighting_one_draw_fraction: at(lit_pixels, lighting_one_draw, 1e9, illum_ms),
                 gbuffer_limit_fraction: at(gbuffer_triangles, gbuffer_tri_mtri_s, 1e6, gbuffer_ms),
                 gbuffer_fill_fraction: at(s.width as u64 * s.height as u64, gbuffer_fill_gpix_s, 1e9, gbuffer_ms),
+                cpu_cull_ms,
+                cpu_record_ms,
+                pairs_total,
+                pairs_replanned,
+                pairs_kept,
+                kept_bytes,
             };
             progress(&row);
             rows.push(row);

@@ -159,6 +159,9 @@ pub fn settings(s: &UmbragePassSettings) -> Result<PassSettings, CError> {
             compute_draws,
             mesh_task: s.disableMeshTask == 0,
         },
+        // Plans kept across frames, as in every host (this version of the ABI has no field to
+        // turn it off: the default, on, is what the pass does).
+        ..PassSettings::default()
     })
 }
 
@@ -288,6 +291,9 @@ pub unsafe fn desc(info: &UmbragePassCreateInfo) -> Result<ShadowPassDesc, CErro
         transmit_format: (info.transmitFormat != vk::Format::UNDEFINED).then_some(info.transmitFormat),
         debug_color_format: None,
         pipeline_cache: info.pipelineCache,
+        // The kept plans' memory budget and the planning threads: the engine's defaults (this
+        // version of the ABI has no fields for them).
+        ..ShadowPassDesc::default()
     })
 }
 

@@ -79,6 +79,11 @@ struct FrameArgs {
     /// edges) or flat. Shadows are the same in every mode.
     #[arg(long, value_enum, default_value = "smooth")]
     shading: ShadingArg,
+    /// Plan every light–caster pair from scratch every frame (default: each pair's plan and
+    /// index lists are kept across frames until its light, caster or case changes; the same
+    /// pictures either way).
+    #[arg(long)]
+    no_keep: bool,
 }
 
 /// `--shading`.
@@ -313,6 +318,7 @@ impl Default for FrameArgs {
             jitter: false,
             msaa: 1,
             shading: ShadingArg::Smooth,
+            no_keep: false,
         }
     }
 }
@@ -399,6 +405,7 @@ impl FrameArgs {
             jitter: self.jitter,
             samples: self.msaa,
             shading: self.shading.shading(),
+            keep: !self.no_keep,
             ..Default::default()
         })
     }

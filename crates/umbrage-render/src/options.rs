@@ -142,6 +142,9 @@ pub struct FrameSettings {
     /// fragments its volumes rasterise) and pipeline statistics around the determination.
     /// Adds a pass per light: do not time such frames.
     pub counters: bool,
+    /// Keep each light–caster pair's plan across frames ([`umbrage::pass::PassSettings::keep`];
+    /// on by default, off: `--no-keep`). The same pictures either way.
+    pub keep: bool,
 }
 
 /// Everything a renderer is created with: its [`RenderConfig`] and first [`FrameSettings`].
@@ -184,6 +187,8 @@ pub struct RenderOptions {
     ///
     /// [`FrameOutput::samples`]: crate::FrameOutput::samples
     pub samples: u32,
+    /// Keep the shadow plans across frames ([`FrameSettings::keep`]; default on).
+    pub keep: bool,
 }
 
 impl RenderOptions {
@@ -212,6 +217,7 @@ impl RenderOptions {
             jitter: self.jitter,
             toggles: PassToggles::default(),
             counters: false,
+            keep: self.keep,
         }
     }
 }
@@ -233,6 +239,7 @@ impl Default for RenderOptions {
             frames_in_flight: 2,
             jitter: false,
             samples: 1,
+            keep: true,
         }
     }
 }

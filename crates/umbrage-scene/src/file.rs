@@ -33,7 +33,7 @@ pub fn parse(src: &str, origin: &str, objs: ObjSource<'_>) -> Result<Scene> {
     parse_animated(src, origin, objs).map(|(scene, _)| scene)
 }
 
-/// [`parse`], with the scene's motion (spins and light paths).
+/// [`parse`], with the scene's motion (spins, light paths and the camera's path).
 pub fn parse_animated(src: &str, origin: &str, objs: ObjSource<'_>) -> Result<(Scene, Motion)> {
     let cx = Ctx { origin, src };
     let file: FileScene = toml::from_str(src).map_err(|e| match e.span() {
@@ -44,7 +44,9 @@ pub fn parse_animated(src: &str, origin: &str, objs: ObjSource<'_>) -> Result<(S
     let ambient = cx.color(&top, "ambient", file.ambient, Vec3::splat(0.08))?;
 
     let cs = file.camera.span();
-    let camera = lights::camera(&cx, &cs, file.camera.into_inner())?;
+    let mut file_camera = file.camera.into_inner();
+    let camera_moves = (file_camera.orbit.take(), file_camera.keyframes.take());
+    let camera = lights::camera(&cx, &cs, file_camera)?;
 
     let mut lights = Vec::new();
     for sl in &file.light {
@@ -63,7 +65,8 @@ pub fn parse_animated(src: &str, origin: &str, objs: ObjSource<'_>) -> Result<(S
         spheres.push(sp);
     }
 
-    let motion = motion::motion(&cx, &file.mesh, &file.light, &lights)?;
+    let mut motion = motion::motion(&cx, &file.mesh, &file.light, &lights)?;
+    motion.camera = motion::camera_motion(&cx, &cs, camera_moves, &camera)?;
     let name = file
         .name
         .unwrap_or_else(|| Path::new(origin).file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| origin.to_string()));

@@ -55,6 +55,43 @@ impl LightPath {
     }
 }
 
+/// How the camera moves.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CameraPath {
+    /// The eye on a horizontal circle, as a light's [`LightPath::Orbit`] (`orbit = { center,
+    /// radius, period_s }`, the phase from the eye at rest); the target stays.
+    Orbit {
+        /// Centre of the circle (its height is the eye's height).
+        center: Vec3,
+        /// Radius (> 0).
+        radius: f32,
+        /// Seconds per turn (> 0).
+        period_s: f32,
+        /// Angle at t = 0, radians.
+        phase: f64,
+    },
+    /// `keyframes = [{ t, eye, target }, ...]`: eye and target linear between keys, repeating
+    /// with the last key's time as the period (as a light's keyframes).
+    Keyframes(Vec<(f32, Vec3, Vec3)>),
+}
+
+impl CameraPath {
+    /// The eye and the target at time `t` seconds, from the camera at rest.
+    pub fn eye_target(&self, rest: &super::Camera, t: f64) -> (Vec3, Vec3) {
+        match self {
+            CameraPath::Orbit { center, radius, period_s, phase } => {
+                let eye = LightPath::Orbit { center: *center, radius: *radius, period_s: *period_s, phase: *phase }.position(t);
+                (eye, rest.target)
+            }
+            CameraPath::Keyframes(keys) => {
+                let eyes = LightPath::Keyframes(keys.iter().map(|k| (k.0, k.1)).collect()).position(t);
+                let targets = LightPath::Keyframes(keys.iter().map(|k| (k.0, k.2)).collect()).position(t);
+                (eyes, targets)
+            }
+        }
+    }
+}
+
 /// What moves in a scene, by scene index.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Motion {
@@ -64,12 +101,14 @@ pub struct Motion {
     pub spins: Vec<Option<Vec3>>,
     /// Per light (scene order): its path.
     pub paths: Vec<Option<LightPath>>,
+    /// The camera's path (`[camera]`'s `orbit` or `keyframes`).
+    pub camera: Option<CameraPath>,
 }
 
 impl Motion {
     /// Nothing moves.
     pub fn is_static(&self) -> bool {
-        self.spins.iter().all(Option::is_none) && self.paths.iter().all(Option::is_none)
+        self.spins.iter().all(Option::is_none) && self.paths.iter().all(Option::is_none) && self.camera.is_none()
     }
 
     /// Mesh `index`'s transform at `t`, from its transform at rest `rest`.
@@ -99,6 +138,9 @@ impl Motion {
         }
         for (i, l) in s.lights.iter_mut().enumerate() {
             *l = self.light(i, l, t);
+        }
+        if let Some(path) = &self.camera {
+            (s.camera.eye, s.camera.target) = path.eye_target(&rest.camera, t);
         }
         s
     }
@@ -139,7 +181,7 @@ mod tests {
 
     #[test]
     fn spin_turns_about_the_mesh_origin() {
-        let m = Motion { spins: vec![Some(Vec3::new(0.0, 90.0, 0.0))], paths: vec![] };
+        let m = Motion { spins: vec![Some(Vec3::new(0.0, 90.0, 0.0))], paths: vec![], camera: None };
         let rest = Mat4::from_translation(Vec3::new(5.0, 1.0, 0.0));
         let t = m.mesh_transform(0, rest, 1.0);
         // The origin stays, +x goes to -z.

@@ -261,6 +261,7 @@ impl ComputeFrame {
                 let offset = (w * 4) as u64;
                 let draw = |cap_draw: bool, offset: u64| Draw {
                     vertices: chunk_buffers[chunk],
+                    kept: None,
                     offset,
                     count: 0,
                     format: IndexFormat::U16,
@@ -363,6 +364,7 @@ impl ComputeFrame {
                     let n = (range.end - first).min(MAX_TASKS);
                     draws.push(Draw {
                         vertices: vk::Buffer::null(),
+                        kept: None,
                         offset: 0,
                         count: 0,
                         format: IndexFormat::U16,

@@ -51,6 +51,10 @@ pub(crate) struct BenchArgs {
     /// (`mesh`, `mesh-notask`: no task stage, every meshlet's mesh workgroup runs).
     #[arg(long, value_enum, value_delimiter = ',', default_value = "on")]
     mesh_task: Vec<OnOff>,
+    /// Plan every light–caster pair from scratch every frame (default: plans kept across
+    /// frames, `PassSettings::keep`).
+    #[arg(long)]
+    no_keep: bool,
     /// Write the report as JSON.
     #[arg(long)]
     json: Option<PathBuf>,
@@ -113,6 +117,7 @@ pub(crate) fn bench_command(a: BenchArgs) -> Result<ExitCode> {
         height: a.size.1,
         index_format: a.index_format,
         frames_in_flight: a.frames_in_flight,
+        keep: !a.no_keep,
         ..Default::default()
     };
     let listed = Listed {

@@ -35,6 +35,7 @@ pub(super) fn pass_settings(s: &FrameSettings) -> PassSettings {
         counter: s.counter,
         index_format: s.index_format,
         toggles: s.toggles,
+        keep: s.keep,
     }
 }
 

@@ -498,6 +498,7 @@ impl Parts {
             transmit_format: Some(transmit_format),
             debug_color_format: Some(accum_format),
             pipeline_cache: ctx.pipeline_cache,
+            ..ShadowPassDesc::default()
         };
         let mut pass = ShadowPass::new(&ctx.instance, ctx.physical, &ctx.device, (*ctx.allocator).clone(), &desc)?;
         let mut caster_ids = Vec::with_capacity(scene.meshes.len());

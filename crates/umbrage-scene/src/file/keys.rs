@@ -41,6 +41,19 @@ pub(super) struct FileCamera {
     pub(super) up: Option<[f64; 3]>,
     pub(super) fov_y_deg: Option<f64>,
     pub(super) near: Option<f64>,
+    /// The eye on a horizontal circle about `center` (the target stays).
+    pub(super) orbit: Option<FileOrbit>,
+    /// `[{ t, eye, target }, ...]`.
+    pub(super) keyframes: Option<Vec<FileCameraKey>>,
+}
+
+/// One of the camera's `keyframes = [{ t, eye, target }, ...]`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct FileCameraKey {
+    pub(super) t: f64,
+    pub(super) eye: [f64; 3],
+    pub(super) target: [f64; 3],
 }
 
 #[derive(Deserialize)]

@@ -1,9 +1,11 @@
 //! The motion keys: a mesh's `spin_deg_per_s = [x, y, z]`, a light's
-//! `orbit = { center, radius, period_s }` or `keyframes = [{ t, position }, ...]`.
+//! `orbit = { center, radius, period_s }` or `keyframes = [{ t, position }, ...]`, the camera's
+//! `orbit` (the same keys as a light's: the eye moves, the target stays) or
+//! `keyframes = [{ t, eye, target }, ...]`.
 
-use super::keys::{Ctx, FileLight, FileMesh};
-use crate::motion::{orbit_phase, LightPath, Motion};
-use crate::{Light, LightKind};
+use super::keys::{Ctx, FileCameraKey, FileLight, FileMesh, FileOrbit};
+use crate::motion::{orbit_phase, CameraPath, LightPath, Motion};
+use crate::{Camera, Light, LightKind};
 use toml::Spanned;
 use umbrage::error::Result;
 
@@ -52,6 +54,46 @@ pub(super) fn motion(cx: &Ctx, meshes: &[Spanned<FileMesh>], file_lights: &[Span
         });
     }
     Ok(m)
+}
+
+/// The camera's motion (`[camera]`'s `orbit` or `keyframes`), from the camera at rest.
+pub(super) fn camera_motion(
+    cx: &Ctx,
+    s: &std::ops::Range<usize>,
+    (orbit, keyframes): (Option<FileOrbit>, Option<Vec<FileCameraKey>>),
+    rest: &Camera,
+) -> Result<Option<CameraPath>> {
+    let s = s.clone();
+    Ok(match (&orbit, &keyframes) {
+        (Some(_), Some(_)) => return Err(cx.key_err(&s, "keyframes", "give the camera either `orbit` or `keyframes`, not both")),
+        (Some(o), None) => {
+            let center = cx.v3(&s, "orbit", o.center)?;
+            let radius = cx.positive(&s, "orbit", Some(o.radius), 1.0)?;
+            let period_s = cx.positive(&s, "orbit", Some(o.period_s), 1.0)?;
+            Some(CameraPath::Orbit { center, radius, period_s, phase: orbit_phase(center, rest.eye) })
+        }
+        (None, Some(keys)) => {
+            if keys.len() < 2 {
+                return Err(cx.key_err(&s, "keyframes", "needs at least two keys"));
+            }
+            let mut out: Vec<(f32, glam::Vec3, glam::Vec3)> = Vec::with_capacity(keys.len());
+            for k in keys {
+                let t = cx.num(&s, "keyframes", k.t)?;
+                if let Some(&(prev, _, _)) = out.last() {
+                    if t <= prev {
+                        return Err(cx.key_err(&s, "keyframes", format!("key times must increase ({t} after {prev})")));
+                    }
+                }
+                let (eye, target) = (cx.v3(&s, "keyframes", k.eye)?, cx.v3(&s, "keyframes", k.target)?);
+                if eye == target {
+                    return Err(cx.key_err(&s, "keyframes", format!("a key at t = {t} has its eye on its target")));
+                }
+                out.push((t, eye, target));
+            }
+            Some(CameraPath::Keyframes(out))
+        }
+        (None, None) => None,
+    })
 }
 
 #[cfg(test)]
@@ -108,6 +150,39 @@ mod tests {
         assert!(e.contains("spin_deg_per_s"), "{e}");
         let e = err("[[mesh]]\nshape = \"box\"\nspin_deg_per_s = [0.0, 1.0]\n");
         assert!(e.contains("spin_deg_per_s") || e.contains("length"), "{e}");
+    }
+
+    #[test]
+    fn the_camera_orbits_or_follows_its_keyframes() {
+        let orbit = "[camera]\neye = [4.0, 2.0, 0.0]\ntarget = [0.0, 0.0, 0.0]\norbit = { center = [0.0, 2.0, 0.0], radius = 4.0, period_s = 8.0 }\n";
+        let (scene, motion) = load_animated_str(orbit);
+        assert!(!motion.is_static());
+        // at rest where the file puts it; a quarter turn later at +z; the target stays
+        let at0 = motion.scene_at(&scene, 0.0).camera;
+        assert!(at0.eye.distance(scene.camera.eye) < 1e-5, "{}", at0.eye);
+        let q = motion.scene_at(&scene, 2.0).camera;
+        assert!(q.eye.distance(Vec3::new(0.0, 2.0, 4.0)) < 1e-4 && q.target == Vec3::ZERO, "{q:?}");
+        let keys = "[camera]\neye = [0.0, 2.0, 6.0]\ntarget = [0.0, 0.0, 0.0]\n\
+                    keyframes = [{ t = 0.0, eye = [0.0, 2.0, 6.0], target = [0.0, 0.0, 0.0] }, \
+                    { t = 2.0, eye = [4.0, 2.0, 6.0], target = [2.0, 0.0, 0.0] }]\n";
+        let (scene, motion) = load_animated_str(keys);
+        let c = motion.scene_at(&scene, 1.0).camera;
+        assert_eq!((c.eye, c.target), (Vec3::new(2.0, 2.0, 6.0), Vec3::new(1.0, 0.0, 0.0)));
+        // refused: both, one key, times not increasing, an eye on its target
+        for (bad, want) in [
+            ("orbit = { center = [0.0, 2.0, 0.0], radius = 4.0, period_s = 8.0 }\nkeyframes = [{ t = 0.0, eye = [0.0, 2.0, 6.0], target = [0.0, 0.0, 0.0] }, { t = 1.0, eye = [1.0, 2.0, 6.0], target = [0.0, 0.0, 0.0] }]\n", "not both"),
+            ("keyframes = [{ t = 0.0, eye = [0.0, 2.0, 6.0], target = [0.0, 0.0, 0.0] }]\n", "at least two"),
+            ("keyframes = [{ t = 1.0, eye = [0.0, 2.0, 6.0], target = [0.0, 0.0, 0.0] }, { t = 1.0, eye = [1.0, 2.0, 6.0], target = [0.0, 0.0, 0.0] }]\n", "increase"),
+            ("keyframes = [{ t = 0.0, eye = [0.0, 2.0, 6.0], target = [0.0, 2.0, 6.0] }, { t = 1.0, eye = [1.0, 2.0, 6.0], target = [0.0, 0.0, 0.0] }]\n", "on its target"),
+        ] {
+            let text = format!("{BASE}{bad}");
+            let e = load_str(&text, "m.toml", Path::new("")).err().map(|e| e.to_string()).unwrap_or_else(|| panic!("accepted: {bad}"));
+            assert!(e.contains(want), "{e}");
+        }
+    }
+
+    fn load_animated_str(text: &str) -> (crate::Scene, crate::motion::Motion) {
+        crate::file::parse_animated(text, "cam.toml", crate::file::ObjSource::Dir(Path::new(""))).expect("loads")
     }
 
     #[test]
