@@ -252,9 +252,10 @@ enum Command {
         /// driver crash ends the run.
         #[arg(long)]
         no_isolate: bool,
-        /// Seconds a child may run before it is killed and its cases reported as hung.
-        #[arg(long, default_value_t = 300.0, value_name = "SECONDS")]
-        timeout: f64,
+        /// Seconds a child may run before it is killed and its cases reported as hung (default
+        /// 300; 30 in the dEQP-compatible mode, below deqp-runner's 60 s per-test timer).
+        #[arg(long, value_name = "SECONDS")]
+        timeout: Option<f64>,
         /// Child processes at once (0: one per CPU core, as deqp-runner does).
         #[arg(long, default_value_t = 0, value_name = "N")]
         jobs: usize,
@@ -263,6 +264,25 @@ enum Command {
         /// unexpected pass.
         #[arg(long, value_name = "FILE")]
         expect: Option<PathBuf>,
+        /// Mesa's baseline: `name,Status` lines (Fail, Crash, Timeout, ...), e.g. a previous
+        /// run's failures.csv; exit 0 only when every result is as listed or passes.
+        #[arg(long, value_name = "FILE")]
+        baseline: Option<PathBuf>,
+        /// Regexes (one a line) of flaky cases: an unexpected result there is KnownFlake.
+        #[arg(long, value_name = "FILE")]
+        flakes: Vec<PathBuf>,
+        /// Regexes (one a line) of cases not to run (reported Skip).
+        #[arg(long, value_name = "FILE")]
+        skips: Vec<PathBuf>,
+        /// Run one case in N of the list (a shard; with --fraction-start).
+        #[arg(long, value_name = "N")]
+        fraction: Option<usize>,
+        /// The first case of this shard, 1-based: shards 1..=N of --fraction N run every case once.
+        #[arg(long, value_name = "K")]
+        fraction_start: Option<usize>,
+        /// The most cases of a configuration one child process draws (default 64).
+        #[arg(long, value_name = "N")]
+        chunk: Option<usize>,
         /// Internal: run one unit and write its result to --child-result (crash isolation).
         #[arg(long, hide = true, value_name = "UNIT")]
         child: Option<String>,
@@ -317,7 +337,15 @@ fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    // `conform`'s dEQP flags (--deqp-*, as deqp-runner appends them) are taken out before clap.
+    let (argv, mut deqp_args) = match umbrage::conform::deqp::args::split(std::env::args_os().collect()) {
+        Ok(split) => split,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let cli = Cli::parse_from(argv);
     let result = match cli.command.unwrap_or(Command::Render {
         frame: FrameArgs::default(),
         out: "umbrage.png".into(),
@@ -333,21 +361,40 @@ fn main() -> ExitCode {
         Command::Info { json, scene, .. } => info(json, scene.as_deref()),
         Command::Check { dir, band, threshold } => check(&dir, band, threshold),
         Command::Bench(args) => bench_cli::bench_command(args),
-        Command::Conform { out, filter, list, junit, device, no_isolate, timeout, jobs, expect, child, child_result } => {
-            umbrage::conform::run(umbrage::conform::RunArgs {
-                filter,
-                list,
-                junit,
-                out,
-                device,
-                isolate: !no_isolate,
-                timeout_s: timeout,
-                jobs,
-                child,
-                child_result,
-                expect,
-            })
-        }
+        Command::Conform {
+            out,
+            filter,
+            list,
+            junit,
+            device,
+            no_isolate,
+            timeout,
+            jobs,
+            expect,
+            baseline,
+            flakes,
+            skips,
+            fraction,
+            fraction_start,
+            chunk,
+            child,
+            child_result,
+        } => umbrage::conform::run(umbrage::conform::RunArgs {
+            filter,
+            list,
+            junit,
+            out,
+            device,
+            isolate: !no_isolate,
+            timeout_s: timeout.unwrap_or(300.0),
+            jobs,
+            child,
+            child_result,
+            expect,
+            timeout_given: timeout.is_some(),
+            ci: umbrage::conform::deqp::CiArgs { baseline, flakes, skips, fraction, fraction_start, chunk },
+            deqp: deqp_args.take(),
+        }),
         Command::ConformMatrix { columns, notes, out } => {
             umbrage::conform::matrix::run(&columns, notes.as_deref(), &out).map(|_| ExitCode::SUCCESS)
         }
