@@ -53,6 +53,7 @@ pub mod deqp;
 pub mod devices;
 pub mod expect;
 pub mod harness;
+mod image_sink;
 pub mod images;
 pub mod isolate;
 pub mod junit;

@@ -178,7 +178,9 @@ pub fn run_legacy(
             continue;
         }
         let t0 = Instant::now();
+        super::image_sink::begin(opts.image_dir.as_ref().map(|d| d.join("failures").join(&o.name)));
         let mut r = f().unwrap_or_else(|e| CheckResult::error(name, &e));
+        o.images = super::image_sink::finish();
         super::with_validation(&mut r, ctx.take_validation_errors());
         o.status = r.status;
         o.message = r.summary.clone();

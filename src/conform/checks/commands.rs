@@ -431,6 +431,37 @@ fn compare_grid(format: vk::Format, g: &Grid, depth: &[u8], stencil: &[u8]) -> (
     (dm, sm)
 }
 
+/// A grid check's failure images (`<label>.expected_stencil`, `.actual_stencil`,
+/// `.expected_depth`, `.actual_depth`, `.diff`: red where the stencil differs, yellow where the
+/// depth does).
+fn grid_images(label: &str, format: vk::Format, g: &Grid, depth: &[u8], stencil: &[u8]) {
+    use super::super::image_sink::{save, texels, unit_gray};
+    let db = depth_texel_bytes(format);
+    let got_depth = |i: usize| -> f64 {
+        let b = &depth[i * db..(i + 1) * db];
+        match format {
+            vk::Format::D16_UNORM_S8_UINT => u16::from_le_bytes([b[0], b[1]]) as f64 / 65_535.0,
+            vk::Format::D24_UNORM_S8_UINT => (u32::from_le_bytes([b[0], b[1], b[2], b[3]]) & 0x00ff_ffff) as f64 / 16_777_215.0,
+            _ => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+        }
+    };
+    let gray = |v: u8| image::Rgb([v, v, v]);
+    save(&format!("{label}.expected_stencil"), &texels(W, H, |i| gray(g.stencil[i])));
+    save(&format!("{label}.actual_stencil"), &texels(W, H, |i| gray(stencil[i])));
+    save(&format!("{label}.expected_depth"), &texels(W, H, |i| unit_gray(g.depth[i] as f64)));
+    save(&format!("{label}.actual_depth"), &texels(W, H, |i| unit_gray(got_depth(i))));
+    let diff = texels(W, H, |i| {
+        if stencil[i] != g.stencil[i] {
+            image::Rgb([255, 0, 0])
+        } else if !depth_matches(format, &depth[i * db..(i + 1) * db], g.depth[i]) {
+            image::Rgb([255, 255, 0])
+        } else {
+            image::Rgb([0, 0, 0])
+        }
+    });
+    save(&format!("{label}.diff"), &diff);
+}
+
 fn models(ctx: &Context) -> Vec<Model> {
     let mut v = vec![Model::RenderPass];
     if ctx.features.dynamic_rendering {
@@ -455,6 +486,7 @@ pub fn clears(ctx: &Context) -> Result<CheckResult> {
             numbers.insert(label.clone(), json!({ "depth_mismatches": dm, "stencil_mismatches": sm }));
             if dm + sm > 0 {
                 fails.push(format!("{label}: {dm} depth and {sm} stencil texels differ from the load ops' and clears' result"));
+                grid_images(&label, format, &grid, &depth, &stencil);
             }
         }
     }
