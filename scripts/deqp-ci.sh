@@ -3,14 +3,15 @@
 # (docs/conform/driver-ci.md):
 #
 #   scripts/deqp-ci.sh [--full] [--fraction N] [DRIVER...]
+#   scripts/deqp-ci.sh --install-only     only step 1 (.ci/run starts it first, in the background)
 #
 # 1. installs deqp-runner $DEQP_RUNNER_VERSION (default 0.24.0; 0.20.3 is what Mesa pins) with
 #    `cargo install --locked` into $UMBRAGE_TOOLS_DIR (default .tools/), skipped when present;
 # 2. checks that conform/umbrage-cases.txt is `umbrage conform --list`;
 # 3. runs conform/deqp-umbrage.toml on each DRIVER (default: 22.3.6 swiftshader; any of
 #    scripts/drivers.sh's versions) against conform/umbrage-<driver>-fails.txt: 0 unexpected
-#    results. CI runs one case in $FRACTION (default 4, a different quarter each run of the
-#    same commit is not wanted: always shard 1); --full runs every case;
+#    results (and its -flakes.txt where there is one). CI runs one case in $FRACTION (default
+#    4, always shard 1: the same quarter every run); --full runs every case;
 # 4. a crash injected into one case (UMBRAGE_CONFORM_CRASH_CASE=<case>:abort) costs exactly that
 #    case (Crash), and the run passes with it in the baseline; an injected hang costs exactly
 #    that case (Timeout);
@@ -25,10 +26,12 @@ TOOLS="${UMBRAGE_TOOLS_DIR:-$REPO/.tools}"
 case "$TOOLS" in /*) ;; *) TOOLS="$PWD/$TOOLS" ;; esac
 OUT="${DEQP_CI_OUT:-$REPO/target/deqp-ci}"
 FRACTION=4
+INSTALL_ONLY=0
 DRIVERS=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --full) FRACTION=1 ;;
+    --install-only) INSTALL_ONLY=1 ;;
     --fraction) FRACTION="$2"; shift ;;
     -h|--help) sed -n '2,/^set -e/p' "$0" | sed '$d;s/^# \{0,1\}//'; exit 0 ;;
     -*) echo "deqp-ci: unknown flag $1" >&2; exit 2 ;;
@@ -45,6 +48,7 @@ if [ ! -x "$RUNNER" ]; then
   echo "deqp-ci: installing deqp-runner $VERSION into $TOOLS (cargo install --locked; minutes)"
   cargo install deqp-runner --locked --version "$VERSION" --root "$TOOLS/deqp-runner-$VERSION" --quiet
 fi
+[ "$INSTALL_ONLY" = 0 ] || { "$RUNNER" --version; exit 0; }
 cargo build --quiet --bin umbrage
 export PATH="$REPO/target/debug:$PATH"
 
@@ -67,7 +71,10 @@ for d in "${DRIVERS[@]}"; do
   [ -f "$(baseline_of "$d")" ] || fail "no baseline $(baseline_of "$d")"
   mkdir -p "$OUT/$d"
   start=$(date +%s)
-  if ! run_suite "$d" "$OUT/$d" --fraction "$FRACTION"; then
+  flakes=()
+  f="$(baseline_of "$d")"; f="${f%-fails.txt}-flakes.txt"
+  [ ! -f "$f" ] || flakes=(--flakes "$f")
+  if ! run_suite "$d" "$OUT/$d" --fraction "$FRACTION" "${flakes[@]}"; then
     tail -20 "$OUT/$d.log" >&2
     fail "deqp-runner on $d: unexpected results (failures.csv: $OUT/$d/failures.csv)"
   fi

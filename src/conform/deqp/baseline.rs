@@ -250,7 +250,7 @@ mod tests {
         let b = Baseline::parse("# c\numbrage.a,Fail\numbrage.b,Crash\numbrage.c,Timeout,1.0\nstencil.x-1,Fail\n").unwrap();
         assert_eq!(b.cases["umbrage.a"], Judged::Fail);
         assert_eq!(b.cases["umbrage.c"], Judged::Timeout);
-        assert_eq!(b.cases["umbrage.stencil.x_1"], Judged::Fail);
+        assert_eq!(b.cases["umbrage.stencil.xm1"], Judged::Fail);
         assert!(Baseline::parse("umbrage.a,Fail\numbrage.a,Fail\n").is_err());
         assert!(Baseline::parse("umbrage.a,Bogus\n").is_err());
         assert!(Baseline::parse("umbrage.a\n").is_err());

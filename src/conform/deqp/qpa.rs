@@ -203,7 +203,7 @@ mod tests {
     /// deqp-runner do: markers, one well-formed document per case, CasePath = the name, the
     /// status code, and each image's base64 a PNG of the stated size.
     #[test]
-    fn records_parse_as_dEQP_logs() {
+    fn records_parse_as_deqp_logs() {
         let img = image::RgbImage::from_fn(8, 4, |x, y| image::Rgb([x as u8 * 30, y as u8 * 60, 7]));
         let mut png = Vec::new();
         img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png).unwrap();
