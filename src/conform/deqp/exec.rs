@@ -71,6 +71,16 @@ pub struct Done {
     pub outcome: CaseOutcome,
 }
 
+/// What the children sent back besides their cases: each configuration submission's record and
+/// the single-configuration checks' full results (for `conform.json` and `conform.md`).
+#[derive(Clone, Debug, Default)]
+pub struct Extras {
+    /// One record per child that drew a configuration's cases.
+    pub configs: Vec<super::super::suite::ConfigRun>,
+    /// The full results of the `legacy.*`, `commands.*`, `mesh.*` and pipeline checks.
+    pub legacy: Vec<super::super::CheckResult>,
+}
+
 /// How the runner starts its children.
 #[derive(Clone, Debug)]
 pub struct Exec {
@@ -122,7 +132,8 @@ pub fn run(
     opts: &SuiteOptions,
     started: &mut dyn FnMut(&str),
     done: &mut dyn FnMut(Done),
-) -> Result<()> {
+) -> Result<Extras> {
+    let mut extras = Extras::default();
     std::fs::create_dir_all(&ex.scratch).map_err(|e| Error::io(ex.scratch.display().to_string(), e))?;
     let wanted: HashSet<&str> = selected.iter().map(String::as_str).collect();
     let mut queue: VecDeque<Job> = VecDeque::new();
@@ -181,6 +192,8 @@ pub fn run(
             let _ = std::fs::remove_file(&r.stderr);
             match end {
                 End::Result(res) => {
+                    extras.configs.extend(res.config);
+                    extras.legacy.extend(res.legacy);
                     let mut by_name: HashMap<String, CaseOutcome> = res.cases.into_iter().map(|c| (c.name.clone(), c)).collect();
                     for n in &r.job.names {
                         match by_name.remove(n) {
@@ -216,7 +229,7 @@ pub fn run(
             std::thread::sleep(Duration::from_millis(5));
         }
     }
-    Ok(())
+    Ok(extras)
 }
 
 /// Filter patterns that select exactly `names` (see [`suite::matches`]'s `=` form).

@@ -303,7 +303,7 @@ pub fn run_deqp(d: DeqpArgs, a: &RunArgs, chunk: Option<usize>, timeout_given: b
         },
     );
     let _ = std::fs::remove_dir_all(&scratch);
-    result?;
+    result.map(|_| ())?;
     if let Some(e) = failure {
         return Err(e);
     }
@@ -350,7 +350,7 @@ pub fn run_standalone(ctx: &Context, a: &RunArgs, filter: &[String], out: &Path,
     };
     let names_to_run: Vec<String> = to_run.iter().map(|(_, s)| s.clone()).collect();
     let mut first: Vec<Done> = Vec::new();
-    exec::run(ctx, &names_to_run, &ex, opts, &mut |_| {}, &mut |d| first.push(d))?;
+    let extras = exec::run(ctx, &names_to_run, &ex, opts, &mut |_| {}, &mut |d| first.push(d))?;
     let judge = |d: &Done| {
         let j = Judged::with_baseline(d.code, base.cases.get(&d.public).copied());
         if !j.is_success() && flakes.is_match(&d.public) {
@@ -391,9 +391,9 @@ pub fn run_standalone(ctx: &Context, a: &RunArgs, filter: &[String], out: &Path,
         subpixel_bits: ctx.limits.sub_pixel_precision_bits,
         filter: filter.to_vec(),
         formats: suite::format_support(ctx).into_iter().map(|(_, s)| s).collect(),
-        configs: Vec::new(),
+        configs: extras.configs,
         cases,
-        legacy: Vec::new(),
+        legacy: extras.legacy,
         seconds: start.elapsed().as_secs_f64(),
     };
     report::write_all(out, a.junit.as_deref(), &r)?;
