@@ -12,6 +12,7 @@ use std::path::PathBuf;
 struct Sink {
     dir: PathBuf,
     written: Vec<String>,
+    draws: usize,
 }
 
 thread_local! {
@@ -20,7 +21,7 @@ thread_local! {
 
 /// Opens `dir` (when given) for the images of the check about to run.
 pub(crate) fn begin(dir: Option<PathBuf>) {
-    SINK.with(|s| *s.borrow_mut() = dir.map(|dir| Sink { dir, written: Vec::new() }));
+    SINK.with(|s| *s.borrow_mut() = dir.map(|dir| Sink { dir, written: Vec::new(), draws: 0 }));
 }
 
 /// Closes the directory: the paths of the images written since [`begin`].
@@ -54,4 +55,35 @@ pub(crate) fn texels(w: u32, h: u32, px: impl Fn(usize) -> Rgb<u8>) -> RgbImage 
 pub(crate) fn unit_gray(v: f64) -> Rgb<u8> {
     let g = (v.clamp(0.0, 1.0) * 255.0).round() as u8;
     Rgb([g, g, g])
+}
+
+/// A draw's stencil that differs from its prediction (the checks' `count_mismatches`):
+/// `draw<k>.expected_stencil` (magenta: not judged), `.actual_stencil` (both grey, normalised to
+/// the largest value of the two) and `.diff` (red: differs, blue: not judged), `k` counting the
+/// draws of the check that differed.
+pub(crate) fn stencil_mismatch(w: u32, h: u32, expected: &[u8], judged: &[bool], actual: &[u8]) {
+    let n = (w * h) as usize;
+    if expected.len() != n || judged.len() != n || actual.len() != n {
+        return;
+    }
+    let k = SINK.with(|s| {
+        s.borrow_mut().as_mut().map(|sink| {
+            sink.draws += 1;
+            sink.draws
+        })
+    });
+    let Some(k) = k else { return };
+    let top = expected.iter().chain(actual).copied().max().unwrap_or(0).max(1) as u32;
+    let gray = |v: u8| {
+        let g = (v as u32 * 255 / top) as u8;
+        Rgb([g, g, g])
+    };
+    save(&format!("draw{k}.expected_stencil"), &texels(w, h, |i| if judged[i] { gray(expected[i]) } else { Rgb([160, 0, 160]) }));
+    save(&format!("draw{k}.actual_stencil"), &texels(w, h, |i| gray(actual[i])));
+    let diff = texels(w, h, |i| match (judged[i], expected[i] == actual[i]) {
+        (false, _) => Rgb([0, 0, 160]),
+        (true, false) => Rgb([255, 0, 0]),
+        (true, true) => Rgb([0, 0, 0]),
+    });
+    save(&format!("draw{k}.diff"), &diff);
 }
