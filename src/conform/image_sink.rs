@@ -13,6 +13,8 @@ struct Sink {
     dir: PathBuf,
     written: Vec<String>,
     draws: usize,
+    /// (case, path) of the files [`copy_for`] copied, for a check that covers several cases.
+    per_case: Vec<(String, String)>,
 }
 
 thread_local! {
@@ -21,12 +23,33 @@ thread_local! {
 
 /// Opens `dir` (when given) for the images of the check about to run.
 pub(crate) fn begin(dir: Option<PathBuf>) {
-    SINK.with(|s| *s.borrow_mut() = dir.map(|dir| Sink { dir, written: Vec::new(), draws: 0 }));
+    SINK.with(|s| *s.borrow_mut() = dir.map(|dir| Sink { dir, written: Vec::new(), draws: 0, per_case: Vec::new() }));
 }
 
 /// Closes the directory: the paths of the images written since [`begin`].
 pub(crate) fn finish() -> Vec<String> {
     SINK.with(|s| s.borrow_mut().take().map(|s| s.written).unwrap_or_default())
+}
+
+/// Closes the directory of a check that covers several cases: (case, path) of each file
+/// [`copy_for`] copied.
+pub(crate) fn finish_per_case() -> Vec<(String, String)> {
+    SINK.with(|s| s.borrow_mut().take().map(|s| s.per_case).unwrap_or_default())
+}
+
+/// Copies `src` (an image the check already wrote) into `<dir>/<case>/` when a directory is open.
+pub(crate) fn copy_for(case: &str, src: &std::path::Path) {
+    SINK.with(|s| {
+        let mut s = s.borrow_mut();
+        let Some(sink) = s.as_mut() else { return };
+        let dir = sink.dir.join(case);
+        let Some(name) = src.file_name() else { return };
+        let path = dir.join(name);
+        match std::fs::create_dir_all(&dir).and_then(|_| std::fs::copy(src, &path)) {
+            Ok(_) => sink.per_case.push((case.to_string(), path.display().to_string())),
+            Err(e) => eprintln!("umbrage conform: failure image {} not written: {e}", path.display()),
+        }
+    });
 }
 
 /// Saves `img` as `<dir>/<name>.png` when a directory is open (a failure to write is reported
