@@ -82,6 +82,8 @@ fn runs_a_case_list_as_deqp_runner_does() {
         assert!(r.xml.contains("<Result StatusCode=\""));
     }
     assert_eq!(std::fs::read_dir(&cwd).unwrap().count(), 0, "the working directory stays empty");
+    let _ = std::fs::remove_dir_all(&dir);
+    let _ = std::fs::remove_dir_all(&cwd);
 }
 
 #[test]
@@ -99,6 +101,7 @@ fn answers_the_renderer_probe() {
     assert!(recs[0].xml.contains(&format!("<Text>{}</Text>", qpa::esc(&ctx.info.name))), "{}", recs[0].xml);
     assert!(recs[1].xml.contains("<Text>Vulkan "));
     assert!(recs[2].xml.matches("<Text>VK_").count() > 3, "{}", recs[2].xml);
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -124,6 +127,8 @@ fn a_crash_and_a_hang_cost_one_case_each() {
                 assert!(s == "Pass" || s == "NotSupported", "{how} cost {n} too: {s}");
             }
         }
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "the working directory stays empty");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }
 
@@ -171,4 +176,5 @@ fn shards_baselines_and_csvs() {
     assert_eq!(failures, format!("{first},UnexpectedImprovement(Pass)\n"));
     let results = std::fs::read_to_string(out_dir.join("results.csv")).unwrap();
     assert!(results.lines().any(|l| l.starts_with(&format!("{},Skip,", all[1]))), "{results}");
+    let _ = std::fs::remove_dir_all(&dir);
 }
