@@ -12,9 +12,9 @@ deps:
 	@./scripts/drivers.sh install 25.0.7 >/dev/null || echo "warning: Mesa lavapipe 25.0.7 not installed (scripts/drivers.sh install 25.0.7): no --method rayquery here" >&2
 
 # What the tests and the conformance runs need as well (off Debian: the validation layer too),
-# lavapipe 25.0.7, which tests/rayquery.rs and tests/mesh.rs run on when the system's driver has
+# lavapipe 25.0.7, which tests/engine/rayquery.rs and tests/engine/mesh.rs run on when the system's driver has
 # no ray query or mesh shaders, lavapipe 22.3.6, a known driver without mesh shaders for
-# tests/cli.rs (and the quick matrix's), and SwiftShader, which tests/hard_cases.rs, the quick
+# tests/cli/cli.rs (and the quick matrix's), and SwiftShader, which tests/engine/hard_cases.rs, the quick
 # matrix and the minimal example run on.
 deps-tests:
 	@./scripts/deps.sh --tests
@@ -32,29 +32,29 @@ run: deps
 view: deps
 	$(CARGO) run --release -- view --scene stress
 
-# Every test with validation on, the quick conformance matrix on three Mesa lavapipes
-# (scripts/drivers.sh installs them into .drivers/), the doc examples, and the library an engine embeds
-# (`default-features = false`) built, documented with warnings denied, and run as examples/minimal.rs.
+# Every test of the workspace with validation on, the quick conformance matrix on three Mesa
+# lavapipes (scripts/drivers.sh installs them into .drivers/), the doc examples, and the engine
+# crate an engine embeds built alone, documented with warnings denied, and run as
+# examples/minimal.rs (crates/umbrage-minimal: the engine and nothing else).
 test: deps-tests lint
 	./scripts/fetch-assets.sh || true
-	UMBRAGE_VALIDATION=1 $(CARGO) test --all-targets
+	UMBRAGE_VALIDATION=1 $(CARGO) test --workspace --all-targets
 	./scripts/conform-matrix.sh --quick
-	$(CARGO) test --doc
-	$(CARGO) build --lib --no-default-features
-	UMBRAGE_VALIDATION=1 $(CARGO) run --example minimal --no-default-features
-	eval "$$(./scripts/drivers.sh env swiftshader)" && UMBRAGE_VALIDATION=1 $(CARGO) run --example minimal --no-default-features
+	$(CARGO) test --workspace --doc
+	$(CARGO) build -p umbrage --lib
+	UMBRAGE_VALIDATION=1 $(CARGO) run -p umbrage-minimal --example minimal
+	eval "$$(./scripts/drivers.sh env swiftshader)" && UMBRAGE_VALIDATION=1 $(CARGO) run -p umbrage-minimal --example minimal
 	$(MAKE) doc
 
-# Formatting and lints (Cargo.toml's [lints]: every unsafe block and unsafe fn documented),
-# warnings denied; examples/minimal.rs also as an engine builds it (no default features).
+# Formatting and lints of every crate (Cargo.toml's [workspace.lints]: every unsafe block and
+# unsafe fn documented), warnings denied.
 lint:
-	$(CARGO) fmt --check
-	$(CARGO) clippy --all-targets -- -D warnings
-	$(CARGO) clippy --example minimal --no-default-features -- -D warnings
+	$(CARGO) fmt --all --check
+	$(CARGO) clippy --workspace --all-targets -- -D warnings
 
 doc:
-	RUSTDOCFLAGS="-D warnings" $(CARGO) doc --no-deps
-	RUSTDOCFLAGS="-D warnings" $(CARGO) doc --no-deps --no-default-features
+	RUSTDOCFLAGS="-D warnings" $(CARGO) doc --workspace --no-deps
+	RUSTDOCFLAGS="-D warnings" $(CARGO) doc -p umbrage --no-deps --no-default-features
 
 bench: deps
 	$(CARGO) bench
@@ -63,7 +63,7 @@ bench: deps
 # 1/20 as many raw-byte OBJ files: >= 1,000,000 cases in all), the counts printed per generator.
 FUZZ_CASES ?= 250000
 fuzz: deps
-	UMBRAGE_FUZZ_CASES=$(FUZZ_CASES) $(CARGO) test --release --test fuzz -- --nocapture
+	UMBRAGE_FUZZ_CASES=$(FUZZ_CASES) $(CARGO) test -p umbrage --release --test fuzz -- --nocapture
 
 conform: deps-tests
 	UMBRAGE_VALIDATION=1 $(CARGO) run -- conform --out conform-report --junit conform-report/junit.xml

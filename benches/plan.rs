@@ -72,7 +72,7 @@ fn buildings(c: &mut Criterion) {
         eprintln!("NOTE: {path} missing (scripts/fetch-assets.sh): plan/buildings not measured");
         return;
     }
-    let scene = umbrage::scene::load_str(&CITY.replace("OBJ", path), "buildings", std::path::Path::new(".")).expect("city loads");
+    let scene = umbrage_scene::load_str(&CITY.replace("OBJ", path), "buildings", std::path::Path::new(".")).expect("city loads");
     let city = &scene.meshes[0];
     let loaded = city.caster().expect("city caster");
     let shuffled = Caster::new("city", &testmesh::shuffled(&city.mesh), city.transform).expect("shuffled city caster");
@@ -101,7 +101,7 @@ fn buildings(c: &mut Criterion) {
 }
 
 fn bench(c: &mut Criterion) {
-    let scene = umbrage::scene::load("bench/vertex").expect("bench/vertex loads");
+    let scene = umbrage_scene::load("bench/vertex").expect("bench/vertex loads");
     let casters: Vec<Caster> = scene.meshes.iter().filter(|m| m.casts_shadow).map(|m| m.caster().expect("caster builds")).collect();
     let tris: usize = casters.iter().map(|c| c.triangle_count).sum();
     let (w, h) = (640u32, 480u32);

@@ -13,8 +13,8 @@
 //! `PassToggles::mesh_task` off: every meshlet's mesh workgroup runs), and the mesh
 //! workgroups that ran against the meshlets the draws covered. `SWEEP_QUICK=1`: the 10k and
 //! 100k spheres only, both views.
-use umbrage::render::{RenderOptions, Renderer, Technique};
 use umbrage::shadow::Method;
+use umbrage_render::{RenderOptions, Renderer, Technique};
 
 fn scene(segments: u32, rings: u32, eye: [f32; 3]) -> String {
     format!(
@@ -71,7 +71,7 @@ fn main() -> umbrage::Result<()> {
         for &(segments, rings) in if quick { &sizes[1..3] } else { &sizes[..] } {
             let eye = *eye;
             let src = scene(segments, rings, eye);
-            let s = umbrage::scene::load_str(&src, "sweep", std::path::Path::new("."))?;
+            let s = umbrage_scene::load_str(&src, "sweep", std::path::Path::new("."))?;
             let tris = s.meshes[1].mesh.triangles.len();
             let opts = RenderOptions { width: 320, height: 240, ..Default::default() };
             let mut r = Renderer::new(ctx, s, opts)?;

@@ -7,8 +7,8 @@
 //! FMA its vertex pipeline uses (docs/mesh.md, "Exactness").
 //!
 //! `cargo run --example mesh_viewport -- 128x96 128x128 256x192`
-use umbrage::render::{RenderOptions, Renderer, Technique};
 use umbrage::shadow::Method;
+use umbrage_render::{RenderOptions, Renderer, Technique};
 
 fn main() -> umbrage::Result<()> {
     let mut sizes: Vec<(u32, u32)> = Vec::new();
@@ -24,13 +24,13 @@ fn main() -> umbrage::Result<()> {
         return Err(umbrage::Error::Other("no mesh shaders: run on Mesa lavapipe 25.0.7 (scripts/drivers.sh)".into()));
     }
     println!("device: {}", ctx.info.name);
-    let mut names: Vec<&str> = umbrage::scene::builtin_names().into_iter().filter(|n| n.starts_with("hard/")).collect();
+    let mut names: Vec<&str> = umbrage_scene::builtin_names().into_iter().filter(|n| n.starts_with("hard/")).collect();
     names.extend(["default", "stairs", "cubes", "spheres"]);
     for (w, h) in sizes {
         let mut differing = 0;
         for name in &names {
             let opts = RenderOptions { width: w, height: h, capture: true, ..Default::default() };
-            let mut r = Renderer::new(ctx, umbrage::scene::load(name)?, opts)?;
+            let mut r = Renderer::new(ctx, umbrage_scene::load(name)?, opts)?;
             let mut frame = |t: Technique| {
                 r.settings.technique = t;
                 r.render().map(|f| f.stencil)

@@ -118,7 +118,7 @@ def main():
             f"(`profiles/LunarG/VP_LUNARG_desktop_*/vp_gpuinfo_*.json`) of "
             f"[KhronosGroup/Vulkan-Profiles](https://github.com/KhronosGroup/Vulkan-Profiles) at commit `{commit}` "
             f"({date}); Apache-2.0, exported from https://vulkan.gpuinfo.org by Sascha Willems. Only the fields "
-            f"umbrage's device selection reads are kept, in the reports' own schema. `tests/devices.rs` turns "
+            f"umbrage's device selection reads are kept, in the reports' own schema. `tests/engine/devices.rs` turns "
             f"them into `docs/devices.md`.\n"
         )
     print(f"{len(newest)} reports -> {out}")

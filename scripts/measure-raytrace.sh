@@ -18,7 +18,7 @@ scenes=(--scene default --scene bench/fill --scene bench/vertex)
 ./scripts/fetch-assets.sh || true
 if [ -f target/assets/buildings.obj ]; then
   # The OpenFOAM city block (z-up, rotated y-up) with a street light among the buildings, as
-  # tests/parts.rs sets it up.
+  # tests/engine/parts.rs sets it up.
   cat > target/assets/city.toml <<EOF
 [camera]
 eye = [120.0, 260.0, 60.0]

@@ -1,5 +1,4 @@
 #version 450
-// @variant raw RAW_W0
 // @variant table TABLE
 // McGuire et al. 2003, EXTRUDE: the dual-length vertex buffer holds every caster vertex twice,
 // (xyz, 1) and (xyz, 0). A w = 0 copy is sent to infinity away from the light:

@@ -61,7 +61,7 @@ pub enum Error {
         #[source]
         source: gpu_allocator::AllocationError,
     },
-    /// An allocation would exceed the memory budget (`UMBRAGE_MEMORY_BUDGET`, see
+    /// An allocation would exceed the memory budget (set by the host, see
     /// [`crate::gpu::fault`]) or a scene's buffers would not fit the device's memory.
     #[error("out of GPU memory for {name}: {size} bytes requested, {used} bytes in use, limit {budget} bytes")]
     OutOfMemory {

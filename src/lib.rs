@@ -1,23 +1,22 @@
-//! umbrage: exact hard shadows with stencil shadow volumes on raw Vulkan.
+//! umbrage: the engine crate. Exact hard shadows with stencil shadow volumes on raw Vulkan:
+//! geometry, planning, the GPU layer and [`pass::ShadowPass`], what an engine links.
 //!
 //! Layers, each using only those before it: [`geom`] (meshes, topology, silhouettes, culling
 //! volumes, the camera and light models; safe Rust, no Vulkan) <- [`shadow`] (pure CPU
 //! planning: per caster and light the case, caps and index lists of McGuire et al. 2003; safe
 //! Rust, no Vulkan) <- [`pass`] (the embeddable [`pass::ShadowPass`]: the plans on the GPU)
-//! which uses [`gpu`] (thin ash wrappers, knowing nothing of shadows). With the default
-//! feature `cli` the crate also has `scene` (TOML / OBJ / built-in scenes; the one place the
-//! algorithm meets it is `SceneMesh::caster`, in `scene`: `shadow` imports nothing of it), `render`
-//! (umbrage's own frame, a host of the pass), `reference` (the exact CPU ground truth, which
-//! shares nothing with the shadow algorithm but the camera model), `conform`, `bench`,
-//! `accuracy`, `output` and the `umbrage` binary on top.
+//! which uses [`gpu`] (thin ash wrappers, knowing nothing of shadows). The crate compiles the
+//! pass's own shaders and nothing else; scenes, the CPU reference, umbrage's own renderer, the
+//! conformance suite, the benchmark and the command line are the workspace's other crates
+//! (ARCHITECTURE.md in the repository maps them).
 //!
 //! # Features
 //!
-//! - `cli` (default): everything above, and the crates it needs (tobj, image, clap, serde, toml,
-//!   serde_json). An engine depends on umbrage with `default-features = false` and gets
-//!   [`geom`], [`shadow`], [`pass`], [`gpu`] and [`Error`] on ash, glam, gpu-allocator, robust, thiserror,
-//!   bytemuck and meshopt (which builds meshoptimizer's C++: a C++ compiler is needed) only.
-//! - `serde` (enabled by `cli`): `serde::Serialize` on the planner's public types.
+//! - `serde`: `serde::Serialize` on the planner's public types (plans, cases, methods) and the
+//!   named options.
+//!
+//! The dependencies are those of `Cargo.toml` (meshopt builds meshoptimizer's C++: a C++
+//! compiler is needed).
 //!
 //! # Example
 //!
@@ -68,30 +67,18 @@
 #![warn(unsafe_op_in_unsafe_fn)]
 // `!(x > 0.0)` is used on purpose throughout: it is true for NaN, which must be rejected too.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
-#[cfg(feature = "cli")]
-pub mod accuracy;
-#[cfg(feature = "cli")]
-pub mod bench;
-#[cfg(feature = "cli")]
-pub mod conform;
 pub mod error;
 pub mod geom;
 pub mod gpu;
 mod named_enum;
-#[cfg(feature = "cli")]
-pub mod output;
 pub mod pass;
-#[cfg(feature = "cli")]
-pub mod profiles;
-#[cfg(feature = "cli")]
-pub mod reference;
-#[cfg(feature = "cli")]
-pub mod render;
-#[cfg(feature = "cli")]
-pub mod scene;
 pub mod shadow;
-#[cfg(feature = "cli")]
-pub mod soak;
-#[cfg(feature = "view")]
-pub mod view;
 pub use error::{Error, Result};
+pub use named_enum::NamedEnum;
+
+/// What the exported macros need, not part of the API.
+#[doc(hidden)]
+pub mod __private {
+    #[cfg(feature = "serde")]
+    pub use serde;
+}

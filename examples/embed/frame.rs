@@ -343,7 +343,7 @@ impl Host {
             })
             .collect();
         let mut sample_frames = Vec::with_capacity(samples as usize);
-        for (si, &(sx, sy)) in umbrage::render::standard_sample_locations(samples).iter().enumerate() {
+        for (si, &(sx, sy)) in umbrage_render::standard_sample_locations(samples).iter().enumerate() {
             let geometry = &words[layout.geometry(si as u32) as usize..][..GEOMETRY_WORDS as usize * n];
             let mut positions = Vec::with_capacity(3 * n);
             let mut normals = Vec::with_capacity(3 * n);
@@ -391,9 +391,9 @@ impl Host {
                 });
                 masks.push(mask.collect::<Vec<u8>>());
             }
-            let dump = umbrage::output::scene_dump(s, (w, h), positions, normals, masks);
+            let dump = umbrage_render::output::scene_dump(s, (w, h), positions, normals, masks);
             let name = format!("frame {} sample {si}", fl.frame);
-            let report = umbrage::reference::check(&dump, &name, BAND).map_err(|e| format!("check {name}: {e}"))?;
+            let report = umbrage_reference::check(&dump, &name, BAND).map_err(|e| format!("check {name}: {e}"))?;
             for (li, l) in lights.iter_mut().enumerate() {
                 let m = &report.lights[li].metrics;
                 l.mismatches.push(m.mismatches_outside_band);

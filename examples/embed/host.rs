@@ -3,7 +3,7 @@
 //! a debug-utils messenger when `UMBRAGE_VALIDATION` is set), physical device, logical device,
 //! one queue, a gpu-allocator shared with the pass, its own WGSL shaders, a depth-stencil
 //! image, two frames in flight and its own lighting pass. It uses umbrage's public API only,
-//! never `umbrage::render::Renderer` or `umbrage::gpu::Context`.
+//! never `umbrage_render::Renderer` or `umbrage::gpu::Context`.
 //!
 //! [`Config`] picks what engines differ on:
 //! - `samples` (1, 2, 4, 8): every target and pipeline at that count; each sample is read back
@@ -31,7 +31,7 @@
 //! the setup and the teardown; `frame.rs` records, submits and reads back a frame;
 //! `extract.rs` is the per-sample readback; `shaders.rs` the WGSL; `vulkan.rs` the Vulkan
 //! plumbing and `pipelines.rs` its pipelines and render passes. `examples/embed/main.rs` is the
-//! command line; `tests/embed.rs` includes this file and runs every configuration.
+//! command line; `tests/engine/embed.rs` includes this file and runs every configuration.
 #![allow(dead_code)]
 
 use ash::vk;
@@ -42,8 +42,8 @@ use std::ffi::c_void;
 use std::sync::{Arc, Mutex};
 use umbrage::pass::stats::{CpuMs, LightStats, Totals};
 use umbrage::pass::{CasterId, DepthDirection, EnabledFeatures, RenderPassTarget, ShadowPass, ShadowPassDesc, TargetModel};
-use umbrage::reference::Dump;
-use umbrage::scene::Scene;
+use umbrage_reference::Dump;
+use umbrage_scene::Scene;
 use vulkan::{
     color_samples_supported, create_device, create_image, create_view, debug_callback, pick_device, validation_requested, vkerr, Buf, Img,
 };
@@ -78,7 +78,7 @@ pub struct Config {
     /// Frame height.
     pub height: u32,
     /// `None`: the embedded scene ([`scene`], the box turning and sliding); otherwise a scene
-    /// (`umbrage::scene::load`'s file or built-in name) whose last shadow-casting mesh slides
+    /// (`umbrage_scene::load`'s file or built-in name) whose last shadow-casting mesh slides
     /// 0.25 a frame along +x (frame 0 is the scene as loaded).
     pub scene: Option<String>,
     /// Frames the host skips after `prepare`, and how (what a host does when its swapchain
@@ -222,7 +222,7 @@ mod scenes;
 #[path = "setup.rs"]
 mod setup;
 use scenes::Scenes;
-#[allow(unused_imports)] // used by tests/embed.rs
+#[allow(unused_imports)] // used by tests/engine/embed.rs
 pub use scenes::{box_transform, scene};
 #[path = "shaders.rs"]
 mod shaders;

@@ -151,14 +151,14 @@ fn run(args: &Args) -> Result<bool, String> {
     let last = results.last().ok_or("no frame rendered")?;
     if let Some(path) = &args.out {
         let rgba = resolve(last);
-        umbrage::output::write_png(path, config.width, config.height, &rgba).map_err(|e| e.to_string())?;
+        umbrage_render::output::write_png(path, config.width, config.height, &rgba).map_err(|e| e.to_string())?;
         println!("embed: wrote {}", path.display());
     }
     if let Some(dir) = &args.dump {
         for (si, s) in last.samples.iter().enumerate() {
             let d = if last.samples.len() > 1 { dir.join(format!("sample_{si}")) } else { dir.clone() };
             let color = shade(&s.dump);
-            umbrage::output::write_scene_dump(&d, &last.scene, &s.dump, &s.stencil, &color).map_err(|e| e.to_string())?;
+            umbrage_render::output::write_scene_dump(&d, &last.scene, &s.dump, &s.stencil, &color).map_err(|e| e.to_string())?;
         }
         println!("embed: dumped frame {} into {}", last.frame, dump_names(dir, last.samples.len()));
     }
@@ -180,7 +180,7 @@ fn dump_names(dir: &Path, samples: usize) -> String {
 
 /// One sample's picture (RGBA8): the floor-grey albedo lit by every light that reaches the
 /// sample (its mask), Lambert on the dumped normal, a little ambient; the sky for background.
-fn shade(d: &umbrage::reference::Dump) -> Vec<u8> {
+fn shade(d: &umbrage_reference::Dump) -> Vec<u8> {
     let n = (d.width * d.height) as usize;
     let mut out = Vec::with_capacity(4 * n);
     for i in 0..n {

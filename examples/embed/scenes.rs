@@ -4,7 +4,7 @@
 use super::MOVING_MESH;
 use glam::{Mat4, Quat, Vec2, Vec3};
 use umbrage::geom::{Camera, Light};
-use umbrage::scene::{shapes, Scene, SceneMesh};
+use umbrage_scene::{shapes, Scene, SceneMesh};
 
 /// The moving caster's transform at `frame`: the box slides towards the torus and turns.
 pub fn box_transform(frame: usize) -> Mat4 {
@@ -49,7 +49,7 @@ pub(super) struct Scenes {
 impl Scenes {
     pub(super) fn new(spec: Option<&str>) -> Result<Scenes, String> {
         let Some(spec) = spec else { return Ok(Scenes { base: scene(0), moving: Some((MOVING_MESH, box_transform(0))), embedded: true }) };
-        let base = umbrage::scene::load(spec).map_err(|e| e.to_string())?;
+        let base = umbrage_scene::load(spec).map_err(|e| e.to_string())?;
         if !base.spheres.is_empty() || base.meshes.iter().any(|m| m.casts_shadow && m.opacity < 1.0) {
             return Err(format!(
                 "scene '{spec}': this host draws opaque triangle meshes only (no analytic spheres, no transparent casters)"

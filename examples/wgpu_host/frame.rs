@@ -16,7 +16,7 @@ use glam::{DMat4, DVec3, Mat4, Vec3, Vec4};
 use std::time::Instant;
 use umbrage::geom::LightKind;
 use umbrage::pass::ShadowView;
-use umbrage::render::{FrameOutput, Stats};
+use umbrage_render::{FrameOutput, Stats};
 
 /// Where the moving caster is at frame `f`, relative to where the scene puts it: it slides
 /// along +x, 0.25 a frame (frame 0, and so `--frames 1`, is the scene as loaded). The dump

@@ -10,7 +10,7 @@ use glam::Mat4;
 use gpu_allocator::vulkan::Allocator;
 use std::sync::{Arc, Mutex};
 use umbrage::pass::{lit_stencil_state, CasterId, DepthStencilTarget, EnabledFeatures, ShadowPass, ShadowPassDesc};
-use umbrage::scene::Scene;
+use umbrage_scene::Scene;
 use wgpu::util::DeviceExt;
 
 /// Ring slots: two frames in flight.

@@ -99,7 +99,7 @@ fn main() -> ExitCode {
 }
 
 fn run(args: &Args) -> Result<(), String> {
-    let (scene, motion) = umbrage::scene::load_animated(&args.scene).map_err(|e| e.to_string())?;
+    let (scene, motion) = umbrage_scene::load_animated(&args.scene).map_err(|e| e.to_string())?;
     let scene = motion.scene_at(&scene, 0.0);
     let (w, h) = args.size;
     let frames = args.frames as usize;
@@ -150,7 +150,7 @@ fn run(args: &Args) -> Result<(), String> {
         s.totals.triangles.total(),
         args.out.display()
     );
-    umbrage::output::write_png(&args.out, out.width, out.height, &out.color).map_err(|e| e.to_string())?;
+    umbrage_render::output::write_png(&args.out, out.width, out.height, &out.color).map_err(|e| e.to_string())?;
     if let Some(dir) = &args.dump {
         write_dump(dir, &host, &out)?;
         println!("wgpu_host: dump written to {} (check it with `umbrage check {}`)", dir.display(), dir.display());
@@ -159,7 +159,7 @@ fn run(args: &Args) -> Result<(), String> {
     Ok(())
 }
 
-fn write_dump(dir: &Path, host: &host::Host, out: &umbrage::render::FrameOutput) -> Result<(), String> {
+fn write_dump(dir: &Path, host: &host::Host, out: &umbrage_render::FrameOutput) -> Result<(), String> {
     // The scene as the last frame drew it (the moving mesh where that frame put it).
-    umbrage::output::write_frame_dump(dir, &host.scene, out).map_err(|e| e.to_string())
+    umbrage_render::output::write_frame_dump(dir, &host.scene, out).map_err(|e| e.to_string())
 }

@@ -20,7 +20,7 @@
 //! Emission: each sample is a point light (it lights both sides of the light's plane, with the
 //! renderer's point-light shading), so an area light of size 0 is exactly the point light at
 //! its centre, and the light of an area light at a point is the average over its area of the
-//! point light there. The CPU reference (`reference::area`, behind the `cli` feature) computes the visible fraction
+//! point light there. The CPU reference (`umbrage_reference::area`, another crate of the workspace) computes the visible fraction
 //! of the area with many shadow rays, not with these samples.
 
 pub use super::area_shape::{concentric_disc, default_tangent, mix64, pattern_seed, stratified_square, AreaLight, AreaShape, MAX_SAMPLES};

@@ -9,7 +9,6 @@ pub const MAX_SAMPLES: u32 = 1024;
 
 /// The shape of an area light, in its own plane (centred on the light's position).
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[non_exhaustive]
 pub enum AreaShape {
     /// A disc of this radius (world units, > 0).
     Disc {

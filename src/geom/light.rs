@@ -80,7 +80,6 @@ impl Camera {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
-#[non_exhaustive]
 pub enum LightKind {
     /// A point light at `position`, shining in every direction (w = 1).
     Point,
@@ -88,6 +87,17 @@ pub enum LightKind {
     Spot,
     /// A light at infinity, travelling along `direction` (w = 0): every extrusion is parallel.
     Directional,
+}
+
+impl LightKind {
+    /// The kind's name in scene files, dumps and reports: `point`, `spot` or `directional`.
+    pub fn name(self) -> &'static str {
+        match self {
+            LightKind::Point => "point",
+            LightKind::Spot => "spot",
+            LightKind::Directional => "directional",
+        }
+    }
 }
 
 /// A light. `direction` is the unit direction the light travels (directional, spot).

@@ -64,12 +64,28 @@ pub(crate) fn timed<T>(label: impl FnOnce() -> String, f: impl FnOnce() -> Resul
     r
 }
 
-/// The name of a shader constant of [`super::shaders`] (`shadow.vert`), found by content;
-/// other SPIR-V is named by its size.
+/// A table of named SPIR-V modules: a crate's `shaders::ALL`.
+pub type ShaderTable = &'static [(&'static str, &'static [u8])];
+
+/// The tables [`shader_name`] searches beyond the pass's own ([`name_shaders`]).
+static SHADER_TABLES: Mutex<Vec<ShaderTable>> = Mutex::new(Vec::new());
+
+/// Lets the pipeline trace and the creation records name the shaders of another crate's
+/// table (its `shaders::ALL`) by content, as they name the pass's own; without it, its
+/// modules are named by their size. Registering a table twice is harmless.
+pub fn name_shaders(table: ShaderTable) {
+    if let Ok(mut t) = SHADER_TABLES.lock() {
+        if !t.iter().any(|known| std::ptr::eq(*known, table)) {
+            t.push(table);
+        }
+    }
+}
+
+/// The name of a shader constant of [`super::shaders`] (`shadow.vert`), or of a table given to
+/// [`name_shaders`], found by content; other SPIR-V is named by its size.
 pub(crate) fn shader_name(spirv: &[u8]) -> String {
-    super::shaders::ALL
-        .iter()
-        .find(|(_, s)| *s == spirv)
-        .map(|(n, _)| n.to_string())
+    let find = |table: ShaderTable| table.iter().find(|(_, s)| *s == spirv).map(|(n, _)| n.to_string());
+    find(super::shaders::ALL)
+        .or_else(|| SHADER_TABLES.lock().ok().and_then(|t| t.iter().find_map(|table| find(table))))
         .unwrap_or_else(|| format!("spirv[{} bytes]", spirv.len()))
 }

@@ -1,22 +1,26 @@
-//! Test seams for device faults: a memory budget that makes allocations fail, and injected
-//! results from queue submission and presentation.
+//! Fault injection a host installs: a memory budget that makes allocations fail, and injected
+//! results from queue submission and presentation. Nothing is injected unless a host asks:
+//! the engine reads no environment variable; the `umbrage` command line installs what its
+//! `UMBRAGE_FAULT` and `UMBRAGE_MEMORY_BUDGET` say ([`parse_faults`], [`parse_bytes`]).
 //!
 //! Real devices rarely run out of memory or get lost on demand, so the error paths they take
 //! are exercised here by injection:
 //!
-//! - **Memory budget**: `UMBRAGE_MEMORY_BUDGET=<bytes>[K|M|G]` (or [`set_memory_budget`]) caps
-//!   the bytes the crate's buffers and images may hold in one allocator. An allocation that
-//!   would cross it fails with [`crate::Error::OutOfMemory`] before any Vulkan memory is taken,
-//!   and the object it was for is destroyed again.
-//! - **Injected results**: `UMBRAGE_FAULT=<point>=<result>@<n>[,...]` makes the `n`-th call
-//!   (1-based, counted per point over the process) at `point` return `result` instead of
-//!   calling Vulkan. Points: `submit` (every `vkQueueSubmit` of the crate), `present` (the
-//!   viewer's `vkQueuePresentKHR` and `vkAcquireNextImageKHR`), `alloc` (every buffer and
-//!   image memory allocation, failing with [`crate::Error::Allocation`]). Results: `device_lost`,
+//! - **Memory budget** ([`set_memory_budget`]) caps the bytes the crate's buffers and images
+//!   may hold in one allocator. An allocation that would cross it fails with
+//!   [`crate::Error::OutOfMemory`] before any Vulkan memory is taken, and the object it was
+//!   for is destroyed again.
+//! - **Injected results** ([`set_faults`]; text form `<point>=<result>@<n>[,...]`) make the
+//!   `n`-th call (1-based, counted per point) at `point` return `result` instead of calling
+//!   Vulkan. Points: `submit` (every `vkQueueSubmit` of the crate), `present` (the viewer's
+//!   `vkQueuePresentKHR` and `vkAcquireNextImageKHR`), `alloc` (every buffer and image memory
+//!   allocation, failing with [`crate::Error::Allocation`]). Results: `device_lost`,
 //!   `out_of_date`, `out_of_device_memory`, `out_of_host_memory`, `surface_lost`. For example
-//!   `UMBRAGE_FAULT=submit=device_lost@3` loses the device on the third frame.
+//!   `submit=device_lost@3` loses the device on the third frame.
 //!
-//! The environment is read once, at the first query; the programmatic setters win over it.
+//! [`set_faults`] and [`set_memory_budget`] act on the whole process (a command line's run);
+//! [`set_thread_faults`] on the calling thread alone, so that a test injecting faults does not
+//! reach the tests running beside it in the same process.
 
 use ash::vk;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -106,31 +110,21 @@ struct State {
 
 fn state() -> &'static State {
     static STATE: OnceLock<State> = OnceLock::new();
-    STATE.get_or_init(|| {
-        let faults = match std::env::var("UMBRAGE_FAULT") {
-            Ok(spec) => parse_faults(&spec).unwrap_or_else(|e| {
-                // A typo in a test seam must not silently disable it.
-                eprintln!("umbrage: ignoring UMBRAGE_FAULT: {e}");
-                Vec::new()
-            }),
-            Err(_) => Vec::new(),
-        };
-        let budget = std::env::var("UMBRAGE_MEMORY_BUDGET").ok().and_then(|v| {
-            let b = parse_bytes(&v);
-            if b.is_none() {
-                eprintln!("umbrage: ignoring UMBRAGE_MEMORY_BUDGET='{v}' (expected bytes, e.g. 64M)");
-            }
-            b
-        });
-        State {
-            faults: Mutex::new(faults),
-            calls: [AtomicU64::new(0), AtomicU64::new(0), AtomicU64::new(0)],
-            budget: AtomicU64::new(budget.unwrap_or(u64::MAX)),
-        }
+    STATE.get_or_init(|| State {
+        faults: Mutex::new(Vec::new()),
+        calls: [AtomicU64::new(0), AtomicU64::new(0), AtomicU64::new(0)],
+        budget: AtomicU64::new(u64::MAX),
     })
 }
 
-/// Replaces the injected faults (and restarts the call counts); `[]` turns injection off.
+thread_local! {
+    /// The calling thread's own faults and call counts ([`set_thread_faults`]): while set, they
+    /// replace the process's on this thread, and this thread's calls do not count there.
+    static THREAD: std::cell::RefCell<Option<(Vec<Fault>, [u64; 3])>> = const { std::cell::RefCell::new(None) };
+}
+
+/// Replaces the process's injected faults (and restarts the call counts); `[]` turns
+/// injection off.
 pub fn set_faults(faults: &[Fault]) {
     let s = state();
     *s.faults.lock().unwrap_or_else(|p| p.into_inner()) = faults.to_vec();
@@ -139,9 +133,25 @@ pub fn set_faults(faults: &[Fault]) {
     }
 }
 
+/// Injects `faults` on the calling thread only, counting this thread's calls from zero; `None`
+/// goes back to the process's faults. For tests that share a process with other tests.
+pub fn set_thread_faults(faults: Option<&[Fault]>) {
+    THREAD.with(|t| *t.borrow_mut() = faults.map(|f| (f.to_vec(), [0; 3])));
+}
+
 /// Counts one call at `point` and returns the injected result for it, if any. Callers return
 /// it as if Vulkan had.
 pub fn inject(point: FaultPoint) -> Option<vk::Result> {
+    let own = THREAD.with(|t| {
+        t.borrow_mut().as_mut().map(|(faults, calls)| {
+            calls[point.index()] += 1;
+            let n = calls[point.index()];
+            faults.iter().find(|f| f.point == point && f.nth == n).map(|f| f.result)
+        })
+    });
+    if let Some(result) = own {
+        return result;
+    }
     let s = state();
     let n = s.calls[point.index()].fetch_add(1, Ordering::SeqCst) + 1;
     let faults = s.faults.lock().unwrap_or_else(|p| p.into_inner());
@@ -167,7 +177,7 @@ pub(crate) fn check_budget(allocator: &gpu_allocator::vulkan::Allocator, name: &
     if let Some(result) = inject(FaultPoint::Alloc) {
         let source = match result {
             vk::Result::ERROR_OUT_OF_DEVICE_MEMORY => gpu_allocator::AllocationError::OutOfMemory,
-            other => gpu_allocator::AllocationError::Internal(format!("injected {other:?} (UMBRAGE_FAULT)")),
+            other => gpu_allocator::AllocationError::Internal(format!("injected {other:?} (fault injection)")),
         };
         return Err(crate::Error::Allocation { name: name.to_string(), size, source });
     }

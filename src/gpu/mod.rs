@@ -1,8 +1,8 @@
 //! Thin wrappers over ash: context, memory, images, pipelines. Knows nothing about shadows.
-//! The crate's `unsafe` lives in the GPU layer: this module, [`crate::pass`], and with `cli`
-//! the modules that record their own command buffers (`render`, `view`, and the GPU parts of
-//! `conform` and `bench`); [`crate::geom`] and [`crate::shadow`] forbid it. Every block has a
-//! `// SAFETY:` line and every `unsafe fn` a `# Safety` section (`Cargo.toml`'s `[lints]`).
+//! The engine's `unsafe` lives in the GPU layer: this module and [`crate::pass`] (the other
+//! crates of the workspace that record their own command buffers have theirs); [`crate::geom`]
+//! and [`crate::shadow`] forbid it. Every block has a `// SAFETY:` line and every `unsafe fn` a
+//! `# Safety` section (`Cargo.toml`'s `[workspace.lints]`).
 #![warn(missing_docs)]
 pub mod accel;
 pub mod cache;

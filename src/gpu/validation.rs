@@ -4,7 +4,6 @@ use ash::vk;
 
 /// What `UMBRAGE_VALIDATION` asks the Khronos layer to check beyond API usage.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[non_exhaustive]
 pub enum ValidationMode {
     /// `1`, `true` or `sync`: API usage and synchronisation validation (the default of every
     /// test and CI run).

@@ -507,7 +507,7 @@ impl super::ShadowPass {
         self.casters.add(&self.dev, caster, transform)
     }
 
-    /// Adds a caster prepared by the caller (e.g. `SceneMesh::caster` with the `cli` feature, or [`Caster::new`] then [`Caster::into_transparent`]).
+    /// Adds a caster prepared by the caller (e.g. `umbrage_scene::SceneMesh::caster`, or [`Caster::new`] then [`Caster::into_transparent`]).
     pub fn add_prepared_caster(&mut self, caster: Caster, transform: DMat4) -> Result<CasterId> {
         check_transform(&caster.name, &transform)?;
         if let Some(t) = caster.transmittance {

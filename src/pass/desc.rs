@@ -47,7 +47,6 @@ pub fn reverse_z(proj: glam::Mat4) -> glam::Mat4 {
 /// Where the pass records its determination: its own rendering instances, or inside the host's
 /// render pass.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-#[non_exhaustive]
 pub enum TargetModel {
     /// Dynamic rendering (Vulkan 1.3, or `VK_KHR_dynamic_rendering` promoted): each
     /// `cmd_determine` begins and ends its own rendering instance on the host's image, and

@@ -116,9 +116,7 @@ pub use desc::{
 pub use draw::LightFrame;
 pub use frame::{PreparedFrame, MAX_CONE_DEG};
 pub use pipelines::COUNT_FORMAT;
-#[cfg(feature = "cli")]
-pub(crate) use rays::light_rel;
-pub use rays::{RayCounts, RayQueryFrame, RayQueryInputs};
+pub use rays::{light_rel, RayCounts, RayQueryFrame, RayQueryInputs};
 pub use record::{lit_stencil_state, VolumeKind};
 pub use spheres::{SphereId, SphereInfo};
 pub use target::DepthStencilTarget;

@@ -10,7 +10,6 @@ use ash::vk;
 
 /// What a volume draw counts into (the pipelines differ, the geometry is the same).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[non_exhaustive]
 pub enum VolumeKind {
     /// Opaque casters into the stencil (two-sided wrapping ops; light caps with depth NEVER).
     Stencil,

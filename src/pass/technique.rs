@@ -44,7 +44,6 @@ named_enum!(
 /// [`ShadowMap`](Technique::ShadowMap) is a whole renderer path: a `ShadowPass` refuses it
 /// with [`Error::InvalidDesc`] ([`PassSettings::check`](super::PassSettings::check)).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-#[non_exhaustive]
 pub enum Technique {
     /// CPU possible silhouettes and index streams, with one of the papers' case rules.
     Volumes(Method),

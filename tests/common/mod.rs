@@ -2,6 +2,8 @@
 //! failure when no Vulkan device exists while `CI` is set.
 #![allow(dead_code)]
 
+pub mod exe;
+
 use umbrage::gpu::Context;
 
 /// A context with validation on. Without a device: panics under CI (a failure), otherwise
@@ -75,6 +77,8 @@ pub fn rerun_on_lavapipe_25(test: &str, ignored: bool, env: &[(&str, &str)]) -> 
 /// Runs test `test` of this binary in a child process with the driver environment `vars` and
 /// `env` added, and asserts that it passed (and ran).
 fn run_child(test: &str, ignored: bool, env: &[(&str, &str)], vars: &[(String, Option<String>)], driver: &str) {
+    // `concat!(module_path!(), "::name")` at the call site: libtest's names leave out the crate.
+    let test = test.split_once("::").map_or(test, |(_, rest)| rest);
     let mut cmd = std::process::Command::new(std::env::current_exe().expect("test binary"));
     cmd.args(["--exact", test, "--nocapture", "--test-threads", "1"]);
     if ignored {
@@ -159,7 +163,7 @@ pub fn rerun_on_swiftshader(test: &str, env: &[(&str, &str)]) -> bool {
 /// input among them: light_in_face_plane, light_at_vertex, light_inside_caster, zero_area,
 /// slivers, near_coplanar, far_coordinates, open_casters) and the built-in scenes with casters.
 pub fn hard_and_builtin_scenes() -> Vec<&'static str> {
-    let mut names: Vec<&str> = umbrage::scene::builtin_names().into_iter().filter(|n| n.starts_with("hard/")).collect();
+    let mut names: Vec<&str> = umbrage_scene::builtin_names().into_iter().filter(|n| n.starts_with("hard/")).collect();
     names.extend(["default", "stairs", "cubes", "spheres"]);
     names
 }
@@ -207,8 +211,8 @@ translate = [2.6, 1.0, 0.0]
 "#;
 
 /// [`MIXED`], loaded.
-pub fn mixed_scene() -> umbrage::scene::Scene {
-    umbrage::scene::load_str(MIXED, "mixed", std::path::Path::new(".")).unwrap()
+pub fn mixed_scene() -> umbrage_scene::Scene {
+    umbrage_scene::load_str(MIXED, "mixed", std::path::Path::new(".")).unwrap()
 }
 
 /// The seed of a GPU property test's random source: `default` (so that CI is reproducible),
@@ -244,5 +248,5 @@ fn random_seed() -> u64 {
 
 /// The fraction of `hard/big_caster` that SwiftShader's sliver defect costs the z-fail methods
 /// with both caps everywhere (docs/conform/drivers-notes.md §1e), measured: the worst of the
-/// defect's cells, which `tests/hard_cases.rs` and `tests/proptest_gpu.rs` hold it to.
+/// defect's cells, which `tests/engine/hard_cases.rs` and `tests/engine/proptest_gpu.rs` hold it to.
 pub const SWIFTSHADER_BIG_CASTER_SLIVERS: f64 = 0.00058;

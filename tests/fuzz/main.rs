@@ -19,8 +19,8 @@ use std::sync::Once;
 use std::time::Instant;
 use umbrage::geom::topology::{Topology, Weld};
 use umbrage::geom::{Camera, Light, LightKind, Mesh};
-use umbrage::scene::{obj::load_obj_str, shapes};
 use umbrage::shadow::{plan_light_with, Caster, Method, PlanInput, PlanOptions};
+use umbrage_scene::{obj::load_obj_str, shapes};
 
 mod mesh;
 mod obj;
@@ -186,7 +186,7 @@ fn fuzz_obj() {
         },
         |b| {
             std::fs::write(&path, b).unwrap();
-            if let Ok(m) = umbrage::scene::load_obj(&path) {
+            if let Ok(m) = umbrage_scene::load_obj(&path) {
                 m.validate("fuzz.obj").unwrap();
             }
         },

@@ -5,8 +5,8 @@ use crate::Rng;
 use glam::{Mat4, Vec3};
 use umbrage::geom::topology::{Topology, Weld};
 use umbrage::geom::Mesh;
-use umbrage::scene::shapes;
 use umbrage::shadow::Caster;
+use umbrage_scene::shapes;
 
 /// Named base meshes for mutation.
 fn base_mesh(rng: &mut Rng) -> Mesh {

@@ -6,8 +6,8 @@ use glam::Mat4;
 use std::fmt::Write as _;
 use std::sync::atomic::Ordering;
 use umbrage::geom::topology::Topology;
-use umbrage::scene::obj::load_obj_str;
 use umbrage::shadow::Caster;
+use umbrage_scene::obj::load_obj_str;
 
 fn number(rng: &mut Rng) -> String {
     if !rng.bad() {

@@ -352,7 +352,7 @@ pub(crate) fn scene_text(rng: &mut Rng) -> String {
 }
 
 /// Plans every caster of a loaded scene for every light and checks the volumes.
-fn plan_scene(scene: &umbrage::scene::Scene, method: Method) {
+fn plan_scene(scene: &umbrage_scene::Scene, method: Method) {
     let casters: Vec<Caster> = scene.meshes.iter().filter(|m| m.casts_shadow).filter_map(|m| m.caster().ok()).collect();
     for light in &scene.lights {
         let vp = scene.camera.proj_infinite(1.5) * scene.camera.view();
@@ -364,7 +364,7 @@ fn plan_scene(scene: &umbrage::scene::Scene, method: Method) {
 
 pub(crate) fn check_scene(text: &(String, bool, usize)) {
     let (text, plan, method) = text;
-    if let Ok(scene) = umbrage::scene::load_str(text, "fuzz.toml", &data_dir()) {
+    if let Ok(scene) = umbrage_scene::load_str(text, "fuzz.toml", &data_dir()) {
         SCENE_OK.fetch_add(1, Ordering::Relaxed);
         if *plan {
             plan_scene(&scene, Method::ALL[*method]);

@@ -52,7 +52,7 @@ use proptest_state_machine::{ReferenceStateMachine, StateMachineTest};
 use sut::Sequences;
 use umbrage::geom::{Light, Mesh, Sphere};
 use umbrage::pass::ShadowView;
-use umbrage::scene::shapes;
+use umbrage_scene::shapes;
 
 const W: u32 = 48;
 const H: u32 = 36;

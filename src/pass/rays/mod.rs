@@ -128,8 +128,9 @@ pub struct RayCounts {
 }
 
 /// The eye-relative homogeneous light, f32: (position - eye, 1) or (direction towards the
-/// light, 0). The rays and the renderer's lighting pass take the same one.
-pub(crate) fn light_rel(l: &Light, eye: DVec3) -> [f32; 4] {
+/// light, 0). The rays take this one; a host's lighting pass that takes the same one agrees
+/// with them to the bit.
+pub fn light_rel(l: &Light, eye: DVec3) -> [f32; 4] {
     match l.kind {
         LightKind::Directional => (-l.direction.normalize()).extend(0.0).to_array(),
         _ => (l.position.as_dvec3() - eye).as_vec3().extend(1.0).to_array(),

@@ -50,7 +50,7 @@ fn counts(p: &CasterPlan) -> (Case, usize, usize, usize) {
 }
 
 #[test]
-#[cfg(feature = "cli")] // serde_json
+#[cfg(feature = "serde")] // serde_json
 fn method_names() {
     for m in Method::ALL {
         assert_eq!(m.to_string().parse::<Method>().unwrap(), m);

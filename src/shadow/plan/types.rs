@@ -7,7 +7,6 @@ use glam::Mat4;
 /// Which shadow-volume algorithm to plan for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize))]
-#[non_exhaustive]
 pub enum Method {
     /// Heidmann's z-pass for every caster: sides only ([`Case::ZPass`]); wrong wherever a volume
     /// crosses the near plane.
