@@ -3,7 +3,7 @@
 export PATH := $(HOME)/.cargo/bin:$(PATH)
 CARGO ?= cargo
 
-.PHONY: capi capi-test deps deps-tests drivers lint run view test docs-unchanged bench conform conform-docs conform-matrix doc clean fuzz
+.PHONY: capi capi-test deps deps-tests drivers lint run view test docs-unchanged bench conform conform-docs conform-matrix deqp-ci doc clean fuzz
 
 # The loader, a driver and the tools; then Mesa lavapipe 25.0.7 in .drivers/ (ray query,
 # Vulkan 1.4) beside the system's driver, for `--method rayquery` (a warning if it cannot be had).
@@ -87,6 +87,12 @@ fuzz: deps
 
 conform: deps-tests
 	UMBRAGE_VALIDATION=1 $(CARGO) run -- conform --out conform-report --junit conform-report/junit.xml
+
+# deqp-runner (crates.io, pinned) drives the suite on lavapipe 22.3.6 and SwiftShader against
+# conform/'s baselines, with an injected crash, an injected hang and three shards
+# (docs/conform/driver-ci.md).
+deqp-ci: deps-tests
+	./scripts/deqp-ci.sh
 
 # Regenerates this device's report in docs/conform/ (DEVICE_DOC names it: lavapipe, or a GPU's name).
 DEVICE_DOC ?= lavapipe

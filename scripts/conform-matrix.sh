@@ -46,8 +46,8 @@ run() {
     grep -v '^WARNING: lavapipe is not a conformant' | grep -E '^(PASS|FAIL|NEW|UNEXPECTED|expectations|llvmpipe|SwiftShader)' || true
   # The pipeline above hides the exit status; the report says what happened.
   if [ $quick = 1 ]; then
-    if ! grep -q '"new_failures": \[\]' "$dir/expectations.json" 2>/dev/null ||
-      ! grep -q '"unexpected_passes": \[\]' "$dir/expectations.json"; then
+    if ! grep -q '"new_failures": \[\]' "$dir/conform-expect.json" 2>/dev/null ||
+      ! grep -q '"unexpected_passes": \[\]' "$dir/conform-expect.json"; then
       rc=1
     fi
   fi

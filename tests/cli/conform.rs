@@ -31,6 +31,7 @@ fn json(dir: &Path) -> serde_json::Value {
 
 #[test]
 fn list_prints_every_case_name_once() {
+    // The public names (docs/conform/driver-ci.md): `umbrage.` + the short name.
     let out = umbrage().args(["conform", "--list"]).output().unwrap();
     assert!(out.status.success());
     let text = String::from_utf8(out.stdout).unwrap();
@@ -39,20 +40,20 @@ fn list_prints_every_case_name_once() {
     assert!(names.len() >= 500, "{} cases", names.len());
     assert_eq!(names.iter().collect::<HashSet<_>>().len(), names.len(), "duplicate case names");
     assert!(names.contains(
-        &"stencil.d24s8.dynamic_rendering.static_state.zfail.front_dfail_decr_wrap.back_dfail_incr_wrap.comp_always.ref_0.masks_ff_ff"
+        &"umbrage.stencil.d24s8.dynamic_rendering.static_state.zfail.front_dfail_decr_wrap.back_dfail_incr_wrap.comp_always.ref_0.masks_ff_ff"
     ));
     for fmt in ["d16s8", "d24s8", "d32s8", "s8"] {
         for model in
             ["dynamic_rendering.static_state", "dynamic_rendering.dynamic_state", "render_pass.static_state", "render_pass.dynamic_state"]
         {
-            assert!(names.iter().any(|n| n.starts_with(&format!("stencil.{fmt}.{model}."))), "{fmt}.{model}");
+            assert!(names.iter().any(|n| n.starts_with(&format!("umbrage.stencil.{fmt}.{model}."))), "{fmt}.{model}");
         }
     }
     // A filtered list is the matching subset.
     let out = umbrage().args(["conform", "--list", "--filter", "zoo.*.render_pass.*"]).output().unwrap();
     let sub = String::from_utf8(out.stdout).unwrap();
     assert!(!sub.is_empty());
-    assert!(sub.lines().all(|n| n.starts_with("zoo.") && n.contains(".render_pass.")));
+    assert!(sub.lines().all(|n| n.starts_with("umbrage.zoo.") && n.contains(".render_pass.")));
 }
 
 #[test]

@@ -9,6 +9,7 @@ mod area_lights;
 mod bench_suite;
 mod cli;
 mod conform;
+mod conform_deqp;
 mod faults;
 mod validation;
 mod view;

@@ -268,9 +268,10 @@ enum Command {
         /// driver crash ends the run.
         #[arg(long)]
         no_isolate: bool,
-        /// Seconds a child may run before it is killed and its cases reported as hung.
-        #[arg(long, default_value_t = 300.0, value_name = "SECONDS")]
-        timeout: f64,
+        /// Seconds a child may run before it is killed and its cases reported as hung (default
+        /// 300; 30 in the dEQP-compatible mode, below deqp-runner's 60 s per-test timer).
+        #[arg(long, value_name = "SECONDS")]
+        timeout: Option<f64>,
         /// Child processes at once (0: one per CPU core, as deqp-runner does).
         #[arg(long, default_value_t = 0, value_name = "N")]
         jobs: usize,
@@ -279,6 +280,25 @@ enum Command {
         /// unexpected pass.
         #[arg(long, value_name = "FILE")]
         expect: Option<PathBuf>,
+        /// Mesa's baseline: `name,Status` lines (Fail, Crash, Timeout, ...), e.g. a previous
+        /// run's failures.csv; exit 0 only when every result is as listed or passes.
+        #[arg(long, value_name = "FILE")]
+        baseline: Option<PathBuf>,
+        /// Regexes (one a line) of flaky cases: an unexpected result there is KnownFlake.
+        #[arg(long, value_name = "FILE")]
+        flakes: Vec<PathBuf>,
+        /// Regexes (one a line) of cases not to run (reported Skip).
+        #[arg(long, value_name = "FILE")]
+        skips: Vec<PathBuf>,
+        /// Run one case in N of the list (a shard; with --fraction-start).
+        #[arg(long, value_name = "N")]
+        fraction: Option<usize>,
+        /// The first case of this shard, 1-based: shards 1..=N of --fraction N run every case once.
+        #[arg(long, value_name = "K")]
+        fraction_start: Option<usize>,
+        /// The most cases of a configuration one child process draws (default 64).
+        #[arg(long, value_name = "N")]
+        chunk: Option<usize>,
         /// Internal: run one unit and write its result to --child-result (crash isolation).
         #[arg(long, hide = true, value_name = "UNIT")]
         child: Option<String>,
@@ -334,7 +354,15 @@ fn parse_size(s: &str) -> std::result::Result<(u32, u32), String> {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    // `conform`'s dEQP flags (--deqp-*, as deqp-runner appends them) are taken out before clap.
+    let (argv, mut deqp_args) = match umbrage_conform::deqp::args::split(std::env::args_os().collect()) {
+        Ok(split) => split,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    let cli = Cli::parse_from(argv);
     // The pipeline trace and `info --pipelines` name every crate's shaders, not only the pass's.
     for table in [umbrage_render::shaders::ALL, umbrage_conform::shaders::ALL, umbrage_bench::shaders::ALL] {
         umbrage::gpu::creation::name_shaders(table);
@@ -359,21 +387,40 @@ fn main() -> ExitCode {
         Command::Check { dir, band, threshold } => check(&dir, band, threshold),
         Command::ExportScene { scene, out } => export_scene_cli::export_scene(&scene, &out).map(|()| ExitCode::SUCCESS),
         Command::Bench(args) => bench_cli::bench_command(args),
-        Command::Conform { out, filter, list, junit, device, no_isolate, timeout, jobs, expect, child, child_result } => {
-            umbrage_conform::run(umbrage_conform::RunArgs {
-                filter,
-                list,
-                junit,
-                out,
-                device,
-                isolate: !no_isolate,
-                timeout_s: timeout,
-                jobs,
-                child,
-                child_result,
-                expect,
-            })
-        }
+        Command::Conform {
+            out,
+            filter,
+            list,
+            junit,
+            device,
+            no_isolate,
+            timeout,
+            jobs,
+            expect,
+            baseline,
+            flakes,
+            skips,
+            fraction,
+            fraction_start,
+            chunk,
+            child,
+            child_result,
+        } => umbrage_conform::run(umbrage_conform::RunArgs {
+            filter,
+            list,
+            junit,
+            out,
+            device,
+            isolate: !no_isolate,
+            timeout_s: timeout.unwrap_or(300.0),
+            jobs,
+            child,
+            child_result,
+            expect,
+            timeout_given: timeout.is_some(),
+            ci: umbrage_conform::deqp::CiArgs { baseline, flakes, skips, fraction, fraction_start, chunk },
+            deqp: deqp_args.take(),
+        }),
         Command::ConformMatrix { columns, notes, out } => {
             umbrage_conform::matrix::run(&columns, notes.as_deref(), &out).map(|_| ExitCode::SUCCESS)
         }

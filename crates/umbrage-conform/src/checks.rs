@@ -57,6 +57,9 @@ fn count_mismatches(rb: &Readback, expected: &[u8], judged: &[bool]) -> (u64, u6
             mism += 1;
         }
     }
+    if mism > 0 {
+        super::image_sink::stencil_mismatch(rb.width, rb.height, expected, judged, &rb.stencil);
+    }
     (mism, unjudged)
 }
 

@@ -57,9 +57,11 @@ pub mod shaders {
 pub mod batch;
 pub mod cases;
 pub mod checks;
+pub mod deqp;
 pub mod devices;
 pub mod expect;
 pub mod harness;
+mod image_sink;
 pub mod images;
 pub mod isolate;
 pub mod junit;
@@ -203,6 +205,12 @@ pub struct RunArgs {
     /// The driver's expected failures ([`expect`]): the exit status then says whether the
     /// run matched them (no new failure, no unexpected pass) instead of whether it passed.
     pub expect: Option<PathBuf>,
+    /// Whether `--timeout` was given (the dEQP-compatible mode's default is lower).
+    pub timeout_given: bool,
+    /// The standalone driver-CI flags ([`deqp::CiArgs`]).
+    pub ci: deqp::CiArgs,
+    /// The dEQP flags: the dEQP-compatible mode ([`deqp::run_deqp`]).
+    pub deqp: Option<deqp::args::DeqpArgs>,
 }
 
 /// Child mode: runs one unit and writes its result as JSON (see [`isolate`]).
@@ -210,6 +218,7 @@ fn run_child(ctx: &Context, unit: &str, result: Option<&std::path::Path>, opts: 
     let unit = isolate::Unit::parse(unit).ok_or_else(|| Error::Other(format!("--child: unknown unit '{unit}'")))?;
     let result = result.ok_or_else(|| Error::Other("--child needs --child-result FILE".into()))?;
     isolate::injected_crash(unit);
+    deqp::exec::injected_case_fault(&opts.filter);
     let validation = ctx.validation;
     let r = isolate::run_unit(ctx, unit, &|| Context::with_validation(validation), opts);
     let json = serde_json::to_string(&r).map_err(|e| Error::Other(e.to_string()))?;
@@ -226,7 +235,10 @@ pub const EXIT_NOTHING_SELECTED: u8 = 2;
 /// `UMBRAGE_DEVICE` for the context after checking that such a device exists (else the
 /// error lists the devices). `UMBRAGE_CONFORM_BREAK=<op>` is the test seam of
 /// [`SuiteOptions::break_op`].
-pub fn run(a: RunArgs) -> Result<ExitCode> {
+pub fn run(mut a: RunArgs) -> Result<ExitCode> {
+    if let Some(d) = a.deqp.take() {
+        return deqp::run_deqp(d, &a, a.ci.chunk, a.timeout_given);
+    }
     let filter: Vec<String> =
         a.filter.as_deref().unwrap_or("").split(',').map(|p| p.trim().to_string()).filter(|p| !p.is_empty()).collect();
     let names: Vec<String> =
@@ -240,8 +252,13 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         return Ok(ExitCode::from(EXIT_NOTHING_SELECTED));
     }
     if a.list {
-        for n in &names {
-            println!("{n}");
+        // A closed pipe (`--list | head`) ends the listing quietly.
+        use std::io::Write as _;
+        let mut stdout = std::io::stdout().lock();
+        for n in deqp::list(&filter) {
+            if writeln!(stdout, "{n}").is_err() {
+                break;
+            }
         }
         return Ok(ExitCode::SUCCESS);
     }
@@ -267,6 +284,9 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
     if !(a.timeout_s > 0.0 && a.timeout_s.is_finite()) {
         return Err(Error::Other(format!("--timeout must be a positive number of seconds, got {}", a.timeout_s)));
     }
+    if a.ci.any() {
+        return deqp::run_standalone(&ctx, &a, &filter, &out, &opts);
+    }
     let r = if a.isolate {
         let exe = std::env::current_exe().map_err(|e| Error::io("the umbrage executable", e))?;
         let iso = isolate::Isolation {
@@ -287,6 +307,7 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
         run_suite(&ctx, &|| Context::with_validation(validation), &opts)
     };
     report::write_all(&out, a.junit.as_deref(), &r)?;
+    deqp::write_plain_csvs(&out, &r)?;
     println!("{} | {} | Vulkan {}", r.device.name, r.device.driver_info, r.device.api_version);
     for c in r.failed() {
         println!("FAIL {}: {}", c.name, c.message);
@@ -311,7 +332,7 @@ pub fn run(a: RunArgs) -> Result<ExitCode> {
             v.new_failures.len(),
             v.unexpected_passes.len()
         );
-        let p = out.join("expectations.json");
+        let p = out.join("conform-expect.json");
         let json = serde_json::to_string_pretty(&v).map_err(|e| Error::Other(e.to_string()))?;
         std::fs::write(&p, json + "\n").map_err(|e| Error::io(p.display().to_string(), e))?;
         return Ok(if v.ok() { ExitCode::SUCCESS } else { ExitCode::FAILURE });

@@ -30,8 +30,12 @@ impl Default for SuiteOptions {
     }
 }
 
-/// Whether `name` matches `pattern` (glob with `*` and `?` when it has either, else substring).
+/// Whether `name` matches `pattern` (`=NAME`: exactly that name; glob with `*` and `?` when it
+/// has either; else substring).
 pub fn matches(pattern: &str, name: &str) -> bool {
+    if let Some(exact) = pattern.strip_prefix('=') {
+        return name == exact;
+    }
     if !pattern.contains(['*', '?']) {
         return name.contains(pattern);
     }

@@ -178,7 +178,9 @@ pub fn run_legacy(
             continue;
         }
         let t0 = Instant::now();
+        super::image_sink::begin(opts.image_dir.as_ref().map(|d| d.join("failures").join(&o.name)));
         let mut r = f().unwrap_or_else(|e| CheckResult::error(name, &e));
+        o.images = super::image_sink::finish();
         super::with_validation(&mut r, ctx.take_validation_errors());
         o.status = r.status;
         o.message = r.summary.clone();
@@ -248,7 +250,10 @@ pub fn run_pipeline(
         let t0 = Instant::now();
         let (w, h) = opts.pipeline_size;
         let chosen = |scene: &str, m: umbrage::shadow::Method| names.contains(&pipeline_name(scene, m));
-        match super::checks::shadow_pipeline_hard_cases(new_context, w, h, &chosen) {
+        super::image_sink::begin(opts.image_dir.as_ref().map(|d| d.join("failures")));
+        let result = super::checks::shadow_pipeline_hard_cases(new_context, w, h, &chosen);
+        let images = super::image_sink::finish_per_case();
+        match result {
             Ok(r) => {
                 let per = t0.elapsed().as_secs_f64() / r.cases.len().max(1) as f64;
                 for k in &r.cases {
@@ -270,6 +275,7 @@ pub fn run_pipeline(
                     if k.expected_failure {
                         o.message.push_str(" — a known limitation of this method (accuracy::expected_failure), reproduced");
                     }
+                    o.images = images.iter().filter(|(c, _)| *c == o.name).map(|(_, p)| p.clone()).collect();
                     out.push(o);
                 }
                 results.push(r);

@@ -431,6 +431,45 @@ fn compare_grid(format: vk::Format, g: &Grid, depth: &[u8], stencil: &[u8]) -> (
     (dm, sm)
 }
 
+/// A texel's depth in 0..1 from a read-back depth aspect (`db` bytes a texel).
+fn depth_value(format: vk::Format, depth: &[u8], i: usize) -> f64 {
+    let db = depth_texel_bytes(format);
+    let b = &depth[i * db..(i + 1) * db];
+    match format {
+        vk::Format::D16_UNORM_S8_UINT => u16::from_le_bytes([b[0], b[1]]) as f64 / 65_535.0,
+        vk::Format::D24_UNORM_S8_UINT => (u32::from_le_bytes([b[0], b[1], b[2], b[3]]) & 0x00ff_ffff) as f64 / 16_777_215.0,
+        _ => f32::from_le_bytes([b[0], b[1], b[2], b[3]]) as f64,
+    }
+}
+
+/// A depth-stencil check's failure images (`<label>.expected_stencil`, `.actual_stencil`,
+/// `.expected_depth`, `.actual_depth`, `.diff`: red where the stencil differs, yellow where the
+/// depth does), `W` x `H` texels.
+fn aspect_images(
+    label: &str,
+    format: vk::Format,
+    (exp_depth, exp_stencil): (&dyn Fn(usize) -> f64, &[u8]),
+    (depth, stencil): (&[u8], &[u8]),
+    depth_bad: &dyn Fn(usize) -> bool,
+) {
+    use super::super::image_sink::{save, texels, unit_gray};
+    let gray = |v: u8| image::Rgb([v, v, v]);
+    save(&format!("{label}.expected_stencil"), &texels(W, H, |i| gray(exp_stencil[i])));
+    save(&format!("{label}.actual_stencil"), &texels(W, H, |i| gray(stencil[i])));
+    save(&format!("{label}.expected_depth"), &texels(W, H, |i| unit_gray(exp_depth(i))));
+    save(&format!("{label}.actual_depth"), &texels(W, H, |i| unit_gray(depth_value(format, depth, i))));
+    let diff = texels(W, H, |i| {
+        if stencil[i] != exp_stencil[i] {
+            image::Rgb([255, 0, 0])
+        } else if depth_bad(i) {
+            image::Rgb([255, 255, 0])
+        } else {
+            image::Rgb([0, 0, 0])
+        }
+    });
+    save(&format!("{label}.diff"), &diff);
+}
+
 fn models(ctx: &Context) -> Vec<Model> {
     let mut v = vec![Model::RenderPass];
     if ctx.features.dynamic_rendering {
@@ -455,6 +494,9 @@ pub fn clears(ctx: &Context) -> Result<CheckResult> {
             numbers.insert(label.clone(), json!({ "depth_mismatches": dm, "stencil_mismatches": sm }));
             if dm + sm > 0 {
                 fails.push(format!("{label}: {dm} depth and {sm} stencil texels differ from the load ops' and clears' result"));
+                let db = depth_texel_bytes(format);
+                let bad = |t: usize| !depth_matches(format, &depth[t * db..(t + 1) * db], grid.depth[t]);
+                aspect_images(&label, format, (&|t| grid.depth[t] as f64, &grid.stencil), (&depth, &stencil), &bad);
             }
         }
     }
@@ -583,6 +625,9 @@ pub fn layouts(ctx: &Context) -> Result<CheckResult> {
         numbers.insert(short(format).into(), json!({ "chain": names, "depth_mismatches": dm, "stencil_mismatches": sm }));
         if dm + sm > 0 {
             fails.push(format!("{}: {dm} depth and {sm} stencil texels changed through {}", short(format), names.join(" -> ")));
+            let bad = |t: usize| depth[t * db..t * db + kept] != before.0[t * db..t * db + kept];
+            let exp = |t: usize| depth_value(format, &before.0, t);
+            aspect_images(short(format), format, (&exp, &before.1), (&depth, &stencil), &bad);
         }
     }
     let what = "depth and stencil kept through DEPTH_STENCIL_READ_ONLY, SHADER_READ_ONLY (where sampled), \

@@ -43,6 +43,18 @@ pub fn multiview_cube_faces(ctx: &Context, new_context: &dyn Fn() -> Result<Cont
         fails.push(format!(
             "{differ} of {compared} pixels' shadow counts differ between six multiview views and six atlas tiles (clipped triangles lost?)"
         ));
+        // Per light: the atlas's shadow (expected), the views' (actual), red where they differ.
+        use super::super::image_sink::{save, texels};
+        let (w, h) = (96u32, 72u32);
+        let shade = |c: i32| if c == 0 { image::Rgb([255, 255, 255]) } else { image::Rgb([64, 64, 64]) };
+        for (l, (a, b)) in tiles.counts.iter().zip(&views.counts).enumerate() {
+            if a.len() != (w * h) as usize || b.len() != a.len() {
+                continue;
+            }
+            save(&format!("light{l}.expected_atlas"), &texels(w, h, |i| shade(a[i])));
+            save(&format!("light{l}.actual_multiview"), &texels(w, h, |i| shade(b[i])));
+            save(&format!("light{l}.diff"), &texels(w, h, |i| if a[i] != b[i] { image::Rgb([255, 0, 0]) } else { image::Rgb([0, 0, 0]) }));
+        }
     }
     let numbers = json!({ "compared": compared, "differ": differ, "shadowed": shadowed });
     let numbers = numbers.as_object().cloned().unwrap_or_default();

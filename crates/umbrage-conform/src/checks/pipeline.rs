@@ -50,8 +50,13 @@ pub fn shadow_pipeline_hard_cases(
             let validation = renderer.context().take_validation_errors();
             let dir = tmp.join(format!("{}-{}", name.replace('/', "_"), method.name()));
             umbrage_render::output::write_frame_dump(&dir, renderer.scene(), &frame)?;
-            let report = umbrage_reference::check_dump(&dir, 1)?;
-            let _ = std::fs::remove_dir_all(&dir);
+            let report = match umbrage_reference::check_dump(&dir, 1) {
+                Ok(r) => r,
+                Err(e) => {
+                    let _ = std::fs::remove_dir_all(&dir);
+                    return Err(e);
+                }
+            };
             let expected_failure = umbrage_render::accuracy::expected_failure(name, method, umbrage_render::Counter::Stencil).is_some();
             let passed = report.passed(PIPELINE_THRESHOLD);
             let sum = |f: &dyn Fn(&umbrage_reference::metrics::Metrics) -> u64| report.lights.iter().map(|l| f(&l.metrics)).sum::<u64>();
@@ -69,8 +74,18 @@ pub fn shadow_pipeline_hard_cases(
                 "pass"
             } else {
                 fails.push(format!("{name} {}: {:.4}% outside the band", method.name(), report.worst_fraction() * 100.0));
+                // The frame's picture and each light's shadow mask, as the failure's images.
+                let case = format!("pipeline.hard_cases.{}.{}", name.trim_start_matches("hard/"), method.name());
+                let mut pngs: Vec<std::path::PathBuf> = std::fs::read_dir(&dir)
+                    .map(|d| d.flatten().map(|e| e.path()).filter(|p| p.extension().is_some_and(|x| x == "png")).collect())
+                    .unwrap_or_default();
+                pngs.sort();
+                for p in &pngs {
+                    super::super::image_sink::copy_for(&case, p);
+                }
                 "fail"
             };
+            let _ = std::fs::remove_dir_all(&dir);
             cases.push(CaseResult {
                 scene: name.to_string(),
                 method: method.name().to_string(),
