@@ -70,9 +70,12 @@ struct Row {
     refused: Vec<(String, Probe)>,
 }
 
+/// Fields drop in declaration order: the pass before the context whose device it uses, also
+/// when a probe panics (a context dropped first would leave the pass's drop calling a
+/// destroyed device).
 struct Harness {
-    ctx: Context,
     pass: ShadowPass,
+    ctx: Context,
 }
 
 impl Harness {
@@ -554,7 +557,7 @@ fn every_documented_range_is_checked_at_and_past_its_edges() {
     let pass = ShadowPass::new(&ctx.instance, ctx.physical, &ctx.device, (*ctx.allocator).clone(), &desc).unwrap();
     let rows = rows(&ctx);
     let doc = markdown(&rows);
-    let mut h = Harness { ctx, pass };
+    let mut h = Harness { pass, ctx };
     let mut failures = Vec::new();
     let (mut accepted, mut refused) = (0, 0);
     for r in &rows {

@@ -40,9 +40,11 @@ fn cell_range(b: &Aabb, cell: f32) -> (IVec3, IVec3) {
     (clamp(lo), clamp(hi))
 }
 
+/// How many cells a range covers, saturating: a box of huge coordinates (clamped to 1e9
+/// cells a side) covers more than an `i64` counts, and is then simply "too big to place".
 fn volume((lo, hi): (IVec3, IVec3)) -> i64 {
-    let d = (hi - lo).as_i64vec3() + 1;
-    d.x.max(0) * d.y.max(0) * d.z.max(0)
+    let d = (hi.as_i64vec3() - lo.as_i64vec3()) + 1;
+    d.x.max(0).saturating_mul(d.y.max(0)).saturating_mul(d.z.max(0))
 }
 
 impl Grid {
