@@ -38,7 +38,6 @@ pub fn export_scene(spec: &str, out: &Path) -> Result<()> {
             LightKind::Point => "point",
             LightKind::Spot => "spot",
             LightKind::Directional => "directional",
-            _ => return Err(Error::input(spec, format!("light {i}: a kind the scene export does not know"))),
         };
         let _ = writeln!(s, "light {kind} {} {} {} {}", v(l.position), v(l.direction), l.cone_deg, l.radius.unwrap_or(0.0));
     }
