@@ -84,6 +84,9 @@ pub struct Config {
     /// Frames the host skips after `prepare`, and how (what a host does when its swapchain
     /// goes out of date): they produce no [`FrameResult`], and the pass must lose nothing.
     pub skip: Vec<(usize, Skip)>,
+    /// The Khronos validation layer on (errors fail the run): `None` follows
+    /// `UMBRAGE_VALIDATION` (`1` or `true`), as the command line does; the tests say `Some(true)`.
+    pub validation: Option<bool>,
 }
 
 /// How a host gives up a prepared frame.
@@ -98,7 +101,16 @@ pub enum Skip {
 
 impl Default for Config {
     fn default() -> Config {
-        Config { samples: 1, reverse_z: false, render_pass: false, width: WIDTH, height: HEIGHT, scene: None, skip: Vec::new() }
+        Config {
+            samples: 1,
+            reverse_z: false,
+            render_pass: false,
+            width: WIDTH,
+            height: HEIGHT,
+            scene: None,
+            skip: Vec::new(),
+            validation: None,
+        }
     }
 }
 
@@ -339,7 +351,7 @@ impl Host {
         let scenes = Scenes::new(config.scene.as_deref())?;
         // SAFETY: loads the Vulkan loader; `entry` is kept in the host as long as the instance.
         let entry = unsafe { ash::Entry::load() }.map_err(|e| format!("no Vulkan loader (libvulkan.so.1): {e}"))?;
-        let validation = validation_requested();
+        let validation = config.validation.unwrap_or_else(validation_requested);
         let layer = c"VK_LAYER_KHRONOS_validation";
         let (mut layers, mut extensions) = (Vec::new(), Vec::new());
         if validation {

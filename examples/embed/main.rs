@@ -82,6 +82,7 @@ fn run(args: &Args) -> Result<bool, String> {
         height: args.size.1,
         scene: args.scene.clone(),
         skip: Vec::new(),
+        validation: None,
     };
     let results = host::run(&config, args.frames as usize)?;
     let mut bad = 0u64;

@@ -20,11 +20,84 @@ use std::sync::{Arc, Mutex};
 /// Shared sink for validation messages, filled by the debug messenger (only when validation is on).
 #[derive(Default)]
 pub struct ValidationLog {
-    /// ERROR-severity messages, in the order reported, until drained by
-    /// [`Context::take_validation_errors`] or [`Context::check_validation`].
+    /// ERROR-severity messages, and WARNING-severity ones that the allowlist
+    /// ([`super::validation::ALLOWED_WARNINGS`]) does not name, in the order reported, until
+    /// drained by [`Context::take_validation_errors`] or [`Context::check_validation`]: both fail.
     pub errors: Vec<String>,
-    /// How many WARNING-severity messages were reported (printed only with `UMBRAGE_VERBOSE`).
+    /// How many WARNING-severity messages were reported, allowed ones included.
     pub warnings: usize,
+    /// How many of those the allowlist names (printed only with `UMBRAGE_VERBOSE`).
+    pub allowed: usize,
+    /// Each of `errors`' process-wide sequence number: draining a context's errors drains them
+    /// from the process's record too.
+    seqs: Vec<u64>,
+}
+
+impl ValidationLog {
+    fn push(&mut self, seq: u64, msg: String) {
+        self.errors.push(msg);
+        self.seqs.push(seq);
+    }
+
+    /// Drains the errors; a context's drained errors leave the process's record as well.
+    fn drain(&mut self) -> Vec<String> {
+        let seqs = std::mem::take(&mut self.seqs);
+        if !seqs.is_empty() {
+            if let Ok(mut p) = PROCESS_LOG.try_lock() {
+                let keep: Vec<bool> = p.seqs.iter().map(|s| !seqs.contains(s)).collect();
+                let mut k = keep.iter();
+                p.errors.retain(|_| *k.next().unwrap_or(&true));
+                p.seqs.retain(|s| !seqs.contains(s));
+            }
+        }
+        std::mem::take(&mut self.errors)
+    }
+}
+
+/// The next validation message's process-wide sequence number.
+static SEQ: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// Everything validation reported in this process, whichever context it came from: what a
+/// command line checks after it has destroyed every device and instance (leaks are reported at
+/// `vkDestroyDevice`), see [`process_validation`].
+static PROCESS_LOG: Mutex<ValidationLog> = Mutex::new(ValidationLog { errors: Vec::new(), warnings: 0, allowed: 0, seqs: Vec::new() });
+
+/// `Err(Error::Validation)` if validation reported, anywhere in this process so far, an error
+/// or a warning the allowlist does not name (drains them). A command line calls it after its
+/// last context is dropped, so that objects leaked at teardown fail the run.
+pub fn process_validation() -> Result<()> {
+    let errors = PROCESS_LOG.lock().map(|mut l| {
+        l.seqs.clear();
+        std::mem::take(&mut l.errors)
+    });
+    validation_result(errors.unwrap_or_default())
+}
+
+fn validation_result(errors: Vec<String>) -> Result<()> {
+    match errors.first() {
+        None => Ok(()),
+        Some(first) => Err(Error::Validation { count: errors.len(), first: first.clone() }),
+    }
+}
+
+/// A context's validation log, kept past the context: [`ValidationWatch::finish`] after the
+/// context (and everything made from it) is dropped reports what teardown said too, leaked
+/// objects included.
+#[derive(Clone)]
+pub struct ValidationWatch(Arc<Mutex<ValidationLog>>);
+
+impl ValidationWatch {
+    /// `Err(Error::Validation)` if the context's validation reported any error, or any warning
+    /// the allowlist does not name, that was not drained before (drains them).
+    pub fn finish(&self) -> Result<()> {
+        let errors = self.0.lock().map(|mut l| l.drain()).unwrap_or_default();
+        validation_result(errors)
+    }
+
+    /// Warnings reported so far (allowed ones included), and how many of them were allowed.
+    pub fn warnings(&self) -> (usize, usize) {
+        self.0.lock().map(|l| (l.warnings, l.allowed)).unwrap_or((0, 0))
+    }
 }
 
 /// umbrage's own Vulkan context: instance, one physical and logical device with a single
@@ -40,6 +113,11 @@ pub struct Context {
     debug: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
     /// Also the debug messenger's user data (`Arc::as_ptr`), alive until the messenger is gone.
     log: Arc<Mutex<ValidationLog>>,
+    /// When set, dropping the context panics if validation reported anything not drained by
+    /// then, teardown included (objects leaked are reported at `vkDestroyDevice`): what a test
+    /// sets, so that a leak fails the test that leaked, wherever the context ended up (a
+    /// renderer that owns it included). Off by default; never set on a path a host runs.
+    pub panic_on_teardown_validation: bool,
     /// The chosen physical device: the best-ranked Vulkan 1.3 device with a graphics queue
     /// (discrete > integrated > virtual > CPU, ties in enumeration order) among those whose
     /// name contains `UMBRAGE_DEVICE` (case-insensitive) when that is set.
@@ -102,23 +180,27 @@ unsafe extern "system" fn debug_callback(
 ) -> vk::Bool32 {
     // SAFETY: the loader passes a valid callback-data pointer for the duration of the call, and
     // `user` is `Arc::as_ptr` of the context's log, alive until the messenger is destroyed.
-    let (msg, log) = unsafe {
-        let msg = if data.is_null() || (*data).p_message.is_null() {
-            String::from("(no message)")
-        } else {
-            CStr::from_ptr((*data).p_message).to_string_lossy().into_owned()
-        };
-        (msg, &*(user as *const Mutex<ValidationLog>))
+    let (msg, id, log) = unsafe {
+        let text = |p: *const std::ffi::c_char| (!p.is_null()).then(|| CStr::from_ptr(p).to_string_lossy().into_owned());
+        let (msg, id) = if data.is_null() { (None, None) } else { (text((*data).p_message), text((*data).p_message_id_name)) };
+        (msg.unwrap_or_else(|| String::from("(no message)")), id.unwrap_or_default(), &*(user as *const Mutex<ValidationLog>))
     };
-    if let Ok(mut log) = log.lock() {
-        if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
-            eprintln!("[vulkan validation] {msg}");
-            log.errors.push(msg);
-        } else if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING) {
-            if std::env::var_os("UMBRAGE_VERBOSE").is_some() {
-                eprintln!("[vulkan warning] {msg}");
+    let error = severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR);
+    let warning = !error && severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::WARNING);
+    let allowed = warning && super::validation::allowed_warning(&id).is_some();
+    if error || (warning && !allowed) {
+        eprintln!("[vulkan validation] {}{msg}", if warning { "warning: " } else { "" });
+    } else if allowed && std::env::var_os("UMBRAGE_VERBOSE").is_some() {
+        eprintln!("[vulkan warning, allowed] {msg}");
+    }
+    let seq = SEQ.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    for log in [log, &PROCESS_LOG] {
+        if let Ok(mut log) = log.lock() {
+            log.warnings += usize::from(warning);
+            log.allowed += usize::from(allowed);
+            if error || (warning && !allowed) {
+                log.push(seq, msg.clone());
             }
-            log.warnings += 1;
         }
     }
     vk::FALSE
@@ -292,6 +374,7 @@ impl Context {
                     depth_format,
                     limits,
                     validation,
+                    panic_on_teardown_validation: false,
                 };
                 if minimum == Minimum::Vulkan13 && ctx.null_hardware() {
                     return Err(Error::Unsupported(format!(
@@ -331,16 +414,19 @@ impl Context {
 
     /// Validation errors reported so far (drains them).
     pub fn take_validation_errors(&self) -> Vec<String> {
-        self.log.lock().map(|mut l| std::mem::take(&mut l.errors)).unwrap_or_default()
+        self.log.lock().map(|mut l| l.drain()).unwrap_or_default()
     }
 
-    /// `Err(Error::Validation)` if validation reported any error so far.
+    /// `Err(Error::Validation)` if validation reported any error, or any warning the allowlist
+    /// does not name, so far (drains them).
     pub fn check_validation(&self) -> Result<()> {
-        let errors = self.take_validation_errors();
-        match errors.first() {
-            None => Ok(()),
-            Some(first) => Err(Error::Validation { count: errors.len(), first: first.clone() }),
-        }
+        validation_result(self.take_validation_errors())
+    }
+
+    /// The validation log as a [`ValidationWatch`], to check after this context is dropped
+    /// (what teardown reports: leaked objects at `vkDestroyDevice`).
+    pub fn watch(&self) -> ValidationWatch {
+        ValidationWatch(self.log.clone())
     }
 
     /// The allocator, locked (a poisoned lock is recovered: the allocator's state is only
@@ -446,6 +532,16 @@ impl Drop for Context {
                 du.destroy_debug_utils_messenger(m, None);
             }
             self.instance.destroy_instance(None);
+        }
+        if self.panic_on_teardown_validation && !std::thread::panicking() {
+            let errors = self.log.lock().map(|mut l| l.drain()).unwrap_or_default();
+            if let Some(first) = errors.first() {
+                panic!(
+                    "Vulkan validation reported {} message(s) not checked before the context was dropped, teardown \
+                     included (leaked objects are reported at vkDestroyDevice); first: {first}",
+                    errors.len()
+                );
+            }
         }
     }
 }

@@ -14,8 +14,8 @@ pub enum ValidationMode {
     /// descriptor, buffer and indirect-argument accesses). Synchronisation validation cannot
     /// run in the same instance, so it is off.
     GpuAssisted,
-    /// `best`: API usage, synchronisation and best-practices warnings (logged with
-    /// `UMBRAGE_VERBOSE`, never fatal).
+    /// `best`: API usage, synchronisation and best-practices warnings (each fails like an
+    /// error unless [`ALLOWED_WARNINGS`] names it).
     BestPractices,
 }
 
@@ -47,4 +47,48 @@ impl ValidationMode {
             }
         }
     }
+}
+
+/// A validation warning that does not fail a run: its message ID, why it is expected, and the
+/// driver or layer versions it was seen with. Every other warning fails like an error.
+#[derive(Clone, Copy, Debug)]
+pub struct AllowedWarning {
+    /// The layer's message ID name (`VUID-...`, `WARNING-...`, `BestPractices-...`).
+    pub id: &'static str,
+    /// Why umbrage does what the warning names, on purpose.
+    pub reason: &'static str,
+    /// The driver or layer version(s) it applies to.
+    pub applies_to: &'static str,
+}
+
+/// The one allowlist of validation warnings (see [`AllowedWarning`]).
+pub const ALLOWED_WARNINGS: &[AllowedWarning] = &[
+    AllowedWarning {
+        id: "UNASSIGNED-BestPractices-Error-Result",
+        reason: "feature detection: vkGetPhysicalDeviceImageFormatProperties is asked about formats and sample counts the \
+                 device may lack, and VK_ERROR_FORMAT_NOT_SUPPORTED is the answer that says so",
+        applies_to: "Khronos validation layer 1.3.239 (Debian 12), best-practices mode (UMBRAGE_VALIDATION=best) only",
+    },
+    AllowedWarning {
+        id: "UNASSIGNED-BestPractices-pipeline-stage-flags",
+        reason: "umbrage's own context's uploads and read-backs wait with ALL_COMMANDS barriers: correct and off the \
+                 measured path (the shadow pass's own barriers name their stages)",
+        applies_to: "Khronos validation layer 1.3.239 (Debian 12), best-practices mode only",
+    },
+    AllowedWarning {
+        id: "UNASSIGNED-BestPractices-ImageBarrierAccessLayout",
+        reason: "the renderer's layout transitions use MEMORY_READ|MEMORY_WRITE access, a superset of the \
+                 attachment accesses the layout implies: correct, not the narrowest",
+        applies_to: "Khronos validation layer 1.3.239 (Debian 12), best-practices mode only",
+    },
+    AllowedWarning {
+        id: "UNASSIGNED-BestPractices-vkCreateCommandPool-command-buffer-reset",
+        reason: "the context's pool resets command buffers one by one (frames in flight reuse their own buffer)",
+        applies_to: "Khronos validation layer 1.3.239 (Debian 12), best-practices mode only",
+    },
+];
+
+/// The allowlist's entry for a warning with message ID name `id`, if it has one.
+pub fn allowed_warning(id: &str) -> Option<&'static AllowedWarning> {
+    ALLOWED_WARNINGS.iter().find(|a| a.id == id)
 }

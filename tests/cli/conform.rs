@@ -320,15 +320,16 @@ fn a_multiview_crash_costs_only_the_multiview_check() {
 fn a_hanging_driver_is_killed_at_the_timeout() {
     let Some(_ctx) = common::context() else { return };
     let dir = tmp("hang");
-    let t0 = std::time::Instant::now();
     let out = umbrage()
         .args(["conform", "--filter", "zoo.", "--timeout", "5", "--out"])
         .arg(&dir)
         .env("UMBRAGE_CONFORM_CRASH", "s8.render_pass.static_state:hang")
         .output()
         .unwrap();
+    // The status the timeout produced, not the wall clock: the hung unit's cases name the
+    // timeout that ended them (mutation: a kill that never fires leaves this run hanging and the
+    // message absent).
     assert_eq!(out.status.code(), Some(1));
-    assert!(t0.elapsed().as_secs() < 240, "the hung child was not killed in time");
     let j = json(&dir);
     let cases = j["cases"].as_array().unwrap();
     let hung: Vec<_> = cases.iter().filter(|c| c["status"] == "crash").collect();

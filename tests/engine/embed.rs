@@ -123,7 +123,7 @@ fn every_host_configuration_matches_the_reference() {
     for samples in [1, 4] {
         for render_pass in [false, true] {
             for scene in [None, Some("hard/eye_in_volume")] {
-                let forward = Config { samples, render_pass, ..Config::default() };
+                let forward = Config { samples, render_pass, ..validated() };
                 let reverse = Config { reverse_z: true, ..forward.clone() };
                 let Some(f) = run_checked(&forward, scene) else { return };
                 let Some(r) = run_checked(&reverse, scene) else { return };
@@ -143,7 +143,7 @@ fn every_host_configuration_matches_the_reference() {
 fn host_stencil_matches_umbrage_renderer() {
     // Fails under CI without a device (panics), skips loudly otherwise; validation on.
     let Some(ctx) = common::context() else { return };
-    let frames = host::run(&Config::default(), 1).unwrap_or_else(|e| panic!("host renderer: {e}"));
+    let frames = host::run(&validated(), 1).unwrap_or_else(|e| panic!("host renderer: {e}"));
     let (w, h) = (host::WIDTH, host::HEIGHT);
     let mut r = Renderer::new(ctx, host::scene(0), RenderOptions { width: w, height: h, capture: true, ..Default::default() }).unwrap();
     let out = r.render().unwrap();
@@ -163,9 +163,9 @@ fn host_stencil_matches_umbrage_renderer() {
 #[test]
 fn bad_configurations_are_clear_errors() {
     for (config, expected) in [
-        (Config { samples: 3, ..Config::default() }, "1, 2, 4 or 8"),
-        (Config { scene: Some("analytic/sphere_only".into()), ..Config::default() }, "opaque triangle meshes only"),
-        (Config { scene: Some("no/such/scene".into()), ..Config::default() }, "no/such/scene"),
+        (Config { samples: 3, ..validated() }, "1, 2, 4 or 8"),
+        (Config { scene: Some("analytic/sphere_only".into()), ..validated() }, "opaque triangle meshes only"),
+        (Config { scene: Some("no/such/scene".into()), ..validated() }, "no/such/scene"),
     ] {
         let e = host::run(&config, 1).expect_err("refused");
         assert!(e.contains(expected), "{}: '{e}' does not say '{expected}'", config.name());
@@ -260,7 +260,7 @@ fn skipped_frames_lose_no_uploads() {
     ];
     for render_pass in [false, true] {
         for plan in plans {
-            let config = Config { render_pass, skip: plan.to_vec(), ..Config::default() };
+            let config = Config { render_pass, skip: plan.to_vec(), ..validated() };
             let frames = match host::run(&config, 5) {
                 Ok(f) => f,
                 Err(e) if e.starts_with("no Vulkan loader") || e.contains("no Vulkan driver") => {
@@ -281,4 +281,10 @@ fn skipped_frames_lose_no_uploads() {
             }
         }
     }
+}
+
+/// The default configuration with the validation layer on: switched on here, by the test, not
+/// by the environment the tests happen to run in.
+fn validated() -> Config {
+    Config { validation: Some(true), ..Config::default() }
 }

@@ -103,11 +103,14 @@ fn samples_are_at_their_own_locations_and_the_resolve_antialiases() {
     let moved = four.samples[0].positions.iter().zip(&four.samples[3].positions).filter(|(a, b)| a[0].is_finite() && a != b).count();
     assert!(moved > 10_000, "samples 0 and 3 share their positions at {moved} pixels only");
     // The resolve: identical to the single-sample frame inside surfaces and shadows, blended at
-    // their edges (a few per cent of the pixels).
+    // their edges. Measured on lavapipe 22.3.6: 994 of 19,200 pixels (5.2 %); held to
+    // twice that, where the bound was 20 % (a resolve blending four times the edges it should
+    // would have passed).
     let differ = one.color.chunks(4).zip(four.color.chunks(4)).filter(|(a, b)| a.iter().zip(*b).any(|(x, y)| x.abs_diff(*y) > 2)).count();
     let pixels = (one.width * one.height) as usize;
+    println!("the 4x resolve differs from 1x at {differ} of {pixels} pixels");
     assert!(differ > pixels / 200, "the 4x resolve differs from 1x at {differ} of {pixels} pixels: no antialiasing");
-    assert!(differ < pixels / 5, "the 4x resolve differs from 1x at {differ} of {pixels} pixels");
+    assert!(differ <= 2 * 994 * pixels / 19_200, "the 4x resolve differs from 1x at {differ} of {pixels} pixels (measured: 994 of 19,200)");
     // A sample's stencil agrees with the single-sample frame's away from edges.
     for (li, (a, b)) in one.stencil.iter().zip(&four.samples[0].stencil).enumerate() {
         let same = a.iter().zip(b).filter(|(x, y)| x == y).count();

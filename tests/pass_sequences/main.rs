@@ -196,6 +196,7 @@ fn a_failing_sequence_is_reported() {
         .args(["every_call_sequence_matches_a_fresh_pass", "--exact", "--nocapture", "--test-threads", "1"])
         .env("PASS_SEQUENCES_INJECT_FAILURE", "1")
         .env("PASS_SEQUENCES_CASES", "4")
+        .env("UMBRAGE_VALIDATION", "1")
         .output()
         .unwrap();
     let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
@@ -205,5 +206,7 @@ fn a_failing_sequence_is_reported() {
     for needle in ["UMBRAGE_PROPTEST_SEED=", INJECTED, "minimal failing input"] {
         assert!(text.contains(needle), "the child's output lacks {needle:?}:\n{tail}");
     }
-    assert!(!text.contains("Validation Error"), "a validation error in the failure path:\n{tail}");
+    // umbrage's own tag for every validation message it reports (gpu::context), not the layer's
+    // wording, which changes between layer versions.
+    assert!(!text.contains("[vulkan validation]"), "a validation message in the failure path:\n{tail}");
 }

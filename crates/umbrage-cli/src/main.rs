@@ -372,6 +372,10 @@ fn main() -> ExitCode {
             umbrage_conform::matrix::run(&columns, notes.as_deref(), &out).map(|_| ExitCode::SUCCESS)
         }
     };
+    // Every context is gone by now: what validation said while they were torn down (objects
+    // leaked at vkDestroyDevice) fails the run like any other validation message. Mutation, run
+    // once: the renderer's sampler left undestroyed made `umbrage render` exit 1 (it exited 0).
+    let result = result.and_then(|code| umbrage::gpu::context::process_validation().map(|()| code));
     match result {
         Ok(code) => code,
         Err(e) => {
