@@ -340,6 +340,11 @@ static void image_barrier(VkCommandBuffer cb, VkImage image, VkImageAspectFlags 
     vkCmdPipelineBarrier(cb, src_stage, dst_stage, 0, 0, NULL, 0, NULL, 1, &b);
 }
 
+static int cmp_double(const void *a, const void *b) {
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
 static const float standard_1[2] = {0.5f, 0.5f};
 static const float standard_2[4] = {0.75f, 0.75f, 0.25f, 0.25f};
 static const float standard_4[8] = {0.375f, 0.125f, 0.875f, 0.375f, 0.125f, 0.625f, 0.625f, 0.875f};
@@ -380,7 +385,8 @@ int main(int argc, char **argv) {
     int validation = getenv("UMBRAGE_VALIDATION") && strcmp(getenv("UMBRAGE_VALIDATION"), "0") != 0;
     uint32_t i, f, mi, li, si;
     uint32_t w = args.width, h = args.height, n = args.width * args.height;
-    const float *locations = args.samples == 8 ? standard_8 : args.samples == 4 ? standard_4 : args.samples == 2 ? standard_2 : standard_1;
+    const float *standard = args.samples == 8 ? standard_8 : args.samples == 4 ? standard_4 : args.samples == 2 ? standard_2 : standard_1;
+    float locations[16];
     int moving = -1;
     float (*transforms)[16];
     UmbrageCasterId *casters;
@@ -824,6 +830,135 @@ int main(int argc, char **argv) {
             ai.commandBufferCount = 1;
             CHECK_VK(vkAllocateCommandBuffers(device, &ai, &cb));
             CHECK_VK(vkCreateFence(device, &fi, NULL, &fence));
+        }
+
+        /* ---- where the device evaluates each sample's depth: a plane sloped in x, then in y,
+         * drawn at every sample and read back; each sample's median offset. A conformant device
+         * gives the standard locations; SwiftShader's 4-sample ones are mirrored in x
+         * (docs/conform/drivers-notes.md). As `umbrage render --msaa N` measures them. ---- */
+        memcpy(locations, standard, 2 * args.samples * sizeof(float));
+        for (i = 0; i < 2 && args.samples > 1; i++) {
+            /* depth = 0.5 + 0.25 * clip (x or y): a full-screen quad in clip space, identity MVP */
+            static const float corners[6][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, -1}, {1, 1}, {-1, 1}};
+            float *vd = (float *)vertices.mapped, mvp[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
+            VkCommandBufferBeginInfo begin = {VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+            VkSubmitInfo submit = {VK_STRUCTURE_TYPE_SUBMIT_INFO};
+            VkViewport viewport = {0, 0, 0, 0, 0, 1};
+            VkRect2D full = {{0, 0}, {0, 0}};
+            VkDeviceSize offset = 0;
+            VkMemoryBarrier mb = {VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+            uint32_t k;
+            viewport.width = (float)w;
+            viewport.height = (float)h;
+            full.extent.width = w;
+            full.extent.height = h;
+            for (k = 0; k < 6; k++) {
+                float *v = &vd[7 * k];
+                memset(v, 0, 7 * sizeof(float));
+                v[0] = corners[k][0];
+                v[1] = corners[k][1];
+                v[2] = 0.5f + 0.25f * corners[k][i];
+            }
+            CHECK_VK(vkBeginCommandBuffer(cb, &begin));
+            if (dynamic) {
+                VkRenderingAttachmentInfo color = {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+                VkRenderingAttachmentInfo depth = {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+                VkRenderingInfo ri = {VK_STRUCTURE_TYPE_RENDERING_INFO};
+                image_barrier(cb, plane.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                              VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+                              VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT);
+                image_barrier(cb, ds.image, VK_IMAGE_ASPECT_DEPTH_BIT | VK_IMAGE_ASPECT_STENCIL_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                              VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0,
+                              VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
+                              VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
+                color.imageView = plane_view;
+                color.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+                color.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+                color.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+                depth.imageView = ds_view;
+                depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+                depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+                depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+                depth.clearValue.depthStencil.depth = args.reverse_z ? 0.0f : 1.0f;
+                ri.renderArea = full;
+                ri.layerCount = 1;
+                ri.colorAttachmentCount = 1;
+                ri.pColorAttachments = &color;
+                ri.pDepthAttachment = &depth;
+                ri.pStencilAttachment = &depth;
+                vkCmdBeginRendering(cb, &ri);
+            } else {
+                VkClearValue clears[2];
+                VkRenderPassBeginInfo rb = {VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+                memset(clears, 0, sizeof clears);
+                clears[1].depthStencil.depth = args.reverse_z ? 0.0f : 1.0f;
+                rb.renderPass = prepass_rp;
+                rb.framebuffer = prepass_fb;
+                rb.renderArea = full;
+                rb.clearValueCount = 2;
+                rb.pClearValues = clears;
+                vkCmdBeginRenderPass(cb, &rb, VK_SUBPASS_CONTENTS_INLINE);
+            }
+            vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, prepass_pipe);
+            vkCmdSetViewport(cb, 0, 1, &viewport);
+            vkCmdSetScissor(cb, 0, 1, &full);
+            vkCmdPushConstants(cb, prepass_layout, VK_SHADER_STAGE_VERTEX_BIT, 0, 64, mvp);
+            vkCmdBindVertexBuffers(cb, 0, 1, &vertices.buffer, &offset);
+            vkCmdDraw(cb, 6, 1, 0, 0);
+            if (dynamic) {
+                vkCmdEndRendering(cb);
+                image_barrier(cb, plane.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                              VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+                              VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+                image_barrier(cb, ds.image, VK_IMAGE_ASPECT_DEPTH_BIT | VK_IMAGE_ASPECT_STENCIL_BIT,
+                              VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL, VK_IMAGE_LAYOUT_DEPTH_STENCIL_READ_ONLY_OPTIMAL,
+                              VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
+                              VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+            } else {
+                vkCmdEndRenderPass(cb);
+            }
+            vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, extract_pipe);
+            vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, extract_layout, 0, 1, &set, 0, NULL);
+            for (si = 0; si < args.samples; si++) {
+                uint32_t push[5] = {w, h, si, 0, 5 * n * si};
+                vkCmdPushConstants(cb, extract_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, 20, push);
+                vkCmdDispatch(cb, (w + 7) / 8, (h + 7) / 8, 1);
+            }
+            mb.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+            mb.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+            vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &mb, 0, NULL, 0, NULL);
+            CHECK_VK(vkEndCommandBuffer(cb));
+            submit.commandBufferCount = 1;
+            submit.pCommandBuffers = &cb;
+            CHECK_VK(vkQueueSubmit(queue, 1, &submit, fence));
+            CHECK_VK(vkWaitForFences(device, 1, &fence, VK_TRUE, UINT64_MAX));
+            CHECK_VK(vkResetFences(device, 1, &fence));
+            for (si = 0; si < args.samples; si++) {
+                const uint32_t *g = (const uint32_t *)readback.mapped + 5 * n * si;
+                double *off = malloc(n * sizeof(double)), med;
+                uint32_t p, count = 0;
+                for (p = 0; p < n; p++) {
+                    float d;
+                    double pix = i == 0 ? (double)(p % w) : (double)(p / w), size = i == 0 ? w : h;
+                    memcpy(&d, &g[5 * p], 4);
+                    /* clip = (d - 0.5) / 0.25; window = (clip + 1) * size / 2 */
+                    if (d > 0.0f && d < 1.0f) off[count++] = ((d - 0.5) / 0.25 + 1.0) * size / 2.0 - pix;
+                }
+                if (count == 0) {
+                    free(off);
+                    continue;
+                }
+                qsort(off, count, sizeof(double), cmp_double);
+                med = off[count / 2];
+                /* the standard location where the measure agrees with it to the depth's precision */
+                if (fabs(med - standard[2 * si + i]) > 1e-3) locations[2 * si + i] = (float)med;
+                free(off);
+            }
+        }
+        if (args.samples > 1) {
+            printf("umbrage-c-host: sample depth locations:");
+            for (si = 0; si < args.samples; si++) printf(" (%g, %g)", (double)locations[2 * si], (double)locations[2 * si + 1]);
+            printf("\n");
         }
 
         /* ---- the frames ---- */
