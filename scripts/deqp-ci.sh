@@ -85,7 +85,8 @@ done
 # Crash and hang, pinned: one configuration's first 80 cases on lavapipe 22.3.6 (two children
 # of 64 and 16 cases), the injected case among the first child's.
 D=22.3.6
-grep '^umbrage\.stencil\.d32s8\.dynamic_rendering\.static_state\.' conform/umbrage-cases.txt | head -80 > "$OUT/pin-list.txt"
+# (awk, not grep | head: under pipefail, head closing the pipe early fails the script with SIGPIPE)
+awk '/^umbrage\.stencil\.d32s8\.dynamic_rendering\.static_state\./ && n < 80 { print; n++ }' conform/umbrage-cases.txt > "$OUT/pin-list.txt"
 victim=$(sed -n 5p "$OUT/pin-list.txt")
 pin_run() { # NAME FAULT BASELINE_LINE
   local dir="$OUT/pin-$1"
