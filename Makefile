@@ -37,7 +37,7 @@ view: deps
 # crate an engine embeds built alone, documented with warnings denied, and run as
 # examples/minimal.rs (crates/umbrage-minimal: the engine and nothing else).
 test: deps-tests lint
-	./scripts/fetch-assets.sh || true
+	./scripts/fetch-assets.sh
 	$(CARGO) test --workspace --all-targets
 	$(MAKE) docs-unchanged
 	./scripts/conform-matrix.sh --quick

@@ -256,3 +256,31 @@ fn random_seed() -> u64 {
 /// with both caps everywhere (docs/conform/drivers-notes.md §1e), measured: the worst of the
 /// defect's cells, which `tests/engine/hard_cases.rs` and `tests/engine/proptest_gpu.rs` hold it to.
 pub const SWIFTSHADER_BIG_CASTER_SLIVERS: f64 = 0.00058;
+
+/// `have`, for a check that needs the device feature `name`: without it the check cannot run.
+/// Under `CI` that is a failure, never a silent skip (every feature asked for this way is one
+/// CI's drivers have: lavapipe 22.3.6 has depthClamp, indexTypeUint8, precise occlusion
+/// queries and pipeline statistics); elsewhere the skip is said out loud.
+pub fn feature(have: bool, name: &str) -> bool {
+    if !have {
+        assert!(std::env::var_os("CI").is_none(), "the device lacks {name} under CI: the check that needs it would be skipped");
+        eprintln!("SKIPPED (the device lacks {name}): the check that needs it");
+    }
+    have
+}
+
+/// For a refusal check that needs a device *without* a feature: when the default device has
+/// it, runs test `test` (a module path, `concat!(module_path!(), "::name")`) in a child process
+/// on Mesa lavapipe 22.3.6, which has neither mesh shaders nor ray query, and asserts that it
+/// passed. Returns false when that driver is not installed and `CI` is not set (a loud skip);
+/// under `CI` that is a failure.
+pub fn rerun_without_the_feature(test: &str) -> bool {
+    let Some(vars) = driver_env("22.3.6") else {
+        let why = "Mesa lavapipe 22.3.6 is not installed (scripts/drivers.sh install 22.3.6)";
+        assert!(std::env::var_os("CI").is_none(), "{why}");
+        eprintln!("SKIPPED: {why}");
+        return false;
+    };
+    run_child(test, false, &[], &vars, "Mesa lavapipe 22.3.6");
+    true
+}

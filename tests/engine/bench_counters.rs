@@ -15,8 +15,8 @@ fn frame(r: &mut Renderer, toggles: PassToggles) -> Stats {
 #[test]
 fn counters_count_fragments_and_toggles_cost_what_they_save() {
     let Some(ctx) = common::context() else { return };
-    let precise = ctx.features.occlusion_query_precise;
-    let statistics = ctx.features.pipeline_statistics_query;
+    let precise = common::feature(ctx.features.occlusion_query_precise, "occlusionQueryPrecise");
+    let statistics = common::feature(ctx.features.pipeline_statistics_query, "pipelineStatisticsQuery");
     let scene = umbrage_scene::load("default").expect("scene");
     let opts = RenderOptions { width: 160, height: 90, ..Default::default() };
     let mut r = Renderer::new(ctx, scene, opts).expect("renderer");

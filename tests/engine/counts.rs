@@ -152,7 +152,7 @@ fn bytes_per_triangle_by_index_format() {
         assert_eq!(stats.totals.vertex_bytes, vertex_bpt * tris, "{fmt:?}: static casters send no vertices unless naive");
         ctx = r.into_context();
     }
-    if ctx.features.index_type_uint8 {
+    if common::feature(ctx.features.index_type_uint8, "indexTypeUint8") {
         // A box has 9 vertices (8 + apex): 8-bit indices, 3 bytes a triangle.
         let (stats, _r) = render(ctx, CASES, "cases", Method::McGuire, IndexFormat::U8);
         let small: Vec<_> = stats.lights.iter().flat_map(|l| &l.casters).filter(|c| c.index_format == UsedIndexFormat::U8).collect();

@@ -155,7 +155,7 @@ fn creation_options_are_checked_against_the_device() {
         assert!(matches!(e, Error::Unsupported(_)) && e.to_string().contains("depthClamp"), "{direction:?}: {e}");
         assert!(!e.to_string().contains("--"), "a library message names a CLI flag: {e}");
     }
-    if ctx.features.depth_clamp {
+    if common::feature(ctx.features.depth_clamp, "depthClamp") {
         let d = ShadowPassDesc {
             depth_mode: DepthMode::Clamp,
             depth_direction: DepthDirection::Reverse,

@@ -50,7 +50,7 @@ fn luminance(rgba: &[u8], w: usize, (x, y): (usize, usize)) -> u32 {
 fn stacked_boxes_give_count_two_and_dark_floor() {
     let Some(mut ctx) = common::context() else { return };
     for depth_mode in [DepthMode::Infinite, DepthMode::Clamp] {
-        if depth_mode == DepthMode::Clamp && !ctx.features.depth_clamp {
+        if depth_mode == DepthMode::Clamp && !common::feature(ctx.features.depth_clamp, "depthClamp") {
             continue;
         }
         for method in umbrage::shadow::Method::ALL {

@@ -34,7 +34,9 @@ fn rayquery_follows_a_moving_caster() {
 fn missing_ray_query_is_a_clear_error() {
     let Some(ctx) = common::context() else { return };
     if ctx.features.ray_query {
-        eprintln!("this device has ray query: the missing-extension error cannot be shown here");
+        // The error needs a device without ray query: the same test on lavapipe 22.3.6.
+        drop(ctx);
+        common::rerun_without_the_feature(concat!(module_path!(), "::missing_ray_query_is_a_clear_error"));
         return;
     }
     let scene = umbrage_scene::load("default").unwrap();
