@@ -152,6 +152,9 @@ pub struct Context {
     pub limits: vk::PhysicalDeviceLimits,
     /// Whether the validation layer and debug messenger are active.
     pub validation: bool,
+    /// What the layer checks when [`Context::validation`] is on (`UMBRAGE_VALIDATION`'s mode);
+    /// `None` when validation is off.
+    pub validation_mode: Option<ValidationMode>,
 }
 
 /// Whether validation is requested through `UMBRAGE_VALIDATION`: `1`, `true`, `sync`,
@@ -374,6 +377,7 @@ impl Context {
                     depth_format,
                     limits,
                     validation,
+                    validation_mode: validation.then_some(mode),
                     panic_on_teardown_validation: false,
                 };
                 if minimum == Minimum::Vulkan13 && ctx.null_hardware() {

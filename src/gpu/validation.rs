@@ -34,6 +34,15 @@ impl ValidationMode {
     pub fn from_env() -> Option<ValidationMode> {
         std::env::var("UMBRAGE_VALIDATION").ok().and_then(|v| ValidationMode::parse(&v))
     }
+    /// The mode's name, as `UMBRAGE_VALIDATION` spells it: `sync`, `nosync`, `gpu` or `best`.
+    pub fn name(self) -> &'static str {
+        match self {
+            ValidationMode::Sync => "sync",
+            ValidationMode::ApiOnly => "nosync",
+            ValidationMode::GpuAssisted => "gpu",
+            ValidationMode::BestPractices => "best",
+        }
+    }
     /// The layer features this mode enables.
     pub fn features(self) -> &'static [vk::ValidationFeatureEnableEXT] {
         match self {

@@ -468,6 +468,10 @@ fn render(frame: &FrameArgs, out: &Path, stats: Option<&Path>, view: View, dump:
     let (scene, motion) = umbrage_scene::load_animated(&frame.scene)?;
     let scene = motion.scene_at(&scene, time);
     let ctx = umbrage::gpu::Context::new()?;
+    if let Some(mode) = ctx.validation_mode {
+        // What the run checked, so that a caller can hold it to the mode it asked for.
+        eprintln!("umbrage: validation on ({})", mode.name());
+    }
     let mut renderer = Renderer::new(ctx, scene, opts)?;
     if dump.is_some() {
         // A multisampled capture finds each sample's position where the device evaluated its
