@@ -722,6 +722,12 @@ enum UmbrageResult umbrage_pass_set_sphere(UmbragePass pass, UmbrageSphereId sph
 // Removes a sphere caster.
 enum UmbrageResult umbrage_pass_remove_sphere(UmbragePass pass, UmbrageSphereId sphere);
 
+#if defined(UMBRAGE_TEST_PANIC)
+// Test builds only (`--features test-panic`): panics inside the boundary, so a test can check
+// that it returns `UMBRAGE_ERROR_PANIC` and poisons the pass.
+enum UmbrageResult umbrage_test_inject_panic(UmbragePass pass);
+#endif
+
 // The CPU work of one frame into ring slot `slot` (the host waited for the frame that last
 // used it). `*out` is the frame; its warnings go to the warning callback.
 enum UmbrageResult umbrage_pass_prepare(UmbragePass pass, uint32_t slot, const struct UmbrageView *view, const struct UmbrageLight *lights, uint32_t light_count, struct UmbrageFrame *out);
@@ -759,12 +765,6 @@ enum UmbrageResult umbrage_cmd_light_state(UmbragePass pass, VkCommandBuffer com
 // Records the transparent casters' light-intensity map of `light` into `map` (the pass's
 // `transmitFormat`, dynamic rendering only); `log_space` non-zero: additive log map.
 enum UmbrageResult umbrage_cmd_light_intensity(UmbragePass pass, VkCommandBuffer command_buffer, struct UmbrageFrame frame, uint32_t light, const struct UmbrageDepthStencilTarget *target, VkImageView map, UmbrageBool log_space);
-
-#if defined(UMBRAGE_TEST_PANIC)
-// Test builds only (`--features test-panic`): panics inside the boundary, so a test can check
-// that it returns `UMBRAGE_ERROR_PANIC` and poisons the pass.
-enum UmbrageResult umbrage_test_inject_panic(UmbragePass pass);
-#endif
 
 #ifdef __cplusplus
 }  // extern "C"
