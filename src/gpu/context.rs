@@ -43,7 +43,10 @@ impl ValidationLog {
     fn drain(&mut self) -> Vec<String> {
         let seqs = std::mem::take(&mut self.seqs);
         if !seqs.is_empty() {
-            if let Ok(mut p) = PROCESS_LOG.try_lock() {
+            // The context's log is held here and the process's taken second, the order the
+            // callback never reverses (it holds one at a time): no deadlock, and no drained
+            // error left behind in the process's record to fail the run later.
+            if let Ok(mut p) = PROCESS_LOG.lock() {
                 let keep: Vec<bool> = p.seqs.iter().map(|s| !seqs.contains(s)).collect();
                 let mut k = keep.iter();
                 p.errors.retain(|_| *k.next().unwrap_or(&true));

@@ -12,7 +12,13 @@ use std::path::{Path, PathBuf};
 use std::time::SystemTime;
 
 /// Path of a fresh `target/<profile>/umbrage`; panics (failing the test) if it is missing or stale.
+/// The check walks the sources once a test process; every later call returns its answer.
 pub fn umbrage_exe() -> PathBuf {
+    static EXE: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    EXE.get_or_init(find_fresh_exe).clone()
+}
+
+fn find_fresh_exe() -> PathBuf {
     let test = std::env::current_exe().expect("the test executable's path");
     // target/<profile>/deps/<test>-<hash> -> target/<profile>/umbrage
     let profile_dir = test.parent().and_then(Path::parent).expect("target/<profile>/deps/<test>");

@@ -30,35 +30,7 @@ fn compare(r: &mut Renderer, name: &str) -> FrameOutput {
     }
     let (cs, gs) = (&cpu.stats, &gpu.stats);
     assert_eq!(gs.method, Technique::Compute);
-    for (li, (cl, gl)) in cs.lights.iter().zip(&gs.lights).enumerate() {
-        // the casters drawn, in draw order (with PassSettings::keep the CPU path lists only those)
-        let culled = umbrage::shadow::Case::Culled;
-        let cd: Vec<_> = cl.casters.iter().filter(|c| c.case != culled).collect();
-        let gd: Vec<_> = gl.casters.iter().filter(|c| c.case != culled).collect();
-        assert_eq!(cd.len(), gd.len(), "{name} light {li}: casters drawn");
-        for (&cc, &gc) in cd.iter().zip(&gd) {
-            let what = format!("{name} light {li} caster {}", cc.name);
-            assert_eq!(cc.case, gc.case, "{what}");
-            assert_eq!(
-                (cc.triangles.sides, cc.triangles.dark_cap, cc.triangles.light_cap, cc.silhouette_edges),
-                (gc.triangles.sides, gc.triangles.dark_cap, gc.triangles.light_cap, gc.silhouette_edges),
-                "{what}: triangles and silhouette edges"
-            );
-            assert_eq!(cc.parts.len(), gc.parts.len(), "{what}");
-            for (cp, gp) in cc.parts.iter().zip(&gc.parts) {
-                assert_eq!(cp.case, gp.case, "{what} part {}", cp.part);
-                assert_eq!(
-                    (cp.triangles.sides, cp.triangles.dark_cap, cp.triangles.light_cap, cp.silhouette_edges),
-                    (gp.triangles.sides, gp.triangles.dark_cap, gp.triangles.light_cap, gp.silhouette_edges),
-                    "{what} part {}",
-                    cp.part
-                );
-                if cp.path == VolumePath::Manifold {
-                    assert_eq!(gp.path, VolumePath::Compute, "{what} part {}", cp.part);
-                }
-            }
-        }
-    }
+    common::same_volumes_as_cpu(cs, gs, name, VolumePath::Compute);
     assert_eq!(cs.totals.triangles.total(), gs.totals.triangles.total(), "{name}");
     assert_eq!(gpu2.stats.totals.triangles.total(), gs.totals.triangles.total(), "{name}");
     gpu
