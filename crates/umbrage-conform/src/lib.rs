@@ -4,7 +4,7 @@
 //!
 //! Two layers:
 //!
-//! - **The parametrised suite** ([`cases`], [`model`], [`batch`], [`suite`]): 5,920
+//! - **The parametrised suite** ([`cases`], [`model`], [`batch`], [`suite`]): the
 //!   CTS-style cases (those of formats and features a device lacks are skipped, with the
 //!   reason) — the stencil-op table, depth and infinity, depth clamp and bias, depth bounds, unrestricted depth, rasterisation and occlusion queries, a
 //!   known-bug zoo, and four families beyond the CTS (deep wrap, homogeneous clipping,
