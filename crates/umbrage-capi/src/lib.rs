@@ -10,7 +10,6 @@
 //! # Features
 //!
 #![doc = document_features::document_features!()]
-
 #![allow(clippy::missing_safety_doc)] // the exported functions' contract is the header's
 #![allow(non_snake_case)] // the C structs' field names are the header's (sType, pNext, ...)
 
