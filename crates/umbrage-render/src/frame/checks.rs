@@ -56,7 +56,7 @@ pub(super) fn check_options(ctx: &Context, config: &RenderConfig, s: &FrameSetti
         return Err(umbrage::gpu::accel::missing_ray_query(&ctx.info.name));
     }
     if matches!(s.technique, RenderTechnique::ShadowMap(ShadowMap { cube: CubeFaces::Multiview, .. })) {
-        if let Some(e) = crate::passes::shadowmap::multiview_refusal(ctx) {
+        if let Some(e) = crate::stages::shadowmap::multiview_refusal(ctx) {
             return Err(e);
         }
     }

@@ -6,14 +6,14 @@
 use super::frame_output::{parse, CaptureView, FrameOutput};
 use super::guard::{Destroy, Guard, Owned};
 use super::options::*;
-use super::passes::selfshadow::SelfShadow;
-use super::passes::shadowmap::ShadowMapper;
-use super::passes::{debug, Rec};
 use super::pipelines::FramePipelines;
 use super::push::LightPush;
 use super::readback::Layout;
 use super::scene_gpu::{SceneGeometry, Sidedness};
 use super::sphere_gpu::SphereGeometry;
+use super::stages::selfshadow::SelfShadow;
+use super::stages::shadowmap::ShadowMapper;
+use super::stages::{debug, Rec};
 use super::targets::*;
 use super::technique::RenderTechnique;
 use super::timing::Span;

@@ -2,9 +2,9 @@
 //! output image to present from, and a resize that keeps the casters and the pass.
 
 use super::Renderer;
-use crate::passes::selfshadow::SelfShadow;
 use crate::pipelines::FramePipelines;
 use crate::scene_gpu::Sidedness;
+use crate::stages::selfshadow::SelfShadow;
 use crate::targets::Targets;
 use ash::vk;
 use umbrage::error::{Error, Result};
