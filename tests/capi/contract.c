@@ -211,6 +211,26 @@ int main(void) {
         expect("create: a render pass target without a render pass", umbrage_pass_create(&vk, &info, &out),
                UMBRAGE_ERROR_INVALID_DESC);
     }
+    {
+        UmbrageKeepInfo k1, k2;
+        memset(&k1, 0, sizeof k1);
+        k1.sType = UMBRAGE_STRUCTURE_TYPE_KEEP_INFO;
+        k2 = k1;
+        k1.pNext = &k2;
+        info = base_info();
+        info.pNext = &k1;
+        expect("create: UmbrageKeepInfo chained twice", umbrage_pass_create(&vk, &info, &out), UMBRAGE_ERROR_INVALID_DESC);
+    }
+    {
+        UmbrageRenderPassTarget rp;
+        memset(&rp, 0, sizeof rp);
+        rp.sType = UMBRAGE_STRUCTURE_TYPE_RENDER_PASS_TARGET;
+        rp.renderPass = (VkRenderPass)(uintptr_t)1; /* never used: the chain is refused first */
+        rp.pNext = &rp;                             /* a cycle */
+        info = base_info();
+        info.pNext = &rp;
+        expect("create: a cyclic pNext chain", umbrage_pass_create(&vk, &info, &out), UMBRAGE_ERROR_STRUCTURE_TYPE);
+    }
     expect_true("create: *out untouched by every refusal", out == sentinel);
 
     /* ---- capabilities without a device ---- */
@@ -239,7 +259,18 @@ int main(void) {
     /* ---- a pass ---- */
     info = base_info();
     expect("create: defaults", umbrage_pass_create(&vk, &info, &pass), UMBRAGE_SUCCESS);
-    expect("create: a second pass", umbrage_pass_create(&vk, &info, &other), UMBRAGE_SUCCESS);
+    {
+        /* the second pass plans every frame from scratch, in 8 MiB if it kept anything */
+        UmbrageKeepInfo keep;
+        memset(&keep, 0, sizeof keep);
+        keep.sType = UMBRAGE_STRUCTURE_TYPE_KEEP_INFO;
+        keep.keepBudgetBytes = 8u << 20;
+        keep.planThreads = 1;
+        keep.disableKeep = 1;
+        info.pNext = &keep;
+        expect("create: a second pass, keeping nothing", umbrage_pass_create(&vk, &info, &other), UMBRAGE_SUCCESS);
+        info.pNext = NULL;
+    }
     if (!pass || !other) {
         fprintf(stderr, "contract: no pass, stopping\n");
         printf("%d passed, %d failed\n", passed, failed + 1);
@@ -429,9 +460,38 @@ int main(void) {
         expect("cmd_light_state: light 1 of 1", umbrage_cmd_light_state(pass, VK_NULL_HANDLE, frame, 1, e), UMBRAGE_ERROR_LIGHT_INDEX);
         expect("cmd_light_intensity: no transmit format", umbrage_cmd_light_intensity(pass, VK_NULL_HANDLE, frame, 0, &t, VK_NULL_HANDLE, 0),
                UMBRAGE_ERROR_NOT_CONFIGURED);
+        {
+            UmbrageKeepStats ks;
+            UmbragePassSettings ps;
+            UmbrageFrame foreign2;
+            struct {
+                UmbrageStructureType sType;
+                void *pNext;
+            } unknown = {(UmbrageStructureType)999, NULL};
+            memset(&ks, 0, sizeof ks);
+            ks.sType = UMBRAGE_STRUCTURE_TYPE_KEEP_STATS;
+            st.pNext = &ks;
+            expect("frame_get_stats: with UmbrageKeepStats", umbrage_frame_get_stats(pass, frame, &st), UMBRAGE_SUCCESS);
+            expect_true("keep stats: the cube's pair drawn, planned or kept",
+                        ks.pairsTotal > 0 && ks.pairsKept + ks.pairsReplanned == ks.pairsTotal && st.pNext == &ks);
+            expect("prepare: slot 1, nothing moved", umbrage_pass_prepare(pass, 1, &view, &light, 1, &frame2), UMBRAGE_SUCCESS);
+            expect("frame_get_stats: slot 1", umbrage_frame_get_stats(pass, frame2, &st), UMBRAGE_SUCCESS);
+            expect_true("keep stats: nothing moved, every pair kept, nothing sent for it",
+                        ks.pairsTotal > 0 && ks.pairsKept == ks.pairsTotal && ks.pairsReplanned == 0 && ks.keptBytes > 0);
+            /* the pass that keeps nothing, its settings set again (they do not carry keeping) */
+            expect("get_settings: the other pass", umbrage_pass_get_settings(other, &ps), UMBRAGE_SUCCESS);
+            expect("set_settings: the other pass", umbrage_pass_set_settings(other, &ps), UMBRAGE_SUCCESS);
+            expect("prepare: the other pass, slot 1", umbrage_pass_prepare(other, 1, &view, &light, 1, &foreign2), UMBRAGE_SUCCESS);
+            expect("frame_get_stats: the other pass", umbrage_frame_get_stats(other, foreign2, &st), UMBRAGE_SUCCESS);
+            expect_true("keep stats: UmbrageKeepInfo::disableKeep plans every pair, after set_settings too",
+                        ks.pairsTotal > 0 && ks.pairsKept == 0 && ks.pairsReplanned == ks.pairsTotal && ks.keptBytes == 0);
+            ks.pNext = &unknown;
+            expect("frame_get_stats: an unknown struct chained", umbrage_frame_get_stats(pass, frame2, &st), UMBRAGE_ERROR_STRUCTURE_TYPE);
+            st.pNext = NULL;
+        }
         stale = frame;
-        expect("prepare: slot 1", umbrage_pass_prepare(pass, 1, &view, &light, 1, &frame2), UMBRAGE_SUCCESS);
         expect("frame_get_stats: slot 0's frame still live", umbrage_frame_get_stats(pass, stale, &st), UMBRAGE_SUCCESS);
+        expect("prepare: slot 1 again", umbrage_pass_prepare(pass, 1, &view, &light, 1, &frame2), UMBRAGE_SUCCESS);
         expect("prepare: slot 0 again", umbrage_pass_prepare(pass, 0, &view, &light, 1, &frame), UMBRAGE_SUCCESS);
         expect("frame_get_stats: a stale frame", umbrage_frame_get_stats(pass, stale, &st), UMBRAGE_ERROR_STALE_FRAME);
         expect("cmd_upload: a stale frame", umbrage_cmd_upload(pass, VK_NULL_HANDLE, stale), UMBRAGE_ERROR_STALE_FRAME);

@@ -159,8 +159,8 @@ pub fn settings(s: &UmbragePassSettings) -> Result<PassSettings, CError> {
             compute_draws,
             mesh_task: s.disableMeshTask == 0,
         },
-        // Plans kept across frames, as in every host (this version of the ABI has no field to
-        // turn it off: the default, on, is what the pass does).
+        // Plans kept across frames: on, unless UmbrageKeepInfo at creation turned it off
+        // (`desc`); `umbrage_pass_set_settings` keeps the pass's choice.
         ..PassSettings::default()
     })
 }
@@ -253,6 +253,8 @@ pub unsafe fn desc(info: &UmbragePassCreateInfo) -> Result<ShadowPassDesc, CErro
     let samples = if info.samples == 0 { 1 } else { info.samples };
     let frames = if info.framesInFlight == 0 { 2 } else { info.framesInFlight as usize };
     let mut target = TargetModel::DynamicRendering;
+    let mut keep: Option<UmbrageKeepInfo> = None;
+    let mut chained = 0;
     let mut next = info.pNext;
     while !next.is_null() {
         // SAFETY: the caller's contract: every chained struct starts with sType and pNext.
@@ -270,6 +272,12 @@ pub unsafe fn desc(info: &UmbragePassCreateInfo) -> Result<ShadowPassDesc, CErro
                 samples: sample_flags(samples),
                 color_attachments: rp.colorAttachmentCount,
             });
+        } else if base.s_type == UmbrageStructureType::UMBRAGE_STRUCTURE_TYPE_KEEP_INFO as u32 {
+            if keep.is_some() {
+                return Err(CError::from(engine::Error::desc("UmbrageKeepInfo", "chained twice to UmbragePassCreateInfo")));
+            }
+            // SAFETY: its sType says it is one.
+            keep = Some(unsafe { *next.cast::<UmbrageKeepInfo>() });
         } else {
             return Err(CError::new(
                 UMBRAGE_ERROR_STRUCTURE_TYPE,
@@ -277,7 +285,22 @@ pub unsafe fn desc(info: &UmbragePassCreateInfo) -> Result<ShadowPassDesc, CErro
             ));
         }
         next = base.p_next;
+        chained += 1;
+        if chained > 16 {
+            // (a cycle, or a chain no host needs: refused rather than walked forever)
+            return Err(CError::new(UMBRAGE_ERROR_STRUCTURE_TYPE, "UmbragePassCreateInfo::pNext: more than 16 chained structs"));
+        }
     }
+    let defaults = ShadowPassDesc::default();
+    let mut settings = settings(&info.settings)?;
+    let (keep_budget_bytes, plan_threads) = match keep {
+        Some(k) => {
+            settings.keep = k.disableKeep == 0;
+            let budget = if k.keepBudgetBytes == 0 { defaults.keep_budget_bytes } else { k.keepBudgetBytes };
+            (budget, k.planThreads as usize)
+        }
+        None => (defaults.keep_budget_bytes, defaults.plan_threads),
+    };
     Ok(ShadowPassDesc {
         depth_stencil_format: format,
         frames_in_flight: frames,
@@ -286,13 +309,12 @@ pub unsafe fn desc(info: &UmbragePassCreateInfo) -> Result<ShadowPassDesc, CErro
         samples,
         target,
         features: features(info.enabledFeatures)?,
-        settings: settings(&info.settings)?,
+        settings,
         transmit_format: (info.transmitFormat != vk::Format::UNDEFINED).then_some(info.transmitFormat),
         debug_color_format: None,
         pipeline_cache: info.pipelineCache,
-        // The kept plans' memory budget and the planning threads: the engine's defaults (this
-        // version of the ABI has no fields for them).
-        ..ShadowPassDesc::default()
+        keep_budget_bytes,
+        plan_threads,
     })
 }
 

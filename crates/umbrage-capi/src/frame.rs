@@ -90,9 +90,42 @@ pub unsafe extern "C" fn umbrage_frame_get_stats(pass: UmbragePass, frame: Umbra
             pendingUploads: f.pending_uploads() as u32,
         };
         // SAFETY: non-NULL, writable by the header's contract; its pNext stays the host's.
+        let next = unsafe { (*out).pNext };
+        // The chain first, so that an unknown struct leaves everything unwritten.
+        let mut chain = Vec::new();
+        let mut p = next;
+        while !p.is_null() {
+            // SAFETY: the header's contract: every chained struct starts with sType and pNext.
+            let (stype, after) = unsafe { ((*p.cast::<UmbrageKeepStats>()).sType, (*p.cast::<UmbrageKeepStats>()).pNext) };
+            if stype != UmbrageStructureType::UMBRAGE_STRUCTURE_TYPE_KEEP_STATS as u32 {
+                return Err(CError::new(
+                    UMBRAGE_ERROR_STRUCTURE_TYPE,
+                    format!("UmbrageFrameStats::pNext: a struct with sType {stype} is not one this version fills"),
+                ));
+            }
+            chain.push(p.cast::<UmbrageKeepStats>());
+            if chain.len() > 16 {
+                // (a cycle, or a chain no host needs: refused rather than walked forever)
+                return Err(CError::new(UMBRAGE_ERROR_STRUCTURE_TYPE, "UmbrageFrameStats::pNext: more than 16 chained structs"));
+            }
+            p = after;
+        }
+        let keep = UmbrageKeepStats {
+            sType: UmbrageStructureType::UMBRAGE_STRUCTURE_TYPE_KEEP_STATS as u32,
+            pNext: std::ptr::null_mut(),
+            pairsTotal: t.pairs_total,
+            pairsKept: t.pairs_kept,
+            pairsReplanned: t.pairs_replanned,
+            keptBytes: t.kept_bytes,
+            keptEvictions: t.kept_evictions,
+        };
+        // SAFETY: as above; each chained struct is writable and keeps its own pNext.
         unsafe {
-            let next = (*out).pNext;
             out.write(UmbrageFrameStats { pNext: next, ..st });
+            for k in chain {
+                let after = (*k).pNext;
+                k.write(UmbrageKeepStats { pNext: after, ..keep });
+            }
         }
         Ok(())
     })

@@ -20,6 +20,18 @@ macro_rules! pin {
 mod lp64 {
     use super::*;
     pin!(UmbrageRenderPassTarget, 32, sType = 0, pNext = 8, renderPass = 16, subpass = 24, colorAttachmentCount = 28);
+    pin!(UmbrageKeepInfo, 32, sType = 0, pNext = 8, keepBudgetBytes = 16, planThreads = 24, disableKeep = 28);
+    pin!(
+        UmbrageKeepStats,
+        56,
+        sType = 0,
+        pNext = 8,
+        pairsTotal = 16,
+        pairsKept = 24,
+        pairsReplanned = 32,
+        keptBytes = 40,
+        keptEvictions = 48
+    );
     pin!(
         UmbragePassCreateInfo,
         112,
@@ -178,6 +190,8 @@ const _: () = assert!(UmbrageStructureType::UMBRAGE_STRUCTURE_TYPE_DEVICE_DESCRI
 const _: () = assert!(UmbrageStructureType::UMBRAGE_STRUCTURE_TYPE_FRAME_STATS as u32 == 8);
 const _: () = assert!(UmbrageStructureType::UMBRAGE_STRUCTURE_TYPE_LIGHT_INFO as u32 == 9);
 const _: () = assert!(UmbrageStructureType::UMBRAGE_STRUCTURE_TYPE_RAY_QUERY_INPUTS as u32 == 10);
+const _: () = assert!(UmbrageStructureType::UMBRAGE_STRUCTURE_TYPE_KEEP_INFO as u32 == 11);
+const _: () = assert!(UmbrageStructureType::UMBRAGE_STRUCTURE_TYPE_KEEP_STATS as u32 == 12);
 const _: () = assert!(size_of::<UmbrageStructureType>() == 4);
 const _: () = assert!(UmbrageDepthDirection::UMBRAGE_DEPTH_DIRECTION_FORWARD as u32 == 0);
 const _: () = assert!(UmbrageDepthDirection::UMBRAGE_DEPTH_DIRECTION_REVERSE as u32 == 1);

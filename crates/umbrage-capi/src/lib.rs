@@ -214,13 +214,15 @@ pub unsafe extern "C" fn umbrage_pass_get_settings(pass: UmbragePass, out: *mut 
 }
 
 /// Changes the settings from the next frame on; refused (nothing changed) when the device
-/// cannot honour them.
+/// cannot honour them. Whether plans are kept across frames is not among them: it stays as
+/// the pass was created (`UmbrageKeepInfo`).
 #[no_mangle]
 pub unsafe extern "C" fn umbrage_pass_set_settings(pass: UmbragePass, settings: *const UmbragePassSettings) -> UmbrageResult {
     with_pass(pass, |s| {
         // SAFETY: non-NULL checked; readable by the header's contract.
         let settings = convert::settings(unsafe { &*non_null(settings, "settings")? })?;
-        Ok(s.pass.set_settings(settings)?)
+        let keep = s.pass.settings().keep;
+        Ok(s.pass.set_settings(engine::pass::PassSettings { keep, ..settings })?)
     })
 }
 

@@ -114,6 +114,30 @@ pub struct UmbrageRenderPassTarget {
     pub colorAttachmentCount: u32,
 }
 
+/// The plans kept across frames (chain it to [`UmbragePassCreateInfo::pNext`]; without it the
+/// pass keeps every unchanged light–caster pair's plan, within a 64 MiB budget, and plans on
+/// every core for scenes above 100,000 triangles). A pair whose light, caster and case did not
+/// change is drawn from what the GPU kept, with no planning and 0 bytes sent; the stencil is
+/// the same either way.
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+#[allow(non_snake_case)]
+pub struct UmbrageKeepInfo {
+    /// `UMBRAGE_STRUCTURE_TYPE_KEEP_INFO`.
+    pub sType: UmbrageStructureTypeRaw,
+    /// NULL, or further structs chained to [`UmbragePassCreateInfo`].
+    pub pNext: *const c_void,
+    /// Bytes of GPU memory the kept plans may hold (the least recently drawn are evicted
+    /// beyond it); 0: the default, 64 MiB.
+    pub keepBudgetBytes: u64,
+    /// Threads that plan a frame's changed pairs; 0: automatic (every core above 100,000
+    /// triangles), 1: the calling thread only.
+    pub planThreads: u32,
+    /// Non-zero: plan every pair from scratch every frame (the budget is then unused). The
+    /// settings of `umbrage_pass_set_settings` leave this choice as it was made here.
+    pub disableKeep: UmbrageBool,
+}
+
 /// How the pass is created (`umbrage_pass_create`). All-zero fields mean the defaults, except
 /// `sType` and `abiVersion`, which say what this struct is.
 #[repr(C)]
@@ -122,7 +146,8 @@ pub struct UmbrageRenderPassTarget {
 pub struct UmbragePassCreateInfo {
     /// `UMBRAGE_STRUCTURE_TYPE_PASS_CREATE_INFO`.
     pub sType: UmbrageStructureTypeRaw,
-    /// NULL, or a chain of [`UmbrageRenderPassTarget`].
+    /// NULL, or a chain of [`UmbrageRenderPassTarget`] and [`UmbrageKeepInfo`] (each at most
+    /// once).
     pub pNext: *const c_void,
     /// `UMBRAGE_ABI_VERSION` of the header the host compiled against.
     pub abiVersion: u32,
@@ -426,7 +451,7 @@ pub struct UmbrageLightInfo {
 pub struct UmbrageFrameStats {
     /// `UMBRAGE_STRUCTURE_TYPE_FRAME_STATS`.
     pub sType: UmbrageStructureTypeRaw,
-    /// NULL.
+    /// NULL, or a chain of output structs the call fills ([`UmbrageKeepStats`]).
     pub pNext: *mut c_void,
     /// Side triangles.
     pub sideTriangles: u64,
@@ -460,6 +485,28 @@ pub struct UmbrageFrameStats {
     pub warningCount: u32,
     /// Caster uploads this frame records.
     pub pendingUploads: u32,
+}
+
+/// What the frame's plans kept and replanned (chain it to [`UmbrageFrameStats::pNext`];
+/// `umbrage_frame_get_stats` fills it).
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+#[allow(non_snake_case)]
+pub struct UmbrageKeepStats {
+    /// `UMBRAGE_STRUCTURE_TYPE_KEEP_STATS`.
+    pub sType: UmbrageStructureTypeRaw,
+    /// NULL, or further structs chained to [`UmbrageFrameStats`].
+    pub pNext: *mut c_void,
+    /// Light–caster pairs drawn (not culled), over all lights.
+    pub pairsTotal: u64,
+    /// Of those, drawn from plans kept from an earlier frame (nothing planned or sent).
+    pub pairsKept: u64,
+    /// Of those, planned this frame.
+    pub pairsReplanned: u64,
+    /// Bytes the kept plans hold on the GPU after this frame.
+    pub keptBytes: u64,
+    /// Kept plans evicted this frame to stay within the budget.
+    pub keptEvictions: u64,
 }
 
 /// The ray-query technique's G-buffer inputs.

@@ -132,6 +132,10 @@ typedef enum UmbrageStructureType {
   UMBRAGE_STRUCTURE_TYPE_LIGHT_INFO = 9,
   // [`UmbrageRayQueryInputs`].
   UMBRAGE_STRUCTURE_TYPE_RAY_QUERY_INPUTS = 10,
+  // [`UmbrageKeepInfo`], chained to [`UmbragePassCreateInfo`].
+  UMBRAGE_STRUCTURE_TYPE_KEEP_INFO = 11,
+  // [`UmbrageKeepStats`], chained to [`UmbrageFrameStats`].
+  UMBRAGE_STRUCTURE_TYPE_KEEP_STATS = 12,
 } UmbrageStructureType;
 
 // Which way the host's depth runs.
@@ -369,7 +373,8 @@ typedef void (*UmbrageWarningCallback)(void *user_data, const char *message);
 typedef struct UmbragePassCreateInfo {
   // `UMBRAGE_STRUCTURE_TYPE_PASS_CREATE_INFO`.
   UmbrageStructureType sType;
-  // NULL, or a chain of [`UmbrageRenderPassTarget`].
+  // NULL, or a chain of [`UmbrageRenderPassTarget`] and [`UmbrageKeepInfo`] (each at most
+  // once).
   const void *pNext;
   // `UMBRAGE_ABI_VERSION` of the header the host compiled against.
   uint32_t abiVersion;
@@ -560,7 +565,7 @@ typedef struct UmbrageFrame {
 typedef struct UmbrageFrameStats {
   // `UMBRAGE_STRUCTURE_TYPE_FRAME_STATS`.
   UmbrageStructureType sType;
-  // NULL.
+  // NULL, or a chain of output structs the call fills ([`UmbrageKeepStats`]).
   void *pNext;
   // Side triangles.
   uint64_t sideTriangles;
@@ -651,6 +656,46 @@ typedef struct UmbrageRenderPassTarget {
   uint32_t colorAttachmentCount;
 } UmbrageRenderPassTarget;
 
+// The plans kept across frames (chain it to [`UmbragePassCreateInfo::pNext`]; without it the
+// pass keeps every unchanged light–caster pair's plan, within a 64 MiB budget, and plans on
+// every core for scenes above 100,000 triangles). A pair whose light, caster and case did not
+// change is drawn from what the GPU kept, with no planning and 0 bytes sent; the stencil is
+// the same either way.
+typedef struct UmbrageKeepInfo {
+  // `UMBRAGE_STRUCTURE_TYPE_KEEP_INFO`.
+  UmbrageStructureType sType;
+  // NULL, or further structs chained to [`UmbragePassCreateInfo`].
+  const void *pNext;
+  // Bytes of GPU memory the kept plans may hold (the least recently drawn are evicted
+  // beyond it); 0: the default, 64 MiB.
+  uint64_t keepBudgetBytes;
+  // Threads that plan a frame's changed pairs; 0: automatic (every core above 100,000
+  // triangles), 1: the calling thread only.
+  uint32_t planThreads;
+  // Non-zero: plan every pair from scratch every frame (the budget is then unused). The
+  // settings of `umbrage_pass_set_settings` leave this choice as it was made here.
+  UmbrageBool disableKeep;
+} UmbrageKeepInfo;
+
+// What the frame's plans kept and replanned (chain it to [`UmbrageFrameStats::pNext`];
+// `umbrage_frame_get_stats` fills it).
+typedef struct UmbrageKeepStats {
+  // `UMBRAGE_STRUCTURE_TYPE_KEEP_STATS`.
+  UmbrageStructureType sType;
+  // NULL, or further structs chained to [`UmbrageFrameStats`].
+  void *pNext;
+  // Light–caster pairs drawn (not culled), over all lights.
+  uint64_t pairsTotal;
+  // Of those, drawn from plans kept from an earlier frame (nothing planned or sent).
+  uint64_t pairsKept;
+  // Of those, planned this frame.
+  uint64_t pairsReplanned;
+  // Bytes the kept plans hold on the GPU after this frame.
+  uint64_t keptBytes;
+  // Kept plans evicted this frame to stay within the budget.
+  uint64_t keptEvictions;
+} UmbrageKeepStats;
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
@@ -689,7 +734,8 @@ enum UmbrageResult umbrage_pass_get_capabilities(UmbragePass pass, struct Umbrag
 enum UmbrageResult umbrage_pass_get_settings(UmbragePass pass, struct UmbragePassSettings *out);
 
 // Changes the settings from the next frame on; refused (nothing changed) when the device
-// cannot honour them.
+// cannot honour them. Whether plans are kept across frames is not among them: it stays as
+// the pass was created (`UmbrageKeepInfo`).
 enum UmbrageResult umbrage_pass_set_settings(UmbragePass pass, const struct UmbragePassSettings *settings);
 
 // Creates now the pipelines the first frame of `technique` would create (idempotent).
@@ -789,6 +835,20 @@ UMBRAGE_STATIC_ASSERT(offsetof(UmbrageRenderPassTarget, pNext) == 8, offset_Umbr
 UMBRAGE_STATIC_ASSERT(offsetof(UmbrageRenderPassTarget, renderPass) == 16, offset_UmbrageRenderPassTarget_renderPass);
 UMBRAGE_STATIC_ASSERT(offsetof(UmbrageRenderPassTarget, subpass) == 24, offset_UmbrageRenderPassTarget_subpass);
 UMBRAGE_STATIC_ASSERT(offsetof(UmbrageRenderPassTarget, colorAttachmentCount) == 28, offset_UmbrageRenderPassTarget_colorAttachmentCount);
+UMBRAGE_STATIC_ASSERT(sizeof(UmbrageKeepInfo) == 32, size_UmbrageKeepInfo);
+UMBRAGE_STATIC_ASSERT(offsetof(UmbrageKeepInfo, sType) == 0, offset_UmbrageKeepInfo_sType);
+UMBRAGE_STATIC_ASSERT(offsetof(UmbrageKeepInfo, pNext) == 8, offset_UmbrageKeepInfo_pNext);
+UMBRAGE_STATIC_ASSERT(offsetof(UmbrageKeepInfo, keepBudgetBytes) == 16, offset_UmbrageKeepInfo_keepBudgetBytes);
+UMBRAGE_STATIC_ASSERT(offsetof(UmbrageKeepInfo, planThreads) == 24, offset_UmbrageKeepInfo_planThreads);
+UMBRAGE_STATIC_ASSERT(offsetof(UmbrageKeepInfo, disableKeep) == 28, offset_UmbrageKeepInfo_disableKeep);
+UMBRAGE_STATIC_ASSERT(sizeof(UmbrageKeepStats) == 56, size_UmbrageKeepStats);
+UMBRAGE_STATIC_ASSERT(offsetof(UmbrageKeepStats, sType) == 0, offset_UmbrageKeepStats_sType);
+UMBRAGE_STATIC_ASSERT(offsetof(UmbrageKeepStats, pNext) == 8, offset_UmbrageKeepStats_pNext);
+UMBRAGE_STATIC_ASSERT(offsetof(UmbrageKeepStats, pairsTotal) == 16, offset_UmbrageKeepStats_pairsTotal);
+UMBRAGE_STATIC_ASSERT(offsetof(UmbrageKeepStats, pairsKept) == 24, offset_UmbrageKeepStats_pairsKept);
+UMBRAGE_STATIC_ASSERT(offsetof(UmbrageKeepStats, pairsReplanned) == 32, offset_UmbrageKeepStats_pairsReplanned);
+UMBRAGE_STATIC_ASSERT(offsetof(UmbrageKeepStats, keptBytes) == 40, offset_UmbrageKeepStats_keptBytes);
+UMBRAGE_STATIC_ASSERT(offsetof(UmbrageKeepStats, keptEvictions) == 48, offset_UmbrageKeepStats_keptEvictions);
 UMBRAGE_STATIC_ASSERT(sizeof(UmbragePassCreateInfo) == 112, size_UmbragePassCreateInfo);
 UMBRAGE_STATIC_ASSERT(offsetof(UmbragePassCreateInfo, sType) == 0, offset_UmbragePassCreateInfo_sType);
 UMBRAGE_STATIC_ASSERT(offsetof(UmbragePassCreateInfo, pNext) == 8, offset_UmbragePassCreateInfo_pNext);
@@ -967,6 +1027,8 @@ UMBRAGE_STATIC_ASSERT(UMBRAGE_STRUCTURE_TYPE_DEVICE_DESCRIPTION == 7, value_UMBR
 UMBRAGE_STATIC_ASSERT(UMBRAGE_STRUCTURE_TYPE_FRAME_STATS == 8, value_UMBRAGE_STRUCTURE_TYPE_FRAME_STATS);
 UMBRAGE_STATIC_ASSERT(UMBRAGE_STRUCTURE_TYPE_LIGHT_INFO == 9, value_UMBRAGE_STRUCTURE_TYPE_LIGHT_INFO);
 UMBRAGE_STATIC_ASSERT(UMBRAGE_STRUCTURE_TYPE_RAY_QUERY_INPUTS == 10, value_UMBRAGE_STRUCTURE_TYPE_RAY_QUERY_INPUTS);
+UMBRAGE_STATIC_ASSERT(UMBRAGE_STRUCTURE_TYPE_KEEP_INFO == 11, value_UMBRAGE_STRUCTURE_TYPE_KEEP_INFO);
+UMBRAGE_STATIC_ASSERT(UMBRAGE_STRUCTURE_TYPE_KEEP_STATS == 12, value_UMBRAGE_STRUCTURE_TYPE_KEEP_STATS);
 UMBRAGE_STATIC_ASSERT(sizeof(UmbrageStructureType) == 4, size_UmbrageStructureType);
 UMBRAGE_STATIC_ASSERT(UMBRAGE_DEPTH_DIRECTION_FORWARD == 0, value_UMBRAGE_DEPTH_DIRECTION_FORWARD);
 UMBRAGE_STATIC_ASSERT(UMBRAGE_DEPTH_DIRECTION_REVERSE == 1, value_UMBRAGE_DEPTH_DIRECTION_REVERSE);

@@ -95,6 +95,10 @@ pub enum UmbrageStructureType {
     UMBRAGE_STRUCTURE_TYPE_LIGHT_INFO = 9,
     /// [`UmbrageRayQueryInputs`].
     UMBRAGE_STRUCTURE_TYPE_RAY_QUERY_INPUTS = 10,
+    /// [`UmbrageKeepInfo`], chained to [`UmbragePassCreateInfo`].
+    UMBRAGE_STRUCTURE_TYPE_KEEP_INFO = 11,
+    /// [`UmbrageKeepStats`], chained to [`UmbrageFrameStats`].
+    UMBRAGE_STRUCTURE_TYPE_KEEP_STATS = 12,
 }
 
 /// Which way the host's depth runs.
