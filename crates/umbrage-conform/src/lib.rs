@@ -74,6 +74,7 @@ pub mod raster;
 pub mod report;
 pub mod suite;
 mod units;
+mod value_images;
 
 pub use suite::{run_suite, Report, SuiteOptions};
 
@@ -284,10 +285,16 @@ pub fn run(mut a: RunArgs) -> Result<ExitCode> {
         }
         _ => None,
     };
+    let mismatch: Vec<String> = std::env::var("UMBRAGE_CONFORM_MISMATCH")
+        .unwrap_or_default()
+        .split(',')
+        .map(|s| s.trim().to_string())
+        .filter(|s| !s.is_empty())
+        .collect();
     let out = a.out.clone().unwrap_or_else(|| PathBuf::from("conform-report"));
     let ctx = Context::any_version(umbrage::gpu::context::validation_requested())?;
     let validation = ctx.validation;
-    let opts = SuiteOptions { filter: filter.clone(), image_dir: Some(out.clone()), break_op, ..Default::default() };
+    let opts = SuiteOptions { filter: filter.clone(), image_dir: Some(out.clone()), break_op, mismatch, ..Default::default() };
     if let Some(unit) = &a.child {
         return run_child(&ctx, unit, &a, &opts);
     }

@@ -180,7 +180,9 @@ pub fn run_legacy(
         let t0 = Instant::now();
         super::progress::case(&o.name);
         super::image_sink::begin(opts.image_dir.as_ref().map(|d| d.join("failures").join(&o.name)));
+        super::value_images::set_skew(opts.mismatch.iter().any(|m| m == name || *m == o.name));
         let mut r = f().unwrap_or_else(|e| CheckResult::error(name, &e));
+        super::value_images::set_skew(false);
         o.images = super::image_sink::finish();
         super::progress::step("end");
         super::with_validation(&mut r, ctx.take_validation_errors());
