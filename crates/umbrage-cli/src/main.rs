@@ -483,7 +483,7 @@ fn render(frame: &FrameArgs, out: &Path, stats: Option<&Path>, view: View, dump:
     if dump.is_some() {
         // A multisampled capture finds each sample's position where the device evaluated its
         // depth (measured: SwiftShader's are not the standard locations).
-        umbrage_conform::checks::calibrate_sample_locations(&mut renderer)?;
+        umbrage_render::sample_locations::calibrate_sample_locations(&mut renderer)?;
     }
     let frame_out = renderer.render()?;
     umbrage_render::output::write_png(out, frame_out.width, frame_out.height, &frame_out.color)?;

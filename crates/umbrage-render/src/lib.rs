@@ -35,6 +35,7 @@ pub(crate) mod passes;
 pub mod pipelines;
 pub mod push;
 mod readback;
+pub mod sample_locations;
 pub mod scene_gpu;
 /// The shadow-map baseline (a pass of the frame, in `passes/`).
 pub use passes::shadowmap;
