@@ -123,7 +123,8 @@ pub struct Context {
     pub panic_on_teardown_validation: bool,
     /// The chosen physical device: the best-ranked Vulkan 1.3 device with a graphics queue
     /// (discrete > integrated > virtual > CPU, ties in enumeration order) among those whose
-    /// name contains `UMBRAGE_DEVICE` (case-insensitive) when that is set.
+    /// name contains `UMBRAGE_DEVICE` (case-insensitive) when that is set; `UMBRAGE_DEVICE=#N`
+    /// picks the N-th device of `vkEnumeratePhysicalDevices` (1-based) whatever its name.
     pub physical: vk::PhysicalDevice,
     /// The logical device, with `dynamicRendering` and `synchronization2` and the optional
     /// features recorded in [`Context::features`] enabled.
@@ -270,7 +271,8 @@ unsafe extern "system" fn debug_callback(
 
 impl Context {
     /// Creates the context. Validation follows `UMBRAGE_VALIDATION`; the device can be chosen
-    /// with `UMBRAGE_DEVICE=<substring of its name>`.
+    /// with `UMBRAGE_DEVICE=<substring of its name>`, or `UMBRAGE_DEVICE=#N` (the N-th device
+    /// the loader enumerates, 1-based).
     pub fn new() -> Result<Context> {
         Self::with_validation(validation_requested())
     }

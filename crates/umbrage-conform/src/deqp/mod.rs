@@ -111,12 +111,15 @@ fn device_extensions(ctx: &Context) -> Vec<String> {
     v
 }
 
+/// `--deqp-vk-device-id=N`: the N-th physical device the loader enumerates (1-based, as
+/// VK-GL-CTS counts), by its place rather than its name (two boards of one model have one
+/// name): `UMBRAGE_DEVICE=#N` for this process's context and its children's.
 fn set_device_by_id(id: usize) -> Result<()> {
     let all = devices::list()?;
-    let d = all
-        .get(id - 1)
-        .ok_or_else(|| Error::NoDevice(format!("--deqp-vk-device-id={id}: there are {} Vulkan devices (1-based ids)", all.len())))?;
-    std::env::set_var("UMBRAGE_DEVICE", &d.name);
+    if id == 0 || id > all.len() {
+        return Err(Error::NoDevice(format!("--deqp-vk-device-id={id}: there are {} Vulkan devices (1-based ids)", all.len())));
+    }
+    std::env::set_var("UMBRAGE_DEVICE", format!("#{id}"));
     Ok(())
 }
 
