@@ -8,7 +8,7 @@ use serde::Serialize;
 use umbrage::error::{Error, Result};
 use umbrage::gpu::Context;
 use umbrage_render::accuracy::evaluate;
-use umbrage_render::{ComputeDraws, Counter, RenderOptions, Renderer, Technique};
+use umbrage_render::{ComputeDraws, Counter, RenderOptions, RenderTechnique, Renderer, ShadowMap, Technique};
 
 /// One (scene, method, counter) measurement: medians over the measured frames.
 #[derive(Clone, Debug, Serialize)]
@@ -196,7 +196,7 @@ pub struct BenchConfig {
     /// Scenes, by built-in name or path ([`umbrage_scene::load`]).
     pub scenes: Vec<String>,
     /// Techniques to compare: volume methods, edge quads, shadow maps (each size its own).
-    pub techniques: Vec<Technique>,
+    pub techniques: Vec<RenderTechnique>,
     /// Each volume technique runs with each counter (stencil, float), side by side; shadow
     /// maps run once (they count in the float target).
     pub counters: Vec<Counter>,
@@ -216,9 +216,9 @@ pub struct BenchConfig {
 /// The name of a bench row's technique (`shadowmap-512`; `shadowmap-512-multiview` for cube
 /// faces rendered as views, then `-gather` for the gathering lookup:
 /// `shadowmap-512-multiview-gather`).
-pub fn technique_label(t: Technique) -> String {
+pub fn technique_label(t: RenderTechnique) -> String {
     match t {
-        Technique::ShadowMap { size, pcf, cube } => {
+        RenderTechnique::ShadowMap(ShadowMap { size, pcf, cube }) => {
             let views = match cube {
                 umbrage_render::CubeFaces::Atlas => "",
                 umbrage_render::CubeFaces::Multiview => MULTIVIEW_SUFFIX,
@@ -236,7 +236,7 @@ pub fn technique_label(t: Technique) -> String {
 /// One row's settings: its technique and counter, and the compute and mesh techniques' own.
 #[derive(Clone, Copy, Debug)]
 struct Variant {
-    technique: Technique,
+    technique: RenderTechnique,
     counter: Counter,
     /// [`umbrage::pass::PassToggles::compute_draws`] (only `Auto` for the other techniques).
     draws: ComputeDraws,
@@ -293,7 +293,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
     let device = ctx.info.name.clone();
     let driver = format!("{} {}", ctx.info.driver, ctx.info.driver_info);
     // The compute silhouettes are reported against a plain compute read of their bytes.
-    let read = match cfg.techniques.contains(&Technique::Compute) {
+    let read = match cfg.techniques.contains(&RenderTechnique::Pass(Technique::Compute)) {
         true => Some(super::compute_read::measure(&ctx, 5, 1 << 22)?),
         false => None,
     };
@@ -320,18 +320,18 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         let tasks: &[bool] = if cfg.mesh_task.is_empty() { &[true] } else { &cfg.mesh_task };
         let mut variants: Vec<Variant> = Vec::new();
         for &counter in &cfg.counters {
-            for &technique in cfg.techniques.iter().filter(|t| !matches!(t, Technique::ShadowMap { .. })) {
+            for &technique in cfg.techniques.iter().filter(|t| t.shadow_map().is_none()) {
                 let one = Variant { technique, counter, draws: ComputeDraws::Auto, task: true };
                 match technique {
-                    Technique::Compute => variants.extend(ways.iter().map(|&draws| Variant { draws, ..one })),
-                    Technique::Mesh => variants.extend(tasks.iter().map(|&task| Variant { task, ..one })),
+                    RenderTechnique::Pass(Technique::Compute) => variants.extend(ways.iter().map(|&draws| Variant { draws, ..one })),
+                    RenderTechnique::Pass(Technique::Mesh) => variants.extend(tasks.iter().map(|&task| Variant { task, ..one })),
                     _ => variants.push(one),
                 }
             }
         }
         // Shadow maps do not draw analytic sphere casters (the renderer refuses them): left out.
         let spheres = r.scene().spheres.iter().any(|s| s.casts_shadow);
-        variants.extend(cfg.techniques.iter().filter(|t| matches!(t, Technique::ShadowMap { .. }) && !spheres).map(|&technique| Variant {
+        variants.extend(cfg.techniques.iter().filter(|t| t.shadow_map().is_some() && !spheres).map(|&technique| Variant {
             technique,
             counter: Counter::Float,
             draws: ComputeDraws::Auto,
@@ -400,12 +400,12 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
             let throughput = r.throughput(cfg.frames.max(2))?;
             let s = a.last.ok_or_else(|| Error::Other("no frame".into()))?;
             let c = &s.totals.cases;
-            let maps = matches!(technique, Technique::ShadowMap { .. }) && !a.map.is_empty();
+            let maps = technique.shadow_map().is_some() && !a.map.is_empty();
             let lookup: Vec<f64> = a.shadow.iter().zip(&a.map).map(|(s, m)| s - m).collect();
             // The acceleration structures' stats and times are the ray-query rows' only.
-            let ray = technique == Technique::RayQuery;
+            let ray = technique == RenderTechnique::Pass(Technique::RayQuery);
             let rays = s.ray_query.as_ref().filter(|_| ray);
-            let compute = technique == Technique::Compute && !a.silhouettes.is_empty();
+            let compute = technique == RenderTechnique::Pass(Technique::Compute) && !a.silhouettes.is_empty();
             let silhouettes_ms = compute.then(|| median(a.silhouettes));
             let read_bytes = compute.then_some(s.totals.silhouette_read_bytes);
             let fraction = match (silhouettes_ms, read_bytes, read_gib_s) {
