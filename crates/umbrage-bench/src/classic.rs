@@ -141,7 +141,7 @@ fn refit_ms(r: &mut Renderer) -> Result<Option<f64>> {
                 // The first deformation rebuilds the bottom level with ALLOW_UPDATE.
                 (0, _) => {}
                 (_, Some(g)) if refits > 0 => spans.push(g.accel),
-                _ => return Err(Error::Other(format!("ray query: frame {k} after a deformation refitted nothing"))),
+                _ => return Err(Error::Internal(format!("ray query: frame {k} after a deformation refitted nothing"))),
             }
         }
         Ok(())
@@ -288,7 +288,7 @@ pub fn taps_label_of(label: &str) -> Option<&str> {
 /// they are on) fails the run with [`Error::Validation`].
 pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow)) -> Result<BenchReport> {
     if cfg.frames == 0 {
-        return Err(Error::Other("--frames must be at least 1".into()));
+        return Err(Error::input("--frames", "must be at least 1"));
     }
     let device = ctx.info.name.clone();
     let driver = format!("{} {}", ctx.info.driver, ctx.info.driver_info);
@@ -312,7 +312,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
     let mut rows = Vec::new();
     for name in &cfg.scenes {
         let scene = umbrage_scene::load(name)?;
-        let c = ctx.take().ok_or_else(|| Error::Other("context lost".into()))?;
+        let c = ctx.take().ok_or_else(|| Error::Internal("the bench lost its context".into()))?;
         let mut r = Renderer::new(c, scene, cfg.opts.clone())?;
         // The variants (technique, counter, compute draws, mesh task stage), and their error
         // against the reference.
@@ -398,7 +398,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
             v.apply(&mut r);
             let Variant { technique, counter, .. } = *v;
             let throughput = r.throughput(cfg.frames.max(2))?;
-            let s = a.last.ok_or_else(|| Error::Other("no frame".into()))?;
+            let s = a.last.ok_or_else(|| Error::Internal("no frame was measured".into()))?;
             let c = &s.totals.cases;
             let maps = technique.shadow_map().is_some() && !a.map.is_empty();
             let lookup: Vec<f64> = a.shadow.iter().zip(&a.map).map(|(s, m)| s - m).collect();

@@ -13,7 +13,7 @@ use umbrage_scene::Scene;
 pub(super) fn check_spheres(scene: &Scene, s: &FrameSettings) -> Result<()> {
     for sp in &scene.spheres {
         if let Some(problem) = umbrage_scene::sphere_placement_problem(sp, &scene.camera, &scene.lights) {
-            return Err(Error::Other(problem));
+            return Err(Error::input(format!("scene '{}'", scene.name), problem));
         }
     }
     if s.technique == RenderTechnique::Pass(Technique::RayQuery) {
