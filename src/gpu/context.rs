@@ -123,7 +123,8 @@ pub struct Context {
     pub panic_on_teardown_validation: bool,
     /// The chosen physical device: the best-ranked Vulkan 1.3 device with a graphics queue
     /// (discrete > integrated > virtual > CPU, ties in enumeration order) among those whose
-    /// name contains `UMBRAGE_DEVICE` (case-insensitive) when that is set.
+    /// name contains `UMBRAGE_DEVICE` (case-insensitive) when that is set; `UMBRAGE_DEVICE=#N`
+    /// picks the N-th device of `vkEnumeratePhysicalDevices` (1-based) whatever its name.
     pub physical: vk::PhysicalDevice,
     /// The logical device, with `dynamicRendering` and `synchronization2` and the optional
     /// features recorded in [`Context::features`] enabled.
@@ -170,6 +171,62 @@ fn vkerr(call: &'static str) -> impl Fn(vk::Result) -> Error {
     Error::vk(call)
 }
 
+/// The instance layers and extensions to enable: the validation layer and debug utils when
+/// `validation`, the caller's `instance_extensions` (an error naming those the driver lacks),
+/// and VK_KHR_get_physical_device_properties2 for a Vulkan 1.0 minimum where the loader has it
+/// (the last value: whether it has).
+fn instance_layers_and_extensions(
+    entry: &ash::Entry,
+    validation: bool,
+    instance_extensions: &[*const std::ffi::c_char],
+    minimum: Minimum,
+) -> Result<(Vec<*const std::ffi::c_char>, Vec<*const std::ffi::c_char>, bool)> {
+    let layer_name = c"VK_LAYER_KHRONOS_validation";
+    let mut layers = Vec::new();
+    let mut extensions = Vec::new();
+    if validation {
+        // SAFETY: plain enumeration calls on a loaded entry.
+        let available = unsafe { entry.enumerate_instance_layer_properties() }.map_err(vkerr("vkEnumerateInstanceLayerProperties"))?;
+        let has = available.iter().any(|l| l.layer_name_as_c_str().map(|n| n == layer_name).unwrap_or(false));
+        if !has {
+            return Err(Error::NoDevice(
+                "UMBRAGE_VALIDATION is set but VK_LAYER_KHRONOS_validation is not installed (apt-get install vulkan-validationlayers)"
+                    .into(),
+            ));
+        }
+        layers.push(layer_name.as_ptr());
+        extensions.push(ash::ext::debug_utils::NAME.as_ptr());
+    }
+    extensions.extend_from_slice(instance_extensions);
+    // Vulkan 1.0 devices answer the `*2` property and feature queries only through
+    // VK_KHR_get_physical_device_properties2 (every loader since 2017 offers it).
+    // SAFETY: plain enumeration call on a loaded entry.
+    let instance_exts =
+        unsafe { entry.enumerate_instance_extension_properties(None) }.map_err(vkerr("vkEnumerateInstanceExtensionProperties"))?;
+    // A window's surface extensions the driver lacks: say which, rather than "no driver"
+    // (the viewer takes an X11 window through XCB where a driver has no Xlib surface).
+    let missing: Vec<String> = instance_extensions
+        .iter()
+        // SAFETY: the caller passes NUL-terminated extension names (documented).
+        .map(|&p| unsafe { CStr::from_ptr(p) })
+        .filter(|want| !instance_exts.iter().any(|e| e.extension_name_as_c_str().is_ok_and(|n| n == *want)))
+        .map(|n| n.to_string_lossy().into_owned())
+        .collect();
+    if !missing.is_empty() {
+        return Err(Error::Unsupported(format!(
+            "the Vulkan driver has no instance extension {}, which this window's surface needs: render offscreen \
+             with `umbrage render`",
+            missing.join(", ")
+        )));
+    }
+    let gpdp2 = ash::khr::get_physical_device_properties2::NAME;
+    let has_gpdp2 = instance_exts.iter().any(|e| e.extension_name_as_c_str().map(|n| n == gpdp2).unwrap_or(false));
+    if has_gpdp2 && minimum == Minimum::Vulkan10 {
+        extensions.push(gpdp2.as_ptr());
+    }
+    Ok((layers, extensions, has_gpdp2))
+}
+
 /// The `VK_EXT_debug_utils` messenger callback: records ERROR messages in the
 /// [`ValidationLog`] (and prints them) and counts WARNING messages.
 ///
@@ -214,7 +271,8 @@ unsafe extern "system" fn debug_callback(
 
 impl Context {
     /// Creates the context. Validation follows `UMBRAGE_VALIDATION`; the device can be chosen
-    /// with `UMBRAGE_DEVICE=<substring of its name>`.
+    /// with `UMBRAGE_DEVICE=<substring of its name>`, or `UMBRAGE_DEVICE=#N` (the N-th device
+    /// the loader enumerates, 1-based).
     pub fn new() -> Result<Context> {
         Self::with_validation(validation_requested())
     }
@@ -262,49 +320,7 @@ impl Context {
         let entry =
             unsafe { ash::Entry::load() }.map_err(|e| Error::NoDevice(format!("cannot load the Vulkan loader (libvulkan.so.1): {e}")))?;
 
-        let layer_name = c"VK_LAYER_KHRONOS_validation";
-        let mut layers = Vec::new();
-        let mut extensions = Vec::new();
-        if validation {
-            // SAFETY: plain enumeration calls on a loaded entry.
-            let available = unsafe { entry.enumerate_instance_layer_properties() }.map_err(vkerr("vkEnumerateInstanceLayerProperties"))?;
-            let has = available.iter().any(|l| l.layer_name_as_c_str().map(|n| n == layer_name).unwrap_or(false));
-            if !has {
-                return Err(Error::NoDevice(
-                    "UMBRAGE_VALIDATION is set but VK_LAYER_KHRONOS_validation is not installed (apt-get install vulkan-validationlayers)"
-                        .into(),
-                ));
-            }
-            layers.push(layer_name.as_ptr());
-            extensions.push(ash::ext::debug_utils::NAME.as_ptr());
-        }
-        extensions.extend_from_slice(instance_extensions);
-        // Vulkan 1.0 devices answer the `*2` property and feature queries only through
-        // VK_KHR_get_physical_device_properties2 (every loader since 2017 offers it).
-        // SAFETY: plain enumeration call on a loaded entry.
-        let instance_exts =
-            unsafe { entry.enumerate_instance_extension_properties(None) }.map_err(vkerr("vkEnumerateInstanceExtensionProperties"))?;
-        // A window's surface extensions the driver lacks: say which, rather than "no driver"
-        // (the viewer takes an X11 window through XCB where a driver has no Xlib surface).
-        let missing: Vec<String> = instance_extensions
-            .iter()
-            // SAFETY: the caller passes NUL-terminated extension names (documented).
-            .map(|&p| unsafe { CStr::from_ptr(p) })
-            .filter(|want| !instance_exts.iter().any(|e| e.extension_name_as_c_str().is_ok_and(|n| n == *want)))
-            .map(|n| n.to_string_lossy().into_owned())
-            .collect();
-        if !missing.is_empty() {
-            return Err(Error::Unsupported(format!(
-                "the Vulkan driver has no instance extension {}, which this window's surface needs: render offscreen \
-                 with `umbrage render`",
-                missing.join(", ")
-            )));
-        }
-        let gpdp2 = ash::khr::get_physical_device_properties2::NAME;
-        let has_gpdp2 = instance_exts.iter().any(|e| e.extension_name_as_c_str().map(|n| n == gpdp2).unwrap_or(false));
-        if has_gpdp2 && minimum == Minimum::Vulkan10 {
-            extensions.push(gpdp2.as_ptr());
-        }
+        let (layers, extensions, has_gpdp2) = instance_layers_and_extensions(&entry, validation, instance_extensions, minimum)?;
         let app = vk::ApplicationInfo::default().application_name(c"umbrage").engine_name(c"umbrage").api_version(vk::API_VERSION_1_3);
         // Synchronisation validation on whenever validation is (a missing barrier is invisible
         // on lavapipe and flickers on a real GPU) unless `UMBRAGE_VALIDATION` picks another

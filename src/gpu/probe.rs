@@ -113,7 +113,9 @@ struct Picked {
 }
 
 /// The best device of at least `minimum` with a graphics queue (discrete, integrated, virtual,
-/// CPU, in that order; only those whose name contains `UMBRAGE_DEVICE` when it is set).
+/// CPU, in that order; only those whose name contains `UMBRAGE_DEVICE` when it is set, or only
+/// the N-th of `vkEnumeratePhysicalDevices`' order, 1-based, when it is `#N`: what VK-GL-CTS's
+/// `--deqp-vk-device-id=N` picks, whatever the devices' names).
 fn pick_physical(instance: &ash::Instance, minimum: Minimum) -> Result<Picked> {
     let min_version = match minimum {
         Minimum::Vulkan13 => vk::API_VERSION_1_3,
@@ -129,16 +131,25 @@ fn pick_physical(instance: &ash::Instance, minimum: Minimum) -> Result<Picked> {
         return Err(Error::NoDevice("the Vulkan loader found no physical device".into()));
     }
     let wanted = std::env::var("UMBRAGE_DEVICE").ok().map(|s| s.to_lowercase());
+    let index = wanted.as_deref().and_then(device_index);
+    if let Some(k) = index {
+        if k == 0 || k > physicals.len() {
+            return Err(Error::NoDevice(format!(
+                "UMBRAGE_DEVICE=#{k}: there are {} Vulkan devices (1-based, in vkEnumeratePhysicalDevices' order)",
+                physicals.len()
+            )));
+        }
+    }
     let mut candidates = Vec::new();
     let mut too_old = Vec::new();
-    for &pd in &physicals {
+    for (i, &pd) in physicals.iter().enumerate() {
         // SAFETY: `pd` comes from the enumeration above.
         let props = unsafe { instance.get_physical_device_properties(pd) };
         let name = props.device_name_as_c_str().map(|c| c.to_string_lossy().into_owned()).unwrap_or_default();
-        if let Some(w) = &wanted {
-            if !name.to_lowercase().contains(w) {
-                continue;
-            }
+        match (index, &wanted) {
+            (Some(k), _) if k != i + 1 => continue,
+            (None, Some(w)) if !name.to_lowercase().contains(w) => continue,
+            _ => {}
         }
         if props.api_version < min_version {
             too_old.push(format!("{name} (Vulkan {})", version_string(props.api_version)));
@@ -170,11 +181,17 @@ fn pick_physical(instance: &ash::Instance, minimum: Minimum) -> Result<Picked> {
             )));
         }
         return Err(Error::NoDevice(match wanted {
+            Some(w) if index.is_some() => format!("device {w} (UMBRAGE_DEVICE) has no graphics queue"),
             Some(w) => format!("no {min_name} device with graphics whose name contains '{w}' (UMBRAGE_DEVICE)"),
             None => format!("no {min_name} device with a graphics queue"),
         }));
     };
     Ok(Picked { physical, queue_family, props, name })
+}
+
+/// `#N` (a 1-based device index, as `UMBRAGE_DEVICE` may give it): N.
+pub(crate) fn device_index(wanted: &str) -> Option<usize> {
+    wanted.strip_prefix('#')?.parse().ok()
 }
 
 /// The device's identification; the driver's name and version string where the device has

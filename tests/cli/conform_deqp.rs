@@ -178,3 +178,55 @@ fn shards_baselines_and_csvs() {
     assert!(results.lines().any(|l| l.starts_with(&format!("{},Skip,", all[1]))), "{results}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `--deqp-vk-device-id=N` is the N-th device the loader enumerates (1-based, as VK-GL-CTS
+/// counts), for the context that answers the probe: with lavapipe 22.3.6 and SwiftShader
+/// installed side by side (two devices), each id's renderer is that device's name, in the
+/// order `conform --device` lists them; an id past the last is an error naming the count.
+#[test]
+fn device_id_is_the_nth_device() {
+    let Some(_ctx) = common::context() else { return };
+    let (Some(lvp), Some(ss)) = (common::driver_env("22.3.6"), common::driver_env("swiftshader")) else {
+        assert!(std::env::var_os("CI").is_none(), "CI needs lavapipe 22.3.6 and SwiftShader (scripts/drivers.sh install)");
+        eprintln!("SKIPPED: lavapipe 22.3.6 or SwiftShader not installed (scripts/drivers.sh install 22.3.6 swiftshader)");
+        return;
+    };
+    // Both drivers at once: their ICD lists and library paths joined.
+    let get = |env: &[(String, Option<String>)], k: &str| env.iter().find(|(n, _)| n == k).and_then(|(_, v)| v.clone());
+    let both = |k: &str| [get(&lvp, k), get(&ss, k)].into_iter().flatten().collect::<Vec<_>>().join(":");
+    let dir = tmp("device-id");
+    let run = |args: &[String]| {
+        let mut c = umbrage(&dir);
+        for k in ["VK_ICD_FILENAMES", "VK_DRIVER_FILES", "LD_LIBRARY_PATH"] {
+            c.env(k, both(k));
+        }
+        c.env_remove("VK_ADD_DRIVER_FILES").env_remove("VK_LOADER_DRIVERS_SELECT").env_remove("VK_LOADER_DRIVERS_DISABLE");
+        c.arg("conform").args(args).output().unwrap()
+    };
+    // The devices, in the loader's order: `--device` with no match lists them.
+    let out = run(&["--device".into(), "no-such-device-anywhere".into(), "--filter".into(), "legacy.depth_clamp".into()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let names: Vec<String> = stderr
+        .lines()
+        .filter_map(|l| l.strip_prefix("  "))
+        .filter(|l| l.ends_with(')') && l.contains(", Vulkan "))
+        .filter_map(|l| l.rsplit_once(" (").map(|(name, _)| name.to_string()))
+        .collect();
+    assert_eq!(names.len(), 2, "{names:?} {stderr}");
+    assert_ne!(names[0], names[1]);
+    for (k, name) in names.iter().enumerate() {
+        let log = dir.join(format!("id{}.qpa", k + 1));
+        let out = run(&[
+            "--deqp-case=umbrage.info.renderer".into(),
+            format!("--deqp-vk-device-id={}", k + 1),
+            format!("--deqp-log-filename={}", log.display()),
+        ]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let recs = qpa::parse(&std::fs::read_to_string(&log).unwrap()).unwrap();
+        assert!(recs[0].xml.contains(&format!("<Text>{}</Text>", qpa::esc(name))), "id {}: {}", k + 1, recs[0].xml);
+    }
+    let out = run(&["--deqp-case=umbrage.info.renderer".into(), "--deqp-vk-device-id=3".into()]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("there are 2 Vulkan devices"), "{}", String::from_utf8_lossy(&out.stderr));
+    let _ = std::fs::remove_dir_all(&dir);
+}

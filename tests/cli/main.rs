@@ -10,6 +10,8 @@ mod bench_suite;
 mod cli;
 mod conform;
 mod conform_deqp;
+mod conform_images;
+mod conform_pinning;
 mod faults;
 mod validation;
 mod view;

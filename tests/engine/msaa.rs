@@ -50,7 +50,7 @@ fn render(ctx: umbrage::gpu::Context, name: &str, technique: impl Into<RenderTec
     let scene = umbrage_scene::load(name).unwrap();
     let opts = RenderOptions { width: 160, height: 120, technique: technique.into(), capture: true, samples, ..Default::default() };
     let mut r = Renderer::new(ctx, scene, opts).unwrap_or_else(|e| panic!("{name} at {samples} samples: {e}"));
-    umbrage_conform::checks::calibrate_sample_locations(&mut r).unwrap();
+    umbrage_render::sample_locations::calibrate_sample_locations(&mut r).unwrap();
     let out = r.render().unwrap();
     r.context().check_validation().unwrap();
     (out, r)
@@ -178,7 +178,7 @@ fn swiftshader_samples() {
     let scene = umbrage_scene::load("default").unwrap();
     let opts = RenderOptions { width: 320, height: 240, capture: true, samples: SAMPLES, ..Default::default() };
     let mut r = Renderer::new(ctx, scene, opts).unwrap();
-    umbrage_conform::checks::calibrate_sample_locations(&mut r).unwrap();
+    umbrage_render::sample_locations::calibrate_sample_locations(&mut r).unwrap();
     let out = r.render().unwrap();
     r.context().check_validation().unwrap();
     assert!(out.stats.warnings.iter().any(|w| w.contains("§1f")), "no §1f warning: {:?}", out.stats.warnings);

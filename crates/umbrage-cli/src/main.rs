@@ -194,8 +194,10 @@ enum Command {
         /// driver crash ends the run.
         #[arg(long)]
         no_isolate: bool,
-        /// Seconds a child may run before it is killed and its cases reported as hung (default
-        /// 300; 30 in the dEQP-compatible mode, below deqp-runner's 60 s per-test timer).
+        /// The per-case timer: seconds a child may spend on one case (or one step its cases
+        /// share, such as a configuration's submission) before it is killed and that case
+        /// reported as Timeout (default 60; 30 in the dEQP-compatible mode, below deqp-runner's
+        /// 60 s per-test timer).
         #[arg(long, value_name = "SECONDS")]
         timeout: Option<f64>,
         /// Child processes at once (0: one per CPU core, as deqp-runner does).
@@ -231,6 +233,9 @@ enum Command {
         /// Internal: where a child writes its result.
         #[arg(long, hide = true, value_name = "FILE")]
         child_result: Option<PathBuf>,
+        /// Internal: where a child reports the case it is running.
+        #[arg(long, hide = true)]
+        child_progress: Option<PathBuf>,
     },
     /// The driver matrix: several `conform --out DIR` runs side by side (family x column, every
     /// difference by pattern), as Markdown (`make conform-matrix` writes docs/conform/drivers.md).
@@ -331,6 +336,7 @@ fn main() -> ExitCode {
             chunk,
             child,
             child_result,
+            child_progress,
         } => umbrage_conform::run(umbrage_conform::RunArgs {
             filter,
             list,
@@ -338,10 +344,11 @@ fn main() -> ExitCode {
             out,
             device,
             isolate: !no_isolate,
-            timeout_s: timeout.unwrap_or(300.0),
+            timeout_s: timeout.unwrap_or(umbrage_conform::DEFAULT_TIMEOUT_S),
             jobs,
             child,
             child_result,
+            child_progress,
             expect,
             timeout_given: timeout.is_some(),
             ci: umbrage_conform::deqp::CiArgs { baseline, flakes, skips, fraction, fraction_start, chunk },
@@ -402,7 +409,7 @@ fn render(frame: &FrameArgs, out: &Path, stats: Option<&Path>, view: View, dump:
     if dump.is_some() {
         // A multisampled capture finds each sample's position where the device evaluated its
         // depth (measured: SwiftShader's are not the standard locations).
-        umbrage_conform::checks::calibrate_sample_locations(&mut renderer)?;
+        umbrage_render::sample_locations::calibrate_sample_locations(&mut renderer)?;
     }
     let frame_out = renderer.render()?;
     umbrage_render::output::write_png(out, frame_out.width, frame_out.height, &frame_out.color)?;

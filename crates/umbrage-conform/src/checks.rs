@@ -21,7 +21,7 @@ pub use depth::{depth_bounds, depth_clamp, w0_vertices_and_infinity};
 pub use float_count::deep_wrap_float_count;
 pub use multiview::{multiview_cube_faces, NAME as MULTIVIEW_CUBE_FACES};
 pub use pipeline::{shadow_pipeline_hard_cases, PIPELINE_THRESHOLD};
-pub use sample_locations::{calibrate_sample_locations, measure_depth_locations, msaa_depth_locations, NAME as MSAA_DEPTH_LOCATIONS};
+pub use sample_locations::{msaa_depth_locations, NAME as MSAA_DEPTH_LOCATIONS};
 pub use stencil::{stencil_formats, two_sided_stencil_wrap};
 
 use super::harness::{PipeSpec, Readback};

@@ -52,8 +52,15 @@ pub fn list() -> Result<Vec<DeviceEntry>> {
 }
 
 /// The devices whose name contains `wanted` (case-insensitive), or an error listing every device.
+/// `#N` names the N-th device the loader enumerates (1-based), whatever its name.
 pub fn find(wanted: &str) -> Result<Vec<DeviceEntry>> {
     let all = list()?;
+    if let Some(k) = wanted.strip_prefix('#').and_then(|n| n.parse::<usize>().ok()) {
+        return match k.checked_sub(1).and_then(|i| all.get(i)) {
+            Some(d) => Ok(vec![d.clone()]),
+            None => Err(Error::NoDevice(format!("{wanted}: there are {} Vulkan devices (1-based ids)", all.len()))),
+        };
+    }
     let w = wanted.to_lowercase();
     let hits: Vec<DeviceEntry> = all.iter().filter(|d| d.name.to_lowercase().contains(&w)).cloned().collect();
     if hits.is_empty() {

@@ -49,8 +49,12 @@ impl Expectations {
             let status = match status.trim() {
                 "Fail" => Status::Fail,
                 "Crash" => Status::Crash,
+                "Timeout" => Status::Timeout,
                 other => {
-                    return Err(Error::input(format!("expectations line {}", i + 1), format!("unknown status '{other}' (Fail or Crash)")));
+                    return Err(Error::input(
+                        format!("expectations line {}", i + 1),
+                        format!("unknown status '{other}' (Fail, Crash or Timeout)"),
+                    ));
                 }
             };
             if cases.insert(name.trim().to_string(), status).is_some() {
@@ -73,6 +77,7 @@ impl Expectations {
             .filter_map(|c| match c.status {
                 Status::Fail => Some(format!("{},Fail\n", c.name)),
                 Status::Crash => Some(format!("{},Crash\n", c.name)),
+                Status::Timeout => Some(format!("{},Timeout\n", c.name)),
                 _ => None,
             })
             .collect()
@@ -85,8 +90,8 @@ impl Expectations {
         for c in &r.cases {
             let listed = self.cases.get(&c.name).copied();
             match (c.status, listed) {
-                (Status::Fail | Status::Crash, Some(want)) if want == c.status => v.expected_failures += 1,
-                (Status::Fail | Status::Crash, _) => v.new_failures.push(c.name.clone()),
+                (Status::Fail | Status::Crash | Status::Timeout, Some(want)) if want == c.status => v.expected_failures += 1,
+                (Status::Fail | Status::Crash | Status::Timeout, _) => v.new_failures.push(c.name.clone()),
                 (Status::Pass, Some(_)) => v.unexpected_passes.push(c.name.clone()),
                 _ => {}
             }

@@ -57,7 +57,7 @@ pub fn junit(report: &Report) -> String {
     for (name, cases) in &suites {
         let f = cases.iter().filter(|c| c.status == Status::Fail).count();
         let s = cases.iter().filter(|c| c.status == Status::Skipped).count();
-        let e = cases.iter().filter(|c| c.status == Status::Crash).count();
+        let e = cases.iter().filter(|c| matches!(c.status, Status::Crash | Status::Timeout)).count();
         let t: f64 = cases.iter().map(|c| c.seconds).sum();
         let _ = writeln!(
             x,
@@ -89,11 +89,12 @@ pub fn junit(report: &Report) -> String {
                 Status::Skipped => {
                     let _ = writeln!(x, ">\n      <skipped message=\"{}\"/>\n    </testcase>", escape(&c.message));
                 }
-                Status::Crash => {
+                Status::Crash | Status::Timeout => {
                     let _ = writeln!(
                         x,
-                        ">\n      <error message=\"{}\" type=\"crash\">{}</error>\n    </testcase>",
+                        ">\n      <error message=\"{}\" type=\"{}\">{}</error>\n    </testcase>",
                         escape(&c.message),
+                        c.status.name(),
                         escape(&c.message)
                     );
                 }

@@ -69,10 +69,12 @@ pub mod matrix;
 pub mod mesh;
 pub mod model;
 mod outcome;
+pub mod progress;
 pub mod raster;
 pub mod report;
 pub mod suite;
 mod units;
+mod value_images;
 
 pub use suite::{run_suite, Report, SuiteOptions};
 
@@ -91,20 +93,23 @@ pub enum Status {
     Fail,
     /// The device lacks the feature the check exercises (e.g. `depthClamp`, `depthBounds`).
     Skipped,
-    /// The driver crashed (the child process running the case's configuration died of a
-    /// signal or exited without a result) or hung (no result within the timeout): JUnit's
-    /// `<error>`, as deqp-runner reports a crashing CTS case.
+    /// The driver crashed: the child process running the case died of a signal or exited
+    /// without a result. JUnit's `<error>`, as deqp-runner reports a crashing CTS case.
     Crash,
+    /// The driver hung: the child process running the case made no progress within the
+    /// per-case timer (`--timeout`) and was killed. JUnit's `<error type="timeout">`.
+    Timeout,
 }
 
 impl Status {
-    /// The lowercase name used in the reports: `pass`, `fail` or `skipped`.
+    /// The lowercase name used in the reports: `pass`, `fail`, `skipped`, `crash` or `timeout`.
     pub fn name(self) -> &'static str {
         match self {
             Status::Pass => "pass",
             Status::Fail => "fail",
             Status::Skipped => "skipped",
             Status::Crash => "crash",
+            Status::Timeout => "timeout",
         }
     }
 }
@@ -202,6 +207,8 @@ pub struct RunArgs {
     pub child: Option<String>,
     /// Child mode: where to write the [`isolate::ChildResult`].
     pub child_result: Option<PathBuf>,
+    /// Child mode: where to report progress (the parent's per-case timer and crash pinning).
+    pub child_progress: Option<PathBuf>,
     /// The driver's expected failures ([`expect`]): the exit status then says whether the
     /// run matched them (no new failure, no unexpected pass) instead of whether it passed.
     pub expect: Option<PathBuf>,
@@ -214,17 +221,22 @@ pub struct RunArgs {
 }
 
 /// Child mode: runs one unit and writes its result as JSON (see [`isolate`]).
-fn run_child(ctx: &Context, unit: &str, result: Option<&std::path::Path>, opts: &SuiteOptions) -> Result<ExitCode> {
+fn run_child(ctx: &Context, unit: &str, a: &RunArgs, opts: &SuiteOptions) -> Result<ExitCode> {
     let unit = isolate::Unit::parse(unit).ok_or_else(|| Error::input("--child", format!("unknown unit '{unit}'")))?;
-    let result = result.ok_or_else(|| Error::input("--child", "needs --child-result FILE"))?;
-    isolate::injected_crash(unit);
-    deqp::exec::injected_case_fault(&opts.filter);
+    let result = a.child_result.as_deref().ok_or_else(|| Error::input("--child", "needs --child-result FILE"))?;
+    if let Some(p) = &a.child_progress {
+        progress::open(p, &unit.name())?;
+    }
     let validation = ctx.validation;
     let r = isolate::run_unit(ctx, unit, &|| Context::with_validation(validation), opts);
     let json = serde_json::to_string(&r).map_err(|e| Error::Internal(format!("JSON: {e}")))?;
     std::fs::write(result, json).map_err(|e| Error::io(result.display().to_string(), e))?;
     Ok(ExitCode::SUCCESS)
 }
+
+/// The default per-case timer of `--timeout` (seconds), deqp-runner's default per-test timer
+/// (the dEQP-compatible mode's is [`deqp::DEQP_TIMEOUT_S`]).
+pub const DEFAULT_TIMEOUT_S: f64 = 60.0;
 
 /// Exit status when `--filter` selects nothing.
 pub const EXIT_NOTHING_SELECTED: u8 = 2;
@@ -273,12 +285,18 @@ pub fn run(mut a: RunArgs) -> Result<ExitCode> {
         }
         _ => None,
     };
+    let mismatch: Vec<String> = std::env::var("UMBRAGE_CONFORM_MISMATCH")
+        .unwrap_or_default()
+        .split(',')
+        .map(|s| s.trim().to_string())
+        .filter(|s| !s.is_empty())
+        .collect();
     let out = a.out.clone().unwrap_or_else(|| PathBuf::from("conform-report"));
     let ctx = Context::any_version(umbrage::gpu::context::validation_requested())?;
     let validation = ctx.validation;
-    let opts = SuiteOptions { filter: filter.clone(), image_dir: Some(out.clone()), break_op, ..Default::default() };
+    let opts = SuiteOptions { filter: filter.clone(), image_dir: Some(out.clone()), break_op, mismatch, ..Default::default() };
     if let Some(unit) = &a.child {
-        return run_child(&ctx, unit, a.child_result.as_deref(), &opts);
+        return run_child(&ctx, unit, &a, &opts);
     }
     let expectations = a.expect.as_deref().map(expect::Expectations::load).transpose()?;
     if !(a.timeout_s > 0.0 && a.timeout_s.is_finite()) {
@@ -298,11 +316,7 @@ pub fn run(mut a: RunArgs) -> Result<ExitCode> {
             },
             scratch: out.join("children"),
         };
-        let mut args = vec!["--out".to_string(), out.display().to_string()];
-        if !filter.is_empty() {
-            args.extend(["--filter".to_string(), filter.join(",")]);
-        }
-        isolate::run_suite_isolated(&ctx, &opts, &iso, &args)?
+        isolate::run_suite_isolated(&ctx, &opts, &iso, &out)?
     } else {
         run_suite(&ctx, &|| Context::with_validation(validation), &opts)
     };

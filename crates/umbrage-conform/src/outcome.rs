@@ -22,11 +22,16 @@ pub struct SuiteOptions {
     /// must fail — and only those.
     #[doc(hidden)]
     pub break_op: Option<vk::StencilOp>,
+    /// Test seam: the single-configuration checks named here (short or full names) expect a
+    /// wrong value, so they fail and write their failure images
+    /// (`UMBRAGE_CONFORM_MISMATCH=<check>,...` on the command line; see `value_images`).
+    #[doc(hidden)]
+    pub mismatch: Vec<String>,
 }
 
 impl Default for SuiteOptions {
     fn default() -> Self {
-        SuiteOptions { filter: Vec::new(), pipeline_size: (160, 120), image_dir: None, break_op: None }
+        SuiteOptions { filter: Vec::new(), pipeline_size: (160, 120), image_dir: None, break_op: None, mismatch: Vec::new() }
     }
 }
 

@@ -67,7 +67,7 @@ pub fn markdown(r: &Report) -> String {
             Status::Pass => 0,
             Status::Fail => 1,
             Status::Skipped => 2,
-            Status::Crash => 3,
+            Status::Crash | Status::Timeout => 3,
         };
         match rows.iter_mut().find(|(g, cf, _)| *g == c.group && *cf == cfg) {
             Some((_, _, n)) => n[k] += 1,

@@ -76,9 +76,10 @@ impl Report {
     pub fn failed(&self) -> Vec<&CaseOutcome> {
         self.cases.iter().filter(|c| c.status == Status::Fail).collect()
     }
-    /// The cases whose driver crashed or hung (isolated runs only).
+    /// The cases whose driver crashed or hung (isolated runs only): [`Status::Crash`] and
+    /// [`Status::Timeout`].
     pub fn crashed(&self) -> Vec<&CaseOutcome> {
-        self.cases.iter().filter(|c| c.status == Status::Crash).collect()
+        self.cases.iter().filter(|c| matches!(c.status, Status::Crash | Status::Timeout)).collect()
     }
 }
 

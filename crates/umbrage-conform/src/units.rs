@@ -178,9 +178,13 @@ pub fn run_legacy(
             continue;
         }
         let t0 = Instant::now();
+        super::progress::case(&o.name);
         super::image_sink::begin(opts.image_dir.as_ref().map(|d| d.join("failures").join(&o.name)));
+        super::value_images::set_skew(opts.mismatch.iter().any(|m| m == name || *m == o.name));
         let mut r = f().unwrap_or_else(|e| CheckResult::error(name, &e));
+        super::value_images::set_skew(false);
         o.images = super::image_sink::finish();
+        super::progress::step("end");
         super::with_validation(&mut r, ctx.take_validation_errors());
         o.status = r.status;
         o.message = r.summary.clone();
@@ -213,7 +217,9 @@ pub fn run_mesh(ctx: &Context, opts: &SuiteOptions, out: &mut Vec<CaseOutcome>) 
         }
         let t0 = Instant::now();
         let _ = ctx.take_validation_errors();
+        super::progress::case(&o.name);
         let mut r = f(ctx).unwrap_or_else(|e| CheckResult::error(name, &e));
+        super::progress::step("end");
         super::with_validation(&mut r, ctx.take_validation_errors());
         o.status = r.status;
         o.message = r.summary.clone();
@@ -252,6 +258,7 @@ pub fn run_pipeline(
         let chosen = |scene: &str, m: umbrage::shadow::Method| names.contains(&pipeline_name(scene, m));
         super::image_sink::begin(opts.image_dir.as_ref().map(|d| d.join("failures")));
         let result = super::checks::shadow_pipeline_hard_cases(new_context, w, h, &chosen);
+        super::progress::step("end");
         let images = super::image_sink::finish_per_case();
         match result {
             Ok(r) => {

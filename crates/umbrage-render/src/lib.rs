@@ -34,6 +34,7 @@ pub mod output;
 pub mod pipelines;
 pub mod push;
 mod readback;
+pub mod sample_locations;
 pub mod scene_gpu;
 pub(crate) mod stages;
 /// The shadow-map baseline (a stage of the frame, in `stages/`).

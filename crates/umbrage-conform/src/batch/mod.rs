@@ -197,6 +197,8 @@ fn run_inner(ctx: &Context, cfg: Config, cases: &[&Case], origins: &[(u32, u32)]
         regions.push(region(vk::ImageAspectFlags::DEPTH, 0));
     }
     let (query_pool, render_pass, framebuffer, layout) = (o.query_pool, o.render_pass, o.framebuffer, o.layout);
+    // From here on every case shares the submission: a crash or hang pins none.
+    crate::progress::step("submit");
     ctx.one_shot(|cb| {
         let d = &ctx.device;
         // SAFETY: `cb` is recording (one_shot); every handle was created above on this device
@@ -333,6 +335,8 @@ fn batch_draws(
     let mut recs = Vec::new();
     let mut queries = 0u32;
     for (c, &(ox, oy)) in cases.iter().zip(origins) {
+        // Pipeline creation is where a case of its own can take a driver down.
+        crate::progress::case(&c.name);
         for d in &c.draws {
             let key = d.state.pipeline_key(cfg.state);
             let p = match pipe_of.get(&key) {

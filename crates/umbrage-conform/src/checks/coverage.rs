@@ -204,6 +204,7 @@ pub fn index_types(ctx: &Context) -> Result<CheckResult> {
         let diff = rb.stencil.iter().zip(&base.stencil).filter(|(a, b)| a != b).count();
         numbers.insert(format!("{name}_pixels_differing_from_u32"), json!(diff));
         if diff > 0 {
+            crate::image_sink::stencil_mismatch(w, h, &base.stencil, &vec![true; base.stencil.len()], &rb.stencil);
             fails.push(format!("{name}: {diff} pixels differ from u32"));
         }
     }

@@ -36,6 +36,7 @@ pub fn shadow_pipeline_hard_cases(
     for name in umbrage_scene::builtin_names().into_iter().filter(|n| n.starts_with("hard/")) {
         let methods: Vec<Method> = Method::ALL.into_iter().filter(|&m| selected(name, m)).collect();
         let Some(&first) = methods.first() else { continue };
+        crate::progress::step("scene");
         let scene = umbrage_scene::load(name)?;
         let ctx = match spare.take() {
             Some(c) => c,
@@ -45,6 +46,7 @@ pub fn shadow_pipeline_hard_cases(
         let mut renderer = Renderer::new(ctx, scene, opts)?;
         let _ = renderer.context().take_validation_errors();
         for method in methods {
+            crate::progress::case(&format!("pipeline.hard_cases.{}.{}", name.trim_start_matches("hard/"), method.name()));
             renderer.settings.technique = Technique::Volumes(method).into();
             let frame = renderer.render()?;
             let validation = renderer.context().take_validation_errors();

@@ -98,14 +98,19 @@ pub fn stencil_formats(ctx: &Context) -> Result<CheckResult> {
             &[DrawCall { spec: write_depth(PipeSpec::replace(0xc3)), mvp, vertices: v, indices: Indices::None }],
         )?;
         let (mut bad_stencil, mut bad_depth) = (0u64, 0u64);
+        let mut want = vec![0u8; (w * h) as usize];
         for y in 0..h {
             for x in 0..w {
                 let i = (y * w + x) as usize;
                 let inside = (8..40).contains(&x) && (8..24).contains(&y);
                 let (ws, wd) = if inside { (0xc3, 0.5) } else { (0x5a, 0.25) };
+                want[i] = ws;
                 bad_stencil += (rb.stencil[i] != ws) as u64;
                 bad_depth += (!depth_is(format, rb.depth[i], wd)) as u64;
             }
+        }
+        if bad_stencil > 0 {
+            crate::image_sink::stencil_mismatch(w, h, &want, &vec![true; want.len()], &rb.stencil);
         }
         numbers.insert(
             name.clone(),

@@ -5,9 +5,15 @@
 //! ([`Code::Timeout`]) is reported for the case that caused it alone and the others keep the
 //! results they really have.
 //!
+//! Each child reports its progress ([`crate::progress`]): the timer restarts at each case a
+//! child reaches (a per-case timer, as deqp-runner's), and a crash or hang with a case running
+//! is pinned on that case at once, the child's other cases running again in one fresh child.
+//! A crash in a step the cases share (a configuration's one submission) pins nothing: the
+//! child's cases then run one per child.
+//!
 //! The test seam `UMBRAGE_CONFORM_CRASH_CASE=<case>:abort|hang` (read by the conform harness's
-//! child mode only, never by the engine) makes the child whose cases include `<case>` (public
-//! or short name) abort or hang before it draws; see [`injected_case_fault`].
+//! child mode only, never by the engine) makes a child abort or hang when it reaches `<case>`
+//! (public or short name); see [`crate::progress`].
 
 use super::super::cases::{Config, FORMATS};
 use super::super::isolate::ChildResult;
@@ -33,7 +39,7 @@ pub enum Code {
     NotSupported,
     /// The child process running the case died.
     Crash,
-    /// The child process running the case gave no result within the unit timeout.
+    /// The child process running the case made no progress within the per-case timer.
     Timeout,
 }
 
@@ -49,13 +55,25 @@ impl Code {
         }
     }
 
-    /// The status of `conform.json` (a timeout is a crash there, as it always was).
+    /// The status of `conform.json`.
     pub fn status(self) -> Status {
         match self {
             Code::Pass => Status::Pass,
             Code::Fail => Status::Fail,
             Code::NotSupported => Status::Skipped,
-            Code::Crash | Code::Timeout => Status::Crash,
+            Code::Crash => Status::Crash,
+            Code::Timeout => Status::Timeout,
+        }
+    }
+
+    /// The code of a `conform.json` status.
+    pub fn of(status: Status) -> Code {
+        match status {
+            Status::Pass => Code::Pass,
+            Status::Fail => Code::Fail,
+            Status::Skipped => Code::NotSupported,
+            Status::Crash => Code::Crash,
+            Status::Timeout => Code::Timeout,
         }
     }
 }
@@ -86,7 +104,9 @@ pub struct Extras {
 pub struct Exec {
     /// The `umbrage` executable.
     pub exe: PathBuf,
-    /// A child with no result after this long is killed (its cases then run one per child).
+    /// The per-case timer: a child that reports no progress ([`crate::progress`]: a case
+    /// reached, a shared step begun) for this long is killed, and the case it was running is
+    /// reported as [`Code::Timeout`].
     pub timeout: Duration,
     /// Children at once.
     pub jobs: usize,
@@ -94,9 +114,23 @@ pub struct Exec {
     pub scratch: PathBuf,
     /// Where children write their failure images (`failures/<case>/`).
     pub images: PathBuf,
-    /// The most cases of a configuration one child draws (the single-configuration units
-    /// take an eighth of it, at least 1).
+    /// The most cases of a configuration one child draws.
     pub chunk: usize,
+    /// The most cases of a single-configuration unit (legacy, multiview, mesh, pipeline) one
+    /// child runs.
+    pub unit_chunk: usize,
+    /// Children the pipeline unit's cases are shared among (at least 1; each still at most
+    /// [`Exec::unit_chunk`] cases).
+    pub pipeline_children: usize,
+}
+
+impl Exec {
+    /// How the dEQP-compatible and the driver-CI modes split the cases: at most `chunk` of a
+    /// configuration, an eighth of that of the other units, per child.
+    pub fn chunked(exe: PathBuf, timeout: Duration, jobs: usize, scratch: PathBuf, images: PathBuf, chunk: usize) -> Exec {
+        let chunk = chunk.max(1);
+        Exec { exe, timeout, jobs, scratch, images, chunk, unit_chunk: (chunk / 8).max(1), pipeline_children: 1 }
+    }
 }
 
 struct Job {
@@ -111,7 +145,10 @@ struct Running {
     child: Child,
     result: PathBuf,
     stderr: PathBuf,
-    started: Instant,
+    progress: PathBuf,
+    /// The progress file's length when last looked at, and when it last grew.
+    seen: u64,
+    last: Instant,
 }
 
 enum End {
@@ -135,34 +172,9 @@ pub fn run(
 ) -> Result<Extras> {
     let mut extras = Extras::default();
     std::fs::create_dir_all(&ex.scratch).map_err(|e| Error::io(ex.scratch.display().to_string(), e))?;
-    let wanted: HashSet<&str> = selected.iter().map(String::as_str).collect();
-    let mut queue: VecDeque<Job> = VecDeque::new();
-    let support = suite::format_support(ctx);
-    let chunk = ex.chunk.max(1);
-    for cfg in Config::all(&FORMATS) {
-        let names: Vec<String> =
-            super::super::cases::all(&[cfg]).into_iter().map(|c| c.name).filter(|n| wanted.contains(n.as_str())).collect();
-        if names.is_empty() {
-            continue;
-        }
-        let format_ok = support.iter().any(|(f, s)| *f == cfg.format && s.usable);
-        let o = SuiteOptions { filter: exact(&names), ..opts.clone() };
-        let (outcomes, run) = suite::plan_config(ctx, cfg, format_ok, &o);
-        for out in outcomes.into_iter().filter(|o| o.status == Status::Skipped) {
-            done(finish(out, Code::NotSupported));
-        }
-        let to_run: Vec<String> = run.into_iter().map(|c| c.name).collect();
-        for part in to_run.chunks(chunk) {
-            queue.push_back(Job { unit: Unit::Config(cfg), names: part.to_vec(), retry: false });
-        }
-    }
-    for unit in [Unit::Legacy, Unit::Multiview, Unit::Mesh, Unit::Pipeline { shard: 0, shards: 1 }] {
-        let names: Vec<String> = suite::unit_case_names(unit, &[]).into_iter().filter(|n| wanted.contains(n.as_str())).collect();
-        for part in names.chunks((chunk / 8).max(1)) {
-            queue.push_back(Job { unit, names: part.to_vec(), retry: false });
-        }
-    }
-
+    // The parent's plan of each configuration case (its configuration, description, bug).
+    let mut planned: HashMap<String, CaseOutcome> = HashMap::new();
+    let mut queue = plan(ctx, selected, ex, opts, &mut planned, done);
     let mut running: Vec<Running> = Vec::new();
     let mut serial = 0usize;
     while !queue.is_empty() || !running.is_empty() {
@@ -176,7 +188,7 @@ pub fn run(
                 Ok(r) => running.push(r),
                 Err((job, e)) => {
                     for n in &job.names {
-                        done(lost(n, Code::Crash, &format!("the child process could not be started: {e}")));
+                        done(lost(n, job.unit, Code::Crash, &format!("the child process could not be started: {e}"), &planned));
                     }
                 }
             }
@@ -188,8 +200,11 @@ pub fn run(
                 continue;
             };
             let r = running.swap_remove(k);
-            let _ = std::fs::remove_file(&r.result);
-            let _ = std::fs::remove_file(&r.stderr);
+            let progress = std::fs::read_to_string(&r.progress).unwrap_or_default();
+            for f in [&r.result, &r.stderr, &r.progress] {
+                let _ = std::fs::remove_file(f);
+            }
+            let code = if matches!(end, End::Timeout(_)) { Code::Timeout } else { Code::Crash };
             match end {
                 End::Result(res) => {
                     extras.configs.extend(res.config);
@@ -197,32 +212,42 @@ pub fn run(
                     let mut by_name: HashMap<String, CaseOutcome> = res.cases.into_iter().map(|c| (c.name.clone(), c)).collect();
                     for n in &r.job.names {
                         match by_name.remove(n) {
-                            Some(o) => {
-                                let code = match o.status {
-                                    Status::Pass => Code::Pass,
-                                    Status::Fail => Code::Fail,
-                                    Status::Skipped => Code::NotSupported,
-                                    Status::Crash => Code::Crash,
-                                };
+                            Some(mut o) => {
+                                if let Some(p) = planned.get(n) {
+                                    o.bug.clone_from(&p.bug);
+                                }
+                                let code = Code::of(o.status);
                                 done(finish(o, code));
                             }
-                            None => done(lost(n, Code::Fail, "the child process returned no result for this case")),
+                            None => done(lost(n, r.job.unit, Code::Fail, "the child process returned no result for this case", &planned)),
                         }
                     }
                 }
                 End::Crash(msg) | End::Timeout(msg) if r.job.names.len() > 1 => {
-                    // Pin it: every case again, one per child, before anything else runs.
-                    eprintln!(
-                        "umbrage conform: {msg} (unit {}, {} cases): running them one per child",
-                        r.job.unit.name(),
-                        r.job.names.len()
-                    );
-                    for n in r.job.names.iter().rev() {
-                        queue.push_front(Job { unit: r.job.unit, names: vec![n.clone()], retry: true });
+                    let unit = r.job.unit;
+                    match crate::progress::running(&progress).filter(|c| r.job.names.contains(c)) {
+                        // Pinned: the running case alone; the rest again, in one fresh child.
+                        Some(case) => {
+                            eprintln!("umbrage conform: {msg} (unit {}, running {case}): the other cases run again", unit.name());
+                            done(lost(&case, unit, code, &msg, &planned));
+                            let rest: Vec<String> = r.job.names.into_iter().filter(|n| *n != case).collect();
+                            let retry = rest.len() == 1;
+                            queue.push_front(Job { unit, names: rest, retry });
+                        }
+                        // In a step the cases share: every case again, one per child.
+                        None => {
+                            eprintln!(
+                                "umbrage conform: {msg} (unit {}, {} cases, in a shared step): running them one per child",
+                                unit.name(),
+                                r.job.names.len()
+                            );
+                            for n in r.job.names.iter().rev() {
+                                queue.push_front(Job { unit, names: vec![n.clone()], retry: true });
+                            }
+                        }
                     }
                 }
-                End::Crash(msg) => done(lost(&r.job.names[0], Code::Crash, &msg)),
-                End::Timeout(msg) => done(lost(&r.job.names[0], Code::Timeout, &msg)),
+                End::Crash(msg) | End::Timeout(msg) => done(lost(&r.job.names[0], r.job.unit, code, &msg, &planned)),
             }
         }
         if !running.is_empty() {
@@ -230,6 +255,55 @@ pub fn run(
         }
     }
     Ok(extras)
+}
+
+/// The jobs of `selected`: each configuration's cases to draw in children of at most
+/// [`Exec::chunk`] (those its device skips reported through `done` at once, their plans into
+/// `planned`), then the single-configuration units'.
+fn plan(
+    ctx: &Context,
+    selected: &[String],
+    ex: &Exec,
+    opts: &SuiteOptions,
+    planned: &mut HashMap<String, CaseOutcome>,
+    done: &mut dyn FnMut(Done),
+) -> VecDeque<Job> {
+    let wanted: HashSet<&str> = selected.iter().map(String::as_str).collect();
+    let mut queue: VecDeque<Job> = VecDeque::new();
+    let support = suite::format_support(ctx);
+    for cfg in Config::all(&FORMATS) {
+        let names: Vec<String> =
+            super::super::cases::all(&[cfg]).into_iter().map(|c| c.name).filter(|n| wanted.contains(n.as_str())).collect();
+        if names.is_empty() {
+            continue;
+        }
+        let format_ok = support.iter().any(|(f, s)| *f == cfg.format && s.usable);
+        let o = SuiteOptions { filter: exact(&names), ..opts.clone() };
+        let (outcomes, run) = suite::plan_config(ctx, cfg, format_ok, &o);
+        for out in outcomes {
+            match out.status {
+                Status::Skipped => done(finish(out, Code::NotSupported)),
+                _ => {
+                    planned.insert(out.name.clone(), out);
+                }
+            }
+        }
+        let to_run: Vec<String> = run.into_iter().map(|c| c.name).collect();
+        for part in to_run.chunks(ex.chunk.max(1)) {
+            queue.push_back(Job { unit: Unit::Config(cfg), names: part.to_vec(), retry: false });
+        }
+    }
+    for unit in [Unit::Legacy, Unit::Multiview, Unit::Mesh, Unit::Pipeline { shard: 0, shards: 1 }] {
+        let names: Vec<String> = suite::unit_case_names(unit, &[]).into_iter().filter(|n| wanted.contains(n.as_str())).collect();
+        let mut size = ex.unit_chunk.max(1);
+        if matches!(unit, Unit::Pipeline { .. }) {
+            size = size.min(names.len().div_ceil(ex.pipeline_children.max(1)).max(1));
+        }
+        for part in names.chunks(size) {
+            queue.push_back(Job { unit, names: part.to_vec(), retry: false });
+        }
+    }
+    queue
 }
 
 /// Filter patterns that select exactly `names` (see [`suite::matches`]'s `=` form).
@@ -241,18 +315,24 @@ fn finish(outcome: CaseOutcome, code: Code) -> Done {
     Done { public: names::public(&outcome.name), code, outcome }
 }
 
-fn lost(name: &str, code: Code, msg: &str) -> Done {
-    let group = name.split('.').next().unwrap_or("");
-    let mut o = CaseOutcome::new(name.to_string(), group, None, String::new());
+/// A case the child running it took down (or never returned): its plan when the parent has
+/// one, the message naming the unit.
+fn lost(name: &str, unit: Unit, code: Code, msg: &str, planned: &HashMap<String, CaseOutcome>) -> Done {
+    let mut o = planned.get(name).cloned().unwrap_or_else(|| {
+        let group = name.split('.').next().unwrap_or("");
+        CaseOutcome::new(name.to_string(), group, None, String::new())
+    });
     o.status = code.status();
-    o.message = msg.to_string();
+    o.message = format!("{msg} (unit {})", unit.name());
     finish(o, code)
 }
 
 fn spawn(ex: &Exec, job: Job, serial: usize) -> std::result::Result<Running, (Job, std::io::Error)> {
     let result = ex.scratch.join(format!("child-{serial}.json"));
     let stderr = ex.scratch.join(format!("child-{serial}.stderr"));
+    let progress = ex.scratch.join(format!("child-{serial}.progress"));
     let _ = std::fs::remove_file(&result);
+    let _ = std::fs::remove_file(&progress);
     let file = match std::fs::File::create(&stderr) {
         Ok(f) => f,
         Err(e) => return Err((job, e)),
@@ -260,6 +340,8 @@ fn spawn(ex: &Exec, job: Job, serial: usize) -> std::result::Result<Running, (Jo
     let mut cmd = Command::new(&ex.exe);
     cmd.args(["conform", "--child", &job.unit.name(), "--child-result"])
         .arg(&result)
+        .arg("--child-progress")
+        .arg(&progress)
         .arg("--out")
         .arg(&ex.images)
         .arg("--filter")
@@ -268,20 +350,26 @@ fn spawn(ex: &Exec, job: Job, serial: usize) -> std::result::Result<Running, (Jo
         .stdout(Stdio::null())
         .stderr(file);
     match cmd.spawn() {
-        Ok(child) => Ok(Running { job, child, result, stderr, started: Instant::now() }),
+        Ok(child) => Ok(Running { job, child, result, stderr, progress, seen: 0, last: Instant::now() }),
         Err(e) => Err((job, e)),
     }
 }
 
+/// `Some` once the child has ended, or was killed for making no progress within `timeout`
+/// (the timer restarts whenever its progress file grows).
 fn poll(r: &mut Running, timeout: Duration) -> Option<End> {
+    let len = std::fs::metadata(&r.progress).map(|m| m.len()).unwrap_or(0);
+    if len != r.seen {
+        (r.seen, r.last) = (len, Instant::now());
+    }
     let status = match r.child.try_wait() {
         Ok(Some(s)) => s,
-        Ok(None) if r.started.elapsed() < timeout => return None,
+        Ok(None) if r.last.elapsed() < timeout => return None,
         Ok(None) => {
             let _ = r.child.kill();
             let _ = r.child.wait();
             return Some(End::Timeout(format!(
-                "driver hang: no result within {} s (the unit timeout), the child process was killed",
+                "driver hang: no result within {} s (the per-case timer), the child process was killed",
                 timeout.as_secs_f64()
             )));
         }
@@ -327,24 +415,4 @@ fn stderr_tail(path: &Path) -> String {
     let text = std::fs::read_to_string(path).unwrap_or_default();
     let lines: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
     lines[lines.len().saturating_sub(3)..].join(" | ")
-}
-
-/// The test seam `UMBRAGE_CONFORM_CRASH_CASE=<case>:abort|hang`, honoured in child mode only:
-/// a child whose filter selects `<case>` exactly (the `=name` patterns this runner gives its
-/// children) aborts (SIGABRT, as a driver assertion would) or sleeps forever (a hung driver)
-/// before it draws. `<case>` is a public (`umbrage.…`) or short name.
-pub fn injected_case_fault(filter: &[String]) {
-    let Ok(v) = std::env::var("UMBRAGE_CONFORM_CRASH_CASE") else { return };
-    let Some((name, how)) = v.rsplit_once(':') else { return };
-    let hit = filter.iter().filter_map(|p| p.strip_prefix('=')).any(|n| n == name || names::public(n) == name);
-    if !hit {
-        return;
-    }
-    match how {
-        "abort" => std::process::abort(),
-        "hang" => loop {
-            std::thread::sleep(Duration::from_secs(3600));
-        },
-        _ => {}
-    }
 }

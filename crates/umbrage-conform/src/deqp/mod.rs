@@ -111,12 +111,15 @@ fn device_extensions(ctx: &Context) -> Vec<String> {
     v
 }
 
+/// `--deqp-vk-device-id=N`: the N-th physical device the loader enumerates (1-based, as
+/// VK-GL-CTS counts), by its place rather than its name (two boards of one model have one
+/// name): `UMBRAGE_DEVICE=#N` for this process's context and its children's.
 fn set_device_by_id(id: usize) -> Result<()> {
     let all = devices::list()?;
-    let d = all
-        .get(id - 1)
-        .ok_or_else(|| Error::NoDevice(format!("--deqp-vk-device-id={id}: there are {} Vulkan devices (1-based ids)", all.len())))?;
-    std::env::set_var("UMBRAGE_DEVICE", &d.name);
+    if id == 0 || id > all.len() {
+        return Err(Error::NoDevice(format!("--deqp-vk-device-id={id}: there are {} Vulkan devices (1-based ids)", all.len())));
+    }
+    std::env::set_var("UMBRAGE_DEVICE", format!("#{id}"));
     Ok(())
 }
 
@@ -273,14 +276,9 @@ pub fn run_deqp(d: DeqpArgs, a: &RunArgs, chunk: Option<usize>, timeout_given: b
     let selected: Vec<String> = (0..idx.cases.len()).filter(|&i| picked[i]).map(|i| idx.cases[i].1.clone()).collect();
     let scratch = temp_scratch();
     let timeout = if timeout_given { a.timeout_s } else { DEQP_TIMEOUT_S };
-    let ex = Exec {
-        exe: exe()?,
-        timeout: Duration::from_secs_f64(timeout),
-        jobs: if a.jobs == 0 { 1 } else { a.jobs },
-        scratch: scratch.clone(),
-        images: scratch.clone(),
-        chunk: chunk.unwrap_or(DEFAULT_CHUNK),
-    };
+    let jobs = if a.jobs == 0 { 1 } else { a.jobs };
+    let ex =
+        Exec::chunked(exe()?, Duration::from_secs_f64(timeout), jobs, scratch.clone(), scratch.clone(), chunk.unwrap_or(DEFAULT_CHUNK));
     let opts = SuiteOptions { break_op: None, ..Default::default() };
     let announced: std::cell::RefCell<HashSet<String>> = Default::default();
     let mut failure: Option<Error> = None;
@@ -337,17 +335,18 @@ pub fn run_standalone(ctx: &Context, a: &RunArgs, filter: &[String], out: &Path,
         .collect();
     let mine = names::fraction(&all, fraction, fstart);
     let (skipped, to_run): (Vec<_>, Vec<_>) = mine.into_iter().partition(|(p, _)| skips.is_match(p));
-    let ex = Exec {
-        exe: exe()?,
-        timeout: Duration::from_secs_f64(a.timeout_s),
-        jobs: match a.jobs {
-            0 => std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
-            n => n,
-        },
-        scratch: out.join("children"),
-        images: out.to_path_buf(),
-        chunk: ci.chunk.unwrap_or(DEFAULT_CHUNK),
+    let jobs = match a.jobs {
+        0 => std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1),
+        n => n,
     };
+    let ex = Exec::chunked(
+        exe()?,
+        Duration::from_secs_f64(a.timeout_s),
+        jobs,
+        out.join("children"),
+        out.to_path_buf(),
+        ci.chunk.unwrap_or(DEFAULT_CHUNK),
+    );
     let names_to_run: Vec<String> = to_run.iter().map(|(_, s)| s.clone()).collect();
     let mut first: Vec<Done> = Vec::new();
     let extras = exec::run(ctx, &names_to_run, &ex, opts, &mut |_| {}, &mut |d| first.push(d))?;
@@ -426,19 +425,13 @@ pub fn run_standalone(ctx: &Context, a: &RunArgs, filter: &[String], out: &Path,
     Ok(if bad.is_empty() { ExitCode::SUCCESS } else { ExitCode::FAILURE })
 }
 
-/// `results.csv` and `failures.csv` of a classic run (no baseline: the raw statuses, a crash
-/// or hang as `Crash`), beside its `conform.json`.
+/// `results.csv` and `failures.csv` of a classic run (no baseline: the raw statuses), beside its `conform.json`.
 pub fn write_plain_csvs(out: &Path, r: &Report) -> Result<()> {
     let rows: Vec<Row> = r
         .cases
         .iter()
         .map(|c| {
-            let code = match c.status {
-                super::Status::Pass => Code::Pass,
-                super::Status::Fail => Code::Fail,
-                super::Status::Skipped => Code::NotSupported,
-                super::Status::Crash => Code::Crash,
-            };
+            let code = Code::of(c.status);
             Row { name: names::public(&c.name), status: Judged::raw(code), seconds: c.seconds }
         })
         .collect();

@@ -1,5 +1,5 @@
 //! Where a multisampled frame's depth is evaluated, per sample: the standard locations, or
-//! those the caller measured (`conform::checks::calibrate_sample_locations`), with the driver
+//! those the caller measured (`umbrage_render::sample_locations::calibrate_sample_locations`), with the driver
 //! defect a frame warns of when they differ.
 
 use super::Renderer;
@@ -51,7 +51,7 @@ impl DepthLocations {
 impl Renderer {
     /// Where this device evaluates a multisampled draw's depth, per sample (Vulkan's standard
     /// order, pixels from the pixel's top-left corner), as measured by the caller (umbrage's
-    /// `conform::checks::calibrate_sample_locations` measures it with the conformance case
+    /// `umbrage_render::sample_locations::calibrate_sample_locations` measures it with the conformance case
     /// `legacy.msaa_depth_locations`): a multisampled capture's positions are then found there
     /// instead of at the standard locations, and a frame whose locations are not the standard
     /// ones carries a warning naming the defect.

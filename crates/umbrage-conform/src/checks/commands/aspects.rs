@@ -107,6 +107,16 @@ pub fn copy_aspects(ctx: &Context) -> Result<CheckResult> {
         }
         numbers.insert(short(format).into(), json!({ "depth_mismatches": dm, "other_byte_mismatches": sm, "bytes": size }));
         if dm + sm > 0 {
+            // Every byte the check knows: the region's depth bytes, its stencil, untouched elsewhere.
+            let mut want: Vec<u8> = expected.iter().zip(got.iter()).map(|(e, g)| e.unwrap_or(*g)).collect();
+            for y in 0..ch as usize {
+                for x in 0..cw as usize {
+                    let src = (oy as usize + y) * W as usize + ox as usize + x;
+                    let at = depth_at + (y * row as usize + x) * db;
+                    want[at..at + depth_bytes].copy_from_slice(&ref_depth[src * db..src * db + depth_bytes]);
+                }
+            }
+            crate::value_images::words(short(format), &want, got);
             fails.push(format!(
                 "{}: {dm} depth texels wrong, {sm} stencil or untouched bytes wrong (row length {row}, image height {image_height}, offsets {depth_at}/{stencil_at})",
                 short(format)

@@ -98,11 +98,13 @@ pub fn blit_copy_color(ctx: &Context) -> Result<CheckResult> {
     let copy_bad = (0..copy_bytes).filter(|&k| got[k] != src_bytes[k]).count();
     numbers.insert("copy_image_byte_mismatches".into(), json!(copy_bad));
     if copy_bad > 0 {
+        crate::value_images::words("copy_image", &src_bytes[..copy_bytes], &got[..copy_bytes]);
         fails.push(format!("vkCmdCopyImage: {copy_bad} bytes differ"));
     }
     for (k, &(format, _)) in blits.iter().enumerate() {
         let base = copy_bytes + k * blit_bytes;
         let mut bad = 0;
+        let mut want_bytes = got[base..base + blit_bytes].to_vec();
         for y in 0..dh {
             for x in 0..dw {
                 // NEAREST: the source texel containing the destination centre mapped back,
@@ -112,10 +114,12 @@ pub fn blit_copy_color(ctx: &Context) -> Result<CheckResult> {
                 let want = if format == bgra { [b, g, r, a] } else { [r, g, b, a] };
                 let at = base + ((y * dw + x) * 4) as usize;
                 bad += usize::from(got[at..at + 4] != want);
+                want_bytes[at - base..at - base + 4].copy_from_slice(&want);
             }
         }
         numbers.insert(format!("blit_{format:?}_texel_mismatches"), json!(bad));
         if bad > 0 {
+            crate::value_images::words(&format!("blit_{format:?}"), &want_bytes, &got[base..base + blit_bytes]);
             fails.push(format!("vkCmdBlitImage to {format:?}: {bad} of {} texels differ", dw * dh));
         }
     }
@@ -156,10 +160,16 @@ pub fn buffers(ctx: &Context) -> Result<CheckResult> {
         let chunk = want[src..src + n].to_vec();
         want[dst..dst + n].copy_from_slice(&chunk);
     }
+    if crate::value_images::skewed() {
+        want[0] ^= 0xff;
+    }
     let got = s.buffers[b].read()?;
     let bad = (0..size).filter(|&k| got[k] != want[k]).count();
     let mut numbers = serde_json::Map::new();
     numbers.insert("byte_mismatches".into(), json!(bad));
     let fails = if bad > 0 { vec![format!("{bad} of {size} bytes differ")] } else { vec![] };
+    if bad > 0 {
+        crate::value_images::words("bytes", &want, got);
+    }
     Ok(CheckResult::from_fails("buffers", fails, numbers, "vkCmdUpdateBuffer at an offset and vkCmdCopyBuffer of two regions: every byte"))
 }

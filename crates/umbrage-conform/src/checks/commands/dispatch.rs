@@ -173,8 +173,14 @@ pub fn fill_buffer(ctx: &Context) -> Result<CheckResult> {
             *byte = data.to_le_bytes()[k % 4];
         }
     }
+    if crate::value_images::skewed() {
+        want[0] ^= 0xff;
+    }
     let got = s.buffers[b].read()?;
     let bad: Vec<usize> = (0..size).filter(|&k| got[k] != want[k]).collect();
+    if !bad.is_empty() {
+        crate::value_images::words("bytes", &want, got);
+    }
     let mut numbers = serde_json::Map::new();
     numbers.insert("byte_mismatches".into(), json!(bad.len()));
     let fails = match bad.first() {
@@ -270,7 +276,10 @@ pub fn dispatch(ctx: &Context) -> Result<CheckResult> {
         memory_barrier(ctx, cb, (S::COMPUTE_SHADER, A::SHADER_WRITE), (S::HOST, A::HOST_READ));
     })?;
     let got = words_of(s.buffers[b].read()?);
-    let want = l.model();
+    let mut want = l.model();
+    if crate::value_images::skewed() {
+        want[0] ^= 1;
+    }
     let (o, h, g, c, m) = (l.base, l.base + HEADER, l.base + l.counts, l.base + l.bits, l.end);
     let parts = [
         ("before", 0..o),
@@ -289,6 +298,9 @@ pub fn dispatch(ctx: &Context) -> Result<CheckResult> {
         if bad > 0 {
             fails.push(format!("{name}: {bad} words differ ({})", first.join(", ")));
         }
+    }
+    if !fails.is_empty() {
+        crate::value_images::words("words", &want, &got);
     }
     numbers.insert("header".into(), json!(&got[o..h]));
     numbers.insert("dispatch".into(), json!([l.x, l.y, 1]));
@@ -353,6 +365,9 @@ pub fn dispatch_indirect(ctx: &Context) -> Result<CheckResult> {
         let id = pack_id(g % x, g / x % y, g / (x * y));
         want[base + HEADER + g as usize] = MARK_WG * (id + 1);
     }
+    if crate::value_images::skewed() {
+        want[0] ^= 1;
+    }
     let parts =
         [("commands", 0..base), ("header", base..base + HEADER), ("groups", base + HEADER..zero_base), ("zero_dispatch", zero_base..total)];
     let mut numbers = serde_json::Map::new();
@@ -363,6 +378,9 @@ pub fn dispatch_indirect(ctx: &Context) -> Result<CheckResult> {
         if bad > 0 {
             fails.push(format!("{name}: {bad} words differ ({})", first.join(", ")));
         }
+    }
+    if !fails.is_empty() {
+        crate::value_images::words("words", &want, &got);
     }
     numbers.insert("command".into(), json!(&got[args..args + 3]));
     numbers.insert("header".into(), json!(&got[base..base + HEADER]));

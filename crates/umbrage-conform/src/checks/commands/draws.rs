@@ -97,79 +97,110 @@ pub fn queries(ctx: &Context) -> Result<CheckResult> {
                 }
             }
         })?;
-        let mut numbers = serde_json::Map::new();
-        let mut fails = Vec::new();
-        let d = &ctx.device;
-        let exact = f.occlusion_query_precise;
-        let count_ok = |got: u64, want: u64| if exact { got == want } else { (got > 0) == (want > 0) };
-        let mut q64 = [0u64; 2];
-        // SAFETY: one_shot waited for the submission (here and below); each slice
-        // holds `len` results of the flags' size and layout.
-        unsafe { d.get_query_pool_results(occ, 2, &mut q64, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT) }
-            .map_err(vkerr("vkGetQueryPoolResults"))?;
-        let mut q32 = [0u32; 2];
-        // SAFETY: as above.
-        unsafe { d.get_query_pool_results(occ, 2, &mut q32, vk::QueryResultFlags::WAIT) }.map_err(vkerr("vkGetQueryPoolResults"))?;
-        // Queries 5 (ended) and 6 (reset, never begun) with availability, without waiting: the
-        // call must say VK_NOT_READY, write 5's count and a non-zero availability ("non-zero if
-        // the query's status was available": SwiftShader writes 2, lavapipe 1), and 6's 0.
-        let mut avail = [[0u64, 7], [0, 7]];
-        // SAFETY: as above; two u64 per query (count, availability).
-        let r = unsafe {
-            d.get_query_pool_results(occ, 5, &mut avail, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WITH_AVAILABILITY)
-        };
-        numbers.insert("occlusion_64".into(), json!(q64));
-        numbers.insert("occlusion_32".into(), json!(q32));
-        numbers.insert("occlusion_with_availability".into(), json!(avail));
-        numbers.insert("precise".into(), json!(exact));
-        if !(count_ok(q64[0], 60) && q64[1] == 0) {
-            fails.push(format!("occlusion queries 2..4 (64-bit): {q64:?}, want [60, 0]"));
-        }
-        if q32[0] as u64 != q64[0] || q32[1] != 0 {
-            fails.push(format!("occlusion queries 2..4 (32-bit): {q32:?}, the 64-bit read gave {q64:?}"));
-        }
-        if !count_ok(avail[0][0], 21) || avail[0][1] == 0 || avail[1][1] != 0 {
-            fails.push(format!("queries 5..7 with availability: {avail:?}, want [[21, non-zero], [_, 0]]"));
-        }
-        match r {
-            Err(vk::Result::NOT_READY) => {}
-            other => fails.push(format!("reading an unavailable query without WAIT returned {other:?}, not VK_NOT_READY")),
-        }
-        if let Some(p) = stats {
-            let mut raw = [[0u64; 3]; 1];
-            // SAFETY: as above; three u64 per query, in flag-bit order.
-            unsafe { d.get_query_pool_results(p, 1, &mut raw, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT) }
-                .map_err(vkerr("vkGetQueryPoolResults"))?;
-            let [ia, vs, clip] = raw[0];
-            numbers.insert(
-                "statistics".into(),
-                json!({ "input_assembly_primitives": ia, "vertex_shader_invocations": vs, "clipping_primitives": clip }),
-            );
-            // Five triangles (15 vertices, not indexed), two of them outside the view: exactly
-            // 5 assembled; at least the visible three's 9 vertices shaded; 3 to 5 out of clipping.
-            if ia != 5 || !(9..=45).contains(&vs) || !(3..=5).contains(&clip) {
-                fails.push(format!(
-                    "pipeline statistics [input assembly primitives, vertex invocations, clipping primitives] = {:?}, want [5, 9..=45, 3..=5]",
-                    raw[0]
-                ));
-            }
-        }
-        if let Some(p) = stamps {
-            let mut t = [0u64; 2];
-            // SAFETY: as above.
-            unsafe { d.get_query_pool_results(p, 0, &mut t, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT) }
-                .map_err(vkerr("vkGetQueryPoolResults"))?;
-            numbers.insert("timestamps".into(), json!(t));
-            if t[1] < t[0] {
-                fails.push(format!("the later timestamp {} is before the earlier {}", t[1], t[0]));
-            }
-        }
+        let (fails, numbers) = read_queries(ctx, occ, stats, stamps)?;
         let what = "occlusion queries reset by sub-range, counted (precise where the device can), read from a first query in 64 and \
                     32 bits and with availability (unavailable: 0, VK_NOT_READY); pipeline statistics in flag-bit order; timestamps in order";
         Ok(CheckResult::from_fails("queries", fails, numbers, what))
     })();
     prepared.destroy(ctx);
     result
+}
+
+/// Reads `commands.queries`' results back and judges them: (failures, numbers). A failure
+/// draws every count against its accepted range (`counts.bars.png`, in the order of the
+/// numbers: occlusion 64-bit, 32-bit, with availability; statistics; timestamps).
+fn read_queries(
+    ctx: &Context,
+    occ: vk::QueryPool,
+    stats: Option<vk::QueryPool>,
+    stamps: Option<vk::QueryPool>,
+) -> Result<(Vec<String>, serde_json::Map<String, serde_json::Value>)> {
+    use crate::value_images::Bar;
+    let mut numbers = serde_json::Map::new();
+    let mut fails = Vec::new();
+    let d = &ctx.device;
+    let exact = ctx.features.occlusion_query_precise;
+    // The test seam: a count the device cannot have drawn.
+    let (want60, want0) = if crate::value_images::skewed() { (61, 1) } else { (60, 0) };
+    let mut bars = Vec::new();
+    let count_bar = |got: u64, want: u64| Bar {
+        lo: if exact { want as f64 } else { want.min(1) as f64 },
+        hi: if exact { want as f64 } else { (got.max(want)) as f64 },
+        got: got as f64,
+    };
+    let count_ok = |got: u64, want: u64| if exact { got == want } else { (got > 0) == (want > 0) };
+    let mut q64 = [0u64; 2];
+    // SAFETY: one_shot waited for the submission (here and below); each slice
+    // holds `len` results of the flags' size and layout.
+    unsafe { d.get_query_pool_results(occ, 2, &mut q64, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT) }
+        .map_err(vkerr("vkGetQueryPoolResults"))?;
+    let mut q32 = [0u32; 2];
+    // SAFETY: as above.
+    unsafe { d.get_query_pool_results(occ, 2, &mut q32, vk::QueryResultFlags::WAIT) }.map_err(vkerr("vkGetQueryPoolResults"))?;
+    // Queries 5 (ended) and 6 (reset, never begun) with availability, without waiting: the
+    // call must say VK_NOT_READY, write 5's count and a non-zero availability ("non-zero if
+    // the query's status was available": SwiftShader writes 2, lavapipe 1), and 6's 0.
+    let mut avail = [[0u64, 7], [0, 7]];
+    // SAFETY: as above; two u64 per query (count, availability).
+    let r =
+        unsafe { d.get_query_pool_results(occ, 5, &mut avail, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WITH_AVAILABILITY) };
+    numbers.insert("occlusion_64".into(), json!(q64));
+    numbers.insert("occlusion_32".into(), json!(q32));
+    numbers.insert("occlusion_with_availability".into(), json!(avail));
+    numbers.insert("precise".into(), json!(exact));
+    bars.extend([count_bar(q64[0], want60), count_bar(q64[1], want0)]);
+    if !(count_ok(q64[0], want60) && q64[1] == want0) {
+        fails.push(format!("occlusion queries 2..4 (64-bit): {q64:?}, want [{want60}, {want0}]"));
+    }
+    bars.extend([count_bar(q32[0] as u64, q64[0]), count_bar(q32[1] as u64, 0)]);
+    if q32[0] as u64 != q64[0] || q32[1] != 0 {
+        fails.push(format!("occlusion queries 2..4 (32-bit): {q32:?}, the 64-bit read gave {q64:?}"));
+    }
+    bars.extend([count_bar(avail[0][0], 21), Bar { lo: 1.0, hi: avail[0][1].max(1) as f64, got: avail[0][1] as f64 }]);
+    bars.push(count_bar(avail[1][1], 0));
+    if !count_ok(avail[0][0], 21) || avail[0][1] == 0 || avail[1][1] != 0 {
+        fails.push(format!("queries 5..7 with availability: {avail:?}, want [[21, non-zero], [_, 0]]"));
+    }
+    match r {
+        Err(vk::Result::NOT_READY) => {}
+        other => fails.push(format!("reading an unavailable query without WAIT returned {other:?}, not VK_NOT_READY")),
+    }
+    if let Some(p) = stats {
+        let mut raw = [[0u64; 3]; 1];
+        // SAFETY: as above; three u64 per query, in flag-bit order.
+        unsafe { d.get_query_pool_results(p, 1, &mut raw, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT) }
+            .map_err(vkerr("vkGetQueryPoolResults"))?;
+        let [ia, vs, clip] = raw[0];
+        numbers.insert(
+            "statistics".into(),
+            json!({ "input_assembly_primitives": ia, "vertex_shader_invocations": vs, "clipping_primitives": clip }),
+        );
+        // Five triangles (15 vertices, not indexed), two of them outside the view: exactly
+        // 5 assembled; at least the visible three's 9 vertices shaded; 3 to 5 out of clipping.
+        let range = |lo: u64, hi: u64, got: u64| Bar { lo: lo as f64, hi: hi as f64, got: got as f64 };
+        bars.extend([range(5, 5, ia), range(9, 45, vs), range(3, 5, clip)]);
+        if ia != 5 || !(9..=45).contains(&vs) || !(3..=5).contains(&clip) {
+            fails.push(format!(
+                "pipeline statistics [input assembly primitives, vertex invocations, clipping primitives] = {:?}, want [5, 9..=45, 3..=5]",
+                raw[0]
+            ));
+        }
+    }
+    if let Some(p) = stamps {
+        let mut t = [0u64; 2];
+        // SAFETY: as above.
+        unsafe { d.get_query_pool_results(p, 0, &mut t, vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT) }
+            .map_err(vkerr("vkGetQueryPoolResults"))?;
+        numbers.insert("timestamps".into(), json!(t));
+        bars.push(Bar { lo: t[0] as f64, hi: t[1].max(t[0]) as f64, got: t[1] as f64 });
+        if t[1] < t[0] {
+            fails.push(format!("the later timestamp {} is before the earlier {}", t[1], t[0]));
+        }
+    }
+    if !fails.is_empty() {
+        crate::value_images::bars("counts", &bars);
+    }
+    Ok((fails, numbers))
 }
 
 /// Records a timestamp after every earlier command (synchronization2 where the device has it).
@@ -208,6 +239,9 @@ pub fn scissor(ctx: &Context) -> Result<CheckResult> {
         .collect();
     let rb = harness::render(ctx, ctx.depth_format, W, H, 1.0, 0, &draws)?;
     let bad = (0..g.stencil.len()).filter(|&i| rb.stencil[i] != g.stencil[i]).count();
+    if bad > 0 {
+        crate::image_sink::stencil_mismatch(W, H, &g.stencil, &vec![true; g.stencil.len()], &rb.stencil);
+    }
     let mut numbers = serde_json::Map::new();
     numbers.insert("mismatched_pixels".into(), json!(bad));
     let fails = if bad > 0 { vec![format!("{bad} pixels differ from the scissors' coverage")] } else { vec![] };
@@ -261,7 +295,13 @@ pub fn indirect(ctx: &Context) -> Result<CheckResult> {
             }
         }
     }
+    if crate::value_images::skewed() {
+        want[0] = want[0].wrapping_add(1);
+    }
     let bad = (0..want.len()).filter(|&i| rb.stencil[i] != want[i]).count();
+    if bad > 0 {
+        crate::image_sink::stencil_mismatch(W, H, &want, &vec![true; want.len()], &rb.stencil);
+    }
     let mut numbers = serde_json::Map::new();
     numbers.insert("mismatched_pixels".into(), json!(bad));
     let fails = if bad > 0 { vec![format!("{bad} pixels differ from the records' coverage")] } else { vec![] };

@@ -185,8 +185,14 @@ fn draw(ctx: &Context, calls: &[Call], counts: &[u32]) -> Result<(Vec<u8>, Vec<u
 }
 
 /// The result of a check whose stencil is `got` against `want`.
-fn judge(name: &str, (got, want): (Vec<u8>, Vec<u8>), what: &str) -> CheckResult {
+fn judge(name: &str, (got, mut want): (Vec<u8>, Vec<u8>), what: &str) -> CheckResult {
+    if crate::value_images::skewed() {
+        want[0] = want[0].wrapping_add(1);
+    }
     let bad = (0..want.len()).filter(|&i| got[i] != want[i]).count();
+    if bad > 0 {
+        crate::image_sink::stencil_mismatch(W, H, &want, &vec![true; want.len()], &got);
+    }
     let mut numbers = serde_json::Map::new();
     numbers.insert("mismatched_pixels".into(), json!(bad));
     numbers.insert("covered_pixels".into(), json!(want.iter().filter(|&&c| c > 0).count()));
