@@ -114,6 +114,9 @@ pub struct BenchRow {
     pub pairs_kept: u64,
     /// Median bytes of index lists kept across frames.
     pub kept_bytes: u64,
+    /// Whether the frames ran the scene's motion (`--motion`: frame `k` at `k / 30` s; the
+    /// error is then the last frame's); `false`: every frame at time 0.
+    pub motion: bool,
 }
 
 /// Frames [`refit_ms`] times.
@@ -211,6 +214,10 @@ pub struct BenchConfig {
     pub mesh_task: Vec<bool>,
     /// Renderer options for everything else (size, depth mode, ...).
     pub opts: RenderOptions,
+    /// Run each scene's motion over the frames ([`super::motion`]: the warm-up frame at time
+    /// 0, measured frame `k` at `k / 30` s; each row's error is the last frame's); `false`:
+    /// every frame at time 0.
+    pub motion: bool,
 }
 
 /// The name of a bench row's technique (`shadowmap-512`; `shadowmap-512-multiview` for cube
@@ -311,7 +318,8 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
     let mut ctx = Some(ctx);
     let mut rows = Vec::new();
     for name in &cfg.scenes {
-        let scene = umbrage_scene::load(name)?;
+        let (scene, motion) = umbrage_scene::load_animated(name)?;
+        let moving = cfg.motion.then(|| (scene.clone(), motion));
         let c = ctx.take().ok_or_else(|| Error::Other("context lost".into()))?;
         let mut r = Renderer::new(c, scene, cfg.opts.clone())?;
         // The variants (technique, counter, compute draws, mesh task stage), and their error
@@ -341,9 +349,9 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         let gbuffer_triangles = sc.meshes.iter().filter(|m| m.opacity >= 1.0).map(|m| m.mesh.triangles.len() as u64).sum::<u64>()
             + 12 * sc.spheres.len() as u64;
         let mut errors = Vec::new();
-        for v in &variants {
-            v.apply(&mut r);
-            errors.extend(evaluate(&mut r, name, &[v.technique], 1)?);
+        // With motion, the errors are the last frame's (measured after the frames).
+        if moving.is_none() {
+            errors = variant_errors(&mut r, name, &variants)?;
         }
         // Round-robin over variants, frame by frame, so that drift (thermal, other load) hits
         // every variant alike: the ratios are measured side by side.
@@ -366,6 +374,9 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         }
         let mut acc: Vec<Acc> = variants.iter().map(|_| Acc::default()).collect();
         for frame in 0..=cfg.frames {
+            if let Some((rest, motion)) = &moving {
+                super::motion::move_to(&mut r, rest, motion, super::motion::frame_time(frame))?;
+            }
             for (k, v) in variants.iter().enumerate() {
                 v.apply(&mut r);
                 let f = r.render()?;
@@ -393,6 +404,9 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 }
                 a.last = Some(f.stats);
             }
+        }
+        if moving.is_some() {
+            errors = variant_errors(&mut r, name, &variants)?;
         }
         for ((v, err), a) in variants.iter().zip(&errors).zip(acc) {
             v.apply(&mut r);
@@ -463,6 +477,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
                 pairs_replanned,
                 pairs_kept,
                 kept_bytes,
+                motion: cfg.motion,
             };
             progress(&row);
             rows.push(row);
@@ -489,6 +504,16 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         lighting_sweep: passes.as_ref().map(|p| p.lighting_sweep.clone()).unwrap_or_default(),
         gbuffer_sweep: passes.map(|p| p.gbuffer_sweep).unwrap_or_default(),
     })
+}
+
+/// Each variant's error against the reference, for `r`'s scene as it stands.
+fn variant_errors(r: &mut Renderer, name: &str, variants: &[Variant]) -> Result<Vec<umbrage_render::accuracy::Row>> {
+    let mut errors = Vec::new();
+    for v in variants {
+        v.apply(r);
+        errors.extend(evaluate(r, name, &[v.technique], 1)?);
+    }
+    Ok(errors)
 }
 
 impl BenchReport {

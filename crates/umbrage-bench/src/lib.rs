@@ -29,6 +29,7 @@ pub mod limits;
 mod markdown;
 pub mod methods;
 pub mod model;
+pub mod motion;
 pub mod pass_limits;
 mod phases;
 pub mod plots;

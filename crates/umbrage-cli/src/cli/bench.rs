@@ -18,8 +18,14 @@ pub(crate) struct BenchArgs {
     /// volume methods, edgequad and shadowmap, and rayquery where the device has ray query).
     #[arg(long, value_enum, value_delimiter = ',')]
     methods: Vec<MethodArg>,
+    /// Frames measured per variant (after one warm-up frame).
     #[arg(long, default_value_t = 10)]
     frames: usize,
+    /// Run each scene's motion (its camera's walk or orbit, its meshes' spins, its lights'
+    /// paths) over the frames: the warm-up frame at time 0, frame k at k/30 s; each row's error
+    /// is then the last frame's. Without it every frame is at time 0.
+    #[arg(long)]
+    motion: bool,
     #[arg(long, default_value = "960x540", value_parser = parse_size)]
     size: (u32, u32),
     #[arg(long, value_enum, default_value = "auto")]
@@ -126,7 +132,8 @@ pub(crate) fn bench_command(a: BenchArgs) -> Result<ExitCode> {
         compute_draws: a.compute_draws,
         mesh_task: a.mesh_task.iter().map(|&t| t == OnOff::On).collect(),
     };
-    bench(a.scenes, listed, a.counters, a.frames, opts, a.json.as_deref(), a.markdown.as_deref())
+    let run = Run { frames: a.frames, motion: a.motion, opts };
+    bench(a.scenes, listed, a.counters, run, a.json.as_deref(), a.markdown.as_deref())
 }
 
 /// `bench --suite fill-vertex`: runs the suite, writes its outputs, prints the Markdown.
@@ -256,12 +263,21 @@ struct Listed {
     mesh_task: Vec<bool>,
 }
 
+/// How `bench` runs each row's frames.
+struct Run {
+    /// `--frames`.
+    frames: usize,
+    /// `--motion`.
+    motion: bool,
+    /// The renderer's options.
+    opts: RenderOptions,
+}
+
 fn bench(
     scenes: Vec<String>,
     Listed { techniques, default_list, compute_draws, mesh_task }: Listed,
     counters: Vec<Counter>,
-    frames: usize,
-    opts: RenderOptions,
+    Run { frames, motion, opts }: Run,
     json: Option<&Path>,
     markdown: Option<&Path>,
 ) -> Result<ExitCode> {
@@ -274,7 +290,7 @@ fn bench(
     if default_list && ctx.features.ray_query {
         techniques.push(Technique::RayQuery);
     }
-    let cfg = umbrage_bench::BenchConfig { scenes, techniques, counters, frames, opts, compute_draws, mesh_task };
+    let cfg = umbrage_bench::BenchConfig { scenes, techniques, counters, frames, opts, compute_draws, mesh_task, motion };
     let report = umbrage_bench::run(ctx, &cfg, |r| {
         eprintln!(
             "{:<14} {:<16} {:<8} gpu {:>8} ms  shadow {:>8} ms  {:>7.1} fps  {:>8} tris  error {:.4}%",
