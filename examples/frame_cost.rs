@@ -1,6 +1,7 @@
 //! What a frame of `ShadowPass::prepare` costs on the CPU, and what it sends, with the plans
 //! kept across frames (`PassSettings::keep`) and without, while the camera walks, casters
-//! move or lights move. The numbers of `docs/frame-cost.md` come from here.
+//! move or lights move. The numbers of `docs/frame-cost/example.md` came from here (those
+//! of `docs/frame-cost.md` come from `umbrage bench --suite frame-cost`).
 //!
 //! Scenes: `vertex` (`bench/vertex`: 36 casters, ~435k triangles), any other built-in scene
 //! or scene file (each with its lights or `--lights N` made around it), and `level`: the

@@ -62,3 +62,62 @@ fn motion_rows_carry_the_frame_cost_of_what_moved() {
     assert_eq!((u(&still, "pairs_replanned"), u(&still, "bytes_sent")), (0, 0), "{still}");
     assert_eq!(u(&still, "pairs_kept"), u(&still, "pairs_total"), "{still}");
 }
+
+/// `bench --suite frame-cost` at its tiny size: every scene, case and way rowed with the
+/// invariants of keeping (nothing kept without it, less sent with it where only the camera
+/// moved), the curves, the plots and the report.
+#[test]
+fn frame_cost_suite_writes_its_rows_curves_and_report() {
+    let dir = std::env::temp_dir().join(format!("umbrage-frame-cost-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let md = dir.join("report.md");
+    let out = Command::new(common::exe::umbrage_exe())
+        .args([
+            "bench",
+            "--suite",
+            "frame-cost",
+            "--tiny",
+            "--out",
+            dir.join("plots").to_str().unwrap(),
+            "--markdown",
+            md.to_str().unwrap(),
+        ])
+        .env("UMBRAGE_VALIDATION", "1")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("plots/frame-cost.json")).unwrap()).unwrap();
+    let rows = v["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 4 * 3 * 3, "scenes x cases x ways");
+    let row = |scene: &str, case: &str, way: &str| {
+        rows.iter().find(|r| r["scene"] == scene && r["case"] == case && r["way"] == way).unwrap_or_else(|| panic!("{scene} {case} {way}"))
+    };
+    for r in rows {
+        let total = u(r, "pairs_total");
+        // (medians of each key: kept + replanned is the total frame by frame, not median by median)
+        assert!(total > 0 && u(r, "pairs_kept") <= total && u(r, "pairs_replanned") <= total, "{r}");
+        match r["way"].as_str().unwrap() {
+            "keep-off" | "compute" => assert_eq!((u(r, "pairs_kept"), u(r, "pairs_replanned")), (0, total), "{r}"),
+            _ => {}
+        }
+        assert_eq!(r["moved"].as_u64().unwrap() == 0, r["case"] == "camera", "{r}");
+        assert!(f(r, "cpu_frame_ms") >= f(r, "cpu_shadow_ms") && f(r, "cpu_shadow_ms") > 0.0, "{r}");
+    }
+    for scene in ["bench/level", "default", "stress", "bench/vertex"] {
+        let (off, kept) = (row(scene, "camera", "keep-off"), row(scene, "camera", "kept"));
+        assert!(u(kept, "bytes_sent") < u(off, "bytes_sent") && u(kept, "pairs_kept") > 0, "{kept} against {off}");
+        assert_eq!(u(kept, "pairs_total"), u(off, "pairs_total"), "the same pairs drawn");
+    }
+    assert_eq!(u(row("bench/level", "casters", "kept"), "moved"), 8, "the level's turning characters");
+    for curve in ["lights_curve", "casters_curve"] {
+        let points = v[curve].as_array().unwrap();
+        assert_eq!(points.len(), 2, "{curve}");
+        assert!(points.iter().all(|p| u(p, "pairs_total") > 0 && f(p, "off_ms") > 0.0 && f(p, "kept_ms") > 0.0), "{curve}");
+    }
+    for plot in ["lights.svg", "casters.svg", "lights.png", "casters.png"] {
+        assert!(std::fs::metadata(dir.join("plots").join(plot)).is_ok_and(|m| m.len() > 0), "{plot}");
+    }
+    let text = std::fs::read_to_string(&md).unwrap();
+    assert!(text.contains("umbrage bench --suite frame-cost") && text.contains("](plots/lights.svg)"), "{text}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

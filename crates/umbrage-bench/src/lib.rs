@@ -23,6 +23,7 @@ pub mod shaders {
 pub mod classic;
 pub mod compute_read;
 mod evidence;
+pub mod frame_cost;
 mod frame_passes;
 pub mod identify;
 pub mod limits;

@@ -100,6 +100,11 @@ enum SuiteArg {
     /// Fill-rate vs vertex-rate: the limits, sweeps that cross over, the bound at each point.
     #[value(name = "fill-vertex")]
     FillVertex,
+    /// What a frame costs when only some of the scene changed (issue 55): bench/level,
+    /// default, stress and bench/vertex in motion, planned every frame, kept and compute side
+    /// by side, and the CPU against lights and casters; docs/frame-cost.md.
+    #[value(name = "frame-cost")]
+    FrameCost,
 }
 
 pub(crate) fn bench_command(a: BenchArgs) -> Result<ExitCode> {
@@ -140,6 +145,9 @@ pub(crate) fn bench_command(a: BenchArgs) -> Result<ExitCode> {
 fn suite(a: &BenchArgs) -> Result<ExitCode> {
     use umbrage_bench::sweeps::Scale;
     let tiny = a.tiny || std::env::var("UMBRAGE_BENCH_TINY").is_ok_and(|v| v == "1");
+    if a.suite == Some(SuiteArg::FrameCost) {
+        return frame_cost(a, tiny);
+    }
     let scale = match (tiny, a.quick) {
         (true, _) => Scale::Tiny,
         (false, true) => Scale::Quick,
@@ -165,6 +173,27 @@ fn suite(a: &BenchArgs) -> Result<ExitCode> {
         let text = report.markdown(&rel.display().to_string());
         std::fs::write(m, text).map_err(|e| Error::io(m.display().to_string(), e))?;
     }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `bench --suite frame-cost`: runs it, writes its plots and JSON into --out and its report
+/// (`frame-cost.md` there, or --markdown with the plots linked relative to it), prints it.
+fn frame_cost(a: &BenchArgs, tiny: bool) -> Result<ExitCode> {
+    use umbrage_bench::frame_cost::{self, FrameCostConfig};
+    let cfg = if tiny { FrameCostConfig::tiny(a.out.clone()) } else { FrameCostConfig::full(a.out.clone()) };
+    let ctx = umbrage::gpu::Context::new()?;
+    let report = frame_cost::run(ctx, &cfg)?;
+    let (path, plots) = match &a.markdown {
+        Some(m) => {
+            let base = m.parent().unwrap_or(Path::new(""));
+            let rel = a.out.strip_prefix(base).map(Path::to_path_buf).unwrap_or_else(|_| a.out.clone());
+            (m.clone(), rel.display().to_string())
+        }
+        None => (a.out.join("frame-cost.md"), ".".to_string()),
+    };
+    let md = report.markdown(&plots);
+    std::fs::write(&path, &md).map_err(|e| Error::io(path.display().to_string(), e))?;
+    println!("{md}");
     Ok(ExitCode::SUCCESS)
 }
 
