@@ -21,6 +21,7 @@ pub mod shaders {
     include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
 }
 pub mod classic;
+mod classic_frames;
 pub mod compute_read;
 mod evidence;
 pub mod frame_cost;
