@@ -76,7 +76,7 @@ fn main() -> umbrage::Result<()> {
             let opts = RenderOptions { width: 320, height: 240, ..Default::default() };
             let mut r = Renderer::new(ctx, s, opts)?;
             for &(label, t, task) in &variants {
-                r.settings.technique = t;
+                r.settings.technique = t.into();
                 r.settings.toggles.mesh_task = task;
                 r.render()?; // warm-up: uploads, static tables, pipelines
                 let (mut cpu, mut sil, mut gpu, mut gsil, mut bytes, mut st) = (Vec::new(), Vec::new(), Vec::new(), Vec::new(), 0, 0);

@@ -32,7 +32,7 @@ fn main() -> umbrage::Result<()> {
             let opts = RenderOptions { width: w, height: h, capture: true, ..Default::default() };
             let mut r = Renderer::new(ctx, umbrage_scene::load(name)?, opts)?;
             let mut frame = |t: Technique| {
-                r.settings.technique = t;
+                r.settings.technique = t.into();
                 r.render().map(|f| f.stencil)
             };
             let reference = frame(Technique::Volumes(Method::McGuire))?;

@@ -315,7 +315,7 @@ impl Host {
         ];
         Stats {
             device: self.gpu.name.clone(),
-            method: settings.technique,
+            method: settings.technique.into(),
             depth_mode: self.pass().desc().depth_mode,
             index_format: settings.index_format,
             counter: settings.counter,

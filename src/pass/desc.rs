@@ -182,7 +182,7 @@ named_enum!(
     }
 );
 
-pub use super::technique::{CubeFaces, Pcf, Technique};
+pub use super::technique::Technique;
 
 /// The optional device features the host enabled on its `VkDevice`. The pass uses a feature
 /// only when the host enabled it AND the physical device reports it.
@@ -512,16 +512,6 @@ pub(crate) fn check_depth_stencil_format(format: vk::Format) -> Result<()> {
 impl PassSettings {
     /// Whether the device can honour these settings (checked before every frame).
     pub fn check(&self, caps: &Capabilities) -> Result<()> {
-        if self.technique.pass_technique().is_none() {
-            return Err(Error::InvalidDesc {
-                field: "PassSettings::technique",
-                msg: format!(
-                    "{} is a renderer technique (umbrage::render::Renderer), not one a ShadowPass records: \
-                     use Volumes, EdgeQuads, Planar, Compute, Mesh or RayQuery",
-                    self.technique.name()
-                ),
-            });
-        }
         if self.technique == Technique::RayQuery {
             if !caps.ray_query {
                 return Err(rays_missing());

@@ -112,8 +112,8 @@ mod volumes;
 
 pub use casters::CasterId;
 pub use desc::{
-    reverse_z, Capabilities, ComputeDraws, Counter, CubeFaces, DepthDirection, DepthMode, EnabledFeatures, IndexFormat, PassSettings,
-    PassToggles, Pcf, RenderPassTarget, ShadowPassDesc, TargetModel, Technique,
+    reverse_z, Capabilities, ComputeDraws, Counter, DepthDirection, DepthMode, EnabledFeatures, IndexFormat, PassSettings, PassToggles,
+    RenderPassTarget, ShadowPassDesc, TargetModel, Technique,
 };
 pub use draw::LightFrame;
 pub use frame::{PreparedFrame, MAX_CONE_DEG};

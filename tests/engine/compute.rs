@@ -7,7 +7,7 @@ use umbrage::shadow::{Method, VolumePath};
 use umbrage_render::{ComputeDraws, FrameOutput, RenderOptions, Renderer, Technique};
 
 fn frame(r: &mut Renderer, t: Technique) -> FrameOutput {
-    r.settings.technique = t;
+    r.settings.technique = t.into();
     let out = r.render().unwrap();
     r.context().check_validation().unwrap();
     out
@@ -29,7 +29,7 @@ fn compare(r: &mut Renderer, name: &str) -> FrameOutput {
         assert!(g == g2, "{name}: compute frames differ");
     }
     let (cs, gs) = (&cpu.stats, &gpu.stats);
-    assert_eq!(gs.method, Technique::Compute);
+    assert_eq!(gs.method, Technique::Compute.into());
     common::same_volumes_as_cpu(cs, gs, name, VolumePath::Compute);
     assert_eq!(cs.totals.triangles.total(), gs.totals.triangles.total(), "{name}");
     assert_eq!(gpu2.stats.totals.triangles.total(), gs.totals.triangles.total(), "{name}");
@@ -70,7 +70,7 @@ fn compute_mirrored_chunked_directional_and_static_bytes() {
     assert!(again.stats.totals.index_bytes > 0);
     assert_eq!(again.stats.cpu_ms.silhouettes, 0.0, "no CPU facing for closed casters");
     // frames in flight: both ring slots, validation (synchronisation included) clean
-    r.settings.technique = Technique::Compute;
+    r.settings.technique = Technique::Compute.into();
     r.throughput(4).unwrap();
     r.context().check_validation().unwrap();
 }
@@ -175,7 +175,7 @@ fn compute_draw_ways_are_bit_identical() {
     let mut r = draw_ways_on(ctx, &common::hard_and_builtin_scenes(), &ways);
     // the merged draws with frames in flight: validation (synchronisation included) clean
     r.settings.toggles.compute_draws = ComputeDraws::Auto;
-    r.settings.technique = Technique::Compute;
+    r.settings.technique = Technique::Compute.into();
     r.throughput(4).unwrap();
     r.context().check_validation().unwrap();
 }

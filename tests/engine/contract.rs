@@ -392,10 +392,13 @@ fn rows(ctx: &Context) -> Vec<Row> {
     rows.push(Row {
         input,
         field: "PassSettings::technique",
-        range: "`Volumes(_)`, `EdgeQuads`, `Planar`, `Compute`, `RayQuery` (with ray query); not the renderer's `ShadowMap`",
-        expect: Expect::Desc("PassSettings::technique"),
-        accepted: settings_probes(&[Technique::Volumes(Method::McGuire), Technique::EdgeQuads, Technique::Planar], |s, v| s.technique = v),
-        refused: settings_probes(&[Technique::shadow_map(512)], |s, v| s.technique = v),
+        range: "every `Technique` (the type holds only what a pass runs); `Mesh` and `RayQuery` where the host enabled their features",
+        expect: Expect::Unsupported("EnabledFeatures::"),
+        accepted: settings_probes(
+            &[Technique::Volumes(Method::McGuire), Technique::EdgeQuads, Technique::Planar, Technique::Compute],
+            |s, v| s.technique = v,
+        ),
+        refused: settings_probes(&[Technique::Mesh, Technique::RayQuery], |s, v| s.technique = v),
     });
     rows.push(Row {
         input,

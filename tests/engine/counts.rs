@@ -56,7 +56,7 @@ fn render(ctx: umbrage::gpu::Context, toml: &str, name: &str, method: Method, fm
         RenderOptions {
             width: 320,
             height: 240,
-            technique: umbrage_render::Technique::Volumes(method),
+            technique: umbrage_render::Technique::Volumes(method).into(),
             index_format: fmt,
             ..Default::default()
         },

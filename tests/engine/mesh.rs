@@ -26,7 +26,7 @@ use umbrage_render::{FrameOutput, RenderOptions, Renderer, Technique, View};
 const KNOWN_DIFFS_128X96: [(&str, usize, usize); 3] = [("hard/near_coplanar", 1, 250), ("hard/staircase_300", 0, 4), ("mixed", 1, 4)];
 
 fn frame(r: &mut Renderer, t: Technique) -> FrameOutput {
-    r.settings.technique = t;
+    r.settings.technique = t.into();
     let out = r.render().unwrap();
     r.context().check_validation().unwrap();
     out
@@ -52,7 +52,7 @@ fn compare(r: &mut Renderer, name: &str, allowed: &[(&str, usize, usize)]) -> Fr
         assert!(g == g2, "{name}: mesh frames differ");
     }
     let (cs, gs) = (&cpu.stats, &gpu.stats);
-    assert_eq!(gs.method, Technique::Mesh);
+    assert_eq!(gs.method, Technique::Mesh.into());
     common::same_volumes_as_cpu(cs, gs, name, VolumePath::Mesh);
     assert_eq!(cs.totals.triangles.total(), gs.totals.triangles.total(), "{name}");
     assert_eq!(gpu2.stats.totals.triangles.total(), gs.totals.triangles.total(), "{name}");
@@ -107,7 +107,7 @@ fn mesh_mirrored_chunked_directional_and_static_bytes() {
     assert_eq!(again.stats.cpu_ms.silhouettes, 0.0, "no CPU facing for closed casters");
     // frames in flight: both ring slots, validation (synchronisation included) clean; and
     // switching between the compute and mesh paths, which share the static tables
-    r.settings.technique = Technique::Mesh;
+    r.settings.technique = Technique::Mesh.into();
     r.throughput(4).unwrap();
     r.context().check_validation().unwrap();
     let c = frame(&mut r, Technique::Compute);
@@ -207,7 +207,7 @@ fn mesh_volumes_overlay_is_mcguires() {
         for (view, t) in
             [(View::Shaded, Technique::Mesh), (View::Volumes, Technique::Volumes(Method::McGuire)), (View::Volumes, Technique::Mesh)]
         {
-            let opts = RenderOptions { width: 128, height: 128, view, technique: t, ..Default::default() };
+            let opts = RenderOptions { width: 128, height: 128, view, technique: t.into(), ..Default::default() };
             let mut r = Renderer::new(ctx, umbrage_scene::load(name).unwrap(), opts).unwrap();
             images.push(r.render().unwrap().color);
             r.context().check_validation().unwrap();
@@ -236,7 +236,7 @@ fn mesh_multiplicity_parts_fall_back_to_the_cpu() {
 #[test]
 fn mesh_is_refused_without_mesh_shaders() {
     use umbrage::pass::{Capabilities, PassSettings};
-    assert_eq!(Technique::parse("mesh", 1024).unwrap(), Technique::Mesh);
+    assert_eq!("mesh".parse::<Technique>().unwrap(), Technique::Mesh);
     assert_eq!(Technique::Mesh.name(), "mesh");
     let s = PassSettings { technique: Technique::Mesh, ..Default::default() };
     let e = s.check(&Capabilities::default()).unwrap_err();
@@ -250,7 +250,7 @@ fn mesh_is_refused_without_mesh_shaders() {
         return;
     }
     let mut r = renderer(ctx, umbrage_scene::load("default").unwrap());
-    r.settings.technique = Technique::Mesh;
+    r.settings.technique = Technique::Mesh.into();
     let e = r.render().map(|_| ()).unwrap_err();
     assert!(matches!(e, umbrage::Error::Unsupported(_)) && e.to_string().contains("VK_EXT_mesh_shader"), "{e}");
 }

@@ -7,7 +7,7 @@ use crate::common;
 
 use umbrage::error::Error;
 use umbrage::shadow::Method;
-use umbrage_render::{Counter, FrameOutput, RenderOptions, Renderer, Technique, View};
+use umbrage_render::{Counter, FrameOutput, RenderOptions, RenderTechnique, Renderer, ShadowMap, Technique, View};
 use umbrage_scene::Scene;
 
 const SAMPLES: u32 = 4;
@@ -46,9 +46,9 @@ fn check_samples(out: &FrameOutput, one: &FrameOutput, scene: &Scene, what: &str
     }
 }
 
-fn render(ctx: umbrage::gpu::Context, name: &str, technique: Technique, samples: u32) -> (FrameOutput, Renderer) {
+fn render(ctx: umbrage::gpu::Context, name: &str, technique: impl Into<RenderTechnique>, samples: u32) -> (FrameOutput, Renderer) {
     let scene = umbrage_scene::load(name).unwrap();
-    let opts = RenderOptions { width: 160, height: 120, technique, capture: true, samples, ..Default::default() };
+    let opts = RenderOptions { width: 160, height: 120, technique: technique.into(), capture: true, samples, ..Default::default() };
     let mut r = Renderer::new(ctx, scene, opts).unwrap_or_else(|e| panic!("{name} at {samples} samples: {e}"));
     umbrage_conform::checks::calibrate_sample_locations(&mut r).unwrap();
     let out = r.render().unwrap();
@@ -123,12 +123,12 @@ fn samples_are_at_their_own_locations_and_the_resolve_antialiases() {
 fn what_renders_at_one_sample_is_refused() {
     let Some(mut ctx) = common::context() else { return };
     let refused = [
-        ("default", 3, Technique::default(), Counter::Stencil, View::Shaded, "1, 2, 4 or 8"),
-        ("default", 0, Technique::default(), Counter::Stencil, View::Shaded, "1, 2, 4 or 8"),
-        ("default", SAMPLES, Technique::shadow_map(256), Counter::Stencil, View::Shaded, "shadowmap"),
-        ("default", SAMPLES, Technique::default(), Counter::Float, View::Shaded, "float counter"),
-        ("default", SAMPLES, Technique::default(), Counter::Stencil, View::Volumes, "overlay"),
-        ("transparent/depth_4", SAMPLES, Technique::default(), Counter::Stencil, View::Shaded, "transparent"),
+        ("default", 3, RenderTechnique::default(), Counter::Stencil, View::Shaded, "1, 2, 4 or 8"),
+        ("default", 0, RenderTechnique::default(), Counter::Stencil, View::Shaded, "1, 2, 4 or 8"),
+        ("default", SAMPLES, RenderTechnique::from(ShadowMap::new(256)), Counter::Stencil, View::Shaded, "shadowmap"),
+        ("default", SAMPLES, RenderTechnique::default(), Counter::Float, View::Shaded, "float counter"),
+        ("default", SAMPLES, RenderTechnique::default(), Counter::Stencil, View::Volumes, "overlay"),
+        ("transparent/depth_4", SAMPLES, RenderTechnique::default(), Counter::Stencil, View::Shaded, "transparent"),
     ];
     for (name, samples, technique, counter, view, needle) in refused {
         let scene = umbrage_scene::load(name).unwrap();
@@ -146,10 +146,10 @@ fn what_renders_at_one_sample_is_refused() {
     // Switching a multisampled renderer to a one-sample method is refused at the frame.
     let scene = umbrage_scene::load("default").unwrap();
     let mut r = Renderer::new(ctx, scene, RenderOptions { width: 64, height: 48, samples: SAMPLES, ..Default::default() }).unwrap();
-    r.settings.technique = Technique::shadow_map(256);
+    r.settings.technique = RenderTechnique::from(ShadowMap::new(256));
     let err = r.render().err().expect("a shadow-map frame at 4 samples");
     assert!(err.to_string().contains("one sample"), "{err}");
-    r.settings.technique = Technique::default();
+    r.settings.technique = Technique::default().into();
     r.render().unwrap();
     r.context().check_validation().unwrap();
 }

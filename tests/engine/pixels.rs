@@ -3,7 +3,7 @@
 //! method that should handle the view, including the eye inside the volumes.
 use crate::common;
 use umbrage::shadow::Method;
-use umbrage_render::{CubeFaces, DepthMode, Pcf, RenderOptions, Renderer, Technique};
+use umbrage_render::{CubeFaces, DepthMode, Pcf, RenderOptions, RenderTechnique, Renderer, ShadowMap, Technique};
 
 /// Two boxes stacked above a floor, a point light straight above, camera looking down at the
 /// floor from the side. Floor at the centre of the image lies in both boxes' shadows.
@@ -58,7 +58,7 @@ fn stacked_boxes_give_count_two_and_dark_floor() {
             let opts = RenderOptions {
                 width: 200,
                 height: 150,
-                technique: Technique::Volumes(method),
+                technique: Technique::Volumes(method).into(),
                 depth_mode,
                 capture: true,
                 ..Default::default()
@@ -93,7 +93,7 @@ fn eye_inside_two_volumes_counts_two_except_zpass() {
         let mut r = Renderer::new(
             ctx,
             scene,
-            RenderOptions { width: 160, height: 120, technique: Technique::Volumes(method), capture: true, ..Default::default() },
+            RenderOptions { width: 160, height: 120, technique: Technique::Volumes(method).into(), capture: true, ..Default::default() },
         )
         .unwrap();
         let out = r.render().unwrap();
@@ -117,15 +117,15 @@ fn shadow_map_baseline_is_close_to_the_reference() {
     let Some(mut ctx) = common::context() else { return };
     for name in ["default", "stairs", "spheres", "hard/light_inside_caster", "hard/light_inside_bounds"] {
         let scene = umbrage_scene::load(name).unwrap();
-        let sm = Technique::shadow_map(1024);
+        let sm = RenderTechnique::from(ShadowMap::new(1024));
         let opts = RenderOptions { width: 256, height: 192, technique: sm, capture: true, ..Default::default() };
         let mut r = Renderer::new(ctx, scene, opts).unwrap();
         let rows = umbrage_render::accuracy::evaluate(&mut r, name, &[sm], 1).unwrap();
         let taps = r.render().unwrap();
-        assert!(matches!(taps.stats.method, umbrage_render::Technique::ShadowMap { .. }));
+        assert!(matches!(taps.stats.method, RenderTechnique::ShadowMap(_)));
         assert!(rows[0].fraction < 5e-3, "{name}: shadow map error {:.4}%", rows[0].fraction * 100.0);
         assert!(!taps.counts.is_empty() && taps.counts.iter().flatten().any(|&c| c != 0), "{name}: no shadow to compare");
-        r.settings.technique = Technique::ShadowMap { size: 1024, pcf: Pcf::Gather, cube: CubeFaces::Atlas };
+        r.settings.technique = RenderTechnique::ShadowMap(ShadowMap { size: 1024, pcf: Pcf::Gather, cube: CubeFaces::Atlas });
         let gather = r.render().unwrap();
         assert!(taps.counts == gather.counts, "{name}: the gathers' shadow counts differ from the taps'");
         assert!(taps.color == gather.color, "{name}: the gathers' picture differs from the taps'");
@@ -145,12 +145,12 @@ fn multiview_cube_faces_are_the_atlas_maps() {
     let Some(ctx) = common::context() else { return };
     let scene = umbrage_scene::load("default").unwrap();
     let mut r = Renderer::new(ctx, scene, RenderOptions { width: 64, height: 48, ..Default::default() }).unwrap();
-    r.settings.technique = Technique::ShadowMap { size: 256, pcf: Pcf::Taps, cube: CubeFaces::Multiview };
+    r.settings.technique = RenderTechnique::ShadowMap(ShadowMap { size: 256, pcf: Pcf::Taps, cube: CubeFaces::Multiview });
     if let Err(e) = r.render() {
         let msg = e.to_string();
         assert!(matches!(e, umbrage::Error::Unsupported(_)) && msg.contains("--cube atlas"), "{msg}");
         // Refused, not half-made: the atlas still renders.
-        r.settings.technique = Technique::shadow_map(256);
+        r.settings.technique = RenderTechnique::from(ShadowMap::new(256));
         r.render().unwrap();
         r.context().check_validation().unwrap();
         drop(r);
@@ -160,12 +160,18 @@ fn multiview_cube_faces_are_the_atlas_maps() {
     let mut ctx = r.into_context();
     for name in ["default", "stairs", "hard/light_inside_caster", "hard/light_inside_bounds"] {
         let scene = umbrage_scene::load(name).unwrap();
-        let opts = RenderOptions { width: 256, height: 192, technique: Technique::shadow_map(1024), capture: true, ..Default::default() };
+        let opts = RenderOptions {
+            width: 256,
+            height: 192,
+            technique: RenderTechnique::from(ShadowMap::new(1024)),
+            capture: true,
+            ..Default::default()
+        };
         let mut r = Renderer::new(ctx, scene, opts).unwrap();
         let atlas = r.render().unwrap();
         assert!(atlas.counts.iter().flatten().any(|&c| c != 0), "{name}: no shadow to compare");
         for pcf in [Pcf::Taps, Pcf::Gather] {
-            r.settings.technique = Technique::ShadowMap { size: 1024, pcf, cube: CubeFaces::Multiview };
+            r.settings.technique = RenderTechnique::ShadowMap(ShadowMap { size: 1024, pcf, cube: CubeFaces::Multiview });
             let views = r.render().unwrap();
             assert!(atlas.counts == views.counts, "{name}: {pcf} from multiview faces: the shadow counts differ from the atlas's");
             assert!(atlas.color == views.color, "{name}: {pcf} from multiview faces: the picture differs from the atlas's");

@@ -58,10 +58,10 @@ translate = [0.0, 2.5, 0.0]
             "default" => umbrage_scene::load(name).unwrap(),
             _ => umbrage_scene::load_str(over_block, name, std::path::Path::new(".")).unwrap(),
         };
-        let opts = RenderOptions { width: w, height: h, technique: Technique::Planar, capture: true, ..Default::default() };
+        let opts = RenderOptions { width: w, height: h, technique: Technique::Planar.into(), capture: true, ..Default::default() };
         let mut r = Renderer::new(ctx, scene, opts).unwrap();
         let out = r.render().unwrap();
-        assert_eq!(out.stats.method, umbrage_render::Technique::Planar);
+        assert_eq!(out.stats.method, umbrage_render::Technique::Planar.into());
         let reference = Reference::from_scene(r.scene()).render(&r.scene().camera, &r.scene().lights, w, h);
         let (floor, elsewhere) = split_masks(&out.shadow_masks(r.scene()), &out.positions, &reference);
         let floor_metrics = compare_all(&floor, &reference, 1).unwrap();

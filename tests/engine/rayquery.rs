@@ -5,7 +5,7 @@
 //! error naming the extension and the script that installs a driver with it.
 use crate::common;
 use umbrage_render::accuracy::evaluate;
-use umbrage_render::{RenderOptions, Renderer, Technique};
+use umbrage_render::{RenderOptions, RenderTechnique, Renderer, ShadowMap, Technique};
 
 /// A caster that moves between frames: the top level is rebuilt from the new transform.
 #[test]
@@ -23,7 +23,7 @@ fn rayquery_follows_a_moving_caster() {
         assert!(rows[0].passed, "step {step}: {} mismatches of {}", rows[0].mismatches, rows[0].compared);
     }
     // The float counter counts volumes; the rays write the stencil: refused, not a stale picture.
-    r.settings.technique = Technique::RayQuery;
+    r.settings.technique = Technique::RayQuery.into();
     r.settings.counter = umbrage_render::Counter::Float;
     let e = r.render().err().expect("ray query with the float counter must fail");
     assert!(matches!(e, umbrage::Error::InvalidDesc { field: "FrameSettings::counter", .. }), "{e:?}");
@@ -41,7 +41,7 @@ fn missing_ray_query_is_a_clear_error() {
     }
     let scene = umbrage_scene::load("default").unwrap();
     let mut r = Renderer::new(ctx, scene, RenderOptions { width: 64, height: 48, ..Default::default() }).unwrap();
-    r.settings.technique = Technique::RayQuery;
+    r.settings.technique = Technique::RayQuery.into();
     // The float counter counts volumes: with rays it is refused first, whatever the device.
     r.settings.counter = umbrage_render::Counter::Float;
     let e = r.render().err().expect("ray query with the float counter must fail");
@@ -50,7 +50,7 @@ fn missing_ray_query_is_a_clear_error() {
     let e = r.render().err().expect("ray query without the extension must fail").to_string();
     assert!(e.contains("VK_KHR_ray_query") && e.contains("scripts/drivers.sh install 25.0.7"), "{e}");
     // Nothing was left half-made: another technique still renders.
-    r.settings.technique = Technique::default();
+    r.settings.technique = Technique::default().into();
     r.render().unwrap();
     r.context().check_validation().unwrap();
 }
@@ -70,7 +70,7 @@ fn batched_rays_are_the_per_light_rays() {
         }
         let opts = RenderOptions { width: 200, height: 150, ..Default::default() };
         let mut r = Renderer::new(ctx, scene, opts).unwrap();
-        r.settings.technique = Technique::RayQuery;
+        r.settings.technique = Technique::RayQuery.into();
         r.settings.capture = true;
         r.settings.toggles.ray_batch = true;
         let batched = r.render().unwrap();
@@ -103,7 +103,7 @@ fn rayquery_follows_a_deforming_caster() {
     let mut r = Renderer::new(ctx, scene, opts).unwrap();
     let i = r.scene().meshes.iter().position(|m| m.casts_shadow).unwrap();
     let rest = r.scene().meshes[i].mesh.positions.clone();
-    r.settings.technique = Technique::RayQuery;
+    r.settings.technique = Technique::RayQuery.into();
     let first = r.render().unwrap().stats.ray_query.expect("ray-query stats");
     assert!(first.builds >= 1 && first.refits == 0, "{first:?}");
     // Once the building frame's slot comes round again, the static bottom levels are compacted
@@ -118,7 +118,7 @@ fn rayquery_follows_a_deforming_caster() {
         let k = 0.15 * step as f32;
         let bent: Vec<glam::Vec3> = rest.iter().map(|p| glam::Vec3::new(p.x + k * p.y, p.y * (1.0 - 0.1 * step as f32), p.z)).collect();
         r.set_mesh_positions(i, &bent).unwrap();
-        r.settings.technique = Technique::RayQuery;
+        r.settings.technique = Technique::RayQuery.into();
         let s = r.render().unwrap().stats.ray_query.expect("ray-query stats");
         match step {
             1 => assert_eq!((s.builds, s.refits), (1, 0), "the first deformation rebuilds with ALLOW_UPDATE: {s:?}"),
@@ -132,7 +132,7 @@ fn rayquery_follows_a_deforming_caster() {
     }
     assert_eq!(refits, 2);
     // A shadow-map frame after the ray-query ones prepares no rays (no top level, no stats).
-    r.settings.technique = Technique::ShadowMap { size: 256, pcf: Default::default(), cube: Default::default() };
+    r.settings.technique = RenderTechnique::ShadowMap(ShadowMap { size: 256, pcf: Default::default(), cube: Default::default() });
     let s = r.render().unwrap().stats;
     assert!(s.ray_query.is_none(), "a shadow-map frame prepared ray query: {:?}", s.ray_query);
     // A wrong vertex count is refused and changes nothing.
@@ -150,7 +150,7 @@ fn the_classic_bench_times_builds_refits_and_top_levels() {
     };
     let cfg = umbrage_bench::BenchConfig {
         scenes: vec!["default".into()],
-        techniques: vec![Technique::RayQuery, Technique::default()],
+        techniques: vec![Technique::RayQuery.into(), RenderTechnique::default()],
         counters: vec![umbrage_render::Counter::Stencil],
         frames: 2,
         opts: RenderOptions { width: 160, height: 120, ..Default::default() },
@@ -219,7 +219,7 @@ fn write_docs_raytrace_accel_md() {
             .unwrap();
         let rest = scene.meshes[big].mesh.positions.clone();
         let mut r = Renderer::new(ctx.take().unwrap(), scene, RenderOptions { width: 960, height: 540, ..Default::default() }).unwrap();
-        r.settings.technique = Technique::RayQuery;
+        r.settings.technique = Technique::RayQuery.into();
         let frame = |r: &mut Renderer| {
             let s = r.render().unwrap().stats;
             (s.gpu_ms.expect("timestamps").accel, s.ray_query.unwrap())
@@ -302,7 +302,7 @@ fn write_docs_raytrace_batch_md() {
         let mut times = vec![Vec::new(); variants.len()];
         for round in 0..7 {
             for (k, (t, batch)) in variants.iter().enumerate() {
-                r.settings.technique = *t;
+                r.settings.technique = (*t).into();
                 r.settings.toggles.ray_batch = *batch;
                 let s = r.render().unwrap().stats;
                 if round > 0 {

@@ -6,7 +6,7 @@ use crate::common;
 
 use umbrage::shadow::Method;
 use umbrage_render::accuracy::{evaluate, THRESHOLD};
-use umbrage_render::{Counter, RenderOptions, Renderer, Technique};
+use umbrage_render::{Counter, RenderOptions, RenderTechnique, Renderer, ShadowMap, Technique};
 
 const SCENES: [&str; 2] = ["analytic/sphere_only", "analytic/sphere_and_meshes"];
 
@@ -38,7 +38,7 @@ fn sphere_scenes_match_the_reference_with_the_automatic_n() {
                 assert!(row.fraction <= THRESHOLD, "{name} {} {}: {row:?}", counter.name(), row.method);
             }
             // The stats name every sphere's polygon per light, chosen by the half-pixel rule.
-            r.settings.technique = Technique::Volumes(Method::McGuire);
+            r.settings.technique = Technique::Volumes(Method::McGuire).into();
             let out = r.render().unwrap();
             let casting = r.scene().spheres.iter().filter(|s| s.casts_shadow).count();
             for l in &out.stats.lights {
@@ -111,10 +111,10 @@ fn bad_sphere_frames_are_refused_not_drawn() {
     let opts = RenderOptions { width: 64, height: 48, ..Default::default() };
     let mut r = Renderer::new(ctx, scene.clone(), opts.clone()).unwrap();
     // Shadow maps do not draw spheres: a clear error, and the renderer keeps working after it.
-    r.settings.technique = Technique::shadow_map(512);
+    r.settings.technique = RenderTechnique::from(ShadowMap::new(512));
     let e = r.render().err().expect("refused").to_string();
     assert!(e.contains("sphere"), "{e}");
-    r.settings.technique = Technique::Volumes(Method::McGuire);
+    r.settings.technique = Technique::Volumes(Method::McGuire).into();
     r.render().unwrap();
     r.context().check_validation().unwrap();
     ctx = r.into_context();
@@ -266,7 +266,7 @@ fn planar_flattens_the_tangency_polygon_onto_the_floor() {
     let body = "[[sphere]]\ncenter = [0.0, CY, 0.0]\nradius = RADIUS\n[[sphere]]\ncenter = [0.6, 3.4, 0.4]\nradius = 0.4\n";
     let scene = umbrage_scene::load_str(&one_sphere(1.0, 6.0, body), "planar", std::path::Path::new(".")).unwrap();
     let (w, h) = (320, 240);
-    let opts = RenderOptions { width: w, height: h, technique: Technique::Planar, capture: true, ..Default::default() };
+    let opts = RenderOptions { width: w, height: h, technique: Technique::Planar.into(), capture: true, ..Default::default() };
     let mut r = Renderer::new(ctx, scene, opts).unwrap();
     let out = r.render().unwrap();
     let reference = umbrage_reference::Reference::from_scene(r.scene()).render(&r.scene().camera, &r.scene().lights, w, h);

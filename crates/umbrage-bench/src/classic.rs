@@ -7,7 +7,7 @@ use super::classic_frames::{row_of, time_frames, variant_errors, variants_of, Ro
 use serde::Serialize;
 use umbrage::error::{Error, Result};
 use umbrage::gpu::Context;
-use umbrage_render::{ComputeDraws, Counter, RenderOptions, Renderer, Technique};
+use umbrage_render::{ComputeDraws, Counter, RenderOptions, RenderTechnique, Renderer, ShadowMap, Technique};
 
 /// One (scene, method, counter) measurement: medians over the measured frames.
 #[derive(Clone, Debug, Serialize)]
@@ -161,7 +161,7 @@ pub struct BenchConfig {
     /// Scenes, by built-in name or path ([`umbrage_scene::load`]).
     pub scenes: Vec<String>,
     /// Techniques to compare: volume methods, edge quads, shadow maps (each size its own).
-    pub techniques: Vec<Technique>,
+    pub techniques: Vec<RenderTechnique>,
     /// Each volume technique runs with each counter (stencil, float), side by side; shadow
     /// maps run once (they count in the float target).
     pub counters: Vec<Counter>,
@@ -185,9 +185,9 @@ pub struct BenchConfig {
 /// The name of a bench row's technique (`shadowmap-512`; `shadowmap-512-multiview` for cube
 /// faces rendered as views, then `-gather` for the gathering lookup:
 /// `shadowmap-512-multiview-gather`).
-pub fn technique_label(t: Technique) -> String {
+pub fn technique_label(t: RenderTechnique) -> String {
     match t {
-        Technique::ShadowMap { size, pcf, cube } => {
+        RenderTechnique::ShadowMap(ShadowMap { size, pcf, cube }) => {
             let views = match cube {
                 umbrage_render::CubeFaces::Atlas => "",
                 umbrage_render::CubeFaces::Multiview => MULTIVIEW_SUFFIX,
@@ -205,7 +205,7 @@ pub fn technique_label(t: Technique) -> String {
 /// One row's settings: its technique and counter, and the compute and mesh techniques' own.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Variant {
-    pub(super) technique: Technique,
+    pub(super) technique: RenderTechnique,
     pub(super) counter: Counter,
     /// [`umbrage::pass::PassToggles::compute_draws`] (only `Auto` for the other techniques).
     pub(super) draws: ComputeDraws,
@@ -262,7 +262,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
     let device = ctx.info.name.clone();
     let driver = format!("{} {}", ctx.info.driver, ctx.info.driver_info);
     // The compute silhouettes are reported against a plain compute read of their bytes.
-    let read = match cfg.techniques.contains(&Technique::Compute) {
+    let read = match cfg.techniques.contains(&RenderTechnique::Pass(Technique::Compute)) {
         true => Some(super::compute_read::measure(&ctx, 5, 1 << 22)?),
         false => None,
     };

@@ -6,7 +6,7 @@ use super::classic::{BenchConfig, BenchRow, Variant};
 use super::stats::median;
 use umbrage::error::{Error, Result};
 use umbrage_render::accuracy::evaluate;
-use umbrage_render::{ComputeDraws, Counter, Renderer, Technique};
+use umbrage_render::{ComputeDraws, Counter, RenderTechnique, Renderer, Technique};
 use umbrage_scene::motion::Motion;
 use umbrage_scene::Scene;
 
@@ -31,16 +31,16 @@ pub(super) fn variants_of(cfg: &BenchConfig, spheres: bool) -> Vec<Variant> {
     let tasks: &[bool] = if cfg.mesh_task.is_empty() { &[true] } else { &cfg.mesh_task };
     let mut variants: Vec<Variant> = Vec::new();
     for &counter in &cfg.counters {
-        for &technique in cfg.techniques.iter().filter(|t| !matches!(t, Technique::ShadowMap { .. })) {
+        for &technique in cfg.techniques.iter().filter(|t| t.shadow_map().is_none()) {
             let one = Variant { technique, counter, draws: ComputeDraws::Auto, task: true };
             match technique {
-                Technique::Compute => variants.extend(ways.iter().map(|&draws| Variant { draws, ..one })),
-                Technique::Mesh => variants.extend(tasks.iter().map(|&task| Variant { task, ..one })),
+                RenderTechnique::Pass(Technique::Compute) => variants.extend(ways.iter().map(|&draws| Variant { draws, ..one })),
+                RenderTechnique::Pass(Technique::Mesh) => variants.extend(tasks.iter().map(|&task| Variant { task, ..one })),
                 _ => variants.push(one),
             }
         }
     }
-    variants.extend(cfg.techniques.iter().filter(|t| matches!(t, Technique::ShadowMap { .. }) && !spheres).map(|&technique| Variant {
+    variants.extend(cfg.techniques.iter().filter(|t| t.shadow_map().is_some() && !spheres).map(|&technique| Variant {
         technique,
         counter: Counter::Float,
         draws: ComputeDraws::Auto,
@@ -130,12 +130,12 @@ pub(super) fn row_of(r: &mut Renderer, at: RowAt, a: Acc, limits: &RunLimits) ->
     let throughput = r.throughput(cfg.frames.max(2))?;
     let s = a.last.ok_or_else(|| Error::Other("no frame".into()))?;
     let c = &s.totals.cases;
-    let maps = matches!(technique, Technique::ShadowMap { .. }) && !a.map.is_empty();
+    let maps = technique.shadow_map().is_some() && !a.map.is_empty();
     let lookup: Vec<f64> = a.shadow.iter().zip(&a.map).map(|(s, m)| s - m).collect();
     // The acceleration structures' stats and times are the ray-query rows' only.
-    let ray = technique == Technique::RayQuery;
+    let ray = technique == RenderTechnique::Pass(Technique::RayQuery);
     let rays = s.ray_query.as_ref().filter(|_| ray);
-    let compute = technique == Technique::Compute && !a.silhouettes.is_empty();
+    let compute = technique == RenderTechnique::Pass(Technique::Compute) && !a.silhouettes.is_empty();
     let silhouettes_ms = compute.then(|| median(a.silhouettes));
     let read_bytes = compute.then_some(s.totals.silhouette_read_bytes);
     let fraction = match (silhouettes_ms, read_bytes, limits.read_gib_s) {

@@ -1,11 +1,11 @@
 //! The one list of every technique the benchmarks run: each volume method, edge quads,
 //! planar projection and the shadow-map baseline at each size. A technique added to
-//! [`Technique`] or a method added to [`Method`] fails to compile here until it is listed,
+//! [`Technique`] (the pass's) or a method added to [`Method`] fails to compile here until it is listed,
 //! so new techniques join every bench (the default `umbrage bench` list and every point of the
 //! suite) from this one place.
 
 use umbrage::shadow::Method;
-use umbrage_render::Technique;
+use umbrage_render::{CubeFaces, Pcf, RenderTechnique, ShadowMap, Technique};
 
 /// Every volume method (the papers' case rules and the lecture notes' z-pass with clear).
 pub fn volume_methods() -> Vec<Method> {
@@ -23,46 +23,40 @@ pub fn volume_methods() -> Vec<Method> {
 /// renderer trusts), and ray query when the device has it (`ray_query`:
 /// [`umbrage::gpu::Features::ray_query`]), and mesh-shader extrusion when the device has mesh
 /// shaders (`mesh_shader`: [`umbrage::gpu::Features::mesh_shader`]).
-pub fn all_techniques(shadow_map_sizes: &[u32], ray_query: bool, multiview: bool, mesh_shader: bool) -> Vec<Technique> {
-    let mut out: Vec<Technique> = volume_methods().into_iter().map(Technique::Volumes).collect();
+pub fn all_techniques(shadow_map_sizes: &[u32], ray_query: bool, multiview: bool, mesh_shader: bool) -> Vec<RenderTechnique> {
+    let mut out: Vec<RenderTechnique> = volume_methods().into_iter().map(|m| Technique::Volumes(m).into()).collect();
     // Exhaustive on purpose: a new Technique variant is a compile error until listed below.
     let listed = |t: Technique| match t {
-        Technique::Volumes(_)
-        | Technique::EdgeQuads
-        | Technique::Compute
-        | Technique::Mesh
-        | Technique::Planar
-        | Technique::ShadowMap { .. }
-        | Technique::RayQuery => (),
+        Technique::Volumes(_) | Technique::EdgeQuads | Technique::Compute | Technique::Mesh | Technique::Planar | Technique::RayQuery => (),
     };
     for t in [Technique::EdgeQuads, Technique::Compute, Technique::Planar] {
         listed(t);
-        out.push(t);
+        out.push(t.into());
     }
     for &size in shadow_map_sizes {
-        out.push(Technique::shadow_map(size));
+        out.push(ShadowMap::new(size).into());
         if multiview {
-            out.push(Technique::ShadowMap { size, pcf: umbrage_render::Pcf::Taps, cube: umbrage_render::CubeFaces::Multiview });
+            out.push(ShadowMap { size, pcf: Pcf::Taps, cube: CubeFaces::Multiview }.into());
         }
     }
     if mesh_shader {
         listed(Technique::Mesh);
-        out.push(Technique::Mesh);
+        out.push(Technique::Mesh.into());
     }
     if ray_query {
         listed(Technique::RayQuery);
-        out.push(Technique::RayQuery);
+        out.push(Technique::RayQuery.into());
     }
     out
 }
 
 /// Whether a technique gives exact shadows by construction (the volume methods but z-pass,
 /// z-pass with clear and planar are exact; shadow maps are approximations).
-pub fn is_exact(t: Technique) -> bool {
+pub fn is_exact(t: RenderTechnique) -> bool {
     match t {
-        Technique::Volumes(m) => !matches!(m, Method::ZPass | Method::ZPassClear),
-        Technique::EdgeQuads | Technique::Compute | Technique::Mesh | Technique::RayQuery => true,
-        Technique::Planar | Technique::ShadowMap { .. } => false,
+        RenderTechnique::Pass(Technique::Volumes(m)) => !matches!(m, Method::ZPass | Method::ZPassClear),
+        RenderTechnique::Pass(Technique::EdgeQuads | Technique::Compute | Technique::Mesh | Technique::RayQuery) => true,
+        RenderTechnique::Pass(Technique::Planar) | RenderTechnique::ShadowMap(_) => false,
     }
 }
 

@@ -13,14 +13,14 @@ use std::time::Instant;
 use umbrage::error::{Error, Result};
 use umbrage::gpu::Context;
 use umbrage_render::accuracy::evaluate;
-use umbrage_render::{IndexFormat, PassToggles, RenderOptions, Renderer, Technique};
+use umbrage_render::{IndexFormat, PassToggles, RenderOptions, RenderTechnique, Renderer, ShadowMap, Technique};
 use umbrage_scene::Scene;
 
 /// One way to render a point: the technique plus the pass settings an ablation changes.
 #[derive(Clone, Debug, PartialEq)]
 pub(super) struct Variant {
     /// The technique.
-    pub technique: Technique,
+    pub technique: RenderTechnique,
     /// The pass's optimisations (an ablation switches one off).
     pub toggles: PassToggles,
     /// The index format requested.
@@ -31,7 +31,8 @@ pub(super) struct Variant {
 
 impl Variant {
     /// `t` with every optimisation on and automatic indices.
-    pub fn of(t: Technique) -> Variant {
+    pub fn of(t: impl Into<RenderTechnique>) -> Variant {
+        let t = t.into();
         Variant { technique: t, toggles: PassToggles::default(), index_format: IndexFormat::Auto, label: String::new() }
     }
 }
@@ -141,7 +142,7 @@ struct Measured<'a> {
     counted: Vec<umbrage_render::Stats>,
     acc: Vec<Acc>,
     twin: Option<(u64, Option<u64>)>,
-    error: HashMap<Technique, f64>,
+    error: HashMap<RenderTechnique, f64>,
     frames: usize,
 }
 
@@ -204,7 +205,7 @@ impl Runner {
         let mut kept: Vec<&Variant> = Vec::with_capacity(variants.len());
         for v in variants {
             match v.technique {
-                Technique::ShadowMap { size, .. } if !sweeps::shadow_map_fits(size, nlights) => {
+                RenderTechnique::ShadowMap(ShadowMap { size, .. }) if !sweeps::shadow_map_fits(size, nlights) => {
                     self.skipped.push(format!("{sweep} {name}: shadowmap-{size} with {nlights} lights (over 2^26 map texels a frame)"));
                     self.bar.inc(1);
                 }
@@ -216,10 +217,10 @@ impl Runner {
             }
         }
         let variants = kept;
-        let mut error: HashMap<Technique, f64> = HashMap::new();
+        let mut error: HashMap<RenderTechnique, f64> = HashMap::new();
         if errors {
             let t = Instant::now();
-            let techniques: Vec<Technique> = variants.iter().map(|v| v.technique).collect();
+            let techniques: Vec<RenderTechnique> = variants.iter().map(|v| v.technique).collect();
             let rows = evaluate_fractions(r, name, &techniques)?;
             for (t, f) in techniques.iter().zip(rows) {
                 error.insert(*t, f);
@@ -254,9 +255,10 @@ impl Runner {
         // volumes of the same frame give their rows the sides that cover screen area and the
         // fragments rays pass through, `(sides, fragments)` (one more counting frame, with the
         // first such variant's toggles, where no McGuire variant has them).
-        let mcguire = Technique::Volumes(umbrage::shadow::Method::McGuire);
+        let mcguire = RenderTechnique::Pass(Technique::Volumes(umbrage::shadow::Method::McGuire));
         let of = |s: &umbrage_render::Stats| (s.totals.triangles.sides, s.counters.as_ref().and_then(|c| c.stencil_fragments));
-        let twin = match variants.iter().find(|v| matches!(v.technique, Technique::EdgeQuads | Technique::RayQuery)) {
+        let twin = match variants.iter().find(|v| matches!(v.technique, RenderTechnique::Pass(Technique::EdgeQuads | Technique::RayQuery)))
+        {
             Some(v) => match counted.iter().zip(&variants).find(|(_, w)| w.technique == mcguire && w.toggles == v.toggles) {
                 Some((s, _)) => Some(of(s)),
                 None => Some(of(&count(r, &Variant { technique: mcguire, ..(*v).clone() })?)),
@@ -298,7 +300,7 @@ impl Runner {
         for ((v, s), a) in variants.iter().zip(counted).zip(acc) {
             let c = s.counters.clone().unwrap_or_default();
             let map_size = match v.technique {
-                Technique::ShadowMap { size, .. } => Some(size as u64),
+                RenderTechnique::ShadowMap(ShadowMap { size, .. }) => Some(size as u64),
                 _ => None,
             };
             let shadow_map = map_size.is_some();
@@ -342,8 +344,12 @@ impl Runner {
                 gpu_shadow_ms_p90: p90,
                 gpu_map_ms: map_ms,
                 gpu_lookup_ms: lookup_ms,
-                gpu_tlas_ms: if v.technique == Technique::RayQuery { med(a.accel) } else { None },
-                blas_build_ms: s.ray_query.as_ref().filter(|_| v.technique == Technique::RayQuery).map(|q| q.bottom_level_build_ms),
+                gpu_tlas_ms: if v.technique == RenderTechnique::Pass(Technique::RayQuery) { med(a.accel) } else { None },
+                blas_build_ms: s
+                    .ray_query
+                    .as_ref()
+                    .filter(|_| v.technique == RenderTechnique::Pass(Technique::RayQuery))
+                    .map(|q| q.bottom_level_build_ms),
                 gpu_frame_ms: med(a.frame),
                 gpu_depth_ms: depth_ms,
                 gpu_illuminate_ms: illum_ms,
@@ -362,12 +368,12 @@ impl Runner {
                 caster_passes,
                 bound_triangles,
                 infinite_sides: match v.technique {
-                    Technique::Planar | Technique::ShadowMap { .. } | Technique::RayQuery => 0,
-                    Technique::EdgeQuads => twin.map_or(0, |t| t.0),
+                    RenderTechnique::Pass(Technique::Planar | Technique::RayQuery) | RenderTechnique::ShadowMap(_) => 0,
+                    RenderTechnique::Pass(Technique::EdgeQuads) => twin.map_or(0, |t| t.0),
                     _ => s.totals.triangles.sides,
                 },
                 volume_fragments: match v.technique {
-                    Technique::RayQuery => twin.and_then(|t| t.1),
+                    RenderTechnique::Pass(Technique::RayQuery) => twin.and_then(|t| t.1),
                     _ => None,
                 },
                 draws: s.totals.draws,
@@ -385,7 +391,7 @@ impl Runner {
 }
 
 /// Each technique's worst-light error fraction, in the order given.
-fn evaluate_fractions(r: &mut Renderer, name: &str, techniques: &[Technique]) -> Result<Vec<f64>> {
+fn evaluate_fractions(r: &mut Renderer, name: &str, techniques: &[RenderTechnique]) -> Result<Vec<f64>> {
     let rows = evaluate(r, name, techniques, 1)?;
     if rows.len() != techniques.len() {
         return Err(Error::Other(format!("accuracy rows: {} for {} techniques", rows.len(), techniques.len())));

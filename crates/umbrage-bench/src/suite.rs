@@ -27,7 +27,7 @@ use std::path::PathBuf;
 use umbrage::error::{Error, Result};
 use umbrage::gpu::Context;
 use umbrage::shadow::Method;
-use umbrage_render::Technique;
+use umbrage_render::{Pcf, ShadowMap, Technique};
 
 /// What to run (the CLI's `bench --suite` arguments).
 #[derive(Clone, Debug)]
@@ -103,7 +103,7 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
     let gathers: Vec<Variant> = scale
         .named_shadow_map_sizes()
         .into_iter()
-        .map(|size| Variant::of(Technique::ShadowMap { size, pcf: umbrage_render::Pcf::Gather, cube: Default::default() }))
+        .map(|size| Variant::of(ShadowMap { size, pcf: Pcf::Gather, cube: Default::default() }))
         .collect();
     let units = (points.len() - caps_points) * techniques.len()
         + named.len() * (named_techniques.len() + gathers.len())

@@ -183,7 +183,6 @@ pub fn settings_out(s: &PassSettings) -> UmbragePassSettings {
                 _ => 0,
             },
         ),
-        _ => (0, 0),
     };
     let index = |f: IndexFormat| match f {
         IndexFormat::U32 => 1,

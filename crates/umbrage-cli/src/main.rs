@@ -1,10 +1,10 @@
 //! The `umbrage` command line: render | view | info | check | conform | bench.
 
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use umbrage::{Error, Result};
-use umbrage_render::{Counter, DepthMode, IndexFormat, RenderOptions, Renderer, Technique, TransmitMode, View};
+use umbrage_render::{Counter, DepthMode, IndexFormat, RenderOptions, RenderTechnique, Renderer, Shading, ShadowMap, TransmitMode, View};
 
 // `umbrage bench`: its arguments and the classic, suite and soak modes.
 #[path = "cli/bench.rs"]
@@ -35,8 +35,8 @@ struct FrameArgs {
     /// the Cg article); planar; compute (GPU possible silhouettes); mesh (mesh-shader extrusion;
     /// needs VK_EXT_mesh_shader); shadowmap (the PCF baseline); or rayquery (one shadow ray a
     /// pixel; needs VK_KHR_ray_query).
-    #[arg(long, value_enum, default_value = "auto")]
-    method: MethodArg,
+    #[arg(long, default_value = "auto", value_parser = parse_method)]
+    method: RenderTechnique,
     /// infinite (far plane at infinity) or clamp (finite far plane + depthClamp).
     #[arg(long, value_enum, default_value = "infinite")]
     depth_mode: DepthMode,
@@ -47,8 +47,8 @@ struct FrameArgs {
     #[arg(long, value_enum, default_value = "stencil")]
     counter: Counter,
     /// Transparent casters' light-intensity map: log16 (default), mul16, log32, mul32.
-    #[arg(long, value_enum, default_value = "log16")]
-    transmit: TransmitArg,
+    #[arg(long, default_value = "log16", value_parser = parse_named::<TransmitMode>)]
+    transmit: TransmitMode,
     /// Texels per side of each shadow map (--method shadowmap).
     #[arg(long, default_value_t = 2048)]
     shadow_map_size: u32,
@@ -77,8 +77,8 @@ struct FrameArgs {
     /// smooth (smooth normals, the light reaching zero before the shadow volumes' polygonal
     /// terminator), smooth-naive (smooth normals as they are: a step along the terminator's
     /// edges) or flat. Shadows are the same in every mode.
-    #[arg(long, value_enum, default_value = "smooth")]
-    shading: ShadingArg,
+    #[arg(long, default_value = "smooth", value_parser = parse_named::<Shading>)]
+    shading: Shading,
     /// Plan every light–caster pair from scratch every frame (default: each pair's plan and
     /// index lists are kept across frames until its light, caster or case changes; the same
     /// pictures either way).
@@ -86,97 +86,23 @@ struct FrameArgs {
     no_keep: bool,
 }
 
-/// `--shading`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-enum ShadingArg {
-    Smooth,
-    SmoothNaive,
-    Flat,
+/// `--method`: a name [`RenderTechnique`]'s `FromStr` reads (its shadow maps' settings come
+/// from `--shadow-map-size`, `--pcf` and `--cube`: [`with_shadow_map`]).
+fn parse_method(s: &str) -> std::result::Result<RenderTechnique, String> {
+    s.parse().map_err(|e: Error| e.to_string())
 }
 
-impl ShadingArg {
-    fn shading(self) -> umbrage_render::Shading {
-        match self {
-            ShadingArg::Smooth => umbrage_render::Shading::Smooth,
-            ShadingArg::SmoothNaive => umbrage_render::Shading::SmoothNaive,
-            ShadingArg::Flat => umbrage_render::Shading::Flat,
-        }
+/// `t`, with the shadow-map baseline's settings replaced by `m` (the other techniques as they are).
+fn with_shadow_map(t: RenderTechnique, m: ShadowMap) -> RenderTechnique {
+    match t {
+        RenderTechnique::ShadowMap(_) => m.into(),
+        t => t,
     }
 }
 
-/// `--method`: every technique `render` and `bench` accept.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-enum MethodArg {
-    /// McGuire's three cases (open / non-manifold casters on the multiplicity path).
-    Auto,
-    /// McGuire et al. 2003: z-pass / z-fail / z-fail with light cap per caster.
-    Mcguire,
-    /// Lengyel: z-fail only where the near plane may cut the volume.
-    Lengyel,
-    /// Everitt-Kilgard: z-fail everywhere.
-    #[value(name = "everitt-kilgard")]
-    EverittKilgard,
-    /// Carmack's z-fail everywhere.
-    Zfail,
-    /// z-pass everywhere (wrong with the eye in a volume).
-    Zpass,
-    /// z-pass with the stencil cleared to the number of volumes containing the eye (the
-    /// lecture notes' eye-in-shadow fix; wrong where a volume crosses the near plane).
-    #[value(name = "zpass-clear")]
-    ZpassClear,
-    /// The Cg article's GPU-only edge quads.
-    Edgequad,
-    /// Flat projected shadows onto y = 0 (the Cg article's baseline).
-    Planar,
-    /// McGuire's cases with GPU possible silhouettes (compute pass, indirect draws).
-    Compute,
-    /// McGuire's cases with mesh-shader extrusion (VK_EXT_mesh_shader: Mesa lavapipe 25).
-    Mesh,
-    /// The shadow-map baseline (PCF 3x3).
-    Shadowmap,
-    /// One shadow ray per pixel with VK_KHR_ray_query (Mesa lavapipe 25: scripts/drivers.sh).
-    Rayquery,
-}
-
-impl MethodArg {
-    /// The technique; `shadow_map` is what `shadowmap` means (its size, lookup and cube faces).
-    fn technique(self, shadow_map: Technique) -> Technique {
-        use umbrage::shadow::Method as M;
-        match self {
-            MethodArg::Auto | MethodArg::Mcguire => Technique::Volumes(M::McGuire),
-            MethodArg::Lengyel => Technique::Volumes(M::Lengyel),
-            MethodArg::EverittKilgard => Technique::Volumes(M::EverittKilgard),
-            MethodArg::Zfail => Technique::Volumes(M::ZFail),
-            MethodArg::Zpass => Technique::Volumes(M::ZPass),
-            MethodArg::ZpassClear => Technique::Volumes(M::ZPassClear),
-            MethodArg::Edgequad => Technique::EdgeQuads,
-            MethodArg::Planar => Technique::Planar,
-            MethodArg::Compute => Technique::Compute,
-            MethodArg::Mesh => Technique::Mesh,
-            MethodArg::Shadowmap => shadow_map,
-            MethodArg::Rayquery => Technique::RayQuery,
-        }
-    }
-}
-
-/// `--transmit`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-enum TransmitArg {
-    Log16,
-    Mul16,
-    Log32,
-    Mul32,
-}
-
-impl TransmitArg {
-    fn mode(self) -> TransmitMode {
-        match self {
-            TransmitArg::Log16 => TransmitMode { fp32: false, log: true },
-            TransmitArg::Mul16 => TransmitMode { fp32: false, log: false },
-            TransmitArg::Log32 => TransmitMode { fp32: true, log: true },
-            TransmitArg::Mul32 => TransmitMode { fp32: true, log: false },
-        }
-    }
+/// A value of a named enum of the library (`--shading`, `--transmit`), read by its `FromStr`.
+fn parse_named<T: std::str::FromStr<Err = Error>>(s: &str) -> std::result::Result<T, String> {
+    s.parse().map_err(|e: Error| e.to_string())
 }
 
 #[derive(Subcommand)]
@@ -326,18 +252,18 @@ impl Default for FrameArgs {
         FrameArgs {
             scene: "default".into(),
             size: (960, 540),
-            method: MethodArg::Auto,
+            method: RenderTechnique::default(),
             depth_mode: DepthMode::Infinite,
             index_format: IndexFormat::Auto,
             counter: Counter::Stencil,
-            transmit: TransmitArg::Log16,
+            transmit: TransmitMode { fp32: false, log: true },
             shadow_map_size: 2048,
             pcf: Default::default(),
             cube: Default::default(),
             self_shadow: false,
             jitter: false,
             msaa: 1,
-            shading: ShadingArg::Smooth,
+            shading: Shading::Smooth,
             no_keep: false,
         }
     }
@@ -443,15 +369,15 @@ impl FrameArgs {
         Ok(RenderOptions {
             width: self.size.0,
             height: self.size.1,
-            technique: self.method.technique(Technique::ShadowMap { size: self.shadow_map_size, pcf: self.pcf, cube: self.cube }),
+            technique: with_shadow_map(self.method, ShadowMap { size: self.shadow_map_size, pcf: self.pcf, cube: self.cube }),
             depth_mode: self.depth_mode,
             index_format: self.index_format,
             counter: self.counter,
-            transmit: self.transmit.mode(),
+            transmit: self.transmit,
             self_shadow: self.self_shadow,
             jitter: self.jitter,
             samples: self.msaa,
-            shading: self.shading.shading(),
+            shading: self.shading,
             keep: !self.no_keep,
             ..Default::default()
         })

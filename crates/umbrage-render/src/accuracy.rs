@@ -6,7 +6,7 @@
 //! conform` and the docs table all call it.
 #![warn(missing_docs)]
 
-use crate::{Counter, Renderer, Technique};
+use crate::{Counter, RenderTechnique, Renderer, Technique};
 use umbrage::error::Result;
 use umbrage::shadow::Method;
 use umbrage_reference::metrics::{compare_all, Metrics};
@@ -56,15 +56,21 @@ pub struct Row {
     pub shadow_triangles: u64,
 }
 
-/// Renders the renderer's scene with each technique and compares with the reference.
-pub fn evaluate(renderer: &mut Renderer, scene_name: &str, techniques: &[Technique], band: u32) -> Result<Vec<Row>> {
+/// Renders the renderer's scene with each technique (the pass's [`Technique`]s or
+/// [`RenderTechnique`]s) and compares with the reference.
+pub fn evaluate<T: Into<RenderTechnique> + Copy>(
+    renderer: &mut Renderer,
+    scene_name: &str,
+    techniques: &[T],
+    band: u32,
+) -> Result<Vec<Row>> {
     let (w, h) = (renderer.config().width, renderer.config().height);
     let reference = Reference::from_scene(renderer.scene());
     let image = reference.render(&renderer.scene().camera, &renderer.scene().lights, w, h);
     let saved = renderer.settings;
     renderer.settings.capture = true;
     let mut rows = Vec::new();
-    for &technique in techniques {
+    for technique in techniques.iter().map(|&t| t.into()) {
         renderer.settings.technique = technique;
         let frame = renderer.render();
         let frame = match frame {
@@ -80,7 +86,7 @@ pub fn evaluate(renderer: &mut Renderer, scene_name: &str, techniques: &[Techniq
         let (mismatches, compared, fraction) =
             worst.map(|m| (m.mismatches_outside_band, m.compared, m.fraction_outside_band)).unwrap_or((0, 0, 0.0));
         let method = match technique {
-            Technique::Volumes(m) => m,
+            RenderTechnique::Pass(Technique::Volumes(m)) => m,
             // Edge quads and shadow maps have the failure modes of McGuire's method (none on
             // these scenes but the 8-bit wrap).
             _ => Method::McGuire,
@@ -90,7 +96,7 @@ pub fn evaluate(renderer: &mut Renderer, scene_name: &str, techniques: &[Techniq
         let split = frame.stats.lights.iter().any(|l| l.near_plane_split == Some(true));
         let expected = match (technique, method) {
             // One shadow ray a pixel writes 1, not a count: no 8-bit wrap, no near plane.
-            (Technique::RayQuery, _) => None,
+            (RenderTechnique::Pass(Technique::RayQuery), _) => None,
             (_, method) => match method {
                 Method::ZPassClear if split => Some("zpass-clear with a volume crossing the near plane (partly shadowed viewport)"),
                 // Otherwise it fails where any correct method does (the 8-bit wrap).

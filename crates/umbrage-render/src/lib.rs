@@ -41,17 +41,19 @@ pub use passes::shadowmap;
 mod sphere_gpu;
 pub mod stats;
 pub mod targets;
+pub mod technique;
 mod timing;
 
 pub use counters::PassCounters;
 pub use frame::{largest_device_heap, FrameTicket, MemoryEstimate, NewError, Renderer, Throughput};
 pub use frame_output::{standard_sample_locations, FrameOutput, SampleOutput};
 pub use options::{
-    ComputeDraws, Counter, CubeFaces, DepthMode, FrameSettings, IndexFormat, PassToggles, Pcf, RenderConfig, RenderOptions, Shading,
-    Technique, TransmitMode, View,
+    ComputeDraws, Counter, DepthMode, FrameSettings, IndexFormat, PassToggles, RenderConfig, RenderOptions, Shading, Technique,
+    TransmitMode, View,
 };
 pub use passes::debug::stencil_heatmap;
 pub use stats::Stats;
+pub use technique::{CubeFaces, Pcf, RenderTechnique, ShadowMap};
 
 use ash::vk;
 use gpu_allocator::MemoryLocation;

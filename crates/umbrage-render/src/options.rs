@@ -1,9 +1,10 @@
 //! What a frame is asked to do: the options of [`Renderer`](super::Renderer) and the CLI.
 
+use crate::technique::RenderTechnique;
 use ash::vk;
 use umbrage::error::{Error, Result};
 use umbrage::named_enum;
-pub use umbrage::pass::{ComputeDraws, Counter, CubeFaces, DepthMode, IndexFormat, PassToggles, Pcf, Technique};
+pub use umbrage::pass::{ComputeDraws, Counter, DepthMode, IndexFormat, PassToggles, Technique};
 
 named_enum!(
     /// What the final image shows.
@@ -118,8 +119,8 @@ pub struct RenderConfig {
 /// What may change from one frame to the next.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct FrameSettings {
-    /// Volumes (with a method), edge quads or shadow maps.
-    pub technique: Technique,
+    /// What the shadow pass runs, or the shadow-map baseline.
+    pub technique: RenderTechnique,
     /// Stencil or float counting.
     pub counter: Counter,
     /// Index format of the shadow streams.
@@ -154,8 +155,8 @@ pub struct RenderOptions {
     pub width: u32,
     /// Image height in pixels.
     pub height: u32,
-    /// Volumes, edge quads or shadow maps.
-    pub technique: Technique,
+    /// What the shadow pass runs, or the shadow-map baseline.
+    pub technique: RenderTechnique,
     /// Infinite far plane, or finite with depth clamp.
     pub depth_mode: DepthMode,
     /// Index format of the shadow streams.
@@ -227,7 +228,7 @@ impl Default for RenderOptions {
         RenderOptions {
             width: 960,
             height: 540,
-            technique: Technique::default(),
+            technique: RenderTechnique::default(),
             depth_mode: DepthMode::Infinite,
             index_format: IndexFormat::Auto,
             view: View::Shaded,

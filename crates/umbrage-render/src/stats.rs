@@ -13,13 +13,15 @@ pub struct GpuMs {
     /// [`Technique::Compute`](umbrage::pass::Technique::Compute), recorded once for every light).
     pub shadow: f64,
     /// Of `shadow`, the GPU possible silhouettes of every light (`Technique::Compute`: the
-    /// compute pass; `Technique::Mesh`: its facing stages; 0 for the other techniques).
+    /// compute pass; `Technique::Mesh`: its facing stages; 0 for the other techniques): the
+    /// pass's `cmd_before_rendering`, so with the frame's caster uploads when it has any.
     pub silhouettes: f64,
     /// Every light's illumination, summed.
     pub illuminate: f64,
     /// The whole frame.
     pub frame: f64,
-    /// The frame's acceleration-structure builds (ray query: the top level; 0 otherwise).
+    /// The frame's acceleration-structure builds (ray query: the pass's `cmd_before_rendering`,
+    /// the top level's build and any bottom level's; 0 otherwise).
     pub accel: f64,
     /// Of `shadow`, the shadow-map baseline's map rendering (every light's maps; 0 for the
     /// other techniques). `shadow - shadow_map` is its lookup.
@@ -45,7 +47,7 @@ pub struct Stats {
     /// The device's name.
     pub device: String,
     /// The technique that ran (`mcguire`, ..., `edgequad`, `shadowmap`: its name).
-    pub method: super::Technique,
+    pub method: super::RenderTechnique,
     /// `infinite` or `clamp`.
     pub depth_mode: super::DepthMode,
     /// The requested index format (`auto`, `u16`, ...).
@@ -83,18 +85,7 @@ pub struct Stats {
     /// The ray-query technique's acceleration structures (`None` for the other techniques).
     pub ray_query: Option<RayQueryStats>,
     /// The shadow-map baseline's maps and lookup (`None` for the other techniques).
-    pub shadow_map: Option<ShadowMapStats>,
-}
-
-/// How `--method shadowmap` rendered and read its maps.
-#[derive(Clone, Copy, Debug, Serialize)]
-pub struct ShadowMapStats {
-    /// Texels per side of one map.
-    pub size: u32,
-    /// How the lookup read its 3x3 taps (`taps` or `gather`).
-    pub pcf: super::Pcf,
-    /// How a point light's six cube faces were rendered (`atlas` or `multiview`).
-    pub cube: super::CubeFaces,
+    pub shadow_map: Option<crate::ShadowMap>,
 }
 
 /// What `--method rayquery` traces against.

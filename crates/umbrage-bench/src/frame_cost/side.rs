@@ -44,7 +44,14 @@ impl Way {
             Way::Compute => Technique::Compute,
             _ => Technique::Volumes(Method::McGuire),
         };
-        RenderOptions { width: size.0, height: size.1, technique, keep: self != Way::KeepOff, frames_in_flight: 1, ..Default::default() }
+        RenderOptions {
+            width: size.0,
+            height: size.1,
+            technique: technique.into(),
+            keep: self != Way::KeepOff,
+            frames_in_flight: 1,
+            ..Default::default()
+        }
     }
 }
 

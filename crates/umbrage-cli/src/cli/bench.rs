@@ -1,12 +1,12 @@
 //! `umbrage bench`: its arguments and its three modes (the classic speed-against-error table,
 //! the fill-vertex suite, the soak), split out of main.rs.
 
-use super::{parse_size, MethodArg};
+use super::{parse_method, parse_size, with_shadow_map};
 use clap::ValueEnum;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use umbrage::{Error, Result};
-use umbrage_render::{Counter, IndexFormat, RenderOptions, Technique};
+use umbrage_render::{Counter, IndexFormat, RenderOptions, RenderTechnique, ShadowMap, Technique};
 
 /// `umbrage bench` (one struct so that new modes add fields here, not to the dispatch).
 #[derive(clap::Args)]
@@ -16,8 +16,8 @@ pub(crate) struct BenchArgs {
     scenes: Vec<String>,
     /// Comma-separated techniques, every one `render --method` accepts (default: the five
     /// volume methods, edgequad and shadowmap, and rayquery where the device has ray query).
-    #[arg(long, value_enum, value_delimiter = ',')]
-    methods: Vec<MethodArg>,
+    #[arg(long, value_delimiter = ',', value_parser = parse_method)]
+    methods: Vec<RenderTechnique>,
     /// Frames measured per variant (after one warm-up frame).
     #[arg(long, default_value_t = 10)]
     frames: usize,
@@ -219,14 +219,14 @@ struct SoakArgs {
 fn soak_cmd(
     args: &SoakArgs,
     scene: Option<&str>,
-    methods: &[MethodArg],
+    methods: &[RenderTechnique],
     size: (u32, u32),
     frames_in_flight: usize,
     json: Option<&Path>,
     markdown: Option<&Path>,
 ) -> Result<ExitCode> {
     let frames = args.soak.unwrap_or(0);
-    let technique = methods.first().map(|m| m.technique(Technique::shadow_map(2048))).unwrap_or_default();
+    let technique = methods.first().copied().unwrap_or_default();
     let options = RenderOptions { width: size.0, height: size.1, technique, frames_in_flight, ..Default::default() };
     let cfg = umbrage_cli::soak::SoakConfig {
         scene: scene.unwrap_or("default").to_string(),
@@ -250,25 +250,25 @@ fn soak_cmd(
 }
 
 fn bench_techniques(
-    methods: &[MethodArg],
+    methods: &[RenderTechnique],
     shadow_map_size: u32,
     (pcfs, cubes): (&[umbrage_render::Pcf], &[umbrage_render::CubeFaces]),
-) -> Vec<Technique> {
+) -> Vec<RenderTechnique> {
     let size = if shadow_map_size > 0 { shadow_map_size } else { 2048 };
-    let listed: Vec<Technique> = if methods.is_empty() {
+    let listed: Vec<RenderTechnique> = if methods.is_empty() {
         let sizes: &[u32] = if shadow_map_size > 0 { &[size] } else { &[] };
         // Ray query and mesh shaders join once the device is known (`bench`).
         umbrage_bench::methods::all_techniques(sizes, false, false, false)
     } else {
-        methods.iter().map(|m| m.technique(Technique::shadow_map(size))).collect()
+        methods.iter().map(|&m| with_shadow_map(m, ShadowMap::new(size))).collect()
     };
     // Each listed once, a shadow map once per way of rendering its cube faces and PCF lookup
     // asked for (`--cube`, `--pcf`, never empty).
-    let mut out: Vec<Technique> = Vec::new();
+    let mut out: Vec<RenderTechnique> = Vec::new();
     for t in listed {
-        let variants: Vec<Technique> = match t {
-            Technique::ShadowMap { size, .. } => {
-                cubes.iter().flat_map(|&cube| pcfs.iter().map(move |&pcf| Technique::ShadowMap { size, pcf, cube })).collect()
+        let variants: Vec<RenderTechnique> = match t {
+            RenderTechnique::ShadowMap(ShadowMap { size, .. }) => {
+                cubes.iter().flat_map(|&cube| pcfs.iter().map(move |&pcf| ShadowMap { size, pcf, cube }.into())).collect()
             }
             t => vec![t],
         };
@@ -283,7 +283,7 @@ fn bench_techniques(
 
 /// The rows `bench` runs: the techniques, and the variants of the compute and mesh ones.
 struct Listed {
-    techniques: Vec<Technique>,
+    techniques: Vec<RenderTechnique>,
     /// No `--methods` given: the device's mesh and ray-query techniques are added.
     default_list: bool,
     /// `--compute-draws`.
@@ -314,10 +314,10 @@ fn bench(
     let ctx = umbrage::gpu::Context::new()?;
     let mut techniques = techniques;
     if default_list && ctx.features.mesh_shader {
-        techniques.push(Technique::Mesh);
+        techniques.push(Technique::Mesh.into());
     }
     if default_list && ctx.features.ray_query {
-        techniques.push(Technique::RayQuery);
+        techniques.push(Technique::RayQuery.into());
     }
     let cfg = umbrage_bench::BenchConfig { scenes, techniques, counters, frames, opts, compute_draws, mesh_task, motion };
     let report = umbrage_bench::run(ctx, &cfg, |r| {

@@ -15,7 +15,9 @@ use umbrage::error::{Error, Result};
 use umbrage::gpu::context::ValidationLog;
 use umbrage::gpu::{Buffer, Context};
 use umbrage::shadow::Method;
-use umbrage_render::{Counter, FrameOutput, FrameSettings, FrameTicket, RenderOptions, Renderer, Shading, Technique, View};
+use umbrage_render::{
+    Counter, FrameOutput, FrameSettings, FrameTicket, RenderOptions, RenderTechnique, Renderer, Shading, ShadowMap, Technique, View,
+};
 use umbrage_scene::motion::Motion;
 use umbrage_scene::Scene;
 use winit::application::ApplicationHandler;
@@ -133,7 +135,7 @@ pub(super) struct Live {
     pub motion: Motion,
     pub edits: Edits,
     /// `M` cycles these.
-    pub techniques: Vec<Technique>,
+    pub techniques: Vec<RenderTechnique>,
     pub technique: usize,
     /// The last settings a frame was accepted with (a refused change reverts to them).
     pub good: FrameSettings,
@@ -179,18 +181,19 @@ pub(super) struct Live {
 
 /// The techniques `M` cycles through, in the order of `render --method`: ray query and mesh
 /// shaders where the device has them.
-pub(super) fn technique_cycle(shadow_map: Technique, ray_query: bool, mesh_shader: bool) -> Vec<Technique> {
-    let mut v: Vec<Technique> =
+pub(super) fn technique_cycle(shadow_map: ShadowMap, ray_query: bool, mesh_shader: bool) -> Vec<RenderTechnique> {
+    let mut v: Vec<RenderTechnique> =
         [Method::McGuire, Method::Lengyel, Method::EverittKilgard, Method::ZFail, Method::ZPass, Method::ZPassClear]
             .into_iter()
-            .map(Technique::Volumes)
+            .map(|m| Technique::Volumes(m).into())
             .collect();
-    v.extend([Technique::EdgeQuads, Technique::Planar, Technique::Compute, shadow_map]);
+    v.extend([Technique::EdgeQuads, Technique::Planar, Technique::Compute].map(RenderTechnique::Pass));
+    v.push(shadow_map.into());
     if ray_query {
-        v.push(Technique::RayQuery);
+        v.push(Technique::RayQuery.into());
     }
     if mesh_shader {
-        v.push(Technique::Mesh);
+        v.push(Technique::Mesh.into());
     }
     v
 }
@@ -243,10 +246,7 @@ impl Live {
         let at0 = motion.scene_at(&scene, args.time);
         let good = opts.settings();
         // The shadow map the cycle offers: the one asked for, or the default's.
-        let shadow_map = match opts.technique {
-            t @ Technique::ShadowMap { .. } => t,
-            _ => Technique::shadow_map(2048),
-        };
+        let shadow_map = opts.technique.shadow_map().unwrap_or_default();
         let mut techniques = technique_cycle(shadow_map, ctx.features.ray_query, ctx.features.mesh_shader);
         let technique = match techniques.iter().position(|t| *t == opts.technique) {
             Some(i) => i,
@@ -444,7 +444,7 @@ impl Live {
         if let Some(t) = self.techniques.get(i) {
             self.technique = i;
             self.renderer.settings.technique = *t;
-            if *t == Technique::RayQuery {
+            if *t == RenderTechnique::Pass(Technique::RayQuery) {
                 // The rays write the stencil; the float counter would be refused.
                 self.renderer.settings.counter = Counter::Stencil;
             }
@@ -500,14 +500,14 @@ mod cycle_tests {
 
     #[test]
     fn the_cycle_offers_every_technique_the_device_has_once() {
-        let sm = Technique::shadow_map(2048);
+        let sm = ShadowMap::new(2048);
         let base = technique_cycle(sm, false, false);
-        assert_eq!(base[0], Technique::Volumes(Method::McGuire));
-        assert!(base.contains(&Technique::Compute) && base.contains(&sm));
-        assert!(!base.contains(&Technique::RayQuery) && !base.contains(&Technique::Mesh));
+        assert_eq!(base[0], Technique::Volumes(Method::McGuire).into());
+        assert!(base.contains(&Technique::Compute.into()) && base.contains(&sm.into()));
+        assert!(!base.contains(&Technique::RayQuery.into()) && !base.contains(&Technique::Mesh.into()));
         let all = technique_cycle(sm, true, true);
         assert_eq!(all.len(), base.len() + 2);
-        assert_eq!(&all[all.len() - 2..], &[Technique::RayQuery, Technique::Mesh]);
+        assert_eq!(&all[all.len() - 2..], &[Technique::RayQuery.into(), Technique::Mesh.into()]);
         for (i, t) in all.iter().enumerate() {
             assert!(!all[i + 1..].contains(t), "{} twice", t.name());
         }

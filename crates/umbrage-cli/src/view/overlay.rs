@@ -6,7 +6,7 @@
 use super::controls::Mode;
 use glam::Vec3;
 use std::collections::HashMap;
-use umbrage_render::{Counter, Stats, Technique, View};
+use umbrage_render::{Counter, RenderTechnique, Stats, View};
 
 /// Lights whose GPU times the overlay lists one by one (the rest are counted).
 const PER_LIGHT_SHOWN: usize = 8;
@@ -20,7 +20,7 @@ pub struct Shown<'a> {
     /// The last finished frame's stats.
     pub stats: Option<&'a Stats>,
     /// The technique list `M` cycles, and the current one's index.
-    pub techniques: &'a [Technique],
+    pub techniques: &'a [RenderTechnique],
     /// Index into `techniques`.
     pub technique: usize,
     /// The counter.
@@ -140,7 +140,7 @@ pub fn ui(ctx: &egui::Context, s: &Shown, menu_at: &mut Option<egui::Pos2>) -> C
 /// The settings and the selected light as widgets.
 fn controls(ui: &mut egui::Ui, s: &Shown, ch: &mut Changes) {
     {
-        let name = |t: &Technique| t.name().to_string();
+        let name = |t: &RenderTechnique| t.name().to_string();
         let mut t = s.technique;
         egui::ComboBox::from_label("method (M)").selected_text(s.techniques.get(t).map(name).unwrap_or_default()).show_ui(ui, |ui| {
             for (i, tech) in s.techniques.iter().enumerate() {

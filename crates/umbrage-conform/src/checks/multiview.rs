@@ -12,7 +12,7 @@ use crate::CheckResult;
 use serde_json::json;
 use umbrage::error::Result;
 use umbrage::gpu::Context;
-use umbrage_render::{CubeFaces, Pcf, RenderOptions, Renderer, Technique};
+use umbrage_render::{CubeFaces, Pcf, RenderOptions, Renderer, ShadowMap};
 
 /// The check's name (`legacy.multiview_cube_faces`).
 pub const NAME: &str = "multiview_cube_faces";
@@ -26,11 +26,11 @@ pub fn multiview_cube_faces(ctx: &Context, new_context: &dyn Fn() -> Result<Cont
         return Ok(CheckResult::skipped(NAME, "skipped: not supported (multiview)"));
     }
     let scene = umbrage_scene::load("hard/light_inside_caster")?;
-    let atlas = Technique::ShadowMap { size: 64, pcf: Pcf::Taps, cube: CubeFaces::Atlas };
+    let atlas = ShadowMap { size: 64, pcf: Pcf::Taps, cube: CubeFaces::Atlas }.into();
     let opts = RenderOptions { width: 96, height: 72, technique: atlas, capture: true, ..Default::default() };
     let mut r = Renderer::new(new_context()?, scene, opts)?;
     let tiles = r.render()?;
-    r.settings.technique = Technique::ShadowMap { size: 64, pcf: Pcf::Taps, cube: CubeFaces::Multiview };
+    r.settings.technique = ShadowMap { size: 64, pcf: Pcf::Taps, cube: CubeFaces::Multiview }.into();
     let views = umbrage::gpu::quirks::ignoring(|| r.render())?;
     let mut fails: Vec<String> = r.context().take_validation_errors().into_iter().take(3).map(|e| format!("validation: {e}")).collect();
     let compared: usize = tiles.counts.iter().map(Vec::len).sum();

@@ -41,11 +41,11 @@ pub fn shadow_pipeline_hard_cases(
             Some(c) => c,
             None => new_context()?,
         };
-        let opts = RenderOptions { width, height, technique: Technique::Volumes(first), capture: true, ..Default::default() };
+        let opts = RenderOptions { width, height, technique: Technique::Volumes(first).into(), capture: true, ..Default::default() };
         let mut renderer = Renderer::new(ctx, scene, opts)?;
         let _ = renderer.context().take_validation_errors();
         for method in methods {
-            renderer.settings.technique = Technique::Volumes(method);
+            renderer.settings.technique = Technique::Volumes(method).into();
             let frame = renderer.render()?;
             let validation = renderer.context().take_validation_errors();
             let dir = tmp.join(format!("{}-{}", name.replace('/', "_"), method.name()));

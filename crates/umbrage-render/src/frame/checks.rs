@@ -2,6 +2,7 @@
 //! it can draw, and the pass's share of the frame settings.
 
 use crate::options::*;
+use crate::technique::{CubeFaces, RenderTechnique, ShadowMap};
 use umbrage::error::{Error, Result};
 use umbrage::gpu::Context;
 use umbrage::pass::PassSettings;
@@ -15,12 +16,12 @@ pub(super) fn check_spheres(scene: &Scene, s: &FrameSettings) -> Result<()> {
             return Err(Error::Other(problem));
         }
     }
-    if s.technique == Technique::RayQuery {
+    if s.technique == RenderTechnique::Pass(Technique::RayQuery) {
         if let Some(why) = super::techniques::ray_query_unsupported(scene) {
             return Err(Error::Unsupported(why));
         }
     }
-    if matches!(s.technique, Technique::ShadowMap { .. }) && scene.spheres.iter().any(|s| s.casts_shadow) {
+    if s.technique.shadow_map().is_some() && scene.spheres.iter().any(|s| s.casts_shadow) {
         return Err(Error::Unsupported(
             "--method shadowmap does not draw analytic sphere casters into its maps; use a shadow-volume method".into(),
         ));
@@ -30,13 +31,7 @@ pub(super) fn check_spheres(scene: &Scene, s: &FrameSettings) -> Result<()> {
 
 /// The pass's share of the frame settings.
 pub(super) fn pass_settings(s: &FrameSettings) -> PassSettings {
-    PassSettings {
-        technique: s.technique.pass_technique().unwrap_or_default(),
-        counter: s.counter,
-        index_format: s.index_format,
-        toggles: s.toggles,
-        keep: s.keep,
-    }
+    PassSettings { technique: s.technique.pass(), counter: s.counter, index_format: s.index_format, toggles: s.toggles, keep: s.keep }
 }
 
 /// The options this device can honour (checked at creation and before every frame, since
@@ -49,7 +44,7 @@ pub(super) fn check_options(ctx: &Context, config: &RenderConfig, s: &FrameSetti
     if s.index_format == IndexFormat::U8 && !f.index_type_uint8 {
         return Err(Error::Unsupported("--index-format u8 needs VK_EXT_index_type_uint8; use auto or u16".into()));
     }
-    if s.technique == Technique::RayQuery && s.counter == Counter::Float {
+    if s.technique == RenderTechnique::Pass(Technique::RayQuery) && s.counter == Counter::Float {
         // The rays write the stencil; the float counter counts volumes (and would light from a
         // count image nothing wrote this frame).
         return Err(Error::InvalidDesc {
@@ -57,15 +52,15 @@ pub(super) fn check_options(ctx: &Context, config: &RenderConfig, s: &FrameSetti
             msg: "--method rayquery writes the stencil, not a volume count: use --counter stencil".into(),
         });
     }
-    if s.technique == Technique::RayQuery && !f.ray_query {
+    if s.technique == RenderTechnique::Pass(Technique::RayQuery) && !f.ray_query {
         return Err(umbrage::gpu::accel::missing_ray_query(&ctx.info.name));
     }
-    if matches!(s.technique, Technique::ShadowMap { cube: CubeFaces::Multiview, .. }) {
+    if matches!(s.technique, RenderTechnique::ShadowMap(ShadowMap { cube: CubeFaces::Multiview, .. })) {
         if let Some(e) = crate::passes::shadowmap::multiview_refusal(ctx) {
             return Err(e);
         }
     }
-    let shadow_map = matches!(s.technique, Technique::ShadowMap { .. });
+    let shadow_map = s.technique.shadow_map().is_some();
     if (s.counter == Counter::Float || shadow_map || config.self_shadow) && !f.r32f_blend {
         return Err(Error::Unsupported(
             "--counter float, --method shadowmap and --self-shadow need R32_SFLOAT colour blending, which this device lacks; use --counter stencil".into(),
@@ -113,7 +108,7 @@ fn check_samples(ctx: &Context, config: &RenderConfig, s: &FrameSettings) -> Res
             ctx.info.name
         )));
     }
-    let why = match (s.technique.pass_technique(), s.counter, s.view) {
+    let why = match (s.technique, s.counter, s.view) {
         _ if !s.technique.is_volume_pass() => Some(format!("the {} baseline", s.technique.name())),
         (_, Counter::Float, _) => Some("the float counter".to_string()),
         (_, _, View::Volumes) => Some("the volume overlay view".to_string()),

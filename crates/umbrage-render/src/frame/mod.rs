@@ -15,6 +15,7 @@ use super::readback::Layout;
 use super::scene_gpu::{SceneGeometry, Sidedness};
 use super::sphere_gpu::SphereGeometry;
 use super::targets::*;
+use super::technique::RenderTechnique;
 use super::timing::Span;
 mod area;
 mod checks;
@@ -309,12 +310,12 @@ impl Renderer {
         self.update_ray_inputs(settings.technique)?;
 
         // 1. The CPU work: plans and streams (the shadow-map baseline plans scissors only).
-        let frame = match settings.technique.pass_technique() {
-            Some(t) => {
+        let frame = match settings.technique {
+            RenderTechnique::Pass(t) => {
                 self.own.parts.pass.set_settings(PassSettings { technique: t, ..pass_settings(&settings) })?;
                 self.own.parts.pass.prepare(slot, &view, &self.own.parts.scene.lights)?
             }
-            None => self.own.parts.pass.prepare_culled(slot, &view, &self.own.parts.scene.lights)?,
+            RenderTechnique::ShadowMap(_) => self.own.parts.pass.prepare_culled(slot, &view, &self.own.parts.scene.lights)?,
         };
         let record_start = Instant::now();
         let instances = self.own.parts.geo.write_instances(slot, &self.own.parts.scene)?;
@@ -349,15 +350,6 @@ impl Renderer {
         if settings.counters {
             s.counters.begin(&self.own.ctx, cb, nlights as u32)?;
         }
-        let mut accel = Span::default();
-        if frame.ray_query().is_some() {
-            let timer = &self.own.parts.slots[slot].timer;
-            accel.begin = timer.stamp(&self.own.ctx, cb, vk::PipelineStageFlags2::ALL_COMMANDS);
-            // SAFETY: `cb` is recording outside a rendering instance; the slot retired; the
-            // frames before it were submitted earlier on the same queue.
-            unsafe { self.own.parts.pass.cmd_before_rendering(cb, &frame)? };
-            accel.end = timer.stamp(&self.own.ctx, cb, vk::PipelineStageFlags2::ALL_COMMANDS);
-        }
         let s = &self.own.parts.slots[slot];
         let counters = settings.counters.then_some(&s.counters);
         let full = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: self.own.parts.targets.extent };
@@ -365,8 +357,7 @@ impl Renderer {
         let rec = Rec { ctx: &self.own.ctx, cb, full, viewport, timer: &s.timer, readback };
         let input =
             record::FrameInputs { frame: &frame, layout: &layout, instances, spheres, vp_rel, lights: &lights, float_counts, counters };
-        let mut spans = self.record_frame(&rec, &input)?;
-        spans.accel = accel;
+        let spans = self.record_frame(&rec, &input)?;
         // SAFETY: recording finished; the submission signals the slot's fence.
         unsafe {
             d.end_command_buffer(cb).map_err(Error::vk("vkEndCommandBuffer"))?;

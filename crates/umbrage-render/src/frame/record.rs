@@ -8,6 +8,7 @@ use crate::push::LightPush;
 use crate::readback::Layout;
 use crate::scene_gpu::Sidedness;
 use crate::shadowmap::Lookup;
+use crate::technique::RenderTechnique;
 use ash::vk;
 use glam::Mat4;
 use umbrage::error::Result;
@@ -43,29 +44,30 @@ impl Renderer {
         let all = vk::PipelineStageFlags2::ALL_COMMANDS;
         let mut spans = FrameSpans::default();
         spans.frame.begin = stamp(vk::PipelineStageFlags2::TOP_OF_PIPE);
-        spans.depth.begin = spans.frame.begin;
         // SAFETY: every pass records into `rec.cb` (recording, outside rendering instances
         // between passes) with this renderer's objects, alive until the slot retires; the
         // layouts each pass expects are those the previous pass leaves.
         unsafe {
-            pass.cmd_upload(rec.cb, frame)?;
+            // The shadow pass's documented sequence, as any host calls it: what precedes
+            // rendering (uploads, and the technique's GPU work: every light's silhouettes for
+            // compute and mesh, the acceleration structures for ray query), then the depth
+            // pass, then `cmd_determine` per light.
+            pass.cmd_before_rendering(rec.cb, frame)?;
+            let before = passes::timing_span(spans.frame.begin, stamp(all));
+            match self.settings.technique {
+                RenderTechnique::Pass(Technique::Compute | Technique::Mesh) => spans.silhouettes = before,
+                RenderTechnique::Pass(Technique::RayQuery) => spans.accel = before,
+                _ => (),
+            }
+            spans.depth.begin = before.end;
             gbuffer::record(rec, &sd, spheres);
             spans.depth.end = stamp(all);
-            if matches!(self.settings.technique, Technique::Compute | Technique::Mesh) {
-                // every light's GPU silhouettes at once, timed on their own (`gpu_ms.silhouettes`)
-                spans.silhouettes.begin = spans.depth.end;
-                pass.cmd_compute_silhouettes(rec.cb, frame)?;
-                spans.silhouettes.end = stamp(all);
-            }
             let into = match (&self.own.parts.shadow_mapper, self.settings.counter) {
                 (Some(_), _) => determine::CountInto::External,
                 (None, Counter::Float) => determine::CountInto::Float,
                 (None, Counter::Stencil) => determine::CountInto::Stencil,
             };
-            let pcf = match self.settings.technique {
-                Technique::ShadowMap { pcf, .. } => pcf,
-                _ => Default::default(),
-            };
+            let pcf = self.settings.technique.shadow_map().map(|m| m.pcf).unwrap_or_default();
             for (li, light) in self.own.parts.scene.lights.iter().enumerate() {
                 let begin = stamp(all);
                 if let Some(c) = counters {

@@ -3,7 +3,7 @@
 
 use super::{FrameTicket, InFlight, Renderer};
 use crate::options::{DepthMode, IndexFormat, TransmitMode};
-use crate::stats::{GpuMs, LightGpuMs, RayQueryStats, ShadowMapStats, Stats};
+use crate::stats::{GpuMs, LightGpuMs, RayQueryStats, Stats};
 use umbrage::error::Result;
 
 impl Renderer {
@@ -108,10 +108,7 @@ impl Renderer {
                     batched: r.batched,
                 }
             }),
-            shadow_map: match f.settings.technique {
-                crate::Technique::ShadowMap { size, pcf, cube } => Some(ShadowMapStats { size, pcf, cube }),
-                _ => None,
-            },
+            shadow_map: f.settings.technique.shadow_map(),
         })
     }
 }

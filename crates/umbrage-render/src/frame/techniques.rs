@@ -6,6 +6,7 @@
 use super::Renderer;
 use crate::options::Technique;
 use crate::shadowmap::ShadowMapper;
+use crate::technique::RenderTechnique;
 use glam::DVec3;
 use umbrage::error::{Error, Result};
 use umbrage_scene::Scene;
@@ -15,8 +16,8 @@ impl Renderer {
     /// offset (2e-5 of the scene's diagonal, recomputed when the scene moved). The pass keeps
     /// its acceleration structures across frames and techniques, so a bench alternating
     /// techniques does not rebuild them.
-    pub(super) fn update_ray_inputs(&mut self, technique: Technique) -> Result<()> {
-        if technique != Technique::RayQuery {
+    pub(super) fn update_ray_inputs(&mut self, technique: RenderTechnique) -> Result<()> {
+        if technique != RenderTechnique::Pass(Technique::RayQuery) {
             return Ok(());
         }
         let p = &mut self.own.parts;
@@ -37,11 +38,8 @@ impl Renderer {
     /// Makes the shadow-map baseline of the asked size and cube layout current (built, or taken from the
     /// kept ones when built for the scene's placement now), and sets it aside when another
     /// technique runs; baselines built for an older placement are destroyed.
-    pub(super) fn update_shadow_mapper(&mut self, technique: Technique) -> Result<()> {
-        let wanted = match technique {
-            Technique::ShadowMap { size, cube, .. } => Some((size, cube)),
-            _ => None,
-        };
+    pub(super) fn update_shadow_mapper(&mut self, technique: RenderTechnique) -> Result<()> {
+        let wanted = technique.shadow_map().map(|m| (m.size, m.cube));
         let version = self.own.parts.scene_version;
         let parts = &mut self.own.parts;
         let current = parts.shadow_mapper.as_ref().map(|(m, v)| ((m.size, m.cube), *v));
