@@ -13,9 +13,9 @@ use umbrage_scene::{LightKind, Scene};
 pub enum Case {
     /// Only the camera.
     Camera,
-    /// The camera and a few casters ([`MOVERS`]).
+    /// The camera and a few casters (at most `MOVERS`).
     Casters,
-    /// The camera and a few lights ([`MOVERS`]).
+    /// The camera and a few lights (at most `MOVERS`).
     Lights,
 }
 

@@ -9,7 +9,7 @@
 //!   recording, bytes sent, pairs planned and kept, GPU shadow time, medians over the frames.
 //! - **Curves** ([`curves`]): the shadow pass alone (no drawing), camera walking, CPU per frame
 //!   against lights (the level's casters, 8 to 1,024 lights) and against casters (levels of
-//!   2 x 2 to 16 x 16 rooms: 68 to 4,352 casters), kept and not, with plots ([`plot`]).
+//!   2 x 2 to 16 x 16 rooms: 68 to 4,352 casters), kept and not, with plots (`plot.rs`).
 //!
 //! Every timing comes from the timers around the pass's and the renderer's phases
 //! (`Stats::cpu_ms`, `gpu_ms`), or the wall clock around `ShadowPass::prepare`.
