@@ -90,7 +90,10 @@ fn method(s: &mut String, r: &FrameCostReport) {
            (`cpu_record_ms`; every light's passes: much the same whatever the shadows' planning);\n\
          - **CPU ms**: the two together, frame by frame;\n\
          - **bytes sent**: geometry bytes the CPU wrote for the frame (the stream and new kept lists);\n\
-         - **GPU shadow ms**: the shadow determination's timestamps, every light.\n\n",
+         - **GPU shadow ms**: the shadow determination's timestamps, every light.\n\n\
+         The first measurements, with `examples/frame_cost.rs` on the shadow pass alone (the calling \
+         thread's CPU time), and the planning threads' 1 against 2 with the serial fraction, are in \
+         `docs/frame-cost/example.md`.\n\n",
         r.size[0], r.size[1], r.frames
     );
 }
@@ -228,4 +231,22 @@ fn curves(s: &mut String, r: &FrameCostReport, plots: &str) {
     curve_table(s, "level (rooms: casters, lights)", &r.casters_curve, |p| {
         format!("{0}x{0}: {1}, {2}", p.rooms, thousands(p.casters as u64), p.lights)
     });
+    // The same point measured twice in one run: how far apart repeat timings land here.
+    let same = |a: &&CurvePoint, b: &&CurvePoint| a.rooms == b.rooms && a.lights == b.lights;
+    if let Some((a, b)) = r.lights_curve.iter().find_map(|a| r.casters_curve.iter().find(|b| same(&a, b)).map(|b| (a, b))) {
+        let _ = writeln!(
+            s,
+            "The {0}x{0} level with its {1} lights is a point of both curves, measured twice in this run: planned every \
+             frame {2} and {3} ms, kept {4} and {5} ms (ratios {6} and {7}): the spread of repeat timings on this \
+             shared machine.",
+            a.rooms,
+            a.lights,
+            ms(a.off_ms),
+            ms(b.off_ms),
+            ms(a.kept_ms),
+            ms(b.kept_ms),
+            ratio(a.off_ms, a.kept_ms),
+            ratio(b.off_ms, b.kept_ms)
+        );
+    }
 }
