@@ -14,14 +14,14 @@ fn main() -> umbrage::Result<()> {
     let mut sizes: Vec<(u32, u32)> = Vec::new();
     for a in std::env::args().skip(1) {
         let size = a.split_once('x').and_then(|(w, h)| Some((w.parse().ok()?, h.parse().ok()?)));
-        sizes.push(size.ok_or_else(|| umbrage::Error::Other(format!("{a}: not WxH")))?);
+        sizes.push(size.ok_or_else(|| umbrage::Error::input(a.to_string(), "not WxH"))?);
     }
     if sizes.is_empty() {
         sizes = vec![(128, 96), (128, 128)];
     }
     let mut ctx = umbrage::gpu::Context::new()?;
     if !ctx.features.mesh_shader {
-        return Err(umbrage::Error::Other("no mesh shaders: run on Mesa lavapipe 25.0.7 (scripts/drivers.sh)".into()));
+        return Err(umbrage::Error::Unsupported("no mesh shaders: run on Mesa lavapipe 25.0.7 (scripts/drivers.sh)".into()));
     }
     println!("device: {}", ctx.info.name);
     let mut names: Vec<&str> = umbrage_scene::builtin_names().into_iter().filter(|n| n.starts_with("hard/")).collect();

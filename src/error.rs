@@ -7,8 +7,9 @@
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum Error {
-    /// Bad user input in a file: scene TOML, OBJ, dump directory. `location` is
-    /// `path` or `path:line` where a line is known.
+    /// Bad user input: a file (scene TOML, OBJ, dump directory, expectations) or a
+    /// command-line value. `location` is `path`, `path:line` where a line is known, or the
+    /// flag.
     #[error("{location}: {msg}")]
     Input {
         /// `path` or `path:line` of the offending input.
@@ -102,9 +103,6 @@ pub enum Error {
     /// another pass or slot, an argument out of range). Nothing was recorded or changed.
     #[error("{0}")]
     Misuse(#[from] Misuse),
-    /// Any other failure, described by its message.
-    #[error("{0}")]
-    Other(String),
     /// Reading or writing a file failed.
     #[error("I/O error on {path}: {source}")]
     Io {

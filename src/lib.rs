@@ -12,8 +12,7 @@
 //!
 //! # Features
 //!
-//! - `serde`: `serde::Serialize` on the planner's public types (plans, cases, methods) and the
-//!   named options.
+#![doc = document_features::document_features!()]
 //!
 //! The dependencies are those of `Cargo.toml` (meshopt builds meshoptimizer's C++: a C++
 //! compiler is needed).

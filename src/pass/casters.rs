@@ -88,8 +88,9 @@ pub(crate) struct CasterTable {
     pub cpu: Vec<Caster>,
     /// Their GPU side, index for index.
     pub live: Vec<GpuCaster>,
-    /// Per id index: its current generation and dense position in `live` (None: removed).
-    slots: Vec<(u32, Option<usize>)>,
+    /// Per id index: its current generation and dense position in `live` (None: removed). (Not
+    /// a ring slot: "slot" is the frames-in-flight ring's word alone.)
+    ids: Vec<(u32, Option<usize>)>,
     /// Staging copies not yet known to have reached the GPU.
     pub pending: Vec<PendingUpload>,
     graves: Vec<Grave>,
@@ -103,7 +104,7 @@ impl CasterTable {
             pass,
             cpu: Vec::new(),
             live: Vec::new(),
-            slots: Vec::new(),
+            ids: Vec::new(),
             pending: Vec::new(),
             graves: Vec::new(),
             arena: ComputeArena::default(),
@@ -121,7 +122,7 @@ impl CasterTable {
             }
             .into());
         }
-        match self.slots.get(id.index as usize) {
+        match self.ids.get(id.index as usize) {
             Some(&(generation, Some(i))) if generation == id.generation => Ok(i),
             _ => Err(crate::error::Misuse::UnknownId { what: "caster", id: format!("{}:{}", id.index, id.generation) }.into()),
         }
@@ -173,9 +174,9 @@ impl CasterTable {
 
     pub fn add(&mut self, dev: &PassDevice, caster: Caster, transform: DMat4) -> Result<CasterId> {
         let chunks = self.upload_chunks(dev, &caster)?;
-        let index = self.slots.len() as u32;
+        let index = self.ids.len() as u32;
         let id = CasterId { pass: self.pass, index, generation: 0 };
-        self.slots.push((0, Some(self.live.len())));
+        self.ids.push((0, Some(self.live.len())));
         let shells = shell_count(caster.mesh());
         self.cpu.push(caster);
         self.live.push(GpuCaster { id, transform, shells, chunks, edge_quads: None, compute: None, version: 0, pose: 0 });
@@ -187,8 +188,8 @@ impl CasterTable {
         let i = self.find(id)?;
         let mut c = self.live.remove(i);
         self.cpu.remove(i);
-        self.slots[id.index as usize] = (id.generation.wrapping_add(1), None);
-        for s in self.slots.iter_mut() {
+        self.ids[id.index as usize] = (id.generation.wrapping_add(1), None);
+        for s in self.ids.iter_mut() {
             if let (_, Some(j)) = s {
                 if *j > i {
                     *j -= 1;

@@ -184,8 +184,9 @@ named_enum!(
 
 pub use super::technique::Technique;
 
-/// The optional device features the host enabled on its `VkDevice`. The pass uses a feature
-/// only when the host enabled it AND the physical device reports it.
+/// The optional device features the host enabled on its `VkDevice`: set by the host, in
+/// [`ShadowPassDesc::features`], once. The pass uses a feature only when the host enabled it
+/// AND the physical device reports it (what it then uses is [`Capabilities`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct EnabledFeatures {
     /// `VkPhysicalDeviceFeatures::depthClamp` (needed by [`DepthMode::Clamp`]).
@@ -250,8 +251,9 @@ named_enum!(
     }
 );
 
-/// What a [`ShadowPass`](super::ShadowPass) is created for. Everything here is fixed for the
-/// pass's lifetime (pipelines and ring slots are built from it); per-frame choices are in
+/// What a [`ShadowPass`](super::ShadowPass) is created for: set by the host, once, at
+/// [`ShadowPass::new`](super::ShadowPass::new). Everything here is fixed for the pass's
+/// lifetime (pipelines and ring slots are built from it); per-frame choices are in
 /// [`PassSettings`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct ShadowPassDesc {
@@ -355,7 +357,9 @@ impl Default for ShadowPassDesc {
     }
 }
 
-/// What may change from one frame to the next.
+/// The pass's choices that may change from one frame to the next: set by the host, first in
+/// [`ShadowPassDesc::settings`], then with [`ShadowPass::set_settings`](super::ShadowPass::set_settings)
+/// between frames; checked against [`Capabilities`] before every frame.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PassSettings {
     /// Volumes with a case rule, or edge quads.
@@ -398,7 +402,8 @@ impl Default for PassSettings {
 
 /// The per-light optimisations McGuire et al. claim constant factors for; switching one off
 /// keeps the shadows exact (they only bound where the volumes are drawn) and costs what it
-/// saves. `umbrage bench --suite fill-vertex` measures each as an ablation.
+/// saves. Part of [`PassSettings`] (all on by default); a host switches one off to measure it,
+/// as `umbrage bench --suite fill-vertex` does for each.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PassToggles {
     /// Limit each light's determination (and lighting) to its screen-space scissor rectangle
@@ -441,8 +446,11 @@ impl Default for PassToggles {
     }
 }
 
-/// What the pass can use: the host's enabled features intersected with what the physical
-/// device reports, plus the format capabilities it probed.
+/// What the pass can use: the host's [`EnabledFeatures`] intersected with what the physical
+/// device reports, plus the format capabilities it probed. Computed by the pass
+/// ([`ShadowPass::capabilities`](super::ShadowPass::capabilities), or
+/// [`ShadowPass::capabilities_for`](super::ShadowPass::capabilities_for) without a device);
+/// the host reads it, never sets it.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Capabilities {
     /// Ray query enabled and present ([`EnabledFeatures::ray_query`]).

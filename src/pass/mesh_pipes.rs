@@ -212,3 +212,19 @@ impl MeshPipes {
         }
     }
 }
+
+/// [`Technique::Mesh`](super::Technique::Mesh)'s state: its pipelines, made with its first
+/// frame or `create_pipelines` (its facing bits are [`ComputeState`](super::compute::ComputeState)'s).
+#[derive(Default)]
+pub(super) struct MeshState {
+    pub pipes: Option<MeshPipes>,
+}
+
+impl super::techniques::TechniqueState for MeshState {
+    fn destroy(&mut self, dev: &PassDevice) {
+        if let Some(mut m) = self.pipes.take() {
+            // SAFETY: the pass is dropped after every command buffer that used it completed.
+            unsafe { m.destroy(&dev.device) };
+        }
+    }
+}

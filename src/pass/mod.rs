@@ -107,6 +107,7 @@ mod spheres;
 pub mod stats;
 mod target;
 mod technique;
+mod techniques;
 mod view;
 mod volumes;
 
@@ -145,8 +146,6 @@ use std::time::Instant;
 struct Slot {
     stream: Option<Buffer>,
     staging: Vec<Buffer>,
-    /// The compute pass's records, output and facing buffers and descriptor sets.
-    compute: compute::SlotCompute,
     /// Serial of the frame last prepared in this slot.
     serial: Option<u64>,
     /// Set by `cmd_upload` of the frame last prepared in this slot (shared with that frame),
@@ -165,24 +164,15 @@ pub struct ShadowPass {
     casters: CasterTable,
     slots: Vec<Slot>,
     serial: u64,
-    planar_receiver: glam::DVec4,
-    compute_pipes: Option<compute::ComputePipes>,
-    /// [`Technique::Compute`]'s merged draws' pipelines (with the compute pipelines, where the
-    /// pass has `drawIndirectFirstInstance`).
-    merged_pipes: Option<compute::draws_record::DrawPipes>,
-    /// [`Technique::Mesh`]'s pipelines (made with its first frame or `create_pipelines`).
-    mesh_pipes: Option<mesh_pipes::MeshPipes>,
+    /// Each technique's own pipelines and per-slot objects (planar, compute, mesh, ray query).
+    techniques: techniques::Techniques,
     /// Analytic sphere casters, in draw order (after the mesh casters).
     spheres: Vec<spheres::SphereCaster>,
     next_sphere: u64,
     /// Unique among the process's passes: a frame carries it, so another pass's frame is refused.
     id: u64,
-    /// The host's instance (for the ray-query extension's functions).
+    /// The host's instance (for the ray-query and mesh-shader extensions' functions).
     instance: ash::Instance,
-    /// [`Technique::RayQuery`]'s structures, made by the first frame that asks for it.
-    rays: Option<rays::Rays>,
-    /// The G-buffer the rays read ([`ShadowPass::set_ray_query_inputs`]).
-    ray_inputs: Option<RayQueryInputs>,
     /// The plans kept across frames ([`PassSettings::keep`]).
     kept: keep::Kept,
 }
@@ -248,7 +238,7 @@ impl ShadowPass {
         let pipes = Pipelines::new(&dev, desc, caps.depth_clamp, caps.depth_bounds, caps.r32f_blend)?;
         let id = NEXT_PASS_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let slots = (0..desc.frames_in_flight)
-            .map(|_| Slot { stream: None, staging: Vec::new(), compute: Default::default(), serial: None, recorded: Default::default() })
+            .map(|_| Slot { stream: None, staging: Vec::new(), serial: None, recorded: Default::default() })
             .collect();
         Ok(ShadowPass {
             dev,
@@ -259,16 +249,11 @@ impl ShadowPass {
             casters: CasterTable::new(id),
             slots,
             serial: 0,
-            planar_receiver: glam::DVec4::Y,
-            compute_pipes: None,
-            merged_pipes: None,
-            mesh_pipes: None,
+            techniques: techniques::Techniques::new(desc.frames_in_flight),
             spheres: Vec::new(),
             next_sphere: 0,
             id,
             instance: instance.clone(),
-            rays: None,
-            ray_inputs: None,
             kept: keep::Kept::default(),
         })
     }
@@ -306,7 +291,7 @@ impl ShadowPass {
         if !plane.is_finite() || plane.truncate().length_squared() == 0.0 {
             return Err(Error::argument("planar receiver", format!("{plane} is not a plane")));
         }
-        self.planar_receiver = plane;
+        self.techniques.planar.receiver = plane;
         Ok(())
     }
 
@@ -348,22 +333,23 @@ impl ShadowPass {
         if technique == Technique::Mesh && !self.caps.mesh_shader {
             return Err(desc::mesh_missing());
         }
-        if gpu && self.compute_pipes.is_none() {
-            self.compute_pipes = Some(compute::ComputePipes::new(&self.dev)?);
+        let t = &mut self.techniques;
+        if gpu && t.compute.pipes.is_none() {
+            t.compute.pipes = Some(compute::ComputePipes::new(&self.dev)?);
         }
-        if technique == Technique::Compute && self.caps.draw_indirect_first_instance && self.merged_pipes.is_none() {
+        if technique == Technique::Compute && self.caps.draw_indirect_first_instance && t.compute.merged.is_none() {
             let c = &self.caps;
             let caps = (c.depth_clamp, c.depth_bounds, c.r32f_blend);
-            self.merged_pipes = Some(compute::draws_record::DrawPipes::new(&self.dev, &self.desc, self.pipes.layout, caps)?);
+            t.compute.merged = Some(compute::draws_record::DrawPipes::new(&self.dev, &self.desc, self.pipes.layout, caps)?);
         }
         if technique == Technique::Mesh {
             let c = &self.caps;
-            if self.mesh_pipes.is_none() {
+            if t.mesh.pipes.is_none() {
                 let features = (c.depth_clamp, c.depth_bounds, c.r32f_blend);
-                self.mesh_pipes = Some(mesh_pipes::MeshPipes::new(&self.instance, &self.dev, features, c.task_shader)?);
+                t.mesh.pipes = Some(mesh_pipes::MeshPipes::new(&self.instance, &self.dev, features, c.task_shader)?);
             }
             let culled = c.task_shader && self.settings.toggles.mesh_task;
-            if let Some(m) = self.mesh_pipes.as_mut() {
+            if let Some(m) = t.mesh.pipes.as_mut() {
                 m.ensure(&self.dev, &self.desc, culled)?;
             }
         }
@@ -395,23 +381,9 @@ impl Drop for ShadowPass {
         // SAFETY: the embedding contract (module docs): the host drops the pass only after
         // every command buffer that used it has completed, while the device is alive.
         unsafe { self.pipes.destroy(&self.dev.device) };
-        if let Some(mut c) = self.compute_pipes.take() {
-            // SAFETY: as above.
-            unsafe { c.destroy(&self.dev.device) };
-        }
-        if let Some(mut m) = self.merged_pipes.take() {
-            // SAFETY: as above.
-            unsafe { m.destroy(&self.dev.device) };
-        }
-        if let Some(mut m) = self.mesh_pipes.take() {
-            // SAFETY: as above.
-            unsafe { m.destroy(&self.dev.device) };
-        }
+        self.techniques.destroy(&self.dev);
         self.casters.destroy(&self.dev);
         self.kept.destroy(&self.dev);
-        if let Some(mut r) = self.rays.take() {
-            r.destroy(&self.dev);
-        }
         for s in &mut self.slots {
             if let Some(mut b) = s.stream.take() {
                 b.destroy(&self.dev);
@@ -419,7 +391,6 @@ impl Drop for ShadowPass {
             for mut b in s.staging.drain(..) {
                 b.destroy(&self.dev);
             }
-            s.compute.destroy(&self.dev);
         }
     }
 }

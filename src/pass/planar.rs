@@ -47,3 +47,21 @@ pub(crate) fn flatten(plan: &mut LightPlan, table: &CasterTable, light: &Light, 
     }
     m
 }
+
+/// [`Technique::Planar`](super::Technique::Planar)'s state: the receiver plane
+/// ([`ShadowPass::set_planar_receiver`](super::ShadowPass::set_planar_receiver)).
+pub(super) struct PlanarState {
+    /// `n·x + d = 0` as `(n, d)`, `n` towards the light's side.
+    pub receiver: glam::DVec4,
+}
+
+impl Default for PlanarState {
+    /// y = 0, up.
+    fn default() -> Self {
+        PlanarState { receiver: glam::DVec4::Y }
+    }
+}
+
+impl super::techniques::TechniqueState for PlanarState {
+    fn destroy(&mut self, _dev: &super::device::PassDevice) {}
+}

@@ -61,9 +61,7 @@ impl ShadowPass {
         }
         self.casters.slot_retired(&self.dev, slot);
         self.kept.slot_retired(&self.dev, slot);
-        if let Some(r) = &mut self.rays {
-            r.slot_retired(&self.dev, slot);
-        }
+        self.techniques.slot_retired(&self.dev, slot);
         if self.settings.technique == Technique::EdgeQuads {
             self.casters.ensure_edge_quads(&self.dev)?;
         }
@@ -89,7 +87,7 @@ impl ShadowPass {
                 u8_ok: self.caps.index_type_uint8,
                 depth_bounds: self.caps.depth_bounds && self.settings.toggles.depth_bounds,
                 casters,
-                planar_receiver: self.planar_receiver,
+                planar_receiver: self.techniques.planar.receiver,
                 spheres: &self.spheres,
             },
             kept,

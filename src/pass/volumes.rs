@@ -193,7 +193,9 @@ impl ShadowPass {
     /// has task shaders and the frame's [`PassToggles::mesh_task`](super::PassToggles::mesh_task) is on, else the plain one.
     pub(super) fn mesh_set(&self, frame: &PreparedFrame) -> Result<&super::mesh_pipes::MeshPipeSet> {
         let culled = self.caps.task_shader && frame.settings.toggles.mesh_task;
-        self.mesh_pipes
+        self.techniques
+            .mesh
+            .pipes
             .as_ref()
             .and_then(|mp| mp.set(culled))
             .ok_or_else(|| Misuse::NotConfigured { call: "cmd_draw_volumes (mesh draws)", needs: "Technique::Mesh's pipelines" }.into())
@@ -217,7 +219,7 @@ impl ShadowPass {
         color: [f32; 4],
     ) -> Result<()> {
         let culled = self.caps.task_shader && frame.settings.toggles.mesh_task;
-        let (Some(mp), Some(cf)) = (self.mesh_pipes.as_ref(), frame.compute.as_ref()) else {
+        let (Some(mp), Some(cf)) = (self.techniques.mesh.pipes.as_ref(), frame.compute.as_ref()) else {
             return Err(Misuse::NotConfigured { call: "cmd_draw_volumes (mesh draws)", needs: "Technique::Mesh's pipelines" }.into());
         };
         let push = md.push(&VolumePush::new(c.mvp, c.light_object, color));

@@ -1,4 +1,4 @@
-//! `--self-shadow` (partial self-shadowing of transparent casters, src/render/passes/selfshadow.rs):
+//! `--self-shadow` (partial self-shadowing of transparent casters, crates/umbrage-render/src/stages/selfshadow.rs):
 //! a transparent surface under another transparent surface gets darker, the opaque receivers'
 //! light fractions do not change. The ignored `self_shadow_perf` writes
 //! docs/transparency-perf.md (run it with `-- --ignored`).
@@ -141,7 +141,7 @@ fn self_shadow_perf() {
     md += &format!(
         "Scene `{name}`, {w}x{h}, one point light, default options (`--counter stencil`, `--transmit log16`), \
          median of 5 frames after one warm-up, device **{device}**, optimised build, validation layers off. \"opaque\" is the same scene with \
-         every mesh's opacity set to 1; \"s.s.\" is `--self-shadow` (partial self-shadowing, src/render/passes/selfshadow.rs).\n\
+         every mesh's opacity set to 1; \"s.s.\" is `--self-shadow` (partial self-shadowing, crates/umbrage-render/src/stages/selfshadow.rs).\n\
          Frame = wall time of `Renderer::render` (CPU planning, recording, submission, wait, read-back of the \
          colour image); GPU = the timestamped frame on the device.\n\n"
     );

@@ -257,7 +257,7 @@ pub fn taps_label_of(label: &str) -> Option<&str> {
 /// they are on) fails the run with [`Error::Validation`].
 pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow)) -> Result<BenchReport> {
     if cfg.frames == 0 {
-        return Err(Error::Other("--frames must be at least 1".into()));
+        return Err(Error::input("--frames", "must be at least 1"));
     }
     let device = ctx.info.name.clone();
     let driver = format!("{} {}", ctx.info.driver, ctx.info.driver_info);
@@ -285,7 +285,7 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
     for name in &cfg.scenes {
         let (scene, motion) = umbrage_scene::load_animated(name)?;
         let moving = cfg.motion.then(|| (scene.clone(), motion));
-        let c = ctx.take().ok_or_else(|| Error::Other("context lost".into()))?;
+        let c = ctx.take().ok_or_else(|| Error::Internal("the bench lost its context".into()))?;
         let mut r = Renderer::new(c, scene, cfg.opts.clone())?;
         // The variants (technique, counter, compute draws, mesh task stage). Shadow maps do not
         // draw analytic sphere casters (the renderer refuses them): left out.

@@ -128,7 +128,7 @@ pub(super) fn row_of(r: &mut Renderer, at: RowAt, a: Acc, limits: &RunLimits) ->
     v.apply(r);
     let Variant { technique, counter, .. } = *v;
     let throughput = r.throughput(cfg.frames.max(2))?;
-    let s = a.last.ok_or_else(|| Error::Other("no frame".into()))?;
+    let s = a.last.ok_or_else(|| Error::Internal("no frame was measured".into()))?;
     let c = &s.totals.cases;
     let maps = technique.shadow_map().is_some() && !a.map.is_empty();
     let lookup: Vec<f64> = a.shadow.iter().zip(&a.map).map(|(s, m)| s - m).collect();
@@ -233,7 +233,7 @@ fn refit_ms(r: &mut Renderer) -> Result<Option<f64>> {
                 // The first deformation rebuilds the bottom level with ALLOW_UPDATE.
                 (0, _) => {}
                 (_, Some(g)) if refits > 0 => spans.push(g.accel),
-                _ => return Err(Error::Other(format!("ray query: frame {k} after a deformation refitted nothing"))),
+                _ => return Err(Error::Internal(format!("ray query: frame {k} after a deformation refitted nothing"))),
             }
         }
         Ok(())

@@ -259,7 +259,7 @@ fn setup(ctx: &Context, cfg: &LimitsConfig, made: &mut Made) -> Result<(vk::Pipe
             let (mut ds, mut color) = (ds, color);
             ds.destroy(ctx);
             color.destroy(ctx);
-            return Err(l.err().or(p.err()).unwrap_or_else(|| Error::Other("limits target".into())));
+            return Err(l.err().or(p.err()).unwrap_or_else(|| Error::Internal("the limits target was not made".into())));
         }
     };
     made.target = Some(Target { ds, color, pool, layout, extent });
@@ -291,7 +291,7 @@ fn setup(ctx: &Context, cfg: &LimitsConfig, made: &mut Made) -> Result<(vk::Pipe
 fn measure_with(ctx: &Context, cfg: &LimitsConfig, made: &mut Made) -> Result<Limits> {
     let (w, h) = (cfg.width.max(16), cfg.height.max(16));
     let (stencil, color) = setup(ctx, cfg, made)?;
-    let t = made.target.as_ref().ok_or_else(|| Error::Other("limits target".into()))?;
+    let t = made.target.as_ref().ok_or_else(|| Error::Internal("the limits target was not made".into()))?;
     let quick = cfg.scale < 1.0;
     let mut lab = Lab {
         ctx,

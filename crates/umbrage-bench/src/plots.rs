@@ -62,7 +62,7 @@ pub(crate) fn register_font() {
 }
 
 fn err<E: std::fmt::Debug>(what: &str) -> impl Fn(E) -> Error + '_ {
-    move |e| Error::Other(format!("plot {what}: {e:?}"))
+    move |e| Error::io(format!("plot {what}"), std::io::Error::other(format!("{e:?}")))
 }
 
 /// Writes every plot into `dir` and returns the file names.

@@ -168,7 +168,7 @@ impl SuiteReport {
     /// Writes `bench.json` and `bench.csv` into `dir` (created if missing).
     pub fn write(&self, dir: &Path) -> Result<()> {
         std::fs::create_dir_all(dir).map_err(|e| Error::io(dir.display().to_string(), e))?;
-        let json = serde_json::to_string_pretty(self).map_err(|e| Error::Other(e.to_string()))?;
+        let json = serde_json::to_string_pretty(self).map_err(|e| Error::Internal(format!("bench report JSON: {e}")))?;
         let p = dir.join("bench.json");
         std::fs::write(&p, json).map_err(|e| Error::io(p.display().to_string(), e))?;
         let p = dir.join("bench.csv");

@@ -23,7 +23,7 @@ const TESSELLATION: &[(&str, &str, i64, i64)] = &[
 /// (spheres and tori: about a quarter of the triangles; the same shapes, radii and places);
 /// `None` where no caster has a parameter left to halve (boxes, grids of cubes, OBJ files).
 pub fn coarser_toml(text: &str) -> Result<Option<String>> {
-    let mut doc: toml::Table = toml::from_str(text).map_err(|e| Error::Other(format!("scene TOML: {e}")))?;
+    let mut doc: toml::Table = toml::from_str(text).map_err(|e| Error::input("scene TOML", e.to_string()))?;
     let mut changed = false;
     if let Some(toml::Value::Array(meshes)) = doc.get_mut("mesh") {
         for m in meshes.iter_mut().filter_map(|m| m.as_table_mut()) {
@@ -44,7 +44,7 @@ pub fn coarser_toml(text: &str) -> Result<Option<String>> {
     if !changed {
         return Ok(None);
     }
-    toml::to_string(&doc).map(Some).map_err(|e| Error::Other(format!("scene TOML: {e}")))
+    toml::to_string(&doc).map(Some).map_err(|e| Error::input("scene TOML", e.to_string()))
 }
 
 /// The point's scene with a coarser tessellation of the same shapes, and its name; `None`

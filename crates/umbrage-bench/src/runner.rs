@@ -169,7 +169,7 @@ impl Runner {
     /// A renderer for `scene` at `size`, on the runner's context (give it back with
     /// [`release`](Runner::release)).
     pub fn renderer(&mut self, scene: Scene, size: (u32, u32)) -> Result<Renderer> {
-        let ctx = self.ctx.take().ok_or_else(|| Error::Other("context lost".into()))?;
+        let ctx = self.ctx.take().ok_or_else(|| Error::Internal("the bench lost its context".into()))?;
         let opts = RenderOptions { width: size.0, height: size.1, frames_in_flight: self.frames_in_flight, ..Default::default() };
         match Renderer::try_new(ctx, scene, opts) {
             Ok(r) => Ok(r),
@@ -394,7 +394,7 @@ impl Runner {
 fn evaluate_fractions(r: &mut Renderer, name: &str, techniques: &[RenderTechnique]) -> Result<Vec<f64>> {
     let rows = evaluate(r, name, techniques, 1)?;
     if rows.len() != techniques.len() {
-        return Err(Error::Other(format!("accuracy rows: {} for {} techniques", rows.len(), techniques.len())));
+        return Err(Error::Internal(format!("accuracy rows: {} for {} techniques", rows.len(), techniques.len())));
     }
     Ok(rows.iter().map(|row| row.fraction).collect())
 }

@@ -112,6 +112,6 @@ mod tests {
         let (peak, _) = saturate(Rules { max_steps: 3, max_ms: 1e9 }, 1.0, 1.0, |_| Ok(0.01)).unwrap();
         assert!((peak - 400_000.0).abs() < 1e-6, "{peak}");
         // An error stops it too.
-        assert!(saturate(rules, 1.0, 1.0, |_| Err(Error::Other("x".into()))).is_err());
+        assert!(saturate(rules, 1.0, 1.0, |_| Err(Error::Internal("x".into()))).is_err());
     }
 }

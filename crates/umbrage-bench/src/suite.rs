@@ -148,7 +148,7 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
     let bound_proofs = proof::prove(&mut run, &mut rows, &origins, &model, proof_frames)?;
     clock.lap("proofs", bound_proofs.points, 0);
     run.bar.finish_and_clear();
-    let ctx = run.ctx.take().ok_or_else(|| Error::Other("context lost".into()))?;
+    let ctx = run.ctx.take().ok_or_else(|| Error::Internal("the bench lost its context".into()))?;
     ctx.check_validation()?;
     let rows = in_order(&rows, &segments);
     let crossovers = sweeps::crossovers(&rows);

@@ -49,7 +49,6 @@ pub fn code_of(e: &Error) -> UmbrageResult {
         Error::Validation { .. } => UMBRAGE_ERROR_VALIDATION,
         Error::Internal(_) => UMBRAGE_ERROR_INTERNAL,
         Error::InvalidDesc { .. } => UMBRAGE_ERROR_INVALID_DESC,
-        Error::Other(_) => UMBRAGE_ERROR_OTHER,
         Error::Io { .. } => UMBRAGE_ERROR_IO,
         Error::Misuse(m) => match m {
             Misuse::LightIndex { .. } => UMBRAGE_ERROR_LIGHT_INDEX,
@@ -153,7 +152,6 @@ mod tests {
             (Error::Validation { count: 1, first: "x".into() }, 9),
             (Error::Internal("x".into()), 10),
             (Error::desc("f", "x"), 11),
-            (Error::Other("x".into()), 12),
             (Error::io("p", std::io::Error::other("x")), 13),
             (Misuse::LightIndex { index: 1, lights: 1 }.into(), 100),
             (Misuse::SlotOutOfRange { slot: 1, slots: 1 }.into(), 101),

@@ -6,7 +6,10 @@
 //! committed at `include/umbrage/umbrage.h`; `docs/c-api.md` is the integration guide. Every
 //! Vulkan function the pass calls comes from the host's `vkGetInstanceProcAddr` (and
 //! `vkGetDeviceProcAddr` where given): the library never links or opens the Vulkan loader.
-
+//!
+//! # Features
+//!
+#![doc = document_features::document_features!()]
 #![allow(clippy::missing_safety_doc)] // the exported functions' contract is the header's
 #![allow(non_snake_case)] // the C structs' field names are the header's (sType, pNext, ...)
 

@@ -389,7 +389,7 @@ fn render(frame: &FrameArgs, out: &Path, stats: Option<&Path>, view: View, dump:
     opts.view = view;
     opts.capture = dump.is_some();
     if !time.is_finite() {
-        return Err(Error::Other(format!("--time must be a finite number of seconds, got {time}")));
+        return Err(Error::input("--time", format!("must be a finite number of seconds, got {time}")));
     }
     let (scene, motion) = umbrage_scene::load_animated(&frame.scene)?;
     let scene = motion.scene_at(&scene, time);
@@ -407,7 +407,7 @@ fn render(frame: &FrameArgs, out: &Path, stats: Option<&Path>, view: View, dump:
     let frame_out = renderer.render()?;
     umbrage_render::output::write_png(out, frame_out.width, frame_out.height, &frame_out.color)?;
     if let Some(path) = stats {
-        let json = serde_json::to_string_pretty(&frame_out.stats).map_err(|e| Error::Other(e.to_string()))?;
+        let json = serde_json::to_string_pretty(&frame_out.stats).map_err(|e| Error::Internal(format!("JSON: {e}")))?;
         std::fs::write(path, json).map_err(|e| Error::io(path.display().to_string(), e))?;
     }
     if let Some(dir) = dump {
@@ -473,14 +473,14 @@ fn info(json: bool, scene: Option<&str>) -> Result<ExitCode> {
     let ctx = umbrage::gpu::Context::any_version(umbrage::gpu::context::validation_requested())?;
     let report = umbrage_render::output::info_report(&ctx);
     if json {
-        let mut value = serde_json::to_value(&report).map_err(|e| Error::Other(e.to_string()))?;
+        let mut value = serde_json::to_value(&report).map_err(|e| Error::Internal(format!("JSON: {e}")))?;
         if let (Some(obj), Some(c)) = (value.as_object_mut(), casters) {
-            obj.insert("casters".into(), serde_json::to_value(c).map_err(|e| Error::Other(e.to_string()))?);
+            obj.insert("casters".into(), serde_json::to_value(c).map_err(|e| Error::Internal(format!("JSON: {e}")))?);
         }
         if let (Some(obj), Some(l)) = (value.as_object_mut(), &lights) {
-            obj.insert("lights".into(), serde_json::to_value(l).map_err(|e| Error::Other(e.to_string()))?);
+            obj.insert("lights".into(), serde_json::to_value(l).map_err(|e| Error::Internal(format!("JSON: {e}")))?);
         }
-        println!("{}", serde_json::to_string_pretty(&value).map_err(|e| Error::Other(e.to_string()))?);
+        println!("{}", serde_json::to_string_pretty(&value).map_err(|e| Error::Internal(format!("JSON: {e}")))?);
     } else {
         println!("{}", umbrage_render::output::info_text(&report));
         for (i, l) in lights.iter().flatten().enumerate() {

@@ -183,7 +183,7 @@ fn mismatches(a: &FrameOutput, sa: &Scene, b: &FrameOutput, sb: &Scene) -> usize
 /// Runs the soak (see the module docs), printing a progress line every tenth of the run.
 pub fn soak(cfg: &SoakConfig) -> Result<SoakReport> {
     if cfg.frames == 0 || cfg.period == 0 || cfg.sample_every == 0 {
-        return Err(Error::Other("soak: frames, period and sample interval must be at least 1".into()));
+        return Err(Error::input("--soak", "frames, period and sample interval must be at least 1"));
     }
     let base = umbrage_scene::load(&cfg.scene)?;
     let ctx = Context::new()?;
@@ -202,7 +202,7 @@ pub fn soak(cfg: &SoakConfig) -> Result<SoakReport> {
         queue.push_back(r.submit()?);
         if queue.len() >= depth || i + 1 == cfg.frames {
             while queue.len() >= depth || (i + 1 == cfg.frames && !queue.is_empty()) {
-                let ticket = queue.pop_front().ok_or_else(|| Error::Other("soak: empty frame queue".into()))?;
+                let ticket = queue.pop_front().ok_or_else(|| Error::Internal("soak: empty frame queue".into()))?;
                 last = Some(r.finish(ticket)?);
             }
         }
@@ -216,7 +216,7 @@ pub fn soak(cfg: &SoakConfig) -> Result<SoakReport> {
             eprintln!("soak: {done}/{} frames, {:.0} s", cfg.frames, start.elapsed().as_secs_f64());
         }
     }
-    let last = last.ok_or_else(|| Error::Other("soak: no frame finished".into()))?;
+    let last = last.ok_or_else(|| Error::Internal("soak: no frame finished".into()))?;
     let state = state_at(&base, cfg.frames - 1, cfg.period);
     let (width, height, frames_in_flight) = (r.config().width, r.config().height, r.config().frames_in_flight);
     let seconds = start.elapsed().as_secs_f64();

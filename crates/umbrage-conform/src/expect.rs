@@ -43,18 +43,18 @@ impl Expectations {
             if line.is_empty() || line.starts_with('#') {
                 continue;
             }
-            let (name, status) = line
-                .rsplit_once(',')
-                .ok_or_else(|| Error::Other(format!("expectations line {}: expected `case,Fail` or `case,Crash`, got '{line}'", i + 1)))?;
+            let (name, status) = line.rsplit_once(',').ok_or_else(|| {
+                Error::input(format!("expectations line {}", i + 1), format!("expected `case,Fail` or `case,Crash`, got '{line}'"))
+            })?;
             let status = match status.trim() {
                 "Fail" => Status::Fail,
                 "Crash" => Status::Crash,
                 other => {
-                    return Err(Error::Other(format!("expectations line {}: unknown status '{other}' (Fail or Crash)", i + 1)));
+                    return Err(Error::input(format!("expectations line {}", i + 1), format!("unknown status '{other}' (Fail or Crash)")));
                 }
             };
             if cases.insert(name.trim().to_string(), status).is_some() {
-                return Err(Error::Other(format!("expectations line {}: '{}' listed twice", i + 1, name.trim())));
+                return Err(Error::input(format!("expectations line {}", i + 1), format!("'{}' listed twice", name.trim())));
             }
         }
         Ok(Expectations { cases })
@@ -63,7 +63,7 @@ impl Expectations {
     /// Reads and parses `path`.
     pub fn load(path: &Path) -> Result<Expectations> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path.display().to_string(), e))?;
-        Self::parse(&text).map_err(|e| Error::Other(format!("{}: {e}", path.display())))
+        Self::parse(&text).map_err(|e| Error::input(path.display().to_string(), e.to_string()))
     }
 
     /// The list a run would need: every failed or crashed case of `r`, in the file format.

@@ -24,7 +24,7 @@ fn depth_gray(v: f64) -> Rgb<u8> {
 }
 
 fn save(img: &RgbImage, path: &Path) -> Result<String> {
-    img.save(path).map_err(|e| Error::Other(format!("{}: {e}", path.display())))?;
+    img.save(path).map_err(|e| Error::io(path.display().to_string(), std::io::Error::other(e.to_string())))?;
     Ok(path.display().to_string())
 }
 

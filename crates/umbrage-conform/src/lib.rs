@@ -4,7 +4,7 @@
 //!
 //! Two layers:
 //!
-//! - **The parametrised suite** ([`cases`], [`model`], [`batch`], [`suite`]): 5,920
+//! - **The parametrised suite** ([`cases`], [`model`], [`batch`], [`suite`]): the
 //!   CTS-style cases (those of formats and features a device lacks are skipped, with the
 //!   reason) — the stencil-op table, depth and infinity, depth clamp and bias, depth bounds, unrestricted depth, rasterisation and occlusion queries, a
 //!   known-bug zoo, and four families beyond the CTS (deep wrap, homogeneous clipping,
@@ -215,13 +215,13 @@ pub struct RunArgs {
 
 /// Child mode: runs one unit and writes its result as JSON (see [`isolate`]).
 fn run_child(ctx: &Context, unit: &str, result: Option<&std::path::Path>, opts: &SuiteOptions) -> Result<ExitCode> {
-    let unit = isolate::Unit::parse(unit).ok_or_else(|| Error::Other(format!("--child: unknown unit '{unit}'")))?;
-    let result = result.ok_or_else(|| Error::Other("--child needs --child-result FILE".into()))?;
+    let unit = isolate::Unit::parse(unit).ok_or_else(|| Error::input("--child", format!("unknown unit '{unit}'")))?;
+    let result = result.ok_or_else(|| Error::input("--child", "needs --child-result FILE"))?;
     isolate::injected_crash(unit);
     deqp::exec::injected_case_fault(&opts.filter);
     let validation = ctx.validation;
     let r = isolate::run_unit(ctx, unit, &|| Context::with_validation(validation), opts);
-    let json = serde_json::to_string(&r).map_err(|e| Error::Other(e.to_string()))?;
+    let json = serde_json::to_string(&r).map_err(|e| Error::Internal(format!("JSON: {e}")))?;
     std::fs::write(result, json).map_err(|e| Error::io(result.display().to_string(), e))?;
     Ok(ExitCode::SUCCESS)
 }
@@ -269,7 +269,7 @@ pub fn run(mut a: RunArgs) -> Result<ExitCode> {
     }
     let break_op = match std::env::var("UMBRAGE_CONFORM_BREAK") {
         Ok(v) if !v.is_empty() => {
-            Some(cases::parse_op(&v).ok_or_else(|| Error::Other(format!("UMBRAGE_CONFORM_BREAK: unknown stencil op '{v}'")))?)
+            Some(cases::parse_op(&v).ok_or_else(|| Error::input("UMBRAGE_CONFORM_BREAK", format!("unknown stencil op '{v}'")))?)
         }
         _ => None,
     };
@@ -282,7 +282,7 @@ pub fn run(mut a: RunArgs) -> Result<ExitCode> {
     }
     let expectations = a.expect.as_deref().map(expect::Expectations::load).transpose()?;
     if !(a.timeout_s > 0.0 && a.timeout_s.is_finite()) {
-        return Err(Error::Other(format!("--timeout must be a positive number of seconds, got {}", a.timeout_s)));
+        return Err(Error::input("--timeout", format!("must be a positive number of seconds, got {}", a.timeout_s)));
     }
     if a.ci.any() {
         return deqp::run_standalone(&ctx, &a, &filter, &out, &opts);
@@ -333,7 +333,7 @@ pub fn run(mut a: RunArgs) -> Result<ExitCode> {
             v.unexpected_passes.len()
         );
         let p = out.join("conform-expect.json");
-        let json = serde_json::to_string_pretty(&v).map_err(|e| Error::Other(e.to_string()))?;
+        let json = serde_json::to_string_pretty(&v).map_err(|e| Error::Internal(format!("JSON: {e}")))?;
         std::fs::write(&p, json + "\n").map_err(|e| Error::io(p.display().to_string(), e))?;
         return Ok(if v.ok() { ExitCode::SUCCESS } else { ExitCode::FAILURE });
     }

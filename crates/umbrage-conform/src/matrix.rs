@@ -20,10 +20,10 @@ impl Column {
     /// Reads `DIR/conform.json` for the column `NAME=DIR` (the name may contain `=`, as in
     /// `25.0.7 LP_DEBUG=no_fastpath`; the directory may not).
     pub fn load(spec: &str) -> Result<Column> {
-        let (name, dir) = spec.rsplit_once('=').ok_or_else(|| Error::Other(format!("--column '{spec}': expected NAME=DIR")))?;
+        let (name, dir) = spec.rsplit_once('=').ok_or_else(|| Error::input("--column", format!("'{spec}': expected NAME=DIR")))?;
         let path = PathBuf::from(dir).join("conform.json");
         let text = std::fs::read_to_string(&path).map_err(|e| Error::io(path.display().to_string(), e))?;
-        let report = serde_json::from_str(&text).map_err(|e| Error::Other(format!("{}: {e}", path.display())))?;
+        let report = serde_json::from_str(&text).map_err(|e| Error::input(path.display().to_string(), e.to_string()))?;
         Ok(Column { name: name.to_string(), report })
     }
 
@@ -194,7 +194,7 @@ fn shorten(m: &str, n: usize) -> String {
 /// `umbrage conform-matrix`: reads the columns, writes the Markdown to `out`.
 pub fn run(columns: &[String], notes: Option<&Path>, out: &Path) -> Result<()> {
     if columns.is_empty() {
-        return Err(Error::Other("conform-matrix needs at least one --column NAME=DIR".into()));
+        return Err(Error::input("--column", "conform-matrix needs at least one --column NAME=DIR"));
     }
     let cols: Vec<Column> = columns.iter().map(|c| Column::load(c)).collect::<Result<_>>()?;
     let notes = notes.map(|p| std::fs::read_to_string(p).map_err(|e| Error::io(p.display().to_string(), e))).transpose()?;

@@ -129,7 +129,7 @@ pub fn markdown(r: &Report) -> String {
 /// Writes `conform.json` and `conform.md` into `dir` and, when given, the JUnit XML to `junit_path`.
 pub fn write_all(dir: &Path, junit_path: Option<&Path>, r: &Report) -> Result<()> {
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir.display().to_string(), e))?;
-    let json = serde_json::to_string_pretty(r).map_err(|e| Error::Other(e.to_string()))?;
+    let json = serde_json::to_string_pretty(r).map_err(|e| Error::Internal(format!("JSON: {e}")))?;
     let p = dir.join("conform.json");
     std::fs::write(&p, json + "\n").map_err(|e| Error::io(p.display().to_string(), e))?;
     let p = dir.join("conform.md");

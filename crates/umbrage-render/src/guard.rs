@@ -150,8 +150,8 @@ impl<T: Destroy> Drop for Owned<T> {
 mod impls {
     use super::{Context, Destroy};
     use crate::{
-        passes::selfshadow::SelfShadow, passes::shadowmap::ShadowMapper, pipelines::FramePipelines, scene_gpu::SceneGeometry,
-        sphere_gpu::SphereGeometry, targets::Targets,
+        pipelines::FramePipelines, scene_gpu::SceneGeometry, sphere_gpu::SphereGeometry, stages::selfshadow::SelfShadow,
+        stages::shadowmap::ShadowMapper, targets::Targets,
     };
 
     macro_rules! safe_destroy {

@@ -31,13 +31,13 @@ mod frame_output;
 pub(crate) mod guard;
 pub mod options;
 pub mod output;
-pub(crate) mod passes;
 pub mod pipelines;
 pub mod push;
 mod readback;
 pub mod scene_gpu;
-/// The shadow-map baseline (a pass of the frame, in `passes/`).
-pub use passes::shadowmap;
+pub(crate) mod stages;
+/// The shadow-map baseline (a stage of the frame, in `stages/`).
+pub use stages::shadowmap;
 mod sphere_gpu;
 pub mod stats;
 pub mod targets;
@@ -51,7 +51,7 @@ pub use options::{
     ComputeDraws, Counter, DepthMode, FrameSettings, IndexFormat, PassToggles, RenderConfig, RenderOptions, Shading, Technique,
     TransmitMode, View,
 };
-pub use passes::debug::stencil_heatmap;
+pub use stages::debug::stencil_heatmap;
 pub use stats::Stats;
 pub use technique::{CubeFaces, Pcf, RenderTechnique, ShadowMap};
 

@@ -97,7 +97,8 @@ impl TransmitMode {
 }
 
 /// What a [`Renderer`](super::Renderer) is built for: fixed at creation (targets and
-/// pipelines are made for it).
+/// pipelines are made for it). Set by the renderer's caller (the CLI, the bench, the tests)
+/// through [`RenderOptions`] at creation; read back with `Renderer::config`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct RenderConfig {
     /// Image width in pixels (1..=16384).
@@ -108,7 +109,7 @@ pub struct RenderConfig {
     pub depth_mode: DepthMode,
     /// The light-intensity map's format: RGBA32F (true) or RGBA16F.
     pub transmit_fp32: bool,
-    /// Partial self-shadowing of transparent casters (src/render/passes/selfshadow.rs).
+    /// Partial self-shadowing of transparent casters (src/render/stages/selfshadow.rs).
     pub self_shadow: bool,
     /// Frames the renderer keeps in flight (command buffers, fences, readbacks per slot).
     pub frames_in_flight: usize,
@@ -116,7 +117,11 @@ pub struct RenderConfig {
     pub samples: u32,
 }
 
-/// What may change from one frame to the next.
+/// The renderer's choices that may change from one frame to the next: what it hands the
+/// shadow pass (its [`PassSettings`](umbrage::pass::PassSettings) fields: technique, counter,
+/// index format, toggles, keep) and what it draws itself (view, shading, capture, ...). Set by
+/// the renderer's caller in `Renderer::settings` between frames (first through
+/// [`RenderOptions`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct FrameSettings {
     /// What the shadow pass runs, or the shadow-map baseline.
@@ -148,7 +153,10 @@ pub struct FrameSettings {
     pub keep: bool,
 }
 
-/// Everything a renderer is created with: its [`RenderConfig`] and first [`FrameSettings`].
+/// Everything a renderer is created with, in one struct literal: its [`RenderConfig`] and first
+/// [`FrameSettings`] ([`config`](RenderOptions::config) and
+/// [`settings`](RenderOptions::settings) split it). For creation only: afterwards the
+/// renderer's caller reads the config and changes the settings.
 #[derive(Clone, Debug)]
 pub struct RenderOptions {
     /// Image width in pixels.
@@ -171,7 +179,7 @@ pub struct RenderOptions {
     pub transmit: TransmitMode,
     /// Read back per-light stencil counts, positions and normals (dumps, tests).
     pub capture: bool,
-    /// Partial self-shadowing of transparent casters (src/render/passes/selfshadow.rs); no effect on
+    /// Partial self-shadowing of transparent casters (src/render/stages/selfshadow.rs); no effect on
     /// scenes without them.
     pub self_shadow: bool,
     /// Frames in flight (at least 1).

@@ -11,13 +11,13 @@ use umbrage_scene::Scene;
 /// Writes RGBA8 pixels as a PNG.
 pub fn write_png(path: &Path, width: u32, height: u32, rgba: &[u8]) -> Result<()> {
     image::save_buffer(path, rgba, width, height, image::ExtendedColorType::Rgba8)
-        .map_err(|e| Error::Other(format!("{}: cannot write PNG: {e}", path.display())))
+        .map_err(|e| Error::io(path.display().to_string(), std::io::Error::other(format!("cannot write PNG: {e}"))))
 }
 
 /// Writes an 8-bit grey PNG.
 pub fn write_grey_png(path: &Path, width: u32, height: u32, grey: &[u8]) -> Result<()> {
     image::save_buffer(path, grey, width, height, image::ExtendedColorType::L8)
-        .map_err(|e| Error::Other(format!("{}: cannot write PNG: {e}", path.display())))
+        .map_err(|e| Error::io(path.display().to_string(), std::io::Error::other(format!("cannot write PNG: {e}"))))
 }
 
 /// The dump of a captured frame: frame.json, world.obj, positions.f32, normals.f32,
@@ -35,7 +35,7 @@ pub fn write_frame_dump(dir: &Path, scene: &Scene, frame: &FrameOutput) -> Resul
         return Ok(());
     }
     if frame.positions.is_empty() {
-        return Err(Error::Other("frame was rendered without capture; cannot dump".into()));
+        return Err(Error::argument("frame", "it was rendered without capture; cannot dump"));
     }
     let positions = frame.positions.iter().flatten().copied().collect();
     let normals = frame.normals.iter().flatten().copied().collect();

@@ -83,10 +83,10 @@ impl Readback {
 
     /// The bytes of `range`.
     pub fn bytes(&self, range: Range) -> Result<&[u8]> {
-        let b = self.buffer.as_ref().ok_or_else(|| umbrage::Error::Other("no readback buffer".into()))?;
+        let b = self.buffer.as_ref().ok_or_else(|| umbrage::Error::Internal("no readback buffer".into()))?;
         let all = b.read()?;
         all.get(range.offset as usize..(range.offset + range.size) as usize)
-            .ok_or_else(|| umbrage::Error::Other(format!("readback range {range:?} outside {} bytes", all.len())))
+            .ok_or_else(|| umbrage::Error::Internal(format!("readback range {range:?} outside {} bytes", all.len())))
     }
 
     pub fn destroy(&mut self, ctx: &Context) {

@@ -131,7 +131,7 @@ impl SceneGeometry {
         }
         if all.is_empty() {
             if scene.spheres.is_empty() {
-                return Err(Error::Other(format!("scene '{}' has no triangle or sphere to draw", scene.name)));
+                return Err(Error::input(format!("scene '{}'", scene.name), "it has no triangle or sphere to draw"));
             }
             // Spheres only: a buffer to bind (never drawn from; no mesh ranges).
             all.push([0.0; 14]);
@@ -179,7 +179,7 @@ impl SceneGeometry {
                 nrm.z_axis.as_vec3().extend(0.0).to_array(),
             ]);
         }
-        let buf = self.instances.get_mut(slot).ok_or_else(|| Error::Other(format!("instance slot {slot} out of range")))?;
+        let buf = self.instances.get_mut(slot).ok_or_else(|| Error::Internal(format!("instance slot {slot} out of range")))?;
         buf.write(0, bytemuck::cast_slice(&data))?;
         Ok(buf.raw)
     }

@@ -68,7 +68,7 @@ impl SphereGeometry {
             return Ok(None);
         }
         if 36 * scene.spheres.len() as u32 != self.count {
-            return Err(Error::Other("the scene's spheres changed in number after the renderer was created".into()));
+            return Err(Error::argument("scene spheres", "their number changed after the renderer was created"));
         }
         let eye = scene.camera.eye.as_dvec3();
         let mut data: Vec<[f32; 10]> = Vec::with_capacity(self.count as usize);
@@ -80,7 +80,7 @@ impl SphereGeometry {
                 data.push([p.x, p.y, p.z, cf.x, cf.y, cf.z, s.color.x, s.color.y, s.color.z, s.sphere.radius as f32]);
             }
         }
-        let buf = self.buffers.get_mut(slot).ok_or_else(|| Error::Other(format!("sphere slot {slot} out of range")))?;
+        let buf = self.buffers.get_mut(slot).ok_or_else(|| Error::Internal(format!("sphere slot {slot} out of range")))?;
         buf.write(0, bytemuck::cast_slice(&data))?;
         Ok(Some((buf.raw, self.count)))
     }

@@ -200,7 +200,7 @@ impl ShadowPass {
         if !m.compacts() {
             return Ok(());
         }
-        let Some(dp) = self.merged_pipes.as_ref() else {
+        let Some(dp) = self.techniques.compute.merged.as_ref() else {
             return Err(Misuse::NotConfigured { call: "cmd_compute_silhouettes", needs: "the merged draws' pipelines" }.into());
         };
         let d = &self.dev.device;
@@ -244,7 +244,7 @@ impl ShadowPass {
         kind: VolumeKind,
     ) -> Result<()> {
         let Some((cf, m)) = frame.compute.as_ref().and_then(|cf| cf.merged.as_ref().map(|m| (cf, m))) else { return Ok(()) };
-        let Some(dp) = self.merged_pipes.as_ref() else {
+        let Some(dp) = self.techniques.compute.merged.as_ref() else {
             return Err(Misuse::NotConfigured { call: "cmd_draw_volumes (merged draws)", needs: "the merged draws' pipelines" }.into());
         };
         let count = || dp.count.ok_or(Misuse::NotConfigured { call: "cmd_draw_volumes (float kinds)", needs: "R32_SFLOAT blending" });

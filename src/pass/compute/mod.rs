@@ -381,6 +381,39 @@ impl ComputePipes {
     }
 }
 
+/// The GPU possible silhouettes' state ([`Technique::Compute`](crate::pass::Technique::Compute)
+/// and the facing stage of [`Technique::Mesh`](crate::pass::Technique::Mesh)): the compute
+/// pipelines, the merged draws' pipelines (with `drawIndirectFirstInstance`), both made with
+/// the first frame or `create_pipelines`, and each ring slot's buffers and descriptor sets.
+pub(crate) struct ComputeState {
+    pub pipes: Option<ComputePipes>,
+    pub merged: Option<draws_record::DrawPipes>,
+    pub slots: Vec<SlotCompute>,
+}
+
+impl ComputeState {
+    /// Nothing made yet, for a ring of `slots` slots.
+    pub fn new(slots: usize) -> ComputeState {
+        ComputeState { pipes: None, merged: None, slots: (0..slots).map(|_| SlotCompute::default()).collect() }
+    }
+}
+
+impl crate::pass::techniques::TechniqueState for ComputeState {
+    fn destroy(&mut self, dev: &PassDevice) {
+        if let Some(mut c) = self.pipes.take() {
+            // SAFETY: the pass is dropped after every command buffer that used it completed.
+            unsafe { c.destroy(&dev.device) };
+        }
+        if let Some(mut m) = self.merged.take() {
+            // SAFETY: as above.
+            unsafe { m.destroy(&dev.device) };
+        }
+        for s in &mut self.slots {
+            s.destroy(dev);
+        }
+    }
+}
+
 /// One ring slot's buffers and descriptor set for the compute pass.
 #[derive(Default)]
 pub(crate) struct SlotCompute {

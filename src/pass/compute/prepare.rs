@@ -20,25 +20,25 @@ impl ShadowPass {
     ) -> Result<ComputeFrame> {
         let draws = if cf.mesh { crate::pass::ComputeDraws::PerChunk } else { draws };
         cf.merged = super::draws::plan(&mut cf.records, &cf.chunk_records, lights, draws, self.dev.max_draw_indirect_count);
-        let merged_layout = match (&cf.merged, self.merged_pipes.as_ref()) {
+        let merged_layout = match (&cf.merged, self.techniques.compute.merged.as_ref()) {
             (None, _) => vk::DescriptorSetLayout::null(),
             (Some(_), Some(p)) => p.set_layout,
             (Some(_), None) => return Err(Error::Internal("merged draws without their pipelines".into())),
         };
-        let Some(pipes) = self.compute_pipes.as_ref() else {
+        let Some(pipes) = self.techniques.compute.pipes.as_ref() else {
             return Err(
                 Misuse::NotConfigured { call: "Technique::Compute", needs: "a device with compute silhouettes (Capabilities)" }.into()
             );
         };
         let set_layout = pipes.set_layout;
-        let mesh_layout = match (cf.mesh, self.mesh_pipes.as_ref()) {
+        let mesh_layout = match (cf.mesh, self.techniques.mesh.pipes.as_ref()) {
             (false, _) => None,
             (true, Some(m)) => Some(m.set_layout),
             (true, None) => return Err(crate::pass::desc::mesh_missing()),
         };
         let dev = &self.dev;
         let arena = self.casters.arena.raw();
-        let sc = &mut self.slots[slot].compute;
+        let sc = &mut self.techniques.compute.slots[slot];
         let storage = vk::BufferUsageFlags::STORAGE_BUFFER;
         // (buffer, name, bytes, usage, where): every range the set binds, each at most the
         // device's maxStorageBufferRange
@@ -180,7 +180,7 @@ impl ShadowPass {
             if cf.read_back.replace(true) || cf.mesh_metas.is_empty() {
                 return Ok(());
             }
-            let Some(counts) = slot.compute.counts.as_ref() else { return Ok(()) };
+            let Some(counts) = self.techniques.compute.slots[frame.slot].counts.as_ref() else { return Ok(()) };
             let bytes = counts.read()?;
             let words: &[u32] = bytemuck::try_cast_slice(&bytes[..cf.counts_words as usize * 4])
                 .map_err(|e| Error::Internal(format!("mesh counters: {e}")))?;
@@ -189,7 +189,7 @@ impl ShadowPass {
         if cf.metas.is_empty() {
             return Ok(());
         }
-        let Some(records) = slot.compute.records.as_ref() else { return Ok(()) };
+        let Some(records) = self.techniques.compute.slots[frame.slot].records.as_ref() else { return Ok(()) };
         let bytes = records.read()?;
         let words: &[u32] =
             bytemuck::try_cast_slice(&bytes[..cf.records.len() * 4]).map_err(|e| Error::Internal(format!("compute records: {e}")))?;

@@ -56,7 +56,7 @@ impl ShadowPass {
         if cf.recorded.replace(true) || cf.jobs.is_empty() {
             return Ok(());
         }
-        let Some(cp) = self.compute_pipes.as_ref() else {
+        let Some(cp) = self.techniques.compute.pipes.as_ref() else {
             return Err(crate::error::Misuse::NotConfigured {
                 call: "cmd_compute_silhouettes",
                 needs: "Technique::Compute on a device with compute silhouettes",

@@ -564,3 +564,25 @@ fn make_pipeline(
         }
     }
 }
+
+/// [`Technique::RayQuery`](super::Technique::RayQuery)'s state: its acceleration structures
+/// (made by the first frame that traces) and the G-buffer the rays read
+/// ([`ShadowPass::set_ray_query_inputs`](super::ShadowPass::set_ray_query_inputs)).
+#[derive(Default)]
+pub(super) struct RayState {
+    pub structures: Option<Rays>,
+    pub inputs: Option<RayQueryInputs>,
+}
+
+impl super::techniques::TechniqueState for RayState {
+    fn slot_retired(&mut self, dev: &PassDevice, slot: usize) {
+        if let Some(r) = &mut self.structures {
+            r.slot_retired(dev, slot);
+        }
+    }
+    fn destroy(&mut self, dev: &PassDevice) {
+        if let Some(mut r) = self.structures.take() {
+            r.destroy(dev);
+        }
+    }
+}

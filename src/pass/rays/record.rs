@@ -127,7 +127,7 @@ impl ShadowPass {
     /// same queue (a refit rewrites a structure they read).
     pub(crate) unsafe fn cmd_build_rays(&self, cb: vk::CommandBuffer, frame: &PreparedFrame) -> Result<()> {
         self.check_frame(frame)?;
-        let (Some(rf), Some(rays)) = (&frame.rays, &self.rays) else { return Ok(()) };
+        let (Some(rf), Some(rays)) = (&frame.rays, &self.techniques.rays.structures) else { return Ok(()) };
         if rf.recorded.replace(true) {
             return Ok(());
         }
@@ -206,19 +206,19 @@ impl ShadowPass {
                 format!("{} is not a finite offset >= 0", inputs.surface_offset),
             ));
         }
-        self.ray_inputs = Some(inputs);
+        self.techniques.rays.inputs = Some(inputs);
         Ok(())
     }
 
     /// What the ray-query structures have cost since the pass was created (bottom-level builds,
     /// refits, compactions); `None` before the first ray-query frame.
     pub fn ray_counts(&self) -> Option<RayCounts> {
-        self.rays.as_ref().map(|r| r.counts)
+        self.techniques.rays.structures.as_ref().map(|r| r.counts)
     }
 
     /// Refuses a ray-query frame the pass cannot trace.
     pub(crate) fn check_rays(&self) -> Result<()> {
-        if self.ray_inputs.is_none() {
+        if self.techniques.rays.inputs.is_none() {
             return Err(Misuse::NotConfigured {
                 call: "prepare (Technique::RayQuery)",
                 needs: "set_ray_query_inputs (the G-buffer the rays start from)",
@@ -235,12 +235,12 @@ impl ShadowPass {
     }
 
     pub(crate) fn prepare_rays(&mut self, slot: usize, view: &ShadowView, lights: &[Light], scissors: &[vk::Rect2D]) -> Result<RayFrame> {
-        let inputs = self.ray_inputs.ok_or_else(|| Error::Internal("no ray-query inputs".into()))?;
-        if self.rays.is_none() {
-            self.rays = Some(Rays::new(&self.dev, &self.instance, self.slots.len())?);
+        let inputs = self.techniques.rays.inputs.ok_or_else(|| Error::Internal("no ray-query inputs".into()))?;
+        if self.techniques.rays.structures.is_none() {
+            self.techniques.rays.structures = Some(Rays::new(&self.dev, &self.instance, self.slots.len())?);
         }
         let all = self.all_slots();
-        let r = self.rays.as_mut().ok_or_else(|| Error::Internal("no ray-query state".into()))?;
+        let r = self.techniques.rays.structures.as_mut().ok_or_else(|| Error::Internal("no ray-query state".into()))?;
         let mut transient = Vec::new();
         let input = super::FrameInput {
             dev: &self.dev,

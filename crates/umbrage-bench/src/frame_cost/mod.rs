@@ -97,7 +97,7 @@ pub struct FrameCostReport {
 /// Runs everything on `ctx` and writes the plots into `cfg.out` (and `frame-cost.json`).
 pub fn run(ctx: Context, cfg: &FrameCostConfig) -> Result<FrameCostReport> {
     if cfg.frames == 0 || cfg.curve_frames == 0 {
-        return Err(Error::Other("frame-cost: frames must be at least 1".into()));
+        return Err(Error::input("frame-cost frames", "must be at least 1"));
     }
     let load0 = super::phases::load_average();
     let device = ctx.info.name.clone();
@@ -120,7 +120,7 @@ pub fn run(ctx: Context, cfg: &FrameCostConfig) -> Result<FrameCostReport> {
     std::fs::create_dir_all(&cfg.out).map_err(|e| Error::io(cfg.out.display().to_string(), e))?;
     plot::write(&report, &cfg.out)?;
     let p = cfg.out.join("frame-cost.json");
-    let text = serde_json::to_string_pretty(&report).map_err(|e| Error::Other(e.to_string()))?;
+    let text = serde_json::to_string_pretty(&report).map_err(|e| Error::Internal(format!("frame-cost report JSON: {e}")))?;
     std::fs::write(&p, text).map_err(|e| Error::io(p.display().to_string(), e))?;
     Ok(report)
 }

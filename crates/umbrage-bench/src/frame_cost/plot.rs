@@ -8,7 +8,7 @@ use std::path::Path;
 use umbrage::error::{Error, Result};
 
 fn err<E: std::fmt::Debug>(what: &str) -> impl Fn(E) -> Error + '_ {
-    move |e| Error::Other(format!("plot {what}: {e:?}"))
+    move |e| Error::io(format!("plot {what}"), std::io::Error::other(format!("{e:?}")))
 }
 
 /// A series' value at a point.
@@ -50,7 +50,7 @@ where
     let (x0, x1) = xs.iter().fold((f64::MAX, f64::MIN), |(a, b), &v| (a.min(v), b.max(v)));
     let (y0, y1) = ys.fold((f64::MAX, f64::MIN), |(a, b), v| (a.min(v), b.max(v)));
     if !(x0 < x1 && y0 <= y1) {
-        return Err(Error::Other(format!("plot {title}: fewer than two points")));
+        return Err(Error::input(format!("plot {title}"), "a curve needs at least two points"));
     }
     let mut chart = ChartBuilder::on(&root)
         .caption(title, ("sans-serif", 18))

@@ -203,7 +203,7 @@ fn measure(ctx: Context, name: &str, case: Case, way: Way, cfg: &FrameCostConfig
         wall_ms: wall,
     };
     if row.pairs_total == 0 {
-        return Err(Error::Other(format!("frame-cost: {name} drew no light–caster pair")));
+        return Err(Error::Internal(format!("frame-cost: {name} drew no light–caster pair")));
     }
     Ok((ctx, row))
 }

@@ -32,7 +32,8 @@ pub enum UmbrageResult {
     UMBRAGE_ERROR_INTERNAL = 10,
     /// `Error::InvalidDesc`: a creation option that cannot be honoured; the message names it.
     UMBRAGE_ERROR_INVALID_DESC = 11,
-    /// `Error::Other`.
+    /// Reserved: the engine's `Error::Other` is gone (0.2), so no call returns it; kept so the
+    /// codes after it keep their values.
     UMBRAGE_ERROR_OTHER = 12,
     /// `Error::Io`.
     UMBRAGE_ERROR_IO = 13,

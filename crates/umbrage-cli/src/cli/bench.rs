@@ -240,7 +240,7 @@ fn soak_cmd(
     let md = report.markdown();
     println!("{md}");
     if let Some(p) = json {
-        let text = serde_json::to_string_pretty(&report).map_err(|e| Error::Other(e.to_string()))?;
+        let text = serde_json::to_string_pretty(&report).map_err(|e| Error::Internal(format!("JSON: {e}")))?;
         std::fs::write(p, text).map_err(|e| Error::io(p.display().to_string(), e))?;
     }
     if let Some(p) = markdown {
@@ -336,7 +336,7 @@ fn bench(
     let md = report.markdown();
     println!("{md}");
     if let Some(p) = json {
-        let s = serde_json::to_string_pretty(&report).map_err(|e| Error::Other(e.to_string()))?;
+        let s = serde_json::to_string_pretty(&report).map_err(|e| Error::Internal(format!("JSON: {e}")))?;
         std::fs::write(p, s).map_err(|e| Error::io(p.display().to_string(), e))?;
     }
     if let Some(p) = markdown {

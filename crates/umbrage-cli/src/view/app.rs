@@ -29,7 +29,7 @@ use winit::window::{Window, WindowId};
 /// Runs the event loop until the viewer exits; the first error wins.
 pub(super) fn run(scene: Scene, motion: Motion, opts: RenderOptions, args: &ViewArgs) -> Result<()> {
     let el = EventLoop::new()
-        .map_err(|e| Error::Other(format!("cannot open the display ({e}); use `umbrage render` for headless rendering")))?;
+        .map_err(|e| Error::Unsupported(format!("cannot open the display ({e}); use `umbrage render` for headless rendering")))?;
     let mut app = App { init: Some((scene, motion, opts)), args, live: None, error: None };
     let run = el.run_app(&mut app);
     if let Some(live) = app.live.take() {
@@ -40,7 +40,7 @@ pub(super) fn run(scene: Scene, motion: Motion, opts: RenderOptions, args: &View
     if let Some(e) = app.error {
         return Err(e);
     }
-    run.map_err(|e| Error::Other(format!("event loop: {e}")))
+    run.map_err(|e| Error::Unsupported(format!("the window's event loop: {e}")))
 }
 
 struct App<'a> {
@@ -203,9 +203,9 @@ impl Live {
         let attrs = Window::default_attributes()
             .with_title(format!("umbrage view - {}", scene.name))
             .with_inner_size(winit::dpi::PhysicalSize::new(opts.width, opts.height));
-        let window = el.create_window(attrs).map_err(|e| Error::Other(format!("cannot create a window: {e}")))?;
-        let display = window.display_handle().map_err(|e| Error::Other(format!("no display handle: {e}")))?.as_raw();
-        let handle = window.window_handle().map_err(|e| Error::Other(format!("no window handle: {e}")))?.as_raw();
+        let window = el.create_window(attrs).map_err(|e| Error::Unsupported(format!("cannot create a window: {e}")))?;
+        let display = window.display_handle().map_err(|e| Error::Unsupported(format!("no display handle: {e}")))?.as_raw();
+        let handle = window.window_handle().map_err(|e| Error::Unsupported(format!("no window handle: {e}")))?.as_raw();
         let (display, handle) = super::surface::surface_handles(display, handle)?;
         let exts = ash_window::enumerate_required_extensions(display)
             .map_err(|e| Error::Unsupported(format!("no Vulkan surface for this display: {e:?}")))?;
@@ -213,7 +213,7 @@ impl Live {
         // SAFETY: the handles come from a live window that outlives the surface (the surface
         // is destroyed in `teardown`, before the window is dropped).
         let surface = unsafe { ash_window::create_surface(&ctx.entry, &ctx.instance, display, handle, None) }
-            .map_err(|e| Error::Other(format!("cannot create a Vulkan surface for the window: {e:?}")))?;
+            .map_err(|e| Error::Unsupported(format!("cannot create a Vulkan surface for the window: {e:?}")))?;
         let size = window.inner_size();
         let sc = Swapchain::new(&ctx, surface, (size.width.max(1), size.height.max(1)), args.vsync == super::Vsync::On)?;
         let log = ctx.validation_log();
@@ -234,7 +234,7 @@ impl Live {
             Err(e) => {
                 let mut sc = sc;
                 sc.destroy(&ctx);
-                return Err(Error::Other(format!("egui overlay: {e}")));
+                return Err(Error::Unsupported(format!("egui overlay: {e}")));
             }
         };
         let (w, h) = (sc.extent.width.max(1), sc.extent.height.max(1));

@@ -42,7 +42,9 @@ impl Live {
         self.apply_scene(time)?;
         let ticket = match self.renderer.submit() {
             Ok(t) => t,
-            Err(e @ (Error::Unsupported(_) | Error::Other(_) | Error::Mesh { .. })) if self.renderer.settings != self.good => {
+            Err(e @ (Error::Unsupported(_) | Error::Misuse(_) | Error::InvalidDesc { .. } | Error::Mesh { .. }))
+                if self.renderer.settings != self.good =>
+            {
                 let tried = self.renderer.settings;
                 self.notes.push(format!("{} / {} refused: {e}", tried.technique.name(), tried.counter.name()));
                 self.renderer.settings = self.good;
@@ -150,7 +152,7 @@ impl Live {
                         depth_attachment_format: None,
                         stencil_attachment_format: None,
                     });
-                    r.set_render_mode(mode).map_err(|e| Error::Other(format!("egui overlay: {e}")))?;
+                    r.set_render_mode(mode).map_err(|e| Error::Unsupported(format!("egui overlay: {e}")))?;
                 }
             }
             self.need_rebuild = false;
@@ -280,7 +282,7 @@ impl Live {
         self.settle()?;
         let Some((out, time)) = &self.last else {
             if args.screenshot.is_some() {
-                return Err(Error::Other("no frame was rendered, so there is no --screenshot to write".into()));
+                return Err(Error::Internal("no frame was rendered, so there is no --screenshot to write".into()));
             }
             return Ok(());
         };
@@ -288,7 +290,7 @@ impl Live {
             umbrage_render::output::write_png(p, out.width, out.height, &out.color)?;
         }
         if let Some(p) = &args.stats {
-            let json = serde_json::to_string_pretty(&self.report(out, *time)).map_err(|e| Error::Other(e.to_string()))?;
+            let json = serde_json::to_string_pretty(&self.report(out, *time)).map_err(|e| Error::Internal(format!("JSON: {e}")))?;
             std::fs::write(p, json).map_err(|e| Error::io(p.display().to_string(), e))?;
         }
         let s = &out.stats;
@@ -361,7 +363,7 @@ fn set_textures(ctx: &Context, egui: &mut super::app::Egui, delta: &egui::Textur
             None => img.as_ref().clone(),
             Some([x, y]) => {
                 let mut base =
-                    egui.images.remove(id).ok_or_else(|| Error::Other(format!("egui: partial update of unknown texture {id:?}")))?;
+                    egui.images.remove(id).ok_or_else(|| Error::Internal(format!("egui: partial update of unknown texture {id:?}")))?;
                 let (w, bw) = (img.size[0], base.size[0]);
                 for row in 0..img.size[1] {
                     let dst = (y + row) * bw + x;
@@ -371,7 +373,7 @@ fn set_textures(ctx: &Context, egui: &mut super::app::Egui, delta: &egui::Textur
             }
         };
         r.set_texture(ctx.queue, ctx.pool, *id, &egui::epaint::ImageDelta::full(full.clone(), d.options))
-            .map_err(|e| Error::Other(format!("egui texture: {e}")))?;
+            .map_err(|e| Error::Unsupported(format!("egui texture: {e}")))?;
         egui.images.insert(*id, full);
     }
     Ok(())
@@ -386,7 +388,7 @@ fn free_textures(ctx: &Context, egui: &mut super::app::Egui, ids: &[egui::Textur
     // SAFETY: waiting before destroying textures the other frame in flight may read.
     unsafe { ctx.device.device_wait_idle() }.map_err(Error::vk("vkDeviceWaitIdle"))?;
     for id in ids {
-        r.free_texture(*id).map_err(|e| Error::Other(format!("egui texture: {e}")))?;
+        r.free_texture(*id).map_err(|e| Error::Unsupported(format!("egui texture: {e}")))?;
         egui.images.remove(id);
     }
     Ok(())

@@ -90,10 +90,10 @@ pub fn display_available() -> bool {
 /// initial inner size) until Esc, a close, or `--frames`.
 pub fn run(spec: &str, opts: RenderOptions, args: &ViewArgs) -> Result<ExitCode> {
     if !display_available() {
-        return Err(Error::Other(NO_DISPLAY.into()));
+        return Err(Error::Unsupported(NO_DISPLAY.into()));
     }
     if !args.time.is_finite() || args.time_step.map(|s| !s.is_finite() || s < 0.0).unwrap_or(false) {
-        return Err(Error::Other("--time must be finite and --time-step finite and >= 0".into()));
+        return Err(Error::input("--time", "--time must be finite and --time-step finite and >= 0"));
     }
     let (scene, motion) = umbrage_scene::load_animated(spec)?;
     app::run(scene, motion, opts, args)?;

@@ -150,7 +150,7 @@ pub fn present(
             d.cmd_begin_rendering(cb, &info);
             let r = o.renderer.cmd_draw(cb, full, o.pixels_per_point, o.primitives);
             d.cmd_end_rendering(cb);
-            r.map_err(|e| Error::Other(format!("egui overlay: {e}")))?;
+            r.map_err(|e| Error::Unsupported(format!("egui overlay: {e}")))?;
         }
         let mut last = vk::ImageLayout::COLOR_ATTACHMENT_OPTIMAL;
         if let Some(buf) = shot {

@@ -219,7 +219,7 @@ impl Swapchain {
         unsafe {
             ctx.device.device_wait_idle().map_err(Error::vk("vkDeviceWaitIdle"))?;
             let new = self.swapchain_fn.create_swapchain(&info, None).map_err(|e| {
-                Error::Other(format!(
+                Error::Unsupported(format!(
                     "cannot create a {}x{} swapchain ({e:?}); resize the window or use `umbrage render`",
                     extent.width, extent.height
                 ))

@@ -170,7 +170,7 @@ impl Baseline {
     /// Reads and parses `path`.
     pub fn load(path: &Path) -> Result<Baseline> {
         let text = std::fs::read_to_string(path).map_err(|e| Error::io(path.display().to_string(), e))?;
-        Self::parse(&text).map_err(|e| Error::Other(format!("{}: {e}", path.display())))
+        Self::parse(&text).map_err(|e| Error::input(path.display().to_string(), e.to_string()))
     }
 }
 
@@ -208,7 +208,7 @@ impl Regexes {
             texts.push(std::fs::read_to_string(p).map_err(|e| Error::io(p.display().to_string(), e))?);
         }
         Self::parse(&texts)
-            .map_err(|e| Error::Other(format!("{}: {e}", paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "))))
+            .map_err(|e| Error::input(paths.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "), e.to_string()))
     }
 
     /// Whether any regex matches `name`.

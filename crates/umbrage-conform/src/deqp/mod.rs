@@ -329,7 +329,7 @@ pub fn run_standalone(ctx: &Context, a: &RunArgs, filter: &[String], out: &Path,
     let skips = Regexes::load(&ci.skips)?;
     let (fraction, fstart) = (ci.fraction.unwrap_or(1), ci.fraction_start.unwrap_or(1));
     if fraction == 0 || fstart == 0 {
-        return Err(Error::Other("--fraction and --fraction-start count from 1".into()));
+        return Err(Error::input("--fraction", "--fraction and --fraction-start count from 1"));
     }
     let all: Vec<(String, String)> = names::all()
         .into_iter()

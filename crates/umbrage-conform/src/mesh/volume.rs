@@ -130,7 +130,7 @@ impl Caster {
     /// Meshlet `m`'s volume triangles (clip space, as the shader emits them): the light and
     /// dark cap of each light-facing triangle, then the side quad of each owned silhouette edge.
     pub fn meshlet_volume(&self, m: usize, light: [f32; 4], mvp: Mat4) -> Result<Vec<[DVec4; 3]>> {
-        let exact = |c: Option<DVec4>| c.ok_or_else(|| Error::Other("mesh.watertight_meshlets: a vertex is not exact in f32".into()));
+        let exact = |c: Option<DVec4>| c.ok_or_else(|| Error::Internal("mesh.watertight_meshlets: a vertex is not exact in f32".into()));
         let pos = |i: u32| self.positions[i as usize];
         let [first, count, e_first, e_count] = self.meshlets[m];
         let mut out = Vec::new();
@@ -177,7 +177,7 @@ pub(super) fn volume(c: &Caster) -> Result<(Vec<[DVec4; 3]>, Vec<u32>)> {
         let caps = (first..first + tris).filter(|&t| c.facing(t, LIGHT)).count() as u32;
         let sides = c.edges[e_first as usize..(e_first + edges) as usize].iter().filter(|e| c.silhouette(e, LIGHT)).count() as u32;
         if 6 * caps + 4 * sides > BUDGET.0 || v.len() as u32 > BUDGET.1 {
-            return Err(Error::Other(format!("mesh.watertight_meshlets: meshlet {m} emits more than the shader holds {BUDGET:?}")));
+            return Err(Error::Internal(format!("mesh.watertight_meshlets: meshlet {m} emits more than the shader holds {BUDGET:?}")));
         }
         counts.push(v.len() as u32);
         all.extend(v);

@@ -96,7 +96,7 @@ pub(super) fn clip_tris(s: &Scenario, mvp: Mat4, near_zero: bool) -> Result<Vec<
         .chunks_exact(3)
         .map(|t| match (place(t[0]), place(t[1]), place(t[2])) {
             (Some(a), Some(b), Some(c)) => Ok([a, b, c]),
-            _ => Err(Error::Other(format!("mesh.w0_vertices: the {} vertices are not exact in f32 (the model's premise)", s.name))),
+            _ => Err(Error::Internal(format!("mesh.w0_vertices: the {} vertices are not exact in f32 (the model's premise)", s.name))),
         })
         .collect()
 }

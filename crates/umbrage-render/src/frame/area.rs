@@ -28,21 +28,25 @@ pub(super) fn checked_lights(lights: &[Light]) -> Result<Vec<Light>> {
     for (i, l) in lights.iter().enumerate() {
         if let Some(a) = &l.area {
             if l.kind != LightKind::Point {
-                return Err(Error::Other(format!("light {i}: an area light must be of kind point (its centre), got {:?}", l.kind)));
+                return Err(Error::argument(
+                    "area light",
+                    format!("light {i}: an area light must be of kind point (its centre), got {:?}", l.kind),
+                ));
             }
             if !l.position.is_finite() {
-                return Err(Error::Other(format!("light {i}: area light centre {:?} is not finite", l.position)));
+                return Err(Error::argument("area light", format!("light {i}: area light centre {:?} is not finite", l.position)));
             }
-            a.validate().map_err(|m| Error::Other(format!("light {i}: {m}")))?;
+            a.validate().map_err(|m| Error::argument("area light", format!("light {i}: {m}")))?;
             total += a.samples as usize;
         } else {
             total += 1;
         }
     }
     if total > MAX_FRAME_LIGHTS {
-        return Err(Error::Other(format!(
-            "{total} point lights once the area lights are split into samples (at most {MAX_FRAME_LIGHTS}); lower `samples`"
-        )));
+        return Err(Error::argument(
+            "area light",
+            format!("{total} point lights once the area lights are split into samples (at most {MAX_FRAME_LIGHTS}); lower `samples`"),
+        ));
     }
     Ok(lights.to_vec())
 }

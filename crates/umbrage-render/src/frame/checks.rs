@@ -13,7 +13,7 @@ use umbrage_scene::Scene;
 pub(super) fn check_spheres(scene: &Scene, s: &FrameSettings) -> Result<()> {
     for sp in &scene.spheres {
         if let Some(problem) = umbrage_scene::sphere_placement_problem(sp, &scene.camera, &scene.lights) {
-            return Err(Error::Other(problem));
+            return Err(Error::input(format!("scene '{}'", scene.name), problem));
         }
     }
     if s.technique == RenderTechnique::Pass(Technique::RayQuery) {
@@ -56,7 +56,7 @@ pub(super) fn check_options(ctx: &Context, config: &RenderConfig, s: &FrameSetti
         return Err(umbrage::gpu::accel::missing_ray_query(&ctx.info.name));
     }
     if matches!(s.technique, RenderTechnique::ShadowMap(ShadowMap { cube: CubeFaces::Multiview, .. })) {
-        if let Some(e) = crate::passes::shadowmap::multiview_refusal(ctx) {
+        if let Some(e) = crate::stages::shadowmap::multiview_refusal(ctx) {
             return Err(e);
         }
     }

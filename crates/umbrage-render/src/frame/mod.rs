@@ -6,14 +6,14 @@
 use super::frame_output::{parse, CaptureView, FrameOutput};
 use super::guard::{Destroy, Guard, Owned};
 use super::options::*;
-use super::passes::selfshadow::SelfShadow;
-use super::passes::shadowmap::ShadowMapper;
-use super::passes::{debug, Rec};
 use super::pipelines::FramePipelines;
 use super::push::LightPush;
 use super::readback::Layout;
 use super::scene_gpu::{SceneGeometry, Sidedness};
 use super::sphere_gpu::SphereGeometry;
+use super::stages::selfshadow::SelfShadow;
+use super::stages::shadowmap::ShadowMapper;
+use super::stages::{debug, Rec};
 use super::targets::*;
 use super::technique::RenderTechnique;
 use super::timing::Span;
@@ -429,12 +429,12 @@ impl Renderer {
         let s = &mut self.own.parts.slots[ticket.slot];
         match &s.in_flight {
             Some(f) if f.serial == ticket.serial => {}
-            _ => return Err(Error::Other(format!("frame {} was already finished or overwritten", ticket.serial))),
+            _ => return Err(umbrage::error::Misuse::Order(format!("frame {} was already finished or overwritten", ticket.serial)).into()),
         }
         // SAFETY: the fence belongs to this device and was submitted with the frame.
         unsafe { self.own.ctx.device.wait_for_fences(&[s.fence], true, u64::MAX) }.map_err(Error::vk("vkWaitForFences"))?;
         self.own.ctx.check_validation()?;
-        s.in_flight.take().ok_or_else(|| Error::Other("no frame in flight".into()))
+        s.in_flight.take().ok_or_else(|| umbrage::error::Misuse::Order("no frame in flight".into()).into())
     }
 
     /// Makes `slot` free: waits for the frame in flight in it (its output is dropped).
@@ -456,10 +456,13 @@ impl Parts {
         let source_lights = area::checked_lights(&scene.lights)?;
         scene.lights = umbrage::geom::area::expand_lights(&source_lights, None);
         if config.width == 0 || config.height == 0 || config.width > 16384 || config.height > 16384 {
-            return Err(Error::Other(format!("invalid image size {}x{} (1..=16384 each)", config.width, config.height)));
+            return Err(Error::desc(
+                "RenderConfig::width",
+                format!("invalid image size {}x{} (1..=16384 each)", config.width, config.height),
+            ));
         }
         if config.frames_in_flight == 0 || config.frames_in_flight > 16 {
-            return Err(Error::Other(format!("frames in flight must be 1..=16, got {}", config.frames_in_flight)));
+            return Err(Error::desc("RenderConfig::frames_in_flight", format!("must be 1..=16, got {}", config.frames_in_flight)));
         }
         check_options(ctx, &config, &settings)?;
         memory::check_fits(ctx, &scene, &config)?;

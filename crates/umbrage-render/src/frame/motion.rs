@@ -10,7 +10,7 @@ impl Renderer {
     /// Moves the camera (from the next frame).
     pub fn set_camera(&mut self, camera: Camera) -> Result<()> {
         if !(camera.eye.is_finite() && camera.target.is_finite() && camera.up.is_finite()) || camera.eye == camera.target {
-            return Err(Error::Other(format!("invalid camera {camera:?}")));
+            return Err(Error::argument("camera", format!("invalid camera {camera:?}")));
         }
         self.own.parts.scene.camera = camera;
         self.own.parts.scene_version += 1;
@@ -30,7 +30,7 @@ impl Renderer {
     /// Moves mesh `index` (object -> world; from the next frame). A transform must keep the
     /// mesh's handedness (its winding was fixed at load).
     pub fn set_mesh_transform(&mut self, index: usize, transform: Mat4) -> Result<()> {
-        let m = self.own.parts.scene.meshes.get(index).ok_or_else(|| Error::Other(format!("no mesh {index}")))?;
+        let m = self.own.parts.scene.meshes.get(index).ok_or_else(|| Error::argument("mesh index", format!("no mesh {index}")))?;
         let det = transform.determinant();
         if !(transform.is_finite() && det.is_finite() && det != 0.0) {
             return Err(Error::mesh(&m.name, "transform is not finite or singular"));
@@ -56,7 +56,7 @@ impl Renderer {
     /// [`finish`](Renderer::finish)). On error nothing changes.
     pub fn set_mesh_positions(&mut self, index: usize, positions: &[Vec3]) -> Result<()> {
         let parts = &mut self.own.parts;
-        let m = parts.scene.meshes.get(index).ok_or_else(|| Error::Other(format!("no mesh {index}")))?;
+        let m = parts.scene.meshes.get(index).ok_or_else(|| Error::argument("mesh index", format!("no mesh {index}")))?;
         if positions.len() != m.mesh.positions.len() {
             return Err(Error::mesh(&m.name, format!("{} positions for a mesh of {} vertices", positions.len(), m.mesh.positions.len())));
         }

@@ -2,9 +2,9 @@
 //! output image to present from, and a resize that keeps the casters and the pass.
 
 use super::Renderer;
-use crate::passes::selfshadow::SelfShadow;
 use crate::pipelines::FramePipelines;
 use crate::scene_gpu::Sidedness;
+use crate::stages::selfshadow::SelfShadow;
 use crate::targets::Targets;
 use ash::vk;
 use umbrage::error::{Error, Result};
@@ -27,7 +27,7 @@ impl Renderer {
     /// keeps its old size and stays usable.
     pub fn resize(&mut self, width: u32, height: u32) -> Result<()> {
         if width == 0 || height == 0 || width > 16384 || height > 16384 {
-            return Err(Error::Other(format!("invalid image size {width}x{height} (1..=16384 each)")));
+            return Err(Error::argument("image size", format!("invalid image size {width}x{height} (1..=16384 each)")));
         }
         if (width, height) == (self.own.parts.config.width, self.own.parts.config.height) {
             return Ok(());

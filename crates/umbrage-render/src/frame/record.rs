@@ -1,13 +1,13 @@
-//! Recording one frame: the paper's passes in order (section 8), one pass function each.
+//! Recording one frame: the paper's passes in order (section 8), one stage function each.
 
 use super::{FrameSpans, Renderer};
 use crate::counters::CounterPools;
 use crate::options::*;
-use crate::passes::{self, debug, determine, gbuffer, illuminate, intensity, samples, tonemap, transparent, Rec, SceneDraw};
 use crate::push::LightPush;
 use crate::readback::Layout;
 use crate::scene_gpu::Sidedness;
 use crate::shadowmap::Lookup;
+use crate::stages::{self, debug, determine, gbuffer, illuminate, intensity, samples, tonemap, transparent, Rec, SceneDraw};
 use crate::technique::RenderTechnique;
 use ash::vk;
 use glam::Mat4;
@@ -53,7 +53,7 @@ impl Renderer {
             // compute and mesh, the acceleration structures for ray query), then the depth
             // pass, then `cmd_determine` per light.
             pass.cmd_before_rendering(rec.cb, frame)?;
-            let before = passes::timing_span(spans.frame.begin, stamp(all));
+            let before = stages::timing_span(spans.frame.begin, stamp(all));
             match self.settings.technique {
                 RenderTechnique::Pass(Technique::Compute | Technique::Mesh) => spans.silhouettes = before,
                 RenderTechnique::Pass(Technique::RayQuery) => spans.accel = before,
@@ -76,7 +76,7 @@ impl Renderer {
                 if let Some((sm, _)) = &self.own.parts.shadow_mapper {
                     determine::begin_float(rec, t);
                     let maps = sm.record_maps(rec.ctx, rec.cb, light, self.own.parts.scene.camera.eye.as_dvec3());
-                    spans.shadow_map.push(passes::timing_span(begin, stamp(all)));
+                    spans.shadow_map.push(stages::timing_span(begin, stamp(all)));
                     let lookup = Lookup { light_pos: lights[li].light_pos, scissor: frame.lights[li].scissor, pcf };
                     sm.record_lookup(rec.ctx, rec.cb, t, &maps, lookup);
                 }
@@ -85,7 +85,7 @@ impl Renderer {
                 if let Some(c) = counters {
                     c.statistics(rec.ctx, rec.cb, li as u32, false);
                 }
-                spans.shadow.push(passes::timing_span(begin, stamp(all)));
+                spans.shadow.push(stages::timing_span(begin, stamp(all)));
                 if let Some(c) = counters {
                     determine::record_count(rec, pass, frame, li, t, c)?;
                 }
@@ -95,7 +95,7 @@ impl Renderer {
                 let begin = stamp(all);
                 let mode = illuminate::Lighting { float: float_counts, transmit: self.own.parts.has_transparent };
                 illuminate::record(rec, pass, frame, li, &sd, mode, &lights[li])?;
-                spans.illuminate.push(passes::timing_span(begin, stamp(all)));
+                spans.illuminate.push(stages::timing_span(begin, stamp(all)));
             }
             if self.own.parts.geo.of(Sidedness::Transparent).next().is_some() {
                 let forward = if self.own.parts.self_shadow.is_some() { &[][..] } else { lights };

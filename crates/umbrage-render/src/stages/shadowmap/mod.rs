@@ -166,7 +166,7 @@ impl ShadowMapper {
         sampler: vk::Sampler,
     ) -> Result<ShadowMapper> {
         if !(16..=8192).contains(&size) {
-            return Err(Error::Other(format!("shadow map size {size} out of range (16..=8192)")));
+            return Err(Error::argument("shadow map size", format!("{size} is out of range (16..=8192)")));
         }
         if let Some(e) = (cube == CubeFaces::Multiview).then(|| multiview_refusal(ctx)).flatten() {
             return Err(e);
@@ -293,16 +293,16 @@ impl ShadowMapper {
         let views = match cube {
             CubeFaces::Atlas => None,
             CubeFaces::Multiview => {
-                let set = made.sets.pop().ok_or_else(|| Error::Other("shadow-map views set".into()))?;
+                let set = made.sets.pop().ok_or_else(|| Error::Internal("shadow-map views set not made".into()))?;
                 Some(Views { set, layout: made.layouts[2], pipeline: made.pipelines[3] })
             }
         };
         made.pipelines.clear();
         made.layouts.clear();
         made.sampler = None;
-        let set = made.sets.pop().ok_or_else(|| Error::Other("shadow-map set".into()))?;
-        let atlas = made.images.pop().ok_or_else(|| Error::Other("shadow-map atlas".into()))?;
-        let faces = made.buffers.pop().ok_or_else(|| Error::Other("shadow-map faces".into()))?;
+        let set = made.sets.pop().ok_or_else(|| Error::Internal("shadow-map set not made".into()))?;
+        let atlas = made.images.pop().ok_or_else(|| Error::Internal("shadow-map atlas not made".into()))?;
+        let faces = made.buffers.pop().ok_or_else(|| Error::Internal("shadow-map faces not made".into()))?;
         let casters = made.buffers.pop();
         Ok(ShadowMapper {
             size,

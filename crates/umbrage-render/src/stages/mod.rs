@@ -1,4 +1,5 @@
-//! The frame's passes, one file each, in the order [`Renderer::render`](super::Renderer) runs
+//! The frame's stages, one file each (what the paper calls its passes: "pass" in this
+//! workspace names the engine's `ShadowPass` alone, and Vulkan's are "render passes"), in the order [`Renderer::render`](super::Renderer) runs
 //! them: G-buffer, per light determination (+ light-intensity map; the shadow-map baseline's
 //! maps and lookup, `shadowmap`) and illumination, the transparent casters (with
 //! `--self-shadow`, `selfshadow`), the debug views, the tone map.
