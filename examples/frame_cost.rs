@@ -1,11 +1,13 @@
 //! What a frame of `ShadowPass::prepare` costs on the CPU, and what it sends, with the plans
 //! kept across frames (`PassSettings::keep`) and without, while the camera walks, casters
-//! move or lights move. The numbers of `docs/frame-cost.md` come from here.
+//! move or lights move. The numbers of `docs/frame-cost/example.md` came from here (those
+//! of `docs/frame-cost.md` come from `umbrage bench --suite frame-cost`).
 //!
 //! Scenes: `vertex` (`bench/vertex`: 36 casters, ~435k triangles), any other built-in scene
-//! or scene file (each with its lights or `--lights N` made around it), and `level`, a level made in code: a grid of rooms (walls, pillars, crates and a
-//! character each; 1,088 casters at the default 8 x 8 rooms) with two bounded point or spot
-//! lights a room (128), the camera walking from room to room.
+//! or scene file (each with its lights or `--lights N` made around it), and `level`: the
+//! built-in `bench/level` (a grid of rooms with walls, pillars, crates and a character each;
+//! 1,088 casters at its 8 x 8 rooms, two bounded point or spot lights a room: 128), or with
+//! `--rooms N` the same level with N x N rooms, the camera on the scene's walk.
 //!
 //! Run: `cargo run --release --example frame_cost -- [vertex|level] [--frames N] [--lights N]
 //! [--rooms N] [--modes off,keep,keep1]`. Every frame's `prepare` is timed whole (wall clock)
@@ -19,10 +21,9 @@
 
 use glam::{DMat4, DVec3, Vec3};
 use std::time::Instant;
-use umbrage::geom::{Camera, Light, LightKind, Mesh};
+use umbrage::geom::{Camera, Light, Mesh};
 use umbrage::pass::{PassSettings, ShadowPass, ShadowPassDesc, ShadowView, Technique};
 use umbrage::shadow::Method;
-use umbrage_scene::shapes;
 
 const W: u32 = 1280;
 const H: u32 = 720;
@@ -69,62 +70,33 @@ fn scene_world(name: &str, lights: Option<usize>) -> World {
     }
 }
 
-/// Rooms of `ROOM` units on a side, walls with doorways, pillars, crates and a character each.
-const ROOM: f32 = 10.0;
-
+/// The built-in `bench/level` (`rooms` = 8), or the same level with another number of rooms a
+/// side (`umbrage_scene::level::level_toml`): its casters and lights, the camera on the scene's
+/// walk (frame `k` at `k / 30` s), the characters that turn in the scene as the casters that move.
 fn level(rooms: usize) -> World {
-    let wall_x = shapes::cuboid(Vec3::new(ROOM * 0.4, 3.0, 0.3));
-    let wall_z = shapes::cuboid(Vec3::new(0.3, 3.0, ROOM * 0.4));
-    let pillar = shapes::cylinder(0.35, 3.0, 12);
-    let crate_ = shapes::cuboid(Vec3::splat(0.8));
-    let character = shapes::sphere(0.45, 12, 8);
+    let (scene, motion) = if rooms == umbrage_scene::level::LEVEL_ROOMS {
+        umbrage_scene::load_animated("bench/level").expect("bench/level")
+    } else {
+        let text = umbrage_scene::level::level_toml(rooms);
+        let no_objs = umbrage_scene::file::ObjSource::Dir(std::path::Path::new(""));
+        umbrage_scene::file::parse_animated(&text, "level", no_objs).expect("level")
+    };
     let mut casters = Vec::new();
-    let mut lights = Vec::new();
     let mut movers = Vec::new();
-    let t = |x: f32, y: f32, z: f32| DMat4::from_translation(DVec3::new(x as f64, y as f64, z as f64));
-    for rx in 0..rooms {
-        for rz in 0..rooms {
-            let (cx, cz) = (rx as f32 * ROOM, rz as f32 * ROOM);
-            let h = ROOM * 0.5;
-            // two wall pieces a side, a doorway between them
-            for s in [-1.0f32, 1.0] {
-                casters.push(("wall".into(), wall_x.clone(), t(cx + s * ROOM * 0.27, 1.5, cz - h)));
-                casters.push(("wall".into(), wall_z.clone(), t(cx - h, 1.5, cz + s * ROOM * 0.27)));
-            }
-            for (px, pz) in [(-2.5f32, -2.5f32), (2.5, -2.5), (-2.5, 2.5), (2.5, 2.5)] {
-                casters.push(("pillar".into(), pillar.clone(), t(cx + px, 1.5, cz + pz)));
-            }
-            for k in 0..8 {
-                let a = (k as f32 * 2.399) + (rx * 7 + rz) as f32;
-                let r = 1.0 + (k % 3) as f32 * 1.2;
-                casters.push(("crate".into(), crate_.clone(), t(cx + r * a.cos(), 0.4 + (k % 2) as f32 * 0.8, cz + r * a.sin())));
-            }
-            if (rx + rz) % 3 == 0 {
-                movers.push(casters.len());
-            }
-            casters.push(("character".into(), character.clone(), t(cx + 1.5, 0.85, cz - 1.0)));
-            // one point light over the room, one spot light in a corner
-            lights.push(Light { radius: Some(ROOM * 0.8), ..Light::point(Vec3::new(cx + 0.5, 2.6, cz + 0.3)) });
-            lights.push(Light {
-                kind: LightKind::Spot,
-                direction: Vec3::new(1.0, -1.0, 1.0).normalize(),
-                cone_deg: 70.0,
-                radius: Some(ROOM * 0.9),
-                ..Light::point(Vec3::new(cx - h + 0.6, 2.8, cz - h + 0.6))
-            });
+    for (i, m) in scene.meshes.iter().enumerate().filter(|(_, m)| m.casts_shadow) {
+        if motion.spins.get(i).is_some_and(Option::is_some) {
+            movers.push(casters.len());
         }
+        casters.push((m.name.clone(), m.mesh.clone(), m.transform.as_dmat4()));
     }
-    let span = (rooms - 1) as f32 * ROOM;
+    let rest = scene.camera.clone();
     World {
         casters,
-        lights,
+        lights: scene.lights.clone(),
         movers,
-        // walk along a row of rooms and back at 1.5 units a frame-second (frames at 30 Hz)
-        walk: Box::new(move |k| {
-            let s = (k as f32 * 0.05) % (2.0 * span.max(1.0));
-            let x = if s < span { s } else { 2.0 * span - s };
-            let z = ROOM * (rooms / 2) as f32 - 1.0;
-            (Vec3::new(x, 1.7, z), Vec3::new(x + 4.0, 1.2, z + 0.5))
+        walk: Box::new(move |k| match &motion.camera {
+            Some(path) => path.eye_target(&rest, k as f64 / 30.0),
+            None => (rest.eye, rest.target),
         }),
     }
 }

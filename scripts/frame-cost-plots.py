@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Draws docs/frame-cost's curves (SVG, no dependencies) from docs/frame-cost/results.md, the
-output of `examples/frame_cost.rs` (see docs/frame-cost.md for the runs)."""
+output of `examples/frame_cost.rs` (see docs/frame-cost/example.md for the runs)."""
 import math
 import os
 import re
@@ -68,10 +68,10 @@ def main():
         off.sort(); on.sort()
         return off, on
     off, on = curve("lights", lambda n, row: n)
-    svg("lights.svg", "bench/vertex, camera orbiting: CPU per frame against lights", "lights (36 casters)",
+    svg("example-lights.svg", "bench/vertex, camera orbiting: CPU per frame against lights", "lights (36 casters)",
         [("planned every frame (keep off)", off), ("kept (keep on)", on)], [(x, str(x)) for x, _ in off])
     off, on = curve("rooms", lambda n, row: 17 * n * n)
-    svg("casters.svg", "level, camera walking: CPU per frame against casters", "casters (2 bounded lights a room)",
+    svg("example-casters.svg", "level, camera walking: CPU per frame against casters", "casters (2 bounded lights a room)",
         [("planned every frame (keep off)", off), ("kept (keep on)", on)], [(x, str(x)) for x, _ in off])
 
 

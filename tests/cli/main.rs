@@ -6,6 +6,7 @@
 mod common;
 
 mod area_lights;
+mod bench_motion;
 mod bench_suite;
 mod cli;
 mod conform;

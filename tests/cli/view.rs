@@ -153,6 +153,39 @@ fn thirty_frames_equal_render_on_swiftshader() {
     assert_same(&d.join("a.png"), &d.join("b.png"));
 }
 
+/// The overlay shows the light–caster pairs kept across frames and planned again
+/// (issue 55): with keeping, a still scene draws every pair from kept plans after its first
+/// frame; with `--no-keep`, every pair is planned every frame. `--stats` records the line as
+/// the overlay showed it, from the frame's own counts.
+#[test]
+fn the_overlay_shows_pairs_kept_and_replanned() {
+    let _g = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    if !x_tools(false) {
+        return;
+    }
+    let d = tmp("pairs");
+    let run = "$UMBRAGE view --scene default --size 320x240 --frames 12 --time-step 0 --stats kept.json --vsync off
+echo rc=$?
+               $UMBRAGE view --scene default --size 320x240 --frames 12 --time-step 0 --stats fresh.json --vsync off --no-keep
+echo rc=$?
+";
+    let out = in_xvfb(&d, run);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.matches("rc=0").count() == 2, "view failed: {stdout}");
+    for (file, keep) in [("kept.json", true), ("fresh.json", false)] {
+        let s = json(&d.join(file));
+        let t = &s["stats"]["totals"];
+        let (total, kept, replanned) =
+            (t["pairs_total"].as_u64().unwrap(), t["pairs_kept"].as_u64().unwrap(), t["pairs_replanned"].as_u64().unwrap());
+        assert!(total > 0, "{file}: {t}");
+        assert_eq!((kept, replanned), if keep { (total, 0) } else { (0, total) }, "{file}: {t}");
+        // The line the overlay showed (a frame or two before the last: the same still frame).
+        let line = s["overlay"]["shown"]["pairs"].as_str().unwrap_or_else(|| panic!("{file}: no pairs line: {s}"));
+        let want = format!("pairs {total}: kept {kept}, replanned {replanned}");
+        assert!(line.starts_with(&want), "{file}: the overlay showed '{line}', the frame counted '{want}'");
+    }
+}
+
 #[test]
 fn synthetic_input_moves_the_light_and_changes_the_method() {
     let _g = SERIAL.lock().unwrap_or_else(|e| e.into_inner());

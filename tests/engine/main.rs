@@ -15,6 +15,7 @@ mod embed;
 mod gpu_smoke;
 mod hard_cases;
 mod keep;
+mod level_motion;
 mod mesh;
 mod minimal;
 mod motion;

@@ -156,6 +156,7 @@ fn the_classic_bench_times_builds_refits_and_top_levels() {
         opts: RenderOptions { width: 160, height: 120, ..Default::default() },
         compute_draws: Vec::new(),
         mesh_task: Vec::new(),
+        motion: false,
     };
     let report = umbrage_bench::run(ctx, &cfg, |_| {}).unwrap();
     let rays = report.rows.iter().find(|r| r.method == "rayquery").expect("a rayquery row");

@@ -3,11 +3,10 @@
 //! timestamps and wall clock), the shadow geometry sent, and the mismatch fraction against
 //! the CPU reference.
 
-use super::stats::median;
+use super::classic_frames::{row_of, time_frames, variant_errors, variants_of, RowAt, RunLimits};
 use serde::Serialize;
 use umbrage::error::{Error, Result};
 use umbrage::gpu::Context;
-use umbrage_render::accuracy::evaluate;
 use umbrage_render::{ComputeDraws, Counter, RenderOptions, RenderTechnique, Renderer, ShadowMap, Technique};
 
 /// One (scene, method, counter) measurement: medians over the measured frames.
@@ -114,43 +113,9 @@ pub struct BenchRow {
     pub pairs_kept: u64,
     /// Median bytes of index lists kept across frames.
     pub kept_bytes: u64,
-}
-
-/// Frames [`refit_ms`] times.
-const REFIT_FRAMES: usize = 5;
-
-/// Ray query's refit cost on `r`'s scene: the largest mesh caster deformed (a 1 % stretch,
-/// growing each frame) `REFIT_FRAMES` times after the deformation that rebuilds it with
-/// `ALLOW_UPDATE`; the median acceleration span of the refitting frames. The caster's
-/// positions are restored before returning (on error too), so the scene is unchanged.
-fn refit_ms(r: &mut Renderer) -> Result<Option<f64>> {
-    let meshes = &r.scene().meshes;
-    let Some(big) = (0..meshes.len()).filter(|&i| meshes[i].casts_shadow).max_by_key(|&i| meshes[i].mesh.triangles.len()) else {
-        return Ok(None);
-    };
-    let rest = meshes[big].mesh.positions.clone();
-    let mut spans = Vec::with_capacity(REFIT_FRAMES);
-    let mut measure = |r: &mut Renderer| -> Result<()> {
-        for k in 0..=REFIT_FRAMES {
-            let s = 1.0 + 0.01 * (k + 1) as f32;
-            let moved: Vec<glam::Vec3> = rest.iter().map(|p| *p * glam::Vec3::new(s, 1.0 / s, 1.0)).collect();
-            r.set_mesh_positions(big, &moved)?;
-            let f = r.render()?;
-            let refits = f.stats.ray_query.as_ref().map_or(0, |q| q.refits);
-            match (k, f.stats.gpu_ms) {
-                // The first deformation rebuilds the bottom level with ALLOW_UPDATE.
-                (0, _) => {}
-                (_, Some(g)) if refits > 0 => spans.push(g.accel),
-                _ => return Err(Error::Internal(format!("ray query: frame {k} after a deformation refitted nothing"))),
-            }
-        }
-        Ok(())
-    };
-    let measured = measure(r);
-    let restored = r.set_mesh_positions(big, &rest);
-    measured?;
-    restored?;
-    Ok((!spans.is_empty()).then(|| median(spans)))
+    /// Whether the frames ran the scene's motion (`--motion`: frame `k` at `k / 30` s; the
+    /// error is then the last frame's); `false`: every frame at time 0.
+    pub motion: bool,
 }
 
 /// A whole `umbrage bench` run: the device and every row (the JSON `--out` writes).
@@ -211,6 +176,10 @@ pub struct BenchConfig {
     pub mesh_task: Vec<bool>,
     /// Renderer options for everything else (size, depth mode, ...).
     pub opts: RenderOptions,
+    /// Run each scene's motion over the frames ([`super::motion`]: the warm-up frame at time
+    /// 0, measured frame `k` at `k / 30` s; each row's error is the last frame's); `false`:
+    /// every frame at time 0.
+    pub motion: bool,
 }
 
 /// The name of a bench row's technique (`shadowmap-512`; `shadowmap-512-multiview` for cube
@@ -235,18 +204,18 @@ pub fn technique_label(t: RenderTechnique) -> String {
 
 /// One row's settings: its technique and counter, and the compute and mesh techniques' own.
 #[derive(Clone, Copy, Debug)]
-struct Variant {
-    technique: RenderTechnique,
-    counter: Counter,
+pub(super) struct Variant {
+    pub(super) technique: RenderTechnique,
+    pub(super) counter: Counter,
     /// [`umbrage::pass::PassToggles::compute_draws`] (only `Auto` for the other techniques).
-    draws: ComputeDraws,
+    pub(super) draws: ComputeDraws,
     /// [`umbrage::pass::PassToggles::mesh_task`] (only `true` for the other techniques).
-    task: bool,
+    pub(super) task: bool,
 }
 
 impl Variant {
     /// Sets the renderer up to draw this variant.
-    fn apply(&self, r: &mut Renderer) {
+    pub(super) fn apply(&self, r: &mut Renderer) {
         r.settings.technique = self.technique;
         r.settings.counter = self.counter;
         r.settings.toggles.compute_draws = self.draws;
@@ -255,7 +224,7 @@ impl Variant {
 
     /// The row's `method`: [`technique_label`], then `-<way>` for a compute way other than
     /// `Auto`, or [`NOTASK_SUFFIX`] for a mesh row without its task stage.
-    fn label(&self) -> String {
+    pub(super) fn label(&self) -> String {
         let base = technique_label(self.technique);
         match (self.draws, self.task) {
             (ComputeDraws::Auto, true) => base,
@@ -304,166 +273,40 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         true => Some(super::pass_limits::measure(&ctx, cfg.opts.width, cfg.opts.height, 5, 9)?),
         false => None,
     };
-    let lighting_gpix_s = passes.as_ref().map(|p| p.lighting_gpix_s);
-    let gbuffer_tri_mtri_s = passes.as_ref().map(|p| p.gbuffer_tri_mtri_s);
-    let gbuffer_fill_gpix_s = passes.as_ref().map(|p| p.gbuffer_fill_gpix_s);
-    let lighting_one_draw = passes.as_ref().and_then(|p| p.lighting_sweep.first()).map(|p| p[1]);
+    let limits = RunLimits {
+        read_gib_s,
+        lighting_gpix_s: passes.as_ref().map(|p| p.lighting_gpix_s),
+        lighting_one_draw: passes.as_ref().and_then(|p| p.lighting_sweep.first()).map(|p| p[1]),
+        gbuffer_tri_mtri_s: passes.as_ref().map(|p| p.gbuffer_tri_mtri_s),
+        gbuffer_fill_gpix_s: passes.as_ref().map(|p| p.gbuffer_fill_gpix_s),
+    };
     let mut ctx = Some(ctx);
     let mut rows = Vec::new();
     for name in &cfg.scenes {
-        let scene = umbrage_scene::load(name)?;
+        let (scene, motion) = umbrage_scene::load_animated(name)?;
+        let moving = cfg.motion.then(|| (scene.clone(), motion));
         let c = ctx.take().ok_or_else(|| Error::Internal("the bench lost its context".into()))?;
         let mut r = Renderer::new(c, scene, cfg.opts.clone())?;
-        // The variants (technique, counter, compute draws, mesh task stage), and their error
-        // against the reference.
-        let ways: &[ComputeDraws] = if cfg.compute_draws.is_empty() { &[ComputeDraws::Auto] } else { &cfg.compute_draws };
-        let tasks: &[bool] = if cfg.mesh_task.is_empty() { &[true] } else { &cfg.mesh_task };
-        let mut variants: Vec<Variant> = Vec::new();
-        for &counter in &cfg.counters {
-            for &technique in cfg.techniques.iter().filter(|t| t.shadow_map().is_none()) {
-                let one = Variant { technique, counter, draws: ComputeDraws::Auto, task: true };
-                match technique {
-                    RenderTechnique::Pass(Technique::Compute) => variants.extend(ways.iter().map(|&draws| Variant { draws, ..one })),
-                    RenderTechnique::Pass(Technique::Mesh) => variants.extend(tasks.iter().map(|&task| Variant { task, ..one })),
-                    _ => variants.push(one),
-                }
-            }
-        }
-        // Shadow maps do not draw analytic sphere casters (the renderer refuses them): left out.
+        // The variants (technique, counter, compute draws, mesh task stage). Shadow maps do not
+        // draw analytic sphere casters (the renderer refuses them): left out.
         let spheres = r.scene().spheres.iter().any(|s| s.casts_shadow);
-        variants.extend(cfg.techniques.iter().filter(|t| t.shadow_map().is_some() && !spheres).map(|&technique| Variant {
-            technique,
-            counter: Counter::Float,
-            draws: ComputeDraws::Auto,
-            task: true,
-        }));
+        let variants = variants_of(cfg, spheres);
         let sc = r.scene();
         let gbuffer_triangles = sc.meshes.iter().filter(|m| m.opacity >= 1.0).map(|m| m.mesh.triangles.len() as u64).sum::<u64>()
             + 12 * sc.spheres.len() as u64;
         let mut errors = Vec::new();
-        for v in &variants {
-            v.apply(&mut r);
-            errors.extend(evaluate(&mut r, name, &[v.technique], 1)?);
+        // With motion, the errors are the last frame's (measured after the frames).
+        if moving.is_none() {
+            errors = variant_errors(&mut r, name, &variants)?;
         }
         // Round-robin over variants, frame by frame, so that drift (thermal, other load) hits
         // every variant alike: the ratios are measured side by side.
-        #[derive(Default)]
-        struct Acc {
-            gpu: Vec<f64>,
-            depth: Vec<f64>,
-            shadow: Vec<f64>,
-            illum: Vec<f64>,
-            map: Vec<f64>,
-            accel: Vec<f64>,
-            silhouettes: Vec<f64>,
-            wall: Vec<f64>,
-            plan: Vec<f64>,
-            cull: Vec<f64>,
-            record: Vec<f64>,
-            bytes: Vec<f64>,
-            pairs: [Vec<f64>; 4],
-            last: Option<umbrage_render::Stats>,
-        }
-        let mut acc: Vec<Acc> = variants.iter().map(|_| Acc::default()).collect();
-        for frame in 0..=cfg.frames {
-            for (k, v) in variants.iter().enumerate() {
-                v.apply(&mut r);
-                let f = r.render()?;
-                if frame == 0 {
-                    continue; // warm-up: buffers sized, caches hot
-                }
-                let a = &mut acc[k];
-                if let Some(g) = &f.stats.gpu_ms {
-                    a.gpu.push(g.frame);
-                    a.depth.push(g.depth);
-                    a.shadow.push(g.shadow);
-                    a.illum.push(g.illuminate);
-                    a.map.push(g.shadow_map);
-                    a.accel.push(g.accel);
-                    a.silhouettes.push(g.silhouettes);
-                }
-                a.wall.push(f.stats.wall_ms);
-                a.plan.push(f.stats.cpu_ms.plan + f.stats.cpu_ms.silhouettes);
-                a.cull.push(f.stats.cpu_ms.cull);
-                a.record.push(f.stats.cpu_ms.record);
-                let t = &f.stats.totals;
-                a.bytes.push(t.bytes_sent as f64);
-                for (v, n) in a.pairs.iter_mut().zip([t.pairs_total, t.pairs_replanned, t.pairs_kept, t.kept_bytes]) {
-                    v.push(n as f64);
-                }
-                a.last = Some(f.stats);
-            }
+        let acc = time_frames(&mut r, &variants, cfg.frames, moving.as_ref())?;
+        if moving.is_some() {
+            errors = variant_errors(&mut r, name, &variants)?;
         }
         for ((v, err), a) in variants.iter().zip(&errors).zip(acc) {
-            v.apply(&mut r);
-            let Variant { technique, counter, .. } = *v;
-            let throughput = r.throughput(cfg.frames.max(2))?;
-            let s = a.last.ok_or_else(|| Error::Internal("no frame was measured".into()))?;
-            let c = &s.totals.cases;
-            let maps = technique.shadow_map().is_some() && !a.map.is_empty();
-            let lookup: Vec<f64> = a.shadow.iter().zip(&a.map).map(|(s, m)| s - m).collect();
-            // The acceleration structures' stats and times are the ray-query rows' only.
-            let ray = technique == RenderTechnique::Pass(Technique::RayQuery);
-            let rays = s.ray_query.as_ref().filter(|_| ray);
-            let compute = technique == RenderTechnique::Pass(Technique::Compute) && !a.silhouettes.is_empty();
-            let silhouettes_ms = compute.then(|| median(a.silhouettes));
-            let read_bytes = compute.then_some(s.totals.silhouette_read_bytes);
-            let fraction = match (silhouettes_ms, read_bytes, read_gib_s) {
-                (Some(ms), Some(b), Some(rate)) if ms > 0.0 && rate > 0.0 => Some(b as f64 / (rate * (1u64 << 30) as f64) * 1e3 / ms),
-                _ => None,
-            };
-            let lit_pixels: u64 =
-                s.lights.iter().map(|l| l.scissor.map_or(s.width as u64 * s.height as u64, |[_, _, w, h]| w as u64 * h as u64)).sum();
-            let illum_ms = (!a.illum.is_empty()).then(|| median(a.illum));
-            let gbuffer_ms = (!a.depth.is_empty()).then(|| median(a.depth));
-            let at = |n: u64, rate: Option<f64>, unit: f64, ms: Option<f64>| match (rate, ms) {
-                (Some(rate), Some(ms)) if rate > 0.0 && ms > 0.0 => Some(n as f64 / (rate * unit) * 1e3 / ms),
-                _ => None,
-            };
-            let [pairs_total, pairs_replanned, pairs_kept, kept_bytes] = a.pairs.map(|v| median(v) as u64);
-            let (cpu_cull_ms, cpu_record_ms) = (median(a.cull), median(a.record));
-            let row = BenchRow {
-                scene: name.clone(),
-                method: v.label(),
-                counter: counter.name().to_string(),
-                index_format: s.index_format.name().to_string(),
-                frames: cfg.frames,
-                gpu_frame_ms: (!a.gpu.is_empty()).then(|| median(a.gpu)),
-                gpu_shadow_ms: (!a.shadow.is_empty()).then(|| median(a.shadow)),
-                gpu_illuminate_ms: illum_ms,
-                gpu_map_ms: maps.then(|| median(a.map)),
-                gpu_lookup_ms: maps.then(|| median(lookup)),
-                wall_ms: median(a.wall),
-                cpu_plan_ms: median(a.plan),
-                throughput_fps: throughput.fps,
-                frames_in_flight: r.config().frames_in_flight,
-                shadow_triangles: s.totals.triangles.total(),
-                shadow_bytes: s.totals.index_bytes + s.totals.vertex_bytes,
-                bytes_sent: median(a.bytes) as u64,
-                error_fraction: err.fraction,
-                cases: [c.culled, c.zpass, c.zfail, c.zfail_light_cap],
-                volume_draws: s.totals.draws,
-                gpu_tlas_ms: (ray && !a.accel.is_empty()).then(|| median(a.accel)),
-                blas_build_ms: rays.map(|q| q.bottom_level_build_ms),
-                blas_bytes: rays.map(|q| q.bottom_level_bytes),
-                blas_refit_ms: if ray { refit_ms(&mut r)? } else { None },
-                gpu_silhouettes_ms: silhouettes_ms,
-                silhouette_read_bytes: read_bytes,
-                silhouette_limit_fraction: fraction,
-                gpu_gbuffer_ms: gbuffer_ms,
-                gbuffer_triangles,
-                lit_pixels,
-                lighting_limit_fraction: at(lit_pixels, lighting_gpix_s, 1e9, illum_ms),
-                lighting_one_draw_fraction: at(lit_pixels, lighting_one_draw, 1e9, illum_ms),
-                gbuffer_limit_fraction: at(gbuffer_triangles, gbuffer_tri_mtri_s, 1e6, gbuffer_ms),
-                gbuffer_fill_fraction: at(s.width as u64 * s.height as u64, gbuffer_fill_gpix_s, 1e9, gbuffer_ms),
-                cpu_cull_ms,
-                cpu_record_ms,
-                pairs_total,
-                pairs_replanned,
-                pairs_kept,
-                kept_bytes,
-            };
+            let row = row_of(&mut r, RowAt { name, variant: v, error: err, cfg, gbuffer_triangles }, a, &limits)?;
             progress(&row);
             rows.push(row);
         }
@@ -481,9 +324,9 @@ pub fn run(ctx: Context, cfg: &BenchConfig, mut progress: impl FnMut(&BenchRow))
         rows,
         compute_read_gib_s: read_gib_s,
         compute_read_sweep: read.map(|r| r.sweep).unwrap_or_default(),
-        lighting_gpix_s,
-        gbuffer_tri_mtri_s,
-        gbuffer_fill_gpix_s,
+        lighting_gpix_s: limits.lighting_gpix_s,
+        gbuffer_tri_mtri_s: limits.gbuffer_tri_mtri_s,
+        gbuffer_fill_gpix_s: limits.gbuffer_fill_gpix_s,
         lighting_shaded_gpix_s: passes.as_ref().map(|p| p.lighting_shaded_gpix_s),
         lighting_instance_ms: passes.as_ref().map(|p| p.lighting_instance_ms),
         lighting_sweep: passes.as_ref().map(|p| p.lighting_sweep.clone()).unwrap_or_default(),

@@ -21,14 +21,17 @@ pub mod shaders {
     include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
 }
 pub mod classic;
+mod classic_frames;
 pub mod compute_read;
 mod evidence;
+pub mod frame_cost;
 mod frame_passes;
 pub mod identify;
 pub mod limits;
 mod markdown;
 pub mod methods;
 pub mod model;
+pub mod motion;
 pub mod pass_limits;
 mod phases;
 pub mod plots;

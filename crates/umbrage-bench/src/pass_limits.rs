@@ -121,12 +121,19 @@ fn ds_att(img: &Image, load: vk::AttachmentLoadOp) -> vk::RenderingAttachmentInf
         .clear_value(vk::ClearValue { depth_stencil: vk::ClearDepthStencilValue { depth: 1.0, stencil: 0 } })
 }
 
-fn measure_with(ctx: &Context, w: u32, h: u32, reps: usize, max_steps: u32, made: &mut Made) -> Result<PassLimits> {
-    if !ctx.features.timestamps {
-        return Err(Error::Unsupported("the pass limits need timestamp queries, which this device lacks".into()));
-    }
+/// The pass limits' images, sampler, descriptor set, layouts, timestamp queries and pipelines,
+/// each recorded in `made` (which `measure` destroys).
+struct Objects {
+    set_handle: vk::DescriptorSet,
+    light_layout: vk::PipelineLayout,
+    gb_layout: vk::PipelineLayout,
+    lighting: vk::Pipeline,
+    shaded: vk::Pipeline,
+    gbuffer: vk::Pipeline,
+}
+
+fn objects(ctx: &Context, extent: vk::Extent2D, made: &mut Made) -> Result<Objects> {
     let d = &ctx.device;
-    let extent = vk::Extent2D { width: w, height: h };
     let color = vk::ImageUsageFlags::COLOR_ATTACHMENT;
     let sampled = color | vk::ImageUsageFlags::SAMPLED;
     for (name, format, usage) in [
@@ -184,7 +191,12 @@ fn measure_with(ctx: &Context, w: u32, h: u32, reps: usize, max_steps: u32, made
     g.depth_compare = vk::CompareOp::LESS;
     let gbuffer = pipeline::create(ctx, &g)?;
     made.pipelines.push(gbuffer);
+    Ok(Objects { set_handle, light_layout, gb_layout, lighting, shaded, gbuffer })
+}
 
+/// The G-buffer limit's grid, the identity instance record and the fill limit's full-screen
+/// quad, into `made.buffers` (in that order); the grid's and the quad's vertex counts.
+fn buffers(ctx: &Context, w: u32, h: u32, made: &mut Made) -> Result<(usize, usize)> {
     // The grid in the scene vertex layout (14 floats): position (clip space, the push's
     // view_proj the identity), face normal, colour, opacity, smooth normal, bound.
     // The grid's first rows, at most GRID_TRIANGLES (a point of the sweep then stays well under
@@ -216,8 +228,20 @@ fn measure_with(ctx: &Context, w: u32, h: u32, reps: usize, max_steps: u32, made
         .collect();
     let qb = Buffer::with_data(ctx, "pass limits: quad", bytemuck::cast_slice(&quad), vk::BufferUsageFlags::VERTEX_BUFFER)?;
     made.buffers.push(qb);
+    Ok((grid.len(), quad.len()))
+}
+
+fn measure_with(ctx: &Context, w: u32, h: u32, reps: usize, max_steps: u32, made: &mut Made) -> Result<PassLimits> {
+    if !ctx.features.timestamps {
+        return Err(Error::Unsupported("the pass limits need timestamp queries, which this device lacks".into()));
+    }
+    let d = &ctx.device;
+    let extent = vk::Extent2D { width: w, height: h };
+    let vf = vk::ShaderStageFlags::VERTEX | vk::ShaderStageFlags::FRAGMENT;
+    let Objects { set_handle, light_layout, gb_layout, lighting, shaded, gbuffer } = objects(ctx, extent, made)?;
+    let (grid_len, quad_len) = buffers(ctx, w, h, made)?;
     let (vb, ib, qb) = (made.buffers[0].raw, made.buffers[1].raw, made.buffers[2].raw);
-    let tris = (grid.len() / 3) as f64;
+    let tris = (grid_len / 3) as f64;
     let im = &made.images;
     let area = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent };
     let viewport = vk::Viewport { x: 0.0, y: 0.0, width: w as f32, height: h as f32, min_depth: 0.0, max_depth: 1.0 };
@@ -259,9 +283,9 @@ fn measure_with(ctx: &Context, w: u32, h: u32, reps: usize, max_steps: u32, made
     let sweep = |units: f64, unit: f64, prep: &dyn Fn(vk::CommandBuffer), timed: &dyn Fn(vk::CommandBuffer, u32)| {
         saturate(rules, units, unit, |k| time_gpu(ctx, queries, reps, prep, &|cb| timed(cb, k)))
     };
-    let grid_draw = (vb, grid.len() as u32);
+    let grid_draw = (vb, grid_len as u32);
     let (gbuffer_tri_mtri_s, gbuffer_sweep) = sweep(tris, 1e6, &gb_prep, &|cb, k| gb_timed(cb, grid_draw, k))?;
-    let quad_draw = (qb, quad.len() as u32);
+    let quad_draw = (qb, quad_len as u32);
     let layer = w as f64 * h as f64;
     let (gbuffer_fill_gpix_s, gbuffer_fill_sweep) = sweep(layer, 1e9, &gb_prep, &|cb, k| gb_timed(cb, quad_draw, k))?;
 

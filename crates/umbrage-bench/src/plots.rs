@@ -53,7 +53,8 @@ static FONT: &[u8] = include_bytes!("../../../assets/fonts/DejaVuSansMono.ttf");
 const W: u32 = 960;
 const H: u32 = 600;
 
-fn register_font() {
+/// Registers the embedded font as "sans-serif" (once).
+pub(crate) fn register_font() {
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| {
         let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);

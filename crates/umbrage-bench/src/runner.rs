@@ -119,6 +119,33 @@ pub(super) struct Point<'a> {
     pub name: &'a str,
 }
 
+/// A variant's timed rounds: each GPU span and the CPU planning, frame by frame.
+#[derive(Default)]
+struct Acc {
+    shadow: Vec<f64>,
+    map: Vec<f64>,
+    frame: Vec<f64>,
+    depth: Vec<f64>,
+    illum: Vec<f64>,
+    accel: Vec<f64>,
+    plan: Vec<f64>,
+}
+
+/// What a point's rows are made of: where it sits, its frame size and scene, the variants
+/// measured, their counting frames' statistics and timed rounds, the McGuire twin's
+/// `(sides, fragments)` for edge quads and ray query, each technique's error, the rounds.
+struct Measured<'a> {
+    at: Point<'a>,
+    size: (u32, u32),
+    shape: PointShape,
+    variants: &'a [&'a Variant],
+    counted: Vec<umbrage_render::Stats>,
+    acc: Vec<Acc>,
+    twin: Option<(u64, Option<u64>)>,
+    error: HashMap<RenderTechnique, f64>,
+    frames: usize,
+}
+
 impl Runner {
     /// Measures every variant on one scene and size: each row with the variant it measured
     /// (variants the device cannot run are left out, and listed in `skipped`). `errors`:
@@ -168,12 +195,13 @@ impl Runner {
 
     /// Measures every variant on `r`'s scene at its size (see [`point`](Runner::point)).
     pub fn measure(&mut self, r: &mut Renderer, at: Point, variants: &[Variant], errors: bool) -> Result<Vec<(SuiteRow, Variant)>> {
-        let Point { sweep, x, name } = at;
+        let Point { sweep, name, .. } = at;
         if self.log {
             let (w, h) = (r.config().width, r.config().height);
             eprintln!("[{:>6.1} s] {sweep} {name} {w}x{h} ({} variants)", self.start.elapsed().as_secs_f64(), variants.len());
         }
-        let PointShape { casters, triangles, nlights, map_faces, mesh_triangles, gbuffer_triangles } = PointShape::of(r.scene());
+        let shape = PointShape::of(r.scene());
+        let nlights = shape.nlights;
         let mut kept: Vec<&Variant> = Vec::with_capacity(variants.len());
         for v in variants {
             match v.technique {
@@ -241,16 +269,6 @@ impl Runner {
         self.note("counting frames (the warm-up round)", counting);
         let timing = Instant::now();
         // Timed frames, round-robin.
-        #[derive(Default)]
-        struct Acc {
-            shadow: Vec<f64>,
-            map: Vec<f64>,
-            frame: Vec<f64>,
-            depth: Vec<f64>,
-            illum: Vec<f64>,
-            accel: Vec<f64>,
-            plan: Vec<f64>,
-        }
         let mut acc: Vec<Acc> = variants.iter().map(|_| Acc::default()).collect();
         for _ in 0..frames {
             for (v, a) in variants.iter().zip(&mut acc) {
@@ -270,6 +288,14 @@ impl Runner {
         r.settings = base;
         self.note(&format!("{frames} timed rounds"), timing);
         let (w, h) = (r.config().width, r.config().height);
+        let measured = Measured { at, size: (w, h), shape, variants: &variants, counted, acc, twin, error, frames };
+        Ok(self.rows(measured))
+    }
+
+    /// The rows of a point's variants, from their counting frames and timed rounds.
+    fn rows(&mut self, m: Measured) -> Vec<(SuiteRow, Variant)> {
+        let Measured { at: Point { sweep, x, name }, size: (w, h), shape, variants, counted, acc, twin, error, frames } = m;
+        let PointShape { casters, triangles, nlights, map_faces, mesh_triangles, gbuffer_triangles } = shape;
         let mut rows = Vec::new();
         for ((v, s), a) in variants.iter().zip(counted).zip(acc) {
             let c = s.counters.clone().unwrap_or_default();
@@ -360,7 +386,7 @@ impl Runner {
             self.bar.inc(1);
             rows.push((row, (*v).clone()));
         }
-        Ok(rows)
+        rows
     }
 }
 

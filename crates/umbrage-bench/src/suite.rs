@@ -110,15 +110,7 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
         + caps_points * caps.len()
         + (ablation_scenes.len() + 1) * toggle_variants.len()
         + index_variants.len();
-    let bar = if cfg.progress {
-        let b = indicatif::ProgressBar::new(units as u64);
-        if let Ok(style) = indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} {msg}") {
-            b.set_style(style);
-        }
-        b
-    } else {
-        indicatif::ProgressBar::hidden()
-    };
+    let bar = progress_bar(cfg.progress, units);
     let log = cfg.progress && bar.is_hidden();
     let mut run = Runner {
         ctx: Some(ctx),
@@ -131,22 +123,7 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
         start: std::time::Instant::now(),
         point_budget_s: if cfg.frames.is_some() { f64::INFINITY } else { scale.point_budget_s() },
     };
-    let mut rows: Vec<SuiteRow> = Vec::new();
-    let mut origins: Vec<Origin> = Vec::new();
-    let mut segments: Vec<Segment> = Vec::new();
-    // Each point's rows, and how each was measured (for its bound's proof).
-    let mut keep = |rows: &mut Vec<SuiteRow>,
-                    segments: &mut Vec<Segment>,
-                    measured: Vec<(SuiteRow, Variant)>,
-                    scene: &PointScene,
-                    size: (u32, u32)| {
-        let first = rows.len();
-        for (row, variant) in measured {
-            rows.push(row);
-            origins.push(Origin { scene: scene.clone(), size, variant });
-        }
-        segments.push(Segment { rows: first..rows.len(), copy_as: None });
-    };
+    let mut got = Collected::default();
     let all: Vec<Variant> = techniques.iter().map(|&t| Variant::of(t)).collect();
     let named_all: Vec<Variant> = named_techniques.iter().map(|&t| Variant::of(t)).chain(gathers.iter().cloned()).collect();
     // The named scenes, with their error (the Pareto chart).
@@ -154,51 +131,13 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
         run.bar.set_message(format!("scenes {n}"));
         let scene = umbrage_scene::load(n)?;
         let measured = run.point(Point { sweep: "scenes", x: 0.0, name: n }, scene, base, &named_all, true)?;
-        keep(&mut rows, &mut segments, measured, &PointScene::Named(n.into()), base);
+        got.keep(measured, &PointScene::Named(n.into()), base);
     }
     clock.lap("scenes", named.len(), 0);
-    // Every technique's points, measured once: a one-factor point identical to one measured
-    // before (the same scene at the same size, every technique) takes its rows.
-    let mut measured_points: Vec<(PointScene, (u32, u32), Range<usize>)> = Vec::new();
-    for p in &points {
-        let SweepPoint { sweep, x, scene: source, size } = p;
-        let variants = if *sweep == "caps" { &caps } else { &all };
-        let earlier = measured_points.iter().find(|(s, z, _)| s == source && z == size).map(|m| m.2.clone());
-        match earlier.filter(|_| ONE_FACTOR.contains(sweep)) {
-            Some(range) => {
-                run.bar.inc(range.len() as u64);
-                segments.push(Segment { rows: range, copy_as: Some((sweep, *x)) });
-                clock.lap(sweep, 0, 1);
-            }
-            None => {
-                let (scene, name) = scene_of(source)?;
-                run.bar.set_message(format!("{sweep} {name} {}x{}", size.0, size.1));
-                let first = rows.len();
-                let measured = run.point(Point { sweep, x: *x, name: &name }, scene, *size, variants, false)?;
-                keep(&mut rows, &mut segments, measured, source, *size);
-                if variants == &all {
-                    measured_points.push((source.clone(), *size, first..rows.len()));
-                }
-                clock.lap(sweep, 1, 0);
-            }
-        }
-    }
-    // Ablations: McGuire with each optimisation off; index formats on the vertex scene.
-    for &n in ablation_scenes {
-        run.bar.set_message(format!("ablation {n}"));
-        let scene = umbrage_scene::load(n)?;
-        let measured = run.point(Point { sweep: "ablation", x: 0.0, name: n }, scene, base, &toggle_variants, false)?;
-        keep(&mut rows, &mut segments, measured, &PointScene::Named(n.into()), base);
-    }
-    // Lights with a range, casters beyond some of them: what scissor and culling are for.
-    let ranged = super::scenes::SweepScene::ranged();
-    let measured = run.point(Point { sweep: "ablation", x: 0.0, name: &ranged.name() }, ranged.build(), base, &toggle_variants, false)?;
-    keep(&mut rows, &mut segments, measured, &PointScene::Param(ranged), base);
-    run.bar.set_message("ablation index formats");
-    let measured =
-        run.point(Point { sweep: "ablation", x: 0.0, name: index_scene }, umbrage_scene::load(index_scene)?, base, &index_variants, false)?;
-    keep(&mut rows, &mut segments, measured, &PointScene::Named(index_scene.into()), base);
+    measure_sweeps(&mut run, &mut clock, &mut got, &points, (&all, &caps))?;
+    measure_ablations(&mut run, &mut got, base, (ablation_scenes, &toggle_variants), (index_scene, &index_variants))?;
     clock.lap("ablation", ablation_scenes.len() + 2, 0);
+    let Collected { mut rows, origins, segments } = got;
     let model = super::model::fit(&mut rows, limit_costs(&limits));
     for r in &mut rows {
         sweeps::classify(r, row_limits);
@@ -211,20 +150,7 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
     run.bar.finish_and_clear();
     let ctx = run.ctx.take().ok_or_else(|| Error::Internal("the bench lost its context".into()))?;
     ctx.check_validation()?;
-    // The rows in measurement order, the shared points' copies relabelled in their places.
-    let rows: Vec<SuiteRow> = segments
-        .iter()
-        .flat_map(|seg| {
-            seg.rows.clone().map(|i| {
-                let mut r = rows[i].clone();
-                if let Some((sweep, x)) = seg.copy_as {
-                    r.measured_in = std::mem::replace(&mut r.sweep, sweep.to_string());
-                    r.x = x;
-                }
-                r
-            })
-        })
-        .collect::<Vec<_>>();
+    let rows = in_order(&rows, &segments);
     let crossovers = sweeps::crossovers(&rows);
     let mut ablations = ablations(&rows);
     if !ctx.features.depth_bounds {
@@ -267,6 +193,119 @@ pub fn run(ctx: Context, cfg: &SuiteConfig) -> Result<SuiteReport> {
     report.load_average = load_average();
     report.write(&cfg.out)?;
     Ok(report)
+}
+
+/// The suite's progress bar over `units` variants measured (hidden without `progress`).
+fn progress_bar(progress: bool, units: usize) -> indicatif::ProgressBar {
+    if !progress {
+        return indicatif::ProgressBar::hidden();
+    }
+    let b = indicatif::ProgressBar::new(units as u64);
+    if let Ok(style) = indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {pos}/{len} {msg}") {
+        b.set_style(style);
+    }
+    b
+}
+
+/// The rows measured so far, how each was measured (for its bound's proof), and the segments
+/// that put them in order.
+#[derive(Default)]
+struct Collected {
+    rows: Vec<SuiteRow>,
+    origins: Vec<Origin>,
+    segments: Vec<Segment>,
+}
+
+impl Collected {
+    /// A point's rows, measured on `scene` at `size`.
+    fn keep(&mut self, measured: Vec<(SuiteRow, Variant)>, scene: &PointScene, size: (u32, u32)) {
+        let first = self.rows.len();
+        for (row, variant) in measured {
+            self.rows.push(row);
+            self.origins.push(Origin { scene: scene.clone(), size, variant });
+        }
+        self.segments.push(Segment { rows: first..self.rows.len(), copy_as: None });
+    }
+}
+
+/// Every technique's sweep points (`all`; the caps sweep's `caps`), measured once: a
+/// one-factor point identical to one measured before (the same scene at the same size, every
+/// technique) takes its rows.
+fn measure_sweeps(
+    run: &mut Runner,
+    clock: &mut Clock,
+    got: &mut Collected,
+    points: &[SweepPoint],
+    (all, caps): (&[Variant], &[Variant]),
+) -> Result<()> {
+    let mut measured_points: Vec<(PointScene, (u32, u32), Range<usize>)> = Vec::new();
+    for p in points {
+        let SweepPoint { sweep, x, scene: source, size } = p;
+        let variants = if *sweep == "caps" { caps } else { all };
+        let earlier = measured_points.iter().find(|(s, z, _)| s == source && z == size).map(|m| m.2.clone());
+        match earlier.filter(|_| ONE_FACTOR.contains(sweep)) {
+            Some(range) => {
+                run.bar.inc(range.len() as u64);
+                got.segments.push(Segment { rows: range, copy_as: Some((sweep, *x)) });
+                clock.lap(sweep, 0, 1);
+            }
+            None => {
+                let (scene, name) = scene_of(source)?;
+                run.bar.set_message(format!("{sweep} {name} {}x{}", size.0, size.1));
+                let first = got.rows.len();
+                let measured = run.point(Point { sweep, x: *x, name: &name }, scene, *size, variants, false)?;
+                got.keep(measured, source, *size);
+                if variants == all {
+                    measured_points.push((source.clone(), *size, first..got.rows.len()));
+                }
+                clock.lap(sweep, 1, 0);
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Ablations: McGuire with each optimisation off on `scenes` and on lights with a range
+/// (casters beyond some of them: what scissor and culling are for); index formats on
+/// `index_scene`.
+fn measure_ablations(
+    run: &mut Runner,
+    got: &mut Collected,
+    base: (u32, u32),
+    (scenes, toggle_variants): (&[&str], &[Variant]),
+    (index_scene, index_variants): (&str, &[Variant]),
+) -> Result<()> {
+    for &n in scenes {
+        run.bar.set_message(format!("ablation {n}"));
+        let scene = umbrage_scene::load(n)?;
+        let measured = run.point(Point { sweep: "ablation", x: 0.0, name: n }, scene, base, toggle_variants, false)?;
+        got.keep(measured, &PointScene::Named(n.into()), base);
+    }
+    let ranged = super::scenes::SweepScene::ranged();
+    let measured = run.point(Point { sweep: "ablation", x: 0.0, name: &ranged.name() }, ranged.build(), base, toggle_variants, false)?;
+    got.keep(measured, &PointScene::Param(ranged), base);
+    run.bar.set_message("ablation index formats");
+    let measured =
+        run.point(Point { sweep: "ablation", x: 0.0, name: index_scene }, umbrage_scene::load(index_scene)?, base, index_variants, false)?;
+    got.keep(measured, &PointScene::Named(index_scene.into()), base);
+    Ok(())
+}
+
+/// The rows in measurement order, the shared points' copies relabelled in their places.
+fn in_order(rows: &[SuiteRow], segments: &[Segment]) -> Vec<SuiteRow> {
+    segments
+        .iter()
+        .flat_map(|seg| {
+            seg.rows.clone().map(|i| {
+                let mut r = rows[i].clone();
+                if let Some((sweep, x)) = seg.copy_as {
+                    r.measured_in = std::mem::replace(&mut r.sweep, sweep.to_string());
+                    r.x = x;
+                }
+                r
+            })
+        })
+        .collect()
 }
 
 /// Each term's cost at the device's measured limit, ns per unit, where a limit measures it.

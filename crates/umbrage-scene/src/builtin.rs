@@ -10,6 +10,7 @@ pub const SCENES: &[(&str, &str)] = &[
     ("bench/fill", include_str!("../../../scenes/bench/fill.toml")),
     ("bench/vertex", include_str!("../../../scenes/bench/vertex.toml")),
     ("bench/caps", include_str!("../../../scenes/bench/caps.toml")),
+    ("bench/level", include_str!("../../../scenes/bench/level.toml")),
     ("hard/big_caster", include_str!("../../../scenes/hard/big_caster.toml")),
     ("hard/light_inside_caster", include_str!("../../../scenes/hard/light_inside_caster.toml")),
     ("hard/nested_256", include_str!("../../../scenes/hard/nested_256.toml")),

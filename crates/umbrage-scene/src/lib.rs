@@ -113,6 +113,7 @@ pub struct Scene {
 
 pub mod builtin;
 pub mod file;
+pub mod level;
 pub mod motion;
 pub mod obj;
 pub mod shapes;

@@ -18,8 +18,14 @@ pub(crate) struct BenchArgs {
     /// volume methods, edgequad and shadowmap, and rayquery where the device has ray query).
     #[arg(long, value_delimiter = ',', value_parser = parse_method)]
     methods: Vec<RenderTechnique>,
+    /// Frames measured per variant (after one warm-up frame).
     #[arg(long, default_value_t = 10)]
     frames: usize,
+    /// Run each scene's motion (its camera's walk or orbit, its meshes' spins, its lights'
+    /// paths) over the frames: the warm-up frame at time 0, frame k at k/30 s; each row's error
+    /// is then the last frame's. Without it every frame is at time 0.
+    #[arg(long)]
+    motion: bool,
     #[arg(long, default_value = "960x540", value_parser = parse_size)]
     size: (u32, u32),
     #[arg(long, value_enum, default_value = "auto")]
@@ -94,6 +100,11 @@ enum SuiteArg {
     /// Fill-rate vs vertex-rate: the limits, sweeps that cross over, the bound at each point.
     #[value(name = "fill-vertex")]
     FillVertex,
+    /// What a frame costs when only some of the scene changed (issue 55): bench/level,
+    /// default, stress and bench/vertex in motion, planned every frame, kept and compute side
+    /// by side, and the CPU against lights and casters; docs/frame-cost.md.
+    #[value(name = "frame-cost")]
+    FrameCost,
 }
 
 pub(crate) fn bench_command(a: BenchArgs) -> Result<ExitCode> {
@@ -126,13 +137,17 @@ pub(crate) fn bench_command(a: BenchArgs) -> Result<ExitCode> {
         compute_draws: a.compute_draws,
         mesh_task: a.mesh_task.iter().map(|&t| t == OnOff::On).collect(),
     };
-    bench(a.scenes, listed, a.counters, a.frames, opts, a.json.as_deref(), a.markdown.as_deref())
+    let run = Run { frames: a.frames, motion: a.motion, opts };
+    bench(a.scenes, listed, a.counters, run, a.json.as_deref(), a.markdown.as_deref())
 }
 
 /// `bench --suite fill-vertex`: runs the suite, writes its outputs, prints the Markdown.
 fn suite(a: &BenchArgs) -> Result<ExitCode> {
     use umbrage_bench::sweeps::Scale;
     let tiny = a.tiny || std::env::var("UMBRAGE_BENCH_TINY").is_ok_and(|v| v == "1");
+    if a.suite == Some(SuiteArg::FrameCost) {
+        return frame_cost(a, tiny);
+    }
     let scale = match (tiny, a.quick) {
         (true, _) => Scale::Tiny,
         (false, true) => Scale::Quick,
@@ -158,6 +173,27 @@ fn suite(a: &BenchArgs) -> Result<ExitCode> {
         let text = report.markdown(&rel.display().to_string());
         std::fs::write(m, text).map_err(|e| Error::io(m.display().to_string(), e))?;
     }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `bench --suite frame-cost`: runs it, writes its plots and JSON into --out and its report
+/// (`frame-cost.md` there, or --markdown with the plots linked relative to it), prints it.
+fn frame_cost(a: &BenchArgs, tiny: bool) -> Result<ExitCode> {
+    use umbrage_bench::frame_cost::{self, FrameCostConfig};
+    let cfg = if tiny { FrameCostConfig::tiny(a.out.clone()) } else { FrameCostConfig::full(a.out.clone()) };
+    let ctx = umbrage::gpu::Context::new()?;
+    let report = frame_cost::run(ctx, &cfg)?;
+    let (path, plots) = match &a.markdown {
+        Some(m) => {
+            let base = m.parent().unwrap_or(Path::new(""));
+            let rel = a.out.strip_prefix(base).map(Path::to_path_buf).unwrap_or_else(|_| a.out.clone());
+            (m.clone(), rel.display().to_string())
+        }
+        None => (a.out.join("frame-cost.md"), ".".to_string()),
+    };
+    let md = report.markdown(&plots);
+    std::fs::write(&path, &md).map_err(|e| Error::io(path.display().to_string(), e))?;
+    println!("{md}");
     Ok(ExitCode::SUCCESS)
 }
 
@@ -256,12 +292,21 @@ struct Listed {
     mesh_task: Vec<bool>,
 }
 
+/// How `bench` runs each row's frames.
+struct Run {
+    /// `--frames`.
+    frames: usize,
+    /// `--motion`.
+    motion: bool,
+    /// The renderer's options.
+    opts: RenderOptions,
+}
+
 fn bench(
     scenes: Vec<String>,
     Listed { techniques, default_list, compute_draws, mesh_task }: Listed,
     counters: Vec<Counter>,
-    frames: usize,
-    opts: RenderOptions,
+    Run { frames, motion, opts }: Run,
     json: Option<&Path>,
     markdown: Option<&Path>,
 ) -> Result<ExitCode> {
@@ -274,7 +319,7 @@ fn bench(
     if default_list && ctx.features.ray_query {
         techniques.push(Technique::RayQuery.into());
     }
-    let cfg = umbrage_bench::BenchConfig { scenes, techniques, counters, frames, opts, compute_draws, mesh_task };
+    let cfg = umbrage_bench::BenchConfig { scenes, techniques, counters, frames, opts, compute_draws, mesh_task, motion };
     let report = umbrage_bench::run(ctx, &cfg, |r| {
         eprintln!(
             "{:<14} {:<16} {:<8} gpu {:>8} ms  shadow {:>8} ms  {:>7.1} fps  {:>8} tris  error {:.4}%",

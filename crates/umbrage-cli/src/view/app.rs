@@ -173,8 +173,9 @@ pub(super) struct Live {
     pub notes: Vec<String>,
     pub overlay_visible: bool,
     pub menu_at: Option<egui::Pos2>,
-    /// What the overlay showed last: method, counter, view, mode.
-    pub shown: Option<[String; 4]>,
+    /// What the overlay showed last: method, counter, view, mode, the pairs line
+    /// ([`overlay::pairs_line`](super::overlay::pairs_line); empty before a frame finished).
+    pub shown: Option<[String; 5]>,
     pub resizes: u32,
 }
 

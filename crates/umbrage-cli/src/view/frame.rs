@@ -168,6 +168,7 @@ impl Live {
         }
         let raw = self.egui.state.take_egui_input(&self.window);
         let stats = self.last.as_ref().map(|(f, _)| &f.stats);
+        let pairs = stats.map(overlay::pairs_line).unwrap_or_default();
         let drawn = self.renderer.scene();
         let caster_name = self.caster_index().map(|i| drawn.meshes[i].name.clone()).unwrap_or_else(|| "(no casters)".into());
         let light = self.renderer.source_lights().get(self.light).map(|l| (self.light, l.position));
@@ -207,6 +208,7 @@ impl Live {
                 settings.counter.name().to_string(),
                 settings.view.name().to_string(),
                 self.mode.name().to_string(),
+                pairs,
             ]);
         }
         self.egui.state.handle_platform_output(&self.window, out.platform_output);
@@ -325,7 +327,7 @@ impl Live {
             "selected_light": self.light,
             "overlay": {
                 "visible": self.overlay_visible,
-                "shown": self.shown.as_ref().map(|s| serde_json::json!({"method": s[0], "counter": s[1], "view": s[2], "mode": s[3]})),
+                "shown": self.shown.as_ref().map(|s| serde_json::json!({"method": s[0], "counter": s[1], "view": s[2], "mode": s[3], "pairs": s[4]})),
             },
             "camera": {"eye": v3(scene.camera.eye), "target": v3(scene.camera.target), "up": v3(scene.camera.up)},
             "lights": scene.lights.iter().map(|l| serde_json::json!({"position": v3(l.position), "direction": v3(l.direction)})).collect::<Vec<_>>(),

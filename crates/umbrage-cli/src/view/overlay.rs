@@ -1,5 +1,5 @@
 //! The egui overlay: what the frame did (fps, frame time, GPU ms per pass, shadow triangles
-//! by case, bytes sent), the settings and the control mode, and the same controls as widgets;
+//! by case, bytes sent, light–caster pairs kept and replanned), the settings and the control mode, and the same controls as widgets;
 //! the right-click menu of control modes. Drawn by egui-ash-renderer straight into the
 //! swapchain image after the blit of the renderer's output.
 
@@ -7,6 +7,9 @@ use super::controls::Mode;
 use glam::Vec3;
 use std::collections::HashMap;
 use umbrage_render::{Counter, RenderTechnique, Stats, View};
+
+/// Lights whose GPU times the overlay lists one by one (the rest are counted).
+const PER_LIGHT_SHOWN: usize = 8;
 
 /// What the overlay shows.
 pub struct Shown<'a> {
@@ -68,6 +71,21 @@ pub fn triangles_by_case(stats: &Stats) -> Vec<(String, u64)> {
     v
 }
 
+/// The light–caster pairs the frame drew, how many were drawn from plans kept across frames
+/// and how many planned again (`PassSettings::keep`; `--no-keep`: every one planned), and the
+/// kept lists' bytes and evictions.
+pub fn pairs_line(stats: &Stats) -> String {
+    let t = &stats.totals;
+    format!(
+        "pairs {}: kept {}, replanned {}  (kept lists {:.1} KiB, {} evicted)",
+        t.pairs_total,
+        t.pairs_kept,
+        t.pairs_replanned,
+        t.kept_bytes as f64 / 1024.0,
+        t.kept_evictions
+    )
+}
+
 /// Builds the overlay's widgets; `menu_at`: where the right-click menu is open (window
 /// points), cleared when it closes.
 pub fn ui(ctx: &egui::Context, s: &Shown, menu_at: &mut Option<egui::Pos2>) -> Changes {
@@ -75,14 +93,21 @@ pub fn ui(ctx: &egui::Context, s: &Shown, menu_at: &mut Option<egui::Pos2>) -> C
     egui::Window::new("umbrage").default_pos([8.0, 8.0]).resizable(false).show(ctx, |ui| {
         ui.label(format!("{:.1} fps  {:.2} ms/frame  t = {:.2} s{}", s.fps, s.frame_ms, s.time, if s.paused { " (paused)" } else { "" }));
         if let Some(st) = s.stats {
+            ui.label(pairs_line(st));
             match &st.gpu_ms {
                 Some(g) => {
                     ui.label(format!(
                         "GPU ms: depth {:.2}  shadow {:.2}  illuminate {:.2}  frame {:.2}",
                         g.depth, g.shadow, g.illuminate, g.frame
                     ));
-                    let per: Vec<String> = g.per_light.iter().map(|l| format!("{:.2}+{:.2}", l.shadow, l.illuminate)).collect();
-                    ui.label(format!("  per light (shadow+illuminate): {}", per.join("  ")));
+                    // The first lights only: a level's hundred lights would fill the window.
+                    let per: Vec<String> =
+                        g.per_light.iter().take(PER_LIGHT_SHOWN).map(|l| format!("{:.2}+{:.2}", l.shadow, l.illuminate)).collect();
+                    let more = match g.per_light.len().saturating_sub(PER_LIGHT_SHOWN) {
+                        0 => String::new(),
+                        n => format!("  (+{n} more)"),
+                    };
+                    ui.label(format!("  per light (shadow+illuminate): {}{more}", per.join("  ")));
                 }
                 None => {
                     ui.label("GPU ms: no timestamps on this device");
