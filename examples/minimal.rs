@@ -26,7 +26,7 @@
 //! teardown order at the end of [`run`].
 
 use ash::vk::{self, AccessFlags2 as A, PipelineStageFlags2 as S};
-use glam::{DMat4, DVec2, DVec3, DVec4, Vec3, Vec3Swizzles};
+use glam::{DMat4, DVec2, DVec3, DVec4, Mat4, Vec3, Vec3Swizzles};
 use gpu_allocator::vulkan::{Allocation, AllocationCreateDesc, AllocationScheme, Allocator, AllocatorCreateDesc};
 use gpu_allocator::MemoryLocation;
 use std::ffi::c_void;
@@ -34,7 +34,7 @@ use std::process::ExitCode;
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::sync::{Arc, Mutex};
 use umbrage::geom::{Light, LightKind, Mesh};
-use umbrage::pass::{DepthStencilTarget, ShadowPass, ShadowPassDesc, ShadowView};
+use umbrage::pass::{DepthStencilTarget, PreparedFrame, ShadowPass, ShadowPassDesc, ShadowView};
 
 /// The image's size in pixels.
 const WIDTH: u32 = 320;
@@ -90,6 +90,139 @@ fn main() -> ExitCode {
 /// when there is no loader, driver or suitable device.
 pub fn run() -> Result<(), String> {
     // ---- 1. Vulkan: instance, device, queue, allocator --------------------------------------
+    let gpu = create_device()?;
+    let (Gpu { instance, device, allocator, .. }, physical, ds_format) = (&gpu, gpu.physical, gpu.ds_format);
+
+    // ---- 2. The scene, and the pass -----------------------------------------------------------
+    let floor: Vec<Vec3> =
+        [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(x, z)| Vec3::new(x, 0.0, z) * FLOOR_HALF as f32).to_vec();
+    let box_corners: Vec<Vec3> = (0..8).map(|i| (corner_sign(i) * BOX_HALF).as_vec3()).collect();
+    let box_model = DMat4::from_translation(BOX_CENTRE); // object -> world, in f64
+
+    let desc = ShadowPassDesc { depth_stencil_format: ds_format, frames_in_flight: 1, ..Default::default() };
+    let mut pass = ShadowPass::new(instance, physical, device, allocator.clone(), &desc).map_err(|e| format!("ShadowPass::new: {e}"))?;
+    // A caster is any closed (or open) triangle mesh; the pass keeps its own GPU copy.
+    let box_mesh = Mesh::new(box_corners.clone(), BOX_TRIANGLES.to_vec());
+    pass.add_caster("box", &box_mesh, box_model).map_err(|e| format!("add_caster: {e}"))?;
+
+    // The engine's own copy of the geometry for its depth pre-pass: floor and box, vec4 (w = 1).
+    let vertices: Vec<[f32; 4]> = floor.iter().chain(&box_corners).map(|p| p.extend(1.0).to_array()).collect();
+    let indices: Vec<u32> = [0, 1, 2, 0, 2, 3].into_iter().chain(BOX_TRIANGLES.iter().flatten().copied()).collect();
+    let vertex_buffer = buffer(device, allocator, bytemuck::cast_slice(&vertices), vk::BufferUsageFlags::VERTEX_BUFFER)?;
+    let index_buffer = buffer(device, allocator, bytemuck::cast_slice(&indices), vk::BufferUsageFlags::INDEX_BUFFER)?;
+    // Where the stencil is copied to, one byte a pixel (TRANSFER_DST: read back, not uploaded).
+    let pixels = (WIDTH * HEIGHT) as usize;
+    let readback = buffer(device, allocator, &vec![0; pixels], vk::BufferUsageFlags::TRANSFER_DST)?;
+
+    // The depth-stencil image: the pre-pass writes its depth, the pass its stencil.
+    let extent = vk::Extent2D { width: WIDTH, height: HEIGHT };
+    let image_info = vk::ImageCreateInfo::default().image_type(vk::ImageType::TYPE_2D).format(ds_format).extent(extent.into());
+    let usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC; // TRANSFER_SRC: the stencil copy
+    let image_info = image_info.mip_levels(1).array_layers(1).samples(vk::SampleCountFlags::TYPE_1).usage(usage);
+    let both_aspects = vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL;
+    let range = vk::ImageSubresourceRange::default().aspect_mask(both_aspects).level_count(1).layer_count(1);
+    // SAFETY: valid create infos on a valid device; the memory is bound before the view is made.
+    let (depth_image, depth_memory, depth_view) = unsafe {
+        let image = device.create_image(&image_info, None).map_err(vk_err("vkCreateImage"))?;
+        let requirements = device.get_image_memory_requirements(image);
+        let memory = allocate(allocator, requirements, MemoryLocation::GpuOnly)?;
+        device.bind_image_memory(image, memory.memory(), memory.offset()).map_err(vk_err("vkBindImageMemory"))?;
+        let view_info = vk::ImageViewCreateInfo::default().image(image).view_type(vk::ImageViewType::TYPE_2D).format(ds_format);
+        let view = device.create_image_view(&view_info.subresource_range(range), None).map_err(vk_err("vkCreateImageView"))?;
+        (image, memory, view)
+    };
+
+    // The engine's depth pre-pass pipeline (depth only) and its layout (an `mvp` push constant).
+    let (layout, pipeline) = prepass_pipeline(device, ds_format)?;
+
+    // ---- 3. One frame ---------------------------------------------------------------------------
+    // The camera, as the pass wants it: the eye in f64, a view without translation (world
+    // directions -> view space) and Vulkan's projection with the far plane at infinity (depth
+    // 0 at the near plane, 1 at infinity; y down in the framebuffer). Z-fail volumes reach
+    // infinity, so this is `DepthMode::Infinite`, the default.
+    let view = glam::camera::rh::view::look_at_mat4(Vec3::ZERO, (LOOK_AT - EYE).as_vec3(), Vec3::Y);
+    let proj = glam::camera::rh::proj::vulkan::perspective_infinite(FOV_Y_DEG.to_radians(), WIDTH as f32 / HEIGHT as f32, NEAR);
+    // Every draw uses `proj * view * (world - eye)`, composed in f64 and rounded once, exactly as
+    // the pass composes its volumes' matrices: the pre-pass depths and the volumes then agree.
+    let mvp = |model: DMat4| (proj.as_dmat4() * view.as_dmat4() * DMat4::from_translation(-EYE) * model).as_mat4();
+    let light = Light {
+        kind: LightKind::Point,
+        position: LIGHT.as_vec3(),
+        direction: Vec3::NEG_Y, // unused by a point light
+        color: Vec3::ONE,
+        intensity: 1.0,
+        radius: None, // no attenuation range: the light reaches everything
+        cone_deg: 180.0,
+        area: None,
+    };
+    // The CPU work: per light, which casters matter, their case (z-pass, z-fail, ...), their
+    // silhouettes and index streams, written into ring slot 0.
+    let shadow_view = ShadowView { eye: EYE, view, proj, width: WIDTH, height: HEIGHT };
+    let frame = pass.prepare(0, &shadow_view, std::slice::from_ref(&light)).map_err(|e| format!("prepare: {e}"))?;
+    for c in &frame.lights[0].stats.casters {
+        println!("minimal: {}: {}, {} silhouette edges, {} shadow triangles", c.name, c.case, c.silhouette_edges, c.triangles.total());
+    }
+
+    let geometry = (box_model, &vertex_buffer, &index_buffer);
+    record_frame(&gpu, &pass, &frame, mvp, geometry, (depth_image, depth_view, extent, range), (layout, pipeline, &readback))?;
+    let stencil = readback.1.mapped_slice().ok_or("the readback buffer is not mapped")?[..pixels].to_vec();
+
+    // ---- 4. Teardown: the GPU is idle; children before parents, the pass before the device --
+    let Gpu { entry: _entry, instance, debug_utils, messenger, device, allocator, pool, fence, .. } = gpu;
+    // SAFETY: the fence was waited, so no command uses any of these objects; each is destroyed
+    // once; the pass goes while the device and the allocator are alive (its drop contract).
+    unsafe {
+        drop(pass);
+        device.destroy_command_pool(pool, None); // frees `cb` too
+        device.destroy_fence(fence, None);
+        device.destroy_pipeline(pipeline, None);
+        device.destroy_pipeline_layout(layout, None);
+        device.destroy_image_view(depth_view, None);
+        device.destroy_image(depth_image, None);
+        let mut guard = allocator.lock().map_err(|_| "allocator lock poisoned")?;
+        for (buffer, memory) in [vertex_buffer, index_buffer, readback] {
+            device.destroy_buffer(buffer, None);
+            guard.free(memory).map_err(|e| format!("free: {e}"))?;
+        }
+        guard.free(depth_memory).map_err(|e| format!("free: {e}"))?;
+        drop(guard);
+        // The last reference (the pass's clone went with the pass): frees the memory blocks.
+        drop(allocator);
+        device.destroy_device(None);
+        if let Some(m) = messenger {
+            debug_utils.destroy_debug_utils_messenger(m, None);
+        }
+        instance.destroy_instance(None);
+    }
+
+    // ---- 5. The check --------------------------------------------------------------------------
+    check(&stencil, proj.as_dmat4() * view.as_dmat4())?;
+    match VALIDATION_ERRORS.load(Ordering::SeqCst) {
+        0 => Ok(()),
+        n => Err(format!("{n} validation error(s)")),
+    }
+}
+
+/// Step 1's objects: the instance and its messenger, the device, its queue and allocator, and
+/// the frame's command pool, fence and command buffer.
+struct Gpu {
+    entry: ash::Entry,
+    instance: ash::Instance,
+    debug_utils: ash::ext::debug_utils::Instance,
+    messenger: Option<vk::DebugUtilsMessengerEXT>,
+    physical: vk::PhysicalDevice,
+    ds_format: vk::Format,
+    device: ash::Device,
+    queue: vk::Queue,
+    allocator: Arc<Mutex<Allocator>>,
+    pool: vk::CommandPool,
+    fence: vk::Fence,
+    cb: vk::CommandBuffer,
+}
+
+/// Step 1: the instance, the first Vulkan 1.3 device with a graphics queue, its queue and
+/// allocator, one command buffer and its fence.
+fn create_device() -> Result<Gpu, String> {
     // SAFETY: loads the system's Vulkan loader; `entry` outlives every object made from it.
     let entry = unsafe { ash::Entry::load() }.map_err(|e| format!("no Vulkan loader: {e}"))?;
     let validation = std::env::var("UMBRAGE_VALIDATION").is_ok_and(|v| v == "1");
@@ -160,76 +293,6 @@ pub fn run() -> Result<(), String> {
     // Shared with the pass, which allocates its caster buffers and index streams from it.
     let allocator = Arc::new(Mutex::new(allocator));
 
-    // ---- 2. The scene, and the pass -----------------------------------------------------------
-    let floor: Vec<Vec3> =
-        [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)].map(|(x, z)| Vec3::new(x, 0.0, z) * FLOOR_HALF as f32).to_vec();
-    let box_corners: Vec<Vec3> = (0..8).map(|i| (corner_sign(i) * BOX_HALF).as_vec3()).collect();
-    let box_model = DMat4::from_translation(BOX_CENTRE); // object -> world, in f64
-
-    let desc = ShadowPassDesc { depth_stencil_format: ds_format, frames_in_flight: 1, ..Default::default() };
-    let mut pass = ShadowPass::new(&instance, physical, &device, allocator.clone(), &desc).map_err(|e| format!("ShadowPass::new: {e}"))?;
-    // A caster is any closed (or open) triangle mesh; the pass keeps its own GPU copy.
-    let box_mesh = Mesh::new(box_corners.clone(), BOX_TRIANGLES.to_vec());
-    pass.add_caster("box", &box_mesh, box_model).map_err(|e| format!("add_caster: {e}"))?;
-
-    // The engine's own copy of the geometry for its depth pre-pass: floor and box, vec4 (w = 1).
-    let vertices: Vec<[f32; 4]> = floor.iter().chain(&box_corners).map(|p| p.extend(1.0).to_array()).collect();
-    let indices: Vec<u32> = [0, 1, 2, 0, 2, 3].into_iter().chain(BOX_TRIANGLES.iter().flatten().copied()).collect();
-    let vertex_buffer = buffer(&device, &allocator, bytemuck::cast_slice(&vertices), vk::BufferUsageFlags::VERTEX_BUFFER)?;
-    let index_buffer = buffer(&device, &allocator, bytemuck::cast_slice(&indices), vk::BufferUsageFlags::INDEX_BUFFER)?;
-    // Where the stencil is copied to, one byte a pixel (TRANSFER_DST: read back, not uploaded).
-    let pixels = (WIDTH * HEIGHT) as usize;
-    let readback = buffer(&device, &allocator, &vec![0; pixels], vk::BufferUsageFlags::TRANSFER_DST)?;
-
-    // The depth-stencil image: the pre-pass writes its depth, the pass its stencil.
-    let extent = vk::Extent2D { width: WIDTH, height: HEIGHT };
-    let image_info = vk::ImageCreateInfo::default().image_type(vk::ImageType::TYPE_2D).format(ds_format).extent(extent.into());
-    let usage = vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | vk::ImageUsageFlags::TRANSFER_SRC; // TRANSFER_SRC: the stencil copy
-    let image_info = image_info.mip_levels(1).array_layers(1).samples(vk::SampleCountFlags::TYPE_1).usage(usage);
-    let both_aspects = vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL;
-    let range = vk::ImageSubresourceRange::default().aspect_mask(both_aspects).level_count(1).layer_count(1);
-    // SAFETY: valid create infos on a valid device; the memory is bound before the view is made.
-    let (depth_image, depth_memory, depth_view) = unsafe {
-        let image = device.create_image(&image_info, None).map_err(vk_err("vkCreateImage"))?;
-        let requirements = device.get_image_memory_requirements(image);
-        let memory = allocate(&allocator, requirements, MemoryLocation::GpuOnly)?;
-        device.bind_image_memory(image, memory.memory(), memory.offset()).map_err(vk_err("vkBindImageMemory"))?;
-        let view_info = vk::ImageViewCreateInfo::default().image(image).view_type(vk::ImageViewType::TYPE_2D).format(ds_format);
-        let view = device.create_image_view(&view_info.subresource_range(range), None).map_err(vk_err("vkCreateImageView"))?;
-        (image, memory, view)
-    };
-
-    // The engine's depth pre-pass pipeline (depth only) and its layout (an `mvp` push constant).
-    let (layout, pipeline) = prepass_pipeline(&device, ds_format)?;
-
-    // ---- 3. One frame ---------------------------------------------------------------------------
-    // The camera, as the pass wants it: the eye in f64, a view without translation (world
-    // directions -> view space) and Vulkan's projection with the far plane at infinity (depth
-    // 0 at the near plane, 1 at infinity; y down in the framebuffer). Z-fail volumes reach
-    // infinity, so this is `DepthMode::Infinite`, the default.
-    let view = glam::camera::rh::view::look_at_mat4(Vec3::ZERO, (LOOK_AT - EYE).as_vec3(), Vec3::Y);
-    let proj = glam::camera::rh::proj::vulkan::perspective_infinite(FOV_Y_DEG.to_radians(), WIDTH as f32 / HEIGHT as f32, NEAR);
-    // Every draw uses `proj * view * (world - eye)`, composed in f64 and rounded once, exactly as
-    // the pass composes its volumes' matrices: the pre-pass depths and the volumes then agree.
-    let mvp = |model: DMat4| (proj.as_dmat4() * view.as_dmat4() * DMat4::from_translation(-EYE) * model).as_mat4();
-    let light = Light {
-        kind: LightKind::Point,
-        position: LIGHT.as_vec3(),
-        direction: Vec3::NEG_Y, // unused by a point light
-        color: Vec3::ONE,
-        intensity: 1.0,
-        radius: None, // no attenuation range: the light reaches everything
-        cone_deg: 180.0,
-        area: None,
-    };
-    // The CPU work: per light, which casters matter, their case (z-pass, z-fail, ...), their
-    // silhouettes and index streams, written into ring slot 0.
-    let shadow_view = ShadowView { eye: EYE, view, proj, width: WIDTH, height: HEIGHT };
-    let frame = pass.prepare(0, &shadow_view, std::slice::from_ref(&light)).map_err(|e| format!("prepare: {e}"))?;
-    for c in &frame.lights[0].stats.casters {
-        println!("minimal: {}: {}, {} silhouette edges, {} shadow triangles", c.name, c.case, c.silhouette_edges, c.triangles.total());
-    }
-
     // SAFETY: creation on a valid device; destroyed at the end.
     let (pool, fence) = unsafe {
         let pool_info = vk::CommandPoolCreateInfo::default().queue_family_index(family);
@@ -239,7 +302,22 @@ pub fn run() -> Result<(), String> {
     let cb_info = vk::CommandBufferAllocateInfo::default().command_pool(pool).command_buffer_count(1);
     // SAFETY: one primary buffer from the pool just made.
     let cb = unsafe { device.allocate_command_buffers(&cb_info) }.map_err(vk_err("vkAllocateCommandBuffers"))?[0];
+    Ok(Gpu { entry, instance, debug_utils, messenger, physical, ds_format, device, queue, allocator, pool, fence, cb })
+}
 
+/// Step 3's commands: the engine's depth pre-pass (`geometry`: the box's model matrix, the
+/// vertex and index buffers), `cmd_determine` on the depth-stencil image, the stencil's copy
+/// into `readback`; submitted and waited for.
+fn record_frame(
+    gpu: &Gpu,
+    pass: &ShadowPass,
+    frame: &PreparedFrame,
+    mvp: impl Fn(DMat4) -> Mat4,
+    (box_model, vertex_buffer, index_buffer): (DMat4, &Buffer, &Buffer),
+    (depth_image, depth_view, extent, range): (vk::Image, vk::ImageView, vk::Extent2D, vk::ImageSubresourceRange),
+    (layout, pipeline, readback): (vk::PipelineLayout, vk::Pipeline, &Buffer),
+) -> Result<(), String> {
+    let &Gpu { ref device, queue, fence, cb, .. } = gpu;
     // Barriers (synchronization2) on the depth-stencil image: both aspects, a layout change
     // `old -> new` (or none), after `src` (stages, accesses) and before `dst`.
     let (tests, attachment) = (S::EARLY_FRAGMENT_TESTS | S::LATE_FRAGMENT_TESTS, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
@@ -271,7 +349,7 @@ pub fn run() -> Result<(), String> {
         // The depth-stencil image into the attachment layout (its old contents discarded).
         barrier(vk::ImageLayout::UNDEFINED, attachment, (S::NONE, A::NONE), (tests, ds_rw));
         // New casters' vertex copies (and compute silhouettes, where used): outside rendering.
-        pass.cmd_before_rendering(cb, &frame).map_err(|e| format!("cmd_before_rendering: {e}"))?;
+        pass.cmd_before_rendering(cb, frame).map_err(|e| format!("cmd_before_rendering: {e}"))?;
 
         // The engine's depth pre-pass: floor (indices 0..6) and box (6..42, vertices from 4).
         device.cmd_begin_rendering(cb, &rendering);
@@ -291,7 +369,7 @@ pub fn run() -> Result<(), String> {
         // number of shadow volumes around the visible point (0 = lit).
         // The target is declared in DEPTH_STENCIL_ATTACHMENT_OPTIMAL, and left there.
         let target = DepthStencilTarget::new(depth_image, depth_view, extent);
-        pass.cmd_determine(cb, &frame, 0, &target).map_err(|e| format!("cmd_determine: {e}"))?;
+        pass.cmd_determine(cb, frame, 0, &target).map_err(|e| format!("cmd_determine: {e}"))?;
 
         // An engine's lighting pass would now test `stencil == 0` (`lit_stencil_state`); we
         // copy the stencil out and make the copy visible to the host.
@@ -307,41 +385,7 @@ pub fn run() -> Result<(), String> {
         device.queue_submit2(queue, &[vk::SubmitInfo2::default().command_buffer_infos(&cbs)], fence).map_err(vk_err("vkQueueSubmit2"))?;
         device.wait_for_fences(&[fence], true, u64::MAX).map_err(vk_err("vkWaitForFences"))?;
     }
-    let stencil = readback.1.mapped_slice().ok_or("the readback buffer is not mapped")?[..pixels].to_vec();
-
-    // ---- 4. Teardown: the GPU is idle; children before parents, the pass before the device --
-    // SAFETY: the fence was waited, so no command uses any of these objects; each is destroyed
-    // once; the pass goes while the device and the allocator are alive (its drop contract).
-    unsafe {
-        drop(pass);
-        device.destroy_command_pool(pool, None); // frees `cb` too
-        device.destroy_fence(fence, None);
-        device.destroy_pipeline(pipeline, None);
-        device.destroy_pipeline_layout(layout, None);
-        device.destroy_image_view(depth_view, None);
-        device.destroy_image(depth_image, None);
-        let mut guard = allocator.lock().map_err(|_| "allocator lock poisoned")?;
-        for (buffer, memory) in [vertex_buffer, index_buffer, readback] {
-            device.destroy_buffer(buffer, None);
-            guard.free(memory).map_err(|e| format!("free: {e}"))?;
-        }
-        guard.free(depth_memory).map_err(|e| format!("free: {e}"))?;
-        drop(guard);
-        // The last reference (the pass's clone went with the pass): frees the memory blocks.
-        drop(allocator);
-        device.destroy_device(None);
-        if let Some(m) = messenger {
-            debug_utils.destroy_debug_utils_messenger(m, None);
-        }
-        instance.destroy_instance(None);
-    }
-
-    // ---- 5. The check --------------------------------------------------------------------------
-    check(&stencil, proj.as_dmat4() * view.as_dmat4())?;
-    match VALIDATION_ERRORS.load(Ordering::SeqCst) {
-        0 => Ok(()),
-        n => Err(format!("{n} validation error(s)")),
-    }
+    Ok(())
 }
 
 /// What a pixel centre's camera ray sees, computed from the scene's definition alone.
