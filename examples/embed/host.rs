@@ -46,6 +46,7 @@ use umbrage_reference::Dump;
 use umbrage_scene::Scene;
 use vulkan::{
     color_samples_supported, create_device, create_image, create_view, debug_callback, pick_device, validation_requested, vkerr, Buf, Img,
+    Picked,
 };
 
 /// The default frame size.
@@ -349,34 +350,8 @@ impl Host {
             return Err(format!("--msaa {}: the sample count is 1, 2, 4 or 8", config.samples));
         }
         let scenes = Scenes::new(config.scene.as_deref())?;
-        // SAFETY: loads the Vulkan loader; `entry` is kept in the host as long as the instance.
-        let entry = unsafe { ash::Entry::load() }.map_err(|e| format!("no Vulkan loader (libvulkan.so.1): {e}"))?;
-        let validation = config.validation.unwrap_or_else(validation_requested);
-        let layer = c"VK_LAYER_KHRONOS_validation";
-        let (mut layers, mut extensions) = (Vec::new(), Vec::new());
-        if validation {
-            // SAFETY: a plain enumeration on a loaded entry.
-            let available = unsafe { entry.enumerate_instance_layer_properties() }.map_err(vkerr("vkEnumerateInstanceLayerProperties"))?;
-            if !available.iter().any(|l| l.layer_name_as_c_str().map(|n| n == layer).unwrap_or(false)) {
-                return Err("UMBRAGE_VALIDATION is set but VK_LAYER_KHRONOS_validation is not installed".into());
-            }
-            layers.push(layer.as_ptr());
-            extensions.push(ash::ext::debug_utils::NAME.as_ptr());
-        }
         let dynamic = !config.render_pass;
-        let api = if dynamic { vk::API_VERSION_1_3 } else { vk::API_VERSION_1_1 };
-        let app = vk::ApplicationInfo::default().application_name(c"umbrage-embed").api_version(api);
-        // Synchronisation validation too: the host's barriers around the pass are checked.
-        let sync = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
-        let mut features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&sync);
-        let mut info =
-            vk::InstanceCreateInfo::default().application_info(&app).enabled_layer_names(&layers).enabled_extension_names(&extensions);
-        if !layers.is_empty() {
-            info = info.push_next(&mut features);
-        }
-        // SAFETY: every pointer in `info` refers to locals alive for the call.
-        let instance =
-            unsafe { entry.create_instance(&info, None) }.map_err(|e| format!("vkCreateInstance failed ({e:?}): no Vulkan driver?"))?;
+        let (entry, instance, validation) = create_instance(config, dynamic)?;
         let log = Arc::new(Mutex::new(Vec::new()));
         let mut host = Host {
             config: config.clone(),
@@ -412,16 +387,7 @@ impl Host {
             extent: vk::Extent2D { width: config.width, height: config.height },
         };
         if validation {
-            let du = ash::ext::debug_utils::Instance::new(&host._entry, &host.instance);
-            let info = vk::DebugUtilsMessengerCreateInfoEXT::default()
-                .message_severity(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING)
-                .message_type(vk::DebugUtilsMessageTypeFlagsEXT::GENERAL | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION)
-                .pfn_user_callback(Some(debug_callback))
-                .user_data(Arc::as_ptr(&host.log) as *mut c_void);
-            // SAFETY: the callback is a plain function and the log (user data) outlives the
-            // messenger: `Drop for Host` destroys the messenger before the fields drop.
-            let m = unsafe { du.create_debug_utils_messenger(&info, None) }.map_err(vkerr("vkCreateDebugUtilsMessengerEXT"))?;
-            host.debug = Some((du, m));
+            host.create_messenger()?;
         }
         let picked = pick_device(&host.instance, dynamic)?;
         if config.samples > 1 && !picked.standard_sample_locations {
@@ -432,89 +398,11 @@ impl Host {
                 return Err(format!("{}: {format:?} has no {}-sample sampled colour attachments", picked.name, config.samples));
             }
         }
-        host.physical = picked.physical;
-        host.device_name = picked.name.clone();
-        host.ds_format = picked.ds_format;
-        host.features = EnabledFeatures {
-            depth_clamp: picked.depth_clamp,
-            depth_bounds: picked.depth_bounds,
-            index_type_uint8: picked.index_type_uint8,
-            // This host's G-buffer is depth only: no positions and normals for rays.
-            ray_query: false,
-            mesh_shader: false,
-            // A host that enables none of the indirect-draw features: the compute path's
-            // volumes are drawn one chunk at a time with push constants.
-            draw_indirect_first_instance: false,
-            multi_draw_indirect: false,
-            draw_indirect_count: false,
-            task_shader: false,
-        };
-        let device = create_device(&host.instance, &picked, dynamic)?;
-        host.device = Some(device.clone());
-        // SAFETY: queue 0 of this family was requested at device creation.
-        host.queue = unsafe { device.get_device_queue(picked.queue_family, 0) };
-        let allocator = Allocator::new(&AllocatorCreateDesc {
-            instance: host.instance.clone(),
-            device: device.clone(),
-            physical_device: host.physical,
-            debug_settings: Default::default(),
-            buffer_device_address: false,
-            allocation_sizes: Default::default(),
-        })
-        .map_err(|e| format!("gpu-allocator: {e}"))?;
-        let allocator = Arc::new(Mutex::new(allocator));
-        host.allocator = Some(allocator.clone());
+        let (device, allocator) = host.open_device(&picked, dynamic)?;
 
-        // The render passes first (the pass's pipelines are built against the lighting one).
-        let mut target = TargetModel::DynamicRendering;
-        if config.render_pass {
-            let pre = RenderPassDesc::new(NORMAL_FORMAT, host.ds_format, config.samples, true, false);
-            host.passes.prepass = create_render_pass(&device, &pre, |_, _| Ok(()))?.0;
-            let light = RenderPassDesc::new(LIT_FORMAT, host.ds_format, config.samples, false, true);
-            let (rp, t) = create_render_pass(&device, &light, |rp, info| {
-                // SAFETY: `info` is the create info `rp` was just created from, its pointers alive.
-                unsafe { RenderPassTarget::new(rp, info, 0) }.map_err(|e| format!("RenderPassTarget::new: {e}"))
-            })?;
-            host.passes.lighting = rp;
-            target = TargetModel::RenderPass(t);
-        }
-        let desc = ShadowPassDesc {
-            depth_stencil_format: host.ds_format,
-            frames_in_flight: FRAMES_IN_FLIGHT,
-            features: host.features,
-            samples: config.samples,
-            depth_direction: if config.reverse_z { DepthDirection::Reverse } else { DepthDirection::Forward },
-            target,
-            ..Default::default()
-        };
-        let pass = ShadowPass::new(&host.instance, host.physical, &device, allocator.clone(), &desc)
-            .map_err(|e| format!("ShadowPass::new: {e}"))?;
-        host.depth_bounds = host.features.depth_bounds && pass.capabilities().depth_bounds;
-        host.pass = Some(pass);
+        host.create_pass(config, &device, &allocator)?;
 
-        let extent = host.extent;
-        let sampled = vk::ImageUsageFlags::SAMPLED;
-        let ds_aspects = vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL;
-        host.depth = Some(create_image(
-            &device,
-            &allocator,
-            "depth-stencil",
-            host.ds_format,
-            extent,
-            config.samples,
-            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | sampled,
-            ds_aspects,
-        )?);
-        let ds_raw = host.depth.as_ref().map(|d| d.raw).ok_or("no depth image")?;
-        host.depth_view = create_view(&device, ds_raw, host.ds_format, vk::ImageAspectFlags::DEPTH)?;
-        host.stencil_view = create_view(&device, ds_raw, host.ds_format, vk::ImageAspectFlags::STENCIL)?;
-        let color = vk::ImageUsageFlags::COLOR_ATTACHMENT | sampled;
-        let aspect = vk::ImageAspectFlags::COLOR;
-        host.lit_target = Some(create_image(&device, &allocator, "lit", LIT_FORMAT, extent, config.samples, color, aspect)?);
-        host.normal_target = Some(create_image(&device, &allocator, "normal", NORMAL_FORMAT, extent, config.samples, color, aspect)?);
-        if config.render_pass {
-            host.create_framebuffers(&device)?;
-        }
+        host.create_targets(config, &device, &allocator)?;
 
         // SAFETY: object creation on a valid device; destroyed in `Drop for Host`.
         host.pool = unsafe {
@@ -554,6 +442,119 @@ impl Host {
         Ok(host)
     }
 
+    /// The validation messenger: messages go to `self.log`, destroyed in `Drop for Host`.
+    fn create_messenger(&mut self) -> Result<(), String> {
+        let du = ash::ext::debug_utils::Instance::new(&self._entry, &self.instance);
+        let info = vk::DebugUtilsMessengerCreateInfoEXT::default()
+            .message_severity(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING)
+            .message_type(vk::DebugUtilsMessageTypeFlagsEXT::GENERAL | vk::DebugUtilsMessageTypeFlagsEXT::VALIDATION)
+            .pfn_user_callback(Some(debug_callback))
+            .user_data(Arc::as_ptr(&self.log) as *mut c_void);
+        // SAFETY: the callback is a plain function and the log (user data) outlives the
+        // messenger: `Drop for Host` destroys the messenger before the fields drop.
+        let m = unsafe { du.create_debug_utils_messenger(&info, None) }.map_err(vkerr("vkCreateDebugUtilsMessengerEXT"))?;
+        self.debug = Some((du, m));
+        Ok(())
+    }
+
+    /// The picked device opened: its features recorded in `self.features`, the device, its
+    /// queue and the allocator shared with the pass.
+    fn open_device(&mut self, picked: &Picked, dynamic: bool) -> Result<(ash::Device, Arc<Mutex<Allocator>>), String> {
+        self.physical = picked.physical;
+        self.device_name = picked.name.clone();
+        self.ds_format = picked.ds_format;
+        self.features = EnabledFeatures {
+            depth_clamp: picked.depth_clamp,
+            depth_bounds: picked.depth_bounds,
+            index_type_uint8: picked.index_type_uint8,
+            // This host's G-buffer is depth only: no positions and normals for rays.
+            ray_query: false,
+            mesh_shader: false,
+            // A host that enables none of the indirect-draw features: the compute path's
+            // volumes are drawn one chunk at a time with push constants.
+            draw_indirect_first_instance: false,
+            multi_draw_indirect: false,
+            draw_indirect_count: false,
+            task_shader: false,
+        };
+        let device = create_device(&self.instance, picked, dynamic)?;
+        self.device = Some(device.clone());
+        // SAFETY: queue 0 of this family was requested at device creation.
+        self.queue = unsafe { device.get_device_queue(picked.queue_family, 0) };
+        let allocator = Allocator::new(&AllocatorCreateDesc {
+            instance: self.instance.clone(),
+            device: device.clone(),
+            physical_device: self.physical,
+            debug_settings: Default::default(),
+            buffer_device_address: false,
+            allocation_sizes: Default::default(),
+        })
+        .map_err(|e| format!("gpu-allocator: {e}"))?;
+        let allocator = Arc::new(Mutex::new(allocator));
+        self.allocator = Some(allocator.clone());
+        Ok((device, allocator))
+    }
+
+    /// The render passes (with `--render-pass`) and the shadow pass, built against the lighting one.
+    fn create_pass(&mut self, config: &Config, device: &ash::Device, allocator: &Arc<Mutex<Allocator>>) -> Result<(), String> {
+        // The render passes first (the pass's pipelines are built against the lighting one).
+        let mut target = TargetModel::DynamicRendering;
+        if config.render_pass {
+            let pre = RenderPassDesc::new(NORMAL_FORMAT, self.ds_format, config.samples, true, false);
+            self.passes.prepass = create_render_pass(device, &pre, |_, _| Ok(()))?.0;
+            let light = RenderPassDesc::new(LIT_FORMAT, self.ds_format, config.samples, false, true);
+            let (rp, t) = create_render_pass(device, &light, |rp, info| {
+                // SAFETY: `info` is the create info `rp` was just created from, its pointers alive.
+                unsafe { RenderPassTarget::new(rp, info, 0) }.map_err(|e| format!("RenderPassTarget::new: {e}"))
+            })?;
+            self.passes.lighting = rp;
+            target = TargetModel::RenderPass(t);
+        }
+        let desc = ShadowPassDesc {
+            depth_stencil_format: self.ds_format,
+            frames_in_flight: FRAMES_IN_FLIGHT,
+            features: self.features,
+            samples: config.samples,
+            depth_direction: if config.reverse_z { DepthDirection::Reverse } else { DepthDirection::Forward },
+            target,
+            ..Default::default()
+        };
+        let pass = ShadowPass::new(&self.instance, self.physical, device, allocator.clone(), &desc)
+            .map_err(|e| format!("ShadowPass::new: {e}"))?;
+        self.depth_bounds = self.features.depth_bounds && pass.capabilities().depth_bounds;
+        self.pass = Some(pass);
+        Ok(())
+    }
+
+    /// The depth-stencil image (and its depth and stencil views), the lit and normal targets,
+    /// and with `--render-pass` the framebuffers.
+    fn create_targets(&mut self, config: &Config, device: &ash::Device, allocator: &Arc<Mutex<Allocator>>) -> Result<(), String> {
+        let extent = self.extent;
+        let sampled = vk::ImageUsageFlags::SAMPLED;
+        let ds_aspects = vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL;
+        self.depth = Some(create_image(
+            device,
+            allocator,
+            "depth-stencil",
+            self.ds_format,
+            extent,
+            config.samples,
+            vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT | sampled,
+            ds_aspects,
+        )?);
+        let ds_raw = self.depth.as_ref().map(|d| d.raw).ok_or("no depth image")?;
+        self.depth_view = create_view(device, ds_raw, self.ds_format, vk::ImageAspectFlags::DEPTH)?;
+        self.stencil_view = create_view(device, ds_raw, self.ds_format, vk::ImageAspectFlags::STENCIL)?;
+        let color = vk::ImageUsageFlags::COLOR_ATTACHMENT | sampled;
+        let aspect = vk::ImageAspectFlags::COLOR;
+        self.lit_target = Some(create_image(device, allocator, "lit", LIT_FORMAT, extent, config.samples, color, aspect)?);
+        self.normal_target = Some(create_image(device, allocator, "normal", NORMAL_FORMAT, extent, config.samples, color, aspect)?);
+        if config.render_pass {
+            self.create_framebuffers(device)?;
+        }
+        Ok(())
+    }
+
     fn dev(&self) -> &ash::Device {
         self.device.as_ref().expect("the device exists once Host::new returned")
     }
@@ -561,4 +562,38 @@ impl Host {
     fn pass(&mut self) -> &mut ShadowPass {
         self.pass.as_mut().expect("the pass exists once Host::new returned")
     }
+}
+
+/// The Vulkan loader and an instance (Vulkan 1.3 with dynamic rendering, 1.1 with render
+/// passes), with the validation layer and synchronisation validation when asked for; also
+/// whether validation is on.
+fn create_instance(config: &Config, dynamic: bool) -> Result<(ash::Entry, ash::Instance, bool), String> {
+    // SAFETY: loads the Vulkan loader; `entry` is kept in the host as long as the instance.
+    let entry = unsafe { ash::Entry::load() }.map_err(|e| format!("no Vulkan loader (libvulkan.so.1): {e}"))?;
+    let validation = config.validation.unwrap_or_else(validation_requested);
+    let layer = c"VK_LAYER_KHRONOS_validation";
+    let (mut layers, mut extensions) = (Vec::new(), Vec::new());
+    if validation {
+        // SAFETY: a plain enumeration on a loaded entry.
+        let available = unsafe { entry.enumerate_instance_layer_properties() }.map_err(vkerr("vkEnumerateInstanceLayerProperties"))?;
+        if !available.iter().any(|l| l.layer_name_as_c_str().map(|n| n == layer).unwrap_or(false)) {
+            return Err("UMBRAGE_VALIDATION is set but VK_LAYER_KHRONOS_validation is not installed".into());
+        }
+        layers.push(layer.as_ptr());
+        extensions.push(ash::ext::debug_utils::NAME.as_ptr());
+    }
+    let api = if dynamic { vk::API_VERSION_1_3 } else { vk::API_VERSION_1_1 };
+    let app = vk::ApplicationInfo::default().application_name(c"umbrage-embed").api_version(api);
+    // Synchronisation validation too: the host's barriers around the pass are checked.
+    let sync = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
+    let mut features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&sync);
+    let mut info =
+        vk::InstanceCreateInfo::default().application_info(&app).enabled_layer_names(&layers).enabled_extension_names(&extensions);
+    if !layers.is_empty() {
+        info = info.push_next(&mut features);
+    }
+    // SAFETY: every pointer in `info` refers to locals alive for the call.
+    let instance =
+        unsafe { entry.create_instance(&info, None) }.map_err(|e| format!("vkCreateInstance failed ({e:?}): no Vulkan driver?"))?;
+    Ok((entry, instance, validation))
 }
