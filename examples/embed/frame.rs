@@ -139,41 +139,16 @@ impl Host {
         let compute_read = (vk::PipelineStageFlags::COMPUTE_SHADER, vk::AccessFlags::SHADER_READ);
         // Whatever ran before (the previous frame's readback, on the same queue): done first.
         let before = (vk::PipelineStageFlags::ALL_COMMANDS, vk::AccessFlags::empty());
-        let attachment = |view, load, clear| {
-            vk::RenderingAttachmentInfo::default()
-                .image_view(view)
-                .image_layout(if view == depth.view { ds_att } else { color_att })
-                .load_op(load)
-                .store_op(vk::AttachmentStoreOp::STORE)
-                .clear_value(clear)
-        };
         let draw = |pipeline, draws: Option<&Vec<(u32, u32)>>| {
             // SAFETY: `cb` is recording inside the matching rendering instance or subpass.
-            unsafe {
-                device.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipeline);
-                for (mi, m) in self.meshes.iter().enumerate() {
-                    device.cmd_push_constants(cb, self.layout, vk::ShaderStageFlags::VERTEX, 0, bytemuck::cast_slice(&push[mi]));
-                    device.cmd_bind_vertex_buffers(cb, 0, &[m.vertices.raw], &[0]);
-                    match draws {
-                        None => {
-                            device.cmd_bind_index_buffer(cb, m.indices.raw, 0, vk::IndexType::UINT32);
-                            device.cmd_draw_indexed(cb, m.index_count, 1, 0, 0, 0);
-                        }
-                        Some(d) if d[mi].1 > 0 => {
-                            device.cmd_bind_index_buffer(cb, slot_ref.lit.raw, 0, vk::IndexType::UINT32);
-                            device.cmd_draw_indexed(cb, d[mi].1, 1, d[mi].0, 0, 0);
-                        }
-                        Some(_) => {}
-                    }
-                }
-            }
+            unsafe { self.draw_meshes(cb, pipeline, push, slot_ref.lit.raw, draws) }
         };
         // Dynamic rendering: `color` (its old contents discarded, cleared) and the depth-stencil
         // (`ds_load`: CLEAR for the pre-pass, LOAD for the lighting), over the whole frame.
         let begin_rendering = |color: &super::vulkan::Img, ds_load| {
             image_barrier(device, cb, color.raw, vk::ImageAspectFlags::COLOR, (vk::ImageLayout::UNDEFINED, color_att), before, output);
-            let c = [attachment(color.view, vk::AttachmentLoadOp::CLEAR, color_clear)];
-            let d = attachment(depth.view, ds_load, ds_clear);
+            let c = [attachment(color.view, color_att, vk::AttachmentLoadOp::CLEAR, color_clear)];
+            let d = attachment(depth.view, ds_att, ds_load, ds_clear);
             let info = vk::RenderingInfo::default()
                 .render_area(full)
                 .layer_count(1)
@@ -184,11 +159,7 @@ impl Host {
             // in the layouts the barriers before left them in.
             unsafe { device.cmd_begin_rendering(cb, &info) };
         };
-        let begin_render_pass = |rp, fb, clears: &[vk::ClearValue]| {
-            let info = vk::RenderPassBeginInfo::default().render_pass(rp).framebuffer(fb).render_area(full).clear_values(clears);
-            // SAFETY: the framebuffer matches the render pass; `cb` is outside any render pass.
-            unsafe { device.cmd_begin_render_pass(cb, &info, vk::SubpassContents::INLINE) };
-        };
+        let begin_render_pass = |rp, fb, clears: &[vk::ClearValue]| begin_render_pass(device, cb, (rp, fb), full, clears);
 
         // SAFETY: (the whole recording) the caller's contract; every object recorded belongs to
         // this device and lives until the device is idle at teardown; the layouts named are
@@ -270,17 +241,7 @@ impl Host {
                     image_barrier(device, cb, depth.raw, ds_aspects, (ds_att, ds_read), written, compute_read);
                 }
                 // Every sample's stencil and lit bit (and, once, its depth and normal).
-                for sample in 0..samples {
-                    let push = ExtractPush {
-                        sample,
-                        width: self.extent.width,
-                        height: self.extent.height,
-                        geometry: (li == 0) as u32,
-                        geometry_at: layout.geometry(sample),
-                        packed_at: layout.packed(li, sample),
-                    };
-                    self.extract.record(device, cb, slot, push);
-                }
+                self.record_extract(cb, slot, li, &layout);
             }
             timestamp(vk::PipelineStageFlags::BOTTOM_OF_PIPE, 2 * lights + 1);
             memory_barrier(
@@ -292,6 +253,61 @@ impl Host {
             device.end_command_buffer(cb).map_err(vkerr("vkEndCommandBuffer"))?;
         }
         Ok(())
+    }
+
+    /// Binds `pipeline` and draws every mesh with its `push` block: all its triangles (`draws`
+    /// `None`), or its (first index, count) range of `draws` in the slot's `lit` index buffer.
+    ///
+    /// # Safety
+    /// `cb` is recording inside the matching rendering instance or subpass.
+    unsafe fn draw_meshes(
+        &self,
+        cb: vk::CommandBuffer,
+        pipeline: vk::Pipeline,
+        push: &[[[f32; 16]; 2]],
+        lit: vk::Buffer,
+        draws: Option<&Vec<(u32, u32)>>,
+    ) {
+        let device = self.dev();
+        // SAFETY: the caller's contract.
+        unsafe {
+            device.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipeline);
+            for (mi, m) in self.meshes.iter().enumerate() {
+                device.cmd_push_constants(cb, self.layout, vk::ShaderStageFlags::VERTEX, 0, bytemuck::cast_slice(&push[mi]));
+                device.cmd_bind_vertex_buffers(cb, 0, &[m.vertices.raw], &[0]);
+                match draws {
+                    None => {
+                        device.cmd_bind_index_buffer(cb, m.indices.raw, 0, vk::IndexType::UINT32);
+                        device.cmd_draw_indexed(cb, m.index_count, 1, 0, 0, 0);
+                    }
+                    Some(d) if d[mi].1 > 0 => {
+                        device.cmd_bind_index_buffer(cb, lit, 0, vk::IndexType::UINT32);
+                        device.cmd_draw_indexed(cb, d[mi].1, 1, d[mi].0, 0, 0);
+                    }
+                    Some(_) => {}
+                }
+            }
+        }
+    }
+
+    /// Records the extraction of light `li`'s every sample into slot `slot`'s readback.
+    ///
+    /// # Safety
+    /// As `Extract::record`'s: `cb` is recording outside any render pass; the views are in the
+    /// layouts `Views` names, their writes made visible to compute shader reads.
+    unsafe fn record_extract(&self, cb: vk::CommandBuffer, slot: usize, li: usize, layout: &Layout) {
+        for sample in 0..self.config.samples {
+            let push = ExtractPush {
+                sample,
+                width: self.extent.width,
+                height: self.extent.height,
+                geometry: (li == 0) as u32,
+                geometry_at: layout.geometry(sample),
+                packed_at: layout.packed(li, sample),
+            };
+            // SAFETY: the caller's contract.
+            unsafe { self.extract.record(self.dev(), cb, slot, push) };
+        }
     }
 
     /// Waits for the frame in flight in `slot` (if any), turns each sample of its readback
@@ -423,4 +439,33 @@ impl Host {
         });
         Ok(())
     }
+}
+
+/// A dynamic-rendering attachment at `view` in `layout`, loaded with `load` (or cleared to
+/// `clear`) and stored.
+fn attachment(
+    view: vk::ImageView,
+    layout: vk::ImageLayout,
+    load: vk::AttachmentLoadOp,
+    clear: vk::ClearValue,
+) -> vk::RenderingAttachmentInfo<'static> {
+    vk::RenderingAttachmentInfo::default()
+        .image_view(view)
+        .image_layout(layout)
+        .load_op(load)
+        .store_op(vk::AttachmentStoreOp::STORE)
+        .clear_value(clear)
+}
+
+/// Begins render pass `rp` with framebuffer `fb` over `area`, inline contents.
+fn begin_render_pass(
+    device: &ash::Device,
+    cb: vk::CommandBuffer,
+    (rp, fb): (vk::RenderPass, vk::Framebuffer),
+    area: vk::Rect2D,
+    clears: &[vk::ClearValue],
+) {
+    let info = vk::RenderPassBeginInfo::default().render_pass(rp).framebuffer(fb).render_area(area).clear_values(clears);
+    // SAFETY: the framebuffer matches the render pass; `cb` is outside any render pass.
+    unsafe { device.cmd_begin_render_pass(cb, &info, vk::SubpassContents::INLINE) };
 }
