@@ -73,32 +73,9 @@ impl Host {
 
         // Uniforms: per mesh its MVP (composed in f64 exactly as the pass composes its
         // volumes', so the volumes land on these depths), eye-relative model and normal map.
-        let vp = proj.as_dmat4() * view_rel.as_dmat4() * DMat4::from_translation(-eye);
-        let mut mesh_bytes = vec![0u8; UNIFORM_STRIDE as usize * self.scene.meshes.len().max(1)];
-        for (i, m) in self.scene.meshes.iter().enumerate() {
-            let model = m.transform.as_dmat4();
-            let normal = model.inverse().transpose();
-            let col = |v: glam::DVec4| v.truncate().as_vec3().extend(0.0).to_array();
-            let block = MeshBlock {
-                mvp: flip_y((vp * model).as_mat4()).to_cols_array(),
-                model_rel: (DMat4::from_translation(-eye) * model).as_mat4().to_cols_array(),
-                n: [col(normal.x_axis), col(normal.y_axis), col(normal.z_axis)],
-                color: m.color.extend(1.0).to_array(),
-                ambient: self.scene.ambient.extend(0.0).to_array(),
-            };
-            let o = i * UNIFORM_STRIDE as usize;
-            mesh_bytes[o..o + std::mem::size_of::<MeshBlock>()].copy_from_slice(bytemuck::bytes_of(&block));
-        }
-        let mut light_bytes = vec![0u8; UNIFORM_STRIDE as usize * self.scene.lights.len().max(1)];
-        for (i, l) in self.scene.lights.iter().enumerate() {
-            let block = light_block(l, eye);
-            let o = i * UNIFORM_STRIDE as usize;
-            light_bytes[o..o + std::mem::size_of::<LightBlock>()].copy_from_slice(bytemuck::bytes_of(&block));
-        }
+        self.write_uniforms(slot, eye, proj.as_dmat4() * view_rel.as_dmat4());
         let s = &self.slots[slot];
         let (device, queue) = (&self.gpu.device, &self.gpu.queue);
-        queue.write_buffer(&s.meshes, 0, &mesh_bytes);
-        queue.write_buffer(&s.lights, 0, &light_bytes);
 
         let t = &self.targets;
         let pass = self.pass.as_ref().ok_or("no pass")?;
@@ -151,28 +128,11 @@ impl Host {
         cbs.push(e.finish());
 
         // 2. Per light: determination (raw), stencil out, lighting (wgpu).
-        let stencil_pitch = pitch(w, 1);
         for (li, lf) in prepared.lights.iter().enumerate() {
             cbs.push(shadow::determine(device, &self.gpu.raw_device, pass, &prepared, li, &t.ds_target)?);
             let mut e = encoder("stencil readback + lighting");
             if let Some(c) = capture {
-                e.copy_texture_to_buffer(
-                    wgpu::TexelCopyTextureInfo {
-                        texture: &t.ds.texture,
-                        mip_level: 0,
-                        origin: wgpu::Origin3d::ZERO,
-                        aspect: wgpu::TextureAspect::StencilOnly,
-                    },
-                    wgpu::TexelCopyBufferInfo {
-                        buffer: &c.stencil,
-                        layout: wgpu::TexelCopyBufferLayout {
-                            offset: li as u64 * stencil_pitch as u64 * h as u64,
-                            bytes_per_row: Some(stencil_pitch),
-                            rows_per_image: Some(h),
-                        },
-                    },
-                    wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-                );
+                copy_stencil_out(&mut e, &t.ds.texture, &c.stencil, li, (w, h));
             }
             let sc = lf.scissor;
             if sc.extent.width > 0 && sc.extent.height > 0 {
@@ -204,33 +164,11 @@ impl Host {
 
         // 3. Tone map and copies out.
         let mut e = encoder("tone map + readback");
-        {
-            let mut rp = e.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("tone map"),
-                color_attachments: &[clear(&t.output.view)],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            rp.set_pipeline(&self.pipes.tonemap);
-            rp.set_bind_group(0, &self.pipes.tonemap_group, &[]);
-            rp.draw(0..3, 0..1);
-        }
-        let copy_out = |e: &mut wgpu::CommandEncoder, texture: &wgpu::Texture, buffer: &wgpu::Buffer, bpp: u32| {
-            e.copy_texture_to_buffer(
-                texture.as_image_copy(),
-                wgpu::TexelCopyBufferInfo {
-                    buffer,
-                    layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(pitch(w, bpp)), rows_per_image: Some(h) },
-                },
-                wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
-            );
-        };
-        copy_out(&mut e, &t.output.texture, &s.readback.color, 4);
+        self.tone_map(&mut e);
+        copy_out(&mut e, &t.output.texture, &s.readback.color, 4, (w, h));
         if let Some(c) = capture {
-            copy_out(&mut e, &t.position.texture, &c.positions, 16);
-            copy_out(&mut e, &t.normal.texture, &c.normals, 16);
+            copy_out(&mut e, &t.position.texture, &c.positions, 16, (w, h));
+            copy_out(&mut e, &t.normal.texture, &c.normals, 16, (w, h));
         }
         cbs.push(e.finish());
         let submission = queue.submit(cbs);
@@ -249,6 +187,60 @@ impl Host {
             record_ms,
         });
         Ok(retired)
+    }
+
+    /// Writes slot `slot`'s uniforms: per mesh its MVP (`view_proj`, eye-relative, times the
+    /// model in f64), eye-relative model and normal map; per light its block.
+    fn write_uniforms(&self, slot: usize, eye: DVec3, view_proj: DMat4) {
+        let vp = view_proj * DMat4::from_translation(-eye);
+        let mut mesh_bytes = vec![0u8; UNIFORM_STRIDE as usize * self.scene.meshes.len().max(1)];
+        for (i, m) in self.scene.meshes.iter().enumerate() {
+            let model = m.transform.as_dmat4();
+            let normal = model.inverse().transpose();
+            let col = |v: glam::DVec4| v.truncate().as_vec3().extend(0.0).to_array();
+            let block = MeshBlock {
+                mvp: flip_y((vp * model).as_mat4()).to_cols_array(),
+                model_rel: (DMat4::from_translation(-eye) * model).as_mat4().to_cols_array(),
+                n: [col(normal.x_axis), col(normal.y_axis), col(normal.z_axis)],
+                color: m.color.extend(1.0).to_array(),
+                ambient: self.scene.ambient.extend(0.0).to_array(),
+            };
+            let o = i * UNIFORM_STRIDE as usize;
+            mesh_bytes[o..o + std::mem::size_of::<MeshBlock>()].copy_from_slice(bytemuck::bytes_of(&block));
+        }
+        let mut light_bytes = vec![0u8; UNIFORM_STRIDE as usize * self.scene.lights.len().max(1)];
+        for (i, l) in self.scene.lights.iter().enumerate() {
+            let block = light_block(l, eye);
+            let o = i * UNIFORM_STRIDE as usize;
+            light_bytes[o..o + std::mem::size_of::<LightBlock>()].copy_from_slice(bytemuck::bytes_of(&block));
+        }
+        let s = &self.slots[slot];
+        let queue = &self.gpu.queue;
+        queue.write_buffer(&s.meshes, 0, &mesh_bytes);
+        queue.write_buffer(&s.lights, 0, &light_bytes);
+    }
+
+    /// The tone map of the float target into the sRGB output.
+    fn tone_map(&self, e: &mut wgpu::CommandEncoder) {
+        let clear = |view| {
+            Some(wgpu::RenderPassColorAttachment {
+                view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT), store: wgpu::StoreOp::Store },
+            })
+        };
+        let mut rp = e.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("tone map"),
+            color_attachments: &[clear(&self.targets.output.view)],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        rp.set_pipeline(&self.pipes.tonemap);
+        rp.set_bind_group(0, &self.pipes.tonemap_group, &[]);
+        rp.draw(0..3, 0..1);
     }
 
     /// Waits for the frame in flight in `slot`, if any; with `read`, maps its readback into a
@@ -377,4 +369,34 @@ fn read_rows(device: &wgpu::Device, buffer: &wgpu::Buffer, w: u32, rows: u32, bp
     };
     buffer.unmap();
     Ok(out)
+}
+
+/// Copies light `li`'s stencil out of the depth-stencil `texture` into its place in `buffer`
+/// (lights one after another, rows `pitch(w, 1)` bytes apart).
+fn copy_stencil_out(e: &mut wgpu::CommandEncoder, texture: &wgpu::Texture, buffer: &wgpu::Buffer, li: usize, (w, h): (u32, u32)) {
+    let stencil_pitch = pitch(w, 1);
+    e.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo { texture, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect: wgpu::TextureAspect::StencilOnly },
+        wgpu::TexelCopyBufferInfo {
+            buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: li as u64 * stencil_pitch as u64 * h as u64,
+                bytes_per_row: Some(stencil_pitch),
+                rows_per_image: Some(h),
+            },
+        },
+        wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+    );
+}
+
+/// Copies `texture` (`bpp` bytes a pixel) into `buffer`, rows `pitch(w, bpp)` bytes apart.
+fn copy_out(e: &mut wgpu::CommandEncoder, texture: &wgpu::Texture, buffer: &wgpu::Buffer, bpp: u32, (w, h): (u32, u32)) {
+    e.copy_texture_to_buffer(
+        texture.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer,
+            layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(pitch(w, bpp)), rows_per_image: Some(h) },
+        },
+        wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+    );
 }
