@@ -182,9 +182,6 @@ pub(crate) fn scene_text(rng: &mut Rng) -> String {
         return scene_text_valid(rng);
     }
     let mut s = String::new();
-    let kv = |s: &mut String, key: &str, val: String| {
-        let _ = writeln!(s, "{key} = {val}");
-    };
     if rng.chance(0.3) {
         kv(&mut s, "name", rng.pick(&["\"fuzz\"", "\"\"", "1", "\"a/b\""]).to_string());
     }
@@ -196,149 +193,13 @@ pub(crate) fn scene_text(rng: &mut Rng) -> String {
         let _ = writeln!(s, "{} = 1", rng.pick(&["unknown", "lights", "meshes", "camera"]));
     }
     if rng.chance(0.95) {
-        let _ = writeln!(s, "[camera]");
-        let eye = toml_vec(rng, 3);
-        kv(&mut s, "eye", eye);
-        let target = if rng.chance(0.05) { "[0.0, 0.0, 0.0]".to_string() } else { toml_vec(rng, 3) };
-        kv(&mut s, "target", target);
-        if rng.chance(0.4) {
-            let up = if rng.chance(0.2) { rng.pick(&["[0, 0, 0]", "[1, 0, 0]", "[0, 1, 0]"]).to_string() } else { toml_vec(rng, 3) };
-            kv(&mut s, "up", up);
-        }
-        if rng.chance(0.4) {
-            let f = if rng.chance(0.5) { rng.pick(&["0", "180", "179.9", "0.001", "-10", "360"]).to_string() } else { toml_num(rng) };
-            kv(&mut s, "fov_y_deg", f);
-        }
-        if rng.chance(0.3) {
-            let n = toml_num(rng);
-            kv(&mut s, "near", n);
-        }
-        if rng.bad() && rng.chance(0.03) {
-            let _ = writeln!(s, "far = 10");
-        }
+        camera_text(rng, &mut s);
     }
     for _ in 0..rng.below(4) {
-        let _ = writeln!(s, "[[light]]");
-        let kind = rng.pick_good(&["\"point\"", "\"spot\"", "\"directional\"", "\"point\"", "\"sun\"", "1", "\"\""], 4).to_string();
-        kv(&mut s, "kind", kind);
-        for (key, p) in [("position", 0.8), ("direction", 0.5), ("color", 0.3)] {
-            if rng.chance(p) {
-                let v = if key == "direction" && rng.chance(0.1) { "[0, 0, 0]".to_string() } else { toml_vec(rng, 3) };
-                kv(&mut s, key, v);
-            }
-        }
-        for (key, p) in [("intensity", 0.3), ("radius", 0.3), ("cone_deg", 0.4)] {
-            if rng.chance(p) {
-                let v = if key == "cone_deg" && rng.chance(0.5) {
-                    rng.pick(&["0", "180", "360", "90", "179", "-5"]).to_string()
-                } else {
-                    toml_num(rng)
-                };
-                kv(&mut s, key, v);
-            }
-        }
+        light_text(rng, &mut s);
     }
     for _ in 0..rng.below(4) {
-        let _ = writeln!(s, "[[mesh]]");
-        if rng.chance(0.2) {
-            let obj = rng
-                .pick_good(
-                    &[
-                        "\"open_box.obj\"",
-                        "\"inside_out_cube.obj\"",
-                        "\"shared_wall_boxes.obj\"",
-                        "\"two_sided_card.obj\"",
-                        "\"zero_area_cube.obj\"",
-                        "\"missing.obj\"",
-                        "\"\"",
-                        "\"..\"",
-                        "\"/\"",
-                        "\"open_box.obj\\u0000\"",
-                    ],
-                    5,
-                )
-                .to_string();
-            kv(&mut s, "obj", obj);
-        }
-        if rng.chance(0.9) {
-            let shape = rng
-                .pick_good(
-                    &[
-                        "\"plane\"",
-                        "\"box\"",
-                        "\"sphere\"",
-                        "\"torus\"",
-                        "\"cylinder\"",
-                        "\"stairs\"",
-                        "\"cube_grid\"",
-                        "\"box_stack\"",
-                        "\"bumpy_slab\"",
-                        "\"cone\"",
-                        "3",
-                    ],
-                    9,
-                )
-                .to_string();
-            kv(&mut s, "shape", shape);
-        }
-        // shape parameters, any of them on any shape
-        if rng.chance(0.4) {
-            let v = match rng.below(4) {
-                0 => toml_num(rng),
-                1 => toml_vec(rng, 2),
-                _ => toml_vec(rng, 3),
-            };
-            kv(&mut s, "size", v);
-        }
-        for key in ["radius", "major_radius", "minor_radius", "height", "spacing", "bump"] {
-            if rng.chance(0.15) {
-                let v = toml_num(rng);
-                kv(&mut s, key, v);
-            }
-        }
-        for key in ["segments", "rings", "sides", "steps", "divisions"] {
-            if rng.chance(0.15) {
-                let v = toml_int(rng);
-                kv(&mut s, key, v);
-            }
-        }
-        if rng.chance(0.15) {
-            let v = match rng.below(3) {
-                0 => format!("{}", 1 + rng.below(30)),
-                1 => format!("[{}, {}]", 1 + rng.below(8), rng.below(9)),
-                _ => toml_num(rng),
-            };
-            kv(&mut s, "count", v);
-        }
-        for key in ["step", "offset", "translate", "rotate_deg", "color"] {
-            if rng.chance(0.2) {
-                let v = toml_vec(rng, 3);
-                kv(&mut s, key, v);
-            }
-        }
-        if rng.chance(0.3) {
-            let v = match rng.below(4) {
-                0 => toml_vec(rng, 3),
-                1 => rng.pick(&["0", "-1", "[1, -1, 1]", "[0, 1, 1]", "1e-20", "1e20"]).to_string(),
-                _ => toml_num(rng),
-            };
-            kv(&mut s, "scale", v);
-        }
-        if rng.chance(0.2) {
-            let v = if rng.chance(0.5) { format!("{:.2}", rng.range(-0.5, 1.5)) } else { toml_num(rng) };
-            kv(&mut s, "opacity", v);
-        }
-        if rng.chance(0.2) {
-            let v = rng.pick(&["true", "false", "1", "\"yes\""]).to_string();
-            kv(&mut s, "casts_shadow", v);
-        }
-        if rng.chance(0.1) {
-            let v = rng.pick(&["\"m\"", "\"\"", "\"a\\nb\""]).to_string();
-            kv(&mut s, "name", v);
-        }
-        if rng.bad() && rng.chance(0.03) {
-            let _ = writeln!(s, "colour = [1, 1, 1]");
-        }
+        mesh_text(rng, &mut s);
     }
     // missing keys and tables: drop a few lines
     if rng.bad() && rng.chance(0.3) {
@@ -349,6 +210,164 @@ pub(crate) fn scene_text(rng: &mut Rng) -> String {
         mutate_bytes(rng, &mut s);
     }
     s
+}
+
+/// A `key = value` line.
+fn kv(s: &mut String, key: &str, val: String) {
+    let _ = writeln!(s, "{key} = {val}");
+}
+
+/// The `[camera]` table: eye and target, maybe up, fov_y_deg and near (and, bad, `far`).
+fn camera_text(rng: &mut Rng, s: &mut String) {
+    let _ = writeln!(s, "[camera]");
+    let eye = toml_vec(rng, 3);
+    kv(s, "eye", eye);
+    let target = if rng.chance(0.05) { "[0.0, 0.0, 0.0]".to_string() } else { toml_vec(rng, 3) };
+    kv(s, "target", target);
+    if rng.chance(0.4) {
+        let up = if rng.chance(0.2) { rng.pick(&["[0, 0, 0]", "[1, 0, 0]", "[0, 1, 0]"]).to_string() } else { toml_vec(rng, 3) };
+        kv(s, "up", up);
+    }
+    if rng.chance(0.4) {
+        let f = if rng.chance(0.5) { rng.pick(&["0", "180", "179.9", "0.001", "-10", "360"]).to_string() } else { toml_num(rng) };
+        kv(s, "fov_y_deg", f);
+    }
+    if rng.chance(0.3) {
+        let n = toml_num(rng);
+        kv(s, "near", n);
+    }
+    if rng.bad() && rng.chance(0.03) {
+        let _ = writeln!(s, "far = 10");
+    }
+}
+
+/// One `[[light]]` table: a kind (maybe a bad one), maybe position, direction, colour,
+/// intensity, radius and cone_deg.
+fn light_text(rng: &mut Rng, s: &mut String) {
+    let _ = writeln!(s, "[[light]]");
+    let kind = rng.pick_good(&["\"point\"", "\"spot\"", "\"directional\"", "\"point\"", "\"sun\"", "1", "\"\""], 4).to_string();
+    kv(s, "kind", kind);
+    for (key, p) in [("position", 0.8), ("direction", 0.5), ("color", 0.3)] {
+        if rng.chance(p) {
+            let v = if key == "direction" && rng.chance(0.1) { "[0, 0, 0]".to_string() } else { toml_vec(rng, 3) };
+            kv(s, key, v);
+        }
+    }
+    for (key, p) in [("intensity", 0.3), ("radius", 0.3), ("cone_deg", 0.4)] {
+        if rng.chance(p) {
+            let v = if key == "cone_deg" && rng.chance(0.5) {
+                rng.pick(&["0", "180", "360", "90", "179", "-5"]).to_string()
+            } else {
+                toml_num(rng)
+            };
+            kv(s, key, v);
+        }
+    }
+}
+
+/// One `[[mesh]]` table: maybe an obj, a shape, any shape's parameters, the transform,
+/// opacity, casts_shadow and name (and, bad, `colour`).
+fn mesh_text(rng: &mut Rng, s: &mut String) {
+    let _ = writeln!(s, "[[mesh]]");
+    if rng.chance(0.2) {
+        let obj = rng
+            .pick_good(
+                &[
+                    "\"open_box.obj\"",
+                    "\"inside_out_cube.obj\"",
+                    "\"shared_wall_boxes.obj\"",
+                    "\"two_sided_card.obj\"",
+                    "\"zero_area_cube.obj\"",
+                    "\"missing.obj\"",
+                    "\"\"",
+                    "\"..\"",
+                    "\"/\"",
+                    "\"open_box.obj\\u0000\"",
+                ],
+                5,
+            )
+            .to_string();
+        kv(s, "obj", obj);
+    }
+    if rng.chance(0.9) {
+        let shape = rng
+            .pick_good(
+                &[
+                    "\"plane\"",
+                    "\"box\"",
+                    "\"sphere\"",
+                    "\"torus\"",
+                    "\"cylinder\"",
+                    "\"stairs\"",
+                    "\"cube_grid\"",
+                    "\"box_stack\"",
+                    "\"bumpy_slab\"",
+                    "\"cone\"",
+                    "3",
+                ],
+                9,
+            )
+            .to_string();
+        kv(s, "shape", shape);
+    }
+    // shape parameters, any of them on any shape
+    if rng.chance(0.4) {
+        let v = match rng.below(4) {
+            0 => toml_num(rng),
+            1 => toml_vec(rng, 2),
+            _ => toml_vec(rng, 3),
+        };
+        kv(s, "size", v);
+    }
+    for key in ["radius", "major_radius", "minor_radius", "height", "spacing", "bump"] {
+        if rng.chance(0.15) {
+            let v = toml_num(rng);
+            kv(s, key, v);
+        }
+    }
+    for key in ["segments", "rings", "sides", "steps", "divisions"] {
+        if rng.chance(0.15) {
+            let v = toml_int(rng);
+            kv(s, key, v);
+        }
+    }
+    if rng.chance(0.15) {
+        let v = match rng.below(3) {
+            0 => format!("{}", 1 + rng.below(30)),
+            1 => format!("[{}, {}]", 1 + rng.below(8), rng.below(9)),
+            _ => toml_num(rng),
+        };
+        kv(s, "count", v);
+    }
+    for key in ["step", "offset", "translate", "rotate_deg", "color"] {
+        if rng.chance(0.2) {
+            let v = toml_vec(rng, 3);
+            kv(s, key, v);
+        }
+    }
+    if rng.chance(0.3) {
+        let v = match rng.below(4) {
+            0 => toml_vec(rng, 3),
+            1 => rng.pick(&["0", "-1", "[1, -1, 1]", "[0, 1, 1]", "1e-20", "1e20"]).to_string(),
+            _ => toml_num(rng),
+        };
+        kv(s, "scale", v);
+    }
+    if rng.chance(0.2) {
+        let v = if rng.chance(0.5) { format!("{:.2}", rng.range(-0.5, 1.5)) } else { toml_num(rng) };
+        kv(s, "opacity", v);
+    }
+    if rng.chance(0.2) {
+        let v = rng.pick(&["true", "false", "1", "\"yes\""]).to_string();
+        kv(s, "casts_shadow", v);
+    }
+    if rng.chance(0.1) {
+        let v = rng.pick(&["\"m\"", "\"\"", "\"a\\nb\""]).to_string();
+        kv(s, "name", v);
+    }
+    if rng.bad() && rng.chance(0.03) {
+        let _ = writeln!(s, "colour = [1, 1, 1]");
+    }
 }
 
 /// Plans every caster of a loaded scene for every light and checks the volumes.
