@@ -194,6 +194,13 @@ fn tiny_suite(tag: &str, driver: &[(String, Option<String>)]) -> serde_json::Val
     assert!(error_of("shadowmap-512-gather").is_some(), "no gather row");
     assert_eq!(error_of("shadowmap-512"), error_of("shadowmap-512-gather"), "taps and gathers disagree");
     keys(limits, &["setup_tri_mtri_s", "clip_tri_mtri_s", "sweeps"], "limits");
+    plots_and_report(&dir);
+    let _ = std::fs::remove_dir_all(&dir);
+    v
+}
+
+/// The suite's plots (SVG and PNG, each more than 1000 bytes) and bench.md's sections.
+fn plots_and_report(dir: &std::path::Path) {
     for p in ["time_vs_triangles", "time_vs_resolution", "roofline", "pareto", "model_fit"] {
         for ext in ["svg", "png"] {
             let f = dir.join(format!("{p}.{ext}"));
@@ -212,8 +219,6 @@ fn tiny_suite(tag: &str, driver: &[(String, Option<String>)]) -> serde_json::Val
     assert!(md.contains("## Separate against merged casters") && md.contains("| mcguire |"), "no separate-against-merged pair");
     assert!(md.contains("## The frame's other passes against their limits") && md.contains("- `default`: the lighting pass is "));
     assert!(md.contains("| phase | wall s | CPU s |"), "no phases table");
-    let _ = std::fs::remove_dir_all(&dir);
-    v
 }
 
 /// The one-factor sweeps (issue #38): each moves one count while the others stay.
