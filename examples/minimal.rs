@@ -317,7 +317,7 @@ fn record_frame(
     (depth_image, depth_view, extent, range): (vk::Image, vk::ImageView, vk::Extent2D, vk::ImageSubresourceRange),
     (layout, pipeline, readback): (vk::PipelineLayout, vk::Pipeline, &Buffer),
 ) -> Result<(), String> {
-    let &Gpu { ref device, queue, fence, cb, .. } = gpu;
+    let (device, queue, fence, cb) = (&gpu.device, gpu.queue, gpu.fence, gpu.cb);
     // Barriers (synchronization2) on the depth-stencil image: both aspects, a layout change
     // `old -> new` (or none), after `src` (stages, accesses) and before `dst`.
     let (tests, attachment) = (S::EARLY_FRAGMENT_TESTS | S::LATE_FRAGMENT_TESTS, vk::ImageLayout::DEPTH_STENCIL_ATTACHMENT_OPTIMAL);
