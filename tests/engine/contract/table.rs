@@ -1,5 +1,5 @@
-//! The rows of [`rows`](super::rows)'s table, one function per group of inputs, in the
-//! table's order.
+//! The rows of `docs/contract.md`'s table, concatenated by [`super::rows`]: one function per
+//! group of inputs, in the table's order.
 
 use super::*;
 
