@@ -91,7 +91,7 @@ fn main() -> ExitCode {
 pub fn run() -> Result<(), String> {
     // ---- 1. Vulkan: instance, device, queue, allocator --------------------------------------
     let gpu = create_device()?;
-    let (Gpu { instance, device, allocator, .. }, physical, ds_format) = (&gpu, gpu.physical, gpu.ds_format);
+    let (instance, physical, device, allocator, ds_format) = (&gpu.instance, gpu.physical, &gpu.device, &gpu.allocator, gpu.ds_format);
 
     // ---- 2. The scene, and the pass -----------------------------------------------------------
     let floor: Vec<Vec3> =
