@@ -10,7 +10,7 @@ use super::planar::flatten;
 use super::stats::{CasterStats, CpuMs, LightStats, PartStats, Totals, Triangles, UsedIndexFormat};
 use super::view::ShadowView;
 use crate::geom::{Camera, Light};
-use crate::shadow::{self, Case, CasterKind, PlanInput, PlanOptions, VolumePath};
+use crate::shadow::{self, Case, CasterKind, LightPlan, PlanInput, PlanOptions, VolumePath};
 use ash::vk;
 use glam::{DMat4, DVec3, Mat4, Vec4};
 
@@ -174,42 +174,58 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput, kept: Option<Vec<supe
             // The spheres' planning (tangency circles, n, volumes) counts as planning.
             cpu.plan += start.elapsed().as_secs_f64() * 1e3;
         }
-        let scissor = plan
-            .scissor
-            .map(|[x, y, sw, sh]| vk::Rect2D {
-                offset: vk::Offset2D { x: x as i32, y: y as i32 },
-                extent: vk::Extent2D { width: sw, height: sh },
-            })
-            .filter(|r| r.extent.width > 0 && r.extent.height > 0 && input.settings.toggles.scissor)
-            .unwrap_or(full);
-        let depth_bounds = if input.depth_bounds { plan.depth_bounds } else { None };
-        let depth_bounds = match input.direction {
-            DepthDirection::Forward => depth_bounds,
-            DepthDirection::Reverse => depth_bounds.map(|(lo, hi)| reversed_bounds(lo, hi)),
-        };
-        let (eye_volumes, near_plane_split) = if method == shadow::Method::ZPassClear {
-            let [c0, c1, c2, c3] = near_corners(&fwd);
-            let counts = super::eye::volumes_containing(&[view.eye, c0, c1, c2, c3], light, &plan, table);
-            (Some(counts[0]), Some(counts[1..].iter().any(|&c| c != counts[0])))
-        } else {
-            (None, None)
-        };
-        let stats = LightStats {
-            index: li,
-            kind: light.kind,
-            scissor: plan.scissor.filter(|_| input.settings.toggles.scissor),
-            depth_bounds: depth_bounds.map(|(a, b)| [a, b]),
-            casters: cstats,
-            eye_volumes,
-            near_plane_split,
-        };
-        let counter_clear = eye_volumes.unwrap_or(0).max(0) as u32;
-        lights.push(LightFrame { scissor, depth_bounds, stats, plan, counter_clear, casters });
+        lights.push(light_frame(table, input, (&fwd, full), (li, light), plan, (cstats, casters)));
     }
     align(&mut stream, 16);
     // what the stream carries (kept pairs' lists were sent when they were planned)
     totals.bytes_sent = totals.index_bytes + totals.vertex_bytes - from_kept;
     Packed { stream, lights, totals, cpu, compute }
+}
+
+/// Light `li`'s frame from its plan and packed casters: its scissor (the whole target `full`
+/// when it has none or scissors are off), depth bounds in the host's direction, and for
+/// z-pass with clear the volumes containing the eye.
+fn light_frame(
+    table: &CasterTable,
+    input: &PackInput,
+    (fwd, full): (&ShadowView, vk::Rect2D),
+    (li, light): (usize, &Light),
+    plan: LightPlan,
+    (cstats, casters): (Vec<CasterStats>, Vec<CasterDraw>),
+) -> LightFrame {
+    let view = input.view;
+    let method = input.settings.technique.method();
+    let scissor = plan
+        .scissor
+        .map(|[x, y, sw, sh]| vk::Rect2D {
+            offset: vk::Offset2D { x: x as i32, y: y as i32 },
+            extent: vk::Extent2D { width: sw, height: sh },
+        })
+        .filter(|r| r.extent.width > 0 && r.extent.height > 0 && input.settings.toggles.scissor)
+        .unwrap_or(full);
+    let depth_bounds = if input.depth_bounds { plan.depth_bounds } else { None };
+    let depth_bounds = match input.direction {
+        DepthDirection::Forward => depth_bounds,
+        DepthDirection::Reverse => depth_bounds.map(|(lo, hi)| reversed_bounds(lo, hi)),
+    };
+    let (eye_volumes, near_plane_split) = if method == shadow::Method::ZPassClear {
+        let [c0, c1, c2, c3] = near_corners(fwd);
+        let counts = super::eye::volumes_containing(&[view.eye, c0, c1, c2, c3], light, &plan, table);
+        (Some(counts[0]), Some(counts[1..].iter().any(|&c| c != counts[0])))
+    } else {
+        (None, None)
+    };
+    let stats = LightStats {
+        index: li,
+        kind: light.kind,
+        scissor: plan.scissor.filter(|_| input.settings.toggles.scissor),
+        depth_bounds: depth_bounds.map(|(a, b)| [a, b]),
+        casters: cstats,
+        eye_volumes,
+        near_plane_split,
+    };
+    let counter_clear = eye_volumes.unwrap_or(0).max(0) as u32;
+    LightFrame { scissor, depth_bounds, stats, plan, counter_clear, casters }
 }
 
 /// One caster's index lists (or naive vertices) for one light, written into the stream.
