@@ -270,8 +270,9 @@ pub fn create(ctx: &impl GpuDevice, d: &PipelineDesc) -> Result<vk::Pipeline> {
     result.map(|p| p[0])
 }
 
-/// The colour attachment state of `blend`, writing the components of `mask`.
-fn blend_attachment(blend: Blend, mask: vk::ColorComponentFlags) -> vk::PipelineColorBlendAttachmentState {
+/// The colour attachment state of `blend`, writing the components of `mask` (what
+/// [`create`] gives each colour attachment; for pipelines made by hand).
+pub fn blend_attachment(blend: Blend, mask: vk::ColorComponentFlags) -> vk::PipelineColorBlendAttachmentState {
     match blend {
         Blend::None => vk::PipelineColorBlendAttachmentState::default().color_write_mask(mask),
         Blend::Additive => vk::PipelineColorBlendAttachmentState::default()

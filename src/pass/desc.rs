@@ -251,6 +251,9 @@ named_enum!(
     }
 );
 
+/// The default [`ShadowPassDesc::keep_budget_bytes`]: 64 MiB.
+pub const DEFAULT_KEEP_BUDGET: u64 = 64 << 20;
+
 /// What a [`ShadowPass`](super::ShadowPass) is created for: set by the host, once, at
 /// [`ShadowPass::new`](super::ShadowPass::new). Everything here is fixed for the pass's
 /// lifetime (pipelines and ring slots are built from it); per-frame choices are in
@@ -351,7 +354,7 @@ impl Default for ShadowPassDesc {
             transmit_format: None,
             debug_color_format: None,
             pipeline_cache: vk::PipelineCache::null(),
-            keep_budget_bytes: super::keep::DEFAULT_KEEP_BUDGET,
+            keep_budget_bytes: DEFAULT_KEEP_BUDGET,
             plan_threads: 0,
         }
     }

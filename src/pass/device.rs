@@ -118,3 +118,11 @@ fn check_samples(caps: &DeviceCaps, desc: &ShadowPassDesc) -> Result<()> {
     }
     Ok(())
 }
+
+/// What the pass asks of every technique's state, whichever technique the frame runs.
+pub(super) trait TechniqueState {
+    /// The ring slot's previous frame retired: release what only that frame used.
+    fn slot_retired(&mut self, _dev: &PassDevice, _slot: usize) {}
+    /// Releases every object (the pass is dropped, after every frame that used it completed).
+    fn destroy(&mut self, dev: &PassDevice);
+}

@@ -5,7 +5,8 @@
 //! `use umbrage::pass::diagnostics::Diagnostics`.
 
 use super::frame::PreparedFrame;
-use super::record::{Instance, VolumeKind};
+use super::record::Instance;
+use super::stencil::VolumeKind;
 use super::target::DepthStencilTarget;
 use super::ShadowPass;
 use crate::error::{Misuse, Result};

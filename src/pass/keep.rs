@@ -33,13 +33,15 @@
 //! casters its range may reach; the pairs to plan are planned on
 //! [`ShadowPassDesc::plan_threads`](super::ShadowPassDesc::plan_threads) threads.
 
+mod fx;
 pub(crate) mod grid;
+use fx::FxBuild;
 
 use super::casters::{CasterId, CasterTable};
 use super::desc::IndexFormat;
 use super::device::PassDevice;
 use super::draw::Draw;
-use super::pack::{write_chunks, ChunkDraws};
+use super::lists::{write_chunks, ChunkDraws};
 use crate::error::Result;
 use crate::geom::{Camera, Light, LightKind};
 use crate::gpu::Buffer;
@@ -48,9 +50,6 @@ use ash::vk;
 use glam::{Mat4, Vec3, Vec4};
 use std::collections::HashMap;
 use std::time::Instant;
-
-/// The default [`ShadowPassDesc::keep_budget_bytes`](super::ShadowPassDesc::keep_budget_bytes): 64 MiB.
-pub const DEFAULT_KEEP_BUDGET: u64 = 64 << 20;
 
 /// Below this many caster triangles to plan, a frame plans them on the calling thread
 /// (starting a thread costs tens of microseconds: about the planning of 50k triangles).
@@ -93,49 +92,6 @@ impl CasesKey {
         CasesKey::Packed { parts: cases.len() as u8, bits }
     }
 }
-
-/// A multiply-rotate hasher (as rustc's FxHash) for the keys and the grid's cells: a look-up a
-/// drawn pair, every frame, where SipHash's resistance to chosen keys buys nothing.
-#[derive(Default, Clone, Copy)]
-pub(crate) struct Fx(u64);
-
-impl std::hash::Hasher for Fx {
-    #[inline]
-    fn write(&mut self, bytes: &[u8]) {
-        for c in bytes.chunks(8) {
-            let mut w = [0u8; 8];
-            w[..c.len()].copy_from_slice(c);
-            self.write_u64(u64::from_le_bytes(w));
-        }
-    }
-    #[inline]
-    fn write_u64(&mut self, v: u64) {
-        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
-    }
-    #[inline]
-    fn write_u32(&mut self, v: u32) {
-        self.write_u64(v as u64);
-    }
-    #[inline]
-    fn write_u8(&mut self, v: u8) {
-        self.write_u64(v as u64);
-    }
-    #[inline]
-    fn write_usize(&mut self, v: usize) {
-        self.write_u64(v as u64);
-    }
-    #[inline]
-    fn write_isize(&mut self, v: isize) {
-        self.write_u64(v as u64);
-    }
-    #[inline]
-    fn finish(&self) -> u64 {
-        self.0
-    }
-}
-
-/// [`Fx`]'s builder.
-pub(crate) type FxBuild = std::hash::BuildHasherDefault<Fx>;
 
 /// One kept pair.
 struct Entry {
@@ -359,6 +315,33 @@ impl Kept {
         let mut stats = KeepStats { active: true, evictions, ..KeepStats::default() };
         let light_keys: Vec<[u32; 4]> = input.lights.iter().map(|l| l.homogeneous().to_array().map(f32::to_bits)).collect();
         let opts = PlanOptions { edge_quads: false, case_per_part: true, gpu_silhouettes: false, no_culling: input.no_culling };
+        let Matched { mut lights, misses, pending } = self.match_pairs(table, input, &opts, (&light_keys, &caster_moved), &mut stats);
+        stats.cull_ms = t0.elapsed().as_secs_f64() * 1e3;
+
+        // Plan the pairs that need it, on every thread allowed.
+        let t1 = Instant::now();
+        let planned = plan_misses(table, input, &opts, &misses);
+        stats.pairs_replanned = pending.len() as u64;
+        // Keep them (or, past the budget, draw them from the stream as planning from scratch
+        // would), then hand each light its plans.
+        let (plans, kept) = self.keep_planned(dev, input, misses, planned, &mut stats)?;
+        distribute(&mut lights, pending, plans, kept);
+        stats.plan_ms = t1.elapsed().as_secs_f64() * 1e3;
+        stats.kept_bytes = self.bytes;
+        self.prev_lights = light_keys;
+        Ok((lights, stats))
+    }
+
+    /// Culls every light's casters (through the grid for a bounded light) and takes each
+    /// drawn pair's plan from what is kept, or records it as a miss to plan.
+    fn match_pairs(
+        &mut self,
+        table: &CasterTable,
+        input: &KeepInput,
+        opts: &PlanOptions,
+        (light_keys, caster_moved): (&[[u32; 4]], &[bool]),
+        stats: &mut KeepStats,
+    ) -> Matched {
         let bounds: Vec<crate::geom::Aabb> = table.cpu.iter().map(|c| c.world_bounds()).collect();
         let mut cases: Vec<Case> = Vec::new();
         let n = table.cpu.len();
@@ -397,7 +380,7 @@ impl Kept {
             let mut omitted = omitted_unvisited;
             for &ci in visit {
                 let (ci, caster) = (ci as usize, &table.cpu[ci as usize]);
-                if !ctx.caster_cases_into(&pi, &opts, caster, bounds[ci], &mut cases) {
+                if !ctx.caster_cases_into(&pi, opts, caster, bounds[ci], &mut cases) {
                     // culled (range, cone or view): left out too
                     omitted += 1;
                     continue;
@@ -447,66 +430,19 @@ impl Kept {
             let (scissor, depth_bounds) = ctx.screen_bounds(&pi);
             lights.push(KeptLight { plan: LightPlan { scissor, depth_bounds, casters, silhouette_ms: 0.0, plan_ms: 0.0 }, draws, omitted });
         }
-        stats.cull_ms = t0.elapsed().as_secs_f64() * 1e3;
+        Matched { lights, misses, pending }
+    }
 
-        // Plan the pairs that need it, on every thread allowed.
-        let t1 = Instant::now();
-        let handles: Vec<Vec<vk::Buffer>> = table.live.iter().map(|g| g.chunks.iter().map(|b| b.raw).collect()).collect();
-        let job = |m: &Miss, scratch: &mut PlanScratch| -> Planned {
-            let pi = PlanInput {
-                camera: input.camera,
-                width: input.width,
-                height: input.height,
-                view_proj: input.view_proj,
-                light: &input.lights[m.light],
-                method: input.method,
-            };
-            let caster = &table.cpu[m.caster];
-            let plan = shadow::plan_caster(&pi, &opts, (m.caster, caster), m.l_obj, &m.cases, scratch);
-            // (a pair that moves goes to the stream: `pack` writes it there)
-            let lists = m.keep.then(|| {
-                let mut bytes = Vec::new();
-                let draws = write_chunks(&mut bytes, (input.format, input.u8_ok), caster, &handles[m.caster], &plan);
-                (bytes, draws)
-            });
-            Planned { plan, lists }
-        };
-        let threads = input.threads.max(1).min(misses.len().max(1));
-        let work: Vec<usize> = misses.iter().map(|m| table.cpu[m.caster].triangle_count.max(1)).collect();
-        let total: usize = work.iter().sum();
-        let planned: Vec<Planned> = if threads <= 1 || total < PARALLEL_MIN_TRIANGLES {
-            let mut scratch = PlanScratch::default();
-            misses.iter().map(|m| job(m, &mut scratch)).collect()
-        } else {
-            // contiguous runs of about equal triangle counts, one a thread
-            let mut parts: Vec<&[Miss]> = Vec::with_capacity(threads);
-            let (mut start, mut acc) = (0, 0);
-            for (i, w) in work.iter().enumerate() {
-                acc += w;
-                if acc * threads >= total * (parts.len() + 1) && parts.len() + 1 < threads {
-                    parts.push(&misses[start..=i]);
-                    start = i + 1;
-                }
-            }
-            parts.push(&misses[start..]);
-            std::thread::scope(|s| {
-                let workers: Vec<_> = parts
-                    .into_iter()
-                    .map(|part| {
-                        let job = &job;
-                        s.spawn(move || {
-                            let mut scratch = PlanScratch::default();
-                            part.iter().map(|m| job(m, &mut scratch)).collect::<Vec<_>>()
-                        })
-                    })
-                    .collect();
-                workers.into_iter().flat_map(|w| w.join().unwrap_or_else(|p| std::panic::resume_unwind(p))).collect()
-            })
-        };
-        stats.pairs_replanned = pending.len() as u64;
-
-        // Keep them (or, past the budget, draw them from the stream as planning from scratch
-        // would).
+    /// Keeps each planned pair's lists in a buffer of its own, within the budget; the plans
+    /// and, for the pairs kept, their draws from the kept buffer.
+    fn keep_planned(
+        &mut self,
+        dev: &PassDevice,
+        input: &KeepInput,
+        misses: Vec<Miss>,
+        planned: Vec<Planned>,
+        stats: &mut KeepStats,
+    ) -> Result<(Vec<CasterPlan>, Vec<Option<ChunkDraws>>)> {
         let mut kept: Vec<Option<ChunkDraws>> = Vec::with_capacity(planned.len());
         let mut plans: Vec<CasterPlan> = Vec::with_capacity(planned.len());
         for (m, p) in misses.into_iter().zip(planned) {
@@ -552,26 +488,93 @@ impl Kept {
             };
             self.entries.insert(m.key, e);
         }
-        // (a plan drawn by one light is moved, not copied: its index lists may be long)
-        let mut uses = vec![0usize; plans.len()];
-        for &(_, _, m) in &pending {
-            uses[m] += 1;
+        Ok((plans, kept))
+    }
+}
+
+/// What [`Kept::match_pairs`] found: each light's plans (the missed pairs' culled
+/// placeholders), the pairs to plan, and where each missed pair goes (light, position in its
+/// lists, miss).
+struct Matched {
+    lights: Vec<KeptLight>,
+    misses: Vec<Miss>,
+    pending: Vec<(usize, usize, usize)>,
+}
+
+/// Plans the missed pairs, on up to `input.threads` threads above
+/// [`PARALLEL_MIN_TRIANGLES`] (contiguous runs of about equal triangle counts, one a thread).
+fn plan_misses(table: &CasterTable, input: &KeepInput, opts: &PlanOptions, misses: &[Miss]) -> Vec<Planned> {
+    let handles: Vec<Vec<vk::Buffer>> = table.live.iter().map(|g| g.chunks.iter().map(|b| b.raw).collect()).collect();
+    let job = |m: &Miss, scratch: &mut PlanScratch| -> Planned {
+        let pi = PlanInput {
+            camera: input.camera,
+            width: input.width,
+            height: input.height,
+            view_proj: input.view_proj,
+            light: &input.lights[m.light],
+            method: input.method,
+        };
+        let caster = &table.cpu[m.caster];
+        let plan = shadow::plan_caster(&pi, opts, (m.caster, caster), m.l_obj, &m.cases, scratch);
+        // (a pair that moves goes to the stream: `pack` writes it there)
+        let lists = m.keep.then(|| {
+            let mut bytes = Vec::new();
+            let draws = write_chunks(&mut bytes, (input.format, input.u8_ok), caster, &handles[m.caster], &plan);
+            (bytes, draws)
+        });
+        Planned { plan, lists }
+    };
+    let threads = input.threads.max(1).min(misses.len().max(1));
+    let work: Vec<usize> = misses.iter().map(|m| table.cpu[m.caster].triangle_count.max(1)).collect();
+    let total: usize = work.iter().sum();
+    if threads <= 1 || total < PARALLEL_MIN_TRIANGLES {
+        let mut scratch = PlanScratch::default();
+        misses.iter().map(|m| job(m, &mut scratch)).collect()
+    } else {
+        // contiguous runs of about equal triangle counts, one a thread
+        let mut parts: Vec<&[Miss]> = Vec::with_capacity(threads);
+        let (mut start, mut acc) = (0, 0);
+        for (i, w) in work.iter().enumerate() {
+            acc += w;
+            if acc * threads >= total * (parts.len() + 1) && parts.len() + 1 < threads {
+                parts.push(&misses[start..=i]);
+                start = i + 1;
+            }
         }
-        let mut plans: Vec<Option<CasterPlan>> = plans.into_iter().map(Some).collect();
-        for (li, k, m) in pending {
-            let l = &mut lights[li];
-            uses[m] -= 1;
-            let mut plan = match uses[m] {
-                0 => plans[m].take().unwrap_or_else(|| l.plan.casters[k].clone()),
-                _ => plans[m].clone().unwrap_or_else(|| l.plan.casters[k].clone()),
-            };
-            plan.caster = l.plan.casters[k].caster;
-            l.plan.casters[k] = plan;
-            l.draws[k] = if uses[m] == 0 { kept[m].take() } else { kept[m].clone() };
-        }
-        stats.plan_ms = t1.elapsed().as_secs_f64() * 1e3;
-        stats.kept_bytes = self.bytes;
-        self.prev_lights = light_keys;
-        Ok((lights, stats))
+        parts.push(&misses[start..]);
+        std::thread::scope(|s| {
+            let workers: Vec<_> = parts
+                .into_iter()
+                .map(|part| {
+                    let job = &job;
+                    s.spawn(move || {
+                        let mut scratch = PlanScratch::default();
+                        part.iter().map(|m| job(m, &mut scratch)).collect::<Vec<_>>()
+                    })
+                })
+                .collect();
+            workers.into_iter().flat_map(|w| w.join().unwrap_or_else(|p| std::panic::resume_unwind(p))).collect()
+        })
+    }
+}
+
+/// Puts each planned pair's plan and draws in the lists of every light that drew it (a plan
+/// drawn by one light is moved, not copied: its index lists may be long).
+fn distribute(lights: &mut [KeptLight], pending: Vec<(usize, usize, usize)>, plans: Vec<CasterPlan>, mut kept: Vec<Option<ChunkDraws>>) {
+    let mut uses = vec![0usize; plans.len()];
+    for &(_, _, m) in &pending {
+        uses[m] += 1;
+    }
+    let mut plans: Vec<Option<CasterPlan>> = plans.into_iter().map(Some).collect();
+    for (li, k, m) in pending {
+        let l = &mut lights[li];
+        uses[m] -= 1;
+        let mut plan = match uses[m] {
+            0 => plans[m].take().unwrap_or_else(|| l.plan.casters[k].clone()),
+            _ => plans[m].clone().unwrap_or_else(|| l.plan.casters[k].clone()),
+        };
+        plan.caster = l.plan.casters[k].caster;
+        l.plan.casters[k] = plan;
+        l.draws[k] = if uses[m] == 0 { kept[m].take() } else { kept[m].clone() };
     }
 }

@@ -103,7 +103,7 @@ impl MeshPipes {
     /// Makes the plain set, or the culled one (`culled`, only with task shaders), for the
     /// pass's `desc` (its depth-stencil format, samples, depth direction and mode, target
     /// model). Idempotent.
-    pub fn ensure(&mut self, dev: &PassDevice, desc: &super::ShadowPassDesc, culled: bool) -> Result<()> {
+    pub fn ensure(&mut self, dev: &PassDevice, desc: &super::desc::ShadowPassDesc, culled: bool) -> Result<()> {
         if self.sets[culled as usize].is_some() {
             return Ok(());
         }
@@ -124,7 +124,7 @@ impl MeshPipes {
         }
     }
 
-    fn create(&self, dev: &PassDevice, desc: &super::ShadowPassDesc, culled: bool, out: &mut MeshPipeSet) -> Result<()> {
+    fn create(&self, dev: &PassDevice, desc: &super::desc::ShadowPassDesc, culled: bool, out: &mut MeshPipeSet) -> Result<()> {
         use super::desc::{sample_flags, DepthDirection, DepthMode, TargetModel};
         use vk::StencilOp as S;
         let (depth_clamp, depth_bounds, r32f_blend) = self.features;
@@ -220,7 +220,7 @@ pub(super) struct MeshState {
     pub pipes: Option<MeshPipes>,
 }
 
-impl super::techniques::TechniqueState for MeshState {
+impl super::device::TechniqueState for MeshState {
     fn destroy(&mut self, dev: &PassDevice) {
         if let Some(mut m) = self.pipes.take() {
             // SAFETY: the pass is dropped after every command buffer that used it completed.

@@ -85,6 +85,7 @@
 
 #![warn(missing_docs)]
 
+mod caster_calls;
 mod casters;
 mod compute;
 mod desc;
@@ -93,7 +94,9 @@ pub mod diagnostics;
 mod draw;
 mod eye;
 mod frame;
+mod frame_calls;
 mod keep;
+mod lists;
 mod mesh;
 mod mesh_pipes;
 mod pack;
@@ -103,8 +106,10 @@ mod prepare;
 pub mod push;
 mod rays;
 mod record;
+mod sphere_calls;
 mod spheres;
 pub mod stats;
+mod stencil;
 mod target;
 mod technique;
 mod techniques;
@@ -112,17 +117,18 @@ mod view;
 mod volumes;
 
 pub use casters::CasterId;
+pub use desc::DEFAULT_KEEP_BUDGET;
 pub use desc::{
     reverse_z, Capabilities, ComputeDraws, Counter, DepthDirection, DepthMode, EnabledFeatures, IndexFormat, PassSettings, PassToggles,
     RenderPassTarget, ShadowPassDesc, TargetModel, Technique,
 };
 pub use draw::LightFrame;
 pub use frame::{PreparedFrame, MAX_CONE_DEG};
-pub use keep::DEFAULT_KEEP_BUDGET;
 pub use pipelines::COUNT_FORMAT;
-pub use rays::{light_rel, RayCounts, RayQueryFrame, RayQueryInputs};
-pub use record::{lit_stencil_state, VolumeKind};
+pub use rays::frame::RayQueryFrame;
+pub use rays::{light_rel, RayCounts, RayQueryInputs};
 pub use spheres::{SphereId, SphereInfo};
+pub use stencil::{lit_stencil_state, VolumeKind};
 pub use target::DepthStencilTarget;
 pub use view::{ShadowView, MAX_TARGET_SIZE};
 
@@ -281,7 +287,7 @@ impl ShadowPass {
             )));
         }
         desc.settings.check(&caps)?;
-        rays::check_host(&desc.settings, desc)?;
+        rays::frame::check_host(&desc.settings, desc)?;
         Ok(caps)
     }
 
@@ -314,7 +320,7 @@ impl ShadowPass {
     /// refused when the device cannot honour them.
     pub fn set_settings(&mut self, settings: PassSettings) -> Result<()> {
         settings.check(&self.caps)?;
-        rays::check_host(&settings, &self.desc)?;
+        rays::frame::check_host(&settings, &self.desc)?;
         self.settings = settings;
         Ok(())
     }
@@ -340,7 +346,7 @@ impl ShadowPass {
         if technique == Technique::Compute && self.caps.draw_indirect_first_instance && t.compute.merged.is_none() {
             let c = &self.caps;
             let caps = (c.depth_clamp, c.depth_bounds, c.r32f_blend);
-            t.compute.merged = Some(compute::draws_record::DrawPipes::new(&self.dev, &self.desc, self.pipes.layout, caps)?);
+            t.compute.merged = Some(compute::draw_pipes::DrawPipes::new(&self.dev, &self.desc, self.pipes.layout, caps)?);
         }
         if technique == Technique::Mesh {
             let c = &self.caps;

@@ -4,13 +4,14 @@
 
 use super::casters::CasterTable;
 use super::compute::frame::ComputeFrame;
-use super::desc::{DepthDirection, IndexFormat, PassSettings, Technique};
-use super::draw::{CasterDraw, Draw, EdgeQuadDraw, LightFrame};
+use super::desc::{DepthDirection, PassSettings, Technique};
+use super::draw::{CasterDraw, EdgeQuadDraw, LightFrame};
+use super::lists::{align, write_chunks, ChunkDraws};
 use super::planar::flatten;
 use super::stats::{CasterStats, CpuMs, LightStats, PartStats, Totals, Triangles, UsedIndexFormat};
 use super::view::ShadowView;
 use crate::geom::{Camera, Light};
-use crate::shadow::{self, Case, CasterKind, PlanInput, PlanOptions, VolumePath};
+use crate::shadow::{self, Case, CasterKind, LightPlan, PlanInput, PlanOptions, VolumePath};
 use ash::vk;
 use glam::{DMat4, DVec3, Mat4, Vec4};
 
@@ -174,37 +175,7 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput, kept: Option<Vec<supe
             // The spheres' planning (tangency circles, n, volumes) counts as planning.
             cpu.plan += start.elapsed().as_secs_f64() * 1e3;
         }
-        let scissor = plan
-            .scissor
-            .map(|[x, y, sw, sh]| vk::Rect2D {
-                offset: vk::Offset2D { x: x as i32, y: y as i32 },
-                extent: vk::Extent2D { width: sw, height: sh },
-            })
-            .filter(|r| r.extent.width > 0 && r.extent.height > 0 && input.settings.toggles.scissor)
-            .unwrap_or(full);
-        let depth_bounds = if input.depth_bounds { plan.depth_bounds } else { None };
-        let depth_bounds = match input.direction {
-            DepthDirection::Forward => depth_bounds,
-            DepthDirection::Reverse => depth_bounds.map(|(lo, hi)| reversed_bounds(lo, hi)),
-        };
-        let (eye_volumes, near_plane_split) = if method == shadow::Method::ZPassClear {
-            let [c0, c1, c2, c3] = near_corners(&fwd);
-            let counts = super::eye::volumes_containing(&[view.eye, c0, c1, c2, c3], light, &plan, table);
-            (Some(counts[0]), Some(counts[1..].iter().any(|&c| c != counts[0])))
-        } else {
-            (None, None)
-        };
-        let stats = LightStats {
-            index: li,
-            kind: light.kind,
-            scissor: plan.scissor.filter(|_| input.settings.toggles.scissor),
-            depth_bounds: depth_bounds.map(|(a, b)| [a, b]),
-            casters: cstats,
-            eye_volumes,
-            near_plane_split,
-        };
-        let counter_clear = eye_volumes.unwrap_or(0).max(0) as u32;
-        lights.push(LightFrame { scissor, depth_bounds, stats, plan, counter_clear, casters });
+        lights.push(light_frame(table, input, (&fwd, full), (li, light), plan, (cstats, casters)));
     }
     align(&mut stream, 16);
     // what the stream carries (kept pairs' lists were sent when they were planned)
@@ -212,79 +183,50 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput, kept: Option<Vec<supe
     Packed { stream, lights, totals, cpu, compute }
 }
 
-/// One caster's index lists (or naive vertices) for one light, written into the stream.
-#[derive(Clone)]
-pub(crate) struct ChunkDraws {
-    pub draws: Vec<Draw>,
-    pub index_bytes: u64,
-    pub vertex_bytes: u64,
-    /// The index format used (`none` when nothing was drawn).
-    pub fmt_used: UsedIndexFormat,
-}
-
-/// Writes caster `cp`'s chunk draws (volume and light-cap lists) into `stream`, each aligned
-/// to 16 bytes in the format the settings (`format`) and the device (`u8_ok`) allow;
-/// `chunks`: the caster's chunks' vertex buffers.
-pub(crate) fn write_chunks(
-    stream: &mut Vec<u8>,
-    (format, u8_ok): (IndexFormat, bool),
-    caster: &shadow::Caster,
-    chunks: &[vk::Buffer],
-    cp: &shadow::CasterPlan,
-) -> ChunkDraws {
-    let mut draws = Vec::new();
-    let mut index_bytes = 0u64;
-    let mut vertex_bytes = 0u64;
-    let mut fmt_used = UsedIndexFormat::None;
-    for cd in &cp.chunks {
-        let chunk = &caster.chunks[cd.chunk];
-        let n = chunk.vertices.len();
-        for (indices, cap) in [(&cd.volume, false), (&cd.light_cap, true)] {
-            if indices.is_empty() {
-                continue;
-            }
-            let fmt = match format {
-                IndexFormat::Auto | IndexFormat::U8 if u8_ok && 2 * n <= 256 => IndexFormat::U8,
-                IndexFormat::Auto | IndexFormat::U8 => IndexFormat::U16,
-                f => f,
-            };
-            fmt_used = fmt.into();
-            align(stream, 16);
-            let offset = stream.len() as u64;
-            match fmt {
-                IndexFormat::U8 => stream.extend(indices.iter().map(|&i| i as u8)),
-                IndexFormat::U16 => stream.extend(indices.iter().flat_map(|&i| i.to_le_bytes())),
-                IndexFormat::U32 => stream.extend(indices.iter().flat_map(|&i| (i as u32).to_le_bytes())),
-                IndexFormat::Naive | IndexFormat::Auto => {
-                    for &i in indices.iter() {
-                        let i = i as usize;
-                        let (v, wv) = if i < n { (chunk.vertices[i], 1.0f32) } else { (chunk.vertices[i - n], 0.0) };
-                        for f in [v.x, v.y, v.z, wv] {
-                            stream.extend(f.to_le_bytes());
-                        }
-                    }
-                }
-            }
-            let bytes = stream.len() as u64 - offset;
-            if fmt == IndexFormat::Naive {
-                vertex_bytes += bytes;
-            } else {
-                index_bytes += bytes;
-            }
-            draws.push(Draw {
-                vertices: chunks[cd.chunk],
-                kept: None,
-                offset,
-                count: indices.len() as u32,
-                format: fmt,
-                case: cd.case,
-                light_cap: cap,
-                indirect: false,
-                mesh: None,
-            });
-        }
-    }
-    ChunkDraws { draws, index_bytes, vertex_bytes, fmt_used }
+/// Light `li`'s frame from its plan and packed casters: its scissor (the whole target `full`
+/// when it has none or scissors are off), depth bounds in the host's direction, and for
+/// z-pass with clear the volumes containing the eye.
+fn light_frame(
+    table: &CasterTable,
+    input: &PackInput,
+    (fwd, full): (&ShadowView, vk::Rect2D),
+    (li, light): (usize, &Light),
+    plan: LightPlan,
+    (cstats, casters): (Vec<CasterStats>, Vec<CasterDraw>),
+) -> LightFrame {
+    let view = input.view;
+    let method = input.settings.technique.method();
+    let scissor = plan
+        .scissor
+        .map(|[x, y, sw, sh]| vk::Rect2D {
+            offset: vk::Offset2D { x: x as i32, y: y as i32 },
+            extent: vk::Extent2D { width: sw, height: sh },
+        })
+        .filter(|r| r.extent.width > 0 && r.extent.height > 0 && input.settings.toggles.scissor)
+        .unwrap_or(full);
+    let depth_bounds = if input.depth_bounds { plan.depth_bounds } else { None };
+    let depth_bounds = match input.direction {
+        DepthDirection::Forward => depth_bounds,
+        DepthDirection::Reverse => depth_bounds.map(|(lo, hi)| reversed_bounds(lo, hi)),
+    };
+    let (eye_volumes, near_plane_split) = if method == shadow::Method::ZPassClear {
+        let [c0, c1, c2, c3] = near_corners(fwd);
+        let counts = super::eye::volumes_containing(&[view.eye, c0, c1, c2, c3], light, &plan, table);
+        (Some(counts[0]), Some(counts[1..].iter().any(|&c| c != counts[0])))
+    } else {
+        (None, None)
+    };
+    let stats = LightStats {
+        index: li,
+        kind: light.kind,
+        scissor: plan.scissor.filter(|_| input.settings.toggles.scissor),
+        depth_bounds: depth_bounds.map(|(a, b)| [a, b]),
+        casters: cstats,
+        eye_volumes,
+        near_plane_split,
+    };
+    let counter_clear = eye_volumes.unwrap_or(0).max(0) as u32;
+    LightFrame { scissor, depth_bounds, stats, plan, counter_clear, casters }
 }
 
 /// What `--stats` reports of caster `cp` for one light.
@@ -348,10 +290,4 @@ fn near_corners(view: &ShadowView) -> [DVec3; 4] {
         let h = inv * glam::DVec4::new(x, y, 0.0, 1.0);
         h.truncate() / h.w + view.eye
     })
-}
-
-fn align(v: &mut Vec<u8>, a: usize) {
-    while !v.len().is_multiple_of(a) {
-        v.push(0);
-    }
 }

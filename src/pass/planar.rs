@@ -62,6 +62,6 @@ impl Default for PlanarState {
     }
 }
 
-impl super::techniques::TechniqueState for PlanarState {
+impl super::device::TechniqueState for PlanarState {
     fn destroy(&mut self, _dev: &super::device::PassDevice) {}
 }

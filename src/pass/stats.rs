@@ -22,14 +22,14 @@ crate::named_enum::named_enum!(
     }
 );
 
-impl From<super::IndexFormat> for UsedIndexFormat {
+impl From<super::desc::IndexFormat> for UsedIndexFormat {
     /// The format a draw used (`Auto` never reaches a draw: it is resolved per chunk first).
-    fn from(f: super::IndexFormat) -> Self {
+    fn from(f: super::desc::IndexFormat) -> Self {
         match f {
-            super::IndexFormat::U8 => UsedIndexFormat::U8,
-            super::IndexFormat::U16 | super::IndexFormat::Auto => UsedIndexFormat::U16,
-            super::IndexFormat::U32 => UsedIndexFormat::U32,
-            super::IndexFormat::Naive => UsedIndexFormat::Naive,
+            super::desc::IndexFormat::U8 => UsedIndexFormat::U8,
+            super::desc::IndexFormat::U16 | super::desc::IndexFormat::Auto => UsedIndexFormat::U16,
+            super::desc::IndexFormat::U32 => UsedIndexFormat::U32,
+            super::desc::IndexFormat::Naive => UsedIndexFormat::Naive,
         }
     }
 }

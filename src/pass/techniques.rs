@@ -4,23 +4,15 @@
 //! casters, the ring slots' streams and staging, the lights, the targets, the uploads and the
 //! kept plans) stays in [`ShadowPass`](super::ShadowPass).
 //!
-//! Adding a technique: its module, its state type implementing [`TechniqueState`], and one
+//! Adding a technique: its module, its state type implementing [`TechniqueState`] (in [`super::device`], below every technique), and one
 //! field here (with its line in [`Techniques::all`]). The per-frame recording reads each
 //! state directly: no dynamic dispatch is added to the hot path.
 
 use super::compute::ComputeState;
-use super::device::PassDevice;
+use super::device::{PassDevice, TechniqueState};
 use super::mesh_pipes::MeshState;
 use super::planar::PlanarState;
 use super::rays::RayState;
-
-/// What the pass asks of every technique's state, whichever technique the frame runs.
-pub(super) trait TechniqueState {
-    /// The ring slot's previous frame retired: release what only that frame used.
-    fn slot_retired(&mut self, _dev: &PassDevice, _slot: usize) {}
-    /// Releases every object (the pass is dropped, after every frame that used it completed).
-    fn destroy(&mut self, dev: &PassDevice);
-}
 
 /// The registry: one field per technique with state of its own.
 pub(super) struct Techniques {

@@ -5,7 +5,7 @@ use super::draw::{CasterDraw, Draw};
 use super::frame::PreparedFrame;
 use super::pipelines::CountPipes;
 use super::push::VolumePush;
-use super::record::VolumeKind;
+use super::stencil::VolumeKind;
 use super::ShadowPass;
 use crate::error::{Misuse, Result};
 use crate::shadow::Case;

@@ -48,7 +48,7 @@ fn statuses(stdout: &str) -> Vec<(String, String)> {
 /// The first `n` cases of the d32s8 dynamic-rendering static-state stencil family (one child
 /// of 64 and one of the rest).
 fn some_cases(n: usize) -> Vec<String> {
-    umbrage_conform::deqp::names::all_public()
+    umbrage_conform::deqp::list::all_public()
         .into_iter()
         .filter(|c| c.starts_with("umbrage.stencil.d32s8.render_pass.static_state."))
         .take(n)

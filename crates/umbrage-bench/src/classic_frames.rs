@@ -2,7 +2,7 @@
 //! scene's variants, the round-robin timed frames (with the scene's motion under `--motion`),
 //! each variant's error, and a row from its frames.
 
-use super::classic::{BenchConfig, BenchRow, Variant};
+use super::classic_rows::{BenchConfig, BenchRow, Variant};
 use super::stats::median;
 use umbrage::error::{Error, Result};
 use umbrage_render::accuracy::evaluate;

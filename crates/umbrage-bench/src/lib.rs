@@ -22,6 +22,7 @@ pub mod shaders {
 }
 pub mod classic;
 mod classic_frames;
+mod classic_rows;
 pub mod compute_read;
 mod evidence;
 pub mod frame_cost;

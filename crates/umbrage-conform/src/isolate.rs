@@ -12,10 +12,10 @@
 //! the file the parent names, and nothing else counts as a result: an exit without that file is
 //! a crash too (with the child's last stderr lines in the message).
 
+pub use super::deqp::exec::ChildResult;
 use super::deqp::exec::{self, Exec};
 use super::suite::{self, CaseOutcome, ConfigRun, Report, SuiteOptions};
 pub use super::units::Unit;
-use super::CheckResult;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 use umbrage::error::Result;
@@ -33,17 +33,6 @@ pub struct Isolation {
     pub jobs: usize,
     /// Where the children write their results (created if missing).
     pub scratch: PathBuf,
-}
-
-/// What a child sends back.
-#[derive(Debug, serde::Serialize, serde::Deserialize)]
-pub struct ChildResult {
-    /// The unit's selected cases, in generation order.
-    pub cases: Vec<CaseOutcome>,
-    /// The submission's record (a configuration unit that drew something).
-    pub config: Option<ConfigRun>,
-    /// The single-configuration checks' full results.
-    pub legacy: Vec<CheckResult>,
 }
 
 /// Runs `unit` in this process (what a child does).

@@ -11,10 +11,10 @@
 
 use super::{rec, ComputeStatic, SilhouettePush, GROUP, HEADER_WORDS, RECORD_WORDS};
 use crate::error::{Error, Result};
+use crate::pass::desc::IndexFormat;
 use crate::pass::draw::{Draw, LightFrame};
 use crate::pass::mesh::{MeshDraw, COUNT_WORDS, MAX_TASKS};
 use crate::pass::stats::{CasterStats, Totals, UsedIndexFormat};
-use crate::pass::IndexFormat;
 use crate::shadow::plan::{Case, CasterPlan, DarkCap, Formulation, VolumePath};
 use crate::shadow::Caster;
 use ash::vk;

@@ -34,12 +34,16 @@
 //! for the same light and caster.
 
 pub(crate) mod arena;
+pub(crate) mod draw_pipes;
 pub(crate) mod draws;
 pub(crate) mod draws_record;
 pub(crate) mod frame;
 mod prepare;
 pub(crate) mod record;
 pub(crate) mod tables;
+
+/// Most workgroups of one dispatch dimension (every device has at least this many).
+pub(crate) const MAX_GROUPS: u32 = 65535;
 
 use super::device::PassDevice;
 use crate::error::{Error, Result};
@@ -387,7 +391,7 @@ impl ComputePipes {
 /// the first frame or `create_pipelines`, and each ring slot's buffers and descriptor sets.
 pub(crate) struct ComputeState {
     pub pipes: Option<ComputePipes>,
-    pub merged: Option<draws_record::DrawPipes>,
+    pub merged: Option<draw_pipes::DrawPipes>,
     pub slots: Vec<SlotCompute>,
 }
 
@@ -398,7 +402,7 @@ impl ComputeState {
     }
 }
 
-impl crate::pass::techniques::TechniqueState for ComputeState {
+impl crate::pass::device::TechniqueState for ComputeState {
     fn destroy(&mut self, dev: &PassDevice) {
         if let Some(mut c) = self.pipes.take() {
             // SAFETY: the pass is dropped after every command buffer that used it completed.

@@ -4,7 +4,8 @@
 use super::frame::{ComputeFrame, GpuJob};
 use super::{SlotCompute, BINDINGS};
 use crate::error::{Error, Misuse, Result};
-use crate::pass::{PreparedFrame, ShadowPass};
+use crate::pass::frame::PreparedFrame;
+use crate::pass::ShadowPass;
 use ash::vk;
 use gpu_allocator::MemoryLocation;
 
@@ -16,9 +17,9 @@ impl ShadowPass {
         &mut self,
         slot: usize,
         mut cf: ComputeFrame,
-        (lights, draws): (usize, crate::pass::ComputeDraws),
+        (lights, draws): (usize, crate::pass::desc::ComputeDraws),
     ) -> Result<ComputeFrame> {
-        let draws = if cf.mesh { crate::pass::ComputeDraws::PerChunk } else { draws };
+        let draws = if cf.mesh { crate::pass::desc::ComputeDraws::PerChunk } else { draws };
         cf.merged = super::draws::plan(&mut cf.records, &cf.chunk_records, lights, draws, self.dev.max_draw_indirect_count);
         let merged_layout = match (&cf.merged, self.techniques.compute.merged.as_ref()) {
             (None, _) => vk::DescriptorSetLayout::null(),
@@ -146,13 +147,13 @@ impl ShadowPass {
             }
         }
         if let Some(m) = cf.merged.as_mut().filter(|_| !cf.jobs.is_empty()) {
-            let b = super::draws_record::MergedBuffers {
+            let b = super::draw_pipes::MergedBuffers {
                 xforms: &cf.xforms,
                 records: (records_raw, ranges[0]),
                 vertices: arena[super::arena::VERTICES],
                 set_layout: merged_layout,
             };
-            super::draws_record::prepare_merged(dev, sc, slot, m, b)?;
+            super::draw_pipes::prepare_merged(dev, sc, slot, m, b)?;
         }
         cf.counts_buffer = counts_raw;
         cf.records_buffer = records_raw;

@@ -15,11 +15,8 @@
 
 use super::super::ShadowPass;
 use super::{rec, LANES};
-use crate::pass::PreparedFrame;
+use crate::pass::frame::PreparedFrame;
 use ash::vk;
-
-/// Most workgroups of one dispatch dimension (every device has at least this many).
-pub(crate) const MAX_GROUPS: u32 = 65535;
 
 /// A global memory barrier, recorded as Vulkan 1.0 (the pass needs no synchronization2).
 fn barrier(
@@ -163,5 +160,5 @@ unsafe fn dispatch_groups(d: &ash::Device, cb: vk::CommandBuffer, n: u32) {
         return;
     }
     // SAFETY: the caller's contract.
-    unsafe { d.cmd_dispatch(cb, n.min(MAX_GROUPS), n.div_ceil(MAX_GROUPS), 1) };
+    unsafe { d.cmd_dispatch(cb, n.min(super::MAX_GROUPS), n.div_ceil(super::MAX_GROUPS), 1) };
 }

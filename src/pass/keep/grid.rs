@@ -22,7 +22,7 @@ const MAX_QUERY_CELLS: i64 = 4096;
 pub(crate) struct Grid {
     /// The cell size (0: no grid built yet).
     cell: f32,
-    cells: HashMap<IVec3, Vec<u32>, super::FxBuild>,
+    cells: HashMap<IVec3, Vec<u32>, super::fx::FxBuild>,
     /// Casters too big for the cells: every query returns them.
     big: Vec<u32>,
     /// Per caster (dense index), the cell range it is listed in (`None`: in `big`).

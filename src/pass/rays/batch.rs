@@ -7,7 +7,7 @@
 //! Per ring slot: the lights' storage buffer (eye-relative light and scissor, 32 bytes each) and
 //! an `R32_UINT` mask image of the frame's extent with the descriptor set that samples it.
 
-use super::RayPush;
+use super::push::RayPush;
 use crate::error::{Error, Result};
 use crate::gpu::descriptors::{pipeline_layout, Binding, DescriptorSet};
 use crate::gpu::pipeline::{self, PipelineDesc};

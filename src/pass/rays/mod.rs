@@ -38,10 +38,12 @@ use std::cell::Cell;
 
 mod balls;
 mod batch;
+pub(crate) mod frame;
+mod push;
+use frame::RayFrame;
+use push::RayPush;
 mod record;
 use balls::Balls;
-pub use record::RayQueryFrame;
-pub(crate) use record::{check_host, RayFrame};
 
 /// The host's G-buffer as the rays read it ([`ShadowPass::set_ray_query_inputs`](super::ShadowPass::set_ray_query_inputs)).
 ///
@@ -61,14 +63,6 @@ pub struct RayQueryInputs {
     /// 2e-5 of the scene's diagonal). The pass raises it where the eye-relative coordinates
     /// need more.
     pub surface_offset: f32,
-}
-
-/// `rayquery.wgsl`'s push constants.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-pub(crate) struct RayPush {
-    light: [f32; 4],
-    params: [f32; 4],
 }
 
 /// A caster's bottom level.
@@ -574,7 +568,7 @@ pub(super) struct RayState {
     pub inputs: Option<RayQueryInputs>,
 }
 
-impl super::techniques::TechniqueState for RayState {
+impl super::device::TechniqueState for RayState {
     fn slot_retired(&mut self, dev: &PassDevice, slot: usize) {
         if let Some(r) = &mut self.structures {
             r.slot_retired(dev, slot);

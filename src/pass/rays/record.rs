@@ -3,120 +3,18 @@
 //! ([`ShadowPass::cmd_determine`]).
 
 use super::batch::BATCH;
-use super::{RayCounts, RayPush, RayQueryInputs, Rays};
+use super::frame::RayFrame;
+use super::push::RayPush;
+use super::{RayCounts, RayQueryInputs, Rays};
 use crate::error::{Error, Misuse, Result};
 use crate::geom::Light;
-use crate::gpu::accel::{self, BlasJob};
-use crate::pass::desc::{PassSettings, ShadowPassDesc, TargetModel, Technique};
+use crate::gpu::accel;
 use crate::pass::device::PassDevice;
-use crate::pass::{DepthStencilTarget, PreparedFrame, ShadowPass, ShadowView};
+use crate::pass::frame::PreparedFrame;
+use crate::pass::target::DepthStencilTarget;
+use crate::pass::view::ShadowView;
+use crate::pass::ShadowPass;
 use ash::vk;
-use std::cell::Cell;
-
-/// What a ray-query frame traces against ([`PreparedFrame::ray_query`](crate::pass::PreparedFrame::ray_query)).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RayQueryFrame {
-    /// World units the rays start off the surface (and stop short of a point light).
-    pub offset: f32,
-    /// Instances in the top level (one per caster, one for all sphere casters).
-    pub instances: usize,
-    /// Bytes of bottom-level storage (compacted where done).
-    pub bottom_level_bytes: u64,
-    /// Bottom levels this frame builds (new or first-deformed casters, a changed sphere set).
-    pub builds: usize,
-    /// Bottom levels this frame refits in place (deformed casters).
-    pub refits: usize,
-    /// Bottom levels this frame compacts.
-    pub compactions: usize,
-    /// Every light traced in one pass per 32 ([`PassToggles::ray_batch`](crate::pass::PassToggles::ray_batch)).
-    pub batched: bool,
-}
-
-/// One frame's ray-query work: the jobs [`cmd_before_rendering`](super::ShadowPass::cmd_before_rendering)
-/// records, and what `cmd_determine` binds.
-#[derive(Debug)]
-pub(crate) struct RayFrame {
-    pub(super) compactions: Vec<(vk::AccelerationStructureKHR, vk::AccelerationStructureKHR)>,
-    pub(super) jobs: Vec<BlasJob>,
-    pub(super) queries: Vec<(vk::QueryPool, vk::AccelerationStructureKHR)>,
-    pub(super) instances: u32,
-    pub(super) tlas_slot: usize,
-    pub set: vk::DescriptorSet,
-    pub layout: vk::PipelineLayout,
-    pub pipeline: vk::Pipeline,
-    /// Per light, the push constants.
-    pub push: Vec<RayPush>,
-    /// Bottom levels built in this frame.
-    pub builds: usize,
-    pub recorded: Cell<bool>,
-    /// The offset the rays use (world units).
-    pub offset: f32,
-    /// Bytes of bottom-level storage.
-    pub blas_bytes: u64,
-    /// Every light in one pass per 32 ([`PassToggles::ray_batch`](crate::pass::PassToggles::ray_batch), two lights or more).
-    pub batch: Option<super::batch::BatchFrame>,
-}
-
-impl RayFrame {
-    pub fn info(&self) -> RayQueryFrame {
-        let refits = self.jobs.iter().filter(|j| j.is_refit()).count();
-        RayQueryFrame {
-            offset: self.offset,
-            instances: self.instances as usize,
-            bottom_level_bytes: self.blas_bytes,
-            builds: self.builds,
-            refits,
-            compactions: self.compactions.len(),
-            batched: self.batch.is_some(),
-        }
-    }
-
-    /// Records the frame's acceleration-structure work: compactions, builds and refits, the
-    /// compacted-size queries of new bottom levels, and the top level.
-    ///
-    /// # Safety
-    /// `cb` is recording outside any rendering instance or render pass; the frame's slot is not
-    /// prepared again before `cb` has completed; every frame recorded before it is submitted
-    /// earlier on the same queue.
-    pub unsafe fn cmd_record(&self, dev: &PassDevice, rays: &Rays, cb: vk::CommandBuffer) -> Result<()> {
-        use vk::AccessFlags2 as A;
-        use vk::PipelineStageFlags2 as S;
-        let build = S::ACCELERATION_STRUCTURE_BUILD_KHR;
-        let l = rays.loader();
-        // Earlier frames' rays and builds finish before a structure is rewritten (refits) or
-        // read (compaction sources).
-        crate::gpu::resources::memory_barrier(
-            dev,
-            cb,
-            (S::FRAGMENT_SHADER | build, A::ACCELERATION_STRUCTURE_READ_KHR | A::ACCELERATION_STRUCTURE_WRITE_KHR),
-            (build, A::ACCELERATION_STRUCTURE_READ_KHR | A::ACCELERATION_STRUCTURE_WRITE_KHR),
-        );
-        // SAFETY: the caller's contract; every structure and buffer lives until the slot retires.
-        unsafe {
-            for &(src, dst) in &self.compactions {
-                accel::cmd_compact(l, cb, src, dst);
-            }
-            for job in &self.jobs {
-                job.cmd_record(l, cb);
-            }
-        }
-        crate::gpu::resources::memory_barrier(
-            dev,
-            cb,
-            (build, A::ACCELERATION_STRUCTURE_WRITE_KHR),
-            (build, A::ACCELERATION_STRUCTURE_READ_KHR),
-        );
-        // SAFETY: as above; the pools are reset before they are written.
-        unsafe {
-            for &(pool, blas) in &self.queries {
-                accel::cmd_write_compacted_size(dev, l, cb, pool, blas);
-            }
-            let tlas = rays.tlas(self.tlas_slot).ok_or_else(|| Error::Internal("no top level".into()))?;
-            tlas.cmd_record(dev, l, cb, self.instances);
-        }
-        Ok(())
-    }
-}
 
 impl ShadowPass {
     /// Records a ray-query frame's acceleration structures once (part of
@@ -189,7 +87,7 @@ impl ShadowPass {
         }
     }
 
-    /// The G-buffer [`Technique::RayQuery`] reads, from the next `prepare` on (again after a
+    /// The G-buffer [`Technique::RayQuery`](crate::pass::Technique::RayQuery) reads, from the next `prepare` on (again after a
     /// resize: the views are bound when a slot is prepared). See [`RayQueryInputs`] for what
     /// the images hold; the pass does not own them.
     ///
@@ -261,22 +159,50 @@ impl ShadowPass {
     }
 }
 
-/// Refuses settings the host's configuration cannot take: ray query traces one ray per pixel
-/// of a single-sample G-buffer, in the pass's own rendering instance.
-pub(crate) fn check_host(settings: &PassSettings, desc: &ShadowPassDesc) -> Result<()> {
-    if settings.technique != Technique::RayQuery {
-        return Ok(());
+impl RayFrame {
+    /// Records the frame's acceleration-structure work: compactions, builds and refits, the
+    /// compacted-size queries of new bottom levels, and the top level.
+    ///
+    /// # Safety
+    /// `cb` is recording outside any rendering instance or render pass; the frame's slot is not
+    /// prepared again before `cb` has completed; every frame recorded before it is submitted
+    /// earlier on the same queue.
+    pub unsafe fn cmd_record(&self, dev: &PassDevice, rays: &Rays, cb: vk::CommandBuffer) -> Result<()> {
+        use vk::AccessFlags2 as A;
+        use vk::PipelineStageFlags2 as S;
+        let build = S::ACCELERATION_STRUCTURE_BUILD_KHR;
+        let l = rays.loader();
+        // Earlier frames' rays and builds finish before a structure is rewritten (refits) or
+        // read (compaction sources).
+        crate::gpu::resources::memory_barrier(
+            dev,
+            cb,
+            (S::FRAGMENT_SHADER | build, A::ACCELERATION_STRUCTURE_READ_KHR | A::ACCELERATION_STRUCTURE_WRITE_KHR),
+            (build, A::ACCELERATION_STRUCTURE_READ_KHR | A::ACCELERATION_STRUCTURE_WRITE_KHR),
+        );
+        // SAFETY: the caller's contract; every structure and buffer lives until the slot retires.
+        unsafe {
+            for &(src, dst) in &self.compactions {
+                accel::cmd_compact(l, cb, src, dst);
+            }
+            for job in &self.jobs {
+                job.cmd_record(l, cb);
+            }
+        }
+        crate::gpu::resources::memory_barrier(
+            dev,
+            cb,
+            (build, A::ACCELERATION_STRUCTURE_WRITE_KHR),
+            (build, A::ACCELERATION_STRUCTURE_READ_KHR),
+        );
+        // SAFETY: as above; the pools are reset before they are written.
+        unsafe {
+            for &(pool, blas) in &self.queries {
+                accel::cmd_write_compacted_size(dev, l, cb, pool, blas);
+            }
+            let tlas = rays.tlas(self.tlas_slot).ok_or_else(|| Error::Internal("no top level".into()))?;
+            tlas.cmd_record(dev, l, cb, self.instances);
+        }
+        Ok(())
     }
-    if desc.samples > 1 {
-        return Err(Error::Unsupported(format!(
-            "Technique::RayQuery traces one ray per pixel from a single-sample G-buffer; the pass has {} samples (per-sample rays are not built)",
-            desc.samples
-        )));
-    }
-    if desc.target != TargetModel::DynamicRendering {
-        return Err(Error::Unsupported(
-            "Technique::RayQuery records in the pass's own rendering instance: TargetModel::DynamicRendering only (inside a host's render pass it is not built)".into(),
-        ));
-    }
-    Ok(())
 }

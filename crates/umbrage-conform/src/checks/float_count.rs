@@ -160,15 +160,7 @@ fn counting_pipeline(ctx: &Context, layout: vk::PipelineLayout, render_pass: vk:
         .front(op(vk::StencilOp::INCREMENT_AND_WRAP))
         .back(op(vk::StencilOp::DECREMENT_AND_WRAP))
         .max_depth_bounds(1.0);
-    let blend = [vk::PipelineColorBlendAttachmentState::default()
-        .blend_enable(true)
-        .src_color_blend_factor(vk::BlendFactor::ONE)
-        .dst_color_blend_factor(vk::BlendFactor::ONE)
-        .color_blend_op(vk::BlendOp::ADD)
-        .src_alpha_blend_factor(vk::BlendFactor::ONE)
-        .dst_alpha_blend_factor(vk::BlendFactor::ONE)
-        .alpha_blend_op(vk::BlendOp::ADD)
-        .color_write_mask(vk::ColorComponentFlags::R)];
+    let blend = [pipeline::blend_attachment(pipeline::Blend::Additive, vk::ColorComponentFlags::R)];
     let cb = vk::PipelineColorBlendStateCreateInfo::default().attachments(&blend);
     let dynamic = [vk::DynamicState::VIEWPORT, vk::DynamicState::SCISSOR];
     let dyn_info = vk::PipelineDynamicStateCreateInfo::default().dynamic_states(&dynamic);

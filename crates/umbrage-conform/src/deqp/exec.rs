@@ -16,9 +16,9 @@
 //! (public or short name); see [`crate::progress`].
 
 use super::super::cases::{Config, FORMATS};
-use super::super::isolate::ChildResult;
-use super::super::suite::{self, CaseOutcome, SuiteOptions};
+use super::super::suite::{self, CaseOutcome, ConfigRun, SuiteOptions};
 use super::super::units::Unit;
+use super::super::CheckResult;
 use super::super::Status;
 use super::names;
 use std::collections::{HashMap, HashSet, VecDeque};
@@ -27,6 +27,17 @@ use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 use umbrage::error::{Error, Result};
 use umbrage::gpu::Context;
+
+/// What a child sends back.
+#[derive(Debug, serde::Serialize, serde::Deserialize)]
+pub struct ChildResult {
+    /// The unit's selected cases, in generation order.
+    pub cases: Vec<CaseOutcome>,
+    /// The submission's record (a configuration unit that drew something).
+    pub config: Option<ConfigRun>,
+    /// The single-configuration checks' full results.
+    pub legacy: Vec<CheckResult>,
+}
 
 /// A case's status, as dEQP names it (the `StatusCode` of its QPA record and its stdout line).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

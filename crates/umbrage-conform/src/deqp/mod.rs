@@ -20,6 +20,7 @@
 pub mod args;
 pub mod baseline;
 pub mod exec;
+pub mod list;
 pub mod names;
 pub mod qpa;
 
@@ -74,7 +75,7 @@ impl CiArgs {
 
 /// The names `umbrage conform --list` prints: the public names of the cases `filter` selects.
 pub fn list(filter: &[String]) -> Vec<String> {
-    names::all()
+    list::all()
         .into_iter()
         .filter(|(p, s)| filter.is_empty() || filter.iter().any(|f| suite::matches(f, s) || suite::matches(f, p)))
         .map(|(p, _)| p)
@@ -129,7 +130,7 @@ fn write_txt_caselist(d: &DeqpArgs) -> Result<ExitCode> {
     let path = dir.join("umbrage-cases.txt");
     let mut s = String::new();
     let mut open: Vec<String> = Vec::new();
-    for n in names::all_public() {
+    for n in list::all_public() {
         let parts: Vec<&str> = n.split('.').collect();
         for depth in 1..parts.len() {
             let g = parts[..depth].join(".");
@@ -190,7 +191,7 @@ pub fn run_deqp(d: DeqpArgs, a: &RunArgs, chunk: Option<usize>, timeout_given: b
     if d.runmode.as_deref() == Some("txt-caselist") {
         return write_txt_caselist(&d);
     }
-    let idx = names::Index::new();
+    let idx = list::Index::new();
     // The selection, in run order, and the names nothing matched.
     let mut picked: Vec<bool> = vec![false; idx.cases.len()];
     let mut info: Vec<&str> = Vec::new();
@@ -329,7 +330,7 @@ pub fn run_standalone(ctx: &Context, a: &RunArgs, filter: &[String], out: &Path,
     if fraction == 0 || fstart == 0 {
         return Err(Error::input("--fraction", "--fraction and --fraction-start count from 1"));
     }
-    let all: Vec<(String, String)> = names::all()
+    let all: Vec<(String, String)> = list::all()
         .into_iter()
         .filter(|(p, s)| filter.is_empty() || filter.iter().any(|f| suite::matches(f, s) || suite::matches(f, p)))
         .collect();
