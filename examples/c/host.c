@@ -340,6 +340,65 @@ static void image_barrier(VkCommandBuffer cb, VkImage image, VkImageAspectFlags 
     vkCmdPipelineBarrier(cb, src_stage, dst_stage, 0, 0, NULL, 0, NULL, 1, &b);
 }
 
+/* The host's pre-pass targets: the G-buffer position plane and the depth-stencil image, with
+   the render pass, framebuffer and pipeline the render-pass model draws them with. */
+typedef struct Prepass {
+    VkImage plane;
+    VkImageView plane_view;
+    VkImage ds;
+    VkImageView ds_view;
+    VkRenderPass render_pass;
+    VkFramebuffer framebuffer;
+    VkPipeline pipeline;
+} Prepass;
+
+/* Begins the host's pre-pass into cb (dynamic rendering, or the pre-pass render pass), both
+   targets cleared (depth to clear_depth), with its pipeline, viewport and scissor bound. */
+static void begin_prepass(VkCommandBuffer cb, int dynamic, const Prepass *p, VkRect2D full, VkViewport viewport, float clear_depth) {
+    if (dynamic) {
+        VkRenderingAttachmentInfo color = {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+        VkRenderingAttachmentInfo depth = {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
+        VkRenderingInfo ri = {VK_STRUCTURE_TYPE_RENDERING_INFO};
+        image_barrier(cb, p->plane, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
+                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+                      VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT);
+        image_barrier(cb, p->ds, VK_IMAGE_ASPECT_DEPTH_BIT | VK_IMAGE_ASPECT_STENCIL_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
+                      VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0,
+                      VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
+                      VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
+        color.imageView = p->plane_view;
+        color.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+        color.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+        color.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+        depth.imageView = p->ds_view;
+        depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
+        depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
+        depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
+        depth.clearValue.depthStencil.depth = clear_depth;
+        ri.renderArea = full;
+        ri.layerCount = 1;
+        ri.colorAttachmentCount = 1;
+        ri.pColorAttachments = &color;
+        ri.pDepthAttachment = &depth;
+        ri.pStencilAttachment = &depth;
+        vkCmdBeginRendering(cb, &ri);
+    } else {
+        VkClearValue clears[2];
+        VkRenderPassBeginInfo rb = {VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
+        memset(clears, 0, sizeof clears);
+        clears[1].depthStencil.depth = clear_depth;
+        rb.renderPass = p->render_pass;
+        rb.framebuffer = p->framebuffer;
+        rb.renderArea = full;
+        rb.clearValueCount = 2;
+        rb.pClearValues = clears;
+        vkCmdBeginRenderPass(cb, &rb, VK_SUBPASS_CONTENTS_INLINE);
+    }
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, p->pipeline);
+    vkCmdSetViewport(cb, 0, 1, &viewport);
+    vkCmdSetScissor(cb, 0, 1, &full);
+}
+
 static int cmp_double(const void *a, const void *b) {
     double x = *(const double *)a, y = *(const double *)b;
     return x < y ? -1 : x > y;
@@ -860,48 +919,8 @@ int main(int argc, char **argv) {
                 v[2] = 0.5f + 0.25f * corners[k][i];
             }
             CHECK_VK(vkBeginCommandBuffer(cb, &begin));
-            if (dynamic) {
-                VkRenderingAttachmentInfo color = {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-                VkRenderingAttachmentInfo depth = {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-                VkRenderingInfo ri = {VK_STRUCTURE_TYPE_RENDERING_INFO};
-                image_barrier(cb, plane.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                              VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
-                              VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT);
-                image_barrier(cb, ds.image, VK_IMAGE_ASPECT_DEPTH_BIT | VK_IMAGE_ASPECT_STENCIL_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-                              VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0,
-                              VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
-                              VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
-                color.imageView = plane_view;
-                color.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-                color.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-                color.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-                depth.imageView = ds_view;
-                depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
-                depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-                depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-                depth.clearValue.depthStencil.depth = args.reverse_z ? 0.0f : 1.0f;
-                ri.renderArea = full;
-                ri.layerCount = 1;
-                ri.colorAttachmentCount = 1;
-                ri.pColorAttachments = &color;
-                ri.pDepthAttachment = &depth;
-                ri.pStencilAttachment = &depth;
-                vkCmdBeginRendering(cb, &ri);
-            } else {
-                VkClearValue clears[2];
-                VkRenderPassBeginInfo rb = {VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
-                memset(clears, 0, sizeof clears);
-                clears[1].depthStencil.depth = args.reverse_z ? 0.0f : 1.0f;
-                rb.renderPass = prepass_rp;
-                rb.framebuffer = prepass_fb;
-                rb.renderArea = full;
-                rb.clearValueCount = 2;
-                rb.pClearValues = clears;
-                vkCmdBeginRenderPass(cb, &rb, VK_SUBPASS_CONTENTS_INLINE);
-            }
-            vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, prepass_pipe);
-            vkCmdSetViewport(cb, 0, 1, &viewport);
-            vkCmdSetScissor(cb, 0, 1, &full);
+            begin_prepass(cb, dynamic, &(Prepass){plane.image, plane_view, ds.image, ds_view, prepass_rp, prepass_fb, prepass_pipe},
+                          full, viewport, args.reverse_z ? 0.0f : 1.0f);
             vkCmdPushConstants(cb, prepass_layout, VK_SHADER_STAGE_VERTEX_BIT, 0, 64, mvp);
             vkCmdBindVertexBuffers(cb, 0, 1, &vertices.buffer, &offset);
             vkCmdDraw(cb, 6, 1, 0, 0);
@@ -1053,48 +1072,8 @@ int main(int argc, char **argv) {
             /* UMBRAGE: before any rendering: the pass's uploads (new or moved casters' copies). */
             CHECK_U(umbrage_cmd_before_rendering(pass, cb, frame));
             /* The host's pre-pass. */
-            if (dynamic) {
-                VkRenderingAttachmentInfo color = {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-                VkRenderingAttachmentInfo depth = {VK_STRUCTURE_TYPE_RENDERING_ATTACHMENT_INFO};
-                VkRenderingInfo ri = {VK_STRUCTURE_TYPE_RENDERING_INFO};
-                image_barrier(cb, plane.image, VK_IMAGE_ASPECT_COLOR_BIT, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-                              VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
-                              VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT);
-                image_barrier(cb, ds.image, VK_IMAGE_ASPECT_DEPTH_BIT | VK_IMAGE_ASPECT_STENCIL_BIT, VK_IMAGE_LAYOUT_UNDEFINED,
-                              VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0,
-                              VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
-                              VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT);
-                color.imageView = plane_view;
-                color.imageLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
-                color.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-                color.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-                depth.imageView = ds_view;
-                depth.imageLayout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL;
-                depth.loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR;
-                depth.storeOp = VK_ATTACHMENT_STORE_OP_STORE;
-                depth.clearValue.depthStencil.depth = args.reverse_z ? 0.0f : 1.0f;
-                ri.renderArea = full;
-                ri.layerCount = 1;
-                ri.colorAttachmentCount = 1;
-                ri.pColorAttachments = &color;
-                ri.pDepthAttachment = &depth;
-                ri.pStencilAttachment = &depth;
-                vkCmdBeginRendering(cb, &ri);
-            } else {
-                VkClearValue clears[2];
-                VkRenderPassBeginInfo rb = {VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO};
-                memset(clears, 0, sizeof clears);
-                clears[1].depthStencil.depth = args.reverse_z ? 0.0f : 1.0f;
-                rb.renderPass = prepass_rp;
-                rb.framebuffer = prepass_fb;
-                rb.renderArea = full;
-                rb.clearValueCount = 2;
-                rb.pClearValues = clears;
-                vkCmdBeginRenderPass(cb, &rb, VK_SUBPASS_CONTENTS_INLINE);
-            }
-            vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, prepass_pipe);
-            vkCmdSetViewport(cb, 0, 1, &viewport);
-            vkCmdSetScissor(cb, 0, 1, &full);
+            begin_prepass(cb, dynamic, &(Prepass){plane.image, plane_view, ds.image, ds_view, prepass_rp, prepass_fb, prepass_pipe},
+                          full, viewport, args.reverse_z ? 0.0f : 1.0f);
             first = 0;
             for (mi = 0; mi < scene.mesh_count; mi++) {
                 double xf[16], a[16], mvp_d[16];

@@ -81,22 +81,18 @@ pub fn case_record(name: &str, code: Code, texts: &[String], images: &[Image], m
     s
 }
 
-/// XML text and attribute escaping (and no control characters, which XML 1.0 forbids).
+/// XML text and attribute escaping ([`crate::junit::escape`]), with tabs and newlines as
+/// spaces and other control characters as `?` (a QPA record's text stays on its line).
 pub fn esc(s: &str) -> String {
-    let mut o = String::with_capacity(s.len());
-    for c in s.chars() {
-        match c {
-            '&' => o.push_str("&amp;"),
-            '<' => o.push_str("&lt;"),
-            '>' => o.push_str("&gt;"),
-            '"' => o.push_str("&quot;"),
-            '\'' => o.push_str("&apos;"),
-            '\n' | '\t' => o.push(' '),
-            c if (c as u32) < 0x20 => o.push('?'),
-            c => o.push(c),
-        }
-    }
-    o
+    let flat: String = s
+        .chars()
+        .map(|c| match c {
+            '\n' | '\t' => ' ',
+            c if (c as u32) < 0x20 => '?',
+            c => c,
+        })
+        .collect();
+    crate::junit::escape(&flat)
 }
 
 const B64: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
