@@ -203,9 +203,9 @@ enum Command {
         /// Child processes at once (0: one per CPU core, as deqp-runner does).
         #[arg(long, default_value_t = 0, value_name = "N")]
         jobs: usize,
-        /// The driver's expected failures (`case,Fail` / `case,Crash` lines, as Mesa's CI
-        /// keeps them): exit 0 only when the run matches the list, no new failure and no
-        /// unexpected pass.
+        /// The driver's expected results (`case,Fail` / `Crash` / `Timeout` / `Skip` lines, as
+        /// Mesa's CI keeps them; `*` patterns): exit 0 only when the run matches the list, no
+        /// new failure, no unexpected pass and, where it lists skips, no new skip.
         #[arg(long, value_name = "FILE")]
         expect: Option<PathBuf>,
         /// Mesa's baseline: `name,Status` lines (Fail, Crash, Timeout, ...), e.g. a previous

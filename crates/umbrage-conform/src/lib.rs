@@ -332,19 +332,29 @@ pub fn run(mut a: RunArgs) -> Result<ExitCode> {
         println!("junit: {}", j.display());
     }
     ctx.check_validation()?;
+    // The expectation list this run matches (a new driver's list starts from it).
+    let needed = out.join("conform-expectations.txt");
+    std::fs::write(&needed, expect::Expectations::from_report(&r, &suite::all_names()))
+        .map_err(|e| Error::io(needed.display().to_string(), e))?;
     if let Some(e) = &expectations {
         let v = e.judge(&r);
         for n in &v.new_failures {
             println!("NEW FAILURE (not in the expectations): {n}");
         }
         for n in &v.unexpected_passes {
-            println!("UNEXPECTED PASS (listed as failing; remove it from the list): {n}");
+            println!("UNEXPECTED PASS (listed as failing or skipping; remove it from the list): {n}");
+        }
+        for n in &v.new_skips {
+            println!("NEW SKIP (not in the expectations; a case that ran now skips): {n}");
         }
         println!(
-            "expectations: {} expected failures, {} new failures, {} unexpected passes",
+            "expectations: {} expected failures, {} expected skips, {} new failures, {} unexpected passes, {} new skips (the list this run matches: {})",
             v.expected_failures,
+            v.expected_skips,
             v.new_failures.len(),
-            v.unexpected_passes.len()
+            v.unexpected_passes.len(),
+            v.new_skips.len(),
+            needed.display()
         );
         let p = out.join("conform-expect.json");
         let json = serde_json::to_string_pretty(&v).map_err(|e| Error::Internal(format!("JSON: {e}")))?;
