@@ -199,7 +199,7 @@ pub fn run() -> Result<(), String> {
     check(&stencil, proj.as_dmat4() * view.as_dmat4())?;
     match VALIDATION_ERRORS.load(Ordering::SeqCst) {
         0 => Ok(()),
-        n => Err(format!("{n} validation error(s)")),
+        n => Err(format!("{n} validation error(s) or warning(s)")),
     }
 }
 
@@ -496,7 +496,8 @@ fn corner_sign(i: u32) -> DVec3 {
     DVec3::from_array([0, 1, 2].map(|bit| if i >> bit & 1 == 1 { 1.0 } else { -1.0 }))
 }
 
-/// Counts validation errors (and prints errors and warnings).
+/// Counts validation errors and warnings (the warnings of umbrage's allowlist,
+/// [`umbrage::gpu::validation::ALLOWED_WARNINGS`], excepted) and prints them all.
 ///
 /// # Safety
 /// Called by the validation layer only, with callback data valid for the call.
@@ -507,9 +508,12 @@ unsafe extern "system" fn on_validation(
     _user: *mut c_void,
 ) -> vk::Bool32 {
     // SAFETY: the layer passes valid callback data (or null) for the duration of the call.
-    let message = unsafe { data.as_ref().and_then(|d| d.message_as_c_str()) };
+    let (message, id) = unsafe { data.as_ref().map_or((None, None), |d| (d.message_as_c_str(), d.message_id_name_as_c_str())) };
+    let id = id.map(|i| i.to_string_lossy()).unwrap_or_default();
     eprintln!("[validation {severity:?}] {}", message.map(|m| m.to_string_lossy()).unwrap_or_default());
-    VALIDATION_ERRORS.fetch_add(severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) as u32, Ordering::SeqCst);
+    let allowed =
+        !severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) && umbrage::gpu::validation::allowed_warning(&id).is_some();
+    VALIDATION_ERRORS.fetch_add(u32::from(!allowed), Ordering::SeqCst);
     vk::FALSE
 }
 

@@ -240,7 +240,7 @@ pub fn run(config: &Config, frames: usize) -> Result<Vec<FrameResult>, String> {
     }
     let errors = log.lock().map(|l| l.clone()).unwrap_or_default();
     if let Some(first) = errors.first() {
-        return Err(format!("{} validation error(s) (teardown included), first: {first}", errors.len()));
+        return Err(format!("{} validation error(s) or warning(s) (teardown included), first: {first}", errors.len()));
     }
     let keep_from = results.len().saturating_sub(FRAMES_IN_FLIGHT);
     for r in &mut results[..keep_from] {

@@ -16,7 +16,9 @@ pub(super) fn validation_requested() -> bool {
     std::env::var("UMBRAGE_VALIDATION").map(|v| v == "1" || v.eq_ignore_ascii_case("true")).unwrap_or(false)
 }
 
-/// Collects validation ERRORs into the `Mutex<Vec<String>>` passed as user data.
+/// Collects validation errors and warnings (the warnings of umbrage's allowlist,
+/// [`umbrage::gpu::validation::ALLOWED_WARNINGS`], excepted) into the `Mutex<Vec<String>>`
+/// passed as user data: any fails the run.
 ///
 /// # Safety
 /// Called by the validation layer only, with the user data the messenger was created with.
@@ -28,15 +30,21 @@ pub(super) unsafe extern "system" fn debug_callback(
 ) -> vk::Bool32 {
     // SAFETY: the loader passes valid callback data for the duration of the call; `user` is
     // `Arc::as_ptr` of the host's log, which outlives the messenger (destroyed first).
-    let (msg, log) = unsafe {
-        let msg = if data.is_null() || (*data).p_message.is_null() {
-            String::from("(no message)")
-        } else {
-            CStr::from_ptr((*data).p_message).to_string_lossy().into_owned()
+    let (msg, id, log) = unsafe {
+        let text = |p: *const std::ffi::c_char| {
+            if data.is_null() || p.is_null() {
+                String::new()
+            } else {
+                CStr::from_ptr(p).to_string_lossy().into_owned()
+            }
         };
-        (msg, &*(user as *const Mutex<Vec<String>>))
+        let (msg, id) =
+            if data.is_null() { (String::new(), String::new()) } else { (text((*data).p_message), text((*data).p_message_id_name)) };
+        (msg, id, &*(user as *const Mutex<Vec<String>>))
     };
-    if severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) {
+    let allowed =
+        !severity.contains(vk::DebugUtilsMessageSeverityFlagsEXT::ERROR) && umbrage::gpu::validation::allowed_warning(&id).is_some();
+    if !allowed {
         eprintln!("[vulkan validation] {msg}");
         if let Ok(mut l) = log.lock() {
             l.push(msg);

@@ -123,3 +123,12 @@ mod tests {
         assert!(!portable_only());
     }
 }
+
+/// The threads this process may use (`std::thread::available_parallelism`, at least 1), asked
+/// once: on Linux each call reads the cgroup's CPU quota from files, which cost more than a
+/// kept frame's whole planning when asked every frame (measured with `perf` on
+/// `examples/frame_cost.rs level`: 17 % of `prepare`).
+pub fn cores() -> usize {
+    static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+}

@@ -388,11 +388,7 @@ impl FacePlanes {
     /// [`facing_packed`](Self::facing_packed), on every available core (at most 8) for meshes
     /// of at least [`PLANES_PARALLEL_THRESHOLD`] triangles, else on this thread.
     pub fn facing_packed_auto(&self, mesh: &Mesh, l: Vec4, flip: bool, out: &mut Vec<u64>) {
-        let th = if self.len < PLANES_PARALLEL_THRESHOLD {
-            1
-        } else {
-            std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1).min(8)
-        };
+        let th = if self.len < PLANES_PARALLEL_THRESHOLD { 1 } else { super::cpu::cores().min(8) };
         self.facing_packed_threads(mesh, l, flip, th, out)
     }
 

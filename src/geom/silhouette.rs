@@ -41,7 +41,7 @@ fn threads_for(n: usize) -> usize {
     if n < PARALLEL_THRESHOLD {
         1
     } else {
-        std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1).min(8)
+        super::cpu::cores().min(8)
     }
 }
 

@@ -183,7 +183,7 @@ impl ShadowPass {
         let fwd = view.forward(self.desc.depth_direction);
         let camera = crate::geom::Camera { eye: view.eye.as_vec3(), ..crate::geom::Camera::default() };
         let threads = match self.desc.plan_threads {
-            0 => std::thread::available_parallelism().map_or(1, |n| n.get()),
+            0 => crate::geom::cpu::cores(),
             n => n,
         };
         let input = keep::KeepInput {
