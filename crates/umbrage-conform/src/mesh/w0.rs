@@ -173,6 +173,13 @@ pub fn w0_vertices(ctx: &Context) -> Result<CheckResult> {
                 }
             }
         }
+        if depth_not_one > 0 {
+            let covered: Vec<Option<f64>> =
+                model.stencil.iter().zip(&model.judged).map(|(&s, &j)| (j && s != START).then_some(1.0)).collect();
+            let actual: Vec<f64> = got.image.depth.iter().map(|&d| harness::depth_value(format, d)).collect();
+            let bad = |i: usize| covered[i].is_some() && !depth_one(format, got.image.depth[i]);
+            crate::image_sink::depth_mismatch(SIZE.0, SIZE.1, &covered, &actual, &bad);
+        }
         let vertex = vertex_pipeline_differences(ctx, run, &tris, &got.image)?;
         numbers.insert(
             run.label.clone(),
