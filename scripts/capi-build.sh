@@ -33,7 +33,8 @@ CARGO_TARGET_DIR="$PWD/target/capi-build" cargo cinstall -p umbrage-capi --profi
 # The scenes, in the flat format C reads (`umbrage export-scene`).
 mkdir -p "$prefix/share/umbrage/scenes"
 cargo build --quiet -p umbrage-cli --bin umbrage
-for s in default; do
+for s in default hard/eye_in_volume; do
+    mkdir -p "$(dirname "$prefix/share/umbrage/scenes/$s.scene")"
     ./target/debug/umbrage export-scene "$s" "$prefix/share/umbrage/scenes/$s.scene"
 done
 

@@ -7,7 +7,10 @@
 #     built against it; only umbrage_* symbols exported; no Vulkan loader linked;
 #  4. the contract from C against a test build (--features test-panic, its own prefix);
 #  5. the C host exact against `umbrage check` on the default scene: 1 and 4 samples, forward and
-#     reverse-Z, dynamic rendering and a render pass, validation on; the C++ host;
+#     reverse-Z, dynamic rendering and a render pass, validation on (any error or warning, leaks at
+#     device or instance destruction included, fails), on lavapipe 22.3.6 and 25.0.7 and
+#     SwiftShader (its 4-sample driver defect bounded); the edge-quad, compute and mesh
+#     techniques on 25.0.7, mesh refused on 22.3.6; the C++ host, validation on too;
 #  6. the hosts under ASan/UBSan (make capi SANITIZE=1), then the C host once under valgrind
 #     (scripts/valgrind-driver.supp for the driver's own allocations).
 # Prints "N passed, M failed" at the end; exits non-zero on any failure. A missing Vulkan device
@@ -74,31 +77,98 @@ contract() {
 }
 step "the contract from C (test-panic build)" contract
 
-host() { # name, extra args...
-    local dir=target/capi-out/$1
-    shift
-    rm -rf "$dir"
-    "$prefix/bin/umbrage-c-host" --scene default --size 320x200 --dump "$dir" --out "$dir.png" "$@" || return 1
-    if [ -d "$dir/sample_0" ]; then
-        for s in "$dir"/sample_*; do ./target/debug/umbrage check --threshold 0 "$s" || return 1; done
-    else
-        ./target/debug/umbrage check --threshold 0 "$dir"
-    fi
+# The mismatches outside the band a light and sample may have: 0, except SwiftShader at more
+# than one sample, whose multisampled depth sits at the standard locations mirrored in x (a
+# driver defect, docs/conform/drivers-notes.md §1f): the host unprojects at the measured
+# locations as `render` does, and a few samples near volume edges (coverage at one location,
+# depth at the other) remain. The bound is tests/engine/embed.rs's SWIFTSHADER_MSAA_MISMATCHES.
+SWIFTSHADER_MSAA_MISMATCHES=6
+swiftshader_residue=0
+# check_dump DIR BOUND: `umbrage check` on DIR (or each DIR/sample_K), every light and sample at
+# most BOUND mismatches outside the band; adds the mismatches to $residue.
+residue=0
+check_dump() {
+    local dir=$1 bound=$2 s out worst counts
+    local samples=("$dir")
+    [ -d "$dir/sample_0" ] && samples=("$dir"/sample_*)
+    for s in "${samples[@]}"; do
+        out=$(./target/debug/umbrage check --threshold 1 "$s") || { echo "$out"; return 1; }
+        counts=$(echo "$out" | sed -n 's/.* \([0-9][0-9]*\) mismatches outside band.*/\1/p')
+        [ -n "$counts" ] || { echo "no per-light lines from umbrage check:"; echo "$out"; return 1; }
+        worst=$(echo "$counts" | sort -n | tail -1)
+        residue=$((residue + $(echo "$counts" | awk '{ t += $1 } END { print t }')))
+        if [ "$worst" -gt "$bound" ]; then
+            echo "$s: $worst mismatches outside the band for one light (at most $bound):"
+            echo "$out"
+            return 1
+        fi
+    done
 }
-for msaa in 1 4; do
-    for z in "" --reverse-z; do
-        for model in "" --render-pass; do
-            name="c-host-${msaa}x${z:+-reverse-z}${model:+-render-pass}"
-            step "$name exact against umbrage check" host "$name" --msaa "$msaa" $z $model
+host() { # driver, name, extra args...
+    local driver=$1 dir=target/capi-out/$2 bound=0
+    shift 2
+    rm -rf "$dir"
+    [ "$driver" = swiftshader ] && [[ " $* " == *" --msaa 4 "* ]] && bound=$SWIFTSHADER_MSAA_MISMATCHES
+    (eval "$(./scripts/drivers.sh env "$driver")" &&
+        "$prefix/bin/umbrage-c-host" --scene default --size 320x200 --dump "$dir" --out "$dir.png" "$@") || return 1
+    residue=0
+    check_dump "$dir" "$bound" || return 1
+    [ "$bound" = 0 ] || swiftshader_residue=$((swiftshader_residue + residue))
+}
+# The scenes the Rust hosts are held to, on the three drivers CI has: 1 and 4 samples, forward
+# and reverse-Z, dynamic rendering and a render pass.
+./scripts/drivers.sh install 22.3.6 25.0.7 swiftshader >/dev/null
+for driver in 22.3.6 25.0.7 swiftshader; do
+    for msaa in 1 4; do
+        for z in "" --reverse-z; do
+            for model in "" --render-pass; do
+                name="c-host-$driver-${msaa}x${z:+-reverse-z}${model:+-render-pass}"
+                step "$name exact against umbrage check" host "$driver" "$name" --msaa "$msaa" $z $model
+            done
         done
     done
 done
+# The hard scene the Rust host is held to besides its own (tests/engine/embed.rs): the eye inside
+# a shadow volume, in every configuration on 22.3.6, and two on 25.0.7 and SwiftShader.
+eye="$prefix/share/umbrage/scenes/hard/eye_in_volume.scene"
+for msaa in 1 4; do
+    for z in "" --reverse-z; do
+        for model in "" --render-pass; do
+            name="c-host-22.3.6-eye_in_volume-${msaa}x${z:+-reverse-z}${model:+-render-pass}"
+            step "$name exact against umbrage check" host 22.3.6 "$name" --scene "$eye" --msaa "$msaa" $z $model
+        done
+    done
+done
+for driver in 25.0.7 swiftshader; do
+    step "c-host-$driver-eye_in_volume-1x exact" host "$driver" "c-host-$driver-eye_in_volume-1x" --scene "$eye"
+    step "c-host-$driver-eye_in_volume-4x-reverse-z-render-pass exact" host "$driver" "c-host-$driver-eye_in_volume-4x" --scene "$eye" --msaa 4 --reverse-z --render-pass
+done
+residue_present() {
+    echo "SwiftShader at 4 samples: $swiftshader_residue mismatches outside the band over its 4-sample runs (each light and sample at most $SWIFTSHADER_MSAA_MISMATCHES)"
+    [ "$swiftshader_residue" -gt 0 ] || { echo "the driver defect's residue is gone: drop SWIFTSHADER_MSAA_MISMATCHES here and in tests/engine/embed.rs, update drivers-notes §1f"; return 1; }
+}
+step "SwiftShader's 4-sample residue still there (the bound is live)" residue_present
+# The other techniques a host feeds the same way, from C, where the device has them: lavapipe
+# 25.0.7 (mesh shaders); each exact, 1 sample forward with dynamic rendering, 4 samples
+# reverse-Z with a render pass.
+for t in edge-quads compute mesh; do
+    step "c-host-25.0.7 --technique $t exact" host 25.0.7 "c-host-25.0.7-$t" --technique "$t"
+    step "c-host-25.0.7 --technique $t, 4x reverse-Z render pass, exact" host 25.0.7 "c-host-25.0.7-$t-4x" --technique "$t" --msaa 4 --reverse-z --render-pass
+done
+# ... and a device without mesh shaders (22.3.6) refuses mesh with a clear error, not a crash.
+mesh_refused() {
+    local out rc=0
+    out=$(eval "$(./scripts/drivers.sh env 22.3.6)" && "$prefix/bin/umbrage-c-host" --scene default --size 64x40 --technique mesh 2>&1) || rc=$?
+    echo "$out" | tail -2
+    [ "$rc" = 1 ] && echo "$out" | grep -q "no VK_EXT_mesh_shader with meshShader"
+}
+step "c-host --technique mesh refused on 22.3.6 (no mesh shaders)" mesh_refused
 step "C++ host (RAII wrapper)" "$prefix/bin/umbrage-cpp-host" --scene default
 
 sanitize() {
     ./scripts/capi-build.sh --sanitize >/dev/null || return 1
     # the driver's own leaks are not ours: leak checks stay on, the ASan runtime reports them
-    ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 host c-host-asan --msaa 4 || return 1
+    ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 host 22.3.6 c-host-asan --msaa 4 || return 1
     ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=halt_on_error=1 "$prefix/bin/umbrage-cpp-host" --scene default
 }
 step "hosts under ASan and UBSan" sanitize

@@ -2,7 +2,9 @@
 // scene: a Vulkan 1.3 device, a depth-stencil image cleared to the far plane (this host has no
 // pre-pass: every shadow volume counts), two frames in flight, each light's determination, and
 // the stencil read back. It checks what the wrapper promises: a stale frame throws
-// umbrage::Error with UMBRAGE_ERROR_STALE_FRAME, and the pass is destroyed by its owner.
+// umbrage::Error with UMBRAGE_ERROR_STALE_FRAME, and the pass is destroyed by its owner. With
+// UMBRAGE_VALIDATION set (not 0) the Khronos validation layer runs with synchronisation
+// validation, from vkCreateInstance to vkDestroyInstance; any error or warning fails the run.
 //   umbrage-cpp-host [--scene FILE|NAME]     (as umbrage-c-host: an `umbrage export-scene` file)
 #include "umbrage.hpp"
 #include "scene.h"
@@ -17,6 +19,16 @@
 #include <unistd.h>
 
 namespace {
+
+uint32_t validation_messages = 0;
+
+VKAPI_ATTR VkBool32 VKAPI_CALL on_validation(VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT,
+                                             const VkDebugUtilsMessengerCallbackDataEXT* data, void*) {
+    ++validation_messages;
+    std::fprintf(stderr, "validation %s: %s\n", (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) ? "error" : "warning",
+                 data->pMessage);
+    return VK_FALSE;
+}
 
 void vk_check(VkResult r, const char* call) {
     if (r != VK_SUCCESS) throw std::runtime_error(std::string(call) + " failed: VkResult " + std::to_string(static_cast<int>(r)));
@@ -51,8 +63,35 @@ int run(int argc, char** argv) {
     app.apiVersion = VK_API_VERSION_1_3;
     VkInstanceCreateInfo ii{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
     ii.pApplicationInfo = &app;
+    const char* env = std::getenv("UMBRAGE_VALIDATION");
+    const bool validation = env && std::strcmp(env, "0") != 0;
+    const char* layer = "VK_LAYER_KHRONOS_validation";
+    const char* debug_ext = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
+    VkValidationFeatureEnableEXT sync = VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
+    VkValidationFeaturesEXT features{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT};
+    VkDebugUtilsMessengerCreateInfoEXT mci{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+    mci.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT;
+    mci.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT;
+    mci.pfnUserCallback = on_validation;
+    if (validation) {
+        features.enabledValidationFeatureCount = 1;
+        features.pEnabledValidationFeatures = &sync;
+        features.pNext = &mci;  // the messenger of vkCreateInstance and vkDestroyInstance themselves
+        ii.pNext = &features;
+        ii.enabledLayerCount = 1;
+        ii.ppEnabledLayerNames = &layer;
+        ii.enabledExtensionCount = 1;
+        ii.ppEnabledExtensionNames = &debug_ext;
+    }
     VkInstance instance;
     vk_check(vkCreateInstance(&ii, nullptr, &instance), "vkCreateInstance");
+    VkDebugUtilsMessengerEXT messenger = VK_NULL_HANDLE;
+    auto destroy_messenger =
+        reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(vkGetInstanceProcAddr(instance, "vkDestroyDebugUtilsMessengerEXT"));
+    if (validation) {
+        auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(vkGetInstanceProcAddr(instance, "vkCreateDebugUtilsMessengerEXT"));
+        vk_check(create(instance, &mci, nullptr, &messenger), "vkCreateDebugUtilsMessengerEXT");
+    }
     uint32_t count = 1;
     VkPhysicalDevice physical;
     VkResult er = vkEnumeratePhysicalDevices(instance, &count, &physical);
@@ -253,8 +292,14 @@ int run(int argc, char** argv) {
     vkDestroyImage(device, image, nullptr);
     vkFreeMemory(device, image_memory, nullptr);
     vkDestroyDevice(device, nullptr);
+    if (messenger) destroy_messenger(instance, messenger, nullptr);
     vkDestroyInstance(instance, nullptr);
     scene_free(&scene);
+    if (validation_messages) {
+        std::fprintf(stderr, "umbrage-cpp-host: %u validation message(s)\n", validation_messages);
+        ++failures;
+    }
+    if (!failures) std::printf("umbrage-cpp-host: ok%s\n", validation ? " (validation on, no message)" : "");
     return failures ? 1 : 0;
 }
 

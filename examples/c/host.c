@@ -51,7 +51,27 @@ typedef struct Args {
     const char *scene, *out, *dump;
     uint32_t width, height, samples, frames;
     int reverse_z, render_pass;
+    UmbrageTechnique technique;
 } Args;
+
+/* --technique NAME: the shadow pass's techniques this host can feed (ray query needs a
+ * world-position G-buffer, planar shadows planar receivers: neither is this host's). */
+static const struct {
+    const char *name;
+    UmbrageTechnique technique;
+} techniques[] = {
+    {"volumes", UMBRAGE_TECHNIQUE_VOLUMES},
+    {"edge-quads", UMBRAGE_TECHNIQUE_EDGE_QUADS},
+    {"compute", UMBRAGE_TECHNIQUE_COMPUTE},
+    {"mesh", UMBRAGE_TECHNIQUE_MESH},
+};
+
+static const char *technique_name(UmbrageTechnique t) {
+    size_t i;
+    for (i = 0; i < sizeof techniques / sizeof techniques[0]; i++)
+        if (techniques[i].technique == t) return techniques[i].name;
+    return "?";
+}
 
 typedef struct Buffer {
     VkBuffer buffer;
@@ -65,18 +85,17 @@ typedef struct Image {
     VkDeviceMemory memory;
 } Image;
 
+/* Validation messages of ERROR or WARNING severity: any fails the run (umbrage's own runs
+ * allow a few best-practices warnings by ID, src/gpu/validation.rs; this host enables the
+ * synchronisation checks only, and none is expected). */
 static uint32_t validation_errors;
 
 static VKAPI_ATTR VkBool32 VKAPI_CALL debug_callback(VkDebugUtilsMessageSeverityFlagBitsEXT severity, VkDebugUtilsMessageTypeFlagsEXT type,
                                                      const VkDebugUtilsMessengerCallbackDataEXT *data, void *user) {
     (void)type;
     (void)user;
-    if (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) {
-        validation_errors++;
-        fprintf(stderr, "validation error: %s\n", data->pMessage);
-    } else {
-        fprintf(stderr, "validation warning: %s\n", data->pMessage);
-    }
+    validation_errors++;
+    fprintf(stderr, "validation %s: %s\n", (severity & VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT) ? "error" : "warning", data->pMessage);
     return VK_FALSE;
 }
 
@@ -89,7 +108,7 @@ static void on_warning(void *user, const char *message) {
 static void usage(void) {
     fprintf(stderr,
             "usage: umbrage-c-host [--scene FILE|NAME] [--size WxH] [--out PNG] [--dump DIR] [--msaa N] [--reverse-z] "
-            "[--render-pass] [--frames N]\n");
+            "[--render-pass] [--frames N] [--technique volumes|edge-quads|compute|mesh]\n");
     exit(1);
 }
 
@@ -128,6 +147,15 @@ static Args parse_args(int argc, char **argv) {
                 fprintf(stderr, "--msaa %s: the sample count is 1, 2, 4 or 8\n", v);
                 exit(1);
             }
+        } else if (strcmp(k, "--technique") == 0) {
+            size_t t;
+            for (t = 0; t < sizeof techniques / sizeof techniques[0] && strcmp(v, techniques[t].name) != 0; t++) {
+            }
+            if (t == sizeof techniques / sizeof techniques[0]) {
+                fprintf(stderr, "--technique %s: volumes, edge-quads, compute or mesh\n", v);
+                exit(1);
+            }
+            a.technique = techniques[t].technique, i++;
         } else if (strcmp(k, "--frames") == 0) {
             a.frames = (uint32_t)atoi(v), i++;
             if (a.frames < 1 || a.frames > 10000) {
@@ -435,7 +463,9 @@ int main(int argc, char **argv) {
     Args args = parse_args(argc, argv);
     HostScene scene;
     char path[1200];
-    int dynamic;
+    int dynamic, api13;
+    /* optional features found and enabled on the device, told to the pass (UmbrageFeatureFlags) */
+    uint32_t enabled_bits = 0;
     VkFormat ds_format = VK_FORMAT_UNDEFINED;
     const VkFormat plane_format = VK_FORMAT_R32G32B32A32_SFLOAT;
     VkPhysicalDeviceFeatures supported;
@@ -464,6 +494,7 @@ int main(int argc, char **argv) {
         if (scene.meshes[mi].casts_shadow) moving = (int)mi;
     }
     dynamic = !args.render_pass;
+    api13 = dynamic || args.technique == UMBRAGE_TECHNIQUE_MESH;
 
     /* Instance: Vulkan 1.3 (dynamic rendering) or 1.1 (render passes). */
     {
@@ -473,12 +504,18 @@ int main(int argc, char **argv) {
         const char *ext = VK_EXT_DEBUG_UTILS_EXTENSION_NAME;
         VkValidationFeatureEnableEXT sync = VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
         VkValidationFeaturesEXT features = {VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT};
+        /* the messenger also sees vkCreateInstance and vkDestroyInstance (leaks reported there) */
+        VkDebugUtilsMessengerCreateInfoEXT m = {VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+        m.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT;
+        m.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT;
+        m.pfnUserCallback = debug_callback;
         app.pApplicationName = "umbrage-c-host";
-        app.apiVersion = dynamic ? VK_API_VERSION_1_3 : VK_API_VERSION_1_1;
+        app.apiVersion = api13 ? VK_API_VERSION_1_3 : VK_API_VERSION_1_1;
         info.pApplicationInfo = &app;
         if (validation) {
             features.enabledValidationFeatureCount = 1;
             features.pEnabledValidationFeatures = &sync;
+            features.pNext = &m;
             info.pNext = &features;
             info.enabledLayerCount = 1;
             info.ppEnabledLayerNames = &layer;
@@ -487,13 +524,9 @@ int main(int argc, char **argv) {
         }
         CHECK_VK(vkCreateInstance(&info, NULL, &instance));
         if (validation) {
-            VkDebugUtilsMessengerCreateInfoEXT m = {VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
             PFN_vkCreateDebugUtilsMessengerEXT create =
                 (PFN_vkCreateDebugUtilsMessengerEXT)vkGetInstanceProcAddr(instance, "vkCreateDebugUtilsMessengerEXT");
             destroy_messenger = (PFN_vkDestroyDebugUtilsMessengerEXT)vkGetInstanceProcAddr(instance, "vkDestroyDebugUtilsMessengerEXT");
-            m.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT;
-            m.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT;
-            m.pfnUserCallback = debug_callback;
             CHECK_VK(create(instance, &m, NULL, &messenger));
         }
     }
@@ -508,7 +541,7 @@ int main(int argc, char **argv) {
             VkQueueFamilyProperties families[16];
             uint32_t fc = 16;
             vkGetPhysicalDeviceProperties(devices[i], &props);
-            if (props.apiVersion < (dynamic ? VK_API_VERSION_1_3 : VK_API_VERSION_1_1)) continue;
+            if (props.apiVersion < (api13 ? VK_API_VERSION_1_3 : VK_API_VERSION_1_1)) continue;
             vkGetPhysicalDeviceQueueFamilyProperties(devices[i], &fc, families);
             for (q = 0; q < fc; q++)
                 if (families[q].queueFlags & VK_QUEUE_GRAPHICS_BIT) {
@@ -518,7 +551,7 @@ int main(int argc, char **argv) {
                 }
         }
         if (!physical) {
-            fprintf(stderr, "umbrage-c-host: no Vulkan %s device with a graphics queue\n", dynamic ? "1.3" : "1.1");
+            fprintf(stderr, "umbrage-c-host: no Vulkan %s device with a graphics queue\n", api13 ? "1.3" : "1.1");
             return 1;
         }
         vkGetPhysicalDeviceProperties(physical, &props);
@@ -526,8 +559,8 @@ int main(int argc, char **argv) {
             fprintf(stderr, "umbrage-c-host: %s has no standard sample locations, so the samples cannot be placed\n", props.deviceName);
             return 1;
         }
-        printf("umbrage-c-host: %s, %ux%u, %ux %s %s\n", props.deviceName, w, h, args.samples, args.reverse_z ? "reverse-Z" : "forward",
-               dynamic ? "dynamic-rendering" : "render-pass");
+        printf("umbrage-c-host: %s, %ux%u, %ux %s %s, technique %s\n", props.deviceName, w, h, args.samples,
+               args.reverse_z ? "reverse-Z" : "forward", dynamic ? "dynamic-rendering" : "render-pass", technique_name(args.technique));
         vkGetPhysicalDeviceMemoryProperties(physical, &memory_props);
         vkGetPhysicalDeviceFeatures(physical, &supported);
         {
@@ -544,16 +577,66 @@ int main(int argc, char **argv) {
             }
         }
     }
-    /* Device: depthBounds and depthClamp where present (told to the pass), dynamic rendering. */
+    /* Device: depthBounds and depthClamp where present, the indirect draws the compute technique
+     * records where present, mesh shaders when asked (all told to the pass), dynamic rendering. */
     {
         float priority = 1.0f;
         VkDeviceQueueCreateInfo q = {VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
         VkDeviceCreateInfo info = {VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
         VkPhysicalDeviceFeatures enabled;
+        VkPhysicalDeviceVulkan12Features v12 = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
         VkPhysicalDeviceVulkan13Features v13 = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_3_FEATURES};
+        VkPhysicalDeviceMeshShaderFeaturesEXT mesh = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT};
+        const char *mesh_ext = VK_EXT_MESH_SHADER_EXTENSION_NAME;
+        void *chain = NULL;
+        int want_mesh = args.technique == UMBRAGE_TECHNIQUE_MESH;
+        if (api13) {
+            /* what the device has: Vulkan 1.2's drawIndirectCount, the mesh shader's features */
+            VkPhysicalDeviceVulkan12Features has12 = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+            VkPhysicalDeviceMeshShaderFeaturesEXT has_mesh = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_MESH_SHADER_FEATURES_EXT};
+            VkPhysicalDeviceFeatures2 f2 = {VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
+            VkExtensionProperties exts[512];
+            uint32_t ext_count = 512, e;
+            int mesh_ext_present = 0;
+            {
+                VkResult r = vkEnumerateDeviceExtensionProperties(physical, NULL, &ext_count, exts);
+                if (r != VK_SUCCESS && r != VK_INCOMPLETE) {
+                    fprintf(stderr, "umbrage-c-host: vkEnumerateDeviceExtensionProperties failed: VkResult %d\n", (int)r);
+                    return 1;
+                }
+            }
+            for (e = 0; e < ext_count; e++)
+                if (strcmp(exts[e].extensionName, mesh_ext) == 0) mesh_ext_present = 1;
+            f2.pNext = &has12;
+            if (mesh_ext_present) has12.pNext = &has_mesh;
+            vkGetPhysicalDeviceFeatures2(physical, &f2);
+            if (has12.drawIndirectCount) {
+                v12.drawIndirectCount = VK_TRUE;
+                enabled_bits |= UMBRAGE_FEATURE_DRAW_INDIRECT_COUNT_BIT;
+            }
+            v12.pNext = chain, chain = &v12;
+            if (want_mesh) {
+                if (!mesh_ext_present || !has_mesh.meshShader) {
+                    fprintf(stderr, "umbrage-c-host: --technique mesh: this device has no VK_EXT_mesh_shader with meshShader\n");
+                    return 1;
+                }
+                mesh.meshShader = VK_TRUE;
+                mesh.taskShader = has_mesh.taskShader;
+                enabled_bits |= UMBRAGE_FEATURE_MESH_SHADER_BIT | (has_mesh.taskShader ? UMBRAGE_FEATURE_TASK_SHADER_BIT : 0u);
+                mesh.pNext = chain, chain = &mesh;
+                info.enabledExtensionCount = 1;
+                info.ppEnabledExtensionNames = &mesh_ext;
+            }
+        }
         memset(&enabled, 0, sizeof enabled);
         enabled.depthBounds = supported.depthBounds;
         enabled.depthClamp = supported.depthClamp;
+        enabled.drawIndirectFirstInstance = supported.drawIndirectFirstInstance;
+        enabled.multiDrawIndirect = supported.multiDrawIndirect;
+        enabled_bits |= (supported.depthBounds ? UMBRAGE_FEATURE_DEPTH_BOUNDS_BIT : 0u) |
+                        (supported.depthClamp ? UMBRAGE_FEATURE_DEPTH_CLAMP_BIT : 0u) |
+                        (supported.drawIndirectFirstInstance ? UMBRAGE_FEATURE_DRAW_INDIRECT_FIRST_INSTANCE_BIT : 0u) |
+                        (supported.multiDrawIndirect ? UMBRAGE_FEATURE_MULTI_DRAW_INDIRECT_BIT : 0u);
         q.queueFamilyIndex = queue_family;
         q.queueCount = 1;
         q.pQueuePriorities = &priority;
@@ -562,8 +645,9 @@ int main(int argc, char **argv) {
         info.pEnabledFeatures = &enabled;
         if (dynamic) {
             v13.dynamicRendering = VK_TRUE;
-            info.pNext = &v13;
+            v13.pNext = chain, chain = &v13;
         }
+        info.pNext = chain;
         CHECK_VK(vkCreateDevice(physical, &info, NULL, &device));
         vkGetDeviceQueue(device, queue_family, 0, &queue);
     }
@@ -701,8 +785,8 @@ int main(int argc, char **argv) {
             info.samples = args.samples;
             info.framesInFlight = 2;
             info.depthDirection = args.reverse_z ? UMBRAGE_DEPTH_DIRECTION_REVERSE : UMBRAGE_DEPTH_DIRECTION_FORWARD;
-            info.enabledFeatures = (supported.depthBounds ? UMBRAGE_FEATURE_DEPTH_BOUNDS_BIT : 0u) |
-                                   (supported.depthClamp ? UMBRAGE_FEATURE_DEPTH_CLAMP_BIT : 0u);
+            info.enabledFeatures = enabled_bits;
+            info.settings.technique = args.technique;
             info.pfnWarning = on_warning;
             if (!dynamic) {
                 rp.sType = UMBRAGE_STRUCTURE_TYPE_RENDER_PASS_TARGET;
@@ -1324,7 +1408,7 @@ int main(int argc, char **argv) {
     vkDestroyInstance(instance, NULL);
     scene_free(&scene);
     if (validation_errors) {
-        fprintf(stderr, "umbrage-c-host: %u validation error(s)\n", validation_errors);
+        fprintf(stderr, "umbrage-c-host: %u validation message(s) (errors and warnings)\n", validation_errors);
         return 1;
     }
     return 0;
