@@ -64,6 +64,9 @@ pub struct Report {
     pub legacy: Vec<CheckResult>,
     /// Wall time of the whole run.
     pub seconds: f64,
+    /// The child processes the run started (0: everything ran in this process): one a unit,
+    /// plus those that re-ran the cases of a child that crashed or hung.
+    pub children: usize,
 }
 
 impl Report {
@@ -359,6 +362,7 @@ pub fn run_suite(ctx: &Context, new_context: &dyn Fn() -> Result<Context>, opts:
         cases: outcomes,
         legacy,
         seconds: start.elapsed().as_secs_f64(),
+        children: 0,
     }
 }
 
