@@ -158,6 +158,31 @@ impl LightResult {
     pub fn mismatches_outside_band(&self) -> u64 {
         self.mismatches.iter().sum()
     }
+
+    /// Mismatches outside the band beyond `allowed` a sample, over all samples.
+    pub fn mismatches_beyond(&self, allowed: u64) -> u64 {
+        self.mismatches.iter().map(|&m| m.saturating_sub(allowed)).sum()
+    }
+}
+
+/// SwiftShader stores multisampled depth at its sample locations mirrored in x
+/// (docs/conform/drivers-notes.md §1f, a driver defect): with several samples, a sample's
+/// stencil counts the volume faces covering its location whose depth, at the mirrored
+/// location, is in front, so near volume edges a few samples disagree with the reference
+/// outside the band whatever location the host unprojects at. At most this many a light and
+/// sample are allowed there (twice the most measured: 3 of ~43,600, chromium-common
+/// 156.0.8078.129, every configuration of the embedded scene; `scripts/capi-test.sh` holds the
+/// C host to the same bound); 1 sample, and every other device, must stay exact.
+pub const SWIFTSHADER_MSAA_MISMATCHES: u64 = 6;
+
+/// The mismatches outside the band allowed a light and sample on `device` at `samples`
+/// samples: [`SWIFTSHADER_MSAA_MISMATCHES`] on SwiftShader at more than one sample, else 0.
+pub fn allowed_mismatches(device: &str, samples: u32) -> u64 {
+    if device.contains("SwiftShader") && samples > 1 {
+        SWIFTSHADER_MSAA_MISMATCHES
+    } else {
+        0
+    }
 }
 
 /// One frame, read back and compared with the CPU reference of that frame's scene.

@@ -10,7 +10,10 @@
 //! `--scene`, `--size`, `--out` and `--dump` mean what they mean for `umbrage render`; with
 //! `--msaa N` (N > 1) the dump of every sample goes to `DIR/sample_0` … `DIR/sample_{N-1}`,
 //! and the PNG is the resolve (the mean of the samples). The dump and the PNG are of the last
-//! frame. Exits non-zero on any mismatch outside the 1-pixel band, or any error.
+//! frame. Exits non-zero on any mismatch outside the 1-pixel band, or any error; the one
+//! exception is SwiftShader at several samples, whose multisampled-depth defect
+//! (docs/conform/drivers-notes.md §1f) leaves a few samples near volume edges: up to
+//! [`host::SWIFTSHADER_MSAA_MISMATCHES`] a light and sample are reported as a warning.
 
 mod host;
 
@@ -86,6 +89,8 @@ fn run(args: &Args) -> Result<bool, String> {
     };
     let results = host::run(&config, args.frames as usize)?;
     let mut bad = 0u64;
+    let mut tolerated = 0u64;
+    let allowed = results.first().map_or(0, |r| host::allowed_mismatches(&r.device, config.samples));
     for r in &results {
         let t = &r.totals;
         println!(
@@ -132,7 +137,8 @@ fn run(args: &Args) -> Result<bool, String> {
                 lr.compared,
                 lr.shadowed
             );
-            bad += lr.mismatches_outside_band();
+            bad += lr.mismatches_beyond(allowed);
+            tolerated += lr.mismatches_outside_band() - lr.mismatches_beyond(allowed);
         }
     }
     // The determination's GPU time (timestamps around cmd_determine), median over frames of
@@ -164,8 +170,15 @@ fn run(args: &Args) -> Result<bool, String> {
         println!("embed: dumped frame {} into {}", last.frame, dump_names(dir, last.samples.len()));
     }
     if bad > 0 {
-        eprintln!("embed: {bad} mismatched pixels outside the band in total");
+        eprintln!("embed: {bad} mismatched pixels outside the band in total (beyond {allowed} a light and sample)");
         return Ok(false);
+    }
+    if tolerated > 0 {
+        println!(
+            "embed: warning: {tolerated} samples mismatched outside the band, each light and sample within the {allowed} allowed \
+             for this device's multisampled-depth defect (docs/conform/drivers-notes.md §1f)"
+        );
+        return Ok(true);
     }
     println!("embed: {} frames ({}), 0 mismatched pixels against the CPU reference", results.len(), config.name());
     Ok(true)

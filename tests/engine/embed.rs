@@ -32,22 +32,7 @@ const STENCIL_DIFF_BOUND: usize = 8;
 /// 1 of 512,000 on `hard/eye_in_volume`, with either target model.
 const REVERSE_Z_DIFF_BOUND: usize = 16;
 
-/// SwiftShader stores multisampled depth at its sample locations mirrored in x
-/// (docs/conform/drivers-notes.md §1f, a driver defect): with several samples, the positions
-/// the host unprojects from the depth buffer are not the points its stencil counted, and a few
-/// pixels near shadow edges disagree with the reference outside the band. At most this many a
-/// light and sample are allowed there (twice the most measured: 3 of ~43,600, chromium-common
-/// 156.0.8078.129, every configuration of the embedded scene); 1 sample must stay exact.
-const SWIFTSHADER_MSAA_MISMATCHES: u64 = 6;
-
-/// The mismatches allowed per light and sample on `device` at `samples` samples.
-fn allowed_mismatches(device: &str, samples: u32) -> u64 {
-    if device.contains("SwiftShader") && samples > 1 {
-        SWIFTSHADER_MSAA_MISMATCHES
-    } else {
-        0
-    }
-}
+use host::allowed_mismatches;
 
 /// Runs `config` for 3 frames (both ring slots, the box moving) and checks every sample.
 fn run_checked(config: &Config, scene: Option<&str>) -> Option<Vec<FrameResult>> {
@@ -117,9 +102,30 @@ fn mask_differences(a: &[FrameResult], b: &[FrameResult]) -> usize {
 
 /// {1, 4} samples x {forward, reverse-Z} x {dynamic rendering, render pass}, on the embedded
 /// scene (z-pass) and on `hard/eye_in_volume` (z-fail, the eye inside a volume); forward and
-/// reverse-Z masks compared sample by sample.
+/// reverse-Z masks compared sample by sample. On the system driver; the next test runs the same
+/// on the other drivers CI has.
 #[test]
 fn every_host_configuration_matches_the_reference() {
+    host_configurations();
+}
+
+/// [`every_host_configuration_matches_the_reference`] on SwiftShader (its 4-sample residue within
+/// [`host::SWIFTSHADER_MSAA_MISMATCHES`], and present) and on Mesa lavapipe 25.0.7 (exact), each in
+/// a child process whose only device it is. A driver that is not installed fails under `CI`.
+#[test]
+fn every_host_configuration_on_swiftshader_and_lavapipe_25() {
+    let helper = concat!(module_path!(), "::host_configurations_on_this_driver");
+    common::rerun_on_swiftshader(helper, &[]);
+    common::rerun_on_lavapipe_25(helper, true, &[]);
+}
+
+#[test]
+#[ignore = "a helper: every_host_configuration_on_swiftshader_and_lavapipe_25 runs it on SwiftShader and lavapipe 25.0.7"]
+fn host_configurations_on_this_driver() {
+    host_configurations();
+}
+
+fn host_configurations() {
     for samples in [1, 4] {
         for render_pass in [false, true] {
             for scene in [None, Some("hard/eye_in_volume")] {
@@ -215,8 +221,8 @@ fn dumps_hold_every_sample() {
         let stdout = String::from_utf8_lossy(&out.stdout);
         let device = stdout.lines().find_map(|l| l.strip_prefix("frame 0 (slot 0, ")).unwrap_or("");
         let allowed = allowed_mismatches(device, samples);
-        let only_mismatches = stderr.lines().filter(|l| !l.trim().is_empty()).all(|l| l.contains("mismatched pixels outside the band"));
-        assert!(out.status.success() || (allowed > 0 && only_mismatches), "{samples} samples: the example failed:\n{stderr}");
+        // exit 0: a residue within the driver-defect bound is a warning, not a failure
+        assert!(out.status.success(), "{samples} samples: the example failed:\n{stderr}");
         assert!(png.is_file(), "no PNG");
         let dumps: Vec<std::path::PathBuf> = if samples == 1 {
             vec![dir.join("dump")]
