@@ -198,6 +198,7 @@ fn depth_and_float_failures_write_images() {
         Forced { case: "legacy.deep_wrap_float_count", image: "count.diff.png", size: (192, 128) },
         Forced { case: "legacy.w0_vertices_and_infinity", image: "draw1.depth_diff.png", size: (160, 120) },
         Forced { case: "legacy.stencil_formats", image: "draw1.depth_diff.png", size: (192, 128) },
+        Forced { case: "legacy.depth_clamp", image: "draw1.depth_diff.png", size: (160, 120) },
         Forced { case: DEPTH_CASE, image: "diff_depth.png", size: (128, 128) },
     ];
     let dir = forced_images("depth", &[], &forced);
@@ -242,6 +243,11 @@ fn mesh_failures_write_images() {
     let dir = forced_images("mesh", &lvp, &forced);
     // One judged pixel (one word) skewed: one red texel each.
     assert_eq!(count(&dir, "mesh.w0_vertices", "draw1.diff.png", [255, 0, 0]), 1);
+    // The dark caps' depth, expected at 0.5 under the seam: the draw after the first run's
+    // stencil, every covered pixel yellow.
+    let depth_diff = "draw2.depth_diff.png";
+    assert_eq!(image::image_dimensions(dir.join("failures/mesh.w0_vertices").join(depth_diff)).unwrap(), (160, 120));
+    assert!(count(&dir, "mesh.w0_vertices", depth_diff, [255, 255, 0]) > 100);
     assert_eq!(count(&dir, "mesh.group_counts", "draw_7x3x2.diff.png", [255, 0, 0]), 21 * 21);
     assert_eq!(count(&dir, "mesh.task_payload", "task_invocations.diff.png", [255, 0, 0]), 128 * 128);
     let _ = std::fs::remove_dir_all(&dir);
