@@ -31,7 +31,8 @@ fn save(img: &RgbImage, path: &Path) -> Result<String> {
 /// Writes `expected.png`, `actual.png` and `diff.png` (stencil: grey = value, magenta = not
 /// judged; diff: red = stencil differs, yellow = depth differs, blue = not judged, black =
 /// equal) and, when the case judges depth, `expected_depth.png`, `actual_depth.png` and
-/// `diff_depth.png` (yellow = depth differs, blue = not judged, black = equal), into `dir`. Returns the paths written.
+/// `diff_depth.png` (yellow = depth differs, blue = not judged, black = equal), into `dir`.
+/// Returns the paths written.
 pub fn write_failure(dir: &Path, case: &Case, exp: &Expected, got: &TileResult) -> Result<Vec<String>> {
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir.display().to_string(), e))?;
     let (w, h) = case.size;
