@@ -230,3 +230,56 @@ fn device_id_is_the_nth_device() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("there are 2 Vulkan devices"), "{}", String::from_utf8_lossy(&out.stderr));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `--deqp-vk-device-id=N` picks by place, not by name: with lavapipe 22.3.6 and 25.0.7
+/// installed side by side, the loader enumerates two devices of ONE name (`llvmpipe (LLVM
+/// 15.0.6, 256 bits)`), told apart only by their Vulkan and driver versions; id 1 must answer
+/// the version probe with the first device's version and id 2 with the second's. Mutation, run
+/// once: `set_device_by_id` choosing the N-th device's name (`UMBRAGE_DEVICE=<name>`, the first
+/// device of that name) answered both ids with the first device's version and failed here,
+/// while `device_id_is_the_nth_device` (two names) still passed.
+#[test]
+fn device_id_picks_by_place_among_devices_of_one_name() {
+    let Some(_ctx) = common::context() else { return };
+    let (Some(old), Some(new)) = (common::driver_env("22.3.6"), common::driver_env("25.0.7")) else {
+        assert!(std::env::var_os("CI").is_none(), "CI needs lavapipe 22.3.6 and 25.0.7 (scripts/drivers.sh install)");
+        eprintln!("SKIPPED: lavapipe 22.3.6 or 25.0.7 not installed (scripts/drivers.sh install 22.3.6 25.0.7)");
+        return;
+    };
+    let get = |env: &[(String, Option<String>)], k: &str| env.iter().find(|(n, _)| n == k).and_then(|(_, v)| v.clone());
+    let both = |k: &str| [get(&old, k), get(&new, k)].into_iter().flatten().collect::<Vec<_>>().join(":");
+    let dir = tmp("device-id-one-name");
+    let run = |args: &[String]| {
+        let mut c = umbrage(&dir);
+        for k in ["VK_ICD_FILENAMES", "VK_DRIVER_FILES", "LD_LIBRARY_PATH"] {
+            c.env(k, both(k));
+        }
+        c.env_remove("VK_ADD_DRIVER_FILES").env_remove("VK_LOADER_DRIVERS_SELECT").env_remove("VK_LOADER_DRIVERS_DISABLE");
+        c.arg("conform").args(args).output().unwrap()
+    };
+    // The devices in the loader's order, as `--device` lists them: (name, Vulkan version).
+    let out = run(&["--device".into(), "no-such-device-anywhere".into(), "--filter".into(), "legacy.depth_clamp".into()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    let devices: Vec<(String, String)> = stderr
+        .lines()
+        .filter_map(|l| l.strip_prefix("  "))
+        .filter_map(|l| l.strip_suffix(')'))
+        .filter_map(|l| l.rsplit_once(", Vulkan "))
+        .filter_map(|(head, version)| head.rsplit_once(" (").map(|(name, _)| (name.to_string(), version.to_string())))
+        .collect();
+    assert_eq!(devices.len(), 2, "{devices:?} {stderr}");
+    assert_eq!(devices[0].0, devices[1].0, "the premise: two devices of one name");
+    assert_ne!(devices[0].1, devices[1].1, "told apart by their versions");
+    for (k, (_, version)) in devices.iter().enumerate() {
+        let log = dir.join(format!("id{}.qpa", k + 1));
+        let out = run(&[
+            "--deqp-case=umbrage.info.version".into(),
+            format!("--deqp-vk-device-id={}", k + 1),
+            format!("--deqp-log-filename={}", log.display()),
+        ]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let recs = qpa::parse(&std::fs::read_to_string(&log).unwrap()).unwrap();
+        assert!(recs[0].xml.contains(&format!("<Text>Vulkan {version} (")), "id {}: want Vulkan {version}: {}", k + 1, recs[0].xml);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

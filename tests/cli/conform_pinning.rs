@@ -32,8 +32,9 @@ fn json(dir: &Path) -> serde_json::Value {
 
 /// One injected fault in plain `umbrage conform`: exactly the victim is `want` (`crash` or
 /// `timeout`), in `conform.json`, the JUnit XML (one `<error>` of that type) and
-/// `failures.csv`; every other case of its unit (and of the run) passes or is skipped.
-fn one_case_costs(victim: &str, how: &str, want: &str, filter: &str, unit: &dyn Fn(&serde_json::Value) -> bool) {
+/// `failures.csv`; every other case of its unit (and of the run) passes or is skipped; the
+/// rest of the unit ran again in one child. Returns `conform.json`.
+fn one_case_costs(victim: &str, how: &str, want: &str, filter: &str, unit: &dyn Fn(&serde_json::Value) -> bool) -> serde_json::Value {
     let dir = tmp(&format!("one-{how}"));
     let junit = dir.join("junit.xml");
     let out = umbrage()
@@ -66,7 +67,21 @@ fn one_case_costs(victim: &str, how: &str, want: &str, filter: &str, unit: &dyn 
     let csv = std::fs::read_to_string(dir.join("failures.csv")).unwrap();
     let word = if want == "crash" { "Crash" } else { "Timeout" };
     assert_eq!(csv.trim(), format!("umbrage.{victim},{word}"), "{how}");
+    // How the unit ran again: the rest of its cases in ONE fresh child, so the run started
+    // exactly one child more than the same run without the fault (one a unit). Mutation, run
+    // once: a runner that re-runs a crashed or hung child's cases one per child (the pinned
+    // branch of `deqp::exec::run` always taking the shared-step fallback) started 66 children
+    // for the crash (against 2 without it) and 15 for the hang, and failed here while every
+    // assertion above still held.
+    let clean = tmp(&format!("clean-{how}"));
+    let out = umbrage().args(["conform", "--timeout", "10", "--filter", filter, "--out"]).arg(&clean).output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stdout));
+    let units = json(&clean)["children"].as_u64().unwrap();
+    assert!(units >= 2, "{how}: {units} children without the fault");
+    assert_eq!(j["children"].as_u64(), Some(units + 1), "{how}: children started with the fault, against {units} without");
+    let _ = std::fs::remove_dir_all(&clean);
     let _ = std::fs::remove_dir_all(&dir);
+    j
 }
 
 /// A crash injected into one case of a configuration's submission, and a hang injected into
@@ -80,7 +95,14 @@ fn a_crash_and_a_hang_cost_one_case_each() {
     let names: Vec<String> = suite::all_names().into_iter().filter(|n| n.starts_with(cfg)).collect();
     assert!(names.len() > 8, "{}", names.len());
     let in_cfg = |c: &serde_json::Value| c["config"] == "d32s8.render_pass.static_state";
-    one_case_costs(&names[4], "abort", "crash", &filter, &in_cfg);
+    let j = one_case_costs(&names[4], "abort", "crash", &filter, &in_cfg);
+    // The configuration's one submission came from the fresh child, with every case but the
+    // victim (the crashed child sent none): not one submission a case.
+    let runs: Vec<&serde_json::Value> =
+        j["configs"].as_array().unwrap().iter().filter(|c| c["name"] == "d32s8.render_pass.static_state").collect();
+    assert_eq!(runs.len(), 1, "{runs:?}");
+    let drawn = j["cases"].as_array().unwrap().iter().filter(|c| in_cfg(c) && c["status"] != "skipped").count() as u64;
+    assert_eq!(runs[0]["cases"].as_u64(), Some(drawn - 1), "{runs:?}");
     let is_command = |c: &serde_json::Value| c["name"].as_str().is_some_and(|n| n.starts_with("commands."));
     one_case_costs("commands.scissor", "hang", "timeout", &filter, &is_command);
 }

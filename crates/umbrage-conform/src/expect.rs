@@ -226,6 +226,7 @@ mod tests {
             cases,
             legacy: Vec::new(),
             seconds: 0.0,
+            children: 0,
         }
     }
 

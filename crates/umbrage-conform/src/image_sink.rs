@@ -89,13 +89,7 @@ pub(crate) fn stencil_mismatch(w: u32, h: u32, expected: &[u8], judged: &[bool],
     if expected.len() != n || judged.len() != n || actual.len() != n {
         return;
     }
-    let k = SINK.with(|s| {
-        s.borrow_mut().as_mut().map(|sink| {
-            sink.draws += 1;
-            sink.draws
-        })
-    });
-    let Some(k) = k else { return };
+    let Some(k) = next_draw() else { return };
     let top = expected.iter().chain(actual).copied().max().unwrap_or(0).max(1) as u32;
     let gray = |v: u8| {
         let g = (v as u32 * 255 / top) as u8;
@@ -109,4 +103,35 @@ pub(crate) fn stencil_mismatch(w: u32, h: u32, expected: &[u8], judged: &[bool],
         (true, true) => Rgb([0, 0, 0]),
     });
     save(&format!("draw{k}.diff"), &diff);
+}
+
+/// A draw's depth that differs from its prediction: `draw<k>.expected_depth` (grey = depth,
+/// magenta: not judged), `.actual_depth` and `.depth_diff` (yellow: differs, blue: not judged,
+/// black: equal), `k` counting the draws of the check that differed, as
+/// [`stencil_mismatch`] counts them. `expected[i]` is `None` where the check does not judge
+/// pixel `i`; `bad(i)` says whether a judged pixel differs (each check has its tolerance).
+pub(crate) fn depth_mismatch(w: u32, h: u32, expected: &[Option<f64>], actual: &[f64], bad: &dyn Fn(usize) -> bool) {
+    let n = (w * h) as usize;
+    if expected.len() != n || actual.len() != n {
+        return;
+    }
+    let Some(k) = next_draw() else { return };
+    save(&format!("draw{k}.expected_depth"), &texels(w, h, |i| expected[i].map_or(Rgb([160, 0, 160]), unit_gray)));
+    save(&format!("draw{k}.actual_depth"), &texels(w, h, |i| unit_gray(actual[i])));
+    let diff = texels(w, h, |i| match expected[i] {
+        None => Rgb([0, 0, 160]),
+        Some(_) if bad(i) => Rgb([255, 255, 0]),
+        Some(_) => Rgb([0, 0, 0]),
+    });
+    save(&format!("draw{k}.depth_diff"), &diff);
+}
+
+/// The number of the next draw that differed (1, 2, ...), when a directory is open.
+fn next_draw() -> Option<usize> {
+    SINK.with(|s| {
+        s.borrow_mut().as_mut().map(|sink| {
+            sink.draws += 1;
+            sink.draws
+        })
+    })
 }

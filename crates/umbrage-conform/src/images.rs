@@ -30,8 +30,9 @@ fn save(img: &RgbImage, path: &Path) -> Result<String> {
 
 /// Writes `expected.png`, `actual.png` and `diff.png` (stencil: grey = value, magenta = not
 /// judged; diff: red = stencil differs, yellow = depth differs, blue = not judged, black =
-/// equal) and, when the case judges depth, `expected_depth.png` / `actual_depth.png`, into
-/// `dir`. Returns the paths written.
+/// equal) and, when the case judges depth, `expected_depth.png`, `actual_depth.png` and
+/// `diff_depth.png` (yellow = depth differs, blue = not judged, black = equal), into `dir`.
+/// Returns the paths written.
 pub fn write_failure(dir: &Path, case: &Case, exp: &Expected, got: &TileResult) -> Result<Vec<String>> {
     std::fs::create_dir_all(dir).map_err(|e| Error::io(dir.display().to_string(), e))?;
     let (w, h) = case.size;
@@ -56,6 +57,12 @@ pub fn write_failure(dir: &Path, case: &Case, exp: &Expected, got: &TileResult) 
         paths.push(save(&e, &dir.join("expected_depth.png"))?);
         let a = scaled(w, h, |i| depth_gray(model::from_raw(kind, got.depth[i])));
         paths.push(save(&a, &dir.join("actual_depth.png"))?);
+        let d = scaled(w, h, |i| match exp.depth[i] {
+            DepthExp::Any => Rgb([0, 0, 160]),
+            _ if depth_bad(i) => Rgb([255, 255, 0]),
+            _ => Rgb([0, 0, 0]),
+        });
+        paths.push(save(&d, &dir.join("diff_depth.png"))?);
     }
     Ok(paths)
 }

@@ -98,5 +98,6 @@ pub fn run_suite_isolated(ctx: &Context, opts: &SuiteOptions, iso: &Isolation, i
         cases,
         legacy: extras.legacy,
         seconds: start.elapsed().as_secs_f64(),
+        children: extras.children,
     })
 }

@@ -23,8 +23,9 @@ pub struct SuiteOptions {
     #[doc(hidden)]
     pub break_op: Option<vk::StencilOp>,
     /// Test seam: the single-configuration checks named here (short or full names) expect a
-    /// wrong value, so they fail and write their failure images
-    /// (`UMBRAGE_CONFORM_MISMATCH=<check>,...` on the command line; see `value_images`).
+    /// wrong value, and the drawn cases named here (full names) a wrong depth, so they fail
+    /// and write their failure images (`UMBRAGE_CONFORM_MISMATCH=<check>,...` on the command
+    /// line; see `value_images`).
     #[doc(hidden)]
     pub mismatch: Vec<String>,
 }

@@ -218,7 +218,11 @@ pub fn run_mesh(ctx: &Context, opts: &SuiteOptions, out: &mut Vec<CaseOutcome>) 
         let t0 = Instant::now();
         let _ = ctx.take_validation_errors();
         super::progress::case(&o.name);
+        super::image_sink::begin(opts.image_dir.as_ref().map(|d| d.join("failures").join(&o.name)));
+        super::value_images::set_skew(opts.mismatch.iter().any(|m| m == name || *m == o.name));
         let mut r = f(ctx).unwrap_or_else(|e| CheckResult::error(name, &e));
+        super::value_images::set_skew(false);
+        o.images = super::image_sink::finish();
         super::progress::step("end");
         super::with_validation(&mut r, ctx.take_validation_errors());
         o.status = r.status;

@@ -13,7 +13,9 @@
 //!
 //! The test seam [`skewed`]: `UMBRAGE_CONFORM_MISMATCH=<check>[,<check>...]` (read by the
 //! command line, like `UMBRAGE_CONFORM_BREAK`) makes the named checks expect a wrong value, so
-//! that they fail and write these images.
+//! that they fail and write these images (or the texel images of
+//! [`super::image_sink`]: `legacy.*`, `commands.*` and `mesh.*` checks alike); a drawn case
+//! named there expects a wrong depth (`suite::skew_depth`), a failure on depth alone.
 
 use super::image_sink::{save, texels};
 use image::{Rgb, RgbImage};

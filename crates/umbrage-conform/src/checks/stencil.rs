@@ -99,18 +99,26 @@ pub fn stencil_formats(ctx: &Context) -> Result<CheckResult> {
         )?;
         let (mut bad_stencil, mut bad_depth) = (0u64, 0u64);
         let mut want = vec![0u8; (w * h) as usize];
+        let mut want_depth = vec![None; want.len()];
+        // The test seam (`value_images::skewed`): expect the written depth at 0.75.
+        let written = if crate::value_images::skewed() { 0.75 } else { 0.5 };
         for y in 0..h {
             for x in 0..w {
                 let i = (y * w + x) as usize;
                 let inside = (8..40).contains(&x) && (8..24).contains(&y);
-                let (ws, wd) = if inside { (0xc3, 0.5) } else { (0x5a, 0.25) };
-                want[i] = ws;
+                let (ws, wd) = if inside { (0xc3, written) } else { (0x5a, 0.25) };
+                (want[i], want_depth[i]) = (ws, Some(wd));
                 bad_stencil += (rb.stencil[i] != ws) as u64;
                 bad_depth += (!depth_is(format, rb.depth[i], wd)) as u64;
             }
         }
         if bad_stencil > 0 {
             crate::image_sink::stencil_mismatch(w, h, &want, &vec![true; want.len()], &rb.stencil);
+        }
+        if bad_depth > 0 {
+            let actual: Vec<f64> = rb.depth.iter().map(|&d| harness::depth_value(format, d)).collect();
+            let bad = |i: usize| want_depth[i].is_some_and(|wd| !depth_is(format, rb.depth[i], wd));
+            crate::image_sink::depth_mismatch(w, h, &want_depth, &actual, &bad);
         }
         numbers.insert(
             name.clone(),

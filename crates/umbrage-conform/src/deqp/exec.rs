@@ -108,6 +108,9 @@ pub struct Extras {
     pub configs: Vec<super::super::suite::ConfigRun>,
     /// The full results of the `legacy.*`, `commands.*`, `mesh.*` and pipeline checks.
     pub legacy: Vec<super::super::CheckResult>,
+    /// The child processes started (those that re-ran the cases of a crashed or hung one
+    /// included).
+    pub children: usize,
 }
 
 /// How the runner starts its children.
@@ -196,7 +199,10 @@ pub fn run(
             }
             serial += 1;
             match spawn(ex, job, serial) {
-                Ok(r) => running.push(r),
+                Ok(r) => {
+                    extras.children += 1;
+                    running.push(r);
+                }
                 Err((job, e)) => {
                     for n in &job.names {
                         done(lost(n, job.unit, Code::Crash, &format!("the child process could not be started: {e}"), &planned));

@@ -395,6 +395,7 @@ pub fn run_standalone(ctx: &Context, a: &RunArgs, filter: &[String], out: &Path,
         cases,
         legacy: extras.legacy,
         seconds: start.elapsed().as_secs_f64(),
+        children: extras.children,
     };
     report::write_all(out, a.junit.as_deref(), &r)?;
     baseline::write_csvs(out, &rows)?;

@@ -246,6 +246,9 @@ pub fn watertight_meshlets(ctx: &Context) -> Result<CheckResult> {
             }
         }
         let words_bad = got.records.iter().zip(&want).filter(|(a, b)| a != b).count();
+        if words_bad > 0 {
+            crate::value_images::words(&format!("{label}.records"), &want, &got.records);
+        }
         let covered = got.image.stencil.iter().filter(|&&s| s != START).count();
         numbers.insert(
             label.clone(),
