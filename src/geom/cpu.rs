@@ -110,6 +110,14 @@ pub(crate) fn on_each_copy<T: PartialEq + std::fmt::Debug>(mut f: impl FnMut() -
     best
 }
 
+/// The threads this process may use (`std::thread::available_parallelism`, at least 1), asked
+/// once per process: on Linux each call reads the cgroup's CPU quota from files (system calls
+/// that the per-frame planning has no reason to repeat).
+pub fn cores() -> usize {
+    static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -122,13 +130,4 @@ mod tests {
         set_portable_only(false);
         assert!(!portable_only());
     }
-}
-
-/// The threads this process may use (`std::thread::available_parallelism`, at least 1), asked
-/// once: on Linux each call reads the cgroup's CPU quota from files, which cost more than a
-/// kept frame's whole planning when asked every frame (measured with `perf` on
-/// `examples/frame_cost.rs level`: 17 % of `prepare`).
-pub fn cores() -> usize {
-    static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
-    *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
 }
