@@ -3,7 +3,7 @@
 //! `pack`, planar projection in `planar`, the draws in `draw`, the camera in `view`.
 
 use super::casters::{CasterTable, Upload};
-use super::compute::frame::ComputeFrame;
+use super::compute::work::ComputeWork;
 use super::desc::{Counter, PassSettings};
 use super::draw::LightFrame;
 use super::stats::{CpuMs, Totals};
@@ -41,14 +41,14 @@ pub struct PreparedFrame {
     pub(crate) extent: vk::Extent2D,
     /// The GPU silhouettes of [`Technique::Compute`] (counts read back by
     /// [`ShadowPass::read_back_counts`](super::ShadowPass::read_back_counts)).
-    pub(crate) compute: Option<ComputeFrame>,
+    pub(crate) compute: Option<ComputeWork>,
     /// [`Technique::RayQuery`](super::Technique::RayQuery)'s structures and bindings.
-    pub(crate) rays: Option<super::rays::frame::RayFrame>,
+    pub(crate) rays: Option<super::rays::work::RayWork>,
 }
 
 impl PreparedFrame {
     /// What a ray-query frame traces against (`None` for the other techniques).
-    pub fn ray_query(&self) -> Option<super::rays::frame::RayQueryFrame> {
+    pub fn ray_query(&self) -> Option<super::rays::work::RayQueryFrame> {
         self.rays.as_ref().map(|r| r.info())
     }
     /// The ring slot this frame uses.

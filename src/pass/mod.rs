@@ -125,7 +125,7 @@ pub use desc::{
 pub use draw::LightFrame;
 pub use frame::{PreparedFrame, MAX_CONE_DEG};
 pub use pipelines::COUNT_FORMAT;
-pub use rays::frame::RayQueryFrame;
+pub use rays::work::RayQueryFrame;
 pub use rays::{light_rel, RayCounts, RayQueryInputs};
 pub use spheres::{SphereId, SphereInfo};
 pub use stencil::{lit_stencil_state, VolumeKind};
@@ -287,7 +287,7 @@ impl ShadowPass {
             )));
         }
         desc.settings.check(&caps)?;
-        rays::frame::check_host(&desc.settings, desc)?;
+        rays::work::check_host(&desc.settings, desc)?;
         Ok(caps)
     }
 
@@ -320,7 +320,7 @@ impl ShadowPass {
     /// refused when the device cannot honour them.
     pub fn set_settings(&mut self, settings: PassSettings) -> Result<()> {
         settings.check(&self.caps)?;
-        rays::frame::check_host(&settings, &self.desc)?;
+        rays::work::check_host(&settings, &self.desc)?;
         self.settings = settings;
         Ok(())
     }

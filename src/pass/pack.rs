@@ -3,7 +3,7 @@
 //! the statistics `--stats` reports.
 
 use super::casters::CasterTable;
-use super::compute::frame::ComputeFrame;
+use super::compute::work::ComputeWork;
 use super::desc::{DepthDirection, PassSettings, Technique};
 use super::draw::{CasterDraw, EdgeQuadDraw, LightFrame};
 use super::lists::{align, write_chunks, ChunkDraws};
@@ -19,7 +19,7 @@ use glam::{DMat4, DVec3, Mat4, Vec4};
 pub(crate) struct Packed {
     pub stream: Vec<u8>,
     /// The compute pass's layout ([`Technique::Compute`]).
-    pub compute: Option<ComputeFrame>,
+    pub compute: Option<ComputeWork>,
     pub lights: Vec<LightFrame>,
     pub totals: Totals,
     pub cpu: CpuMs,
@@ -58,7 +58,7 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput, kept: Option<Vec<supe
     // Mesh-shader extrusion plans as the compute path does and runs its facing stages.
     let mesh = input.settings.technique == Technique::Mesh;
     let gpu_silhouettes = input.settings.technique == Technique::Compute || mesh;
-    let mut compute = gpu_silhouettes.then(|| ComputeFrame { mesh, ..ComputeFrame::default() });
+    let mut compute = gpu_silhouettes.then(|| ComputeWork { mesh, ..ComputeWork::default() });
     let method = input.settings.technique.method();
     let mvps: Vec<Mat4> = table.live.iter().map(|g| (vp_rel_d * DMat4::from_translation(-view.eye) * g.transform).as_mat4()).collect();
     let full = vk::Rect2D { offset: vk::Offset2D { x: 0, y: 0 }, extent: vk::Extent2D { width: view.width, height: view.height } };
@@ -118,7 +118,7 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput, kept: Option<Vec<supe
             };
             let ChunkDraws { mut draws, index_bytes, vertex_bytes, mut fmt_used } = chunk_draws;
             if let (Some(cf), Some(st)) = (compute.as_mut(), gpu.compute.as_ref()) {
-                let at = crate::pass::compute::frame::CasterAt { light: li, stat: cstats.len() };
+                let at = crate::pass::compute::work::CasterAt { light: li, stat: cstats.len() };
                 if cp.parts.iter().any(|p| p.path == VolumePath::Compute && p.case != Case::Culled) {
                     let buffers: Vec<vk::Buffer> = gpu.chunks.iter().map(|b| b.raw).collect();
                     cf.add_caster(at, caster, st, cp, (&buffers, mvps[cp.caster]), &mut draws);

@@ -77,7 +77,7 @@ impl Xform {
 }
 
 /// An enabled chunk record, as the merged draws see it (pushed by
-/// [`super::frame::ComputeFrame::add_caster`]).
+/// [`super::work::ComputeWork::add_caster`]).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct ChunkRecord {
     /// Word offset of the record.

@@ -15,7 +15,7 @@
 //! * the edge table: every edge of the closed manifold parts, `(s0, s1, c0 | c1 << 8, pa | pb
 //!   << 8)`, filed by the pair of blocks its two slots lie in ([`tables::WordPairs`]).
 //!
-//! Per frame the CPU writes one job per (light, caster) pair ([`frame::GpuJob`]: the light,
+//! Per frame the CPU writes one job per (light, caster) pair ([`work::GpuJob`]: the light,
 //! the arena offsets, the first invocation or workgroup of the pair in each stage) and one
 //! small record per chunk (`RECORD_WORDS` words: the chunk's two
 //! `VkDrawIndexedIndirectCommand`s, with zero counts and the first index of the chunk's
@@ -37,7 +37,7 @@ pub(crate) mod arena;
 pub(crate) mod draw_pipes;
 pub(crate) mod draws;
 pub(crate) mod draws_record;
-pub(crate) mod frame;
+pub(crate) mod work;
 mod prepare;
 pub(crate) mod record;
 pub(crate) mod tables;
@@ -552,7 +552,7 @@ mod tests {
 
     #[test]
     fn push_and_job_match_the_wgsl_blocks() {
-        use super::frame::GpuJob;
+        use super::work::GpuJob;
         assert_eq!(SilhouettePush::SIZE, 32);
         assert_eq!(std::mem::offset_of!(SilhouettePush, steps), 16);
         assert_eq!(std::mem::size_of::<GpuJob>(), 96);

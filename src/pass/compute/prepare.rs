@@ -1,7 +1,7 @@
 //! The compute pass's share of `prepare` (the slot's buffers, records and descriptor sets)
 //! and the counts read back after the frame.
 
-use super::frame::{ComputeFrame, GpuJob};
+use super::work::{ComputeWork, GpuJob};
 use super::{SlotCompute, BINDINGS};
 use crate::error::{Error, Misuse, Result};
 use crate::pass::frame::PreparedFrame;
@@ -16,9 +16,9 @@ impl ShadowPass {
     pub(crate) fn prepare_compute(
         &mut self,
         slot: usize,
-        mut cf: ComputeFrame,
+        mut cf: ComputeWork,
         (lights, draws): (usize, crate::pass::desc::ComputeDraws),
-    ) -> Result<ComputeFrame> {
+    ) -> Result<ComputeWork> {
         let draws = if cf.mesh { crate::pass::desc::ComputeDraws::PerChunk } else { draws };
         cf.merged = super::draws::plan(&mut cf.records, &cf.chunk_records, lights, draws, self.dev.max_draw_indirect_count);
         let merged_layout = match (&cf.merged, self.techniques.compute.merged.as_ref()) {

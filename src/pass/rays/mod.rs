@@ -38,9 +38,9 @@ use std::cell::Cell;
 
 mod balls;
 mod batch;
-pub(crate) mod frame;
+pub(crate) mod work;
 mod push;
-use frame::RayFrame;
+use work::RayWork;
 use push::RayPush;
 mod record;
 use balls::Balls;
@@ -207,7 +207,7 @@ impl Rays {
     ///
     /// On error every bottom level is retired (some may have been made or swapped for builds
     /// and copies this frame will never record), so the next frame builds them all again.
-    pub fn prepare(&mut self, f: &FrameInput, all_slots: u64, transient: &mut Vec<Buffer>) -> Result<RayFrame> {
+    pub fn prepare(&mut self, f: &FrameInput, all_slots: u64, transient: &mut Vec<Buffer>) -> Result<RayWork> {
         let r = self.prepare_inner(f, &mut Work { dev: f.dev, transient, all_slots });
         if r.is_err() {
             for e in std::mem::take(&mut self.entries) {
@@ -224,7 +224,7 @@ impl Rays {
         r
     }
 
-    fn prepare_inner(&mut self, f: &FrameInput, w: &mut Work) -> Result<RayFrame> {
+    fn prepare_inner(&mut self, f: &FrameInput, w: &mut Work) -> Result<RayWork> {
         let FrameInput { dev, slot, casters, spheres, view, lights, scissors, batch: settings_batch, inputs, desc } = *f;
         let compactions = self.compact(w, slot)?;
         let mut jobs = Vec::new();
@@ -279,7 +279,7 @@ impl Rays {
             true => Some(self.batch_frame(dev, slot, view, scissors, desc)?),
             false => None,
         };
-        Ok(RayFrame {
+        Ok(RayWork {
             compactions,
             jobs,
             queries,

@@ -3,7 +3,7 @@
 //! ([`ShadowPass::cmd_determine`]).
 
 use super::batch::BATCH;
-use super::frame::RayFrame;
+use super::work::RayWork;
 use super::push::RayPush;
 use super::{RayCounts, RayQueryInputs, Rays};
 use crate::error::{Error, Misuse, Result};
@@ -132,7 +132,7 @@ impl ShadowPass {
         Ok(())
     }
 
-    pub(crate) fn prepare_rays(&mut self, slot: usize, view: &ShadowView, lights: &[Light], scissors: &[vk::Rect2D]) -> Result<RayFrame> {
+    pub(crate) fn prepare_rays(&mut self, slot: usize, view: &ShadowView, lights: &[Light], scissors: &[vk::Rect2D]) -> Result<RayWork> {
         let inputs = self.techniques.rays.inputs.ok_or_else(|| Error::Internal("no ray-query inputs".into()))?;
         if self.techniques.rays.structures.is_none() {
             self.techniques.rays.structures = Some(Rays::new(&self.dev, &self.instance, self.slots.len())?);
@@ -159,7 +159,7 @@ impl ShadowPass {
     }
 }
 
-impl RayFrame {
+impl RayWork {
     /// Records the frame's acceleration-structure work: compactions, builds and refits, the
     /// compacted-size queries of new bottom levels, and the top level.
     ///

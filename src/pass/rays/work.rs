@@ -30,7 +30,7 @@ pub struct RayQueryFrame {
 /// One frame's ray-query work: the jobs [`cmd_before_rendering`](super::ShadowPass::cmd_before_rendering)
 /// records, and what `cmd_determine` binds.
 #[derive(Debug)]
-pub(crate) struct RayFrame {
+pub(crate) struct RayWork {
     pub(super) compactions: Vec<(vk::AccelerationStructureKHR, vk::AccelerationStructureKHR)>,
     pub(super) jobs: Vec<BlasJob>,
     pub(super) queries: Vec<(vk::QueryPool, vk::AccelerationStructureKHR)>,
@@ -52,7 +52,7 @@ pub(crate) struct RayFrame {
     pub batch: Option<super::batch::BatchFrame>,
 }
 
-impl RayFrame {
+impl RayWork {
     pub fn info(&self) -> RayQueryFrame {
         let refits = self.jobs.iter().filter(|j| j.is_refit()).count();
         RayQueryFrame {

@@ -86,7 +86,7 @@ pub(crate) struct RecordMeta {
 /// The frame's compute work, built by `pack` (sizes, jobs and records) and completed by
 /// `prepare` (buffers and the descriptor set).
 #[derive(Debug)]
-pub(crate) struct ComputeFrame {
+pub(crate) struct ComputeWork {
     /// Every (light, caster) pair with GPU work, lights in order.
     pub jobs: Vec<GpuJob>,
     /// The header, then the records of every light, as written to the slot's records buffer.
@@ -129,13 +129,13 @@ pub(crate) struct ComputeFrame {
     pub merged: Option<super::draws::Merged>,
 }
 
-impl Default for ComputeFrame {
+impl Default for ComputeWork {
     fn default() -> Self {
         let mut records = vec![0u32; HEADER_WORDS];
         // the lists' dispatch commands: x grows with the lists, y = z = 1
         records[rec::H_EXACT_X + 1] = 1;
         records[rec::H_EXACT_X + 2] = 1;
-        ComputeFrame {
+        ComputeWork {
             jobs: Vec::new(),
             records,
             metas: Vec::new(),
@@ -170,7 +170,7 @@ pub struct CasterAt {
     pub stat: usize,
 }
 
-impl ComputeFrame {
+impl ComputeWork {
     /// The frame's push constants.
     pub fn push(&self) -> SilhouettePush {
         SilhouettePush {
