@@ -4,9 +4,16 @@
 //! casters, the ring slots' streams and staging, the lights, the targets, the uploads and the
 //! kept plans) stays in [`ShadowPass`](super::ShadowPass).
 //!
-//! Adding a technique: its module, its state type implementing [`TechniqueState`] (in [`super::device`], below every technique), and one
-//! field here (with its line in [`Techniques::all`]). The per-frame recording reads each
-//! state directly: no dynamic dispatch is added to the hot path.
+//! Each technique also records its own draws of a light: `cmd_draw_volumes` (`volumes.rs`)
+//! hands the light to the frame's technique, once per light (an enum match: nothing per draw
+//! is added to the hot path): the CPU-planned volumes and planar shadows in `volumes.rs`,
+//! edge quads in `edge_quads.rs`, mesh draws in `mesh_record.rs`, the compute technique's in
+//! `compute/draws_record.rs`; each falls back on `record_planned_draw` for the parts the
+//! planner leaves on the CPU.
+//!
+//! Adding a technique: its module, its state type implementing [`TechniqueState`] (in
+//! [`super::device`], below every technique), one field here (with its line in
+//! [`Techniques::all`]), and its arm in `cmd_draw_volumes`.
 
 use super::compute::ComputeState;
 use super::device::{PassDevice, TechniqueState};

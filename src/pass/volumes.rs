@@ -1,7 +1,10 @@
-//! The volumes' draws: the pipeline each draw takes, its push block and its bind-and-draw.
+//! The volumes' draws: `cmd_draw_volumes` hands each light to its technique's recording
+//! (here for the CPU-planned volumes and planar shadows; `edge_quads.rs`, `mesh_record.rs`
+//! and `compute/draws_record.rs` for the others), and the CPU-planned draws every technique
+//! falls back on: the pipeline each takes, its push block and its bind-and-draw.
 
-use super::desc::IndexFormat;
-use super::draw::{CasterDraw, Draw};
+use super::desc::{IndexFormat, Technique};
+use super::draw::{CasterDraw, Draw, LightFrame};
 use super::frame::PreparedFrame;
 use super::pipelines::CountPipes;
 use super::push::VolumePush;
@@ -10,6 +13,36 @@ use super::ShadowPass;
 use crate::error::{Misuse, Result};
 use crate::shadow::Case;
 use ash::vk;
+
+/// What the recording of one light last bound: the pipeline, and the caster and block it
+/// last pushed (a repeat is skipped).
+#[derive(Default)]
+pub(super) struct Bound {
+    pub pipeline: vk::Pipeline,
+    pub pushed: Option<(*const CasterDraw, [f32; 4])>,
+}
+
+impl Bound {
+    /// Forgets what was bound (after a draw that binds its own pipeline or layout).
+    pub fn reset(&mut self) {
+        *self = Bound::default();
+    }
+}
+
+/// The casters of `lf` that `kind` draws: not culled, transparent for the light-intensity
+/// map, opaque otherwise.
+pub(super) fn casters_for(lf: &LightFrame, kind: VolumeKind) -> impl Iterator<Item = &CasterDraw> {
+    let transmit = matches!(kind, VolumeKind::Transmit { .. });
+    lf.casters.iter().filter(move |c| c.case != Case::Culled && c.transmittance.is_some() == transmit)
+}
+
+/// The block a draw of `c` pushes for `case`: the sign a front face contributes to the float
+/// counter (+1 z-pass, -1 z-fail), then the caster's transmittance (light-intensity map).
+pub(super) fn color(c: &CasterDraw, case: Case) -> [f32; 4] {
+    let sign = if case == Case::ZPass { 1.0 } else { -1.0 };
+    let t = c.transmittance.unwrap_or_default();
+    [sign, t.x, t.y, t.z]
+}
 
 impl ShadowPass {
     /// Refuses a ray-query frame where volumes are drawn or counted (it has none: the count
@@ -63,177 +96,62 @@ impl ShadowPass {
             }
             _ => {}
         }
-        // Technique::Compute's merged draws: the light's GPU-silhouette volumes in one draw
-        // call per pipeline (src/pass/compute/draws.rs); their chunk draws are skipped below.
-        // SAFETY: the caller's contract; `kind` was checked above.
-        unsafe { self.record_merged(cb, frame, light, kind)? };
-        let merged = frame.compute.as_ref().is_some_and(|cf| cf.merged.is_some());
-        let mut bound = vk::Pipeline::null();
-        for c in lf.casters.iter().filter(|c| c.case != Case::Culled) {
-            let wanted = match kind {
-                VolumeKind::Transmit { .. } => c.transmittance.is_some(),
-                _ => c.transmittance.is_none(),
-            };
-            if !wanted {
-                continue;
-            }
-            // Float counter: the sign a front face contributes (+1 z-pass, -1 z-fail);
-            // light-intensity map: and the caster's transmittance.
-            let color = |case: Case| {
-                let sign = if case == Case::ZPass { 1.0 } else { -1.0 };
-                let t = c.transmittance.unwrap_or_default();
-                [sign, t.x, t.y, t.z]
-            };
-            if let Some(eq) = &c.edge_quad {
-                // SAFETY: the caller's contract; push constants match the pipeline layout.
-                unsafe { self.push(cb, c, color(c.case)) };
-                let (faces, sides) = match (kind, count) {
-                    (VolumeKind::Stencil, _) => (p.stencil.eq_faces, p.stencil.eq_sides),
-                    (VolumeKind::Rasterised, _) => (p.raster.edge_quads, p.raster.edge_quads),
-                    (VolumeKind::Float, Some(cp)) => (cp.eq_faces, cp.eq_sides),
-                    // Self-shadowing leaves edge-quad casters out (their faces are not a
-                    // depth-tested volume); transparent casters never take edge quads.
-                    _ => continue,
-                };
-                let d = &self.dev.device;
-                // SAFETY: as above; the edge-quad buffers live until the slot retires.
-                unsafe {
-                    d.cmd_bind_vertex_buffers(cb, 0, &[eq.vertices], &[0]);
-                    d.cmd_bind_index_buffer(cb, eq.indices, 0, vk::IndexType::UINT32);
-                    d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, faces);
-                    d.cmd_draw_indexed(cb, eq.face_indices, 1, 0, 0, 0);
-                    d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, sides);
-                    d.cmd_draw_indexed(cb, eq.quad_indices, 1, eq.face_indices, 0, 0);
-                }
-                bound = sides;
-                continue;
-            }
-            let mut pushed = None;
-            for dr in &c.draws {
-                if let Some(md) = &dr.mesh {
-                    // SAFETY: the caller's contract; the mesh draw's set and tables live until
-                    // the slot is prepared again.
-                    if unsafe { self.record_mesh_draw(cb, frame, kind, c, dr, md)? } {
-                        bound = vk::Pipeline::null();
-                        pushed = None;
+        // Each technique records its own draws; what the CPU planned (every technique's
+        // volumes, or the parts it leaves to the CPU) goes through `record_planned_draw`.
+        let mut bound = Bound::default();
+        match frame.settings.technique {
+            Technique::Volumes(_) | Technique::Planar => {
+                for c in casters_for(lf, kind) {
+                    for dr in &c.draws {
+                        // SAFETY: the caller's contract; `kind` was checked above.
+                        unsafe { self.record_planned_draw(cb, frame, kind, c, dr, &mut bound) };
                     }
-                    continue;
                 }
-                if dr.indirect && merged {
-                    continue;
-                }
-                let planar = frame.settings.technique == super::desc::Technique::Planar;
-                let Some(pipe) = self.pipeline_for(kind, count, dr.case, dr.light_cap, planar) else { continue };
-                // Parts of one caster may take different cases: the sign follows the draw's.
-                let block = color(dr.case);
-                if pushed != Some(block) {
-                    // SAFETY: as above.
-                    unsafe { self.push(cb, c, block) };
-                    pushed = Some(block);
-                }
-                if pipe != bound {
-                    // SAFETY: as above.
-                    unsafe { self.dev.device.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipe) };
-                    bound = pipe;
-                }
-                // SAFETY: as above.
-                unsafe { self.record_draw(cb, frame, dr) };
             }
+            // SAFETY: as above.
+            Technique::EdgeQuads => unsafe { self.record_edge_quads_light(cb, frame, lf, kind, &mut bound) },
+            // SAFETY: as above.
+            Technique::Compute => unsafe { self.record_compute_light(cb, frame, lf, light, kind, &mut bound)? },
+            // SAFETY: as above.
+            Technique::Mesh => unsafe { self.record_mesh_light(cb, frame, lf, kind, &mut bound)? },
+            // refused by `volume_frame` above: a ray-query frame has no volumes
+            Technique::RayQuery => {}
         }
         Ok(())
     }
 
-    /// Records one mesh draw of [`Technique::Mesh`](super::desc::Technique::Mesh) for `kind`
-    /// (its pipeline, then [`record_mesh`](Self::record_mesh)); returns whether anything was
-    /// bound (a kind the mesh path has no pipeline for draws nothing: the light-intensity
-    /// map's casters are never on it).
+    /// Records one CPU-planned draw of caster `c` (an index stream, or the naive vertices)
+    /// with the pipeline its case takes for `kind`, pushing the caster's block and binding
+    /// the pipeline where they changed since `bound`; a draw `kind` has no pipeline for draws
+    /// nothing.
     ///
     /// # Safety
-    /// As [`cmd_draw_volumes`](Self::cmd_draw_volumes); `dr` and `md` are a draw of `c`, of
-    /// `frame`.
-    unsafe fn record_mesh_draw(
+    /// As [`cmd_draw_volumes`](Self::cmd_draw_volumes); `dr` is a draw of `c`, of `frame`.
+    pub(super) unsafe fn record_planned_draw(
         &self,
         cb: vk::CommandBuffer,
         frame: &PreparedFrame,
         kind: VolumeKind,
-        c: &super::draw::CasterDraw,
-        dr: &super::draw::Draw,
-        md: &super::mesh::MeshDraw,
-    ) -> Result<bool> {
-        let set = self.mesh_set(frame)?;
-        let zpass = dr.case == Case::ZPass;
-        let pipe = match kind {
-            VolumeKind::Stencil => set.stencil_for(dr.case, dr.light_cap),
-            VolumeKind::Rasterised => set.raster,
-            VolumeKind::Float => match set.count {
-                Some(p) => {
-                    p[if zpass {
-                        0
-                    } else if dr.light_cap {
-                        2
-                    } else {
-                        1
-                    }]
-                }
-                None => return Ok(false),
-            },
-            VolumeKind::FloatDepthTested => match set.count {
-                Some(p) => p[if zpass { 0 } else { 1 }],
-                None => return Ok(false),
-            },
-            VolumeKind::Transmit { .. } => return Ok(false),
-        };
-        let sign = if zpass { 1.0 } else { -1.0 };
-        // SAFETY: forwarded contract.
-        unsafe { self.record_mesh(cb, frame, pipe, c, md, [sign, 0.0, 0.0, 0.0])? };
-        Ok(true)
-    }
-
-    /// The mesh pipelines `frame` draws with: the culled set (task stage first) where the pass
-    /// has task shaders and the frame's [`PassToggles::mesh_task`](super::PassToggles::mesh_task) is on, else the plain one.
-    pub(super) fn mesh_set(&self, frame: &PreparedFrame) -> Result<&super::mesh_pipes::MeshPipeSet> {
-        let culled = self.caps.task_shader && frame.settings.toggles.mesh_task;
-        self.techniques
-            .mesh
-            .pipes
-            .as_ref()
-            .and_then(|mp| mp.set(culled))
-            .ok_or_else(|| Misuse::NotConfigured { call: "cmd_draw_volumes (mesh draws)", needs: "Technique::Mesh's pipelines" }.into())
-    }
-
-    /// Binds `pipe` (a mesh pipeline of the frame's set) and the frame's mesh set, pushes the
-    /// caster's block with `color` and draws `md`'s meshlets (`vkCmdDrawMeshTasksEXT`: with
-    /// the task stage, one task workgroup per [`TASK_GROUP`](super::mesh::TASK_GROUP)
-    /// meshlets).
-    ///
-    /// # Safety
-    /// As [`cmd_draw_volumes`](Self::cmd_draw_volumes) (or inside the overlay's rendering
-    /// instance); `md` is a mesh draw of `c`, of `frame`.
-    pub(super) unsafe fn record_mesh(
-        &self,
-        cb: vk::CommandBuffer,
-        frame: &PreparedFrame,
-        pipe: vk::Pipeline,
-        c: &super::draw::CasterDraw,
-        md: &super::mesh::MeshDraw,
-        color: [f32; 4],
-    ) -> Result<()> {
-        let culled = self.caps.task_shader && frame.settings.toggles.mesh_task;
-        let (Some(mp), Some(cf)) = (self.techniques.mesh.pipes.as_ref(), frame.compute.as_ref()) else {
-            return Err(Misuse::NotConfigured { call: "cmd_draw_volumes (mesh draws)", needs: "Technique::Mesh's pipelines" }.into());
-        };
-        let push = md.push(&VolumePush::new(c.mvp, c.light_object, color));
-        let groups = if culled { md.meshlets.div_ceil(super::mesh::TASK_GROUP) } else { md.meshlets };
-        let d = &self.dev.device;
-        // SAFETY: the caller's contract; the push block matches the mesh layout's range; the
-        // frame's mesh set and the arena's tables live until the slot is prepared again.
-        unsafe {
-            d.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipe);
-            d.cmd_bind_descriptor_sets(cb, vk::PipelineBindPoint::GRAPHICS, mp.layout, 0, &[cf.mesh_set], &[]);
-            d.cmd_push_constants(cb, mp.layout, mp.stages, 0, bytemuck::bytes_of(&push));
-            mp.loader.cmd_draw_mesh_tasks(cb, groups, 1, 1);
+        c: &CasterDraw,
+        dr: &Draw,
+        bound: &mut Bound,
+    ) {
+        let planar = frame.settings.technique == Technique::Planar;
+        let Some(pipe) = self.pipeline_for(kind, self.pipes.count.as_ref(), dr.case, dr.light_cap, planar) else { return };
+        // Parts of one caster may take different cases: the sign follows the draw's.
+        let block = color(c, dr.case);
+        if bound.pushed != Some((c as *const CasterDraw, block)) {
+            // SAFETY: the caller's contract.
+            unsafe { self.push(cb, c, block) };
+            bound.pushed = Some((c as *const CasterDraw, block));
         }
-        Ok(())
+        if pipe != bound.pipeline {
+            // SAFETY: as above.
+            unsafe { self.dev.device.cmd_bind_pipeline(cb, vk::PipelineBindPoint::GRAPHICS, pipe) };
+            bound.pipeline = pipe;
+        }
+        // SAFETY: as above.
+        unsafe { self.record_draw(cb, frame, dr) };
     }
 
     /// Which pipeline counts a draw.

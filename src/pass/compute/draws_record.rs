@@ -1,19 +1,53 @@
-//! The merged volume draws on the GPU ([`super::draws`]): their pipelines (the volume
-//! pipelines' states with `shadow.vert`'s TABLE variant, and the compaction stage), the
-//! slot's buffers and descriptor set, the compaction dispatch, and one light's draws.
+//! [`Technique::Compute`](crate::pass::Technique::Compute)'s recording: one light's volumes
+//! (the merged draws, or one indirect draw per GPU-silhouette record, and the planned lists
+//! of the parts the planner leaves on the CPU), and the merged volume draws on the GPU
+//! ([`super::draws`]): their pipelines (the volume pipelines' states with `shadow.vert`'s
+//! TABLE variant, and the compaction stage), the slot's buffers and descriptor set and the
+//! compaction dispatch.
 
 use super::draw_pipes::CompactPush;
 use super::draws::{pieces, Merged, COMMAND_BYTES, COMPACT_GROUP, LIST_HEADER, SIGN};
 use super::HEADER_WORDS;
 use crate::error::{Misuse, Result};
 use crate::pass::desc::ComputeDraws;
+use crate::pass::draw::LightFrame;
 use crate::pass::frame::PreparedFrame;
 use crate::pass::push::VolumePush;
 use crate::pass::stencil::VolumeKind;
+use crate::pass::volumes::{casters_for, Bound};
 use crate::pass::ShadowPass;
 use ash::vk;
 
 impl ShadowPass {
+    /// Records `lf`'s volumes for `kind`: the merged draws (the light's GPU-silhouette
+    /// volumes in one draw call per pipeline) where the frame has them, else each record's
+    /// indirect draw; and the planned draws of the parts left to the CPU.
+    ///
+    /// # Safety
+    /// As [`cmd_draw_volumes`](Self::cmd_draw_volumes), which checked the frame, the light and
+    /// that `kind` has pipelines; the silhouette stages were recorded
+    /// ([`cmd_before_rendering`](Self::cmd_before_rendering)).
+    pub(in crate::pass) unsafe fn record_compute_light(
+        &self,
+        cb: vk::CommandBuffer,
+        frame: &PreparedFrame,
+        lf: &LightFrame,
+        light: usize,
+        kind: VolumeKind,
+        bound: &mut Bound,
+    ) -> Result<()> {
+        // SAFETY: the caller's contract.
+        unsafe { self.record_merged(cb, frame, light, kind)? };
+        let merged = frame.compute.as_ref().is_some_and(|cf| cf.merged.is_some());
+        for c in casters_for(lf, kind) {
+            for dr in c.draws.iter().filter(|dr| !(dr.indirect && merged)) {
+                // SAFETY: the caller's contract.
+                unsafe { self.record_planned_draw(cb, frame, kind, c, dr, bound) };
+            }
+        }
+        Ok(())
+    }
+
     /// Records the merged draws' compaction (`shaders/compact_draws.wgsl`), after the
     /// silhouette stages and their barrier; the caller records the barrier to the draws. The
     /// lists were cleared by [`cmd_clear_draw_lists`](Self::cmd_clear_draw_lists).

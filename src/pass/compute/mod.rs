@@ -37,10 +37,10 @@ pub(crate) mod arena;
 pub(crate) mod draw_pipes;
 pub(crate) mod draws;
 pub(crate) mod draws_record;
-pub(crate) mod work;
 mod prepare;
 pub(crate) mod record;
 pub(crate) mod tables;
+pub(crate) mod work;
 
 /// Most workgroups of one dispatch dimension (every device has at least this many).
 pub(crate) const MAX_GROUPS: u32 = 65535;

@@ -38,10 +38,10 @@ use std::cell::Cell;
 
 mod balls;
 mod batch;
-pub(crate) mod work;
 mod push;
-use work::RayWork;
+pub(crate) mod work;
 use push::RayPush;
+use work::RayWork;
 mod record;
 use balls::Balls;
 

@@ -3,8 +3,8 @@
 //! ([`ShadowPass::cmd_determine`]).
 
 use super::batch::BATCH;
-use super::work::RayWork;
 use super::push::RayPush;
+use super::work::RayWork;
 use super::{RayCounts, RayQueryInputs, Rays};
 use crate::error::{Error, Misuse, Result};
 use crate::geom::Light;
