@@ -32,10 +32,10 @@ CARGO_TARGET_DIR="$PWD/target/capi-build" cargo cinstall -p umbrage-capi --profi
 
 # The scenes, in the flat format C reads (`umbrage export-scene`).
 mkdir -p "$prefix/share/umbrage/scenes"
-cargo build --quiet -p umbrage-cli --bin umbrage
+umbrage=$(./scripts/umbrage-bin.sh)
 for s in default hard/eye_in_volume; do
     mkdir -p "$(dirname "$prefix/share/umbrage/scenes/$s.scene")"
-    ./target/debug/umbrage export-scene "$s" "$prefix/share/umbrage/scenes/$s.scene"
+    "$umbrage" export-scene "$s" "$prefix/share/umbrage/scenes/$s.scene"
 done
 
 export PKG_CONFIG_PATH="$prefix/lib/pkgconfig${PKG_CONFIG_PATH:+:$PKG_CONFIG_PATH}"

@@ -19,8 +19,7 @@ quick=0
 out=target/conform-matrix
 exp=docs/conform/expectations
 ./scripts/drivers.sh install 20.3.5 22.3.6 25.0.7 swiftshader
-cargo build --quiet --bin umbrage
-bin="${CARGO_TARGET_DIR:-target}/debug/umbrage"
+bin=$(./scripts/umbrage-bin.sh)
 export UMBRAGE_VALIDATION=1
 
 # The quick filter: the configuration every driver runs (Vulkan 1.0 render pass, static state),

@@ -50,8 +50,7 @@ if [ ! -x "$RUNNER" ]; then
   cargo install deqp-runner --locked --debug --version "$VERSION" --root "$TOOLS/deqp-runner-$VERSION" --quiet
 fi
 [ "$INSTALL_ONLY" = 0 ] || { "$RUNNER" --version; exit 0; }
-cargo build --quiet --bin umbrage
-export PATH="$REPO/target/debug:$PATH"
+export PATH="$(dirname "$(./scripts/umbrage-bin.sh)"):$PATH"
 
 # The shipped list is the code's.
 diff <(umbrage conform --list) conform/umbrage-cases.txt >/dev/null ||

@@ -117,13 +117,14 @@ check() {
   build
   local out="${TESTLOG_OUT:-$REPO/target/testlog-to-xml}"
   rm -rf "$out" && mkdir -p "$out"
-  cargo build --quiet --bin umbrage
+  local umbrage
+  umbrage=$("$REPO/scripts/umbrage-bin.sh")
   # Two failures with images (a drawn case failing on depth alone, the float count), a pass.
   local depth=umbrage.depth.d32s8.dynamic_rendering.static_state.infinity.forward.dir_0.comp_less
   local cases="$depth,umbrage.legacy.deep_wrap_float_count,umbrage.legacy.depth_clamp"
   (cd "$out" && UMBRAGE_VALIDATION="${UMBRAGE_VALIDATION-1}" \
     UMBRAGE_CONFORM_MISMATCH="${depth#umbrage.},deep_wrap_float_count" \
-    "$REPO/target/debug/umbrage" conform --deqp-case="$cases" --deqp-log-filename="$out/run.qpa" >"$out/run.log")
+    "$umbrage" conform --deqp-case="$cases" --deqp-log-filename="$out/run.qpa" >"$out/run.log")
   "$TOOL" "$out/run.qpa" "$out/run.xml" >"$out/convert.log" 2>&1 ||
     { cat "$out/convert.log" >&2; fail "testlog-to-xml rejected $out/run.qpa"; }
   local qpa_cases xml_cases qpa_images xml_images
