@@ -92,6 +92,7 @@ mod desc;
 mod device;
 pub mod diagnostics;
 mod draw;
+mod draw_volumes;
 mod edge_quads;
 mod eye;
 mod frame;

@@ -4,7 +4,7 @@
 //! casters, the ring slots' streams and staging, the lights, the targets, the uploads and the
 //! kept plans) stays in [`ShadowPass`](super::ShadowPass).
 //!
-//! Each technique also records its own draws of a light: `cmd_draw_volumes` (`volumes.rs`)
+//! Each technique also records its own draws of a light: `cmd_draw_volumes` (`draw_volumes.rs`)
 //! hands the light to the frame's technique, once per light (an enum match: nothing per draw
 //! is added to the hot path): the CPU-planned volumes and planar shadows in `volumes.rs`,
 //! edge quads in `edge_quads.rs`, mesh draws in `mesh_record.rs`, the compute technique's in

@@ -1,7 +1,7 @@
-//! The volumes' draws: `cmd_draw_volumes` hands each light to its technique's recording
-//! (here for the CPU-planned volumes and planar shadows; `edge_quads.rs`, `mesh_record.rs`
-//! and `compute/draws_record.rs` for the others), and the CPU-planned draws every technique
-//! falls back on: the pipeline each takes, its push block and its bind-and-draw.
+//! The CPU-planned volumes' draws, which every technique's recording falls back on for the
+//! parts the planner leaves on the CPU: the pipeline each draw takes, its push block and its
+//! bind-and-draw, and what one light's recording shares ([`Bound`], [`casters_for`],
+//! [`color`]). `draw_volumes.rs` hands each light to its technique.
 
 use super::desc::{IndexFormat, Technique};
 use super::draw::{CasterDraw, Draw, LightFrame};
@@ -56,68 +56,6 @@ impl ShadowPass {
             .into()),
             None => Ok(()),
         }
-    }
-
-    /// Records the volumes of `light` for `kind` inside a rendering instance the caller
-    /// began (attachments: the pass's depth-stencil format, plus an R32F colour attachment
-    /// for the float kinds or the transmit format for `Transmit`), with the viewport and
-    /// scissor set (e.g. by [`cmd_light_state`](Self::cmd_light_state)).
-    ///
-    /// With [`TargetModel::RenderPass`](super::TargetModel::RenderPass), inside the host's subpass (stencil and rasterised
-    /// kinds only).
-    ///
-    /// Errors ([`Error::Misuse`](crate::Error::Misuse)): as `cmd_determine`'s frame and light checks, and a kind the
-    /// pass has no pipelines for (float kinds without R32F blending or in the render-pass
-    /// model, `Transmit` without a transmit format).
-    ///
-    /// # Safety
-    /// `cb` is recording inside such a rendering instance or subpass; the frame's uploads and
-    /// GPU silhouettes were recorded earlier ([`cmd_before_rendering`](Self::cmd_before_rendering));
-    /// `frame`'s slot is not prepared again before `cb` completes.
-    pub unsafe fn cmd_draw_volumes(&self, cb: vk::CommandBuffer, frame: &PreparedFrame, light: usize, kind: VolumeKind) -> Result<()> {
-        let lf = self.light(frame, light)?;
-        Self::volume_frame(frame, "cmd_draw_volumes")?;
-        let p = &self.pipes;
-        let count = p.count.as_ref();
-        match kind {
-            VolumeKind::Float | VolumeKind::FloatDepthTested if count.is_none() => {
-                return Err(Misuse::NotConfigured {
-                    call: "cmd_draw_volumes (float kinds)",
-                    needs: "R32_SFLOAT blending and TargetModel::DynamicRendering",
-                }
-                .into());
-            }
-            VolumeKind::Transmit { .. } if p.transmit.is_none() => {
-                return Err(Misuse::NotConfigured {
-                    call: "cmd_draw_volumes (VolumeKind::Transmit)",
-                    needs: "ShadowPassDesc::transmit_format",
-                }
-                .into());
-            }
-            _ => {}
-        }
-        // Each technique records its own draws; what the CPU planned (every technique's
-        // volumes, or the parts it leaves to the CPU) goes through `record_planned_draw`.
-        let mut bound = Bound::default();
-        match frame.settings.technique {
-            Technique::Volumes(_) | Technique::Planar => {
-                for c in casters_for(lf, kind) {
-                    for dr in &c.draws {
-                        // SAFETY: the caller's contract; `kind` was checked above.
-                        unsafe { self.record_planned_draw(cb, frame, kind, c, dr, &mut bound) };
-                    }
-                }
-            }
-            // SAFETY: as above.
-            Technique::EdgeQuads => unsafe { self.record_edge_quads_light(cb, frame, lf, kind, &mut bound) },
-            // SAFETY: as above.
-            Technique::Compute => unsafe { self.record_compute_light(cb, frame, lf, light, kind, &mut bound)? },
-            // SAFETY: as above.
-            Technique::Mesh => unsafe { self.record_mesh_light(cb, frame, lf, kind, &mut bound)? },
-            // refused by `volume_frame` above: a ray-query frame has no volumes
-            Technique::RayQuery => {}
-        }
-        Ok(())
     }
 
     /// Records one CPU-planned draw of caster `c` (an index stream, or the naive vertices)
