@@ -51,9 +51,11 @@ use glam::{Mat4, Vec3, Vec4};
 use std::collections::HashMap;
 use std::time::Instant;
 
-/// Below this many caster triangles to plan, a frame plans them on the calling thread
-/// (starting a thread costs tens of microseconds: about the planning of 50k triangles).
-const PARALLEL_MIN_TRIANGLES: usize = 100_000;
+/// Below this many caster triangles to plan, a frame plans them on the calling thread:
+/// starting and joining the planning threads costs more than planning fewer (the measurement,
+/// `examples/frame_cost.rs vertex --motions lights`: docs/frame-cost/example.md, "The threads'
+/// threshold").
+const PARALLEL_MIN_TRIANGLES: usize = 1_500_000;
 
 /// What a kept pair's lists are keyed by (see the module docs).
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
