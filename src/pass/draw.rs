@@ -32,6 +32,43 @@ pub(crate) struct Draw {
     pub mesh: Option<super::mesh::MeshDraw>,
 }
 
+/// A caster's draws for one light: its own list (planned this frame), or a kept pair's, shared
+/// with the kept plans ([`super::keep`]) so that a kept pair's frame copies no list.
+#[derive(Clone, Debug)]
+pub(crate) enum DrawList {
+    Own(Vec<Draw>),
+    Shared(std::sync::Arc<[Draw]>),
+}
+
+impl Default for DrawList {
+    fn default() -> Self {
+        DrawList::Own(Vec::new())
+    }
+}
+
+impl std::ops::Deref for DrawList {
+    type Target = [Draw];
+    fn deref(&self) -> &[Draw] {
+        match self {
+            DrawList::Own(v) => v,
+            DrawList::Shared(a) => a,
+        }
+    }
+}
+
+impl DrawList {
+    /// The list to change (a shared one copied first).
+    pub fn to_mut(&mut self) -> &mut Vec<Draw> {
+        if let DrawList::Shared(a) = self {
+            *self = DrawList::Own(a.to_vec());
+        }
+        match self {
+            DrawList::Own(v) => v,
+            DrawList::Shared(_) => unreachable!("made own above"),
+        }
+    }
+}
+
 /// Edge-quad geometry of a caster (static buffers).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct EdgeQuadDraw {
@@ -49,7 +86,7 @@ pub(crate) struct CasterDraw {
     pub light_object: Vec4,
     /// `Some(t)` for a transparent caster (light-intensity map, not the opaque counter).
     pub transmittance: Option<Vec3>,
-    pub draws: Vec<Draw>,
+    pub draws: DrawList,
     pub edge_quad: Option<EdgeQuadDraw>,
 }
 

@@ -56,7 +56,7 @@ impl ShadowPass {
         match frame.settings.technique {
             Technique::Volumes(_) | Technique::Planar => {
                 for c in casters_for(lf, kind) {
-                    for dr in &c.draws {
+                    for dr in c.draws.iter() {
                         // SAFETY: the caller's contract; `kind` was checked above.
                         unsafe { self.record_planned_draw(cb, frame, kind, c, dr, &mut bound) };
                     }

@@ -31,7 +31,7 @@ impl ShadowPass {
         let p = &self.pipes;
         for c in casters_for(lf, kind) {
             let Some(eq) = &c.edge_quad else {
-                for dr in &c.draws {
+                for dr in c.draws.iter() {
                     // SAFETY: the caller's contract.
                     unsafe { self.record_planned_draw(cb, frame, kind, c, dr, bound) };
                 }

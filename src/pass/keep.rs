@@ -40,7 +40,7 @@ use fx::FxBuild;
 use super::casters::{CasterId, CasterTable};
 use super::desc::IndexFormat;
 use super::device::PassDevice;
-use super::draw::Draw;
+use super::draw::{Draw, DrawList};
 use super::lists::{write_chunks, ChunkDraws};
 use crate::error::Result;
 use crate::geom::{Camera, Light, LightKind};
@@ -49,6 +49,7 @@ use crate::shadow::{self, Case, CasterPlan, LightContext, LightPlan, Method, Pla
 use ash::vk;
 use glam::{Mat4, Vec3, Vec4};
 use std::collections::HashMap;
+use std::sync::Arc;
 use std::time::Instant;
 
 /// Below this many caster triangles to plan, a frame plans them on the calling thread:
@@ -100,7 +101,8 @@ struct Entry {
     buffer: Buffer,
     /// The caster's plan without its index lists (which are in `buffer`).
     plan: CasterPlan,
-    draws: Vec<Draw>,
+    /// Shared with each frame that draws the pair ([`DrawList::Shared`]).
+    draws: Arc<[Draw]>,
     index_bytes: u64,
     vertex_bytes: u64,
     fmt_used: super::stats::UsedIndexFormat,
@@ -403,7 +405,7 @@ impl Kept {
                         plan.caster = ci;
                         casters.push(plan);
                         draws.push(Some(ChunkDraws {
-                            draws: e.draws.clone(),
+                            draws: DrawList::Shared(e.draws.clone()),
                             index_bytes: e.index_bytes,
                             vertex_bytes: e.vertex_bytes,
                             fmt_used: e.fmt_used,
@@ -472,17 +474,18 @@ impl Kept {
                 return Err(e);
             }
             stats.bytes_written += bytes.len() as u64;
-            for d in &mut draws.draws {
+            for d in draws.draws.to_mut() {
                 d.kept = Some(buffer.raw);
             }
+            let shared: Arc<[Draw]> = Arc::from(&draws.draws[..]);
             plan.chunks.clear();
             plans.push(plan.clone());
-            kept.push(Some(ChunkDraws { draws: draws.draws.clone(), ..draws }));
+            kept.push(Some(ChunkDraws { draws: DrawList::Shared(shared.clone()), ..draws }));
             self.bytes += buffer.size;
             let e = Entry {
                 buffer,
                 plan,
-                draws: draws.draws,
+                draws: shared,
                 index_bytes: draws.index_bytes,
                 vertex_bytes: draws.vertex_bytes,
                 fmt_used: draws.fmt_used,

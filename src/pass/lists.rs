@@ -2,7 +2,7 @@
 //! frame's stream ([`super::pack`]) or a kept pair's own buffer ([`super::keep`]).
 
 use super::desc::IndexFormat;
-use super::draw::Draw;
+use super::draw::{Draw, DrawList};
 use super::stats::UsedIndexFormat;
 use crate::shadow;
 use ash::vk;
@@ -10,7 +10,7 @@ use ash::vk;
 /// One caster's index lists (or naive vertices) for one light, written into the stream.
 #[derive(Clone)]
 pub(crate) struct ChunkDraws {
-    pub draws: Vec<Draw>,
+    pub draws: DrawList,
     pub index_bytes: u64,
     pub vertex_bytes: u64,
     /// The index format used (`none` when nothing was drawn).
@@ -79,7 +79,7 @@ pub(crate) fn write_chunks(
             });
         }
     }
-    ChunkDraws { draws, index_bytes, vertex_bytes, fmt_used }
+    ChunkDraws { draws: DrawList::Own(draws), index_bytes, vertex_bytes, fmt_used }
 }
 
 /// Pads `v` with zeros to a multiple of `a` bytes.

@@ -31,7 +31,7 @@ impl ShadowPass {
         bound: &mut Bound,
     ) -> Result<()> {
         for c in casters_for(lf, kind) {
-            for dr in &c.draws {
+            for dr in c.draws.iter() {
                 match &dr.mesh {
                     Some(md) => {
                         // SAFETY: the caller's contract; the mesh draw's set and tables live

@@ -121,11 +121,11 @@ pub(crate) fn pack(table: &CasterTable, input: &PackInput, kept: Option<Vec<supe
                 let at = crate::pass::compute::work::CasterAt { light: li, stat: cstats.len() };
                 if cp.parts.iter().any(|p| p.path == VolumePath::Compute && p.case != Case::Culled) {
                     let buffers: Vec<vk::Buffer> = gpu.chunks.iter().map(|b| b.raw).collect();
-                    cf.add_caster(at, caster, st, cp, (&buffers, mvps[cp.caster]), &mut draws);
+                    cf.add_caster(at, caster, st, cp, (&buffers, mvps[cp.caster]), draws.to_mut());
                     fmt_used = UsedIndexFormat::U16;
                 }
                 if cp.parts.iter().any(|p| p.path == VolumePath::Mesh && p.case != Case::Culled) {
-                    cf.add_caster_mesh(at, caster, st, cp, &mut draws);
+                    cf.add_caster_mesh(at, caster, st, cp, draws.to_mut());
                 }
             }
             let tris = Triangles { sides: cp.sides as u64, dark_cap: cp.dark_cap as u64, light_cap: cp.light_cap as u64 };

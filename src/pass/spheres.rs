@@ -205,7 +205,7 @@ pub(crate) fn pack_light(
             mvp: mvp.as_mat4(),
             light_object: light_object.as_vec4(),
             transmittance: None,
-            draws,
+            draws: super::draw::DrawList::Own(draws),
             edge_quad: None,
         });
     }
