@@ -179,6 +179,24 @@ fn shards_baselines_and_csvs() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
+/// Runs `umbrage conform ARGS` in `dir` with two drivers' environments at once (their ICD
+/// lists and library paths joined: the loader enumerates both devices, `a`'s first).
+fn two_drivers<'a>(
+    a: &'a [(String, Option<String>)],
+    b: &'a [(String, Option<String>)],
+    dir: &'a Path,
+) -> impl Fn(&[String]) -> std::process::Output + 'a {
+    let get = |env: &[(String, Option<String>)], k: &str| env.iter().find(|(n, _)| n == k).and_then(|(_, v)| v.clone());
+    move |args: &[String]| {
+        let mut c = umbrage(dir);
+        for k in ["VK_ICD_FILENAMES", "VK_DRIVER_FILES", "LD_LIBRARY_PATH"] {
+            c.env(k, [get(a, k), get(b, k)].into_iter().flatten().collect::<Vec<_>>().join(":"));
+        }
+        c.env_remove("VK_ADD_DRIVER_FILES").env_remove("VK_LOADER_DRIVERS_SELECT").env_remove("VK_LOADER_DRIVERS_DISABLE");
+        c.arg("conform").args(args).output().unwrap()
+    }
+}
+
 /// `--deqp-vk-device-id=N` is the N-th device the loader enumerates (1-based, as VK-GL-CTS
 /// counts), for the context that answers the probe: with lavapipe 22.3.6 and SwiftShader
 /// installed side by side (two devices), each id's renderer is that device's name, in the
@@ -191,18 +209,8 @@ fn device_id_is_the_nth_device() {
         eprintln!("SKIPPED: lavapipe 22.3.6 or SwiftShader not installed (scripts/drivers.sh install 22.3.6 swiftshader)");
         return;
     };
-    // Both drivers at once: their ICD lists and library paths joined.
-    let get = |env: &[(String, Option<String>)], k: &str| env.iter().find(|(n, _)| n == k).and_then(|(_, v)| v.clone());
-    let both = |k: &str| [get(&lvp, k), get(&ss, k)].into_iter().flatten().collect::<Vec<_>>().join(":");
     let dir = tmp("device-id");
-    let run = |args: &[String]| {
-        let mut c = umbrage(&dir);
-        for k in ["VK_ICD_FILENAMES", "VK_DRIVER_FILES", "LD_LIBRARY_PATH"] {
-            c.env(k, both(k));
-        }
-        c.env_remove("VK_ADD_DRIVER_FILES").env_remove("VK_LOADER_DRIVERS_SELECT").env_remove("VK_LOADER_DRIVERS_DISABLE");
-        c.arg("conform").args(args).output().unwrap()
-    };
+    let run = two_drivers(&lvp, &ss, &dir);
     // The devices, in the loader's order: `--device` with no match lists them.
     let out = run(&["--device".into(), "no-such-device-anywhere".into(), "--filter".into(), "legacy.depth_clamp".into()]);
     let stderr = String::from_utf8_lossy(&out.stderr);
@@ -246,17 +254,8 @@ fn device_id_picks_by_place_among_devices_of_one_name() {
         eprintln!("SKIPPED: lavapipe 22.3.6 or 25.0.7 not installed (scripts/drivers.sh install 22.3.6 25.0.7)");
         return;
     };
-    let get = |env: &[(String, Option<String>)], k: &str| env.iter().find(|(n, _)| n == k).and_then(|(_, v)| v.clone());
-    let both = |k: &str| [get(&old, k), get(&new, k)].into_iter().flatten().collect::<Vec<_>>().join(":");
     let dir = tmp("device-id-one-name");
-    let run = |args: &[String]| {
-        let mut c = umbrage(&dir);
-        for k in ["VK_ICD_FILENAMES", "VK_DRIVER_FILES", "LD_LIBRARY_PATH"] {
-            c.env(k, both(k));
-        }
-        c.env_remove("VK_ADD_DRIVER_FILES").env_remove("VK_LOADER_DRIVERS_SELECT").env_remove("VK_LOADER_DRIVERS_DISABLE");
-        c.arg("conform").args(args).output().unwrap()
-    };
+    let run = two_drivers(&old, &new, &dir);
     // The devices in the loader's order, as `--device` lists them: (name, Vulkan version).
     let out = run(&["--device".into(), "no-such-device-anywhere".into(), "--filter".into(), "legacy.depth_clamp".into()]);
     let stderr = String::from_utf8_lossy(&out.stderr);
