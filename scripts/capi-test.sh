@@ -81,8 +81,11 @@ step "the contract from C (test-panic build)" contract
 # than one sample, whose multisampled depth sits at the standard locations mirrored in x (a
 # driver defect, docs/conform/drivers-notes.md §1f): the host unprojects at the measured
 # locations as `render` does, and a few samples near volume edges (coverage at one location,
-# depth at the other) remain. The bound is tests/engine/embed.rs's SWIFTSHADER_MSAA_MISMATCHES.
-SWIFTSHADER_MSAA_MISMATCHES=6
+# depth at the other) remain. The bound is twice the most measured, as for the Rust host
+# (tests/engine/embed.rs's SWIFTSHADER_MSAA_MISMATCHES, 6): this host's default scene at 320x200
+# left at most 6 in a light and sample (spot light, sample 2: a diagonal run along one volume
+# edge), 68 over the 4-sample runs (chromium-common 156.0.8078.129, 2026-12-08).
+SWIFTSHADER_MSAA_MISMATCHES=12
 swiftshader_residue=0
 # check_dump DIR BOUND: `umbrage check` on DIR (or each DIR/sample_K), every light and sample at
 # most BOUND mismatches outside the band; adds the mismatches to $residue.
@@ -145,7 +148,7 @@ for driver in 25.0.7 swiftshader; do
 done
 residue_present() {
     echo "SwiftShader at 4 samples: $swiftshader_residue mismatches outside the band over its 4-sample runs (each light and sample at most $SWIFTSHADER_MSAA_MISMATCHES)"
-    [ "$swiftshader_residue" -gt 0 ] || { echo "the driver defect's residue is gone: drop SWIFTSHADER_MSAA_MISMATCHES here and in tests/engine/embed.rs, update drivers-notes §1f"; return 1; }
+    [ "$swiftshader_residue" -gt 0 ] || { echo "the driver defect's residue is gone: drop SWIFTSHADER_MSAA_MISMATCHES here and in examples/embed/host.rs, update drivers-notes §1f"; return 1; }
 }
 step "SwiftShader's 4-sample residue still there (the bound is live)" residue_present
 # The other techniques a host feeds the same way, from C, where the device has them: lavapipe
