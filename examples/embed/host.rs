@@ -172,7 +172,7 @@ impl LightResult {
 /// outside the band whatever location the host unprojects at. At most this many a light and
 /// sample are allowed there (twice the most measured: 3 of ~43,600, chromium-common
 /// 156.0.8078.129, every configuration of the embedded scene; `scripts/capi-test.sh` holds the
-/// C host to the same bound); 1 sample, and every other device, must stay exact.
+/// C host to twice its own most measured); 1 sample, and every other device, must stay exact.
 pub const SWIFTSHADER_MSAA_MISMATCHES: u64 = 6;
 
 /// The mismatches outside the band allowed a light and sample on `device` at `samples`
