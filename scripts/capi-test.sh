@@ -22,15 +22,15 @@ export UMBRAGE_VALIDATION=1
 passed=0
 failed=0
 step() { # name, command...
-    local name=$1
+    local name=$1 start=$SECONDS
     shift
     echo "=== capi-test: $name"
     if "$@"; then
         passed=$((passed + 1))
-        echo "--- ok: $name"
+        echo "--- ok: $name ($((SECONDS - start)) s)"
     else
         failed=$((failed + 1))
-        echo "--- FAILED: $name"
+        echo "--- FAILED: $name ($((SECONDS - start)) s)"
     fi
 }
 
