@@ -197,6 +197,21 @@ fn two_drivers<'a>(
     }
 }
 
+/// The devices in the loader's order, as `conform --device` lists them when none matches:
+/// (name, Vulkan version) each, and the listing (stderr) for messages.
+fn listed_devices(run: &impl Fn(&[String]) -> std::process::Output) -> (Vec<(String, String)>, String) {
+    let out = run(&["--device".into(), "no-such-device-anywhere".into(), "--filter".into(), "legacy.depth_clamp".into()]);
+    let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+    let devices = stderr
+        .lines()
+        .filter_map(|l| l.strip_prefix("  "))
+        .filter_map(|l| l.strip_suffix(')'))
+        .filter_map(|l| l.rsplit_once(", Vulkan "))
+        .filter_map(|(head, version)| head.rsplit_once(" (").map(|(name, _)| (name.to_string(), version.to_string())))
+        .collect();
+    (devices, stderr)
+}
+
 /// `--deqp-vk-device-id=N` is the N-th device the loader enumerates (1-based, as VK-GL-CTS
 /// counts), for the context that answers the probe: with lavapipe 22.3.6 and SwiftShader
 /// installed side by side (two devices), each id's renderer is that device's name, in the
@@ -211,15 +226,8 @@ fn device_id_is_the_nth_device() {
     };
     let dir = tmp("device-id");
     let run = two_drivers(&lvp, &ss, &dir);
-    // The devices, in the loader's order: `--device` with no match lists them.
-    let out = run(&["--device".into(), "no-such-device-anywhere".into(), "--filter".into(), "legacy.depth_clamp".into()]);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    let names: Vec<String> = stderr
-        .lines()
-        .filter_map(|l| l.strip_prefix("  "))
-        .filter(|l| l.ends_with(')') && l.contains(", Vulkan "))
-        .filter_map(|l| l.rsplit_once(" (").map(|(name, _)| name.to_string()))
-        .collect();
+    let (devices, stderr) = listed_devices(&run);
+    let names: Vec<String> = devices.into_iter().map(|(name, _)| name).collect();
     assert_eq!(names.len(), 2, "{names:?} {stderr}");
     assert_ne!(names[0], names[1]);
     for (k, name) in names.iter().enumerate() {
@@ -256,16 +264,7 @@ fn device_id_picks_by_place_among_devices_of_one_name() {
     };
     let dir = tmp("device-id-one-name");
     let run = two_drivers(&old, &new, &dir);
-    // The devices in the loader's order, as `--device` lists them: (name, Vulkan version).
-    let out = run(&["--device".into(), "no-such-device-anywhere".into(), "--filter".into(), "legacy.depth_clamp".into()]);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    let devices: Vec<(String, String)> = stderr
-        .lines()
-        .filter_map(|l| l.strip_prefix("  "))
-        .filter_map(|l| l.strip_suffix(')'))
-        .filter_map(|l| l.rsplit_once(", Vulkan "))
-        .filter_map(|(head, version)| head.rsplit_once(" (").map(|(name, _)| (name.to_string(), version.to_string())))
-        .collect();
+    let (devices, stderr) = listed_devices(&run);
     assert_eq!(devices.len(), 2, "{devices:?} {stderr}");
     assert_eq!(devices[0].0, devices[1].0, "the premise: two devices of one name");
     assert_ne!(devices[0].1, devices[1].1, "told apart by their versions");

@@ -253,13 +253,13 @@ pub fn run(mut a: RunArgs) -> Result<ExitCode> {
     }
     let filter: Vec<String> =
         a.filter.as_deref().unwrap_or("").split(',').map(|p| p.trim().to_string()).filter(|p| !p.is_empty()).collect();
-    let names: Vec<String> =
-        suite::all_names().into_iter().filter(|n| filter.is_empty() || filter.iter().any(|p| suite::matches(p, n))).collect();
-    if names.is_empty() {
+    // every case's name, asked once: the selection, and the list a run matches
+    let all = suite::all_names();
+    if !all.iter().any(|n| filter.is_empty() || filter.iter().any(|p| suite::matches(p, n))) {
         eprintln!(
             "error: --filter '{}' matches none of the {} cases (patterns are substrings, or globs with '*'; --list shows every name)",
             filter.join(","),
-            suite::all_names().len()
+            all.len()
         );
         return Ok(ExitCode::from(EXIT_NOTHING_SELECTED));
     }
@@ -334,8 +334,7 @@ pub fn run(mut a: RunArgs) -> Result<ExitCode> {
     ctx.check_validation()?;
     // The expectation list this run matches (a new driver's list starts from it).
     let needed = out.join("conform-expectations.txt");
-    std::fs::write(&needed, expect::Expectations::from_report(&r, &suite::all_names()))
-        .map_err(|e| Error::io(needed.display().to_string(), e))?;
+    std::fs::write(&needed, expect::Expectations::from_report(&r, &all)).map_err(|e| Error::io(needed.display().to_string(), e))?;
     if let Some(e) = &expectations {
         let v = e.judge(&r);
         for n in &v.new_failures {
